@@ -1,0 +1,20 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#ifndef OPENCV_RAWGMENT_HPP
+#define OPENCV_RAWGMENT_HPP
+
+#include <opencv2/rawgment/bayer.hpp>
+#include <opencv2/rawgment/noise_model.hpp>
+
+/** @defgroup rawgment Noise-accounted RAW augmentation
+
+Makes RAW images of hard scenes (dark, noisy, blurred) out of RAW images of easy ones, with the noise a
+real sensor would have produced @cite yoshimura2023rawgment. All values are in DN after black-level
+subtraction; gains are linear (0 dB = 1).
+
+@{
+    @defgroup rawgment_bayer Bayer mosaics: CFA patterns, planes and black levels
+    @defgroup rawgment_noise_model The heteroscedastic Gaussian noise model
+@}
+*/
+
+#endif // OPENCV_RAWGMENT_HPP

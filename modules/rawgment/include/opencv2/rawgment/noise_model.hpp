@@ -1,0 +1,101 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#ifndef OPENCV_RAWGMENT_NOISE_MODEL_HPP
+#define OPENCV_RAWGMENT_NOISE_MODEL_HPP
+
+#include <opencv2/core.hpp>
+#include <opencv2/rawgment/export.hpp>
+
+namespace cv {
+namespace rawgment {
+
+//! @addtogroup rawgment_noise_model
+//! @{
+
+/** @brief Linear analog gain of a gain in decibels: \f$ g = 10^{dB/20} \f$ (0 dB = 1).
+ * @throws cv::Exception when dB is not finite.
+ */
+CV_RAWGMENT_EXPORTS double dbToLinearGain(double db);
+
+/** @brief Gain in decibels of a linear gain: \f$ dB = 20 \log_{10} g \f$.
+ * @throws cv::Exception when g is not finite and positive.
+ */
+CV_RAWGMENT_EXPORTS double linearGainToDb(double gain);
+
+/** @brief The noise of one gain as a line in the mean: \f$ \sigma^2 = a\,\mu + b \f$ @cite
+ * yoshimura2023rawgment. */
+struct CV_RAWGMENT_EXPORTS NoiseLine
+{
+    double a = 0; //!< slope, \f$ a = g\alpha \f$
+    double b = 0; //!< offset, \f$ b = g^2\sigma_d^2 + \sigma_r^2 \f$
+};
+
+/** @brief Heteroscedastic Gaussian sensor noise model (paper Eq. 5) @cite yoshimura2023rawgment.
+ *
+ * A pixel with expected black-subtracted value \f$ \mu \f$ (DN) captured at linear analog gain g is
+ * \f[ x \sim \mathcal{N}\left(\mu,\; \sigma^2 = g\,\alpha\,\max(\mu, 0) + g^2\sigma_d^2 + \sigma_r^2\right)
+ * \f] where \f$ \alpha \f$ is the DN per photo-electron at gain 1 (shot noise), \f$ \sigma_d^2 \f$ the read
+ * noise before the gain and \f$ \sigma_r^2 \f$ the noise after it (including quantisation, 1/12 DN^2).
+ *
+ * A negative mean (a pixel whose expectation lies below black, which a real sensor does not produce but
+ * an estimate such as a single noisy value can) has no photon shot noise: the shot term uses
+ * \f$ \max(\mu, 0) \f$, so the variance is never below the read-noise floor and never negative.
+ */
+struct CV_RAWGMENT_EXPORTS NoiseModel
+{
+    //! Version of the file format written by write(); read() rejects newer versions.
+    static constexpr int FORMAT_VERSION = 1;
+
+    double alpha = 0;   //!< shot-noise slope at gain 1, DN per electron (>= 0)
+    double sigmaD2 = 0; //!< read-noise variance before the analog gain, DN^2 at gain 1 (>= 0)
+    double sigmaR2 = 0; //!< noise variance after the analog gain, DN^2 (>= 0)
+
+    NoiseModel() = default;
+    /** @brief A validated model. @throws cv::Exception when a parameter is negative or not finite. */
+    NoiseModel(double alpha, double sigmaD2, double sigmaR2);
+
+    /** @brief Throws cv::Exception (StsBadArg) naming the parameter that is negative or not finite. */
+    void validate() const;
+
+    /** @brief The per-gain line: \f$ a = g\alpha,\; b = g^2\sigma_d^2 + \sigma_r^2 \f$.
+     * @param gain linear gain, finite and > 0
+     */
+    NoiseLine lineAtGain(double gain) const;
+
+    /** @brief Variance of a pixel with mean `mean` at linear gain `gain`:
+     * \f$ g\alpha\max(\mu,0) + g^2\sigma_d^2 + \sigma_r^2 \f$.
+     * @param mean black-subtracted expected value in DN (any finite value)
+     * @param gain linear gain, finite and > 0
+     */
+    double variance(double mean, double gain) const;
+
+    /** @brief variance() of every element of a mean image.
+     * @param mean CV_32FC1 or CV_64FC1 Mat of black-subtracted means (finite values)
+     * @param gain linear gain, finite and > 0
+     * @param dst variance, same size and type as `mean`
+     */
+    void variance(InputArray mean, double gain, OutputArray dst) const;
+
+    /** @brief Writes the model as a map under `name`: format_version, alpha, sigma_d2, sigma_r2. */
+    void write(FileStorage& fs, const String& name) const;
+
+    /** @brief Reads a model written by write().
+     * @throws cv::Exception naming the field when a field is missing, not a number, negative or not
+     *         finite, or when format_version is newer than FORMAT_VERSION.
+     */
+    static NoiseModel read(const FileNode& node);
+
+    /** @brief Saves the model to a YAML (.yml, .yaml) or JSON (.json) file, atomically: the file is
+     * written under a temporary name next to `path` and renamed, so a reader never sees half a file.
+     */
+    void save(const String& path) const;
+
+    /** @brief Loads a model saved by save() (the top-level map is `noise_model`). */
+    static NoiseModel load(const String& path);
+};
+
+//! @}
+
+} // namespace rawgment
+} // namespace cv
+
+#endif // OPENCV_RAWGMENT_NOISE_MODEL_HPP

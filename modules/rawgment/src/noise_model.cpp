@@ -1,0 +1,159 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "opencv2/rawgment/noise_model.hpp"
+#include "precomp.hpp"
+
+namespace cv {
+namespace rawgment {
+
+namespace {
+
+const char* const kTopLevelName = "noise_model";
+
+template <typename T> void varianceOfMeans(const Mat& mean, Mat& dst, const NoiseLine& line)
+{
+    const T a = static_cast<T>(line.a), b = static_cast<T>(line.b);
+    parallel_for_(Range(0, mean.rows), [&](const Range& rows) {
+        for (int r = rows.start; r < rows.end; ++r) {
+            const T* m = mean.ptr<T>(r);
+            T* d = dst.ptr<T>(r);
+            for (int c = 0; c < mean.cols; ++c)
+                d[c] = a * std::max(m[c], T(0)) + b;
+        }
+    });
+}
+
+} // namespace
+
+double dbToLinearGain(double db)
+{
+    if (!std::isfinite(db))
+        CV_Error(Error::StsBadArg, format("gain in dB must be finite (got %g)", db));
+    return std::pow(10.0, db / 20.0);
+}
+
+double linearGainToDb(double gain)
+{
+    detail::checkFinitePositive(gain, "linear gain");
+    return 20.0 * std::log10(gain);
+}
+
+NoiseModel::NoiseModel(double alpha_, double sigmaD2_, double sigmaR2_)
+    : alpha(alpha_), sigmaD2(sigmaD2_), sigmaR2(sigmaR2_)
+{
+    validate();
+}
+
+void NoiseModel::validate() const
+{
+    detail::checkFiniteNonNegative(alpha, "NoiseModel.alpha");
+    detail::checkFiniteNonNegative(sigmaD2, "NoiseModel.sigmaD2");
+    detail::checkFiniteNonNegative(sigmaR2, "NoiseModel.sigmaR2");
+}
+
+NoiseLine NoiseModel::lineAtGain(double gain) const
+{
+    validate();
+    detail::checkFinitePositive(gain, "gain");
+    NoiseLine line;
+    line.a = gain * alpha;
+    line.b = gain * gain * sigmaD2 + sigmaR2;
+    if (!std::isfinite(line.a) || !std::isfinite(line.b))
+        CV_Error(Error::StsBadArg,
+                 format("noise line at gain %g overflows (a = %g, b = %g)", gain, line.a, line.b));
+    return line;
+}
+
+double NoiseModel::variance(double mean, double gain) const
+{
+    if (!std::isfinite(mean))
+        CV_Error(Error::StsBadArg, format("NoiseModel::variance: mean must be finite (got %g)", mean));
+    const NoiseLine line = lineAtGain(gain);
+    return line.a * std::max(mean, 0.0) + line.b;
+}
+
+void NoiseModel::variance(InputArray _mean, double gain, OutputArray _dst) const
+{
+    const NoiseLine line = lineAtGain(gain);
+    const Mat mean = _mean.getMat();
+    if (mean.empty())
+        CV_Error(Error::StsBadArg, "NoiseModel::variance: mean is empty");
+    if (mean.type() != CV_32FC1 && mean.type() != CV_64FC1)
+        CV_Error(Error::StsBadArg, format("NoiseModel::variance: mean type %s is not supported; expected "
+                                          "CV_32FC1 or CV_64FC1",
+                                          typeToString(mean.type()).c_str()));
+    if (!checkRange(mean, true))
+        CV_Error(Error::StsBadArg, "NoiseModel::variance: mean contains NaN or Inf");
+    Mat dst(mean.size(), mean.type());
+    if (mean.depth() == CV_32F)
+        varianceOfMeans<float>(mean, dst, line);
+    else
+        varianceOfMeans<double>(mean, dst, line);
+    _dst.assign(dst);
+}
+
+void NoiseModel::write(FileStorage& fs, const String& name) const
+{
+    validate();
+    fs << name << "{";
+    fs << "format_version" << FORMAT_VERSION;
+    fs << "alpha" << alpha;
+    fs << "sigma_d2" << sigmaD2;
+    fs << "sigma_r2" << sigmaR2;
+    fs << "}";
+}
+
+NoiseModel NoiseModel::read(const FileNode& node)
+{
+    if (node.empty() || !node.isMap())
+        CV_Error(Error::StsParseError,
+                 "noise model: expected a map with format_version, alpha, sigma_d2, sigma_r2");
+    const FileNode versionNode = node["format_version"];
+    if (versionNode.empty() || !versionNode.isInt())
+        CV_Error(Error::StsParseError, "noise model: field 'format_version' is missing or not an integer");
+    const int version = static_cast<int>(versionNode);
+    if (version > FORMAT_VERSION || version < 1)
+        CV_Error(Error::StsParseError,
+                 format("noise model: format_version %d is not supported; this build reads versions 1 to %d "
+                        "(a newer cv::rawgment wrote the file)",
+                        version, FORMAT_VERSION));
+    NoiseModel m;
+    double* const targets[] = {&m.alpha, &m.sigmaD2, &m.sigmaR2};
+    const char* const fields[] = {"alpha", "sigma_d2", "sigma_r2"};
+    for (int i = 0; i < 3; ++i) {
+        try {
+            *targets[i] = detail::readRealField(node, fields[i]);
+        } catch (const Exception& e) {
+            CV_Error(Error::StsParseError, "noise model: " + e.err);
+        }
+        if (!std::isfinite(*targets[i]) || *targets[i] < 0)
+            CV_Error(Error::StsParseError, format("noise model: field '%s' must be finite and >= 0 (got %g)",
+                                                  fields[i], *targets[i]));
+    }
+    return m;
+}
+
+void NoiseModel::save(const String& path) const
+{
+    validate();
+    detail::writeFileStorageAtomically(path, [&](FileStorage& fs) { write(fs, kTopLevelName); });
+}
+
+NoiseModel NoiseModel::load(const String& path)
+{
+    FileStorage fs;
+    try {
+        fs.open(path, FileStorage::READ);
+    } catch (const Exception& e) {
+        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.err);
+    }
+    if (!fs.isOpened())
+        CV_Error(Error::StsError, "cannot open noise model file '" + path + "'");
+    try {
+        return read(fs[kTopLevelName]);
+    } catch (const Exception& e) {
+        CV_Error(e.code, "'" + path + "': " + e.err);
+    }
+}
+
+} // namespace rawgment
+} // namespace cv

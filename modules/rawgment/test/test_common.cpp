@@ -1,0 +1,44 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "test_common.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+
+namespace cv {
+namespace rawgment {
+namespace test {
+
+std::string findDataFile(const std::string& name)
+{
+    namespace fs = std::filesystem;
+    if (const char* dir = std::getenv("RAWGMENT_TEST_DATA_DIR")) {
+        const fs::path p = fs::path(dir) / name;
+        if (fs::exists(p))
+            return p.string();
+    }
+    const fs::path p = fs::path(RAWGMENT_SHARED_DATA_DIR) / name;
+    return fs::exists(p) ? p.string() : std::string();
+}
+
+std::string makeTempDir(const std::string& testName)
+{
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("rawgment_test_" + testName);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir.string();
+}
+
+int countNonFinite(const Mat& m)
+{
+    Mat f;
+    m.convertTo(f, CV_64F);
+    int bad = 0;
+    for (auto it = f.begin<double>(); it != f.end<double>(); ++it)
+        bad += std::isfinite(*it) ? 0 : 1;
+    return bad;
+}
+
+} // namespace test
+} // namespace rawgment
+} // namespace cv

@@ -1,0 +1,48 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Helpers shared by the unit tests.
+#ifndef OPENCV_RAWGMENT_TEST_COMMON_HPP
+#define OPENCV_RAWGMENT_TEST_COMMON_HPP
+
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include <string>
+
+namespace cv {
+namespace rawgment {
+namespace test {
+
+/** Path of a test data file: $RAWGMENT_TEST_DATA_DIR/name, then ../shared/data/name next to the
+ * source tree. Empty when neither exists. */
+std::string findDataFile(const std::string& name);
+
+/** A fresh, empty directory for one test's files, removed by nobody (under the build's temp area). */
+std::string makeTempDir(const std::string& testName);
+
+/** Counts the elements of a float Mat that are NaN or infinite. */
+int countNonFinite(const Mat& m);
+
+} // namespace test
+} // namespace rawgment
+} // namespace cv
+
+//! Sets `var` to the data file's path, or skips the test naming the missing file.
+#define RAWGMENT_DATA_FILE_OR_SKIP(var, name)                                                                \
+    const std::string var = ::cv::rawgment::test::findDataFile(name);                                        \
+    if (var.empty())                                                                                         \
+    GTEST_SKIP() << "test data file '" << (name)                                                             \
+                 << "' not found (set RAWGMENT_TEST_DATA_DIR or put ../shared/data beside the checkout)"
+
+//! Expects `stmt` to throw cv::Exception whose message contains `fragment`.
+#define EXPECT_CV_ERROR_CONTAINS(stmt, fragment)                                                             \
+    do {                                                                                                     \
+        try {                                                                                                \
+            stmt;                                                                                            \
+            ADD_FAILURE() << "expected cv::Exception containing '" << (fragment) << "' from: " #stmt;        \
+        } catch (const cv::Exception& e_) {                                                                  \
+            EXPECT_NE(e_.err.find(fragment), std::string::npos)                                              \
+                << "message '" << e_.err << "' lacks '" << (fragment) << "'";                                \
+        }                                                                                                    \
+    } while (0)
+
+#endif // OPENCV_RAWGMENT_TEST_COMMON_HPP

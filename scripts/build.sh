@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Configures and builds one flavour of the project.
+#   scripts/build.sh release   -> build/release (Release, tests, benchmarks, apps, samples)
+#   scripts/build.sh asan      -> build/asan    (RelWithDebInfo + AddressSanitizer + UBSan, no benchmarks)
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+flavour=${1:-release}
+jobs=${RAWGMENT_JOBS:-$(nproc)}
+
+generator=()
+command -v ninja >/dev/null 2>&1 && generator=(-G Ninja)
+
+case "$flavour" in
+  release) args=(-DCMAKE_BUILD_TYPE=Release) ;;
+  asan) args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAWGMENT_SANITIZE=ON -DRAWGMENT_BUILD_PERF=OFF) ;;
+  *) echo "build.sh: unknown flavour '$flavour' (expected release or asan)" >&2; exit 2 ;;
+esac
+
+build="$root/build/$flavour"
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  cmake -S "$root" -B "$build" "${generator[@]}" "${args[@]}"
+fi
+cmake --build "$build" --parallel "$jobs"

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages that cv::rawgment needs to build, test and run its demo.
+# Idempotent: packages already present are not reinstalled. Runs as root or through sudo.
+set -euo pipefail
+
+packages=(
+  build-essential   # g++ 12
+  cmake             # >= 3.25
+  ninja-build       # faster incremental builds than make on 2 cores
+  pkg-config        # FindLibRaw.cmake reads libraw.pc
+  libopencv-dev     # OpenCV 4.6: core, imgproc, imgcodecs
+  libopencv-contrib-dev  # contrib modules: mcc (colour-checker detection)
+  libceres-dev      # Ceres 2.1: cross-gain noise fits
+  libraw-dev        # LibRaw 0.20: camera RAW input
+  libgtest-dev      # GoogleTest
+  libbenchmark-dev  # Google Benchmark
+  gnuplot-nox       # PNG plots in apps and the demo
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} Debian packages present"
+  exit 0
+fi
+
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null 2>&1 || { echo "install-deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  sudo_cmd=(sudo)
+fi
+
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
