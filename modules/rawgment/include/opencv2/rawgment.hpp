@@ -4,6 +4,7 @@
 
 #include <opencv2/rawgment/bayer.hpp>
 #include <opencv2/rawgment/noise_model.hpp>
+#include <opencv2/rawgment/normality.hpp>
 
 /** @defgroup rawgment Noise-accounted RAW augmentation
 
@@ -14,6 +15,7 @@ subtraction; gains are linear (0 dB = 1).
 @{
     @defgroup rawgment_bayer Bayer mosaics: CFA patterns, planes and black levels
     @defgroup rawgment_noise_model The heteroscedastic Gaussian noise model
+    @defgroup rawgment_normality Shapiro-Wilk tests of the Gaussian noise assumption
 @}
 */
 
