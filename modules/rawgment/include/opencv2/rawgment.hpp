@@ -5,6 +5,7 @@
 #include <opencv2/rawgment/bayer.hpp>
 #include <opencv2/rawgment/noise_model.hpp>
 #include <opencv2/rawgment/normality.hpp>
+#include <opencv2/rawgment/simulate.hpp>
 
 /** @defgroup rawgment Noise-accounted RAW augmentation
 
@@ -16,6 +17,7 @@ subtraction; gains are linear (0 dB = 1).
     @defgroup rawgment_bayer Bayer mosaics: CFA patterns, planes and black levels
     @defgroup rawgment_noise_model The heteroscedastic Gaussian noise model
     @defgroup rawgment_normality Shapiro-Wilk tests of the Gaussian noise assumption
+    @defgroup rawgment_simulate A physical sensor simulator and a ColorChecker scene: the ground truth
 @}
 */
 

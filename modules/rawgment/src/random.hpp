@@ -1,0 +1,100 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Counter-based random numbers: private to the module.
+//
+// Every random value is a pure function of (seed, stream, position in the stream). A parallel loop
+// gives each row, tile or pixel its own stream, so the output does not depend on how the work is split
+// among threads. The generator is Philox4x32-10 (Salmon et al., "Parallel random numbers: as easy as
+// 1, 2, 3", SC 2011), which passes BigCrush and is the standard counter-based generator.
+#ifndef OPENCV_RAWGMENT_SRC_RANDOM_HPP
+#define OPENCV_RAWGMENT_SRC_RANDOM_HPP
+
+#include <opencv2/core.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+namespace cv {
+namespace rawgment {
+namespace detail {
+
+//! One Philox4x32-10 block: 4 random 32-bit words for a 128-bit counter and a 64-bit key.
+inline std::array<uint32_t, 4> philox4x32(std::array<uint32_t, 4> c, std::array<uint32_t, 2> k)
+{
+    const uint32_t M0 = 0xD2511F53u, M1 = 0xCD9E8D57u, W0 = 0x9E3779B9u, W1 = 0xBB67AE85u;
+    for (int round = 0; round < 10; ++round) {
+        const uint64_t p0 = static_cast<uint64_t>(M0) * c[0];
+        const uint64_t p1 = static_cast<uint64_t>(M1) * c[2];
+        c = {static_cast<uint32_t>(p1 >> 32) ^ c[1] ^ k[0], static_cast<uint32_t>(p1),
+             static_cast<uint32_t>(p0 >> 32) ^ c[3] ^ k[1], static_cast<uint32_t>(p0)};
+        k[0] += W0;
+        k[1] += W1;
+    }
+    return c;
+}
+
+/** A stream of random numbers identified by (seed, stream). Cheap to construct: make one per row or
+ * per pixel. */
+class CounterRng
+{
+public:
+    CounterRng(uint64_t seed, uint64_t stream)
+        : key_{static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)},
+          counter_{0u, 0u, static_cast<uint32_t>(stream), static_cast<uint32_t>(stream >> 32)}
+    {
+    }
+
+    uint32_t nextU32()
+    {
+        if (used_ == 4) {
+            block_ = philox4x32(counter_, key_);
+            if (++counter_[0] == 0)
+                ++counter_[1];
+            used_ = 0;
+        }
+        return block_[used_++];
+    }
+
+    //! Uniform in (0, 1): 53 random bits, never 0 (safe for log) and never 1.
+    double uniform()
+    {
+        const uint64_t bits = (static_cast<uint64_t>(nextU32()) << 21) ^ (nextU32() >> 11);
+        return (static_cast<double>(bits) + 0.5) * (1.0 / 9007199254740992.0);
+    }
+
+    //! Standard normal by Box-Muller; the second value of each pair is kept for the next call.
+    double gaussian()
+    {
+        if (hasSpare_) {
+            hasSpare_ = false;
+            return spare_;
+        }
+        const double r = std::sqrt(-2.0 * std::log(uniform()));
+        const double theta = 2.0 * CV_PI * uniform();
+        spare_ = r * std::sin(theta);
+        hasSpare_ = true;
+        return r * std::cos(theta);
+    }
+
+    /** Exact Poisson variate of mean lambda >= 0: inversion below 10, Hormann's transformed rejection
+     * (PTRS, 1993) above. Both are exact up to floating-point rounding, unlike a Gaussian
+     * approximation, which matters at the few-electron counts of dark pixels. */
+    int64_t poisson(double lambda);
+
+private:
+    std::array<uint32_t, 2> key_;
+    std::array<uint32_t, 4> counter_;
+    std::array<uint32_t, 4> block_{};
+    int used_ = 4;
+    bool hasSpare_ = false;
+    double spare_ = 0;
+};
+
+//! log(k!) to about 1e-13 relative: a table below 32, Stirling's series with three terms above.
+double logFactorial(int64_t k);
+
+} // namespace detail
+} // namespace rawgment
+} // namespace cv
+
+#endif // OPENCV_RAWGMENT_SRC_RANDOM_HPP

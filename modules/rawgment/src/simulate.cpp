@@ -1,0 +1,266 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "opencv2/rawgment/simulate.hpp"
+#include "precomp.hpp"
+#include "random.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+namespace cv {
+namespace rawgment {
+
+namespace {
+
+// Streams: captures use (frame << 32 | row); the fixed pattern uses streams with the top bit set, so
+// that the two never share random numbers even when a user picks the same seed for both.
+const uint64_t kFixedPatternStream = uint64_t(1) << 63;
+
+enum DefectCode : uchar
+{
+    DEFECT_NONE = 0,
+    DEFECT_HOT = 1,
+    DEFECT_DEAD = 2,
+    DEFECT_NOISY = 3
+};
+
+void checkFraction(double v, const char* what)
+{
+    if (!(v >= 0 && v <= 1))
+        CV_Error(Error::StsBadArg, format("SensorParams.%s must lie in [0, 1] (got %g)", what, v));
+}
+
+double srgbToLinear(double v8)
+{
+    const double v = v8 / 255.0;
+    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
+}
+
+} // namespace
+
+void SensorParams::validate() const
+{
+    noise.validate();
+    if (pattern < CFA_RGGB || pattern > CFA_GBRG)
+        CV_Error(Error::StsBadArg,
+                 format("SensorParams.pattern %d is not a CFA pattern", static_cast<int>(pattern)));
+    if (bitDepth < 1 || bitDepth > 16)
+        CV_Error(Error::StsBadArg, format("SensorParams.bitDepth must lie in [1, 16] (got %d)", bitDepth));
+    const double white = std::ldexp(1.0, bitDepth) - 1;
+    for (int s = 0; s < 4; ++s)
+        if (!(blackLevel[s] >= 0 && blackLevel[s] < white))
+            CV_Error(Error::StsBadArg, format("SensorParams.blackLevel[%d] must lie in [0, %g) (got %g)", s,
+                                              white, blackLevel[s]));
+    detail::checkFiniteNonNegative(prnu, "SensorParams.prnu");
+    detail::checkFiniteNonNegative(dsnu, "SensorParams.dsnu");
+    checkFraction(hotPixelFraction, "hotPixelFraction");
+    checkFraction(deadPixelFraction, "deadPixelFraction");
+    checkFraction(noisyPixelFraction, "noisyPixelFraction");
+    checkFraction(hotPixelFraction + deadPixelFraction + noisyPixelFraction,
+                  "hotPixelFraction + deadPixelFraction + noisyPixelFraction");
+    detail::checkFiniteNonNegative(noisyPixelVariance, "SensorParams.noisyPixelVariance");
+}
+
+SensorSimulator::SensorSimulator(const SensorParams& params, Size size) : params_(params), size_(size)
+{
+    params_.validate();
+    if (size.width <= 0 || size.height <= 0 || size.width % 2 || size.height % 2)
+        CV_Error(Error::StsBadArg,
+                 format("SensorSimulator: size %dx%d must be positive and even", size.width, size.height));
+    prnu_.create(size, CV_32FC1);
+    dsnu_.create(size, CV_32FC1);
+    defects_.create(size, CV_8UC1);
+    const double hot = params_.hotPixelFraction, dead = hot + params_.deadPixelFraction;
+    const double noisy = dead + params_.noisyPixelFraction;
+    parallel_for_(Range(0, size.height), [&](const Range& rows) {
+        for (int r = rows.start; r < rows.end; ++r) {
+            detail::CounterRng rng(params_.fixedPatternSeed, kFixedPatternStream | static_cast<uint64_t>(r));
+            float* g = prnu_.ptr<float>(r);
+            float* o = dsnu_.ptr<float>(r);
+            uchar* d = defects_.ptr<uchar>(r);
+            for (int c = 0; c < size.width; ++c) {
+                g[c] = static_cast<float>(std::max(0.0, 1.0 + params_.prnu * rng.gaussian()));
+                o[c] = static_cast<float>(params_.dsnu * rng.gaussian());
+                const double u = rng.uniform();
+                d[c] = u < hot ? DEFECT_HOT : u < dead ? DEFECT_DEAD : u < noisy ? DEFECT_NOISY : DEFECT_NONE;
+            }
+        }
+    });
+}
+
+RawFormat SensorSimulator::rawFormat(double gain) const
+{
+    RawFormat f;
+    f.pattern = params_.pattern;
+    f.blackLevel = params_.blackLevel;
+    f.whiteLevel = std::ldexp(1.0, params_.bitDepth) - 1;
+    f.gain = gain;
+    f.validate();
+    return f;
+}
+
+NoiseModel SensorSimulator::effectiveModel() const
+{
+    NoiseModel m = params_.noise;
+    if (params_.quantize)
+        m.sigmaR2 += 1.0 / 12.0;
+    return m;
+}
+
+void SensorSimulator::capture(InputArray _mean, double gain, double exposure, uint64 seed, int frameIndex,
+                              OutputArray _raw) const
+{
+    const Mat mean = _mean.getMat();
+    if (mean.type() != CV_32FC1 || mean.size() != size_)
+        CV_Error(Error::StsBadArg,
+                 format("SensorSimulator::capture: meanAtUnitGain must be CV_32FC1 of %dx%d "
+                        "(got %s, %dx%d)",
+                        size_.width, size_.height, typeToString(mean.type()).c_str(), mean.cols, mean.rows));
+    double lo = 0;
+    minMaxLoc(mean, &lo);
+    if (!checkRange(mean, true) || lo < 0)
+        CV_Error(Error::StsBadArg, "SensorSimulator::capture: meanAtUnitGain must be finite and >= 0");
+    detail::checkFinitePositive(gain, "SensorSimulator::capture: gain");
+    detail::checkFinitePositive(exposure, "SensorSimulator::capture: exposure");
+    if (frameIndex < 0)
+        CV_Error(Error::StsBadArg,
+                 format("SensorSimulator::capture: frameIndex must be >= 0 (got %d)", frameIndex));
+
+    const SensorParams& p = params_;
+    const double white = std::ldexp(1.0, p.bitDepth) - 1;
+    const double alpha = p.noise.alpha, sigmaD = std::sqrt(p.noise.sigmaD2),
+                 sigmaR = std::sqrt(p.noise.sigmaR2);
+    const double noisySigma = std::sqrt(p.noisyPixelVariance);
+    const double hotLevel = std::round(0.9 * white);
+    Mat raw(size_, p.quantize ? CV_16UC1 : CV_32FC1);
+    parallel_for_(Range(0, size_.height), [&](const Range& rows) {
+        for (int r = rows.start; r < rows.end; ++r) {
+            detail::CounterRng rng(seed,
+                                   (static_cast<uint64_t>(frameIndex) << 32) | static_cast<uint64_t>(r));
+            const float* m = mean.ptr<float>(r);
+            const float* prnu = prnu_.ptr<float>(r);
+            const float* dsnu = dsnu_.ptr<float>(r);
+            const uchar* defect = defects_.ptr<uchar>(r);
+            for (int c = 0; c < size_.width; ++c) {
+                const double black = p.blackLevel[cfaSite(r, c)];
+                double x;
+                if (defect[c] == DEFECT_HOT) {
+                    x = hotLevel;
+                } else if (defect[c] == DEFECT_DEAD) {
+                    x = black;
+                } else {
+                    const double signal = m[c] * exposure * prnu[c];
+                    // alpha = 0 is a sensor without shot noise: the signal is then deterministic.
+                    const double photoSignal =
+                        alpha > 0 ? alpha * static_cast<double>(rng.poisson(signal / alpha)) : signal;
+                    x = gain * (photoSignal + sigmaD * rng.gaussian()) + sigmaR * rng.gaussian() + dsnu[c] +
+                        black;
+                    if (defect[c] == DEFECT_NOISY)
+                        x += noisySigma * rng.gaussian();
+                }
+                x = std::min(white, std::max(0.0, p.quantize ? std::round(x) : x));
+                if (p.quantize)
+                    raw.at<ushort>(r, c) = static_cast<ushort>(x);
+                else
+                    raw.at<float>(r, c) = static_cast<float>(x);
+            }
+        }
+    });
+    _raw.assign(raw);
+}
+
+void SensorSimulator::captureBurst(InputArray mean, double gain, double exposure, int frames, uint64 seed,
+                                   std::vector<Mat>& raws) const
+{
+    if (frames < 1)
+        CV_Error(Error::StsBadArg,
+                 format("SensorSimulator::captureBurst: frames must be >= 1 (got %d)", frames));
+    std::vector<Mat> out(frames);
+    for (int t = 0; t < frames; ++t)
+        capture(mean, gain, exposure, seed, t, out[t]);
+    raws.swap(out);
+}
+
+void SensorSimulator::captureBlurred(InputArray _mean, InputArray _kernel, double gain, double exposure,
+                                     uint64 seed, int frameIndex, OutputArray raw) const
+{
+    Mat kernel;
+    _kernel.getMat().convertTo(kernel, CV_64F);
+    if (kernel.empty() || !checkRange(kernel, true))
+        CV_Error(Error::StsBadArg, "SensorSimulator::captureBlurred: kernel must be non-empty and finite");
+    double lo = 0;
+    minMaxLoc(kernel, &lo);
+    const double total = sum(kernel)[0];
+    if (lo < 0 || !(total > 0))
+        CV_Error(Error::StsBadArg,
+                 "SensorSimulator::captureBlurred: kernel must be non-negative with a positive sum");
+    kernel /= total;
+    std::vector<Mat> planes;
+    splitCfaPlanes(_mean, planes);
+    for (Mat& plane : planes)
+        filter2D(plane, plane, CV_32F, kernel, Point(-1, -1), 0, BORDER_REFLECT);
+    Mat blurred;
+    mergeCfaPlanes(planes, blurred);
+    capture(blurred, gain, exposure, seed, frameIndex, raw);
+}
+
+void SensorSimulator::fixedPattern(OutputArray gainFactor, OutputArray offset, OutputArray defects) const
+{
+    gainFactor.assign(prnu_);
+    offset.assign(dsnu_);
+    defects.assign(defects_);
+}
+
+std::vector<Vec3d> colorCheckerReflectances()
+{
+    // Published sRGB (8-bit) values of the classic chart, row by row.
+    static const int srgb[24][3] = {
+        {115, 82, 68},   {194, 150, 130}, {98, 122, 157},  {87, 108, 67},   {133, 128, 177}, {103, 189, 170},
+        {214, 126, 44},  {80, 91, 166},   {193, 90, 99},   {94, 60, 108},   {157, 188, 64},  {224, 163, 46},
+        {56, 61, 150},   {70, 148, 73},   {175, 54, 60},   {231, 199, 31},  {187, 86, 149},  {8, 133, 161},
+        {243, 243, 242}, {200, 200, 200}, {160, 160, 160}, {122, 122, 121}, {85, 85, 85},    {52, 52, 52}};
+    std::vector<Vec3d> out(24);
+    for (int i = 0; i < 24; ++i)
+        out[i] = Vec3d(srgbToLinear(srgb[i][0]), srgbToLinear(srgb[i][1]), srgbToLinear(srgb[i][2]));
+    return out;
+}
+
+ColorCheckerScene makeColorCheckerScene(const ColorCheckerOptions& o)
+{
+    if (o.patchSize < 2 || o.patchSize % 2)
+        CV_Error(Error::StsBadArg,
+                 format("ColorCheckerOptions.patchSize must be even and >= 2 (got %d)", o.patchSize));
+    if (o.border < 0 || o.border % 2)
+        CV_Error(Error::StsBadArg,
+                 format("ColorCheckerOptions.border must be even and >= 0 (got %d)", o.border));
+    detail::checkFiniteNonNegative(o.illumination, "ColorCheckerOptions.illumination");
+    if (!(o.vignetting >= 0 && o.vignetting < 1))
+        CV_Error(Error::StsBadArg,
+                 format("ColorCheckerOptions.vignetting must lie in [0, 1) (got %g)", o.vignetting));
+    if (!(o.frameReflectance >= 0 && o.frameReflectance <= 1))
+        CV_Error(Error::StsBadArg, format("ColorCheckerOptions.frameReflectance must lie in [0, 1] (got %g)",
+                                          o.frameReflectance));
+    ColorCheckerScene scene;
+    scene.reflectance = colorCheckerReflectances();
+    const int step = o.patchSize + o.border;
+    const Size size(6 * step + o.border, 4 * step + o.border);
+    Mat rgb(size, CV_64FC3, Scalar::all(o.frameReflectance));
+    for (int i = 0; i < 24; ++i) {
+        const Rect patch(o.border + (i % 6) * step, o.border + (i / 6) * step, o.patchSize, o.patchSize);
+        scene.patches.push_back(patch);
+        rgb(patch).setTo(Scalar(scene.reflectance[i][0], scene.reflectance[i][1], scene.reflectance[i][2]));
+    }
+    scene.meanAtUnitGain.create(size, CV_32FC1);
+    const double cx = 0.5 * (size.width - 1), cy = 0.5 * (size.height - 1);
+    for (int r = 0; r < size.height; ++r)
+        for (int c = 0; c < size.width; ++c) {
+            const CfaChannel ch = cfaChannelAt(o.pattern, r, c);
+            const int rgbIndex = ch == CFA_R ? 0 : ch == CFA_B ? 2 : 1;
+            const double dx = (c - cx) / cx, dy = (r - cy) / cy;
+            const double shading = 1.0 - o.vignetting * 0.5 * (dx * dx + dy * dy);
+            scene.meanAtUnitGain.at<float>(r, c) =
+                static_cast<float>(o.illumination * shading * rgb.at<Vec3d>(r, c)[rgbIndex]);
+        }
+    return scene;
+}
+
+} // namespace rawgment
+} // namespace cv
