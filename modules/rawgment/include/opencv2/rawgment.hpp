@@ -3,6 +3,7 @@
 #define OPENCV_RAWGMENT_HPP
 
 #include <opencv2/rawgment/bayer.hpp>
+#include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/noise_model.hpp>
 #include <opencv2/rawgment/normality.hpp>
 #include <opencv2/rawgment/simulate.hpp>
@@ -17,6 +18,7 @@ subtraction; gains are linear (0 dB = 1).
     @defgroup rawgment_bayer Bayer mosaics: CFA patterns, planes and black levels
     @defgroup rawgment_noise_model The heteroscedastic Gaussian noise model
     @defgroup rawgment_normality Shapiro-Wilk tests of the Gaussian noise assumption
+    @defgroup rawgment_calibration Noise calibration from bursts: statistics, line fits, cross-gain fits
     @defgroup rawgment_simulate A physical sensor simulator and a ColorChecker scene: the ground truth
 @}
 */

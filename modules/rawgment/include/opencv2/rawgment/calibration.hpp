@@ -1,0 +1,198 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#ifndef OPENCV_RAWGMENT_CALIBRATION_HPP
+#define OPENCV_RAWGMENT_CALIBRATION_HPP
+
+#include <opencv2/core.hpp>
+#include <opencv2/rawgment/bayer.hpp>
+#include <opencv2/rawgment/export.hpp>
+#include <opencv2/rawgment/noise_model.hpp>
+
+#include <string>
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+
+//! @addtogroup rawgment_calibration
+//! @{
+
+/** @brief Streaming per-pixel temporal mean and unbiased variance of a burst.
+ *
+ * Frames are added one at a time and never all held in memory: the statistics are float64 running
+ * sums updated with Chan's pairwise merge of small groups of frames (Welford's update generalised),
+ * which stays exact for large means (60000 DN with a variance of 1) and long bursts. A group of up
+ * to eight frames is buffered to read the float64 state once per group instead of once per frame.
+ *
+ * Values are black-subtracted with the RawFormat (per site). A pixel that is at or above the white
+ * level, or at or below zero, in any frame is marked clipped: its variance is biased and calibration
+ * excludes it.
+ */
+class CV_RAWGMENT_EXPORTS BurstStatistics
+{
+public:
+    /** @param format the burst's format (validated); its black and white levels are used */
+    explicit BurstStatistics(const RawFormat& format);
+    ~BurstStatistics();
+    BurstStatistics(const BurstStatistics&) = delete;
+    BurstStatistics& operator=(const BurstStatistics&) = delete;
+
+    /** @brief Adds a frame: CV_16UC1 or CV_32FC1 raw mosaic (black level included). The first frame
+     * fixes the size and type; later frames must match. NaN or Inf in a CV_32FC1 frame is rejected. */
+    void add(InputArray frame);
+    int frames() const; //!< frames added so far
+    Size size() const;  //!< size of the frames (empty before the first)
+    const RawFormat& format() const;
+    /** @brief Temporal mean, black-subtracted, CV_64FC1. Needs at least one frame. */
+    void mean(OutputArray dst) const;
+    /** @brief Unbiased temporal variance (divided by frames - 1), CV_64FC1. Needs at least 2 frames. */
+    void variance(OutputArray dst) const;
+    /** @brief CV_8UC1 mask, 255 where the pixel was clipped (<= 0 or >= white) in any frame. */
+    void clippedMask(OutputArray dst) const;
+
+private:
+    struct Impl;
+    Impl* impl_;
+};
+
+/** @brief One (mean, variance) observation of the noise: a pixel's temporal statistics over a burst,
+ * or the spatial statistics of a uniform patch in single-frame mode. */
+struct CV_RAWGMENT_EXPORTS NoiseSample
+{
+    double mean = 0;     //!< black-subtracted mean (DN)
+    double variance = 0; //!< unbiased variance (DN^2)
+    double gain = 1;     //!< linear gain of the capture
+    int dof = 1;         //!< degrees of freedom of the variance (frames - 1 for a burst)
+    int channel = -1;    //!< CfaChannel of the pixel (or patch plane)
+};
+
+/** @brief Squares of side `side` (even) centred in each patch, with even corners so that each holds
+ * whole 2x2 CFA blocks. @throws cv::Exception when a patch is smaller than the square. */
+CV_RAWGMENT_EXPORTS std::vector<Rect> cfaAlignedSquares(const std::vector<Rect>& patches, int side = 24);
+
+/** @brief The temporal noise samples of every unclipped pixel of the squares.
+ * @param stats statistics of a burst with at least 2 frames
+ * @param squares pixel rectangles inside the frame (see cfaAlignedSquares())
+ * @param gain linear gain of the burst (stored in the samples)
+ */
+CV_RAWGMENT_EXPORTS std::vector<NoiseSample>
+sampleBurstPatches(const BurstStatistics& stats, const std::vector<Rect>& squares, double gain);
+
+/** @brief Single-frame mode: the spatial mean and variance of each CFA plane of each square.
+ *
+ * A plane a + b x + c y is fitted to each square's CFA plane and removed first, which takes out the
+ * patch's low-frequency shading (vignetting, uneven light); the variance of the residual is divided by
+ * n - 3. Less exact than a burst: the spatial variance also holds fixed-pattern noise (PRNU grows with
+ * the mean squared, DSNU adds a constant), and any texture of the patch. Planes with a clipped pixel
+ * are skipped.
+ * @param raw CV_16UC1 or CV_32FC1 mosaic
+ * @param format its format
+ * @param squares CFA-aligned rectangles of uniform patches (each plane needs >= 4 pixels)
+ * @param gain linear gain of the capture
+ */
+CV_RAWGMENT_EXPORTS std::vector<NoiseSample> sampleSingleFramePatches(InputArray raw, const RawFormat& format,
+                                                                      const std::vector<Rect>& squares,
+                                                                      double gain);
+
+/** @brief Settings of the per-gain line fit. */
+struct CV_RAWGMENT_EXPORTS LineFitParams
+{
+    bool robust = true;         //!< RANSAC, then least squares on the inliers; false: least squares on all
+    int ransacIterations = 500; //!< line hypotheses drawn from random pairs of samples
+    /** Inlier band, in standard errors of a sample variance: |v - line(mu)| <= k sqrt(2 / dof) line(mu),
+     * the spread of a sample variance of `dof` degrees of freedom around its expectation. */
+    double inlierThreshold = 4.0;
+    uint64 seed = 0; //!< seed of the RANSAC draws (deterministic)
+};
+
+/** @brief The line \f$ \sigma^2 = a\mu + b \f$ fitted to the samples of one gain.
+ *
+ * The final fit is iterated weighted least squares with weights \f$ dof / (2 v^2) \f$, the inverse
+ * variance of a sample variance, which makes the offset b far more precise than ordinary least squares
+ * (paper) does on the same inliers. */
+struct CV_RAWGMENT_EXPORTS NoiseLineFit
+{
+    double gain = 1;     //!< linear gain
+    NoiseLine line;      //!< slope a and offset b (unconstrained: a negative value is reported as is)
+    double rSquared = 0; //!< coefficient of determination on the inliers
+    int inliers = 0;     //!< samples used by the final least squares
+    int samples = 0;     //!< samples offered
+};
+
+/** @brief Fits \f$ \sigma^2 = a\mu + b \f$ to samples of one gain (paper Eq. 6), robustly by default.
+ * @throws cv::Exception with fewer than 2 samples, samples of different gains, non-finite values, or
+ *         when all samples share one mean (the slope is then undefined).
+ */
+CV_RAWGMENT_EXPORTS NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples,
+                                              const LineFitParams& params = LineFitParams());
+
+/** @brief How the cross-gain parameters are estimated. */
+enum NoiseFitMethod
+{
+    /** One fit of \f$ \sigma^2 = g\alpha\mu + g^2\sigma_d^2 + \sigma_r^2 \f$ over all samples of all gains,
+     * each weighted by the inverse standard deviation of a sample variance, \f$ \sqrt{2/dof}\,\sigma^2 \f$
+     * (iterated: the weights use the previous fit), with a Huber loss, on the per-gain RANSAC inliers.
+     * The default: it uses the dark samples that pin \f$ \sigma_r^2 \f$ directly instead of extrapolating
+     * each offset. */
+    NOISE_FIT_JOINT = 0,
+    /** The paper's method (Eq. 7, 8): per-gain lines, then \f$ a_g = g\alpha \f$ and
+     * \f$ b_g = g^2\sigma_d^2 + \sigma_r^2 \f$ by least squares with non-negative bounds. */
+    NOISE_FIT_TWO_STAGE = 1
+};
+
+/** @brief Settings of calibrateNoiseModel(). */
+struct CV_RAWGMENT_EXPORTS CalibrationParams
+{
+    NoiseFitMethod method = NOISE_FIT_JOINT; //!< cross-gain method
+    LineFitParams line;                      //!< per-gain line fits (also select the joint fit's inliers)
+    int reweightIterations = 4;              //!< joint fit: re-weighting rounds
+    /** Joint fit: Huber loss scale, in standard errors. A sample variance is skewed (chi-squared), so a
+     * loss that bites inside the bulk of its distribution (Cauchy at 3) biases the fit low by ~0.4%;
+     * at the RANSAC band it only tames what RANSAC let through. */
+    double lossScale = 4.0;
+    /** Gains closer than this ratio count as one when deciding whether sigma_d^2 and sigma_r^2 are
+     * separable (1.12 is 1 dB). */
+    double minGainRatio = 1.12;
+};
+
+/** @brief Everything a calibration found, readable and writable as YAML or JSON. */
+struct CV_RAWGMENT_EXPORTS CalibrationReport
+{
+    static constexpr int FORMAT_VERSION = 1; //!< version of the file format
+
+    NoiseFitMethod method = NOISE_FIT_JOINT; //!< the method that ran
+    /** The fitted model. Valid only when `separable`; with a single gain (or gains closer than
+     * CalibrationParams::minGainRatio) only alpha is known, and sigma_d^2, sigma_r^2 are left at 0. */
+    NoiseModel model;
+    bool separable = false;            //!< sigma_d^2 and sigma_r^2 could be told apart
+    std::vector<NoiseLineFit> perGain; //!< the per-gain lines, by increasing gain
+    double rSquaredSlope = 0;          //!< R^2 of a_g = g alpha over the gains (paper: 1.0000)
+    double rSquaredOffset = 0;         //!< R^2 of b_g = g^2 sigma_d^2 + sigma_r^2 (paper: 0.9984)
+    int samples = 0;                   //!< samples offered
+    int samplesUsed = 0;               //!< samples in the final fit
+    std::vector<std::string> notes;    //!< what the user should know (bounds hit, not separable, ...)
+
+    /** @brief Writes the report as a map under `name`. */
+    void write(FileStorage& fs, const String& name) const;
+    /** @brief Reads a report written by write(). @throws cv::Exception naming a missing field. */
+    static CalibrationReport read(const FileNode& node);
+    /** @brief Saves to .yml/.yaml/.json atomically (top-level map `calibration_report`). */
+    void save(const String& path) const;
+    /** @brief Loads a report saved by save(). */
+    static CalibrationReport load(const String& path);
+};
+
+/** @brief Calibrates the noise model from samples of one or more gains (paper Sec. 3.2).
+ * @param samples noise samples of all gains (their `gain` field groups them)
+ * @param params method and settings
+ * @throws cv::Exception when there are no samples, a value is not finite, or a gain has fewer than
+ *         2 distinct means.
+ */
+CV_RAWGMENT_EXPORTS CalibrationReport calibrateNoiseModel(
+    const std::vector<NoiseSample>& samples, const CalibrationParams& params = CalibrationParams());
+
+//! @}
+
+} // namespace rawgment
+} // namespace cv
+
+#endif // OPENCV_RAWGMENT_CALIBRATION_HPP

@@ -1,0 +1,410 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "test_common.hpp"
+
+#include <opencv2/rawgment/calibration.hpp>
+#include <opencv2/rawgment/simulate.hpp>
+
+namespace cv {
+namespace rawgment {
+namespace {
+
+// A sensor whose sigma_r^2 (2 + 1/12 of quantisation) is small next to g^2 sigma_d^2 at the top gain
+// (251 * 0.5 = 126 at 24 dB), as the issue asks.
+SensorParams truthSensor()
+{
+    SensorParams p;
+    p.noise = NoiseModel(0.4, 0.5, 2.0);
+    p.blackLevel = Vec4d(256, 256, 256, 256);
+    p.bitDepth = 12;
+    return p;
+}
+
+struct ProtocolOptions
+{
+    std::vector<double> gainsDb{6, 12, 24};
+    std::vector<double> levels{0.2, 0.65}; // brightest patch at this fraction of the range
+    int frames = 100;
+    int square = 24;
+    SensorParams sensor = truthSensor();
+    uint64 seed = 42;
+};
+
+/** The paper's protocol (Sec. 4.3) on the simulator: per gain and illumination, a burst of a chart,
+ * temporal statistics, then the pixels of a 24x24 square in each of the 24 patches. */
+std::vector<NoiseSample> protocolSamples(const ProtocolOptions& o)
+{
+    ColorCheckerOptions chart;
+    chart.pattern = o.sensor.pattern;
+    chart.patchSize = 32;
+    chart.border = 8;
+    chart.illumination = 1000;
+    const ColorCheckerScene scene = makeColorCheckerScene(chart);
+    const SensorSimulator sensor(o.sensor, scene.meanAtUnitGain.size());
+    const std::vector<Rect> squares = cfaAlignedSquares(scene.patches, o.square);
+    std::vector<NoiseSample> all;
+    uint64 seed = o.seed;
+    for (double db : o.gainsDb) {
+        const double g = dbToLinearGain(db);
+        const RawFormat fmt = sensor.rawFormat(g);
+        const double range = fmt.whiteLevel - fmt.blackLevel[0];
+        for (double level : o.levels) {
+            const double exposure = level * range / (g * chart.illumination);
+            BurstStatistics stats(fmt);
+            for (int t = 0; t < o.frames; ++t) {
+                Mat raw;
+                sensor.capture(scene.meanAtUnitGain, g, exposure, seed, t, raw);
+                stats.add(raw);
+            }
+            ++seed;
+            const std::vector<NoiseSample> s = sampleBurstPatches(stats, squares, g);
+            all.insert(all.end(), s.begin(), s.end());
+        }
+    }
+    return all;
+}
+
+const std::vector<NoiseSample>& cleanProtocol()
+{
+    static const std::vector<NoiseSample> samples = protocolSamples(ProtocolOptions());
+    return samples;
+}
+
+const std::vector<NoiseSample>& outlierProtocol()
+{
+    static const std::vector<NoiseSample> samples = [] {
+        ProtocolOptions o;
+        o.sensor.hotPixelFraction = 0.02;
+        o.sensor.deadPixelFraction = 0.01;
+        o.sensor.noisyPixelFraction = 0.02; // 5% outliers in all
+        o.sensor.noisyPixelVariance = 400;
+        o.seed = 4242;
+        return protocolSamples(o);
+    }();
+    return samples;
+}
+
+struct Errors
+{
+    double alpha, sigmaD2, sigmaR2;
+};
+
+Errors relativeErrors(const NoiseModel& fit, const NoiseModel& truth)
+{
+    return {fit.alpha / truth.alpha - 1, fit.sigmaD2 / truth.sigmaD2 - 1, fit.sigmaR2 / truth.sigmaR2 - 1};
+}
+
+std::ostream& operator<<(std::ostream& os, const Errors& e)
+{
+    return os << "alpha " << 100 * e.alpha << "%, sigma_d^2 " << 100 * e.sigmaD2 << "%, sigma_r^2 "
+              << 100 * e.sigmaR2 << "%";
+}
+
+NoiseModel truthModel()
+{
+    return SensorSimulator(truthSensor(), Size(2, 2)).effectiveModel();
+}
+
+TEST(Calibration, jointFitRecoversTheSensorOnThePaperProtocol)
+{
+    const std::vector<NoiseSample>& samples = cleanProtocol();
+    ASSERT_EQ(samples.size(), 3u * 2u * 24u * 24u * 24u); // no pixel clipped
+    const CalibrationReport joint = calibrateNoiseModel(samples);
+    ASSERT_TRUE(joint.separable);
+    EXPECT_EQ(joint.method, NOISE_FIT_JOINT);
+    const Errors e = relativeErrors(joint.model, truthModel());
+    std::cout << "joint fit: " << e << "\n";
+    // Over 8 other seeds of this protocol the joint fit's errors had standard deviations of 0.08%
+    // (alpha), 0.45% (sigma_d^2) and 1.7% (sigma_r^2) around means of -0.04%, +0.5% and -0.2%: the
+    // issue's bounds of 0.5%, 3% and 5% are 6, 6 and 3 standard deviations. This seed lands at about
+    // -4% on sigma_r^2, a 2.4-sigma draw, kept as it came rather than re-seeded.
+    EXPECT_LT(std::abs(e.alpha), 0.005);
+    EXPECT_LT(std::abs(e.sigmaD2), 0.03);
+    EXPECT_LT(std::abs(e.sigmaR2), 0.05);
+
+    CalibrationParams paper;
+    paper.method = NOISE_FIT_TWO_STAGE;
+    const CalibrationReport twoStage = calibrateNoiseModel(samples, paper);
+    std::cout << "paper's two-stage fit on the same data: " << relativeErrors(twoStage.model, truthModel())
+              << " (R^2 of a_g: " << twoStage.rSquaredSlope << ", of b_g: " << twoStage.rSquaredOffset
+              << ")\n";
+    EXPECT_EQ(twoStage.method, NOISE_FIT_TWO_STAGE);
+    EXPECT_LT(std::abs(relativeErrors(twoStage.model, truthModel()).alpha), 0.01);
+    // The cross-gain relations hold nearly exactly on model data, as in the paper (1.0000, 0.9984).
+    EXPECT_GT(twoStage.rSquaredSlope, 0.999);
+    EXPECT_GT(twoStage.rSquaredOffset, 0.99);
+}
+
+TEST(Calibration, perGainRSquaredIsWhatTheBurstLengthAllows)
+{
+    const std::vector<NoiseSample>& samples = cleanProtocol();
+    const CalibrationReport report = calibrateNoiseModel(samples);
+    ASSERT_EQ(report.perGain.size(), 3u);
+    const NoiseModel truth = truthModel();
+    for (const NoiseLineFit& f : report.perGain) {
+        // A sample variance of T frames scatters around its expectation v with a relative standard
+        // deviation sqrt(2 / (T - 1)). So E[SS_res] = sum 2 v^2 / (T - 1) and E[SS_tot] adds that to the
+        // spread of the expectations: R^2 = 1 - E[SS_res] / E[SS_tot].
+        double ssNoise = 0, sum = 0, sum2 = 0;
+        int n = 0;
+        for (const NoiseSample& s : samples) {
+            if (s.gain != f.gain)
+                continue;
+            const double v = truth.variance(s.mean, s.gain);
+            ssNoise += 2.0 * v * v / s.dof;
+            sum += v;
+            sum2 += v * v;
+            ++n;
+        }
+        const double ssSpread = sum2 - sum * sum / n;
+        const double expected = 1.0 - ssNoise / (ssSpread + ssNoise);
+        std::cout << "gain " << linearGainToDb(f.gain) << " dB: R^2 " << f.rSquared
+                  << ", expected from T = 100: " << expected << ", inliers " << f.inliers << "/" << f.samples
+                  << "\n";
+        // SS_res is a sum of ~27,000 terms dominated by the brightest few thousand; its relative
+        // standard error is about 3%, so 1 - R^2 must match within 15% (5 standard errors).
+        EXPECT_NEAR(1.0 - f.rSquared, 1.0 - expected, 0.15 * (1.0 - expected));
+        EXPECT_GT(f.inliers, 0.995 * f.samples); // clean data: RANSAC keeps nearly everything
+    }
+}
+
+TEST(Calibration, robustFitsSurviveFivePercentOutliersAndPlainLeastSquaresDoesNot)
+{
+    const std::vector<NoiseSample>& samples = outlierProtocol();
+    const CalibrationReport robust = calibrateNoiseModel(samples);
+    const Errors e = relativeErrors(robust.model, truthModel());
+    std::cout << "robust joint fit with 5% outliers: " << e << "\n";
+    EXPECT_LT(std::abs(e.alpha), 0.005);
+    EXPECT_LT(std::abs(e.sigmaD2), 0.03);
+    EXPECT_LT(std::abs(e.sigmaR2), 0.05);
+    EXPECT_LT(robust.samplesUsed, 0.97 * robust.samples); // the outliers were set aside
+
+    CalibrationParams plain;
+    plain.line.robust = false;
+    const CalibrationReport naive = calibrateNoiseModel(samples, plain);
+    const Errors n = relativeErrors(naive.model, truthModel());
+    std::cout << "plain least squares with 5% outliers: " << n << "\n";
+    EXPECT_TRUE(std::abs(n.alpha) > 0.005 || std::abs(n.sigmaD2) > 0.03 || std::abs(n.sigmaR2) > 0.05);
+}
+
+TEST(Calibration, singleFrameModeIsLessExactButRight)
+{
+    ColorCheckerOptions chart;
+    chart.patchSize = 32;
+    chart.border = 8;
+    chart.illumination = 1000;
+    chart.vignetting = 0.3; // shading inside each patch, which the plane fit removes
+    const ColorCheckerScene scene = makeColorCheckerScene(chart);
+    const SensorSimulator sensor(truthSensor(), scene.meanAtUnitGain.size());
+    const std::vector<Rect> squares = cfaAlignedSquares(scene.patches, 24);
+    std::vector<NoiseSample> samples;
+    for (double db : {6.0, 12.0, 24.0})
+        for (double level : {0.2, 0.65})
+            for (int shot = 0; shot < 4; ++shot) {
+                const double g = dbToLinearGain(db);
+                const RawFormat fmt = sensor.rawFormat(g);
+                Mat raw;
+                sensor.capture(scene.meanAtUnitGain, g, level * 3839 / (g * 1000), 77, shot, raw);
+                const std::vector<NoiseSample> s = sampleSingleFramePatches(raw, fmt, squares, g);
+                samples.insert(samples.end(), s.begin(), s.end());
+            }
+    ASSERT_EQ(samples.size(), 3u * 2u * 4u * 24u * 4u);
+    EXPECT_EQ(samples[0].dof, 144 - 3);
+    const CalibrationReport r = calibrateNoiseModel(samples);
+    const Errors e = relativeErrors(r.model, truthModel());
+    std::cout << "single-frame mode (4 shots per setting): " << e << "\n";
+    // 192 samples per gain with a relative spread of sqrt(2 / 141) = 12% each: the slope is known to
+    // about 1.5%, so 7.5% is 5 standard errors.
+    EXPECT_LT(std::abs(e.alpha), 0.075);
+}
+
+TEST(Calibration, oneGainReportsAlphaButDoesNotInventReadNoise)
+{
+    std::vector<NoiseSample> oneGain;
+    const double g = dbToLinearGain(12);
+    for (const NoiseSample& s : cleanProtocol())
+        if (s.gain == g)
+            oneGain.push_back(s);
+    const CalibrationReport r = calibrateNoiseModel(oneGain);
+    EXPECT_FALSE(r.separable);
+    EXPECT_NEAR(r.model.alpha, truthModel().alpha, 0.01 * truthModel().alpha);
+    EXPECT_EQ(r.model.sigmaD2, 0.0);
+    EXPECT_EQ(r.model.sigmaR2, 0.0);
+    ASSERT_EQ(r.perGain.size(), 1u);
+    EXPECT_NEAR(r.perGain[0].line.b, truthModel().lineAtGain(g).b, 0.05 * truthModel().lineAtGain(g).b);
+    ASSERT_FALSE(r.notes.empty());
+    EXPECT_NE(r.notes.back().find("not separable"), std::string::npos);
+
+    // Two gains 0.01 dB apart cannot separate the two read noises either.
+    std::vector<NoiseSample> close = oneGain;
+    for (NoiseSample s : oneGain) {
+        s.gain = dbToLinearGain(12.01);
+        close.push_back(s);
+    }
+    EXPECT_FALSE(calibrateNoiseModel(close).separable);
+}
+
+TEST(Calibration, burstStatisticsAreExactForLargeMeansAndAnyFrameCount)
+{
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d::all(100);
+    fmt.whiteLevel = 65535;
+    for (int frames : {2, 7, 8, 13, 100}) {
+        BurstStatistics stats(fmt);
+        RNG rng(frames);
+        std::vector<Mat> burst;
+        for (int t = 0; t < frames; ++t) {
+            Mat f(6, 10, CV_32FC1);
+            rng.fill(f, RNG::NORMAL, 60000, 1); // mean 60000, variance 1
+            stats.add(f);
+            burst.push_back(f);
+        }
+        EXPECT_EQ(stats.frames(), frames);
+        Mat mean, var;
+        stats.mean(mean);
+        stats.variance(var);
+        for (int r = 0; r < 6; ++r)
+            for (int c = 0; c < 10; ++c) {
+                // Two-pass reference in long double.
+                long double m = 0;
+                for (const Mat& f : burst)
+                    m += f.at<float>(r, c);
+                m /= frames;
+                long double v = 0;
+                for (const Mat& f : burst)
+                    v += (f.at<float>(r, c) - m) * (f.at<float>(r, c) - m);
+                v /= frames - 1;
+                // Float64 state: errors of order 1e-16 * 60000 on the mean, far below 1e-9.
+                ASSERT_NEAR(mean.at<double>(r, c), static_cast<double>(m) - 100, 1e-9);
+                ASSERT_NEAR(var.at<double>(r, c), static_cast<double>(v),
+                            1e-9 * static_cast<double>(v) + 1e-12);
+            }
+    }
+}
+
+TEST(Calibration, burstStatisticsMarkClippedPixelsAndCheckFrames)
+{
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d::all(10);
+    fmt.whiteLevel = 1023;
+    BurstStatistics stats(fmt);
+    Mat a(4, 4, CV_16UC1, Scalar(500)), b = a.clone();
+    b.at<ushort>(1, 1) = 1023; // at white
+    b.at<ushort>(2, 3) = 0;    // at zero
+    stats.add(a);
+    EXPECT_CV_ERROR_CONTAINS(
+        {
+            Mat v;
+            stats.variance(v);
+        },
+        "at least 2 frames (got 1)");
+    stats.add(b);
+    Mat clipped;
+    stats.clippedMask(clipped);
+    EXPECT_EQ(countNonZero(clipped), 2);
+    EXPECT_EQ(clipped.at<uchar>(1, 1), 255);
+    EXPECT_EQ(clipped.at<uchar>(2, 3), 255);
+    EXPECT_CV_ERROR_CONTAINS(stats.add(Mat(4, 5, CV_16UC1, Scalar(1))), "frame 2 is 5x4");
+    EXPECT_CV_ERROR_CONTAINS(stats.add(Mat(4, 4, CV_32FC1, Scalar(1))), "of type CV_32FC1");
+    EXPECT_CV_ERROR_CONTAINS(stats.add(Mat(4, 4, CV_8UC1, Scalar(1))), "expected CV_16UC1 or CV_32FC1");
+    BurstStatistics floats(fmt);
+    Mat nan(4, 4, CV_32FC1, Scalar(std::numeric_limits<float>::quiet_NaN()));
+    EXPECT_CV_ERROR_CONTAINS(floats.add(nan), "NaN or Inf");
+    // All pixels saturated: nothing to sample, and calibration says so.
+    BurstStatistics saturated(fmt);
+    for (int t = 0; t < 3; ++t)
+        saturated.add(Mat(4, 4, CV_16UC1, Scalar(1023)));
+    const std::vector<NoiseSample> none = sampleBurstPatches(saturated, {Rect(0, 0, 4, 4)}, 1.0);
+    EXPECT_TRUE(none.empty());
+    EXPECT_CV_ERROR_CONTAINS(calibrateNoiseModel(none), "no samples");
+}
+
+std::vector<NoiseSample> linePoints(const std::vector<Point2d>& pts, double gain = 1.0)
+{
+    std::vector<NoiseSample> s;
+    for (const Point2d& p : pts) {
+        NoiseSample n;
+        n.mean = p.x;
+        n.variance = p.y;
+        n.gain = gain;
+        n.dof = 99;
+        s.push_back(n);
+    }
+    return s;
+}
+
+TEST(Calibration, lineFitHardCases)
+{
+    // Collinear: exact, R^2 = 1, every point an inlier.
+    const NoiseLineFit exact = fitNoiseLine(linePoints({{0, 2}, {10, 7}, {100, 52}, {1000, 502}}));
+    EXPECT_NEAR(exact.line.a, 0.5, 1e-12);
+    EXPECT_NEAR(exact.line.b, 2, 1e-9);
+    EXPECT_NEAR(exact.rSquared, 1, 1e-12);
+    EXPECT_EQ(exact.inliers, 4);
+    // Vertical: one mean only.
+    EXPECT_CV_ERROR_CONTAINS(fitNoiseLine(linePoints({{5, 1}, {5, 2}, {5, 3}})), "share one mean");
+    // All outliers: no three points on a line; the fit stays finite and says how few agree.
+    const NoiseLineFit scattered =
+        fitNoiseLine(linePoints({{1, 100}, {2, 1}, {3, 5000}, {4, 3}, {5, 900}, {6, 0.01}, {7, 40000}}));
+    EXPECT_TRUE(std::isfinite(scattered.line.a) && std::isfinite(scattered.line.b));
+    EXPECT_LT(scattered.inliers, 7);
+    // Zero variance everywhere: a flat line at 0, and a calibration that reports its bounds.
+    std::vector<NoiseSample> zero = linePoints({{1, 0}, {50, 0}, {900, 0}}, 2.0);
+    const std::vector<NoiseSample> zero4 = linePoints({{1, 0}, {50, 0}, {900, 0}}, 4.0);
+    zero.insert(zero.end(), zero4.begin(), zero4.end());
+    const CalibrationReport flat = calibrateNoiseModel(zero);
+    EXPECT_EQ(flat.model.alpha, 0);
+    EXPECT_EQ(flat.model.sigmaR2, 0);
+    EXPECT_FALSE(flat.notes.empty());
+    // Negative slope data: reported as is, with a note.
+    std::vector<NoiseSample> falling = linePoints({{0, 100}, {100, 50}, {200, 0.5}}, 2.0);
+    const std::vector<NoiseSample> rising = linePoints({{0, 10}, {100, 60}, {200, 110}}, 8.0);
+    falling.insert(falling.end(), rising.begin(), rising.end());
+    const CalibrationReport neg = calibrateNoiseModel(falling);
+    EXPECT_LT(neg.perGain[0].line.a, 0);
+    EXPECT_NE(neg.notes[0].find("negative slope"), std::string::npos);
+    // Bad samples.
+    std::vector<NoiseSample> bad = linePoints({{1, 1}, {2, std::numeric_limits<double>::quiet_NaN()}});
+    EXPECT_CV_ERROR_CONTAINS(fitNoiseLine(bad), "sample 1 is invalid");
+    EXPECT_CV_ERROR_CONTAINS(fitNoiseLine(linePoints({{1, 1}})), "at least 2 samples");
+    std::vector<NoiseSample> mixed = linePoints({{1, 1}, {2, 2}});
+    mixed[1].gain = 2;
+    EXPECT_CV_ERROR_CONTAINS(fitNoiseLine(mixed), "fit one gain at a time");
+}
+
+TEST(Calibration, squaresAreCfaAlignedAndInside)
+{
+    const std::vector<Rect> patches = {Rect(3, 5, 31, 29), Rect(10, 10, 24, 24), Rect(0, 0, 25, 25)};
+    const std::vector<Rect> sq = cfaAlignedSquares(patches, 24);
+    for (size_t i = 0; i < sq.size(); ++i) {
+        EXPECT_EQ(sq[i].x % 2, 0);
+        EXPECT_EQ(sq[i].y % 2, 0);
+        EXPECT_EQ(sq[i].size(), Size(24, 24));
+        EXPECT_EQ(sq[i] & patches[i], sq[i]) << i;
+    }
+    EXPECT_CV_ERROR_CONTAINS(cfaAlignedSquares({Rect(1, 1, 24, 30)}, 24), "cannot hold");
+    EXPECT_CV_ERROR_CONTAINS(cfaAlignedSquares(patches, 23), "even");
+}
+
+TEST(Calibration, reportRoundTripsThroughYamlAndJson)
+{
+    const CalibrationReport r = calibrateNoiseModel(cleanProtocol());
+    const std::string dir = test::makeTempDir("calibration_report");
+    for (const char* name : {"/report.yml", "/report.json"}) {
+        r.save(dir + name);
+        const CalibrationReport back = CalibrationReport::load(dir + name);
+        EXPECT_EQ(back.method, r.method);
+        EXPECT_EQ(back.separable, r.separable);
+        EXPECT_EQ(back.model.alpha, r.model.alpha);
+        EXPECT_EQ(back.model.sigmaR2, r.model.sigmaR2);
+        ASSERT_EQ(back.perGain.size(), r.perGain.size());
+        EXPECT_EQ(back.perGain[2].line.b, r.perGain[2].line.b);
+        EXPECT_EQ(back.perGain[1].inliers, r.perGain[1].inliers);
+        EXPECT_EQ(back.samplesUsed, r.samplesUsed);
+        EXPECT_EQ(back.notes, r.notes);
+    }
+    EXPECT_CV_ERROR_CONTAINS(CalibrationReport::load(dir + "/missing.yml"), "cannot open");
+}
+
+} // namespace
+} // namespace rawgment
+} // namespace cv
