@@ -15,57 +15,94 @@ namespace rawgment {
 // ---------------------------------------------------------------------------------------------------
 // BurstStatistics
 
+namespace {
+
+/** Folds a group of frames into the running mean and M2 of each pixel of rows [r0, r1).
+ *
+ * Row by row, with loops over columns that vectorise: sums of d = v_k - v_0 (differences from the
+ * group's first frame) and of d^2, then Chan et al.'s pairwise merge with the running statistics.
+ * For 16-bit input every d, sum and m * sum(d^2) - sum(d)^2 is an integer below 2^53, so the group's
+ * mean and M2 are exact; float input keeps full float64 precision because the differences are small
+ * next to a large mean. */
+template <typename T>
+void mergeGroupRows(const std::vector<Mat>& group, int merged, const Vec4d& black, double white, Mat& mean,
+                    Mat& m2, Mat& clipped, int r0, int r1)
+{
+    // Columns in blocks whose running sums stay in L1 while the group's rows stream past.
+    const int kBlock = 256;
+    const int m = static_cast<int>(group.size()), cols = mean.cols;
+    double s1[kBlock], s2[kBlock], lo[kBlock], hi[kBlock];
+    std::vector<const T*> rows(m);
+    const double total = static_cast<double>(merged + m);
+    const double wGroup = m / total, wCross = static_cast<double>(merged) * m / total;
+    for (int r = r0; r < r1; ++r) {
+        for (int k = 0; k < m; ++k)
+            rows[k] = group[k].ptr<T>(r);
+        double* mu = mean.ptr<double>(r);
+        double* acc = m2.ptr<double>(r);
+        uchar* clip = clipped.ptr<uchar>(r);
+        const double b0 = black[2 * (r & 1)], b1 = black[2 * (r & 1) + 1];
+        for (int c0 = 0; c0 < cols; c0 += kBlock) {
+            const int n = std::min(kBlock, cols - c0);
+            const T* first = rows[0] + c0;
+            for (int c = 0; c < n; ++c) {
+                s1[c] = s2[c] = 0;
+                lo[c] = hi[c] = static_cast<double>(first[c]);
+            }
+            for (int k = 1; k < m; ++k) {
+                const T* v = rows[k] + c0;
+                for (int c = 0; c < n; ++c) {
+                    const double x = static_cast<double>(v[c]);
+                    const double d = x - static_cast<double>(first[c]);
+                    s1[c] += d;
+                    s2[c] += d * d;
+                    lo[c] = std::min(lo[c], x);
+                    hi[c] = std::max(hi[c], x);
+                }
+            }
+            for (int c = 0; c < n; ++c) {
+                const int col = c0 + c;
+                const double groupMean = static_cast<double>(first[c]) - ((col & 1) ? b1 : b0) + s1[c] / m;
+                const double groupM2 = (m * s2[c] - s1[c] * s1[c]) / m;
+                const double delta = groupMean - mu[col];
+                mu[col] += delta * wGroup;
+                acc[col] += groupM2 + delta * delta * wCross;
+                if (lo[c] <= 0 || hi[c] >= white)
+                    clip[col] = 255;
+            }
+        }
+    }
+}
+
+} // namespace
+
 struct BurstStatistics::Impl
 {
+    //! Frames buffered before a merge: the float64 state is read once per group instead of per frame.
     static const int kGroup = 8;
     RawFormat format;
     int type = -1;
     int merged = 0; // frames folded into mean/m2
     Mat mean, m2, clipped;
-    std::vector<Mat> pending;
+    //! Reused group buffers: a fresh allocation per frame would page-fault 24 MB each time.
+    std::vector<Mat> buffers = std::vector<Mat>(kGroup);
+    int pending = 0;
 
-    // Folds the pending frames into the running statistics (Chan et al.'s pairwise update).
     void flush()
     {
-        if (pending.empty())
+        if (pending == 0)
             return;
-        const int m = static_cast<int>(pending.size());
-        const int n = merged;
-        const double white = format.whiteLevel;
-        const Vec4d black = format.blackLevel;
+        const std::vector<Mat> group(buffers.begin(), buffers.begin() + pending);
         parallel_for_(Range(0, mean.rows), [&](const Range& rows) {
-            std::vector<double> x(m);
-            for (int r = rows.start; r < rows.end; ++r) {
-                double* mu = mean.ptr<double>(r);
-                double* s2 = m2.ptr<double>(r);
-                uchar* clip = clipped.ptr<uchar>(r);
-                const int site0 = 2 * (r & 1);
-                for (int c = 0; c < mean.cols; ++c) {
-                    const double b = black[site0 + (c & 1)];
-                    bool isClipped = false;
-                    double sum = 0;
-                    for (int k = 0; k < m; ++k) {
-                        const double raw =
-                            type == CV_16UC1 ? pending[k].ptr<ushort>(r)[c] : pending[k].ptr<float>(r)[c];
-                        isClipped = isClipped || raw <= 0 || raw >= white;
-                        x[k] = raw - b;
-                        sum += x[k];
-                    }
-                    const double groupMean = sum / m;
-                    double groupM2 = 0;
-                    for (int k = 0; k < m; ++k)
-                        groupM2 += (x[k] - groupMean) * (x[k] - groupMean);
-                    const double delta = groupMean - mu[c];
-                    const double total = static_cast<double>(n + m);
-                    mu[c] += delta * (m / total);
-                    s2[c] += groupM2 + delta * delta * (static_cast<double>(n) * m / total);
-                    if (isClipped)
-                        clip[c] = 255;
-                }
-            }
+            if (type == CV_16UC1)
+                mergeGroupRows<ushort>(group, merged, format.blackLevel, format.whiteLevel, mean, m2, clipped,
+                                       rows.start, rows.end);
+            else
+                mergeGroupRows<float>(group, merged, format.blackLevel, format.whiteLevel, mean, m2, clipped,
+                                      rows.start, rows.end);
         });
-        merged += m;
-        pending.clear();
+        merged += pending;
+        pending = 0;
     }
 };
 
@@ -106,14 +143,14 @@ void BurstStatistics::add(InputArray _frame)
     if (frame.type() == CV_32FC1 && !checkRange(frame, true))
         CV_Error(Error::StsBadArg,
                  cv::format("BurstStatistics::add: frame %d contains NaN or Inf", frames()));
-    d.pending.push_back(frame.clone());
-    if (static_cast<int>(d.pending.size()) == Impl::kGroup)
+    frame.copyTo(d.buffers[d.pending++]);
+    if (d.pending == Impl::kGroup)
         d.flush();
 }
 
 int BurstStatistics::frames() const
 {
-    return impl_->merged + static_cast<int>(impl_->pending.size());
+    return impl_->merged + impl_->pending;
 }
 Size BurstStatistics::size() const
 {

@@ -21,7 +21,9 @@ namespace rawgment {
  * Frames are added one at a time and never all held in memory: the statistics are float64 running
  * sums updated with Chan's pairwise merge of small groups of frames (Welford's update generalised),
  * which stays exact for large means (60000 DN with a variance of 1) and long bursts. A group of up
- * to eight frames is buffered to read the float64 state once per group instead of once per frame.
+ * to 8 frames is buffered (a copy of each: 8 x 24 MB for 12 MP) so that the float64 state is read
+ * once per group instead of once per frame; for CV_16UC1 input the group's sums are exact integers.
+ * Peak memory for a W x H burst: 17 bytes per pixel of state plus 8 frames.
  *
  * Values are black-subtracted with the RawFormat (per site). A pixel that is at or above the white
  * level, or at or below zero, in any frame is marked clipped: its variance is biased and calibration
