@@ -1,6 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "random.hpp"
 
+#include <algorithm>
+#include <cstring>
 #include <limits>
 
 namespace cv {
@@ -59,6 +61,84 @@ int64_t CounterRng::poisson(double lambda)
         if (std::log(v) + std::log(invAlpha) - std::log(a / (us * us) + b) <=
             -lambda + kd * logLambda - logFactorial(k))
             return k;
+    }
+}
+
+namespace {
+
+// ln(x) for x in (0, 1], float32: exponent and mantissa split, then the Cephes polynomial for
+// ln(1 + f) on [sqrt(1/2) - 1, sqrt(2) - 1].
+inline float logPositive(float x)
+{
+    int32_t bits;
+    std::memcpy(&bits, &x, sizeof(bits));
+    int32_t e = ((bits >> 23) & 0xff) - 126;
+    bits = (bits & 0x007fffff) | 0x3f000000; // mantissa in [0.5, 1)
+    float m;
+    std::memcpy(&m, &bits, sizeof(m));
+    const bool small = m < 0.70710678f;
+    e -= small ? 1 : 0;
+    const float f = (small ? m + m : m) - 1.0f;
+    const float z = f * f;
+    float y = 7.0376836292e-2f;
+    y = y * f - 1.1514610310e-1f;
+    y = y * f + 1.1676998740e-1f;
+    y = y * f - 1.2420140846e-1f;
+    y = y * f + 1.4249322787e-1f;
+    y = y * f - 1.6668057665e-1f;
+    y = y * f + 2.0000714765e-1f;
+    y = y * f - 2.4999993993e-1f;
+    y = y * f + 3.3333331174e-1f;
+    y = y * f * z - 0.5f * z + f;
+    return y + static_cast<float>(e) * 0.693147180559945f;
+}
+
+} // namespace
+
+void fillGaussian(uint64_t seed, uint64_t stream, float* out, int n)
+{
+    // 64 values per chunk: 16 Philox blocks, 32 Box-Muller pairs.
+    const int kChunk = 64;
+    uint32_t words[kChunk];
+    const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
+    for (int base = 0; base < n; base += kChunk) {
+        const uint32_t block0 = static_cast<uint32_t>(base / 4);
+        for (int b = 0; b < kChunk / 4; ++b) {
+            const std::array<uint32_t, 4> r =
+                philox4x32({block0 + static_cast<uint32_t>(b), 0u, static_cast<uint32_t>(stream),
+                            static_cast<uint32_t>(stream >> 32)},
+                           key);
+            words[4 * b] = r[0];
+            words[4 * b + 1] = r[1];
+            words[4 * b + 2] = r[2];
+            words[4 * b + 3] = r[3];
+        }
+        const int count = std::min(kChunk, n - base);
+        float z[kChunk];
+        for (int i = 0; i < kChunk / 2; ++i) {
+            // u1 in (0, 1] from 24 bits (never 0: log is finite); u2 picks the angle.
+            const float u1 = (static_cast<float>(words[2 * i] >> 8) + 1.0f) * (1.0f / 16777216.0f);
+            const uint32_t a = words[2 * i + 1];
+            const float radius = std::sqrt(-2.0f * logPositive(u1));
+            // The angle: quadrant from the top 2 bits, phi in [-pi/4, pi/4) from the next 22. Any
+            // uniform angle serves Box-Muller; this one needs only the short polynomials of |phi| <= pi/4.
+            const uint32_t q = a >> 30;
+            const float phi =
+                (static_cast<float>((a >> 8) & 0x3fffff) * (1.0f / 4194304.0f) - 0.5f) * 1.5707963268f;
+            const float p2 = phi * phi;
+            const float s =
+                phi + phi * p2 * (-1.6666654611e-1f + p2 * (8.3321608736e-3f + p2 * -1.9515295891e-4f));
+            const float c =
+                1.0f - 0.5f * p2 +
+                p2 * p2 *
+                    (4.166664568298827e-2f + p2 * (-1.388731625493765e-3f + p2 * 2.443315711809948e-5f));
+            // Rotate (c, s) by q quarter turns.
+            const float cq = q == 0 ? c : q == 1 ? -s : q == 2 ? -c : s;
+            const float sq = q == 0 ? s : q == 1 ? c : q == 2 ? -s : -c;
+            z[2 * i] = radius * cq;
+            z[2 * i + 1] = radius * sq;
+        }
+        std::memcpy(out + base, z, sizeof(float) * static_cast<size_t>(count));
     }
 }
 

@@ -2,6 +2,7 @@
 #ifndef OPENCV_RAWGMENT_HPP
 #define OPENCV_RAWGMENT_HPP
 
+#include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/bayer.hpp>
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/noise_model.hpp>
@@ -15,6 +16,7 @@ real sensor would have produced @cite yoshimura2023rawgment. All values are in D
 subtraction; gains are linear (0 dB = 1).
 
 @{
+    @defgroup rawgment_augment Noise-accounted augmentation: colour jitter, blur, scenes, random policy
     @defgroup rawgment_bayer Bayer mosaics: CFA patterns, planes and black levels
     @defgroup rawgment_noise_model The heteroscedastic Gaussian noise model
     @defgroup rawgment_normality Shapiro-Wilk tests of the Gaussian noise assumption

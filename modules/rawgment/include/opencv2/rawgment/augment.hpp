@@ -1,0 +1,181 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#ifndef OPENCV_RAWGMENT_AUGMENT_HPP
+#define OPENCV_RAWGMENT_AUGMENT_HPP
+
+#include <opencv2/core.hpp>
+#include <opencv2/rawgment/bayer.hpp>
+#include <opencv2/rawgment/export.hpp>
+#include <opencv2/rawgment/noise_model.hpp>
+
+#include <string>
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+
+//! @addtogroup rawgment_augment
+//! @{
+
+/** @brief How a noise step treats the noise that the input already has (the paper's ablations). */
+enum class NoiseAlignment
+{
+    NONE = 0,         //!< no noise is added: the signal is only scaled or blurred (plain augmentation)
+    IGNORE_PRIOR = 1, //!< the input is treated as clean: the full variance of the target is added
+    ACCOUNT_PRIOR = 2 //!< the paper's method: only the difference between target and prior noise is added
+};
+
+/** @brief What augmentation steps did, for logs and for the user's trust. */
+struct CV_RAWGMENT_EXPORTS AugmentReport
+{
+    int64 brighteningPixels =
+        0; //!< pixels whose noise variance to add was negative (brightening), clipped to 0
+    int64 saturatedPixels = 0;      //!< input pixels at or above the white level (their signal is unknown)
+    std::vector<std::string> steps; //!< the steps that ran, in order; skipped identity steps are absent
+};
+
+/** @brief A change of contrast, brightness and hue, simulated as a change of photons and gain (Eq. 13).
+ *
+ * The new mean of a pixel with black-subtracted value x is \f$ p_c x + p_b \f$, with the contrast
+ * \f$ p_c \f$ of the pixel's CFA site (hue: different per site). The product of photon and gain ratios
+ * is then \f$ p_u p_g = (p_c x + p_b) / x \f$. The gain ratio \f$ p_g \f$ is given (it is the target
+ * capture's gain over the input's); the photon ratio follows as \f$ p_u = (p_c x + p_b) / (x p_g) \f$.
+ * Why the gain is drawn and the photons follow: the gain is a property of the whole frame (one analog
+ * gain per capture) while the photon ratio may vary per pixel (light, reflectance), so only this split
+ * describes a capture a camera could make. Exposure change (Eq. 11) is \f$ p_c = p_u p_g, p_b = 0 \f$:
+ * see exposureChange().
+ */
+struct CV_RAWGMENT_EXPORTS ColorJitter
+{
+    Vec4d contrast = Vec4d::all(1); //!< p_c per CFA site (index = cfaSite()), > 0
+    double brightness = 0;          //!< p_b in DN
+    double gainRatio = 1;           //!< p_g: target gain / input gain, > 0
+
+    //! A pure exposure change: photons x photonRatio, gain x gainRatio (paper Eq. 11).
+    static ColorJitter exposureChange(double photonRatio, double gainRatio);
+    //! True when the step changes nothing (contrast 1, brightness 0, gain ratio 1).
+    bool isIdentity() const;
+};
+
+/** @brief Noise-accounted contrast, brightness and hue (paper Eq. 11 and 13).
+ *
+ * For each pixel with prior value \f$ x \f$ (DN above black, \f$ \mu_x \approx \max(x, 0) \f$), input gain g:
+ * \f[ x_{new} = p_c x + p_b + \mathcal{N}(0, v),\quad
+ *     v = p_u(1-p_u)p_g^2 g\alpha\mu_x + (1-p_u^2)p_g^2 g^2\sigma_d^2 + (1-p_u^2p_g^2)\sigma_r^2 \f]
+ * (ACCOUNT_PRIOR). IGNORE_PRIOR adds the model variance of the new mean at the new gain; NONE adds
+ * nothing. A negative v means the target would be *less* noisy than the input (brightening): it cannot
+ * be reached by adding noise, so v is clipped to 0 and the pixel is counted in
+ * AugmentReport::brighteningPixels. To keep \f$ p_u \f$ finite at \f$ x \to 0 \f$, it is computed with
+ * x floored at 1 DN; a negative \f$ p_u \f$ (brightness pushing the pixel below black) is clamped to 0.
+ * The output is at gain \f$ p_g g \f$: `dstFormat.gain` says so, and later steps must use it.
+ *
+ * The output keeps the input's type: CV_16UC1 is rounded and clipped to [0, white]; CV_32FC1 is clipped.
+ * Note that rounding adds its 1/12 DN^2 once more on top of the input's.
+ * @param src Bayer mosaic with black level, CV_16UC1 or CV_32FC1
+ * @param format its format (its gain is g)
+ * @param model the calibrated noise model
+ * @param jitter the change (a step at identity is skipped: dst shares src's data, no noise is drawn)
+ * @param alignment how the prior noise is treated
+ * @param seed the noise seed: the same seed gives the same output on any number of threads
+ * @param dst output mosaic
+ * @param dstFormat output format (the new gain)
+ * @param report optional: counts of brightening and saturated pixels, steps run
+ * @param saturatedMask optional CV_8UC1 output, 255 where the input was at or above white
+ */
+CV_RAWGMENT_EXPORTS void colorJitter(InputArray src, const RawFormat& format, const NoiseModel& model,
+                                     const ColorJitter& jitter, NoiseAlignment alignment, uint64 seed,
+                                     OutputArray dst, RawFormat& dstFormat, AugmentReport* report = nullptr,
+                                     OutputArray saturatedMask = noArray());
+
+/** @brief A linear motion-blur kernel on the CFA-plane grid (half the mosaic's resolution).
+ * @param length length of the motion in full-resolution mosaic pixels (>= 0); up to 2 pixels (one plane
+ *        pixel) the kernel is the identity 1x1
+ * @param angleDegrees direction of the motion, counter-clockwise from the x axis
+ * @return CV_32FC1 kernel, odd size, sum 1
+ */
+CV_RAWGMENT_EXPORTS Mat linearMotionKernel(double length, double angleDegrees);
+
+/** @brief Noise-accounted blur (paper Eq. 15) on each CFA plane.
+ *
+ * \f[ x_{new} = \sum_k w_k x_k + \mathcal{N}\Big(0,\; g\alpha\sum_k (1-w_k)w_k\max(x_k,0)
+ *     + \big(1 - \sum_k w_k^2\big)(g^2\sigma_d^2 + \sigma_r^2)\Big) \f]
+ * with the exact per-pixel sum (a second filtering with the kernel \f$ w(1-w) \f$), for ACCOUNT_PRIOR.
+ * Real motion blur averages photons but not the read noise: a plain blur (NONE) is too clean.
+ * IGNORE_PRIOR adds the model variance of the blurred mean. Borders replicate the plane's edge.
+ * @param src CV_16UC1 or CV_32FC1 mosaic with black level, even sides
+ * @param format its format (the gain stays)
+ * @param model the noise model
+ * @param kernel non-negative CV_32FC1/CV_64FC1 kernel on the plane grid, normalised here; a 1x1 kernel
+ *        is the identity and the step is skipped
+ * @param alignment how the prior noise is treated
+ * @param seed noise seed
+ * @param dst output, same type
+ * @param report optional
+ */
+CV_RAWGMENT_EXPORTS void motionBlur(InputArray src, const RawFormat& format, const NoiseModel& model,
+                                    InputArray kernel, NoiseAlignment alignment, uint64 seed, OutputArray dst,
+                                    AugmentReport* report = nullptr);
+
+/** @brief The capture to simulate: what changes from the input, applied by applyScene().
+ *
+ * Steps run in the order of the paper's training: shift, colour jitter, blur. Only the effects a scene
+ * asks for are simulated: a step at identity costs nothing, and the identity scene returns the input
+ * itself (dst shares its data), bit for bit.
+ */
+struct CV_RAWGMENT_EXPORTS Scene
+{
+    Point shift = Point(0, 0); //!< translation in mosaic pixels; each component rounded to even (CFA phase)
+    ColorJitter jitter;        //!< exposure, gain, contrast, brightness, hue
+    Mat motionKernel;          //!< blur on the plane grid (empty or 1x1: none)
+    NoiseAlignment alignment = NoiseAlignment::ACCOUNT_PRIOR; //!< for every noise step
+
+    bool isIdentity() const; //!< true when no step would change anything
+    //! Writes the scene as a map under `name` (the kernel as a matrix).
+    void write(FileStorage& fs, const String& name) const;
+    //! Reads a scene written by write(). @throws cv::Exception naming an invalid field.
+    static Scene read(const FileNode& node);
+};
+
+/** @brief Applies a scene: shift (vacated pixels replicate the edge, CFA phase kept), colour jitter,
+ * then blur at the gain the jitter produced. Bounding boxes (x, y, w, h in mosaic pixels) move with
+ * the shift and are clipped to the frame; a box that leaves the frame becomes empty.
+ */
+CV_RAWGMENT_EXPORTS void applyScene(InputArray src, const RawFormat& format, const NoiseModel& model,
+                                    const Scene& scene, uint64 seed, OutputArray dst, RawFormat& dstFormat,
+                                    AugmentReport* report = nullptr, std::vector<Rect>* boxes = nullptr);
+
+/** @brief Draws random scenes with the paper's training defaults; every range is settable and the
+ * policy reads and writes YAML/JSON.
+ *
+ * Contrast p_c is drawn log-uniformly in [contrastMin, contrastMax] (0.01 to 1 spans two decades of
+ * darkening, which a uniform draw would nearly never reach below 0.1); brightness p_b = u min(x) with u
+ * uniform in [brightnessMin, brightnessMax]; with probability hueProbability each site's contrast is
+ * multiplied by a factor uniform in [hueMin, hueMax]; the gain ratio is uniform in dB in
+ * [gainDbMin, gainDbMax]; with probability blurProbability a linear motion of length uniform in
+ * [0, blurLengthMax] and uniform angle; with probability shiftProbability a shift of up to maxShift of
+ * each side.
+ */
+struct CV_RAWGMENT_EXPORTS RandomScenePolicy
+{
+    double contrastMin = 0.01, contrastMax = 1.0;
+    double brightnessMin = -0.1, brightnessMax = 0.1;
+    double hueProbability = 0.5, hueMin = 0.8, hueMax = 1.2;
+    double gainDbMin = 0, gainDbMax = 12;
+    double blurProbability = 0.5, blurLengthMax = 13;
+    double shiftProbability = 0.8, maxShift = 0.1;
+    NoiseAlignment alignment = NoiseAlignment::ACCOUNT_PRIOR;
+
+    void validate() const; //!< throws naming the first inconsistent range
+    /** @brief A scene for `src` (its minimum sets the brightness scale), from `seed` alone. */
+    Scene draw(InputArray src, const RawFormat& format, uint64 seed) const;
+    void write(FileStorage& fs, const String& name) const;
+    static RandomScenePolicy read(const FileNode& node); //!< missing fields keep their defaults
+    void save(const String& path) const;                 //!< .yml/.yaml/.json, atomically
+    static RandomScenePolicy load(const String& path);
+};
+
+//! @}
+
+} // namespace rawgment
+} // namespace cv
+
+#endif // OPENCV_RAWGMENT_AUGMENT_HPP

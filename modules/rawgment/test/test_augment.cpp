@@ -1,0 +1,435 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "test_common.hpp"
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/rawgment/augment.hpp>
+#include <opencv2/rawgment/simulate.hpp>
+
+namespace cv {
+namespace rawgment {
+namespace {
+
+SensorParams sensorParams()
+{
+    SensorParams p;
+    p.noise = NoiseModel(0.4, 0.5, 2.0);
+    p.blackLevel = Vec4d(256, 256, 256, 256);
+    p.bitDepth = 12;
+    return p;
+}
+
+const double kGain = 2.0; // the input bursts' gain (6 dB)
+const int kFrames = 64;
+
+//! Eight levels in blocks of 8 columns: 10 to 1800 DN at gain 1, 20 to 3600 DN at kGain.
+Mat levelScene(Size size)
+{
+    const double levels[8] = {10, 30, 80, 200, 400, 800, 1200, 1800};
+    Mat m(size, CV_32FC1);
+    for (int c = 0; c < size.width; ++c)
+        m.col(c).setTo(levels[(c / 8) % 8]);
+    return m;
+}
+
+//! A burst as CV_32FC1 raw frames (integer DN with black): float output avoids a second rounding.
+std::vector<Mat> floatBurst(const SensorSimulator& sensor, const Mat& mean, uint64 seed)
+{
+    std::vector<Mat> raws;
+    sensor.captureBurst(mean, kGain, 1.0, kFrames, seed, raws);
+    for (Mat& f : raws)
+        f.convertTo(f, CV_32F);
+    return raws;
+}
+
+//! Per-pixel temporal mean and unbiased variance (black-subtracted) of a float burst.
+void temporalStats(const std::vector<Mat>& burst, const RawFormat& fmt, Mat& mean, Mat& var)
+{
+    Mat sum(burst[0].size(), CV_64F, Scalar(0)), sum2 = sum.clone();
+    for (const Mat& f : burst) {
+        Mat x;
+        subtractBlackLevel(f, fmt, x);
+        x.convertTo(x, CV_64F);
+        sum += x;
+        sum2 += x.mul(x);
+    }
+    const double n = static_cast<double>(burst.size());
+    mean = sum / n;
+    var = (sum2 - sum.mul(sum) / n) / (n - 1);
+}
+
+//! Average of a per-pixel map over the 8-column block b, leaving out `margin` columns at its sides.
+double blockAverage(const Mat& m, int b, int margin = 0)
+{
+    return cv::mean(m(Rect(8 * b + margin, 0, 8 - 2 * margin, m.rows)))[0];
+}
+
+TEST(Augment, exposureChangeMatchesTheModelOnlyWhenThePriorIsAccounted)
+{
+    const Size size(64, 32);
+    const SensorSimulator sensor(sensorParams(), size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(kGain);
+    const std::vector<Mat> bright = floatBurst(sensor, levelScene(size), 5);
+    // A block averages 256 per-pixel variances of 64 frames: relative standard error
+    // sqrt(2 / 63) / sqrt(256) = 1.1%; 5 standard errors = 5.6%.
+    const double tolerance = 5 * std::sqrt(2.0 / (kFrames - 1)) / std::sqrt(256.0);
+    for (double factor : {0.5, 0.1}) {
+        double ratio[3][8];
+        for (NoiseAlignment mode :
+             {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR}) {
+            std::vector<Mat> converted;
+            RawFormat outFmt;
+            for (int t = 0; t < kFrames; ++t) {
+                Mat out;
+                colorJitter(bright[t], fmt, model, ColorJitter::exposureChange(factor, 1.0), mode, 1000 + t,
+                            out, outFmt);
+                converted.push_back(out);
+            }
+            EXPECT_EQ(outFmt.gain, kGain);
+            Mat mean, var;
+            temporalStats(converted, outFmt, mean, var);
+            for (int b = 0; b < 8; ++b) {
+                const double m = blockAverage(mean, b);
+                ratio[static_cast<int>(mode)][b] = blockAverage(var, b) / model.variance(m, kGain);
+            }
+        }
+        for (int b = 0; b < 8; ++b) {
+            SCOPED_TRACE(testing::Message() << "x" << factor << ", level block " << b);
+            EXPECT_NEAR(ratio[2][b], 1.0, tolerance) << "ACCOUNT_PRIOR";
+            EXPECT_LT(ratio[0][b], 1.0 - tolerance) << "NONE keeps only the scaled prior noise";
+            if (factor == 0.5 || b >= 4) // the prior noise matters: f^2 v_in is a sizeable part of the target
+                EXPECT_GT(ratio[1][b], 1.0 + tolerance) << "IGNORE_PRIOR adds the target on top of the prior";
+        }
+        std::cout << "x" << factor << " variance / model, brightest block: NONE " << ratio[0][7]
+                  << ", IGNORE_PRIOR " << ratio[1][7] << ", ACCOUNT_PRIOR " << ratio[2][7] << "\n";
+    }
+}
+
+TEST(Augment, motionBlurMatchesACaptureBlurredBeforeTheNoise)
+{
+    const Size size(128, 128);
+    const SensorSimulator sensor(sensorParams(), size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(kGain);
+    Mat scene(size, CV_32FC1);
+    for (int c = 0; c < size.width; ++c) // bars of 16 columns: the blur mixes dark and bright photons
+        scene.col(c).setTo((c / 16) % 2 ? 1500.0 : 60.0);
+    const Mat kernel = linearMotionKernel(13, 0); // horizontal, the paper's largest length
+    std::vector<Mat> truth(kFrames), sharp = floatBurst(sensor, scene, 9);
+    for (int t = 0; t < kFrames; ++t) {
+        sensor.captureBlurred(scene, kernel, kGain, 1.0, 77, t, truth[t]);
+        truth[t].convertTo(truth[t], CV_32F);
+    }
+    Mat truthMean, truthVar;
+    temporalStats(truth, fmt, truthMean, truthVar);
+    const int margin = kernel.cols; // the simulator reflects at the border, the augmentation replicates
+    const Rect inner(margin, 0, size.width - 2 * margin, size.height);
+    double ratio[3];
+    for (NoiseAlignment mode :
+         {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR}) {
+        std::vector<Mat> blurred(kFrames);
+        for (int t = 0; t < kFrames; ++t)
+            motionBlur(sharp[t], fmt, model, kernel, mode, 500 + t, blurred[t]);
+        Mat mean, var;
+        temporalStats(blurred, fmt, mean, var);
+        ratio[static_cast<int>(mode)] = cv::mean(var(inner))[0] / cv::mean(truthVar(inner))[0];
+        // The mean is the blurred mean whatever the mode. Column means over 128 rows x 64 frames, for
+        // both bursts: the difference has standard error sqrt(2 v / (64 * 128)); 5 of them.
+        for (int c = inner.x; c < inner.x + inner.width; ++c) {
+            const double v = cv::mean(truthVar.col(c))[0];
+            EXPECT_NEAR(cv::mean(mean.col(c))[0], cv::mean(truthMean.col(c))[0],
+                        5 * std::sqrt(2 * v / (64.0 * 128)))
+                << "column " << c;
+        }
+        if (mode == NoiseAlignment::ACCOUNT_PRIOR) {
+            // Column by column (edges included, where Eq. 15's per-pixel sum matters most): each column
+            // averages 128 variances of 64 frames, twice (truth and augmentation): the relative standard
+            // error of the ratio is sqrt(2) * sqrt(2 / 63) / sqrt(128) = 2.2%; 5 of them = 11%.
+            for (int c = inner.x; c < inner.x + inner.width; ++c) {
+                const double rc = cv::mean(var.col(c))[0] / cv::mean(truthVar.col(c))[0];
+                EXPECT_NEAR(rc, 1.0, 0.11) << "column " << c;
+            }
+        }
+    }
+    std::cout << "blur variance / true blurred capture: NONE " << ratio[0] << ", IGNORE_PRIOR " << ratio[1]
+              << ", ACCOUNT_PRIOR " << ratio[2] << "\n";
+    // Over the inner 13,000 pixels the standard error is 0.6%: 3% is 5 of them.
+    EXPECT_NEAR(ratio[2], 1.0, 0.03);
+    EXPECT_LT(ratio[0], 0.5); // a plain blur smooths the read noise too: far too clean
+    EXPECT_GT(ratio[1], 1.03);
+}
+
+TEST(Augment, gainTravelsFromJitterToBlur)
+{
+    // Fewer photons x4 at four times the gain: same mean, noisier. The blur that follows must use the
+    // new gain, or the result would have the variance of the old gain.
+    const Size size(64, 64);
+    const SensorSimulator sensor(sensorParams(), size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(kGain);
+    const std::vector<Mat> burst = floatBurst(sensor, Mat(size, CV_32FC1, Scalar(300)), 13);
+    Scene scene;
+    scene.jitter = ColorJitter::exposureChange(0.25, 4.0);
+    scene.motionKernel = linearMotionKernel(9, 30);
+    std::vector<Mat> out(kFrames);
+    RawFormat outFmt;
+    for (int t = 0; t < kFrames; ++t)
+        applyScene(burst[t], fmt, model, scene, 40 + t, out[t], outFmt);
+    EXPECT_DOUBLE_EQ(outFmt.gain, 4 * kGain);
+    Mat mean, var;
+    temporalStats(out, outFmt, mean, var);
+    const double m = cv::mean(mean)[0], v = cv::mean(var)[0];
+    EXPECT_NEAR(m, 600, 2);
+    // 4096 pixels of 64 frames, but the blur correlates neighbours; 5% is still over 5 standard errors
+    // even if only a quarter of the pixels were independent. The old gain would give 0.42 of this.
+    EXPECT_NEAR(v / model.variance(m, 4 * kGain), 1.0, 0.05);
+}
+
+Mat smallMosaic(int type = CV_16UC1)
+{
+    Mat m(16, 24, CV_16UC1);
+    RNG rng(3);
+    rng.fill(m, RNG::UNIFORM, 200, 3000);
+    m.at<ushort>(0, 0) = 0;    // far below black
+    m.at<ushort>(1, 1) = 4095; // saturated
+    m.at<ushort>(2, 2) = 256;  // exactly black
+    Mat out;
+    m.convertTo(out, type);
+    return out;
+}
+
+TEST(Augment, sameSeedSameBitsOnAnyThreadCount)
+{
+    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    Mat src(200, 300, CV_16UC1);
+    RNG(1).fill(src, RNG::UNIFORM, 256, 3000);
+    Scene scene;
+    scene.jitter.contrast = Vec4d(0.3, 0.25, 0.25, 0.35);
+    scene.jitter.gainRatio = 2;
+    scene.motionKernel = linearMotionKernel(11, 45);
+    scene.shift = Point(6, -4);
+    const Mat original = src.clone();
+    const int saved = getNumThreads();
+    std::vector<Mat> outs;
+    for (int threads : {1, 2, 8}) {
+        setNumThreads(threads);
+        Mat out;
+        RawFormat f;
+        applyScene(src, fmt, model, scene, 99, out, f);
+        outs.push_back(out);
+    }
+    setNumThreads(saved);
+    EXPECT_EQ(norm(src, original, NORM_INF), 0) << "the input was written to";
+    EXPECT_EQ(norm(outs[0], outs[1], NORM_INF), 0);
+    EXPECT_EQ(norm(outs[0], outs[2], NORM_INF), 0);
+    Mat other;
+    RawFormat f;
+    applyScene(src, fmt, model, scene, 100, other, f);
+    EXPECT_GT(norm(outs[0], other, NORM_L1), 0);
+}
+
+TEST(Augment, identityStepsAreSkippedAndReturnTheInputItself)
+{
+    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    const Mat src = smallMosaic();
+    Mat out;
+    RawFormat outFmt;
+    AugmentReport report;
+    applyScene(src, fmt, model, Scene(), 1, out, outFmt, &report);
+    EXPECT_EQ(out.data, src.data); // no copy
+    EXPECT_TRUE(report.steps.empty());
+    EXPECT_EQ(outFmt.gain, fmt.gain);
+    Scene identityKernel;
+    identityKernel.motionKernel = linearMotionKernel(1.0, 30); // length 0 or 1: identity
+    EXPECT_TRUE(identityKernel.isIdentity());
+    EXPECT_TRUE(linearMotionKernel(0, 0).total() == 1);
+    motionBlur(src, fmt, model, linearMotionKernel(2, 0), NoiseAlignment::ACCOUNT_PRIOR, 1, out);
+    EXPECT_EQ(out.data, src.data);
+}
+
+TEST(Augment, hardCasesGiveFiniteCorrectOutput)
+{
+    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    const Mat src = smallMosaic(CV_32FC1);
+    Mat x;
+    subtractBlackLevel(src, fmt, x);
+    RawFormat outFmt;
+    // Brightening x2: the target is less noisy than the input; nothing can be added, so the output is
+    // exactly twice the input (clipped), and every pixel is reported.
+    Mat out;
+    AugmentReport report;
+    Mat mask;
+    colorJitter(src, fmt, model, ColorJitter::exposureChange(2, 1), NoiseAlignment::ACCOUNT_PRIOR, 1, out,
+                outFmt, &report, mask);
+    EXPECT_EQ(report.brighteningPixels, static_cast<int64>(src.total()));
+    EXPECT_EQ(report.saturatedPixels, 1);
+    EXPECT_EQ(mask.at<uchar>(1, 1), 255);
+    EXPECT_EQ(countNonZero(mask), 1);
+    for (int r = 0; r < src.rows; ++r)
+        for (int c = 0; c < src.cols; ++c) {
+            const float expected = std::min(std::max(2 * x.at<float>(r, c) + 256.f, 0.f), 4095.f);
+            ASSERT_NEAR(out.at<float>(r, c), expected, 1e-3f);
+        }
+    // p_u -> 0 (1e-6, 1e-9): only read noise remains, around black; finite everywhere.
+    for (double pu : {1e-6, 1e-9}) {
+        colorJitter(src, fmt, model, ColorJitter::exposureChange(pu, 1), NoiseAlignment::ACCOUNT_PRIOR, 2,
+                    out, outFmt);
+        EXPECT_EQ(test::countNonFinite(out), 0);
+        EXPECT_NEAR(cv::mean(out)[0], 256, 3 * std::sqrt(model.variance(0, kGain)));
+    }
+    // 0 dB and 60 dB inputs; 60 dB target gain.
+    for (double gain : {1.0, 1000.0}) {
+        RawFormat g = fmt;
+        g.gain = gain;
+        for (NoiseAlignment mode :
+             {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR}) {
+            colorJitter(src, g, model, ColorJitter::exposureChange(0.01, 10), mode, 3, out, outFmt);
+            EXPECT_EQ(test::countNonFinite(out), 0);
+            motionBlur(src, g, model, linearMotionKernel(9, 10), mode, 3, out);
+            EXPECT_EQ(test::countNonFinite(out), 0);
+        }
+    }
+    // A kernel larger than the image.
+    Mat tiny = src(Rect(0, 0, 4, 4)).clone();
+    motionBlur(tiny, fmt, model, Mat::ones(41, 41, CV_32F), NoiseAlignment::ACCOUNT_PRIOR, 4, out);
+    EXPECT_EQ(out.size(), tiny.size());
+    EXPECT_EQ(test::countNonFinite(out), 0);
+    // 16-bit extremes stay in range.
+    Mat extremes(4, 4, CV_16UC1, Scalar(0));
+    extremes.row(1).setTo(65535);
+    RawFormat wide = fmt;
+    wide.whiteLevel = 65535;
+    colorJitter(extremes, wide, model, ColorJitter::exposureChange(0.5, 3), NoiseAlignment::ACCOUNT_PRIOR, 5,
+                out, outFmt);
+    EXPECT_EQ(out.type(), CV_16UC1);
+}
+
+TEST(Augment, badArgumentsGiveClearErrors)
+{
+    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    const Mat src = smallMosaic();
+    Mat out;
+    RawFormat f;
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(Mat(), fmt, model, ColorJitter(), NoiseAlignment::NONE, 0, out, f),
+                             "src is empty");
+    EXPECT_CV_ERROR_CONTAINS(
+        colorJitter(Mat(4, 4, CV_8UC1), fmt, model, ColorJitter(), NoiseAlignment::NONE, 0, out, f),
+        "expected CV_16UC1 or CV_32FC1");
+    ColorJitter bad;
+    bad.contrast[2] = -1;
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(src, fmt, model, bad, NoiseAlignment::NONE, 0, out, f), "contrast");
+    bad = ColorJitter();
+    bad.gainRatio = std::numeric_limits<double>::infinity();
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(src, fmt, model, bad, NoiseAlignment::NONE, 0, out, f), "gainRatio");
+    bad = ColorJitter();
+    bad.brightness = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(src, fmt, model, bad, NoiseAlignment::NONE, 0, out, f),
+                             "brightness");
+    EXPECT_CV_ERROR_CONTAINS(ColorJitter::exposureChange(0, 1), "photonRatio");
+    EXPECT_CV_ERROR_CONTAINS(
+        motionBlur(src, fmt, model, Mat::zeros(3, 3, CV_32F), NoiseAlignment::NONE, 0, out), "positive sum");
+    EXPECT_CV_ERROR_CONTAINS(
+        motionBlur(src(Rect(0, 0, 5, 4)), fmt, model, Mat::ones(3, 3, CV_32F), NoiseAlignment::NONE, 0, out),
+        "both sides must be even");
+    EXPECT_CV_ERROR_CONTAINS(linearMotionKernel(-1, 0), "length");
+    Mat nan(4, 4, CV_32FC1, Scalar(std::numeric_limits<float>::quiet_NaN()));
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(nan, fmt, model, ColorJitter(), NoiseAlignment::NONE, 0, out, f),
+                             "NaN");
+    EXPECT_CV_ERROR_CONTAINS(
+        colorJitter(src, fmt, model, ColorJitter(), static_cast<NoiseAlignment>(7), 0, out, f),
+        "NoiseAlignment 7");
+}
+
+TEST(Augment, shiftKeepsTheCfaPhaseAndMovesBoxes)
+{
+    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    Mat src(16, 16, CV_16UC1);
+    for (int r = 0; r < 16; ++r)
+        for (int c = 0; c < 16; ++c)
+            src.at<ushort>(r, c) = static_cast<ushort>(1000 * cfaSite(r, c) + 10 * r + c);
+    Scene scene;
+    scene.shift = Point(3, 2); // x rounds to an even 4
+    std::vector<Rect> boxes = {Rect(2, 2, 4, 4), Rect(14, 0, 2, 2)};
+    Mat out;
+    RawFormat f;
+    applyScene(src, fmt, model, scene, 0, out, f, nullptr, &boxes);
+    for (int r = 2; r < 16; ++r)
+        for (int c = 4; c < 16; ++c)
+            ASSERT_EQ(out.at<ushort>(r, c), src.at<ushort>(r - 2, c - 4));
+    for (int r = 0; r < 16; ++r)
+        for (int c = 0; c < 16; ++c)
+            ASSERT_EQ(out.at<ushort>(r, c) / 1000, cfaSite(r, c)); // every pixel keeps its site's colour
+    EXPECT_EQ(boxes[0], Rect(6, 4, 4, 4));
+    EXPECT_EQ(boxes[1].area(), 0); // moved out of the frame
+}
+
+TEST(Augment, randomPolicyDrawsInItsRangesAndRoundTrips)
+{
+    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const Mat src = smallMosaic();
+    RandomScenePolicy policy;
+    policy.gainDbMin = 3;
+    policy.gainDbMax = 9;
+    int blurred = 0, hue = 0;
+    for (uint64 seed = 0; seed < 400; ++seed) {
+        const Scene s = policy.draw(src, fmt, seed);
+        const double base = std::min(
+            {s.jitter.contrast[0], s.jitter.contrast[1], s.jitter.contrast[2], s.jitter.contrast[3]});
+        EXPECT_GE(base, 0.01 * 0.8);
+        EXPECT_LE(s.jitter.contrast[0], 1.0 * 1.2);
+        EXPECT_GE(linearGainToDb(s.jitter.gainRatio), 3 - 1e-9);
+        EXPECT_LE(linearGainToDb(s.jitter.gainRatio), 9 + 1e-9);
+        EXPECT_LE(std::abs(s.shift.x), 0.1 * src.cols + 1);
+        blurred += s.motionKernel.empty() ? 0 : 1;
+        hue += s.jitter.contrast[0] != s.jitter.contrast[3] ? 1 : 0;
+    }
+    // Probabilities 0.5: binomial(400, 0.5) has standard deviation 10; 5 of them around 200.
+    EXPECT_NEAR(blurred, 200, 50);
+    EXPECT_NEAR(hue, 200, 50);
+    const Scene a = policy.draw(src, fmt, 7), b = policy.draw(src, fmt, 7);
+    EXPECT_EQ(a.jitter.contrast, b.jitter.contrast);
+    EXPECT_EQ(a.shift, b.shift);
+    const std::string dir = test::makeTempDir("random_policy");
+    for (const char* name : {"/policy.yml", "/policy.json"}) {
+        policy.save(dir + name);
+        const RandomScenePolicy back = RandomScenePolicy::load(dir + name);
+        EXPECT_EQ(back.gainDbMax, 9);
+        EXPECT_EQ(back.contrastMin, 0.01);
+        EXPECT_EQ(back.alignment, NoiseAlignment::ACCOUNT_PRIOR);
+    }
+    RandomScenePolicy bad;
+    bad.contrastMin = 2;
+    EXPECT_CV_ERROR_CONTAINS(bad.validate(), "contrast range");
+    FileStorage fs("%YAML:1.0\nscene_policy: {hue_probability: 2}\n",
+                   FileStorage::READ | FileStorage::MEMORY);
+    EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy::read(fs["scene_policy"]), "hueProbability");
+}
+
+TEST(Augment, sceneRoundTripsThroughFileStorage)
+{
+    Scene s;
+    s.shift = Point(4, -2);
+    s.jitter.contrast = Vec4d(0.1, 0.2, 0.3, 0.4);
+    s.jitter.brightness = -3;
+    s.jitter.gainRatio = 8;
+    s.motionKernel = linearMotionKernel(7, 20);
+    s.alignment = NoiseAlignment::IGNORE_PRIOR;
+    FileStorage out("", FileStorage::WRITE | FileStorage::MEMORY | FileStorage::FORMAT_YAML);
+    s.write(out, "scene");
+    FileStorage in(out.releaseAndGetString(), FileStorage::READ | FileStorage::MEMORY);
+    const Scene r = Scene::read(in["scene"]);
+    EXPECT_EQ(r.shift, s.shift);
+    EXPECT_EQ(r.jitter.contrast, s.jitter.contrast);
+    EXPECT_EQ(r.jitter.gainRatio, 8);
+    EXPECT_EQ(r.alignment, NoiseAlignment::IGNORE_PRIOR);
+    EXPECT_EQ(norm(r.motionKernel, s.motionKernel, NORM_INF), 0);
+}
+
+} // namespace
+} // namespace rawgment
+} // namespace cv
