@@ -1,0 +1,123 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Augmentation of a 4000x3000 CV_16UC1 mosaic, all in one run:
+//   colour jitter (ACCOUNT_PRIOR), motion blur (length 13), a full random scene,
+//   the same colour jitter composed naively with OpenCV calls (convertTo, RNG::fill NORMAL, Mat
+//   arithmetic, sqrt), and a memcpy of the frame (the floor).
+#include <benchmark/benchmark.h>
+#include <opencv2/core.hpp>
+#include <opencv2/rawgment/augment.hpp>
+
+#include <cstring>
+
+namespace {
+
+using namespace cv;
+using namespace cv::rawgment;
+
+const NoiseModel kModel(0.4, 0.5, 2.0);
+
+RawFormat frameFormat()
+{
+    RawFormat f;
+    f.blackLevel = Vec4d::all(256);
+    f.whiteLevel = 4095;
+    f.gain = 2;
+    return f;
+}
+
+const Mat& frame()
+{
+    static const Mat m = [] {
+        Mat f(3000, 4000, CV_16UC1);
+        RNG(5).fill(f, RNG::UNIFORM, 256, 4000);
+        return f;
+    }();
+    return m;
+}
+
+const ColorJitter kJitter = ColorJitter::exposureChange(0.2, 2.0);
+
+void BM_Augment_colorJitter(benchmark::State& state)
+{
+    Mat out;
+    RawFormat f;
+    uint64 seed = 0;
+    for (auto _ : state) {
+        colorJitter(frame(), frameFormat(), kModel, kJitter, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out, f);
+        benchmark::DoNotOptimize(out.data);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+}
+
+void BM_Augment_colorJitterNaiveOpenCV(benchmark::State& state)
+{
+    // Eq. 11 with whole-frame OpenCV operations and temporaries.
+    const RawFormat fmt = frameFormat();
+    const NoiseLine line = kModel.lineAtGain(fmt.gain);
+    const double pu = 0.2, pg = 2.0;
+    RNG rng(1);
+    for (auto _ : state) {
+        Mat x, mu, v, noise, out;
+        frame().convertTo(x, CV_32F, 1.0, -256.0);
+        mu = max(x, 0.0);
+        v = mu * (pu * (1 - pu) * pg * pg * line.a) +
+            ((1 - pu * pu) * pg * pg * fmt.gain * fmt.gain * kModel.sigmaD2 +
+             (1 - pu * pu * pg * pg) * kModel.sigmaR2);
+        v = max(v, 0.0);
+        sqrt(v, v);
+        noise.create(x.size(), CV_32F);
+        rng.fill(noise, RNG::NORMAL, 0, 1);
+        out = x * (pu * pg) + v.mul(noise) + 256.0;
+        out.convertTo(out, CV_16U);
+        benchmark::DoNotOptimize(out.data);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+}
+
+void BM_Augment_motionBlur13(benchmark::State& state)
+{
+    const Mat kernel = linearMotionKernel(13, 30);
+    Mat out;
+    uint64 seed = 0;
+    for (auto _ : state) {
+        motionBlur(frame(), frameFormat(), kModel, kernel, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out);
+        benchmark::DoNotOptimize(out.data);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+}
+
+void BM_Augment_randomScene(benchmark::State& state)
+{
+    RandomScenePolicy policy;
+    policy.blurProbability = 1; // the expensive case: every scene blurs
+    Mat out;
+    RawFormat f;
+    uint64 seed = 0;
+    for (auto _ : state) {
+        const Scene s = policy.draw(frame(), frameFormat(), ++seed);
+        applyScene(frame(), frameFormat(), kModel, s, seed, out, f);
+        benchmark::DoNotOptimize(out.data);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+}
+
+void BM_Augment_memcpy(benchmark::State& state)
+{
+    Mat out(frame().size(), frame().type());
+    for (auto _ : state) {
+        std::memcpy(out.data, frame().data, frame().total() * frame().elemSize());
+        benchmark::DoNotOptimize(out.data);
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+}
+
+BENCHMARK(BM_Augment_memcpy)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Augment_colorJitter)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Augment_colorJitterNaiveOpenCV)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Augment_motionBlur13)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Augment_randomScene)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+} // namespace
+
+BENCHMARK_MAIN();
