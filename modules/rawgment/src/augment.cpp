@@ -487,14 +487,8 @@ void RandomScenePolicy::save(const String& path) const
 
 RandomScenePolicy RandomScenePolicy::load(const String& path)
 {
-    FileStorage fs(path, FileStorage::READ);
-    if (!fs.isOpened())
-        CV_Error(Error::StsError, "cannot open random scene policy '" + path + "'");
-    try {
-        return read(fs["random_scene_policy"]);
-    } catch (const Exception& e) {
-        CV_Error(e.code, "'" + path + "': " + e.err);
-    }
+    return detail::loadFileStorage(path, "random_scene_policy", "random scene policy",
+                                   [](const FileNode& n) { return read(n); });
 }
 
 } // namespace rawgment

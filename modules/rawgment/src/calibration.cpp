@@ -769,14 +769,8 @@ void CalibrationReport::save(const String& path) const
 
 CalibrationReport CalibrationReport::load(const String& path)
 {
-    FileStorage fs(path, FileStorage::READ);
-    if (!fs.isOpened())
-        CV_Error(Error::StsError, "cannot open calibration report '" + path + "'");
-    try {
-        return read(fs["calibration_report"]);
-    } catch (const Exception& e) {
-        CV_Error(e.code, "'" + path + "': " + e.err);
-    }
+    return detail::loadFileStorage(path, "calibration_report", "calibration report",
+                                   [](const FileNode& n) { return read(n); });
 }
 
 } // namespace rawgment

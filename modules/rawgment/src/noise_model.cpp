@@ -140,19 +140,8 @@ void NoiseModel::save(const String& path) const
 
 NoiseModel NoiseModel::load(const String& path)
 {
-    FileStorage fs;
-    try {
-        fs.open(path, FileStorage::READ);
-    } catch (const Exception& e) {
-        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.err);
-    }
-    if (!fs.isOpened())
-        CV_Error(Error::StsError, "cannot open noise model file '" + path + "'");
-    try {
-        return read(fs[kTopLevelName]);
-    } catch (const Exception& e) {
-        CV_Error(e.code, "'" + path + "': " + e.err);
-    }
+    return detail::loadFileStorage(path, kTopLevelName, "noise model file",
+                                   [](const FileNode& n) { return read(n); });
 }
 
 } // namespace rawgment

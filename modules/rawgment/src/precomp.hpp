@@ -42,6 +42,28 @@ template <typename Writer> void writeFileStorageAtomically(const String& path, W
     commitTemporaryFile(tmp, path);
 }
 
+/** Reads the map `topLevel` of a YAML/JSON file with `read(node)`. Errors name the file: a missing or
+ * unreadable file ("cannot open <what> '<path>'"), text that is not YAML/JSON, or whatever `read`
+ * rejects. */
+template <typename Reader>
+auto loadFileStorage(const String& path, const char* topLevel, const char* what, Reader&& read)
+    -> decltype(read(FileNode()))
+{
+    FileStorage fs;
+    try {
+        fs.open(path, FileStorage::READ);
+    } catch (const Exception& e) {
+        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.err);
+    }
+    if (!fs.isOpened())
+        CV_Error(Error::StsError, String("cannot open ") + what + " '" + path + "'");
+    try {
+        return read(fs[topLevel]);
+    } catch (const Exception& e) {
+        CV_Error(e.code, "'" + path + "': " + e.err);
+    }
+}
+
 } // namespace detail
 } // namespace rawgment
 } // namespace cv
