@@ -27,6 +27,13 @@ template <typename Writer> void writeFileStorageAtomically(const String& path, W
 int fileStorageFormatOf(const String& path);
 void commitTemporaryFile(const String& tmpPath, const String& path);
 String temporaryPathFor(const String& path);
+//! Like commitTemporaryFile(), but fails (removing the temporary) when `path` already exists.
+void commitTemporaryFileNoReplace(const String& tmpPath, const String& path);
+//! Writes bytes to a temporary file beside `path`, syncs it, then commits it (replacing or not).
+//! Every I/O call is checked; errors name the file and the reason.
+void writeBytesAtomically(const String& path, const void* data, size_t size, bool replace);
+//! Whether anything exists at `path`.
+bool fileExists(const String& path);
 
 template <typename Writer> void writeFileStorageAtomically(const String& path, Writer&& writeBody)
 {
@@ -49,6 +56,9 @@ template <typename Reader>
 auto loadFileStorage(const String& path, const char* topLevel, const char* what, Reader&& read)
     -> decltype(read(FileNode()))
 {
+    // Checked first so that OpenCV does not log its own error for a missing file.
+    if (!fileExists(path))
+        CV_Error(Error::StsError, String("cannot open ") + what + " '" + path + "': no such file");
     FileStorage fs;
     try {
         fs.open(path, FileStorage::READ);

@@ -5,8 +5,10 @@
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/bayer.hpp>
 #include <opencv2/rawgment/calibration.hpp>
+#include <opencv2/rawgment/isp.hpp>
 #include <opencv2/rawgment/noise_model.hpp>
 #include <opencv2/rawgment/normality.hpp>
+#include <opencv2/rawgment/raw_io.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
 /** @defgroup rawgment Noise-accounted RAW augmentation
@@ -20,6 +22,8 @@ subtraction; gains are linear (0 dB = 1).
     @defgroup rawgment_bayer Bayer mosaics: CFA patterns, planes and black levels
     @defgroup rawgment_noise_model The heteroscedastic Gaussian noise model
     @defgroup rawgment_normality Shapiro-Wilk tests of the Gaussian noise assumption
+    @defgroup rawgment_isp The paper's simple ISPs: tone curves, white balance, demosaicing for previews
+    @defgroup rawgment_raw_io Camera RAW files in (LibRaw) and augmented mosaics out (PNG, TIFF, DNG)
     @defgroup rawgment_calibration Noise calibration from bursts: statistics, line fits, cross-gain fits
     @defgroup rawgment_simulate A physical sensor simulator and a ColorChecker scene: the ground truth
 @}

@@ -1,0 +1,106 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#ifndef OPENCV_RAWGMENT_RAW_IO_HPP
+#define OPENCV_RAWGMENT_RAW_IO_HPP
+
+#include <opencv2/core.hpp>
+#include <opencv2/rawgment/augment.hpp>
+#include <opencv2/rawgment/bayer.hpp>
+#include <opencv2/rawgment/export.hpp>
+
+namespace cv {
+namespace rawgment {
+
+//! @addtogroup rawgment_raw_io
+//! @{
+
+/** @brief A Bayer mosaic read from a camera RAW file, with what the file says about its capture. */
+struct CV_RAWGMENT_EXPORTS RawImage
+{
+    Mat mosaic;              //!< the visible area as stored (black included), CV_16UC1
+    RawFormat format;        //!< CFA pattern of the visible area, per-site black, white level; gain 1
+    double iso = 0;          //!< ISO speed, 0 when the file does not say
+    double exposureTime = 0; //!< seconds, 0 when the file does not say
+    String make;             //!< camera maker, empty when unknown
+    String model;            //!< camera model, empty when unknown
+    /** As-shot white-balance multipliers for R, G, B, normalised to green = 1; (1, 1, 1) when the file
+     * has none. Pass them to IspParams::whiteBalance for a neutral preview. */
+    Vec3d whiteBalance = Vec3d(1, 1, 1);
+    /** Camera RGB to linear sRGB, rows summing to 1 (from the file's colour matrix as LibRaw derives
+     * it); the identity when the file has none. Pass it to IspParams::colorMatrix. */
+    Matx33d cameraToSrgb = Matx33d::eye();
+};
+
+/** @brief Reads the Bayer mosaic of a camera RAW file (any format LibRaw reads: DNG, NEF, CR2, CRW, ...).
+ *
+ * The mosaic is the visible area LibRaw reports (masked borders removed). The CFA pattern is the one
+ * of the visible area's top-left pixel as LibRaw reports it, never assumed. The black level of each
+ * site is LibRaw's `black + cblack[colour] + cblack[6 + pattern position]`; the white level is LibRaw's
+ * `maximum`. Every LibRaw return code is checked.
+ * @param path the file
+ * @throws cv::Exception naming the file and the reason when the file is missing or unreadable, is not a
+ *         RAW file, is truncated or corrupt (LibRaw's data-error callback fired), or is not a 2x2 Bayer
+ *         mosaic (X-Trans, Foveon, four-colour, or a linear/demosaiced DNG).
+ */
+CV_RAWGMENT_EXPORTS RawImage readRaw(const String& path);
+
+/** @brief Writes a mosaic as an uncompressed DNG 1.4 file that LibRaw and RAW viewers open.
+ *
+ * The file holds the CFA pattern, the per-site black level (BlackLevelRepeatDim 2x2), the white level,
+ * make and model, ISO, exposure time and the as-shot neutral from the white balance. It is written
+ * atomically (a temporary file, then a hard link that fails if `path` exists).
+ * @param path destination, which must not exist
+ * @param image `mosaic` must be CV_16UC1 with even sides; the other fields are written as they are
+ *        (`format.gain` is not a DNG field; writeMosaic() keeps it in the sidecar)
+ * @throws cv::Exception when `path` exists, the mosaic is unsupported, or any write fails.
+ */
+CV_RAWGMENT_EXPORTS void writeDng(const String& path, const RawImage& image);
+
+/** @brief What a sidecar file says about a mosaic written by writeMosaic(). */
+struct CV_RAWGMENT_EXPORTS MosaicMetadata
+{
+    static constexpr int FORMAT_VERSION = 1; //!< version written to and accepted from files
+    RawFormat format;                        //!< the mosaic's format, with the gain after augmentation
+    bool hasScene = false;                   //!< whether `scene` and `seed` describe how the mosaic was made
+    Scene scene;                             //!< the scene applied to the source
+    uint64 seed = 0;                         //!< the noise seed of that scene
+    String source;                           //!< the file the mosaic was made from (informative)
+    Size size;           //!< the mosaic's size; set by writeMosaic(), checked by readMosaic()
+    int type = CV_16UC1; //!< the mosaic's type; set by writeMosaic(), checked by readMosaic()
+
+    //! Writes the metadata as a map under `name`.
+    void write(FileStorage& fs, const String& name) const;
+    //! Reads metadata written by write(). @throws cv::Exception naming an invalid field.
+    static MosaicMetadata read(const FileNode& node);
+};
+
+/** @brief The sidecar of a mosaic file: `path` + ".yml". */
+CV_RAWGMENT_EXPORTS String sidecarPathOf(const String& path);
+
+/** @brief Writes a mosaic and its sidecar YAML (top-level map `mosaic_metadata`).
+ *
+ * The container follows the extension: `.png` (16-bit), `.tif`/`.tiff` (16-bit or 32-bit float) or
+ * `.dng` (16-bit, see writeDng()). The sidecar is written first and the image last, each atomically;
+ * the image never replaces an existing file, so an existing image marks a finished output and an input
+ * can never be overwritten.
+ * @param path destination image, which must not exist
+ * @param mosaic CV_16UC1 (any container) or CV_32FC1 (TIFF only)
+ * @param metadata the format, and optionally the scene and seed that made the mosaic (validated)
+ * @throws cv::Exception when `path` exists, the type does not fit the container, or a write fails.
+ */
+CV_RAWGMENT_EXPORTS void writeMosaic(const String& path, InputArray mosaic, const MosaicMetadata& metadata);
+
+/** @brief Reads a mosaic written by writeMosaic() and its sidecar.
+ * @param path the image; its sidecar must be beside it
+ * @param mosaic output, the stored type
+ * @return the sidecar's metadata
+ * @throws cv::Exception naming the file when either is missing or invalid, or when the image's size or
+ *         type contradicts the sidecar.
+ */
+CV_RAWGMENT_EXPORTS MosaicMetadata readMosaic(const String& path, OutputArray mosaic);
+
+//! @}
+
+} // namespace rawgment
+} // namespace cv
+
+#endif // OPENCV_RAWGMENT_RAW_IO_HPP

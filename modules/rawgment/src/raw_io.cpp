@@ -1,0 +1,575 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "precomp.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/rawgment/raw_io.hpp>
+
+#include <libraw/libraw.h>
+
+#include <cerrno>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+
+namespace {
+
+[[noreturn]] void failOn(const String& path, const String& reason)
+{
+    CV_Error(Error::StsError, "readRaw: '" + path + "': " + reason);
+}
+
+String libRawError(int code)
+{
+    // LibRaw returns negative codes of its own and positive errno values.
+    return code > 0 ? String(std::strerror(code)) : String(libraw_strerror(code));
+}
+
+struct DataErrors
+{
+    int count = 0;
+    int offset = 0;
+};
+
+void recordDataError(void* context, const char*, const int offset)
+{
+    auto* errors = static_cast<DataErrors*>(context);
+    if (errors->count++ == 0)
+        errors->offset = offset;
+}
+
+//! Colour index LibRaw gives a pixel (0 R, 1 G, 2 B, 3 second G) to our channel names.
+CfaChannel channelOfLibRawColour(int colour, int row)
+{
+    switch (colour) {
+    case 0:
+        return CFA_R;
+    case 2:
+        return CFA_B;
+    default:
+        return (row & 1) == 0 ? CFA_G1 : CFA_G2;
+    }
+}
+
+CfaPattern patternOf(LibRaw& raw, const String& path)
+{
+    // FC() covers 8 rows x 2 columns; a 2x2 Bayer layout repeats every 2 rows.
+    for (int r = 2; r < 8; ++r)
+        for (int c = 0; c < 2; ++c)
+            if (raw.COLOR(r, c) != raw.COLOR(r % 2, c))
+                failOn(path, "the colour filter array repeats over more than 2 rows; not a 2x2 Bayer mosaic");
+    int colourAtSite[4];
+    int count[4] = {0, 0, 0, 0};
+    for (int s = 0; s < 4; ++s) {
+        colourAtSite[s] = raw.COLOR(s / 2, s % 2);
+        if (colourAtSite[s] < 0 || colourAtSite[s] > 3)
+            failOn(path, format("LibRaw reports colour %d in the CFA; not a Bayer mosaic", colourAtSite[s]));
+        ++count[colourAtSite[s] == 3 ? 1 : colourAtSite[s]];
+    }
+    if (count[0] != 1 || count[1] != 2 || count[2] != 1)
+        failOn(path, "the 2x2 CFA block is not one red, two greens and one blue");
+    // The red site decides the layout; the greens and blue follow for a Bayer block.
+    for (int p = CFA_RGGB; p <= CFA_GBRG; ++p) {
+        const CfaPattern pattern = static_cast<CfaPattern>(p);
+        bool match = true;
+        for (int s = 0; s < 4; ++s) {
+            const CfaChannel want = cfaChannelAt(pattern, s / 2, s % 2);
+            const CfaChannel got = channelOfLibRawColour(colourAtSite[s], s / 2);
+            const bool bothGreen = (want == CFA_G1 || want == CFA_G2) && (got == CFA_G1 || got == CFA_G2);
+            match = match && (want == got || bothGreen);
+        }
+        if (match)
+            return pattern;
+    }
+    failOn(path, "the 2x2 CFA block is not a Bayer layout (the two greens are not diagonal)");
+}
+
+} // namespace
+
+RawImage readRaw(const String& path)
+{
+    if (path.empty())
+        CV_Error(Error::StsBadArg, "readRaw: the path is empty");
+    if (!detail::fileExists(path))
+        failOn(path, "no such file");
+    // LibRaw's state is a few hundred kilobytes: keep it off the stack.
+    std::unique_ptr<LibRaw> raw(new LibRaw(0));
+    DataErrors errors;
+    raw->set_dataerror_handler(&recordDataError, &errors);
+    int rc = raw->open_file(path.c_str());
+    if (rc != LIBRAW_SUCCESS)
+        failOn(path, "LibRaw cannot open it: " + libRawError(rc));
+    const libraw_data_t& d = raw->imgdata;
+    if (d.idata.filters == 0)
+        failOn(path, "LibRaw reports no colour filter array: a linear or demosaiced DNG, a Foveon or a "
+                     "monochrome sensor, not a Bayer mosaic");
+    if (d.idata.filters == 9)
+        failOn(path, "the sensor has a 6x6 X-Trans colour filter array, not a 2x2 Bayer mosaic");
+    if (d.idata.filters < 1000)
+        failOn(path, "the colour filter array is not a 2x2 Bayer layout");
+    if (d.idata.colors != 3)
+        failOn(path, format("the sensor has %d colours (for example CMYG), not red, green and blue",
+                            d.idata.colors));
+    if (raw->is_floating_point())
+        failOn(path, "the mosaic is stored as floating point, which readRaw does not support");
+    const CfaPattern pattern = patternOf(*raw, path);
+    rc = raw->unpack();
+    if (rc != LIBRAW_SUCCESS)
+        failOn(path, "LibRaw cannot decode the image data (truncated or corrupt?): " + libRawError(rc));
+    if (errors.count > 0)
+        failOn(path, errors.offset < 0 ? String("the file is truncated (LibRaw reached its end early)")
+                                       : format("the image data is corrupt (LibRaw reports a data error at "
+                                                "offset %d)",
+                                                errors.offset));
+    if (!d.rawdata.raw_image)
+        failOn(path, "LibRaw decoded no single-channel Bayer data for it");
+
+    const libraw_image_sizes_t& s = d.sizes;
+    // Our mosaic functions need even sides; an odd visible size loses its last row or column.
+    const int rows = s.height & ~1, cols = s.width & ~1;
+    if (rows < 2 || cols < 2)
+        failOn(path, format("the visible area %dx%d is too small", int(s.width), int(s.height)));
+    if (s.top_margin + rows > s.raw_height || s.left_margin + cols > s.raw_width)
+        failOn(path, "the visible area lies outside the decoded data");
+
+    RawImage out;
+    const Mat full(s.raw_height, s.raw_width, CV_16UC1, d.rawdata.raw_image, s.raw_pitch);
+    full(Rect(s.left_margin, s.top_margin, cols, rows)).copyTo(out.mosaic);
+
+    const libraw_colordata_t& c = d.color;
+    out.format.pattern = pattern;
+    for (int site = 0; site < 4; ++site) {
+        const int r = site / 2, col = site % 2;
+        double black = double(c.black) + double(c.cblack[raw->COLOR(r, col)]);
+        if (c.cblack[4] > 0 && c.cblack[5] > 0) {
+            const unsigned idx = 6 + (r % c.cblack[4]) * c.cblack[5] + (col % c.cblack[5]);
+            if (idx < LIBRAW_CBLACK_SIZE)
+                black += double(c.cblack[idx]);
+        }
+        out.format.blackLevel[site] = black;
+    }
+    out.format.whiteLevel = double(c.maximum);
+    out.format.gain = 1.0;
+    try {
+        out.format.validate();
+    } catch (const Exception& e) {
+        failOn(path, "LibRaw's levels do not make a valid format: " + e.err);
+    }
+    out.iso = d.other.iso_speed > 0 ? double(d.other.iso_speed) : 0.0;
+    out.exposureTime = d.other.shutter > 0 ? double(d.other.shutter) : 0.0;
+    out.make = d.idata.make;
+    out.model = d.idata.model;
+    if (c.cam_mul[0] > 0 && c.cam_mul[1] > 0 && c.cam_mul[2] > 0)
+        out.whiteBalance = Vec3d(c.cam_mul[0] / c.cam_mul[1], 1.0, c.cam_mul[2] / c.cam_mul[1]);
+    bool haveMatrix = false;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            out.cameraToSrgb(i, j) = c.rgb_cam[i][j];
+            haveMatrix = haveMatrix || (i != j && c.rgb_cam[i][j] != 0);
+        }
+    if (!haveMatrix)
+        out.cameraToSrgb = Matx33d::eye();
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// DNG writer: one little-endian TIFF IFD with an uncompressed 16-bit CFA strip.
+
+namespace {
+
+enum TiffType : uint16_t
+{
+    TIFF_BYTE = 1,
+    TIFF_ASCII = 2,
+    TIFF_SHORT = 3,
+    TIFF_LONG = 4,
+    TIFF_RATIONAL = 5,
+    TIFF_SRATIONAL = 10
+};
+
+struct TiffEntry
+{
+    uint16_t tag;
+    uint16_t type;
+    uint32_t count;
+    std::vector<uint8_t> bytes; // the value, little-endian
+};
+
+class TiffBuilder
+{
+public:
+    void add(uint16_t tag, uint16_t type, uint32_t count, std::vector<uint8_t> bytes)
+    {
+        entries_.push_back({tag, type, count, std::move(bytes)});
+    }
+    void shorts(uint16_t tag, std::initializer_list<uint16_t> v)
+    {
+        std::vector<uint8_t> b;
+        for (uint16_t x : v)
+            put16(b, x);
+        add(tag, TIFF_SHORT, uint32_t(v.size()), b);
+    }
+    void longs(uint16_t tag, std::initializer_list<uint32_t> v)
+    {
+        std::vector<uint8_t> b;
+        for (uint32_t x : v)
+            put32(b, x);
+        add(tag, TIFF_LONG, uint32_t(v.size()), b);
+    }
+    void bytes(uint16_t tag, std::initializer_list<uint8_t> v) { add(tag, TIFF_BYTE, uint32_t(v.size()), v); }
+    void ascii(uint16_t tag, const String& s)
+    {
+        std::vector<uint8_t> b(s.begin(), s.end());
+        b.push_back(0);
+        add(tag, TIFF_ASCII, uint32_t(b.size()), b);
+    }
+    void rationals(uint16_t tag, const std::vector<double>& v, bool isSigned)
+    {
+        std::vector<uint8_t> b;
+        for (double x : v) {
+            // A fixed denominator keeps 6 significant digits for the values DNG stores here.
+            const uint32_t den = 1000000;
+            const int64_t num = static_cast<int64_t>(std::llround(x * den));
+            put32(b,
+                  isSigned ? static_cast<uint32_t>(static_cast<int32_t>(num)) : static_cast<uint32_t>(num));
+            put32(b, den);
+        }
+        add(tag, isSigned ? TIFF_SRATIONAL : TIFF_RATIONAL, uint32_t(v.size()), b);
+    }
+
+    //! Moves the entries with these tags into the EXIF sub-IFD (where LibRaw looks for the ISO).
+    void moveToExif(std::initializer_list<uint16_t> tags)
+    {
+        for (uint16_t tag : tags)
+            for (size_t i = 0; i < entries_.size(); ++i)
+                if (entries_[i].tag == tag) {
+                    exif_.push_back(entries_[i]);
+                    entries_.erase(entries_.begin() + static_cast<std::ptrdiff_t>(i));
+                    break;
+                }
+    }
+
+    //! The file: header, main IFD and its values, EXIF IFD and its values, then the image strip.
+    std::vector<uint8_t> build(const Mat& mosaic)
+    {
+        const size_t stripBytes = mosaic.total() * 2;
+        if (stripBytes > 0xF0000000u)
+            CV_Error(Error::StsBadArg, "writeDng: the mosaic is too large for a baseline TIFF (4 GB)");
+        longs(273, {0}); // StripOffsets, patched below
+        longs(279, {uint32_t(stripBytes)});
+        if (!exif_.empty())
+            longs(34665, {0}); // ExifIFD, patched below
+        std::vector<uint8_t> out = {'I', 'I', 42, 0};
+        put32(out, 8);
+        std::vector<std::pair<uint16_t, size_t>> fields = appendIfd(out, entries_);
+        if (!exif_.empty()) {
+            patch32(out, fieldOf(fields, 34665), uint32_t(out.size()));
+            appendIfd(out, exif_);
+        }
+        patch32(out, fieldOf(fields, 273), uint32_t(out.size()));
+        out.reserve(out.size() + stripBytes);
+        for (int r = 0; r < mosaic.rows; ++r) {
+            const ushort* p = mosaic.ptr<ushort>(r);
+            for (int c = 0; c < mosaic.cols; ++c)
+                put16(out, p[c]);
+        }
+        return out;
+    }
+
+private:
+    static void put16(std::vector<uint8_t>& b, uint16_t v)
+    {
+        b.push_back(uint8_t(v));
+        b.push_back(uint8_t(v >> 8));
+    }
+    static void put32(std::vector<uint8_t>& b, uint32_t v)
+    {
+        for (int k = 0; k < 4; ++k)
+            b.push_back(uint8_t(v >> (8 * k)));
+    }
+    //! Appends an IFD at the end of `out` (absolute offsets) with its out-of-line values after it;
+    //! returns where each tag's value field is.
+    static std::vector<std::pair<uint16_t, size_t>> appendIfd(std::vector<uint8_t>& out,
+                                                              std::vector<TiffEntry> entries)
+    {
+        std::sort(entries.begin(), entries.end(),
+                  [](const TiffEntry& a, const TiffEntry& b) { return a.tag < b.tag; });
+        const size_t ifdSize = 2 + 12 * entries.size() + 4;
+        const size_t dataOffset = out.size() + ifdSize;
+        std::vector<uint8_t> data;
+        std::vector<std::pair<uint16_t, size_t>> fields;
+        put16(out, uint16_t(entries.size()));
+        for (const TiffEntry& e : entries) {
+            put16(out, e.tag);
+            put16(out, e.type);
+            put32(out, e.count);
+            fields.emplace_back(e.tag, out.size());
+            if (e.bytes.size() <= 4) {
+                std::vector<uint8_t> v = e.bytes;
+                v.resize(4, 0);
+                out.insert(out.end(), v.begin(), v.end());
+            } else {
+                put32(out, uint32_t(dataOffset + data.size()));
+                data.insert(data.end(), e.bytes.begin(), e.bytes.end());
+                if (data.size() % 2)
+                    data.push_back(0); // TIFF values start on word boundaries
+            }
+        }
+        put32(out, 0); // no next IFD
+        out.insert(out.end(), data.begin(), data.end());
+        return fields;
+    }
+    static size_t fieldOf(const std::vector<std::pair<uint16_t, size_t>>& fields, uint16_t tag)
+    {
+        for (const auto& f : fields)
+            if (f.first == tag)
+                return f.second;
+        CV_Error(Error::StsInternal, "writeDng: missing TIFF tag");
+    }
+    static void patch32(std::vector<uint8_t>& b, size_t at, uint32_t v)
+    {
+        for (int k = 0; k < 4; ++k)
+            b[at + k] = uint8_t(v >> (8 * k));
+    }
+    std::vector<TiffEntry> entries_;
+    std::vector<TiffEntry> exif_;
+};
+
+uint8_t dngColourOf(CfaChannel ch)
+{
+    return ch == CFA_R ? 0 : (ch == CFA_B ? 2 : 1);
+}
+
+} // namespace
+
+void writeDng(const String& path, const RawImage& image)
+{
+    image.format.validate();
+    const Mat& m = image.mosaic;
+    if (m.empty() || m.type() != CV_16UC1)
+        CV_Error(Error::StsBadArg, format("writeDng: '%s': the mosaic must be a non-empty CV_16UC1 (got %s)",
+                                          path.c_str(), typeToString(m.type()).c_str()));
+    if (m.rows % 2 || m.cols % 2)
+        CV_Error(Error::StsBadArg, format("writeDng: '%s': the mosaic is %dx%d; both sides must be even",
+                                          path.c_str(), m.cols, m.rows));
+    std::vector<uint32_t> blacks(4);
+    for (int s = 0; s < 4; ++s) {
+        const double b = image.format.blackLevel[s];
+        if (std::abs(b - std::round(b)) > 1e-9)
+            CV_Error(Error::StsBadArg, format("writeDng: '%s': black level %g of site %d is not an integer; "
+                                              "DNG stores integer levels for 16-bit data",
+                                              path.c_str(), b, s));
+        blacks[s] = static_cast<uint32_t>(std::llround(b));
+    }
+    if (detail::fileExists(path))
+        CV_Error(Error::StsError, "writeDng: '" + path + "' already exists; it is never overwritten");
+
+    TiffBuilder t;
+    t.longs(254, {0});
+    t.longs(256, {uint32_t(m.cols)});
+    t.longs(257, {uint32_t(m.rows)});
+    t.shorts(258, {16});
+    t.shorts(259, {1});
+    t.shorts(262, {32803}); // CFA
+    if (!image.make.empty())
+        t.ascii(271, image.make);
+    if (!image.model.empty())
+        t.ascii(272, image.model);
+    t.shorts(274, {1});
+    t.shorts(277, {1});
+    t.longs(278, {uint32_t(m.rows)});
+    t.shorts(284, {1});
+    t.ascii(305, "cv::rawgment");
+    t.shorts(33421, {2, 2});
+    const CfaPattern p = image.format.pattern;
+    t.bytes(33422, {dngColourOf(cfaChannelAt(p, 0, 0)), dngColourOf(cfaChannelAt(p, 0, 1)),
+                    dngColourOf(cfaChannelAt(p, 1, 0)), dngColourOf(cfaChannelAt(p, 1, 1))});
+    if (image.exposureTime > 0)
+        t.rationals(33434, {image.exposureTime}, false);
+    if (image.iso > 0)
+        t.shorts(34855, {static_cast<uint16_t>(std::min(65535.0, std::round(image.iso)))});
+    t.bytes(50706, {1, 4, 0, 0});
+    t.bytes(50707, {1, 1, 0, 0});
+    t.ascii(50708, image.make.empty() && image.model.empty() ? String("cv::rawgment")
+                                                             : image.make + " " + image.model);
+    t.bytes(50710, {0, 1, 2}); // CFAPlaneColor
+    t.shorts(50711, {1});      // CFALayout: rectangular
+    t.shorts(50713, {2, 2});
+    {
+        std::vector<uint8_t> b;
+        for (uint32_t v : blacks)
+            for (int k = 0; k < 4; ++k)
+                b.push_back(uint8_t(v >> (8 * k)));
+        t.add(50714, TIFF_LONG, 4, b);
+    }
+    t.longs(50717, {static_cast<uint32_t>(std::llround(image.format.whiteLevel))});
+    // ColorMatrix1 maps XYZ to camera RGB: camera = inverse(cameraToSrgb) * (XYZ to linear sRGB, D65).
+    const Matx33d xyzToSrgb(3.2404542, -1.5371385, -0.4985314, -0.9692660, 1.8760108, 0.0415560, 0.0556434,
+                            -0.2040259, 1.0572252);
+    Matx33d inv;
+    if (cv::invert(image.cameraToSrgb, inv, DECOMP_SVD) == 0)
+        CV_Error(Error::StsBadArg, "writeDng: cameraToSrgb is singular");
+    const Matx33d colorMatrix = inv * xyzToSrgb;
+    t.rationals(50721, std::vector<double>(colorMatrix.val, colorMatrix.val + 9), true);
+    t.shorts(50778, {21}); // CalibrationIlluminant1: D65
+    std::vector<double> neutral(3);
+    for (int c = 0; c < 3; ++c) {
+        detail::checkFinitePositive(image.whiteBalance[c], "writeDng: whiteBalance");
+        neutral[c] = image.whiteBalance[1] / image.whiteBalance[c];
+    }
+    t.rationals(50728, neutral, false);
+    t.moveToExif({33434, 34855});
+    const std::vector<uint8_t> bytes = t.build(m);
+    detail::writeBytesAtomically(path, bytes.data(), bytes.size(), false);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Mosaics with sidecars.
+
+void MosaicMetadata::write(FileStorage& fs, const String& name) const
+{
+    format.validate();
+    fs << name << "{";
+    fs << "format_version" << FORMAT_VERSION;
+    format.write(fs, "raw_format");
+    fs << "size" << size;
+    fs << "type" << typeToString(type);
+    fs << "source" << source;
+    fs << "has_scene" << int(hasScene);
+    if (hasScene) {
+        scene.write(fs, "scene");
+        // FileStorage has no 64-bit integer: the seed travels as a decimal string.
+        fs << "seed" << cv::format("%llu", static_cast<unsigned long long>(seed));
+    }
+    fs << "}";
+}
+
+MosaicMetadata MosaicMetadata::read(const FileNode& node)
+{
+    if (node.empty() || !node.isMap())
+        CV_Error(Error::StsParseError, "mosaic metadata: expected a map with format_version and raw_format");
+    const FileNode version = node["format_version"];
+    if (version.empty() || !version.isInt() || int(version) < 1 || int(version) > FORMAT_VERSION)
+        CV_Error(
+            Error::StsParseError,
+            cv::format("mosaic metadata: format_version is missing or not one of 1..%d", FORMAT_VERSION));
+    MosaicMetadata m;
+    m.format = RawFormat::read(node["raw_format"]);
+    node["size"] >> m.size;
+    const String typeName = node["type"].empty() ? String() : String(node["type"]);
+    if (typeName == "CV_16UC1")
+        m.type = CV_16UC1;
+    else if (typeName == "CV_32FC1")
+        m.type = CV_32FC1;
+    else
+        CV_Error(Error::StsParseError,
+                 "mosaic metadata: field 'type' must be CV_16UC1 or CV_32FC1 (got '" + typeName + "')");
+    if (m.size.width <= 0 || m.size.height <= 0)
+        CV_Error(Error::StsParseError, "mosaic metadata: field 'size' is missing or not positive");
+    m.source = node["source"].empty() ? String() : String(node["source"]);
+    m.hasScene = !node["has_scene"].empty() && int(node["has_scene"]) != 0;
+    if (m.hasScene) {
+        m.scene = Scene::read(node["scene"]);
+        const String seed = node["seed"].empty() ? String() : String(node["seed"]);
+        char* end = nullptr;
+        errno = 0;
+        const unsigned long long v = std::strtoull(seed.c_str(), &end, 10);
+        if (seed.empty() || *end != '\0' || errno != 0)
+            CV_Error(Error::StsParseError,
+                     "mosaic metadata: field 'seed' is missing or not a decimal integer");
+        m.seed = static_cast<uint64>(v);
+    }
+    return m;
+}
+
+String sidecarPathOf(const String& path)
+{
+    return path + ".yml";
+}
+
+namespace {
+
+String lowerExtensionOf(const String& path)
+{
+    const size_t dot = path.find_last_of('.');
+    const size_t slash = path.find_last_of('/');
+    if (dot == String::npos || (slash != String::npos && dot < slash))
+        return String();
+    String ext = path.substr(dot);
+    for (char& ch : ext)
+        ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    return ext;
+}
+
+} // namespace
+
+void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& metadata)
+{
+    const Mat mosaic = _mosaic.getMat();
+    const String ext = lowerExtensionOf(path);
+    const bool tiff = ext == ".tif" || ext == ".tiff";
+    if (ext != ".png" && ext != ".dng" && !tiff)
+        CV_Error(Error::StsBadArg, "writeMosaic: '" + path +
+                                       "': unsupported extension; expected .png, .tif, "
+                                       ".tiff or .dng");
+    if (mosaic.empty() || (mosaic.type() != CV_16UC1 && !(tiff && mosaic.type() == CV_32FC1)))
+        CV_Error(Error::StsBadArg,
+                 cv::format("writeMosaic: '%s': a %s mosaic cannot be stored as %s; expected CV_16UC1%s",
+                            path.c_str(), mosaic.empty() ? "empty" : typeToString(mosaic.type()).c_str(),
+                            ext.c_str(), tiff ? " or CV_32FC1" : " (TIFF also takes CV_32FC1)"));
+    if (detail::fileExists(path))
+        CV_Error(Error::StsError, "writeMosaic: '" + path + "' already exists; it is never overwritten");
+    MosaicMetadata meta = metadata;
+    meta.size = mosaic.size();
+    meta.type = mosaic.type();
+    const String sidecar = sidecarPathOf(path);
+    detail::writeFileStorageAtomically(sidecar, [&](FileStorage& fs) { meta.write(fs, "mosaic_metadata"); });
+    if (ext == ".dng") {
+        RawImage image;
+        image.mosaic = mosaic;
+        image.format = meta.format;
+        writeDng(path, image);
+        return;
+    }
+    std::vector<uchar> bytes;
+    const std::vector<int> params = tiff ? std::vector<int>{IMWRITE_TIFF_COMPRESSION, 1} : std::vector<int>{};
+    bool encoded = false;
+    try {
+        encoded = imencode(ext, mosaic, bytes, params);
+    } catch (const Exception& e) {
+        CV_Error(Error::StsError, "writeMosaic: '" + path + "': encoding failed: " + e.err);
+    }
+    if (!encoded)
+        CV_Error(Error::StsError,
+                 "writeMosaic: '" + path + "': OpenCV could not encode the mosaic as " + ext);
+    detail::writeBytesAtomically(path, bytes.data(), bytes.size(), false);
+}
+
+MosaicMetadata readMosaic(const String& path, OutputArray _mosaic)
+{
+    const String sidecar = sidecarPathOf(path);
+    if (!detail::fileExists(path))
+        CV_Error(Error::StsError, "readMosaic: '" + path + "': no such file");
+    const MosaicMetadata meta =
+        detail::loadFileStorage(sidecar, "mosaic_metadata", "mosaic sidecar",
+                                [](const FileNode& n) { return MosaicMetadata::read(n); });
+    Mat mosaic;
+    if (lowerExtensionOf(path) == ".dng")
+        mosaic = readRaw(path).mosaic;
+    else
+        mosaic = imread(path, IMREAD_UNCHANGED);
+    if (mosaic.empty())
+        CV_Error(Error::StsError, "readMosaic: '" + path + "': OpenCV cannot decode it");
+    if (mosaic.size() != meta.size || mosaic.type() != meta.type)
+        CV_Error(Error::StsError,
+                 cv::format("readMosaic: '%s' is %dx%d %s but its sidecar says %dx%d %s", path.c_str(),
+                            mosaic.cols, mosaic.rows, typeToString(mosaic.type()).c_str(), meta.size.width,
+                            meta.size.height, typeToString(meta.type).c_str()));
+    _mosaic.assign(mosaic);
+    return meta;
+}
+
+} // namespace rawgment
+} // namespace cv

@@ -1,0 +1,279 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "test_common.hpp"
+
+#include <opencv2/rawgment/raw_io.hpp>
+
+#include <cstdio>
+#include <dirent.h>
+#include <fstream>
+#include <iterator>
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+namespace {
+
+using test::makeTempDir;
+
+std::vector<char> readBytes(const std::string& path)
+{
+    std::ifstream f(path, std::ios::binary);
+    return std::vector<char>(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+void writeBytes(const std::string& path, const std::vector<char>& bytes)
+{
+    std::ofstream f(path, std::ios::binary);
+    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    ASSERT_TRUE(f.good()) << "cannot write " << path;
+}
+
+std::vector<std::string> filesIn(const std::string& dir)
+{
+    std::vector<std::string> names;
+    DIR* d = opendir(dir.c_str());
+    if (!d)
+        return names;
+    while (dirent* e = readdir(d))
+        if (e->d_name[0] != '.')
+            names.push_back(e->d_name);
+    closedir(d);
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+TEST(RawIo, colorchartDngHasTheLevelsLibRawReports)
+{
+    RAWGMENT_DATA_FILE_OR_SKIP(path, "colorchart.dng");
+    const RawImage img = readRaw(path);
+    EXPECT_EQ(Size(1734, 1156), img.mosaic.size());
+    EXPECT_EQ(CV_16UC1, img.mosaic.type());
+    EXPECT_EQ(CFA_RGGB, img.format.pattern);
+    EXPECT_EQ(Vec4d::all(2056), img.format.blackLevel);
+    EXPECT_EQ(15000, img.format.whiteLevel);
+    EXPECT_EQ(1.0, img.format.gain);
+    EXPECT_EQ("Canon", img.make);
+    EXPECT_EQ(0, img.iso) << "SOURCES.md: no ISO in the metadata";
+    // A camera's as-shot white balance boosts red and blue relative to green under indoor light.
+    EXPECT_GT(img.whiteBalance[0], 1.0);
+    EXPECT_GT(img.whiteBalance[2], 1.0);
+    for (int i = 0; i < 3; ++i)
+        EXPECT_NEAR(1.0, img.cameraToSrgb(i, 0) + img.cameraToSrgb(i, 1) + img.cameraToSrgb(i, 2), 1e-3)
+            << "LibRaw normalises each row of rgb_cam to 1";
+    double minVal, maxVal;
+    minMaxLoc(img.mosaic, &minVal, &maxVal);
+    EXPECT_GT(minVal, 1500) << "the data sits on a 2056 black level";
+    EXPECT_LE(maxVal, 16383) << "14-bit data";
+}
+
+struct CameraFile
+{
+    const char* name;
+    Size visible;
+    CfaPattern pattern;
+    double black;
+    double white;
+    double iso;
+};
+
+class RawIoCamera : public ::testing::TestWithParam<CameraFile>
+{
+};
+
+TEST_P(RawIoCamera, readsVisibleAreaPatternAndLevels)
+{
+    const CameraFile& f = GetParam();
+    RAWGMENT_DATA_FILE_OR_SKIP(path, f.name);
+    const RawImage img = readRaw(path);
+    EXPECT_EQ(f.visible, img.mosaic.size());
+    EXPECT_EQ(cfaPatternName(f.pattern), cfaPatternName(img.format.pattern));
+    EXPECT_EQ(Vec4d::all(f.black), img.format.blackLevel);
+    EXPECT_EQ(f.white, img.format.whiteLevel);
+    EXPECT_EQ(f.iso, img.iso);
+}
+
+// Values from ../shared/data/SOURCES.md (as LibRaw 0.20 reports them).
+INSTANTIATE_TEST_CASE_P(
+    SharedData, RawIoCamera,
+    ::testing::Values(CameraFile{"RAW_NIKON_D1.NEF", Size(2012, 1324), CFA_BGGR, 0, 4095, 200},
+                      CameraFile{"RAW_CANON_D30_SRGB.CRW", Size(2176, 1448), CFA_RGGB, 126, 4095, 100},
+                      CameraFile{"RAW_KODAK_DC50.KDC", Size(768, 512), CFA_GRBG, 0, 16383, 84}));
+
+TEST(RawIo, nikonExposureTimeIsRead)
+{
+    RAWGMENT_DATA_FILE_OR_SKIP(path, "RAW_NIKON_D1.NEF");
+    EXPECT_NEAR(1.0 / 250, readRaw(path).exposureTime, 1e-6);
+}
+
+class RawIoDngPattern : public ::testing::TestWithParam<CfaPattern>
+{
+};
+
+TEST_P(RawIoDngPattern, writtenDngReadsBackExactlyThroughLibRaw)
+{
+    const std::string dir = makeTempDir("raw_io_dng");
+    RawImage img;
+    img.mosaic.create(48, 64, CV_16UC1);
+    randu(img.mosaic, 0, 4096);
+    img.format.pattern = GetParam();
+    img.format.blackLevel = Vec4d(100, 101, 102, 103);
+    img.format.whiteLevel = 4000;
+    img.iso = 400;
+    img.exposureTime = 0.01;
+    img.make = "Rawgment";
+    img.model = "Simulated Sensor";
+    img.whiteBalance = Vec3d(2.0, 1.0, 1.5);
+    const std::string path = dir + "/" + cfaPatternName(GetParam()) + ".dng";
+    writeDng(path, img);
+    const RawImage back = readRaw(path);
+    EXPECT_EQ(0, norm(img.mosaic, back.mosaic, NORM_INF));
+    EXPECT_EQ(cfaPatternName(img.format.pattern), cfaPatternName(back.format.pattern));
+    EXPECT_EQ(img.format.blackLevel, back.format.blackLevel) << "per-site blacks must follow the phase";
+    EXPECT_EQ(img.format.whiteLevel, back.format.whiteLevel);
+    EXPECT_EQ(img.iso, back.iso);
+    EXPECT_NEAR(img.exposureTime, back.exposureTime, 1e-6);
+    EXPECT_EQ(img.make, back.make);
+    EXPECT_EQ(img.model, back.model);
+    // AsShotNeutral holds 6 significant digits.
+    EXPECT_NEAR(2.0, back.whiteBalance[0], 1e-4);
+    EXPECT_NEAR(1.5, back.whiteBalance[2], 1e-4);
+    EXPECT_CV_ERROR_CONTAINS(writeDng(path, img), "already exists");
+}
+
+INSTANTIATE_TEST_CASE_P(AllPatterns, RawIoDngPattern,
+                        ::testing::Values(CFA_RGGB, CFA_BGGR, CFA_GRBG, CFA_GBRG));
+
+TEST(RawIo, writeDngRejectsWhatDngCannotHold)
+{
+    const std::string dir = makeTempDir("raw_io_dng_bad");
+    RawImage img;
+    img.mosaic = Mat(4, 4, CV_32FC1, Scalar(1));
+    EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "CV_16UC1");
+    img.mosaic = Mat(5, 4, CV_16UC1, Scalar(1));
+    EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "even");
+    img.mosaic = Mat(4, 4, CV_16UC1, Scalar(1));
+    img.format.blackLevel = Vec4d(10.5, 10, 10, 10);
+    EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "not an integer");
+    EXPECT_TRUE(filesIn(dir).empty()) << "a refused write leaves nothing behind";
+}
+
+TEST(RawIo, missingUnreadableAndNonRawFilesNameTheFileAndTheReason)
+{
+    const std::string dir = makeTempDir("raw_io_errors");
+    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/nothing.dng"), "nothing.dng': no such file");
+    EXPECT_CV_ERROR_CONTAINS(readRaw(""), "empty");
+    writeBytes(dir + "/text.dng", std::vector<char>(1000, 'x'));
+    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/text.dng"), "text.dng': LibRaw cannot open it");
+    RAWGMENT_DATA_FILE_OR_SKIP(jpeg, "colorchecker_photo_1.jpg");
+    EXPECT_CV_ERROR_CONTAINS(readRaw(jpeg), "LibRaw cannot open it");
+}
+
+TEST(RawIo, truncatedFileIsAnError)
+{
+    const std::string dir = makeTempDir("raw_io_truncated");
+    RawImage img;
+    img.mosaic.create(200, 300, CV_16UC1);
+    randu(img.mosaic, 0, 4096);
+    img.format.whiteLevel = 4095;
+    writeDng(dir + "/whole.dng", img);
+    std::vector<char> bytes = readBytes(dir + "/whole.dng");
+    bytes.resize(bytes.size() / 2);
+    writeBytes(dir + "/half.dng", bytes);
+    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/half.dng"), "half.dng': ");
+    try {
+        readRaw(dir + "/half.dng");
+    } catch (const Exception& e) {
+        EXPECT_NE(std::string::npos, e.err.find("truncated")) << e.err;
+    }
+}
+
+TEST(RawIo, linearDngIsNotABayerMosaic)
+{
+    const std::string dir = makeTempDir("raw_io_linear");
+    RawImage img;
+    // LibRaw ignores images narrower than 22 pixels, so the linear image is 22 wide.
+    img.mosaic = Mat(64, 66, CV_16UC1, Scalar(500));
+    img.format.whiteLevel = 4095;
+    writeDng(dir + "/cfa.dng", img);
+    std::vector<char> bytes = readBytes(dir + "/cfa.dng");
+    // Make it a 3-sample LinearRaw image (demosaiced data): PhotometricInterpretation 32803 -> 34892,
+    // SamplesPerPixel 1 -> 3, ImageWidth 66 -> 22 so that the strip still holds every sample.
+    const auto patchEntry = [&](uint16_t tag, uint16_t value) {
+        for (size_t i = 10; i + 12 <= bytes.size(); i += 12)
+            if (uint8_t(bytes[i]) == (tag & 0xff) && uint8_t(bytes[i + 1]) == (tag >> 8)) {
+                bytes[i + 8] = char(value & 0xff);
+                bytes[i + 9] = char(value >> 8);
+                return true;
+            }
+        return false;
+    };
+    const bool patched = patchEntry(262, 34892) && patchEntry(277, 3) && patchEntry(256, 22);
+    ASSERT_TRUE(patched);
+    writeBytes(dir + "/linear.dng", bytes);
+    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/linear.dng"), "not a Bayer mosaic");
+}
+
+TEST(RawIo, mosaicRoundTripsWithItsSidecarInEveryContainer)
+{
+    const std::string dir = makeTempDir("raw_io_mosaic");
+    Mat m16(32, 48, CV_16UC1);
+    randu(m16, 0, 65536);
+    MosaicMetadata meta;
+    meta.format.pattern = CFA_GBRG;
+    meta.format.blackLevel = Vec4d(64, 64, 64, 64);
+    meta.format.whiteLevel = 65535;
+    meta.format.gain = 3.98;
+    meta.hasScene = true;
+    meta.scene.jitter.brightness = -2.5;
+    meta.scene.jitter.gainRatio = 2.0;
+    meta.seed = 18446744073709551557ull; // the largest 64-bit prime: the seed needs all 64 bits
+    meta.source = "input.dng";
+    for (const char* ext : {".png", ".tif", ".dng"}) {
+        const std::string path = dir + "/out" + ext;
+        writeMosaic(path, m16, meta);
+        Mat back;
+        const MosaicMetadata r = readMosaic(path, back);
+        SCOPED_TRACE(ext);
+        EXPECT_EQ(0, norm(m16, back, NORM_INF));
+        EXPECT_EQ(cfaPatternName(CFA_GBRG), cfaPatternName(r.format.pattern));
+        EXPECT_EQ(3.98, r.format.gain) << "the new gain travels in the sidecar";
+        EXPECT_TRUE(r.hasScene);
+        EXPECT_EQ(-2.5, r.scene.jitter.brightness);
+        EXPECT_EQ(2.0, r.scene.jitter.gainRatio);
+        EXPECT_EQ(meta.seed, r.seed);
+        EXPECT_EQ("input.dng", r.source);
+        EXPECT_CV_ERROR_CONTAINS(writeMosaic(path, m16, meta), "never overwritten");
+    }
+    Mat f32(32, 48, CV_32FC1);
+    randu(f32, -5.0, 1000.0);
+    writeMosaic(dir + "/float.tiff", f32, meta);
+    Mat back;
+    readMosaic(dir + "/float.tiff", back);
+    EXPECT_EQ(0, norm(f32, back, NORM_INF)) << "float TIFF is lossless";
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/float.png", f32, meta), "cannot be stored as .png");
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/x.jpg", m16, meta), "unsupported extension");
+    const std::vector<std::string> expected = {"float.tiff", "float.tiff.yml", "out.dng", "out.dng.yml",
+                                               "out.png",    "out.png.yml",    "out.tif", "out.tif.yml"};
+    EXPECT_EQ(expected, filesIn(dir)) << "no temporary files are left behind";
+}
+
+TEST(RawIo, readMosaicChecksTheSidecar)
+{
+    const std::string dir = makeTempDir("raw_io_sidecar");
+    Mat m(8, 8, CV_16UC1, Scalar(7));
+    MosaicMetadata meta;
+    writeMosaic(dir + "/a.png", m, meta);
+    Mat back;
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/b.png", back), "no such file");
+    ASSERT_EQ(0, std::remove((dir + "/a.png.yml").c_str()));
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/a.png", back), "cannot open mosaic sidecar");
+    // A sidecar that describes another image.
+    Mat other(4, 4, CV_16UC1, Scalar(1));
+    writeMosaic(dir + "/c.png", other, meta);
+    ASSERT_EQ(0, std::rename((dir + "/c.png.yml").c_str(), (dir + "/a.png.yml").c_str()));
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/a.png", back), "but its sidecar says 4x4");
+}
+
+} // namespace
+} // namespace rawgment
+} // namespace cv
