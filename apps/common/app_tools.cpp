@@ -1,0 +1,259 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "app_tools.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace rawgment_apps {
+
+namespace {
+
+std::string temporaryBeside(const std::string& path)
+{
+    static std::atomic<unsigned> counter{0};
+    const std::string dir = directoryOf(path), name = path.substr(path.find_last_of('/') + 1);
+    // The temporary keeps the extension so that encoders that look at it still work.
+    return dir + "/.tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" + name;
+}
+
+void writeBytesAtomically(const std::string& path, const char* data, size_t size)
+{
+    const std::string tmp = temporaryBeside(path);
+    FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f)
+        throw std::runtime_error("cannot open '" + tmp + "' for writing: " + std::strerror(errno));
+    const bool ok = std::fwrite(data, 1, size, f) == size && std::fflush(f) == 0;
+    const int err = errno;
+    if (std::fclose(f) != 0 || !ok) {
+        std::remove(tmp.c_str());
+        throw std::runtime_error("cannot write '" + path + "': " + std::strerror(ok ? errno : err));
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        const int e = errno;
+        std::remove(tmp.c_str());
+        throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "': " + std::strerror(e));
+    }
+}
+
+} // namespace
+
+bool pathExists(const std::string& path)
+{
+    return ::access(path.c_str(), F_OK) == 0;
+}
+
+void makeDirectories(const std::string& path)
+{
+    if (path.empty())
+        return;
+    std::string partial;
+    std::stringstream parts(path);
+    std::string part;
+    if (path[0] == '/')
+        partial = "/";
+    while (std::getline(parts, part, '/')) {
+        if (part.empty())
+            continue;
+        partial += part + "/";
+        if (::mkdir(partial.c_str(), 0777) != 0 && errno != EEXIST)
+            throw std::runtime_error("cannot create directory '" + partial + "': " + std::strerror(errno));
+    }
+    struct stat st;
+    if (::stat(path.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+        throw std::runtime_error("'" + path + "' is not a directory");
+}
+
+std::string directoryOf(const std::string& path)
+{
+    const size_t slash = path.find_last_of('/');
+    if (slash == std::string::npos)
+        return ".";
+    return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+std::string stemOf(const std::string& path)
+{
+    const size_t slash = path.find_last_of('/');
+    std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+    const size_t dot = name.find_last_of('.');
+    return dot == std::string::npos || dot == 0 ? name : name.substr(0, dot);
+}
+
+std::string resolvePath(const std::string& base, const std::string& path)
+{
+    if (path.empty() || path[0] == '/' || base.empty())
+        return path;
+    return base + "/" + path;
+}
+
+void writeTextAtomically(const std::string& path, const std::string& text)
+{
+    writeBytesAtomically(path, text.data(), text.size());
+}
+
+void writeImageAtomically(const std::string& path, const cv::Mat& image)
+{
+    const size_t dot = path.find_last_of('.');
+    if (dot == std::string::npos)
+        throw std::runtime_error("'" + path + "': no image extension");
+    std::vector<uchar> bytes;
+    if (!cv::imencode(path.substr(dot), image, bytes))
+        throw std::runtime_error("cannot encode '" + path + "'");
+    writeBytesAtomically(path, reinterpret_cast<const char*>(bytes.data()), bytes.size());
+}
+
+std::vector<double> parseNumberList(const std::string& text)
+{
+    std::vector<double> values;
+    std::stringstream items(text);
+    std::string item;
+    while (std::getline(items, item, ',')) {
+        char* end = nullptr;
+        const double v = std::strtod(item.c_str(), &end);
+        if (item.empty() || *end != '\0' || !std::isfinite(v))
+            throw std::invalid_argument("'" + item + "' in '" + text + "' is not a number");
+        values.push_back(v);
+    }
+    if (values.empty())
+        throw std::invalid_argument("the list '" + text + "' is empty");
+    return values;
+}
+
+ProgressBar::ProgressBar(std::string label, size_t total)
+    : label_(std::move(label)), total_(total), interactive_(::isatty(STDERR_FILENO) != 0),
+      start_(std::chrono::steady_clock::now()), lastDraw_(start_)
+{
+}
+
+void ProgressBar::advance(size_t steps)
+{
+    std::lock_guard<std::mutex> lock(mutex_);
+    done_ += steps;
+    const auto now = std::chrono::steady_clock::now();
+    if (interactive_ && (now - lastDraw_ > std::chrono::milliseconds(100) || done_ == total_)) {
+        lastDraw_ = now;
+        draw(false);
+    }
+}
+
+void ProgressBar::finish()
+{
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (finished_)
+        return;
+    finished_ = true;
+    draw(true);
+}
+
+void ProgressBar::draw(bool final)
+{
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double fraction = total_ ? double(done_) / double(total_) : 1.0;
+    const int width = 30, filled = static_cast<int>(fraction * width + 0.5);
+    std::string bar(size_t(filled), '#');
+    bar.resize(width, '.');
+    const double eta = fraction > 0 ? seconds * (1 - fraction) / fraction : 0;
+    std::fprintf(stderr, "%s%s [%s] %zu/%zu  %.1f s%s", interactive_ ? "\r" : "", label_.c_str(), bar.c_str(),
+                 done_, total_, final ? seconds : eta, final ? " total\n" : " left ");
+    std::fflush(stderr);
+}
+
+CsvTable::CsvTable(std::vector<std::string> header) : header_(std::move(header)) {}
+
+void CsvTable::addRow(const std::vector<std::string>& cells)
+{
+    if (cells.size() != header_.size())
+        throw std::logic_error("CSV row has " + std::to_string(cells.size()) + " cells for " +
+                               std::to_string(header_.size()) + " columns");
+    std::string line;
+    for (size_t i = 0; i < cells.size(); ++i)
+        line += (i ? "," : "") + cells[i];
+    rows_.push_back(line);
+}
+
+void CsvTable::addRow(const std::vector<double>& values)
+{
+    std::vector<std::string> cells;
+    for (double v : values)
+        cells.push_back(formatNumber(v));
+    addRow(cells);
+}
+
+void CsvTable::write(const std::string& path) const
+{
+    std::string text;
+    for (size_t i = 0; i < header_.size(); ++i)
+        text += (i ? "," : "") + header_[i];
+    text += "\n";
+    for (const std::string& row : rows_)
+        text += row + "\n";
+    writeTextAtomically(path, text);
+}
+
+std::string formatNumber(double value)
+{
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.10g", value);
+    return buf;
+}
+
+bool gnuplotAvailable()
+{
+    return std::system("gnuplot --version > /dev/null 2>&1") == 0;
+}
+
+bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, std::string& message)
+{
+    const std::string scriptPath = pngPath + ".gp";
+    const std::string tmpPng = temporaryBeside(pngPath);
+    std::string script = "set terminal pngcairo size 1100,750 enhanced font 'DejaVu Sans,11'\n";
+    script += "set datafile separator ','\n";
+    script += "set output '" + tmpPng + "'\n" + scriptBody + "\nunset output\n";
+    // The saved script writes the final name, so that a user can re-run it as it is.
+    std::string saved = script;
+    saved.replace(saved.find(tmpPng), tmpPng.size(), pngPath);
+    writeTextAtomically(scriptPath, saved);
+    const std::string tmpScript = temporaryBeside(scriptPath);
+    writeTextAtomically(tmpScript, script);
+    if (!gnuplotAvailable()) {
+        std::remove(tmpScript.c_str());
+        message =
+            "gnuplot is not installed (apt-get install gnuplot-nox); plot with: gnuplot '" + scriptPath + "'";
+        return false;
+    }
+    const std::string command = "gnuplot '" + tmpScript + "' 2>&1";
+    FILE* pipe = ::popen(command.c_str(), "r");
+    std::string output;
+    if (pipe) {
+        char buf[512];
+        while (std::fgets(buf, sizeof buf, pipe))
+            output += buf;
+    }
+    const int status = pipe ? ::pclose(pipe) : -1;
+    std::remove(tmpScript.c_str());
+    if (status != 0 || !pathExists(tmpPng)) {
+        std::remove(tmpPng.c_str());
+        message = "gnuplot failed on '" + scriptPath + "': " + output;
+        return false;
+    }
+    if (std::rename(tmpPng.c_str(), pngPath.c_str()) != 0) {
+        std::remove(tmpPng.c_str());
+        message = "cannot rename the plot to '" + pngPath + "': " + std::strerror(errno);
+        return false;
+    }
+    message.clear();
+    return true;
+}
+
+} // namespace rawgment_apps

@@ -1,0 +1,83 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// What the apps and samples share and the library must not hold (DESIGN.md): file output, progress,
+// command-line lists, CSV and plots.
+#ifndef RAWGMENT_APPS_APP_TOOLS_HPP
+#define RAWGMENT_APPS_APP_TOOLS_HPP
+
+#include <opencv2/core.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace rawgment_apps {
+
+//! Whether a file or directory exists.
+bool pathExists(const std::string& path);
+//! Creates a directory and its parents (like mkdir -p); throws std::runtime_error naming the path.
+void makeDirectories(const std::string& path);
+//! The directory part of a path ("." when there is none).
+std::string directoryOf(const std::string& path);
+//! The file name without directory and without its last extension.
+std::string stemOf(const std::string& path);
+//! `path` resolved against `base` when it is relative.
+std::string resolvePath(const std::string& base, const std::string& path);
+
+/** Writes `text` to `path` atomically: a temporary file beside it, checked writes, then rename.
+ * Throws std::runtime_error naming the file and the reason. */
+void writeTextAtomically(const std::string& path, const std::string& text);
+/** Encodes an image by the extension of `path` and writes it atomically (see writeTextAtomically). */
+void writeImageAtomically(const std::string& path, const cv::Mat& image);
+
+//! Comma-separated numbers ("0,6,12"); throws std::invalid_argument naming the bad item.
+std::vector<double> parseNumberList(const std::string& text);
+
+/** A one-line progress bar on stderr, safe to advance from several threads. Prints nothing when
+ * stderr is not a terminal, except a final summary line. */
+class ProgressBar
+{
+public:
+    ProgressBar(std::string label, size_t total);
+    void advance(size_t steps = 1);
+    void finish();
+
+private:
+    void draw(bool final);
+    std::string label_;
+    size_t total_, done_ = 0;
+    bool interactive_, finished_ = false;
+    std::mutex mutex_;
+    std::chrono::steady_clock::time_point start_, lastDraw_;
+};
+
+/** A CSV table written atomically: a header, then rows of numbers or text. */
+class CsvTable
+{
+public:
+    explicit CsvTable(std::vector<std::string> header);
+    void addRow(const std::vector<std::string>& cells);
+    void addRow(const std::vector<double>& values);
+    void write(const std::string& path) const;
+    size_t rows() const { return rows_.size(); }
+
+private:
+    std::vector<std::string> header_;
+    std::vector<std::string> rows_;
+};
+
+//! Formats a number for CSV and reports with enough digits to round-trip a double.
+std::string formatNumber(double value);
+
+/** Runs gnuplot on a script (written beside the PNG as `<png>.gp`) that must set its output to the
+ * PNG's path. Returns false and explains how to plot by hand when gnuplot is missing or fails; the
+ * data files stay either way. The PNG appears atomically (gnuplot writes a temporary, then rename). */
+bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, std::string& message);
+
+//! Whether gnuplot can be run.
+bool gnuplotAvailable();
+
+} // namespace rawgment_apps
+
+#endif // RAWGMENT_APPS_APP_TOOLS_HPP
