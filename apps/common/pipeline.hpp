@@ -1,0 +1,130 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The work of each app as a function, so that the demo runs exactly what the apps run.
+#ifndef RAWGMENT_APPS_PIPELINE_HPP
+#define RAWGMENT_APPS_PIPELINE_HPP
+
+#include <opencv2/rawgment.hpp>
+
+#include <string>
+#include <vector>
+
+namespace rawgment_apps {
+
+//! A mosaic from any file the apps read: our mosaics with a sidecar, or camera RAW files.
+struct LoadedMosaic
+{
+    cv::Mat mosaic;
+    cv::rawgment::RawFormat format;
+};
+LoadedMosaic loadMosaicFile(const std::string& path);
+
+// ---------------------------------------------------------------------------------------------------
+struct SimulateOptions
+{
+    std::string outDir;
+    std::vector<double> gainsDb = {6, 12, 24};
+    //! Level of the white patch as a fraction of the range (white - black); one burst per level and gain.
+    std::vector<double> levels = {0.3, 0.9};
+    int frames = 100;
+    int patchSize = 40;
+    cv::rawgment::SensorParams sensor;
+    uint64_t seed = 1;
+    std::string extension = ".dng"; //!< container of the frames (.dng, .png or .tif)
+    bool validation = true;         //!< also a bright and two dark bursts (x0.5, x0.1) at validationGainDb
+    double validationGainDb = 12;
+    int validationFrames = 100;
+};
+
+struct SimulateResult
+{
+    std::string manifest;           //!< calibration manifest (YAML)
+    std::string validationManifest; //!< empty when not written
+    std::string truthModel;         //!< the model a calibration should recover
+    int files = 0;
+};
+
+/** Writes simulated colour-checker bursts, their manifests, the ground-truth patches and model.
+ * Refuses (std::runtime_error) when the manifest already exists. */
+SimulateResult simulateBursts(const SimulateOptions& options);
+
+// ---------------------------------------------------------------------------------------------------
+struct CalibrateOptions
+{
+    std::string manifest;
+    std::string outDir;
+    cv::rawgment::NoiseFitMethod method = cv::rawgment::NOISE_FIT_JOINT;
+    int side = 24;            //!< square side used when the manifest asks for detection
+    int shapiroPixels = 2000; //!< pixels per burst tested by Shapiro-Wilk (spread over the squares)
+    bool plots = true;
+};
+
+struct CalibrateResult
+{
+    cv::rawgment::CalibrationReport report;
+    std::vector<std::string> pngs;  //!< plots written
+    std::vector<std::string> notes; //!< what the user should know (plots skipped, ...)
+    double gaussianFraction = 0;    //!< fraction of tested pixels with Shapiro-Wilk p > 0.05
+    int shapiroTested = 0;
+};
+
+CalibrateResult calibrateFromManifest(const CalibrateOptions& options);
+
+// ---------------------------------------------------------------------------------------------------
+struct ValidateOptions
+{
+    std::string manifest;
+    std::string model;
+    std::string outDir;
+    int bins = 10;
+    uint64_t seed = 7;
+    bool plots = true;
+};
+
+//! Per mean bin and factor: the real dark burst's variance and each conversion's.
+struct ValidationRow
+{
+    double factor = 0;
+    double meanLow = 0, meanHigh = 0;
+    int pixels = 0;
+    double realVariance = 0;
+    double noneVariance = 0, ignoreVariance = 0, accountVariance = 0;
+};
+
+struct ValidateResult
+{
+    std::vector<ValidationRow> rows;
+    std::vector<std::string> pngs;
+    std::vector<std::string> notes;
+    std::string table; //!< Markdown
+};
+
+ValidateResult validateConversion(const ValidateOptions& options);
+
+// ---------------------------------------------------------------------------------------------------
+struct AugmentOptions
+{
+    std::vector<std::string> inputs;
+    std::string model;
+    std::string scene;  //!< a Scene file (map `scene`), or
+    std::string policy; //!< a RandomScenePolicy file
+    std::string outDir;
+    int variants = 1;
+    uint64_t seed = 1;
+    std::string extension; //!< output container; empty: .dng for RAW inputs, else the input's
+    bool previews = false;
+};
+
+struct AugmentResult
+{
+    int written = 0, skipped = 0;
+    std::vector<std::string> outputs;
+};
+
+AugmentResult augmentFiles(const AugmentOptions& options);
+
+//! An sRGB-like 8-bit preview of a mosaic (tone curve gamma 2.2 with the sRGB toe, white balance 1).
+cv::Mat previewOf(const cv::Mat& mosaic, const cv::rawgment::RawFormat& format, double exposure = 1.0);
+
+} // namespace rawgment_apps
+
+#endif // RAWGMENT_APPS_PIPELINE_HPP
