@@ -1,0 +1,199 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// End-to-end tests of the apps: each one run as a user runs it, on small inputs.
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/rawgment.hpp>
+
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+
+struct AppRun
+{
+    int status = -1;
+    std::string output;
+};
+
+std::string readText(const std::string& path)
+{
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+bool exists(const std::string& path)
+{
+    return std::ifstream(path).good();
+}
+
+//! Runs an app of this build with arguments (shell-quoted by the caller), capturing stdout and stderr.
+AppRun runApp(const std::string& app, const std::string& args)
+{
+    static int counter = 0;
+    const std::string log = ::testing::TempDir() + "/rawgment_app_" + std::to_string(::getpid()) + "_" +
+                            std::to_string(counter++) + ".log";
+    const std::string command =
+        std::string(RAWGMENT_APP_DIR) + "/" + app + " " + args + " > '" + log + "' 2>&1";
+    const int raw = std::system(command.c_str());
+    AppRun r;
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.output = readText(log);
+    std::remove(log.c_str());
+    return r;
+}
+
+std::string freshDir(const std::string& name)
+{
+    const std::string dir = ::testing::TempDir() + "/rawgment_e2e_" + name + "_" + std::to_string(::getpid());
+    const std::string command = "rm -rf '" + dir + "' && mkdir -p '" + dir + "'";
+    EXPECT_EQ(0, std::system(command.c_str()));
+    return dir;
+}
+
+bool gnuplotAvailable()
+{
+    return std::system("gnuplot --version > /dev/null 2>&1") == 0;
+}
+
+void expectPngDecodes(const std::string& path)
+{
+    if (!gnuplotAvailable() && path.find("gallery") == std::string::npos)
+        return;
+    EXPECT_FALSE(cv::imread(path).empty()) << path << " does not decode";
+}
+
+TEST(Apps, everyAppHasHelpAndRejectsBadArguments)
+{
+    for (const char* app : {"rawgment_demo", "rawgment_simulate", "rawgment_calibrate", "rawgment_validate",
+                            "rawgment_augment"}) {
+        const AppRun help = runApp(app, "--help");
+        EXPECT_EQ(0, help.status) << app;
+        EXPECT_NE(std::string::npos, help.output.find(app)) << app << " --help:\n" << help.output;
+    }
+    EXPECT_EQ(2, runApp("rawgment_simulate", "").status) << "--out is required";
+    const AppRun badList = runApp("rawgment_simulate", "--out=/nonexistent/x --gains=6,x");
+    EXPECT_NE(0, badList.status);
+    EXPECT_NE(std::string::npos, badList.output.find("'x' in '6,x' is not a number")) << badList.output;
+    EXPECT_EQ(2, runApp("rawgment_calibrate", "").status);
+    EXPECT_EQ(2, runApp("rawgment_calibrate", "m.yml --out=/tmp/x --method=magic").status);
+    EXPECT_EQ(
+        2,
+        runApp("rawgment_augment", "--model=m.yml --scene=s.yml --policy=p.yml --out=/tmp/x in.dng").status)
+        << "a scene and a policy at once";
+    const AppRun missing = runApp("rawgment_calibrate", "/nonexistent/manifest.yml --out=/tmp/never");
+    EXPECT_EQ(1, missing.status);
+    EXPECT_NE(std::string::npos, missing.output.find("no such file")) << missing.output;
+}
+
+TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
+{
+    const std::string dir = freshDir("pipeline");
+    // 1. Simulate. 32 frames keep the test short and still pin the model (tolerances below).
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=32 --seed=5");
+    ASSERT_EQ(0, r.status) << r.output;
+    ASSERT_TRUE(exists(dir + "/sim/manifest.yml"));
+    ASSERT_TRUE(exists(dir + "/sim/validation_manifest.yml"));
+    r = runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=32 --seed=5");
+    EXPECT_EQ(1, r.status) << "a second run must not overwrite the first";
+    EXPECT_NE(std::string::npos, r.output.find("already exists")) << r.output;
+
+    // 2. Calibrate.
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + dir + "/cal'");
+    ASSERT_EQ(0, r.status) << r.output;
+    const cv::rawgment::NoiseModel truth = cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
+    const cv::rawgment::NoiseModel fitted = cv::rawgment::NoiseModel::load(dir + "/cal/noise_model.yml");
+    // The joint fit's spread over seeds at 100 frames is 0.08% / 0.45% / 1.7% (README, study_calibration);
+    // a variance of 32 frames is sqrt(99/31) = 1.8x noisier. The bounds are about 5 of those spreads.
+    EXPECT_NEAR(truth.alpha, fitted.alpha, 0.01 * truth.alpha);
+    EXPECT_NEAR(truth.sigmaD2, fitted.sigmaD2, 0.04 * truth.sigmaD2);
+    EXPECT_NEAR(truth.sigmaR2, fitted.sigmaR2, 0.15 * truth.sigmaR2);
+    for (const char* f : {"calibration_report.yml", "samples.csv", "lines.csv", "shapiro.csv"})
+        EXPECT_TRUE(exists(dir + "/cal/" + f)) << f;
+    for (const char* png :
+         {"calib_mean_variance.png", "calib_histograms.png", "calib_cross_gain.png", "shapiro_pvalue.png"})
+        expectPngDecodes(dir + "/cal/" + png);
+    const std::string modelBefore = readText(dir + "/cal/noise_model.yml");
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + dir + "/cal'");
+    EXPECT_EQ(1, r.status);
+    EXPECT_EQ(modelBefore, readText(dir + "/cal/noise_model.yml"))
+        << "an existing output is never overwritten";
+
+    // 3. Validate: ACCOUNT_PRIOR matches the real darker bursts, IGNORE_PRIOR overshoots, NONE undershoots.
+    r = runApp("rawgment_validate", "'" + dir + "/sim/validation_manifest.yml' --model='" + dir +
+                                        "/cal/noise_model.yml' --out='" + dir + "/val'");
+    ASSERT_EQ(0, r.status) << r.output;
+    expectPngDecodes(dir + "/val/validation.png");
+    std::istringstream csv(readText(dir + "/val/validation.csv"));
+    std::string line;
+    std::getline(csv, line);
+    double real = 0, none = 0, ignore = 0, account = 0;
+    int rows = 0;
+    while (std::getline(csv, line)) {
+        std::vector<double> v;
+        std::stringstream cells(line);
+        std::string cell;
+        while (std::getline(cells, cell, ','))
+            v.push_back(std::stod(cell));
+        ASSERT_EQ(11u, v.size()) << line;
+        if (v[0] != 0.5)
+            continue;
+        real += v[5];
+        none += v[6];
+        ignore += v[7];
+        account += v[8];
+        ++rows;
+    }
+    ASSERT_GT(rows, 3);
+    // Pooled over ~10k pixels x 31 degrees of freedom the ratio's noise is far below 1%; 3% allows for the
+    // model error of a 32-frame calibration. The prior noise of the x0.5 conversion is half the target's
+    // signal noise, so IGNORE_PRIOR lands ~1.5x high and NONE ~0.5x low.
+    EXPECT_NEAR(1.0, account / real, 0.03);
+    EXPECT_GT(ignore / real, 1.3);
+    EXPECT_LT(none / real, 0.7);
+
+    // 4. Augment two inputs twice each with a fixed scene; a second run resumes (skips everything).
+    {
+        cv::rawgment::Scene scene;
+        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.25, 2.0);
+        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
+        scene.write(fs, "scene");
+    }
+    const std::string in0 = dir + "/sim/g06dB_level0.90/frame_000.dng",
+                      in1 = dir + "/sim/g06dB_level0.90/frame_001.dng";
+    const std::string inputBytes = readText(in0);
+    const std::string args = "--model='" + dir + "/cal/noise_model.yml' --scene='" + dir +
+                             "/scene.yml' --out='" + dir + "/aug' --variants=2 --preview=true '" + in0 +
+                             "' '" + in1 + "'";
+    r = runApp("rawgment_augment", args);
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("wrote 4 outputs")) << r.output;
+    cv::Mat out;
+    const cv::rawgment::MosaicMetadata meta = cv::rawgment::readMosaic(dir + "/aug/frame_000_v01.dng", out);
+    EXPECT_NEAR(2.0 * cv::rawgment::dbToLinearGain(6), meta.format.gain, 1e-9)
+        << "the new gain is in the sidecar";
+    EXPECT_TRUE(meta.hasScene);
+    expectPngDecodes(dir + "/aug/frame_001_v00_preview.png");
+    r = runApp("rawgment_augment", args);
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("skipped 4")) << r.output;
+    EXPECT_EQ(inputBytes, readText(in0)) << "inputs are never modified";
+}
+
+TEST(Apps, demoWritesAReportAndAGallery)
+{
+    const std::string dir = freshDir("demo");
+    AppRun r = runApp("rawgment_demo", "--out='" + dir + "/demo' --frames=8");
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string report = readText(dir + "/demo/report.md");
+    EXPECT_NE(std::string::npos, report.find("| alpha |")) << report;
+    EXPECT_NE(std::string::npos, report.find("gallery.png"));
+    expectPngDecodes(dir + "/demo/gallery.png");
+    r = runApp("rawgment_demo", "--out='" + dir + "/demo' --frames=8");
+    EXPECT_EQ(1, r.status) << "an existing report is never overwritten";
+}
+
+} // namespace
