@@ -111,7 +111,7 @@ class RawIoDngPattern : public ::testing::TestWithParam<CfaPattern>
 
 TEST_P(RawIoDngPattern, writtenDngReadsBackExactlyThroughLibRaw)
 {
-    const std::string dir = makeTempDir("raw_io_dng");
+    const std::string dir = makeTempDir("raw_io_dng_" + cfaPatternName(GetParam()));
     RawImage img;
     img.mosaic.create(48, 64, CV_16UC1);
     randu(img.mosaic, 0, 4096);
