@@ -9,6 +9,7 @@ bash "$root/scripts/install-deps.sh"
 # Sanitizer findings must stop the run: UBSan halts (the build also sets -fno-sanitize-recover),
 # ASan's leak checker is on.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:strict_string_checks=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/test/lsan_suppressions.txt}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}
 
 for flavour in release asan; do

@@ -122,6 +122,23 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
     EXPECT_EQ(modelBefore, readText(dir + "/cal/noise_model.yml"))
         << "an existing output is never overwritten";
 
+    // 2b. The same bursts with the patches detected by cv::mcc (the sample's method) instead of given.
+    std::string manifest = readText(dir + "/sim/manifest.yml");
+    const size_t at = manifest.find("patches.yml");
+    ASSERT_NE(std::string::npos, at);
+    manifest.replace(at - 1, std::string("\"patches.yml\"").size(), "detect");
+    {
+        std::ofstream f(dir + "/sim/manifest_detect.yml");
+        f << manifest;
+    }
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest_detect.yml' --side=12 --plots=false --out='" +
+                                         dir + "/cal_detect'");
+    ASSERT_EQ(0, r.status) << r.output << manifest;
+    EXPECT_NE(std::string::npos, r.output.find("patches detected with cv::mcc")) << r.output;
+    // A quarter of the pixels of the given squares: alpha still within 2% (about 5 of its spreads).
+    EXPECT_NEAR(truth.alpha, cv::rawgment::NoiseModel::load(dir + "/cal_detect/noise_model.yml").alpha,
+                0.02 * truth.alpha);
+
     // 3. Validate: ACCOUNT_PRIOR matches the real darker bursts, IGNORE_PRIOR overshoots, NONE undershoots.
     r = runApp("rawgment_validate", "'" + dir + "/sim/validation_manifest.yml' --model='" + dir +
                                         "/cal/noise_model.yml' --out='" + dir + "/val'");
