@@ -3,6 +3,8 @@
 //   colour jitter (ACCOUNT_PRIOR), motion blur (length 13), a full random scene,
 //   the same colour jitter composed naively with OpenCV calls (convertTo, RNG::fill NORMAL, Mat
 //   arithmetic, sqrt), and a memcpy of the frame (the floor).
+#include "perf_common.hpp"
+
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
 #include <opencv2/rawgment/augment.hpp>
@@ -18,21 +20,12 @@ const NoiseModel kModel(0.4, 0.5, 2.0);
 
 RawFormat frameFormat()
 {
-    RawFormat f;
-    f.blackLevel = Vec4d::all(256);
-    f.whiteLevel = 4095;
-    f.gain = 2;
-    return f;
+    return perf::perfFrameFormat(2);
 }
 
 const Mat& frame()
 {
-    static const Mat m = [] {
-        Mat f(3000, 4000, CV_16UC1);
-        RNG(5).fill(f, RNG::UNIFORM, 256, 4000);
-        return f;
-    }();
-    return m;
+    return perf::perfFrame();
 }
 
 const ColorJitter kJitter = ColorJitter::exposureChange(0.2, 2.0);

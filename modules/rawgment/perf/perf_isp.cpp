@@ -3,6 +3,8 @@
 //   renderSimpleIsp (bilinear, edge-aware, half size; 8-bit output),
 //   the same preview composed naively with OpenCV calls (convertTo, cv::demosaicing, cv::pow),
 //   readRaw of a 4000x3000 DNG written by writeDng, and of ../shared/data/colorchart.dng when present.
+#include "perf_common.hpp"
+
 #include <benchmark/benchmark.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/isp.hpp>
@@ -18,20 +20,12 @@ using namespace cv::rawgment;
 
 RawFormat frameFormat()
 {
-    RawFormat f;
-    f.blackLevel = Vec4d::all(256);
-    f.whiteLevel = 4095;
-    return f;
+    return perf::perfFrameFormat();
 }
 
 const Mat& frame()
 {
-    static const Mat m = [] {
-        Mat f(3000, 4000, CV_16UC1);
-        RNG(5).fill(f, RNG::UNIFORM, 256, 4000);
-        return f;
-    }();
-    return m;
+    return perf::perfFrame();
 }
 
 void BM_Isp_renderSimpleIsp(benchmark::State& state)
@@ -44,8 +38,9 @@ void BM_Isp_renderSimpleIsp(benchmark::State& state)
         benchmark::DoNotOptimize(out.data);
     }
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
-    state.SetLabel(p.demosaic == DEMOSAIC_BILINEAR ? "bilinear" : p.demosaic == DEMOSAIC_EDGE_AWARE ? "edge-aware"
-                                                                                                   : "half size");
+    state.SetLabel(p.demosaic == DEMOSAIC_BILINEAR     ? "bilinear"
+                   : p.demosaic == DEMOSAIC_EDGE_AWARE ? "edge-aware"
+                                                       : "half size");
 }
 
 void BM_Isp_naiveOpenCV(benchmark::State& state)
