@@ -302,6 +302,18 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     const std::vector<cv::Rect> squares =
         manifestSquares(root["patches"], base, specs.front().files.front(), o.side, result.notes);
 
+    // Shapiro-Wilk positions, the same in every burst: every k-th pixel of the squares, at most
+    // shapiroPixels of them.
+    std::vector<cv::Point> positions;
+    for (const cv::Rect& s : squares)
+        for (int y = s.y; y < s.br().y; ++y)
+            for (int x = s.x; x < s.br().x; ++x)
+                positions.emplace_back(x, y);
+    const size_t step = std::max<size_t>(1, positions.size() / size_t(std::max(1, o.shapiroPixels)));
+    std::vector<cv::Point> tested;
+    for (size_t k = 0; k < positions.size(); k += step)
+        tested.push_back(positions[k]);
+
     std::vector<NoiseSample> samples;
     CsvTable shapiro({"gain_db", "mean", "p_value", "W"});
     int gaussian = 0;
@@ -309,16 +321,6 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     for (const BurstSpec& spec : specs) {
         const double gain = dbToLinearGain(spec.gainDb);
         std::unique_ptr<BurstStatistics> stats;
-        // Shapiro-Wilk positions: every k-th pixel of the squares, at most shapiroPixels of them.
-        std::vector<cv::Point> positions;
-        for (const cv::Rect& s : squares)
-            for (int y = s.y; y < s.br().y; ++y)
-                for (int x = s.x; x < s.br().x; ++x)
-                    positions.emplace_back(x, y);
-        const size_t step = std::max<size_t>(1, positions.size() / size_t(std::max(1, o.shapiroPixels)));
-        std::vector<cv::Point> tested;
-        for (size_t k = 0; k < positions.size(); k += step)
-            tested.push_back(positions[k]);
         cv::Mat series(int(spec.files.size()), int(tested.size()), CV_64F);
         for (size_t t = 0; t < spec.files.size(); ++t) {
             const LoadedMosaic m = loadMosaicFile(spec.files[t]);
@@ -328,16 +330,19 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                 stats.reset(new BurstStatistics(f));
             }
             stats->add(m.mosaic);
-            cv::Mat frame64;
-            m.mosaic.convertTo(frame64, CV_64F);
+            if (t == 0)
+                for (const cv::Rect& s : squares)
+                    if ((s & cv::Rect(cv::Point(), stats->size())) != s)
+                        throw std::runtime_error(
+                            cv::format("square at (%d, %d) lies outside the %dx%d frames", s.x, s.y,
+                                       stats->size().width, stats->size().height));
+            // stats->add() has checked the size and the type (CV_16UC1 or CV_32FC1).
+            const bool integer = m.mosaic.depth() == CV_16U;
             for (size_t k = 0; k < tested.size(); ++k)
-                series.at<double>(int(t), int(k)) = frame64.at<double>(tested[k]);
+                series.at<double>(int(t), int(k)) =
+                    integer ? m.mosaic.at<ushort>(tested[k]) : double(m.mosaic.at<float>(tested[k]));
             progress.advance();
         }
-        for (const cv::Rect& s : squares)
-            if ((s & cv::Rect(cv::Point(), stats->size())) != s)
-                throw std::runtime_error(cv::format("square at (%d, %d) lies outside the %dx%d frames", s.x,
-                                                    s.y, stats->size().width, stats->size().height));
         const std::vector<NoiseSample> burstSamples = sampleBurstPatches(*stats, squares, gain);
         samples.insert(samples.end(), burstSamples.begin(), burstSamples.end());
         std::vector<ShapiroWilkResult> sw;

@@ -179,12 +179,8 @@ TEST(RawIo, truncatedFileIsAnError)
     std::vector<char> bytes = readBytes(dir + "/whole.dng");
     bytes.resize(bytes.size() / 2);
     writeBytes(dir + "/half.dng", bytes);
-    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/half.dng"), "half.dng': ");
-    try {
-        readRaw(dir + "/half.dng");
-    } catch (const Exception& e) {
-        EXPECT_NE(std::string::npos, e.err.find("truncated")) << e.err;
-    }
+    // LibRaw reports an I/O error while decoding ("truncated or corrupt?") or calls the data-error handler.
+    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/half.dng"), "truncated");
 }
 
 TEST(RawIo, linearDngIsNotABayerMosaic)
