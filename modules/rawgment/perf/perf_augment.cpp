@@ -1,6 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Augmentation of a 4000x3000 CV_16UC1 mosaic, all in one run:
-//   colour jitter (ACCOUNT_PRIOR), motion blur (length 13), a full random scene,
+//   colour jitter (ACCOUNT_PRIOR), motion blur (length 13), scaling by 3%, a full random scene,
 //   the same colour jitter composed naively with OpenCV calls (convertTo, RNG::fill NORMAL, Mat
 //   arithmetic, sqrt), and a memcpy of the frame (the floor).
 #include "perf_common.hpp"
@@ -79,6 +79,17 @@ void BM_Augment_motionBlur13(benchmark::State& state)
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
 }
 
+void BM_Augment_scale103(benchmark::State& state)
+{
+    Mat out;
+    uint64 seed = 0;
+    for (auto _ : state) {
+        scaleMosaic(frame(), frameFormat(), kModel, 1.03, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out);
+        benchmark::DoNotOptimize(out.data);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+}
+
 void BM_Augment_randomScene(benchmark::State& state)
 {
     RandomScenePolicy policy;
@@ -109,6 +120,7 @@ BENCHMARK(BM_Augment_memcpy)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Augment_colorJitter)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Augment_colorJitterNaiveOpenCV)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Augment_motionBlur13)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Augment_scale103)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Augment_randomScene)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 } // namespace

@@ -40,16 +40,6 @@ void checkAlignment(NoiseAlignment a)
         CV_Error(Error::StsBadArg, format("unknown NoiseAlignment %d", static_cast<int>(a)));
 }
 
-template <typename T> inline T storeValue(float v, float white);
-template <> inline ushort storeValue<ushort>(float v, float white)
-{
-    return static_cast<ushort>(cvRound(std::min(std::max(v, 0.f), white)));
-}
-template <> inline float storeValue<float>(float v, float white)
-{
-    return std::min(std::max(v, 0.f), white);
-}
-
 struct JitterConstants
 {
     float pc[4], black[4];
@@ -58,48 +48,109 @@ struct JitterConstants
     NoiseAlignment alignment;
 };
 
+// One row of Eq. 11/13, written so that the compiler vectorises it: no branches, per-column constants
+// in arrays (the CFA site alternates along the row), float arithmetic in a fixed order. Returns the
+// number of brightening pixels. Rounding to 16 bits adds 0.5 and truncates (the value is clipped to
+// [0, white] first): the same bits in every vector width.
+template <typename T, NoiseAlignment A>
+inline int jitterRowBody(const T* s, T* d, const float* z, const float* pc, const float* black,
+                         const JitterConstants& k, int cols)
+{
+    const float pg = k.pg, pg2 = k.pg * k.pg, pb = k.pb, white = k.white;
+    const float shotA = pg2 * k.shot, readA = pg2 * k.read;
+    const float shotI = pg * k.shot, floorI = pg2 * k.read + k.post;
+    int bright = 0;
+    for (int c = 0; c < cols; ++c) {
+        const float x = static_cast<float>(s[c]) - black[c];
+        const float mean = pc[c] * x + pb;
+        float out = mean;
+        if (A == NoiseAlignment::ACCOUNT_PRIOR) {
+            const float xf = std::max(x, 1.0f);
+            const float pu = std::max((pc[c] * xf + pb) / (xf * pg), 0.0f);
+            const float mu = std::max(x, 0.0f);
+            const float v = pu * (1 - pu) * shotA * mu + (1 - pu * pu) * readA + (1 - pu * pu * pg2) * k.post;
+            bright += v < 0 ? 1 : 0;
+            out = mean + std::sqrt(std::max(v, 0.0f)) * z[c];
+        } else if (A == NoiseAlignment::IGNORE_PRIOR) {
+            const float v = shotI * std::max(mean, 0.0f) + floorI;
+            out = mean + std::sqrt(std::max(v, 0.0f)) * z[c];
+        }
+        out = std::min(std::max(out + black[c], 0.0f), white);
+        if (std::is_same<T, ushort>::value)
+            d[c] = static_cast<T>(static_cast<int>(out + 0.5f));
+        else
+            d[c] = static_cast<T>(out);
+    }
+    return bright;
+}
+
+RAWGMENT_HOT_KERNEL
+int jitterRow16u(const ushort* s, ushort* d, const float* z, const float* pc, const float* black,
+                 const JitterConstants& k, int cols)
+{
+    switch (k.alignment) {
+    case NoiseAlignment::ACCOUNT_PRIOR:
+        return jitterRowBody<ushort, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, pc, black, k, cols);
+    case NoiseAlignment::IGNORE_PRIOR:
+        return jitterRowBody<ushort, NoiseAlignment::IGNORE_PRIOR>(s, d, z, pc, black, k, cols);
+    default:
+        return jitterRowBody<ushort, NoiseAlignment::NONE>(s, d, z, pc, black, k, cols);
+    }
+}
+
+RAWGMENT_HOT_KERNEL
+int jitterRow32f(const float* s, float* d, const float* z, const float* pc, const float* black,
+                 const JitterConstants& k, int cols)
+{
+    switch (k.alignment) {
+    case NoiseAlignment::ACCOUNT_PRIOR:
+        return jitterRowBody<float, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, pc, black, k, cols);
+    case NoiseAlignment::IGNORE_PRIOR:
+        return jitterRowBody<float, NoiseAlignment::IGNORE_PRIOR>(s, d, z, pc, black, k, cols);
+    default:
+        return jitterRowBody<float, NoiseAlignment::NONE>(s, d, z, pc, black, k, cols);
+    }
+}
+
 template <typename T>
-void jitterRows(const Mat& src, Mat& dst, Mat* mask, const JitterConstants& k, uint64_t seed,
-                const Range& rows, std::atomic<int64>& brightening, std::atomic<int64>& saturated)
+void jitterRows(const Mat& src, Mat& dst, const JitterConstants& k, uint64_t seed, const Range& rows,
+                std::atomic<int64>& brightening)
 {
     const int cols = src.cols;
-    std::vector<float> z(cols);
-    int64 localBright = 0, localSat = 0;
-    const float pg2 = k.pg * k.pg;
+    std::vector<float> z(static_cast<size_t>(cols));
+    // Per-column constants for even rows (sites 0, 1) and odd rows (sites 2, 3).
+    std::vector<float> pcByParity(2 * static_cast<size_t>(cols)),
+        blackByParity(2 * static_cast<size_t>(cols));
+    for (int parity = 0; parity < 2; ++parity)
+        for (int c = 0; c < cols; ++c) {
+            pcByParity[static_cast<size_t>(parity * cols + c)] = k.pc[2 * parity + (c & 1)];
+            blackByParity[static_cast<size_t>(parity * cols + c)] = k.black[2 * parity + (c & 1)];
+        }
+    int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
         if (k.alignment != NoiseAlignment::NONE)
             detail::fillGaussian(seed, static_cast<uint64_t>(r), z.data(), cols);
-        const T* s = src.ptr<T>(r);
-        T* d = dst.ptr<T>(r);
-        uchar* m = mask ? mask->ptr<uchar>(r) : nullptr;
-        const int site0 = 2 * (r & 1);
-        for (int c = 0; c < cols; ++c) {
-            const int site = site0 + (c & 1);
-            const float raw = static_cast<float>(s[c]);
-            const float x = raw - k.black[site];
-            const bool sat = raw >= k.white;
-            localSat += sat ? 1 : 0;
-            if (m)
-                m[c] = sat ? 255 : 0;
-            const float mean = k.pc[site] * x + k.pb;
-            float v = 0;
-            if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR) {
-                const float xf = std::max(x, 1.0f);
-                const float pu = std::max((k.pc[site] * xf + k.pb) / (xf * k.pg), 0.0f);
-                const float mu = std::max(x, 0.0f);
-                v = pu * (1 - pu) * pg2 * k.shot * mu + (1 - pu * pu) * pg2 * k.read +
-                    (1 - pu * pu * pg2) * k.post;
-            } else if (k.alignment == NoiseAlignment::IGNORE_PRIOR) {
-                v = k.pg * k.shot * std::max(mean, 0.0f) + pg2 * k.read + k.post;
-            }
-            localBright += v < 0 ? 1 : 0;
-            v = std::max(v, 0.0f);
-            const float out = mean + std::sqrt(v) * z[c] + k.black[site];
-            d[c] = storeValue<T>(out, k.white);
-        }
+        const float* pc = pcByParity.data() + (r & 1) * cols;
+        const float* black = blackByParity.data() + (r & 1) * cols;
+        if (std::is_same<T, ushort>::value)
+            localBright += jitterRow16u(src.ptr<ushort>(r), dst.ptr<ushort>(r), z.data(), pc, black, k, cols);
+        else
+            localBright += jitterRow32f(src.ptr<float>(r), dst.ptr<float>(r), z.data(), pc, black, k, cols);
     }
     brightening += localBright;
-    saturated += localSat;
+}
+
+// Saturated pixels are only counted or masked when the caller asks: the hot loop does not pay for them.
+void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* report, OutputArray mask)
+{
+    if (!report && !mask.needed())
+        return;
+    Mat saturated;
+    compare(src, format.whiteLevel, saturated, CMP_GE);
+    if (report)
+        report->saturatedPixels += countNonZero(saturated);
+    if (mask.needed())
+        mask.assign(saturated);
 }
 
 } // namespace
@@ -138,12 +189,9 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
 
     if (jitter.isIdentity()) {
         // Skipped entirely: no copy, no random draw.
+        reportSaturation(src, format, report, saturatedMask);
         _dst.assign(src);
         dstFormat = format;
-        if (saturatedMask.needed())
-            compare(src, format.whiteLevel, saturatedMask, CMP_GE);
-        if (report)
-            report->saturatedPixels += countNonZero(src >= format.whiteLevel);
         return;
     }
     const NoiseLine line = model.lineAtGain(format.gain);
@@ -161,26 +209,20 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     k.alignment = alignment;
 
     Mat dst(src.size(), src.type());
-    Mat mask;
-    if (saturatedMask.needed())
-        mask.create(src.size(), CV_8UC1);
-    std::atomic<int64> brightening{0}, saturated{0};
+    std::atomic<int64> brightening{0};
     const uint64_t key = stepSeed(seed, 1);
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
-            jitterRows<ushort>(src, dst, mask.empty() ? nullptr : &mask, k, key, rows, brightening,
-                               saturated);
+            jitterRows<ushort>(src, dst, k, key, rows, brightening);
         else
-            jitterRows<float>(src, dst, mask.empty() ? nullptr : &mask, k, key, rows, brightening, saturated);
+            jitterRows<float>(src, dst, k, key, rows, brightening);
     });
+    reportSaturation(src, format, report, saturatedMask);
     _dst.assign(dst);
-    if (saturatedMask.needed())
-        saturatedMask.assign(mask);
     dstFormat = format;
     dstFormat.gain = newGain;
     if (report) {
         report->brighteningPixels += brightening.load();
-        report->saturatedPixels += saturated.load();
         report->steps.push_back("colorJitter");
     }
 }
@@ -242,6 +284,263 @@ bool isIdentityKernel(const Mat& kernel)
 
 } // namespace
 
+namespace {
+
+// Constants of a resampling step (blur or scale) on one mosaic: Eq. 15 with the step's weights.
+struct ResampleConstants
+{
+    float black[4];
+    float white;
+    float shot;     // g alpha
+    float floorVar; // g^2 sigma_d^2 + sigma_r^2: the read noise a weighted sum removes, (1 - sum w^2) of it
+    NoiseAlignment alignment;
+};
+
+// Plane row `planeRow` of site `site`, black-subtracted, into out[0..pad + width + pad) with the plane's
+// edge replicated `pad` columns on each side.
+template <typename T>
+void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, float* out)
+{
+    const T* s = src.ptr<T>(2 * planeRow + site / 2) + site % 2;
+    const int width = src.cols / 2;
+    for (int j = 0; j < width; ++j)
+        out[pad + j] = static_cast<float>(s[2 * j]) - black;
+    for (int j = 0; j < pad; ++j) {
+        out[j] = out[pad];
+        out[pad + width + j] = out[pad + width - 1];
+    }
+}
+
+// One kernel tap over a row: mean += w x, and for ACCOUNT_PRIOR shot += w (1 - w) max(x, 0) (the prior
+// mean is never negative), in one pass over the source row.
+RAWGMENT_HOT_KERNEL
+void addTapRow(float* mean, float* shot, const float* x, float w, float shotWeight, bool withShot, int n)
+{
+    if (withShot) {
+        for (int j = 0; j < n; ++j) {
+            mean[j] += w * x[j];
+            shot[j] += shotWeight * std::max(x[j], 0.0f);
+        }
+    } else {
+        for (int j = 0; j < n; ++j)
+            mean[j] += w * x[j];
+    }
+}
+
+// mean[j] + N(0, v): v from the per-pixel shot sum and read-noise factor (ACCOUNT_PRIOR), from the
+// mean (IGNORE_PRIOR), or none; black added back, clipped to [0, white].
+RAWGMENT_HOT_KERNEL
+void finishResampledRow(float* mean, const float* shotSum, const float* readFactor, const float* z,
+                        const ResampleConstants& k, float black, int n)
+{
+    if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR) {
+        for (int j = 0; j < n; ++j) {
+            const float v = k.shot * shotSum[j] + readFactor[j] * k.floorVar;
+            mean[j] =
+                std::min(std::max(mean[j] + std::sqrt(std::max(v, 0.0f)) * z[j] + black, 0.0f), k.white);
+        }
+    } else if (k.alignment == NoiseAlignment::IGNORE_PRIOR) {
+        for (int j = 0; j < n; ++j) {
+            const float v = k.shot * std::max(mean[j], 0.0f) + k.floorVar;
+            mean[j] = std::min(std::max(mean[j] + std::sqrt(v) * z[j] + black, 0.0f), k.white);
+        }
+    } else {
+        for (int j = 0; j < n; ++j)
+            mean[j] = std::min(std::max(mean[j] + black, 0.0f), k.white);
+    }
+}
+
+template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int planeRow)
+{
+    T* d = dst.ptr<T>(2 * planeRow + site / 2) + site % 2;
+    const int width = dst.cols / 2;
+    for (int j = 0; j < width; ++j)
+        d[2 * j] = std::is_same<T, ushort>::value ? static_cast<T>(static_cast<int>(v[j] + 0.5f))
+                                                  : static_cast<T>(v[j]);
+}
+
+ResampleConstants resampleConstants(const RawFormat& format, const NoiseModel& model,
+                                    NoiseAlignment alignment)
+{
+    const NoiseLine line = model.lineAtGain(format.gain);
+    ResampleConstants k;
+    for (int s = 0; s < 4; ++s)
+        k.black[s] = static_cast<float>(format.blackLevel[s]);
+    k.white = static_cast<float>(format.whiteLevel);
+    k.shot = static_cast<float>(line.a);
+    k.floorVar = static_cast<float>(line.b);
+    k.alignment = alignment;
+    return k;
+}
+
+struct KernelTap
+{
+    int dy, dx;
+    float w, shotWeight; // w and w (1 - w)
+};
+
+// Plane rows come from a ring of kernel-height rows: consecutive output rows share all but one source
+// row, and the rows a window needs are consecutive after clamping, hence distinct modulo the height.
+template <typename T>
+void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps, Size ksize, float readFactor,
+                   const ResampleConstants& k, uint64_t key, const Range& range)
+{
+    const int pw = src.cols / 2, ph = src.rows / 2, rx = ksize.width / 2, ry = ksize.height / 2;
+    const int padded = pw + 2 * rx;
+    std::vector<float> ring(static_cast<size_t>(ksize.height) * padded);
+    std::vector<int> ringRow(static_cast<size_t>(ksize.height), -1);
+    std::vector<float> mean(static_cast<size_t>(pw)), shotSum(static_cast<size_t>(pw)),
+        z(static_cast<size_t>(pw));
+    const std::vector<float> readFactors(static_cast<size_t>(pw), readFactor);
+    int ringSite = -1;
+    for (int idx = range.start; idx < range.end; ++idx) {
+        const int site = idx / ph, i = idx % ph;
+        if (site != ringSite) {
+            std::fill(ringRow.begin(), ringRow.end(), -1);
+            ringSite = site;
+        }
+        std::fill(mean.begin(), mean.end(), 0.0f);
+        std::fill(shotSum.begin(), shotSum.end(), 0.0f);
+        for (const KernelTap& t : taps) {
+            const int si = std::min(std::max(i + t.dy - ry, 0), ph - 1);
+            const size_t slot = static_cast<size_t>(si % ksize.height);
+            float* row = ring.data() + slot * padded;
+            if (ringRow[slot] != si) {
+                loadPlaneRow<T>(src, site, si, rx, k.black[site], row);
+                ringRow[slot] = si;
+            }
+            addTapRow(mean.data(), shotSum.data(), row + t.dx, t.w, t.shotWeight,
+                      k.alignment == NoiseAlignment::ACCOUNT_PRIOR, pw);
+        }
+        if (k.alignment != NoiseAlignment::NONE)
+            detail::fillGaussian(key, (static_cast<uint64_t>(site) << 32) | static_cast<uint64_t>(i),
+                                 z.data(), pw);
+        finishResampledRow(mean.data(), shotSum.data(), readFactors.data(), z.data(), k, k.black[site], pw);
+        storePlaneRow<T>(mean.data(), dst, site, i);
+    }
+}
+
+} // namespace
+
+namespace {
+
+// Source position on the plane grid of each output plane pixel for a scale about the mosaic centre:
+// plane index j of site column px sits at mosaic x = 2 j + px; its source is C + (x - C) / scale.
+struct BilinearAxis
+{
+    std::vector<int> i0, i1;
+    std::vector<float> f; // weight of i1; 0 when the two clamp onto the same pixel
+};
+
+BilinearAxis bilinearAxis(int planeSize, int phase, double scale)
+{
+    BilinearAxis a;
+    a.i0.resize(static_cast<size_t>(planeSize));
+    a.i1.resize(static_cast<size_t>(planeSize));
+    a.f.resize(static_cast<size_t>(planeSize));
+    const double centre = (2.0 * planeSize - 1) / 2;
+    for (int j = 0; j < planeSize; ++j) {
+        const double x = centre + (2.0 * j + phase - centre) / scale;
+        const double planeX = (x - phase) / 2;
+        const double lo = std::floor(planeX);
+        const int i0 = static_cast<int>(std::min(std::max(lo, 0.0), planeSize - 1.0));
+        const int i1 = static_cast<int>(std::min(std::max(lo + 1, 0.0), planeSize - 1.0));
+        a.i0[static_cast<size_t>(j)] = i0;
+        a.i1[static_cast<size_t>(j)] = i1;
+        a.f[static_cast<size_t>(j)] = i0 == i1 ? 0.0f : static_cast<float>(planeX - lo);
+    }
+    return a;
+}
+
+// Bilinear taps of one output row: mean, Eq. 15's shot sum and the read-noise factor 1 - sum w^2,
+// all per pixel because the weights change along the row.
+RAWGMENT_HOT_KERNEL
+void bilinearRow(const float* row0, const float* row1, float fy, const int* c0, const int* c1,
+                 const float* fx, float* mean, float* shot, float* readFactor, int n)
+{
+    for (int j = 0; j < n; ++j) {
+        const float a = row0[c0[j]], b = row0[c1[j]], c = row1[c0[j]], d = row1[c1[j]];
+        const float w00 = (1 - fx[j]) * (1 - fy), w01 = fx[j] * (1 - fy), w10 = (1 - fx[j]) * fy,
+                    w11 = fx[j] * fy;
+        mean[j] = w00 * a + w01 * b + w10 * c + w11 * d;
+        shot[j] = w00 * (1 - w00) * std::max(a, 0.0f) + w01 * (1 - w01) * std::max(b, 0.0f) +
+                  w10 * (1 - w10) * std::max(c, 0.0f) + w11 * (1 - w11) * std::max(d, 0.0f);
+        readFactor[j] = 1 - (w00 * w00 + w01 * w01 + w10 * w10 + w11 * w11);
+    }
+}
+
+template <typename T>
+void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const BilinearAxis* rows,
+                    const ResampleConstants& k, uint64_t key, const Range& range)
+{
+    const int pw = src.cols / 2, ph = src.rows / 2;
+    std::vector<float> row0(static_cast<size_t>(pw)), row1(static_cast<size_t>(pw));
+    std::vector<float> mean(static_cast<size_t>(pw)), shot(static_cast<size_t>(pw)),
+        readFactor(static_cast<size_t>(pw)), z(static_cast<size_t>(pw));
+    for (int idx = range.start; idx < range.end; ++idx) {
+        const int site = idx / ph, i = idx % ph;
+        const BilinearAxis& ax = cols[site % 2];
+        const BilinearAxis& ay = rows[site / 2];
+        loadPlaneRow<T>(src, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site], row0.data());
+        loadPlaneRow<T>(src, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data());
+        bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
+                    ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
+        if (k.alignment != NoiseAlignment::NONE)
+            detail::fillGaussian(key, (static_cast<uint64_t>(site) << 32) | static_cast<uint64_t>(i),
+                                 z.data(), pw);
+        finishResampledRow(mean.data(), shot.data(), readFactor.data(), z.data(), k, k.black[site], pw);
+        storePlaneRow<T>(mean.data(), dst, site, i);
+    }
+}
+
+} // namespace
+
+void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& model, double scale,
+                 NoiseAlignment alignment, uint64 seed, OutputArray _dst, AugmentReport* report)
+{
+    const Mat src = _src.getMat();
+    checkMosaicInput(src, "scaleMosaic");
+    format.validate();
+    model.validate();
+    checkAlignment(alignment);
+    if (!std::isfinite(scale) || !(scale > 0))
+        CV_Error(Error::StsBadArg, cv::format("scaleMosaic: scale must be finite and > 0 (got %g)", scale));
+    if (src.rows % 2 || src.cols % 2)
+        CV_Error(Error::StsBadArg,
+                 cv::format("scaleMosaic: both sides must be even (got %dx%d)", src.cols, src.rows));
+    if (scale == 1) {
+        _dst.assign(src);
+        return;
+    }
+    const BilinearAxis cols[2] = {bilinearAxis(src.cols / 2, 0, scale), bilinearAxis(src.cols / 2, 1, scale)};
+    const BilinearAxis rows[2] = {bilinearAxis(src.rows / 2, 0, scale), bilinearAxis(src.rows / 2, 1, scale)};
+    const ResampleConstants k = resampleConstants(format, model, alignment);
+    const uint64_t key = stepSeed(seed, 4);
+    Mat dst(src.size(), src.type());
+    parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
+        if (src.depth() == CV_16U)
+            scalePlaneRows<ushort>(src, dst, cols, rows, k, key, range);
+        else
+            scalePlaneRows<float>(src, dst, cols, rows, k, key, range);
+    });
+    _dst.assign(dst);
+    if (report)
+        report->steps.push_back("scale");
+}
+
+Rect scaleBox(const Rect& box, Size size, double scale)
+{
+    // Edges in continuous coordinates (pixel k covers [k, k + 1)); the box grows to whole pixels.
+    const double cx = size.width / 2.0, cy = size.height / 2.0;
+    const int x0 = static_cast<int>(std::floor(cx + (box.x - cx) * scale));
+    const int y0 = static_cast<int>(std::floor(cy + (box.y - cy) * scale));
+    const int x1 = static_cast<int>(std::ceil(cx + (box.x + box.width - cx) * scale));
+    const int y1 = static_cast<int>(std::ceil(cy + (box.y + box.height - cy) * scale));
+    if (box.area() == 0)
+        return Rect();
+    return Rect(Point(x0, y0), Point(x1, y1)) & Rect(Point(0, 0), size);
+}
+
 void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& model, InputArray _kernel,
                 NoiseAlignment alignment, uint64 seed, OutputArray _dst, AugmentReport* report)
 {
@@ -250,48 +549,32 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
     format.validate();
     model.validate();
     checkAlignment(alignment);
+    if (src.rows % 2 || src.cols % 2)
+        CV_Error(Error::StsBadArg,
+                 cv::format("motionBlur: both sides must be even (got %dx%d)", src.cols, src.rows));
     const Mat w = normalisedKernel(_kernel, "motionBlur");
     if (w.total() == 1) {
         _dst.assign(src);
         return;
     }
-    Mat x;
-    subtractBlackLevel(src, format, x);
-    std::vector<Mat> planes;
-    splitCfaPlanes(x, planes);
-    const NoiseLine line = model.lineAtGain(format.gain);
-    const double sumW2 = w.dot(w);
-    Mat shotKernel = w.mul(1.0 - w); // w_k (1 - w_k): the exact per-pixel shot-noise sum of Eq. 15
-    const float shot = static_cast<float>(line.a), readFloor = static_cast<float>((1 - sumW2) * line.b);
-    const uint64_t key = stepSeed(seed, 2);
-    std::vector<Mat> out(4);
-    for (int p = 0; p < 4; ++p) {
-        Mat mean, shotSum;
-        filter2D(planes[p], mean, CV_32F, w, Point(-1, -1), 0, BORDER_REPLICATE);
-        if (alignment == NoiseAlignment::ACCOUNT_PRIOR)
-            filter2D(max(planes[p], 0.0), shotSum, CV_32F, shotKernel, Point(-1, -1), 0, BORDER_REPLICATE);
-        if (alignment != NoiseAlignment::NONE) {
-            parallel_for_(Range(0, mean.rows), [&](const Range& rows) {
-                std::vector<float> z(mean.cols);
-                for (int r = rows.start; r < rows.end; ++r) {
-                    detail::fillGaussian(key, (static_cast<uint64_t>(p) << 32) | static_cast<uint64_t>(r),
-                                         z.data(), mean.cols);
-                    float* m = mean.ptr<float>(r);
-                    const float* s = shotSum.empty() ? nullptr : shotSum.ptr<float>(r);
-                    for (int c = 0; c < mean.cols; ++c) {
-                        const float v = s ? shot * s[c] + readFloor
-                                          : shot * std::max(m[c], 0.0f) + static_cast<float>(line.b);
-                        m[c] += std::sqrt(std::max(v, 0.0f)) * z[c];
-                    }
-                }
-            });
+    // Sparse: a motion kernel is a line, so most of its box is zero and costs nothing.
+    std::vector<KernelTap> taps;
+    for (int y = 0; y < w.rows; ++y)
+        for (int x = 0; x < w.cols; ++x) {
+            const double wk = w.at<double>(y, x);
+            if (wk > 0)
+                taps.push_back({y, x, static_cast<float>(wk), static_cast<float>(wk * (1 - wk))});
         }
-        out[p] = mean;
-    }
-    Mat merged;
-    mergeCfaPlanes(out, merged);
-    Mat dst;
-    addBlackLevel(merged, format, dst, src.depth());
+    const ResampleConstants k = resampleConstants(format, model, alignment);
+    const float readFactor = static_cast<float>(1 - w.dot(w));
+    const uint64_t key = stepSeed(seed, 2);
+    Mat dst(src.size(), src.type());
+    parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
+        if (src.depth() == CV_16U)
+            blurPlaneRows<ushort>(src, dst, taps, w.size(), readFactor, k, key, range);
+        else
+            blurPlaneRows<float>(src, dst, taps, w.size(), readFactor, k, key, range);
+    });
     _dst.assign(dst);
     if (report)
         report->steps.push_back("motionBlur");
@@ -302,13 +585,13 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
 
 bool Scene::isIdentity() const
 {
-    return shift == Point(0, 0) && jitter.isIdentity() && isIdentityKernel(motionKernel);
+    return shift == Point(0, 0) && scale == 1 && jitter.isIdentity() && isIdentityKernel(motionKernel);
 }
 
 void Scene::write(FileStorage& fs, const String& name) const
 {
     fs << name << "{";
-    fs << "shift" << shift;
+    fs << "shift" << shift << "scale" << scale;
     fs << "contrast"
        << "[" << jitter.contrast[0] << jitter.contrast[1] << jitter.contrast[2] << jitter.contrast[3] << "]";
     fs << "brightness" << jitter.brightness << "gain_ratio" << jitter.gainRatio;
@@ -323,6 +606,10 @@ Scene Scene::read(const FileNode& node)
         CV_Error(Error::StsParseError, "scene: expected a map");
     Scene s;
     node["shift"] >> s.shift;
+    if (!node["scale"].empty())
+        s.scale = detail::readRealField(node, "scale");
+    if (!std::isfinite(s.scale) || !(s.scale > 0))
+        CV_Error(Error::StsParseError, "scene: field 'scale' must be a finite number > 0");
     const FileNode c = node["contrast"];
     if (!c.isSeq() || c.size() != 4)
         CV_Error(Error::StsParseError, "scene: field 'contrast' must be a list of 4 numbers (one per site)");
@@ -368,6 +655,12 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
         if (report)
             report->steps.push_back("shift");
     }
+    if (scene.scale != 1) {
+        scaleMosaic(current, fmt, model, scene.scale, scene.alignment, seed, current, report);
+        if (boxes)
+            for (Rect& b : *boxes)
+                b = scaleBox(b, current.size(), scene.scale);
+    }
     colorJitter(current, fmt, model, scene.jitter, scene.alignment, seed, current, fmt, report);
     if (!isIdentityKernel(scene.motionKernel))
         motionBlur(current, fmt, model, scene.motionKernel, scene.alignment, seed, current, report);
@@ -399,9 +692,12 @@ void RandomScenePolicy::validate() const
     range(gainDbMin, gainDbMax, "gain (dB)");
     range(0, blurLengthMax, "blur length");
     range(0, maxShift, "shift");
+    if (!(maxScale >= 0 && maxScale < 1))
+        CV_Error(Error::StsBadArg,
+                 format("RandomScenePolicy: maxScale must lie in [0, 1) (got %g)", maxScale));
     probability(hueProbability, "hueProbability");
     probability(blurProbability, "blurProbability");
-    probability(shiftProbability, "shiftProbability");
+    probability(geometryProbability, "geometryProbability");
     checkAlignment(alignment);
 }
 
@@ -418,9 +714,11 @@ Scene RandomScenePolicy::draw(InputArray _src, const RawFormat& format, uint64 s
     const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * rng.uniform(); };
     Scene s;
     s.alignment = alignment;
-    if (rng.uniform() < shiftProbability)
+    if (rng.uniform() < geometryProbability) {
         s.shift = Point(cvRound(uniform(-maxShift, maxShift) * src.cols),
                         cvRound(uniform(-maxShift, maxShift) * src.rows));
+        s.scale = uniform(1 - maxScale, 1 + maxScale);
+    }
     const double contrast = std::exp(uniform(std::log(contrastMin), std::log(contrastMax)));
     s.jitter.contrast = Vec4d::all(contrast);
     if (rng.uniform() < hueProbability)
@@ -441,7 +739,7 @@ void RandomScenePolicy::write(FileStorage& fs, const String& name) const
     fs << "hue_probability" << hueProbability << "hue_min" << hueMin << "hue_max" << hueMax;
     fs << "gain_db_min" << gainDbMin << "gain_db_max" << gainDbMax;
     fs << "blur_probability" << blurProbability << "blur_length_max" << blurLengthMax;
-    fs << "shift_probability" << shiftProbability << "max_shift" << maxShift;
+    fs << "geometry_probability" << geometryProbability << "max_shift" << maxShift << "max_scale" << maxScale;
     fs << "alignment" << static_cast<int>(alignment);
     fs << "}";
 }
@@ -470,8 +768,9 @@ RandomScenePolicy RandomScenePolicy::read(const FileNode& node)
     field("gain_db_max", p.gainDbMax);
     field("blur_probability", p.blurProbability);
     field("blur_length_max", p.blurLengthMax);
-    field("shift_probability", p.shiftProbability);
+    field("geometry_probability", p.geometryProbability);
     field("max_shift", p.maxShift);
+    field("max_scale", p.maxScale);
     double alignmentValue = static_cast<double>(p.alignment);
     field("alignment", alignmentValue);
     p.alignment = static_cast<NoiseAlignment>(static_cast<int>(alignmentValue));

@@ -93,38 +93,66 @@ inline float logPositive(float x)
     return y + static_cast<float>(e) * 0.693147180559945f;
 }
 
+// Eight Philox4x32-10 blocks side by side, one per 64-bit lane, each 32-bit word of the state in the
+// low half of a lane: a 32x32->64-bit multiply of the low halves is one vector instruction on every
+// x86 (pmuludq) and needs no shuffles. GCC vector extensions: the same source for SSE2, AVX2, AVX-512.
+typedef uint64_t U64x8 __attribute__((vector_size(64)));
+
+inline void philox8Blocks(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key,
+                          uint32_t* words)
+{
+    const U64x8 low = {0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu,
+                       0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu};
+    U64x8 c0, c1 = low & 0, c2 = c1 + static_cast<uint32_t>(stream),
+              c3 = c1 + static_cast<uint32_t>(stream >> 32);
+    for (int b = 0; b < 8; ++b)
+        c0[b] = firstBlock + static_cast<uint32_t>(b);
+    uint64_t k0 = key[0], k1 = key[1];
+    for (int round = 0; round < 10; ++round) {
+        const U64x8 p0 = (c0 & low) * 0xD2511F53u;
+        const U64x8 p1 = (c2 & low) * 0xCD9E8D57u;
+        c0 = (p1 >> 32) ^ c1 ^ k0;
+        c2 = (p0 >> 32) ^ c3 ^ k1;
+        c1 = p1 & low;
+        c3 = p0 & low;
+        k0 = (k0 + 0x9E3779B9u) & 0xffffffffu;
+        k1 = (k1 + 0xBB67AE85u) & 0xffffffffu;
+    }
+    for (int b = 0; b < 8; ++b) {
+        words[b] = static_cast<uint32_t>(c0[b]);
+        words[8 + b] = static_cast<uint32_t>(c1[b]);
+        words[16 + b] = static_cast<uint32_t>(c2[b]);
+        words[24 + b] = static_cast<uint32_t>(c3[b]);
+    }
+}
+
 } // namespace
 
+RAWGMENT_HOT_KERNEL
 void fillGaussian(uint64_t seed, uint64_t stream, float* out, int n)
 {
-    // 64 values per chunk: 16 Philox blocks, 32 Box-Muller pairs.
-    const int kChunk = 64;
+    // 64 values per chunk: 16 Philox blocks (two groups of 8), 32 Box-Muller pairs.
+    const int kChunk = 64, kPairs = kChunk / 2;
     uint32_t words[kChunk];
     const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
     for (int base = 0; base < n; base += kChunk) {
         const uint32_t block0 = static_cast<uint32_t>(base / 4);
-        for (int b = 0; b < kChunk / 4; ++b) {
-            const std::array<uint32_t, 4> r =
-                philox4x32({block0 + static_cast<uint32_t>(b), 0u, static_cast<uint32_t>(stream),
-                            static_cast<uint32_t>(stream >> 32)},
-                           key);
-            words[4 * b] = r[0];
-            words[4 * b + 1] = r[1];
-            words[4 * b + 2] = r[2];
-            words[4 * b + 3] = r[3];
-        }
-        const int count = std::min(kChunk, n - base);
+        philox8Blocks(block0, stream, key, words);
+        philox8Blocks(block0 + 8, stream, key, words + 32);
         float z[kChunk];
-        for (int i = 0; i < kChunk / 2; ++i) {
-            // u1 in (0, 1] from 24 bits (never 0: log is finite); u2 picks the angle.
-            const float u1 = (static_cast<float>(words[2 * i] >> 8) + 1.0f) * (1.0f / 16777216.0f);
-            const uint32_t a = words[2 * i + 1];
+        for (int i = 0; i < kPairs; ++i) {
+            // u1 in (0, 1] from 24 bits (never 0: log is finite), through int32 (x86 before AVX-512
+            // has no vector uint32->float); the other word picks the angle.
+            const float u1 =
+                (static_cast<float>(static_cast<int32_t>(words[i] >> 8)) + 1.0f) * (1.0f / 16777216.0f);
+            const uint32_t a = words[kPairs + i];
             const float radius = std::sqrt(-2.0f * logPositive(u1));
             // The angle: quadrant from the top 2 bits, phi in [-pi/4, pi/4) from the next 22. Any
             // uniform angle serves Box-Muller; this one needs only the short polynomials of |phi| <= pi/4.
             const uint32_t q = a >> 30;
             const float phi =
-                (static_cast<float>((a >> 8) & 0x3fffff) * (1.0f / 4194304.0f) - 0.5f) * 1.5707963268f;
+                (static_cast<float>(static_cast<int32_t>((a >> 8) & 0x3fffff)) * (1.0f / 4194304.0f) - 0.5f) *
+                1.5707963268f;
             const float p2 = phi * phi;
             const float s =
                 phi + phi * p2 * (-1.6666654611e-1f + p2 * (8.3321608736e-3f + p2 * -1.9515295891e-4f));
@@ -132,13 +160,14 @@ void fillGaussian(uint64_t seed, uint64_t stream, float* out, int n)
                 1.0f - 0.5f * p2 +
                 p2 * p2 *
                     (4.166664568298827e-2f + p2 * (-1.388731625493765e-3f + p2 * 2.443315711809948e-5f));
-            // Rotate (c, s) by q quarter turns.
-            const float cq = q == 0 ? c : q == 1 ? -s : q == 2 ? -c : s;
-            const float sq = q == 0 ? s : q == 1 ? c : q == 2 ? -s : -c;
-            z[2 * i] = radius * cq;
-            z[2 * i + 1] = radius * sq;
+            // Rotate (c, s) by q quarter turns: (c, s), (-s, c), (-c, -s), (s, -c).
+            const bool odd = (q & 1) != 0;
+            const float cosRot = (odd ? s : c) * ((q == 1 || q == 2) ? -1.0f : 1.0f);
+            const float sinRot = (odd ? c : s) * (q >= 2 ? -1.0f : 1.0f);
+            z[i] = radius * cosRot;
+            z[kPairs + i] = radius * sinRot;
         }
-        std::memcpy(out + base, z, sizeof(float) * static_cast<size_t>(count));
+        std::memcpy(out + base, z, sizeof(float) * static_cast<size_t>(std::min(kChunk, n - base)));
     }
 }
 

@@ -14,6 +14,17 @@
 #include <cmath>
 #include <cstdint>
 
+/* Hot loops are compiled for x86-64-v4 (AVX-512), x86-64-v3 (AVX2, FMA) and the baseline, and the
+ * loader picks the best the CPU has (GCC function multi-versioning). The library is built with
+ * -ffp-contract=off, and the loops never reassociate, so every version gives the same bits: output
+ * depends on the seed only, not on the machine. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) &&                 \
+    !defined(RAWGMENT_NO_MULTIVERSIONING)
+#define RAWGMENT_HOT_KERNEL __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define RAWGMENT_HOT_KERNEL
+#endif
+
 namespace cv {
 namespace rawgment {
 namespace detail {
@@ -95,9 +106,11 @@ double logFactorial(int64_t k);
 
 /** Fills out[0..n) with standard normal float32 values from the stream (seed, stream).
  *
- * The hot path of every noise step: Philox blocks over an array (the compiler vectorises the rounds),
- * then Box-Muller with polynomial log, sin and cos (no library calls, so the loop vectorises too).
- * Value i depends only on (seed, stream, i): rows filled by different threads never interact.
+ * The hot path of every noise step: Philox blocks eight at a time in vector lanes, then Box-Muller
+ * with polynomial log, sin and cos (no library calls, so the loop vectorises too). Within a chunk of
+ * 64 values, the radius comes from words 0-31 and the angle from words 32-63 (word j of block b sits
+ * at 32 (b / 8) + 8 j + b % 8). Value i depends only on (seed, stream, i): rows filled by different
+ * threads never interact.
  * Accuracy: the polynomials are good to about 2e-7 relative, far below any noise they model;
  * the uniforms have 24 bits, so |z| <= 5.8 (probability of a larger |z| for a true normal: 7e-9). */
 void fillGaussian(uint64_t seed, uint64_t stream, float* out, int n);

@@ -159,6 +159,92 @@ TEST(Augment, motionBlurMatchesACaptureBlurredBeforeTheNoise)
     EXPECT_GT(ratio[1], 1.03);
 }
 
+TEST(Augment, scaleKeepsTheModelVarianceAtEveryInterpolationPosition)
+{
+    const Size size(128, 128);
+    const SensorSimulator sensor(sensorParams(), size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(kGain);
+    const NoiseLine line = model.lineAtGain(kGain);
+    // A horizontal ramp: the model variance is linear in the mean, so a bilinear mix of truly noisy
+    // pixels must have exactly the model variance at the mixed mean (Eq. 15 with interpolation weights).
+    Mat scene(size, CV_32FC1);
+    for (int c = 0; c < size.width; ++c)
+        scene.col(c).setTo(50.0 + 12.0 * c);
+    const std::vector<Mat> burst = floatBurst(sensor, scene, 21);
+    for (double scale : {1.03, 0.97}) {
+        double worstNone = 1;
+        for (NoiseAlignment mode :
+             {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR}) {
+            std::vector<Mat> scaled(kFrames);
+            for (int t = 0; t < kFrames; ++t)
+                scaleMosaic(burst[t], fmt, model, scale, mode, 900 + t, scaled[t]);
+            Mat mean, var;
+            temporalStats(scaled, fmt, mean, var);
+            const Mat expected = line.a * mean + line.b;
+            double total = 0;
+            // Columns away from the left/right edges, where replication makes constant patches.
+            for (int c = 8; c < size.width - 8; ++c) {
+                const double ratio = cv::mean(var.col(c))[0] / cv::mean(expected.col(c))[0];
+                total += ratio;
+                if (mode == NoiseAlignment::NONE)
+                    worstNone = std::min(worstNone, ratio);
+                // A column averages 128 variances of 64 frames (relative standard error sqrt(2/63) =
+                // 17.8% each); neighbouring rows share source rows, so count 64 independent ones:
+                // 2.2%, and 5 of them is 11%.
+                if (mode == NoiseAlignment::ACCOUNT_PRIOR)
+                    EXPECT_NEAR(ratio, 1.0, 0.11) << "scale " << scale << ", column " << c;
+            }
+            const double average = total / (size.width - 16);
+            std::cout << "scale " << scale << ", mode " << static_cast<int>(mode)
+                      << ": variance / model, average over columns " << average << "\n";
+            if (mode == NoiseAlignment::ACCOUNT_PRIOR) // ~14,000 pixels, half independent: 0.8% s.e.
+                EXPECT_NEAR(average, 1.0, 0.04);
+            if (mode == NoiseAlignment::IGNORE_PRIOR) // the prior noise is counted twice
+                EXPECT_GT(average, 1.1);
+        }
+        // Halfway between two pixels in both directions a bilinear mix keeps a quarter of the
+        // variance; columns at x fraction 0.5 keep at most half: plain resampling is far too clean.
+        EXPECT_LT(worstNone, 0.75) << "scale " << scale;
+    }
+}
+
+TEST(Augment, scaleMovesBoxesKeepsThePhaseAndSkipsTheIdentity)
+{
+    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    Mat src(64, 64, CV_16UC1);
+    for (int r = 0; r < 64; ++r)
+        for (int c = 0; c < 64; ++c)
+            src.at<ushort>(r, c) = static_cast<ushort>(300 + 800 * cfaSite(r, c));
+    Mat out;
+    scaleMosaic(src, fmt, model, 1.0, NoiseAlignment::ACCOUNT_PRIOR, 1, out);
+    EXPECT_EQ(out.data, src.data);
+    // Each site resamples only its own plane: a constant plane stays constant (NONE adds no noise).
+    scaleMosaic(src, fmt, model, 1.03, NoiseAlignment::NONE, 1, out);
+    EXPECT_EQ(norm(out, src, NORM_INF), 0);
+    // Boxes: the centre is fixed, edges scale about it, the result grows to whole pixels.
+    EXPECT_EQ(scaleBox(Rect(16, 16, 32, 32), Size(64, 64), 1.5), Rect(8, 8, 48, 48));
+    EXPECT_EQ(scaleBox(Rect(0, 0, 10, 10), Size(64, 64), 2.0).area(), 0); // pushed out of the frame
+    EXPECT_EQ(scaleBox(Rect(30, 30, 4, 4), Size(64, 64), 0.5), Rect(31, 31, 2, 2));
+    Scene scene;
+    scene.scale = 2.0;
+    std::vector<Rect> boxes = {Rect(16, 16, 32, 32)};
+    RawFormat f;
+    AugmentReport report;
+    applyScene(src, fmt, model, scene, 3, out, f, &report, &boxes);
+    EXPECT_EQ(boxes[0], Rect(0, 0, 64, 64));
+    ASSERT_EQ(report.steps.size(), 1u);
+    EXPECT_EQ(report.steps[0], "scale");
+    EXPECT_CV_ERROR_CONTAINS(scaleMosaic(src, fmt, model, 0, NoiseAlignment::NONE, 1, out), "scale");
+    EXPECT_CV_ERROR_CONTAINS(
+        scaleMosaic(src, fmt, model, std::numeric_limits<double>::quiet_NaN(), NoiseAlignment::NONE, 1, out),
+        "scale");
+    EXPECT_CV_ERROR_CONTAINS(
+        scaleMosaic(src(Rect(0, 0, 63, 64)), fmt, model, 1.1, NoiseAlignment::NONE, 1, out),
+        "both sides must be even");
+}
+
 TEST(Augment, gainTravelsFromJitterToBlur)
 {
     // Fewer photons x4 at four times the gain: same mean, noisier. The blur that follows must use the
@@ -209,6 +295,7 @@ TEST(Augment, sameSeedSameBitsOnAnyThreadCount)
     scene.jitter.gainRatio = 2;
     scene.motionKernel = linearMotionKernel(11, 45);
     scene.shift = Point(6, -4);
+    scene.scale = 1.02;
     const Mat original = src.clone();
     const int saved = getNumThreads();
     std::vector<Mat> outs;
@@ -375,7 +462,7 @@ TEST(Augment, randomPolicyDrawsInItsRangesAndRoundTrips)
     RandomScenePolicy policy;
     policy.gainDbMin = 3;
     policy.gainDbMax = 9;
-    int blurred = 0, hue = 0;
+    int blurred = 0, hue = 0, geometry = 0;
     for (uint64 seed = 0; seed < 400; ++seed) {
         const Scene s = policy.draw(src, fmt, seed);
         const double base = std::min(
@@ -385,12 +472,16 @@ TEST(Augment, randomPolicyDrawsInItsRangesAndRoundTrips)
         EXPECT_GE(linearGainToDb(s.jitter.gainRatio), 3 - 1e-9);
         EXPECT_LE(linearGainToDb(s.jitter.gainRatio), 9 + 1e-9);
         EXPECT_LE(std::abs(s.shift.x), 0.1 * src.cols + 1);
+        EXPECT_GE(s.scale, 0.97);
+        EXPECT_LE(s.scale, 1.03);
+        geometry += s.scale != 1 ? 1 : 0;
         blurred += s.motionKernel.empty() ? 0 : 1;
         hue += s.jitter.contrast[0] != s.jitter.contrast[3] ? 1 : 0;
     }
     // Probabilities 0.5: binomial(400, 0.5) has standard deviation 10; 5 of them around 200.
     EXPECT_NEAR(blurred, 200, 50);
     EXPECT_NEAR(hue, 200, 50);
+    EXPECT_NEAR(geometry, 320, 40); // probability 0.8: standard deviation 8
     const Scene a = policy.draw(src, fmt, 7), b = policy.draw(src, fmt, 7);
     EXPECT_EQ(a.jitter.contrast, b.jitter.contrast);
     EXPECT_EQ(a.shift, b.shift);
@@ -414,6 +505,7 @@ TEST(Augment, sceneRoundTripsThroughFileStorage)
 {
     Scene s;
     s.shift = Point(4, -2);
+    s.scale = 1.02;
     s.jitter.contrast = Vec4d(0.1, 0.2, 0.3, 0.4);
     s.jitter.brightness = -3;
     s.jitter.gainRatio = 8;
@@ -424,6 +516,7 @@ TEST(Augment, sceneRoundTripsThroughFileStorage)
     FileStorage in(out.releaseAndGetString(), FileStorage::READ | FileStorage::MEMORY);
     const Scene r = Scene::read(in["scene"]);
     EXPECT_EQ(r.shift, s.shift);
+    EXPECT_EQ(r.scale, 1.02);
     EXPECT_EQ(r.jitter.contrast, s.jitter.contrast);
     EXPECT_EQ(r.jitter.gainRatio, 8);
     EXPECT_EQ(r.alignment, NoiseAlignment::IGNORE_PRIOR);

@@ -115,15 +115,45 @@ CV_RAWGMENT_EXPORTS void motionBlur(InputArray src, const RawFormat& format, con
                                     InputArray kernel, NoiseAlignment alignment, uint64 seed, OutputArray dst,
                                     AugmentReport* report = nullptr);
 
+/** @brief Noise-accounted scaling about the mosaic centre, each CFA plane resampled bilinearly.
+ *
+ * Output pixel of site s at mosaic position X takes its value from \f$ C + (X - C)/\text{scale} \f$ in
+ * the same site's plane (C the centre), so the CFA phase is kept and every site is sampled at its own
+ * position. Interpolation weights are a kernel that changes from pixel to pixel: like a blur, they
+ * average the prior noise away, \f$ \sum_k w_k^2 \f$ of it, which Eq. 15 with those weights puts back:
+ * \f[ x_{new} = \sum_k w_k x_k + \mathcal{N}\Big(0,\; g\alpha\sum_k (1-w_k)w_k\max(x_k,0)
+ *     + \big(1 - \sum_k w_k^2\big)(g^2\sigma_d^2 + \sigma_r^2)\Big) \f]
+ * per pixel (ACCOUNT_PRIOR), so that the output has the model's variance at its new mean everywhere.
+ * NONE is plain bilinear resampling (too clean between pixels), IGNORE_PRIOR adds the full model
+ * variance. Outside the frame the plane's edge is replicated. The output has the input's size.
+ * @param src CV_16UC1 or CV_32FC1 mosaic with black level, even sides
+ * @param format its format (the gain stays)
+ * @param model the noise model
+ * @param scale magnification, > 0 (1.03 enlarges by 3%); exactly 1 is the identity and the step is
+ *        skipped (dst shares src's data)
+ * @param alignment how the prior noise is treated
+ * @param seed noise seed
+ * @param dst output, same type and size
+ * @param report optional
+ */
+CV_RAWGMENT_EXPORTS void scaleMosaic(InputArray src, const RawFormat& format, const NoiseModel& model,
+                                     double scale, NoiseAlignment alignment, uint64 seed, OutputArray dst,
+                                     AugmentReport* report = nullptr);
+
+/** @brief A bounding box (mosaic pixels) after scaleMosaic(): its edges scale about the frame centre,
+ * it grows to whole pixels and is clipped to the frame; an empty result means it left the frame. */
+CV_RAWGMENT_EXPORTS Rect scaleBox(const Rect& box, Size size, double scale);
+
 /** @brief The capture to simulate: what changes from the input, applied by applyScene().
  *
- * Steps run in the order of the paper's training: shift, colour jitter, blur. Only the effects a scene
- * asks for are simulated: a step at identity costs nothing, and the identity scene returns the input
- * itself (dst shares its data), bit for bit.
+ * Steps run in the order of the paper's training: geometry (shift, then scale), colour jitter, blur. Only the
+ * effects a scene asks for are simulated: a step at identity costs nothing, and the identity scene returns
+ * the input itself (dst shares its data), bit for bit.
  */
 struct CV_RAWGMENT_EXPORTS Scene
 {
     Point shift = Point(0, 0); //!< translation in mosaic pixels; each component rounded to even (CFA phase)
+    double scale = 1;          //!< magnification about the centre (see scaleMosaic()); 1: none
     ColorJitter jitter;        //!< exposure, gain, contrast, brightness, hue
     Mat motionKernel;          //!< blur on the plane grid (empty or 1x1: none)
     NoiseAlignment alignment = NoiseAlignment::ACCOUNT_PRIOR; //!< for every noise step
@@ -135,9 +165,10 @@ struct CV_RAWGMENT_EXPORTS Scene
     static Scene read(const FileNode& node);
 };
 
-/** @brief Applies a scene: shift (vacated pixels replicate the edge, CFA phase kept), colour jitter,
- * then blur at the gain the jitter produced. Bounding boxes (x, y, w, h in mosaic pixels) move with
- * the shift and are clipped to the frame; a box that leaves the frame becomes empty.
+/** @brief Applies a scene: shift (vacated pixels replicate the edge, CFA phase kept), scale
+ * (scaleMosaic()), colour jitter, then blur at the gain the jitter produced. Bounding boxes (x, y, w, h
+ * in mosaic pixels) move with the shift and the scale (scaleBox()) and are clipped to the frame; a box
+ * that leaves the frame becomes empty.
  */
 CV_RAWGMENT_EXPORTS void applyScene(InputArray src, const RawFormat& format, const NoiseModel& model,
                                     const Scene& scene, uint64 seed, OutputArray dst, RawFormat& dstFormat,
@@ -151,8 +182,9 @@ CV_RAWGMENT_EXPORTS void applyScene(InputArray src, const RawFormat& format, con
  * uniform in [brightnessMin, brightnessMax]; with probability hueProbability each site's contrast is
  * multiplied by a factor uniform in [hueMin, hueMax]; the gain ratio is uniform in dB in
  * [gainDbMin, gainDbMax]; with probability blurProbability a linear motion of length uniform in
- * [0, blurLengthMax] and uniform angle; with probability shiftProbability a shift of up to maxShift of
- * each side.
+ * [0, blurLengthMax] and uniform angle; with probability geometryProbability a geometric change (the
+ * paper's 0.8): a shift uniform in [-maxShift, maxShift] of each side and a scale uniform in
+ * [1 - maxScale, 1 + maxScale].
  */
 struct CV_RAWGMENT_EXPORTS RandomScenePolicy
 {
@@ -161,7 +193,7 @@ struct CV_RAWGMENT_EXPORTS RandomScenePolicy
     double hueProbability = 0.5, hueMin = 0.8, hueMax = 1.2;
     double gainDbMin = 0, gainDbMax = 12;
     double blurProbability = 0.5, blurLengthMax = 13;
-    double shiftProbability = 0.8, maxShift = 0.1;
+    double geometryProbability = 0.8, maxShift = 0.1, maxScale = 0.03;
     NoiseAlignment alignment = NoiseAlignment::ACCOUNT_PRIOR;
 
     void validate() const; //!< throws naming the first inconsistent range
