@@ -50,7 +50,7 @@ void BM_BurstStatistics_rawgment(benchmark::State& state)
 {
     const std::vector<Mat>& f = frames();
     for (auto _ : state) {
-        BurstStatistics stats(format12bit());
+        BurstStatistics stats(format12bit(), static_cast<int>(state.range(0)));
         for (int t = 0; t < kFrames; ++t)
             stats.add(f[t % kDistinctFrames]);
         Mat mean, var;
@@ -129,8 +129,15 @@ void BM_CalibrationFit(benchmark::State& state)
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(samples.size()));
 }
 
-BENCHMARK(BM_BurstStatistics_rawgment)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK(BM_BurstStatistics_memcpy)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+// The argument is groupFrames: memory (that many buffered frames) against state traffic.
+BENCHMARK(BM_BurstStatistics_rawgment)
+    ->Arg(8)
+    ->Arg(16)
+    ->Arg(32)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);
+BENCHMARK(BM_BurstStatistics_memcpy)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(BM_BurstStatistics_naiveOpenCV)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK(BM_CalibrationFit)
     ->Arg(NOISE_FIT_JOINT)

@@ -248,37 +248,41 @@ TEST(Calibration, burstStatisticsAreExactForLargeMeansAndAnyFrameCount)
     RawFormat fmt;
     fmt.blackLevel = Vec4d::all(100);
     fmt.whiteLevel = 65535;
-    for (int frames : {2, 7, 8, 13, 100}) {
-        BurstStatistics stats(fmt);
-        RNG rng(frames);
-        std::vector<Mat> burst;
-        for (int t = 0; t < frames; ++t) {
-            Mat f(6, 10, CV_32FC1);
-            rng.fill(f, RNG::NORMAL, 60000, 1); // mean 60000, variance 1
-            stats.add(f);
-            burst.push_back(f);
-        }
-        EXPECT_EQ(stats.frames(), frames);
-        Mat mean, var;
-        stats.mean(mean);
-        stats.variance(var);
-        for (int r = 0; r < 6; ++r)
-            for (int c = 0; c < 10; ++c) {
-                // Two-pass reference in long double.
-                long double m = 0;
-                for (const Mat& f : burst)
-                    m += f.at<float>(r, c);
-                m /= frames;
-                long double v = 0;
-                for (const Mat& f : burst)
-                    v += (f.at<float>(r, c) - m) * (f.at<float>(r, c) - m);
-                v /= frames - 1;
-                // Float64 state: errors of order 1e-16 * 60000 on the mean, far below 1e-9.
-                ASSERT_NEAR(mean.at<double>(r, c), static_cast<double>(m) - 100, 1e-9);
-                ASSERT_NEAR(var.at<double>(r, c), static_cast<double>(v),
-                            1e-9 * static_cast<double>(v) + 1e-12);
+    for (int group : {1, 3, 8, 16})
+        for (int frames : {2, 7, 8, 13, 100}) {
+            BurstStatistics stats(fmt, group);
+            RNG rng(frames);
+            std::vector<Mat> burst;
+            for (int t = 0; t < frames; ++t) {
+                Mat f(6, 10, CV_32FC1);
+                rng.fill(f, RNG::NORMAL, 60000, 1); // mean 60000, variance 1
+                stats.add(f);
+                burst.push_back(f);
             }
-    }
+            EXPECT_EQ(stats.frames(), frames);
+            Mat mean, var;
+            stats.mean(mean);
+            stats.variance(var);
+            for (int r = 0; r < 6; ++r)
+                for (int c = 0; c < 10; ++c) {
+                    // Two-pass reference in long double.
+                    long double m = 0;
+                    for (const Mat& f : burst)
+                        m += f.at<float>(r, c);
+                    m /= frames;
+                    long double v = 0;
+                    for (const Mat& f : burst)
+                        v += (f.at<float>(r, c) - m) * (f.at<float>(r, c) - m);
+                    v /= frames - 1;
+                    // Float64 state: errors of order 1e-16 * 60000 on the mean, far below 1e-9.
+                    ASSERT_NEAR(mean.at<double>(r, c), static_cast<double>(m) - 100, 1e-9);
+                    ASSERT_NEAR(var.at<double>(r, c), static_cast<double>(v),
+                                1e-9 * static_cast<double>(v) + 1e-12)
+                        << "group " << group << ", frames " << frames;
+                }
+        }
+    EXPECT_CV_ERROR_CONTAINS(BurstStatistics(fmt, 0), "groupFrames");
+    EXPECT_CV_ERROR_CONTAINS(BurstStatistics(fmt, 257), "groupFrames");
 }
 
 TEST(Calibration, burstStatisticsMarkClippedPixelsAndCheckFrames)

@@ -20,10 +20,12 @@ namespace rawgment {
  *
  * Frames are added one at a time and never all held in memory: the statistics are float64 running
  * sums updated with Chan's pairwise merge of small groups of frames (Welford's update generalised),
- * which stays exact for large means (60000 DN with a variance of 1) and long bursts. A group of up
- * to 8 frames is buffered (a copy of each: 8 x 24 MB for 12 MP) so that the float64 state is read
- * once per group instead of once per frame; for CV_16UC1 input the group's sums are exact integers.
- * Peak memory for a W x H burst: 17 bytes per pixel of state plus 8 frames.
+ * which stays exact for large means (60000 DN with a variance of 1) and long bursts. A group of
+ * frames is buffered (a copy of each) so that the float64 state, eight times the size of a 16-bit
+ * frame, is read and written once per group instead of once per frame; for CV_16UC1 input the group's
+ * sums are exact integers. Peak memory for a W x H burst: 17 bytes per pixel of state plus
+ * `groupFrames` frames (8 x 24 MB for 12 MP by default). The state traffic per frame falls as
+ * 1/groupFrames, but beyond 8-16 frames the buffers' own traffic dominates (see perf_calibration).
  *
  * Values are black-subtracted with the RawFormat (per site). A pixel that is at or above the white
  * level, or at or below zero, in any frame is marked clipped: its variance is biased and calibration
@@ -32,8 +34,10 @@ namespace rawgment {
 class CV_RAWGMENT_EXPORTS BurstStatistics
 {
 public:
-    /** @param format the burst's format (validated); its black and white levels are used */
-    explicit BurstStatistics(const RawFormat& format);
+    /** @param format the burst's format (validated); its black and white levels are used
+     *  @param groupFrames frames buffered between merges, in [1, 256]; results differ between group
+     *         sizes only by float64 rounding */
+    explicit BurstStatistics(const RawFormat& format, int groupFrames = 8);
     ~BurstStatistics();
     BurstStatistics(const BurstStatistics&) = delete;
     BurstStatistics& operator=(const BurstStatistics&) = delete;
