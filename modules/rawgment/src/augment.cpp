@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <atomic>
+#include <limits>
 
 namespace cv {
 namespace rawgment {
@@ -671,6 +672,31 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
 // ---------------------------------------------------------------------------------------------------
 // Random policy
 
+namespace {
+
+// min over pixels of (value - black of its site), without a black-subtracted copy of the frame.
+template <typename T> double minimumAboveBlackOf(const Mat& src, const RawFormat& format)
+{
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < src.rows; ++r) {
+        const T* p = src.ptr<T>(r);
+        T lo[2] = {std::numeric_limits<T>::max(), std::numeric_limits<T>::max()};
+        for (int c = 0; c < src.cols; ++c)
+            lo[c & 1] = std::min(lo[c & 1], p[c]);
+        for (int phase = 0; phase < std::min(2, src.cols); ++phase)
+            lowest = std::min(lowest, static_cast<double>(lo[phase]) - format.blackAt(r, phase));
+    }
+    return lowest;
+}
+
+double minimumAboveBlack(const Mat& src, const RawFormat& format)
+{
+    return src.depth() == CV_16U ? minimumAboveBlackOf<ushort>(src, format)
+                                 : minimumAboveBlackOf<float>(src, format);
+}
+
+} // namespace
+
 void RandomScenePolicy::validate() const
 {
     const auto range = [](double lo, double hi, const char* what) {
@@ -706,10 +732,7 @@ Scene RandomScenePolicy::draw(InputArray _src, const RawFormat& format, uint64 s
     validate();
     const Mat src = _src.getMat();
     checkMosaicInput(src, "RandomScenePolicy::draw");
-    Mat x;
-    subtractBlackLevel(src, format, x);
-    double minX = 0;
-    minMaxLoc(x, &minX);
+    const double minX = minimumAboveBlack(src, format);
     detail::CounterRng rng(stepSeed(seed, 3), 0);
     const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * rng.uniform(); };
     Scene s;

@@ -493,6 +493,19 @@ TEST(Augment, randomPolicyDrawsInItsRangesAndRoundTrips)
         EXPECT_EQ(back.contrastMin, 0.01);
         EXPECT_EQ(back.alignment, NoiseAlignment::ACCOUNT_PRIOR);
     }
+    // p_b = u min(x), with min(x) over black-subtracted pixels of every site.
+    RandomScenePolicy fixedBrightness;
+    fixedBrightness.brightnessMin = fixedBrightness.brightnessMax = 0.1;
+    RawFormat perSite = fmt;
+    perSite.blackLevel = Vec4d(250, 256, 260, 270);
+    for (int type : {CV_16UC1, CV_32FC1}) {
+        const Mat mosaic = smallMosaic(type);
+        Mat x;
+        subtractBlackLevel(mosaic, perSite, x);
+        double minX = 0;
+        minMaxLoc(x, &minX);
+        EXPECT_DOUBLE_EQ(fixedBrightness.draw(mosaic, perSite, 3).jitter.brightness, 0.1 * minX);
+    }
     RandomScenePolicy bad;
     bad.contrastMin = 2;
     EXPECT_CV_ERROR_CONTAINS(bad.validate(), "contrast range");
