@@ -93,39 +93,6 @@ inline float logPositive(float x)
     return y + static_cast<float>(e) * 0.693147180559945f;
 }
 
-// Eight Philox4x32-10 blocks side by side, one per 64-bit lane, each 32-bit word of the state in the
-// low half of a lane: a 32x32->64-bit multiply of the low halves is one vector instruction on every
-// x86 (pmuludq) and needs no shuffles. GCC vector extensions: the same source for SSE2, AVX2, AVX-512.
-typedef uint64_t U64x8 __attribute__((vector_size(64)));
-
-inline void philox8Blocks(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key,
-                          uint32_t* words)
-{
-    const U64x8 low = {0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu,
-                       0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu};
-    U64x8 c0, c1 = low & 0, c2 = c1 + static_cast<uint32_t>(stream),
-              c3 = c1 + static_cast<uint32_t>(stream >> 32);
-    for (int b = 0; b < 8; ++b)
-        c0[b] = firstBlock + static_cast<uint32_t>(b);
-    uint64_t k0 = key[0], k1 = key[1];
-    for (int round = 0; round < 10; ++round) {
-        const U64x8 p0 = (c0 & low) * 0xD2511F53u;
-        const U64x8 p1 = (c2 & low) * 0xCD9E8D57u;
-        c0 = (p1 >> 32) ^ c1 ^ k0;
-        c2 = (p0 >> 32) ^ c3 ^ k1;
-        c1 = p1 & low;
-        c3 = p0 & low;
-        k0 = (k0 + 0x9E3779B9u) & 0xffffffffu;
-        k1 = (k1 + 0xBB67AE85u) & 0xffffffffu;
-    }
-    for (int b = 0; b < 8; ++b) {
-        words[b] = static_cast<uint32_t>(c0[b]);
-        words[8 + b] = static_cast<uint32_t>(c1[b]);
-        words[16 + b] = static_cast<uint32_t>(c2[b]);
-        words[24 + b] = static_cast<uint32_t>(c3[b]);
-    }
-}
-
 } // namespace
 
 RAWGMENT_HOT_KERNEL
