@@ -85,32 +85,33 @@ inline int jitterRowBody(const T* s, T* d, const float* z, const float* pc, cons
     return bright;
 }
 
-RAWGMENT_HOT_KERNEL
-int jitterRow16u(const ushort* s, ushort* d, const float* z, const float* pc, const float* black,
-                 const JitterConstants& k, int cols)
+template <typename T>
+inline int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* pc, const float* black,
+                                 const JitterConstants& k, int cols)
 {
     switch (k.alignment) {
     case NoiseAlignment::ACCOUNT_PRIOR:
-        return jitterRowBody<ushort, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, pc, black, k, cols);
+        return jitterRowBody<T, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, pc, black, k, cols);
     case NoiseAlignment::IGNORE_PRIOR:
-        return jitterRowBody<ushort, NoiseAlignment::IGNORE_PRIOR>(s, d, z, pc, black, k, cols);
+        return jitterRowBody<T, NoiseAlignment::IGNORE_PRIOR>(s, d, z, pc, black, k, cols);
     default:
-        return jitterRowBody<ushort, NoiseAlignment::NONE>(s, d, z, pc, black, k, cols);
+        return jitterRowBody<T, NoiseAlignment::NONE>(s, d, z, pc, black, k, cols);
     }
 }
 
+// One multi-versioned entry point per pixel type: GCC cannot clone a template.
 RAWGMENT_HOT_KERNEL
-int jitterRow32f(const float* s, float* d, const float* z, const float* pc, const float* black,
-                 const JitterConstants& k, int cols)
+int jitterRow(const ushort* s, ushort* d, const float* z, const float* pc, const float* black,
+              const JitterConstants& k, int cols)
 {
-    switch (k.alignment) {
-    case NoiseAlignment::ACCOUNT_PRIOR:
-        return jitterRowBody<float, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, pc, black, k, cols);
-    case NoiseAlignment::IGNORE_PRIOR:
-        return jitterRowBody<float, NoiseAlignment::IGNORE_PRIOR>(s, d, z, pc, black, k, cols);
-    default:
-        return jitterRowBody<float, NoiseAlignment::NONE>(s, d, z, pc, black, k, cols);
-    }
+    return jitterRowAnyAlignment(s, d, z, pc, black, k, cols);
+}
+
+RAWGMENT_HOT_KERNEL
+int jitterRow(const float* s, float* d, const float* z, const float* pc, const float* black,
+              const JitterConstants& k, int cols)
+{
+    return jitterRowAnyAlignment(s, d, z, pc, black, k, cols);
 }
 
 template <typename T>
@@ -133,10 +134,7 @@ void jitterRows(const Mat& src, Mat& dst, const JitterConstants& k, uint64_t see
             detail::fillGaussian(seed, static_cast<uint64_t>(r), z.data(), cols);
         const float* pc = pcByParity.data() + (r & 1) * cols;
         const float* black = blackByParity.data() + (r & 1) * cols;
-        if (std::is_same<T, ushort>::value)
-            localBright += jitterRow16u(src.ptr<ushort>(r), dst.ptr<ushort>(r), z.data(), pc, black, k, cols);
-        else
-            localBright += jitterRow32f(src.ptr<float>(r), dst.ptr<float>(r), z.data(), pc, black, k, cols);
+        localBright += jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), pc, black, k, cols);
     }
     brightening += localBright;
 }
