@@ -9,15 +9,6 @@ namespace cv {
 namespace rawgment {
 namespace {
 
-SensorParams sensorParams()
-{
-    SensorParams p;
-    p.noise = NoiseModel(0.4, 0.5, 2.0);
-    p.blackLevel = Vec4d(256, 256, 256, 256);
-    p.bitDepth = 12;
-    return p;
-}
-
 const double kGain = 2.0; // the input bursts' gain (6 dB)
 const int kFrames = 64;
 
@@ -57,6 +48,19 @@ void temporalStats(const std::vector<Mat>& burst, const RawFormat& fmt, Mat& mea
     var = (sum2 - sum.mul(sum) / n) / (n - 1);
 }
 
+const NoiseAlignment kAllAlignments[] = {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR,
+                                         NoiseAlignment::ACCOUNT_PRIOR};
+
+//! Temporal statistics (as temporalStats) of a burst after `step(frame, t, out)` on every frame.
+template <typename Step>
+void statsAfterStep(const std::vector<Mat>& burst, const RawFormat& fmt, Step step, Mat& mean, Mat& var)
+{
+    std::vector<Mat> out(burst.size());
+    for (size_t t = 0; t < burst.size(); ++t)
+        step(burst[t], static_cast<int>(t), out[t]);
+    temporalStats(out, fmt, mean, var);
+}
+
 //! Average of a per-pixel map over the 8-column block b, leaving out `margin` columns at its sides.
 double blockAverage(const Mat& m, int b, int margin = 0)
 {
@@ -66,7 +70,7 @@ double blockAverage(const Mat& m, int b, int margin = 0)
 TEST(Augment, exposureChangeMatchesTheModelOnlyWhenThePriorIsAccounted)
 {
     const Size size(64, 32);
-    const SensorSimulator sensor(sensorParams(), size);
+    const SensorSimulator sensor(test::referenceSensorParams(), size);
     const NoiseModel model = sensor.effectiveModel();
     const RawFormat fmt = sensor.rawFormat(kGain);
     const std::vector<Mat> bright = floatBurst(sensor, levelScene(size), 5);
@@ -75,19 +79,18 @@ TEST(Augment, exposureChangeMatchesTheModelOnlyWhenThePriorIsAccounted)
     const double tolerance = 5 * std::sqrt(2.0 / (kFrames - 1)) / std::sqrt(256.0);
     for (double factor : {0.5, 0.1}) {
         double ratio[3][8];
-        for (NoiseAlignment mode :
-             {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR}) {
-            std::vector<Mat> converted;
+        for (NoiseAlignment mode : kAllAlignments) {
             RawFormat outFmt;
-            for (int t = 0; t < kFrames; ++t) {
-                Mat out;
-                colorJitter(bright[t], fmt, model, ColorJitter::exposureChange(factor, 1.0), mode, 1000 + t,
-                            out, outFmt);
-                converted.push_back(out);
-            }
-            EXPECT_EQ(outFmt.gain, kGain);
             Mat mean, var;
-            temporalStats(converted, outFmt, mean, var);
+            statsAfterStep(
+                bright, fmt,
+                [&](const Mat& frame, int t, Mat& out) {
+                    colorJitter(frame, fmt, model, ColorJitter::exposureChange(factor, 1.0), mode, 1000 + t,
+                                out, outFmt);
+                },
+                mean, var);
+            EXPECT_EQ(outFmt.gain, kGain);
+            EXPECT_EQ(outFmt.blackLevel, fmt.blackLevel);
             for (int b = 0; b < 8; ++b) {
                 const double m = blockAverage(mean, b);
                 ratio[static_cast<int>(mode)][b] = blockAverage(var, b) / model.variance(m, kGain);
@@ -108,7 +111,7 @@ TEST(Augment, exposureChangeMatchesTheModelOnlyWhenThePriorIsAccounted)
 TEST(Augment, motionBlurMatchesACaptureBlurredBeforeTheNoise)
 {
     const Size size(128, 128);
-    const SensorSimulator sensor(sensorParams(), size);
+    const SensorSimulator sensor(test::referenceSensorParams(), size);
     const NoiseModel model = sensor.effectiveModel();
     const RawFormat fmt = sensor.rawFormat(kGain);
     Mat scene(size, CV_32FC1);
@@ -125,13 +128,14 @@ TEST(Augment, motionBlurMatchesACaptureBlurredBeforeTheNoise)
     const int margin = kernel.cols; // the simulator reflects at the border, the augmentation replicates
     const Rect inner(margin, 0, size.width - 2 * margin, size.height);
     double ratio[3];
-    for (NoiseAlignment mode :
-         {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR}) {
-        std::vector<Mat> blurred(kFrames);
-        for (int t = 0; t < kFrames; ++t)
-            motionBlur(sharp[t], fmt, model, kernel, mode, 500 + t, blurred[t]);
+    for (NoiseAlignment mode : kAllAlignments) {
         Mat mean, var;
-        temporalStats(blurred, fmt, mean, var);
+        statsAfterStep(
+            sharp, fmt,
+            [&](const Mat& frame, int t, Mat& out) {
+                motionBlur(frame, fmt, model, kernel, mode, 500 + t, out);
+            },
+            mean, var);
         ratio[static_cast<int>(mode)] = cv::mean(var(inner))[0] / cv::mean(truthVar(inner))[0];
         // The mean is the blurred mean whatever the mode. Column means over 128 rows x 64 frames, for
         // both bursts: the difference has standard error sqrt(2 v / (64 * 128)); 5 of them.
@@ -162,7 +166,7 @@ TEST(Augment, motionBlurMatchesACaptureBlurredBeforeTheNoise)
 TEST(Augment, scaleKeepsTheModelVarianceAtEveryInterpolationPosition)
 {
     const Size size(128, 128);
-    const SensorSimulator sensor(sensorParams(), size);
+    const SensorSimulator sensor(test::referenceSensorParams(), size);
     const NoiseModel model = sensor.effectiveModel();
     const RawFormat fmt = sensor.rawFormat(kGain);
     const NoiseLine line = model.lineAtGain(kGain);
@@ -174,13 +178,14 @@ TEST(Augment, scaleKeepsTheModelVarianceAtEveryInterpolationPosition)
     const std::vector<Mat> burst = floatBurst(sensor, scene, 21);
     for (double scale : {1.03, 0.97}) {
         double worstNone = 1;
-        for (NoiseAlignment mode :
-             {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR}) {
-            std::vector<Mat> scaled(kFrames);
-            for (int t = 0; t < kFrames; ++t)
-                scaleMosaic(burst[t], fmt, model, scale, mode, 900 + t, scaled[t]);
+        for (NoiseAlignment mode : kAllAlignments) {
             Mat mean, var;
-            temporalStats(scaled, fmt, mean, var);
+            statsAfterStep(
+                burst, fmt,
+                [&](const Mat& frame, int t, Mat& out) {
+                    scaleMosaic(frame, fmt, model, scale, mode, 900 + t, out);
+                },
+                mean, var);
             const Mat expected = line.a * mean + line.b;
             double total = 0;
             // Columns away from the left/right edges, where replication makes constant patches.
@@ -211,7 +216,7 @@ TEST(Augment, scaleKeepsTheModelVarianceAtEveryInterpolationPosition)
 
 TEST(Augment, scaleMovesBoxesKeepsThePhaseAndSkipsTheIdentity)
 {
-    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
     const NoiseModel model(0.4, 0.5, 2.0);
     Mat src(64, 64, CV_16UC1);
     for (int r = 0; r < 64; ++r)
@@ -250,7 +255,7 @@ TEST(Augment, gainTravelsFromJitterToBlur)
     // Fewer photons x4 at four times the gain: same mean, noisier. The blur that follows must use the
     // new gain, or the result would have the variance of the old gain.
     const Size size(64, 64);
-    const SensorSimulator sensor(sensorParams(), size);
+    const SensorSimulator sensor(test::referenceSensorParams(), size);
     const NoiseModel model = sensor.effectiveModel();
     const RawFormat fmt = sensor.rawFormat(kGain);
     const std::vector<Mat> burst = floatBurst(sensor, Mat(size, CV_32FC1, Scalar(300)), 13);
@@ -286,7 +291,7 @@ Mat smallMosaic(int type = CV_16UC1)
 
 TEST(Augment, sameSeedSameBitsOnAnyThreadCount)
 {
-    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
     const NoiseModel model(0.4, 0.5, 2.0);
     Mat src(200, 300, CV_16UC1);
     RNG(1).fill(src, RNG::UNIFORM, 256, 3000);
@@ -318,7 +323,7 @@ TEST(Augment, sameSeedSameBitsOnAnyThreadCount)
 
 TEST(Augment, identityStepsAreSkippedAndReturnTheInputItself)
 {
-    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
     const NoiseModel model(0.4, 0.5, 2.0);
     const Mat src = smallMosaic();
     Mat out;
@@ -338,7 +343,7 @@ TEST(Augment, identityStepsAreSkippedAndReturnTheInputItself)
 
 TEST(Augment, hardCasesGiveFiniteCorrectOutput)
 {
-    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
     const NoiseModel model(0.4, 0.5, 2.0);
     const Mat src = smallMosaic(CV_32FC1);
     Mat x;
@@ -371,8 +376,7 @@ TEST(Augment, hardCasesGiveFiniteCorrectOutput)
     for (double gain : {1.0, 1000.0}) {
         RawFormat g = fmt;
         g.gain = gain;
-        for (NoiseAlignment mode :
-             {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR}) {
+        for (NoiseAlignment mode : kAllAlignments) {
             colorJitter(src, g, model, ColorJitter::exposureChange(0.01, 10), mode, 3, out, outFmt);
             EXPECT_EQ(test::countNonFinite(out), 0);
             motionBlur(src, g, model, linearMotionKernel(9, 10), mode, 3, out);
@@ -396,7 +400,7 @@ TEST(Augment, hardCasesGiveFiniteCorrectOutput)
 
 TEST(Augment, badArgumentsGiveClearErrors)
 {
-    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
     const NoiseModel model(0.4, 0.5, 2.0);
     const Mat src = smallMosaic();
     Mat out;
@@ -433,7 +437,7 @@ TEST(Augment, badArgumentsGiveClearErrors)
 
 TEST(Augment, shiftKeepsTheCfaPhaseAndMovesBoxes)
 {
-    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
     const NoiseModel model(0.4, 0.5, 2.0);
     Mat src(16, 16, CV_16UC1);
     for (int r = 0; r < 16; ++r)
@@ -457,7 +461,7 @@ TEST(Augment, shiftKeepsTheCfaPhaseAndMovesBoxes)
 
 TEST(Augment, randomPolicyDrawsInItsRangesAndRoundTrips)
 {
-    const RawFormat fmt = SensorSimulator(sensorParams(), Size(2, 2)).rawFormat(kGain);
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
     const Mat src = smallMosaic();
     RandomScenePolicy policy;
     policy.gainDbMin = 3;

@@ -39,6 +39,15 @@ int countNonFinite(const Mat& m)
     return bad;
 }
 
+SensorParams referenceSensorParams()
+{
+    SensorParams p;
+    p.noise = NoiseModel(0.4, 0.5, 2.0);
+    p.blackLevel = Vec4d::all(256);
+    p.bitDepth = 12;
+    return p;
+}
+
 } // namespace test
 } // namespace rawgment
 } // namespace cv

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
+#include <opencv2/rawgment/simulate.hpp>
 
 #include <string>
 
@@ -21,6 +22,12 @@ std::string makeTempDir(const std::string& testName);
 
 /** Counts the elements of a float Mat that are NaN or infinite. */
 int countNonFinite(const Mat& m);
+
+/** The ground-truth sensor of the augmentation and calibration tests: alpha 0.4, sigma_d^2 0.5,
+ * sigma_r^2 2 (plus 1/12 of quantisation), 12 bits, black 256. Its sigma_r^2 is small next to
+ * g^2 sigma_d^2 at the top gain (251 * 0.5 = 126 at 24 dB), the case where the paper's two-stage fit
+ * struggles. */
+SensorParams referenceSensorParams();
 
 } // namespace test
 } // namespace rawgment
