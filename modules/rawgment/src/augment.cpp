@@ -281,10 +281,6 @@ bool isIdentityKernel(const Mat& kernel)
     return kernel.empty() || kernel.total() == 1;
 }
 
-} // namespace
-
-namespace {
-
 // Constants of a resampling step (blur or scale) on one mosaic: Eq. 15 with the step's weights.
 struct ResampleConstants
 {
@@ -358,6 +354,20 @@ template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int
                                                   : static_cast<T>(v[j]);
 }
 
+// The end of every resampled row: its noise stream (site, row), the noise, the black level, the store.
+template <typename T>
+void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float* readFactor,
+                    std::vector<float>& z, const ResampleConstants& k, uint64_t key, Mat& dst, int site,
+                    int planeRow)
+{
+    const int n = static_cast<int>(mean.size());
+    if (k.alignment != NoiseAlignment::NONE)
+        detail::fillGaussian(key, (static_cast<uint64_t>(site) << 32) | static_cast<uint64_t>(planeRow),
+                             z.data(), n);
+    finishResampledRow(mean.data(), shotSum, readFactor, z.data(), k, k.black[site], n);
+    storePlaneRow<T>(mean.data(), dst, site, planeRow);
+}
+
 ResampleConstants resampleConstants(const RawFormat& format, const NoiseModel& model,
                                     NoiseAlignment alignment)
 {
@@ -411,17 +421,9 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             addTapRow(mean.data(), shotSum.data(), row + t.dx, t.w, t.shotWeight,
                       k.alignment == NoiseAlignment::ACCOUNT_PRIOR, pw);
         }
-        if (k.alignment != NoiseAlignment::NONE)
-            detail::fillGaussian(key, (static_cast<uint64_t>(site) << 32) | static_cast<uint64_t>(i),
-                                 z.data(), pw);
-        finishResampledRow(mean.data(), shotSum.data(), readFactors.data(), z.data(), k, k.black[site], pw);
-        storePlaneRow<T>(mean.data(), dst, site, i);
+        finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, key, dst, site, i);
     }
 }
-
-} // namespace
-
-namespace {
 
 // Source position on the plane grid of each output plane pixel for a scale about the mosaic centre:
 // plane index j of site column px sits at mosaic x = 2 j + px; its source is C + (x - C) / scale.
@@ -484,11 +486,7 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
         loadPlaneRow<T>(src, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data());
         bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
                     ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
-        if (k.alignment != NoiseAlignment::NONE)
-            detail::fillGaussian(key, (static_cast<uint64_t>(site) << 32) | static_cast<uint64_t>(i),
-                                 z.data(), pw);
-        finishResampledRow(mean.data(), shot.data(), readFactor.data(), z.data(), k, k.black[site], pw);
-        storePlaneRow<T>(mean.data(), dst, site, i);
+        finishPlaneRow<T>(mean, shot.data(), readFactor.data(), z, k, key, dst, site, i);
     }
 }
 
