@@ -156,14 +156,14 @@ struct BurstStatistics::Impl
     }
 };
 
-BurstStatistics::BurstStatistics(const RawFormat& format, int groupFrames) : impl_(new Impl)
+BurstStatistics::BurstStatistics(const RawFormat& format, int groupFrames) : impl_(nullptr)
 {
+    // Arguments first: a constructor that throws never runs its destructor, so nothing may be owned yet.
     format.validate();
-    if (groupFrames < 1 || groupFrames > 256) {
-        delete impl_;
+    if (groupFrames < 1 || groupFrames > 256)
         CV_Error(Error::StsBadArg,
                  cv::format("BurstStatistics: groupFrames must lie in [1, 256] (got %d)", groupFrames));
-    }
+    impl_ = new Impl;
     impl_->format = format;
     impl_->groupFrames = groupFrames;
     impl_->buffers.resize(static_cast<size_t>(groupFrames));

@@ -272,6 +272,9 @@ TEST(Calibration, burstStatisticsAreExactForLargeMeansAndAnyFrameCount)
         }
     EXPECT_CV_ERROR_CONTAINS(BurstStatistics(fmt, 0), "groupFrames");
     EXPECT_CV_ERROR_CONTAINS(BurstStatistics(fmt, 257), "groupFrames");
+    RawFormat badWhite = fmt;
+    badWhite.whiteLevel = std::numeric_limits<double>::infinity();
+    EXPECT_CV_ERROR_CONTAINS(BurstStatistics stats(badWhite), "whiteLevel"); // and leaks nothing (ASan build)
 }
 
 TEST(Calibration, burstStatisticsMarkClippedPixelsAndCheckFrames)
