@@ -35,88 +35,143 @@ void checkMosaicInput(const Mat& src, const char* who)
         CV_Error(Error::StsBadArg, format("%s: src contains NaN or Inf", who));
 }
 
-void checkAlignment(NoiseAlignment a)
-{
-    if (a != NoiseAlignment::NONE && a != NoiseAlignment::IGNORE_PRIOR && a != NoiseAlignment::ACCOUNT_PRIOR)
-        CV_Error(Error::StsBadArg, format("unknown NoiseAlignment %d", static_cast<int>(a)));
-}
-
 struct JitterConstants
 {
     float pc[4], black[4];
     float pb, pg, white;
     float shot, read, post; // g alpha, g^2 sigma_d^2, sigma_r^2 at the input gain
     NoiseAlignment alignment;
+    ShotNoiseSampling sampling;
 };
 
-// One row of Eq. 11/13, written so that the compiler vectorises it: no branches, per-column constants
-// in arrays (the CFA site alternates along the row), float arithmetic in a fixed order. Returns the
-// number of brightening pixels. Rounding to 16 bits adds 0.5 and truncates (the value is clipped to
-// [0, white] first): the same bits in every vector width.
-template <typename T, NoiseAlignment A>
-inline int jitterRowBody(const T* s, T* d, const float* z, const float* pc, const float* black,
-                         const JitterConstants& k, int cols)
+// The variance to add to a pixel, split into its shot part and the rest (read noise, and for
+// ACCOUNT_PRIOR the correction of the scaled prior), before any clipping. xm is the prior-mean estimate
+// (black-subtracted), pc the pixel's contrast. Eq. 13 for ACCOUNT_PRIOR; the model at the new mean and
+// gain for IGNORE_PRIOR.
+struct AddedVariance
 {
-    const float pg = k.pg, pg2 = k.pg * k.pg, pb = k.pb, white = k.white;
-    const float shotA = pg2 * k.shot, readA = pg2 * k.read;
-    const float shotI = pg * k.shot, floorI = pg2 * k.read + k.post;
+    float shot, rest;
+};
+
+template <NoiseAlignment A> inline AddedVariance jitterVariance(float xm, float pc, const JitterConstants& k)
+{
+    const float pg = k.pg, pg2 = k.pg * k.pg;
+    if (A == NoiseAlignment::ACCOUNT_PRIOR) {
+        const float xf = std::max(xm, 1.0f);
+        const float pu = std::max((pc * xf + k.pb) / (xf * pg), 0.0f);
+        const float mu = std::max(xm, 0.0f);
+        return {pu * (1 - pu) * (pg2 * k.shot) * mu,
+                (1 - pu * pu) * (pg2 * k.read) + (1 - pu * pu * pg2) * k.post};
+    }
+    if (A == NoiseAlignment::IGNORE_PRIOR)
+        return {pg * k.shot * std::max(pc * xm + k.pb, 0.0f), pg2 * k.read + k.post};
+    return {0.0f, 0.0f};
+}
+
+template <typename T> inline T storeValue(float out, float white)
+{
+    out = std::min(std::max(out, 0.0f), white);
+    return std::is_same<T, ushort>::value ? static_cast<T>(static_cast<int>(out + 0.5f))
+                                          : static_cast<T>(out);
+}
+
+// One row of Eq. 11/13, written so that the compiler vectorises it: no branches, per-column constants
+// in arrays (the CFA site alternates along the row), float arithmetic in a fixed order. `prior` is the
+// local-mean row, or null to use the pixel's own value. Returns the number of brightening pixels.
+// Rounding to 16 bits adds 0.5 and truncates (the value is clipped to [0, white] first): the same bits
+// in every vector width.
+template <typename T, NoiseAlignment A, bool kLocalMean>
+inline int jitterRowBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
+                         const float* black, const JitterConstants& k, int cols)
+{
     int bright = 0;
     for (int c = 0; c < cols; ++c) {
         const float x = static_cast<float>(s[c]) - black[c];
-        const float mean = pc[c] * x + pb;
-        float out = mean;
-        if (A == NoiseAlignment::ACCOUNT_PRIOR) {
-            const float xf = std::max(x, 1.0f);
-            const float pu = std::max((pc[c] * xf + pb) / (xf * pg), 0.0f);
-            const float mu = std::max(x, 0.0f);
-            const float v = pu * (1 - pu) * shotA * mu + (1 - pu * pu) * readA + (1 - pu * pu * pg2) * k.post;
-            bright += v < 0 ? 1 : 0;
-            out = mean + std::sqrt(std::max(v, 0.0f)) * z[c];
-        } else if (A == NoiseAlignment::IGNORE_PRIOR) {
-            const float v = shotI * std::max(mean, 0.0f) + floorI;
-            out = mean + std::sqrt(std::max(v, 0.0f)) * z[c];
+        float out = pc[c] * x + k.pb;
+        if (A != NoiseAlignment::NONE) {
+            const AddedVariance v = jitterVariance<A>(kLocalMean ? prior[c] : x, pc[c], k);
+            const float total = v.shot + v.rest;
+            bright += total < 0 ? 1 : 0;
+            out += std::sqrt(std::max(total, 0.0f)) * z[c];
         }
-        out = std::min(std::max(out + black[c], 0.0f), white);
-        if (std::is_same<T, ushort>::value)
-            d[c] = static_cast<T>(static_cast<int>(out + 0.5f));
-        else
-            d[c] = static_cast<T>(out);
+        d[c] = storeValue<T>(out + black[c], k.white);
     }
     return bright;
 }
 
-template <typename T>
-inline int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* pc, const float* black,
-                                 const JitterConstants& k, int cols)
+template <typename T, bool kLocalMean>
+inline int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* prior, const float* pc,
+                                 const float* black, const JitterConstants& k, int cols)
 {
     switch (k.alignment) {
     case NoiseAlignment::ACCOUNT_PRIOR:
-        return jitterRowBody<T, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, pc, black, k, cols);
+        return jitterRowBody<T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean>(s, d, z, prior, pc, black, k,
+                                                                           cols);
     case NoiseAlignment::IGNORE_PRIOR:
-        return jitterRowBody<T, NoiseAlignment::IGNORE_PRIOR>(s, d, z, pc, black, k, cols);
+        return jitterRowBody<T, NoiseAlignment::IGNORE_PRIOR, kLocalMean>(s, d, z, prior, pc, black, k, cols);
     default:
-        return jitterRowBody<T, NoiseAlignment::NONE>(s, d, z, pc, black, k, cols);
+        return jitterRowBody<T, NoiseAlignment::NONE, kLocalMean>(s, d, z, prior, pc, black, k, cols);
     }
 }
 
 // One multi-versioned entry point per pixel type: GCC cannot clone a template.
 RAWGMENT_HOT_KERNEL
-int jitterRow(const ushort* s, ushort* d, const float* z, const float* pc, const float* black,
-              const JitterConstants& k, int cols)
+int jitterRow(const ushort* s, ushort* d, const float* z, const float* prior, const float* pc,
+              const float* black, const JitterConstants& k, int cols)
 {
-    return jitterRowAnyAlignment(s, d, z, pc, black, k, cols);
+    return prior ? jitterRowAnyAlignment<ushort, true>(s, d, z, prior, pc, black, k, cols)
+                 : jitterRowAnyAlignment<ushort, false>(s, d, z, prior, pc, black, k, cols);
 }
 
 RAWGMENT_HOT_KERNEL
-int jitterRow(const float* s, float* d, const float* z, const float* pc, const float* black,
-              const JitterConstants& k, int cols)
+int jitterRow(const float* s, float* d, const float* z, const float* prior, const float* pc,
+              const float* black, const JitterConstants& k, int cols)
 {
-    return jitterRowAnyAlignment(s, d, z, pc, black, k, cols);
+    return prior ? jitterRowAnyAlignment<float, true>(s, d, z, prior, pc, black, k, cols)
+                 : jitterRowAnyAlignment<float, false>(s, d, z, prior, pc, black, k, cols);
+}
+
+// Gaussian noise of variance `rest` plus the shot part as an electron count: q (K - m) with
+// K ~ Poisson(m), m = shot / q^2 (ShotNoiseSampling::POISSON). A negative total (brightening) adds
+// nothing; a negative rest (the gain grew) is taken from the Poisson part, so the variance added is
+// always max(shot + rest, 0), the same as the Gaussian path.
+inline float sampledNoise(AddedVariance v, float q, float z, detail::CounterRng& rng)
+{
+    const float total = std::max(v.shot + v.rest, 0.0f);
+    const float shot = q > 0 ? std::min(std::max(v.shot, 0.0f), total) : 0.0f;
+    const double m = static_cast<double>(shot) / (static_cast<double>(q) * q);
+    const float count = shot > 0 ? static_cast<float>(static_cast<double>(rng.poisson(m)) - m) : 0.0f;
+    return q * count + std::sqrt(total - shot) * z;
+}
+
+template <typename T, NoiseAlignment A>
+int jitterRowPoissonBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
+                         const float* black, const JitterConstants& k, detail::CounterRng& rng, int cols)
+{
+    const float q = k.pg * k.shot; // DN per electron at the output gain: g alpha p_g
+    int bright = 0;
+    for (int c = 0; c < cols; ++c) {
+        const float x = static_cast<float>(s[c]) - black[c];
+        const AddedVariance v = jitterVariance<A>(prior ? prior[c] : x, pc[c], k);
+        bright += v.shot + v.rest < 0 ? 1 : 0;
+        d[c] = storeValue<T>(pc[c] * x + k.pb + sampledNoise(v, q, z[c], rng) + black[c], k.white);
+    }
+    return bright;
 }
 
 template <typename T>
-void jitterRows(const Mat& src, Mat& dst, const JitterConstants& k, uint64_t seed, const Range& rows,
-                std::atomic<int64>& brightening)
+int jitterRowPoisson(const T* s, T* d, const float* z, const float* prior, const float* pc,
+                     const float* black, const JitterConstants& k, detail::CounterRng& rng, int cols)
+{
+    if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR)
+        return jitterRowPoissonBody<T, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, prior, pc, black, k, rng,
+                                                                      cols);
+    return jitterRowPoissonBody<T, NoiseAlignment::IGNORE_PRIOR>(s, d, z, prior, pc, black, k, rng, cols);
+}
+
+template <typename T>
+void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstants& k, uint64_t seed,
+                uint64_t poissonSeed, const Range& rows, std::atomic<int64>& brightening)
 {
     const int cols = src.cols;
     std::vector<float> z(static_cast<size_t>(cols));
@@ -128,15 +183,35 @@ void jitterRows(const Mat& src, Mat& dst, const JitterConstants& k, uint64_t see
             pcByParity[static_cast<size_t>(parity * cols + c)] = k.pc[2 * parity + (c & 1)];
             blackByParity[static_cast<size_t>(parity * cols + c)] = k.black[2 * parity + (c & 1)];
         }
+    const bool poisson = k.sampling == ShotNoiseSampling::POISSON && k.alignment != NoiseAlignment::NONE;
     int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
         if (k.alignment != NoiseAlignment::NONE)
             detail::fillGaussian(seed, static_cast<uint64_t>(r), z.data(), cols);
         const float* pc = pcByParity.data() + (r & 1) * cols;
         const float* black = blackByParity.data() + (r & 1) * cols;
-        localBright += jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), pc, black, k, cols);
+        const float* priorRow = prior.empty() ? nullptr : prior.ptr<float>(r);
+        if (poisson) {
+            detail::CounterRng rng(poissonSeed, static_cast<uint64_t>(r));
+            localBright +=
+                jitterRowPoisson(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, pc, black, k, rng, cols);
+        } else {
+            localBright += jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, pc, black, k, cols);
+        }
     }
     brightening += localBright;
+}
+
+// PriorMeanEstimate::LOCAL_MEAN: the black-subtracted mean of each pixel's 3x3 neighbourhood on its own
+// CFA plane. On the mosaic that is a separable [1 0 1 0 1] / 3 filter; reflecting about the edge pixel
+// maps an offset of -2 to +2, so the border also averages pixels of the same site.
+Mat localPriorMean(const Mat& src, const RawFormat& format)
+{
+    Mat x, mean;
+    subtractBlackLevel(src, format, x, false);
+    const Matx<float, 1, 5> taps(1.0f / 3, 0, 1.0f / 3, 0, 1.0f / 3);
+    sepFilter2D(x, mean, CV_32F, taps, taps.t(), Point(-1, -1), 0, BORDER_REFLECT_101);
+    return mean;
 }
 
 // Saturated pixels are only counted or masked when the caller asks: the hot loop does not pay for them.
@@ -154,6 +229,47 @@ void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* re
 
 } // namespace
 
+void NoiseOptions::validate() const
+{
+    if (alignment != NoiseAlignment::NONE && alignment != NoiseAlignment::IGNORE_PRIOR &&
+        alignment != NoiseAlignment::ACCOUNT_PRIOR)
+        CV_Error(Error::StsBadArg, format("NoiseOptions: unknown alignment %d", static_cast<int>(alignment)));
+    if (shotSampling != ShotNoiseSampling::GAUSSIAN && shotSampling != ShotNoiseSampling::POISSON)
+        CV_Error(Error::StsBadArg,
+                 format("NoiseOptions: unknown shotSampling %d", static_cast<int>(shotSampling)));
+    if (priorMean != PriorMeanEstimate::PIXEL_VALUE && priorMean != PriorMeanEstimate::LOCAL_MEAN)
+        CV_Error(Error::StsBadArg, format("NoiseOptions: unknown priorMean %d", static_cast<int>(priorMean)));
+    if (blurNoiseSum != BlurNoiseSum::EXACT && blurNoiseSum != BlurNoiseSum::FROM_BLURRED_MEAN)
+        CV_Error(Error::StsBadArg,
+                 format("NoiseOptions: unknown blurNoiseSum %d", static_cast<int>(blurNoiseSum)));
+}
+
+void NoiseOptions::writeFields(FileStorage& fs) const
+{
+    fs << "alignment" << static_cast<int>(alignment) << "shot_sampling" << static_cast<int>(shotSampling)
+       << "prior_mean" << static_cast<int>(priorMean) << "blur_noise_sum" << static_cast<int>(blurNoiseSum);
+}
+
+NoiseOptions NoiseOptions::readFields(const FileNode& map)
+{
+    NoiseOptions o;
+    const auto field = [&](const char* name, int current) {
+        const FileNode f = map[name];
+        if (f.empty() || f.isNone())
+            return current;
+        const double value = f.isInt() || f.isReal() ? static_cast<double>(f) : 0.5;
+        if (value != std::floor(value))
+            CV_Error(Error::StsParseError, format("noise options: field '%s' must be an integer", name));
+        return static_cast<int>(value);
+    };
+    o.alignment = static_cast<NoiseAlignment>(field("alignment", static_cast<int>(o.alignment)));
+    o.shotSampling = static_cast<ShotNoiseSampling>(field("shot_sampling", static_cast<int>(o.shotSampling)));
+    o.priorMean = static_cast<PriorMeanEstimate>(field("prior_mean", static_cast<int>(o.priorMean)));
+    o.blurNoiseSum = static_cast<BlurNoiseSum>(field("blur_noise_sum", static_cast<int>(o.blurNoiseSum)));
+    o.validate();
+    return o;
+}
+
 ColorJitter ColorJitter::exposureChange(double photonRatio, double gainRatio)
 {
     detail::checkFinitePositive(photonRatio, "exposureChange: photonRatio");
@@ -170,14 +286,14 @@ bool ColorJitter::isIdentity() const
 }
 
 void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& model, const ColorJitter& jitter,
-                 NoiseAlignment alignment, uint64 seed, OutputArray _dst, RawFormat& dstFormat,
+                 const NoiseOptions& noise, uint64 seed, OutputArray _dst, RawFormat& dstFormat,
                  AugmentReport* report, OutputArray saturatedMask)
 {
     const Mat src = _src.getMat();
     checkMosaicInput(src, "colorJitter");
     format.validate();
     model.validate();
-    checkAlignment(alignment);
+    noise.validate();
     for (int s = 0; s < 4; ++s)
         detail::checkFinitePositive(jitter.contrast[s], "colorJitter: contrast");
     if (!std::isfinite(jitter.brightness))
@@ -205,16 +321,21 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     k.shot = static_cast<float>(line.a);
     k.read = static_cast<float>(format.gain * format.gain * model.sigmaD2);
     k.post = static_cast<float>(model.sigmaR2);
-    k.alignment = alignment;
+    k.alignment = noise.alignment;
+    k.sampling = noise.shotSampling;
 
+    const Mat prior =
+        noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && noise.alignment != NoiseAlignment::NONE
+            ? localPriorMean(src, format)
+            : Mat();
     Mat dst(src.size(), src.type());
     std::atomic<int64> brightening{0};
-    const uint64_t key = stepSeed(seed, 1);
+    const uint64_t key = stepSeed(seed, 1), poissonKey = stepSeed(seed, 5);
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
-            jitterRows<ushort>(src, dst, k, key, rows, brightening);
+            jitterRows<ushort>(src, prior, dst, k, key, poissonKey, rows, brightening);
         else
-            jitterRows<float>(src, dst, k, key, rows, brightening);
+            jitterRows<float>(src, prior, dst, k, key, poissonKey, rows, brightening);
     });
     reportSaturation(src, format, report, saturatedMask);
     _dst.assign(dst);
@@ -289,6 +410,8 @@ struct ResampleConstants
     float shot;     // g alpha
     float floorVar; // g^2 sigma_d^2 + sigma_r^2: the read noise a weighted sum removes, (1 - sum w^2) of it
     NoiseAlignment alignment;
+    ShotNoiseSampling sampling;
+    uint64_t key, poissonKey; // the step's Gaussian and Poisson streams
 };
 
 // Plane row `planeRow` of site `site`, black-subtracted, into out[0..pad + width + pad) with the plane's
@@ -354,22 +477,40 @@ template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int
                                                   : static_cast<T>(v[j]);
 }
 
-// The end of every resampled row: its noise stream (site, row), the noise, the black level, the store.
+// ShotNoiseSampling::POISSON for a resampled row: the shot part of Eq. 15 (or of the model, for
+// IGNORE_PRIOR) as an electron count at the input gain (see sampledNoise), the rest Gaussian.
+void finishResampledRowPoisson(float* mean, const float* shotSum, const float* readFactor, const float* z,
+                               const ResampleConstants& k, float black, detail::CounterRng& rng, int n)
+{
+    for (int j = 0; j < n; ++j) {
+        const AddedVariance v = k.alignment == NoiseAlignment::ACCOUNT_PRIOR
+                                    ? AddedVariance{k.shot * shotSum[j], readFactor[j] * k.floorVar}
+                                    : AddedVariance{k.shot * std::max(mean[j], 0.0f), k.floorVar};
+        mean[j] = std::min(std::max(mean[j] + sampledNoise(v, k.shot, z[j], rng) + black, 0.0f), k.white);
+    }
+}
+
+// The end of every resampled row: its noise streams (site, row), the noise, the black level, the store.
 template <typename T>
 void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float* readFactor,
-                    std::vector<float>& z, const ResampleConstants& k, uint64_t key, Mat& dst, int site,
-                    int planeRow)
+                    std::vector<float>& z, const ResampleConstants& k, Mat& dst, int site, int planeRow)
 {
     const int n = static_cast<int>(mean.size());
+    const uint64_t stream = (static_cast<uint64_t>(site) << 32) | static_cast<uint64_t>(planeRow);
     if (k.alignment != NoiseAlignment::NONE)
-        detail::fillGaussian(key, (static_cast<uint64_t>(site) << 32) | static_cast<uint64_t>(planeRow),
-                             z.data(), n);
-    finishResampledRow(mean.data(), shotSum, readFactor, z.data(), k, k.black[site], n);
+        detail::fillGaussian(k.key, stream, z.data(), n);
+    if (k.alignment != NoiseAlignment::NONE && k.sampling == ShotNoiseSampling::POISSON) {
+        detail::CounterRng rng(k.poissonKey, stream);
+        finishResampledRowPoisson(mean.data(), shotSum, readFactor, z.data(), k, k.black[site], rng, n);
+    } else {
+        finishResampledRow(mean.data(), shotSum, readFactor, z.data(), k, k.black[site], n);
+    }
     storePlaneRow<T>(mean.data(), dst, site, planeRow);
 }
 
+// `step` names the step's random streams (stepSeed); its Poisson streams are step + 4.
 ResampleConstants resampleConstants(const RawFormat& format, const NoiseModel& model,
-                                    NoiseAlignment alignment)
+                                    const NoiseOptions& noise, uint64 seed, uint64_t step)
 {
     const NoiseLine line = model.lineAtGain(format.gain);
     ResampleConstants k;
@@ -378,7 +519,10 @@ ResampleConstants resampleConstants(const RawFormat& format, const NoiseModel& m
     k.white = static_cast<float>(format.whiteLevel);
     k.shot = static_cast<float>(line.a);
     k.floorVar = static_cast<float>(line.b);
-    k.alignment = alignment;
+    k.alignment = noise.alignment;
+    k.sampling = noise.shotSampling;
+    k.key = stepSeed(seed, step);
+    k.poissonKey = stepSeed(seed, step + 4);
     return k;
 }
 
@@ -392,7 +536,7 @@ struct KernelTap
 // row, and the rows a window needs are consecutive after clamping, hence distinct modulo the height.
 template <typename T>
 void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps, Size ksize, float readFactor,
-                   const ResampleConstants& k, uint64_t key, const Range& range)
+                   bool shotFromMean, const ResampleConstants& k, const Range& range)
 {
     const int pw = src.cols / 2, ph = src.rows / 2, rx = ksize.width / 2, ry = ksize.height / 2;
     const int padded = pw + 2 * rx;
@@ -401,6 +545,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
     std::vector<float> mean(static_cast<size_t>(pw)), shotSum(static_cast<size_t>(pw)),
         z(static_cast<size_t>(pw));
     const std::vector<float> readFactors(static_cast<size_t>(pw), readFactor);
+    const bool exactShot = k.alignment == NoiseAlignment::ACCOUNT_PRIOR && !shotFromMean;
     int ringSite = -1;
     for (int idx = range.start; idx < range.end; ++idx) {
         const int site = idx / ph, i = idx % ph;
@@ -418,10 +563,12 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
                 loadPlaneRow<T>(src, site, si, rx, k.black[site], row);
                 ringRow[slot] = si;
             }
-            addTapRow(mean.data(), shotSum.data(), row + t.dx, t.w, t.shotWeight,
-                      k.alignment == NoiseAlignment::ACCOUNT_PRIOR, pw);
+            addTapRow(mean.data(), shotSum.data(), row + t.dx, t.w, t.shotWeight, exactShot, pw);
         }
-        finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, key, dst, site, i);
+        if (shotFromMean && k.alignment == NoiseAlignment::ACCOUNT_PRIOR)
+            for (int j = 0; j < pw; ++j) // sum w (1 - w) = 1 - sum w^2, the read-noise factor
+                shotSum[static_cast<size_t>(j)] = readFactor * std::max(mean[static_cast<size_t>(j)], 0.0f);
+        finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i);
     }
 }
 
@@ -472,7 +619,7 @@ void bilinearRow(const float* row0, const float* row1, float fy, const int* c0, 
 
 template <typename T>
 void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const BilinearAxis* rows,
-                    const ResampleConstants& k, uint64_t key, const Range& range)
+                    const ResampleConstants& k, const Range& range)
 {
     const int pw = src.cols / 2, ph = src.rows / 2;
     std::vector<float> row0(static_cast<size_t>(pw)), row1(static_cast<size_t>(pw));
@@ -486,20 +633,20 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
         loadPlaneRow<T>(src, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data());
         bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
                     ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
-        finishPlaneRow<T>(mean, shot.data(), readFactor.data(), z, k, key, dst, site, i);
+        finishPlaneRow<T>(mean, shot.data(), readFactor.data(), z, k, dst, site, i);
     }
 }
 
 } // namespace
 
 void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& model, double scale,
-                 NoiseAlignment alignment, uint64 seed, OutputArray _dst, AugmentReport* report)
+                 const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
 {
     const Mat src = _src.getMat();
     checkMosaicInput(src, "scaleMosaic");
     format.validate();
     model.validate();
-    checkAlignment(alignment);
+    noise.validate();
     if (!std::isfinite(scale) || !(scale > 0))
         CV_Error(Error::StsBadArg, cv::format("scaleMosaic: scale must be finite and > 0 (got %g)", scale));
     if (src.rows % 2 || src.cols % 2)
@@ -511,14 +658,13 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
     }
     const BilinearAxis cols[2] = {bilinearAxis(src.cols / 2, 0, scale), bilinearAxis(src.cols / 2, 1, scale)};
     const BilinearAxis rows[2] = {bilinearAxis(src.rows / 2, 0, scale), bilinearAxis(src.rows / 2, 1, scale)};
-    const ResampleConstants k = resampleConstants(format, model, alignment);
-    const uint64_t key = stepSeed(seed, 4);
+    const ResampleConstants k = resampleConstants(format, model, noise, seed, 4);
     Mat dst(src.size(), src.type());
     parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
         if (src.depth() == CV_16U)
-            scalePlaneRows<ushort>(src, dst, cols, rows, k, key, range);
+            scalePlaneRows<ushort>(src, dst, cols, rows, k, range);
         else
-            scalePlaneRows<float>(src, dst, cols, rows, k, key, range);
+            scalePlaneRows<float>(src, dst, cols, rows, k, range);
     });
     _dst.assign(dst);
     if (report)
@@ -539,13 +685,13 @@ Rect scaleBox(const Rect& box, Size size, double scale)
 }
 
 void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& model, InputArray _kernel,
-                NoiseAlignment alignment, uint64 seed, OutputArray _dst, AugmentReport* report)
+                const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
 {
     const Mat src = _src.getMat();
     checkMosaicInput(src, "motionBlur");
     format.validate();
     model.validate();
-    checkAlignment(alignment);
+    noise.validate();
     if (src.rows % 2 || src.cols % 2)
         CV_Error(Error::StsBadArg,
                  cv::format("motionBlur: both sides must be even (got %dx%d)", src.cols, src.rows));
@@ -562,15 +708,15 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
             if (wk > 0)
                 taps.push_back({y, x, static_cast<float>(wk), static_cast<float>(wk * (1 - wk))});
         }
-    const ResampleConstants k = resampleConstants(format, model, alignment);
+    const ResampleConstants k = resampleConstants(format, model, noise, seed, 2);
     const float readFactor = static_cast<float>(1 - w.dot(w));
-    const uint64_t key = stepSeed(seed, 2);
+    const bool shotFromMean = noise.blurNoiseSum == BlurNoiseSum::FROM_BLURRED_MEAN;
     Mat dst(src.size(), src.type());
     parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
         if (src.depth() == CV_16U)
-            blurPlaneRows<ushort>(src, dst, taps, w.size(), readFactor, k, key, range);
+            blurPlaneRows<ushort>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
         else
-            blurPlaneRows<float>(src, dst, taps, w.size(), readFactor, k, key, range);
+            blurPlaneRows<float>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
     });
     _dst.assign(dst);
     if (report)
@@ -592,7 +738,7 @@ void Scene::write(FileStorage& fs, const String& name) const
     fs << "contrast"
        << "[" << jitter.contrast[0] << jitter.contrast[1] << jitter.contrast[2] << jitter.contrast[3] << "]";
     fs << "brightness" << jitter.brightness << "gain_ratio" << jitter.gainRatio;
-    fs << "alignment" << static_cast<int>(alignment);
+    noise.writeFields(fs);
     fs << "motion_kernel" << (motionKernel.empty() ? Mat::ones(1, 1, CV_32F) : motionKernel);
     fs << "}";
 }
@@ -614,8 +760,7 @@ Scene Scene::read(const FileNode& node)
         s.jitter.contrast[i] = static_cast<double>(c[i]);
     s.jitter.brightness = detail::readRealField(node, "brightness");
     s.jitter.gainRatio = detail::readRealField(node, "gain_ratio");
-    s.alignment = static_cast<NoiseAlignment>(static_cast<int>(detail::readRealField(node, "alignment")));
-    checkAlignment(s.alignment);
+    s.noise = NoiseOptions::readFields(node);
     node["motion_kernel"] >> s.motionKernel;
     return s;
 }
@@ -653,14 +798,14 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
             report->steps.push_back("shift");
     }
     if (scene.scale != 1) {
-        scaleMosaic(current, fmt, model, scene.scale, scene.alignment, seed, current, report);
+        scaleMosaic(current, fmt, model, scene.scale, scene.noise, seed, current, report);
         if (boxes)
             for (Rect& b : *boxes)
                 b = scaleBox(b, current.size(), scene.scale);
     }
-    colorJitter(current, fmt, model, scene.jitter, scene.alignment, seed, current, fmt, report);
+    colorJitter(current, fmt, model, scene.jitter, scene.noise, seed, current, fmt, report);
     if (!isIdentityKernel(scene.motionKernel))
-        motionBlur(current, fmt, model, scene.motionKernel, scene.alignment, seed, current, report);
+        motionBlur(current, fmt, model, scene.motionKernel, scene.noise, seed, current, report);
     _dst.assign(current);
     dstFormat = fmt;
 }
@@ -720,7 +865,7 @@ void RandomScenePolicy::validate() const
     probability(hueProbability, "hueProbability");
     probability(blurProbability, "blurProbability");
     probability(geometryProbability, "geometryProbability");
-    checkAlignment(alignment);
+    noise.validate();
 }
 
 Scene RandomScenePolicy::draw(InputArray _src, const RawFormat& format, uint64 seed) const
@@ -732,7 +877,7 @@ Scene RandomScenePolicy::draw(InputArray _src, const RawFormat& format, uint64 s
     detail::CounterRng rng(stepSeed(seed, 3), 0);
     const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * rng.uniform(); };
     Scene s;
-    s.alignment = alignment;
+    s.noise = noise;
     if (rng.uniform() < geometryProbability) {
         s.shift = Point(cvRound(uniform(-maxShift, maxShift) * src.cols),
                         cvRound(uniform(-maxShift, maxShift) * src.rows));
@@ -759,7 +904,7 @@ void RandomScenePolicy::write(FileStorage& fs, const String& name) const
     fs << "gain_db_min" << gainDbMin << "gain_db_max" << gainDbMax;
     fs << "blur_probability" << blurProbability << "blur_length_max" << blurLengthMax;
     fs << "geometry_probability" << geometryProbability << "max_shift" << maxShift << "max_scale" << maxScale;
-    fs << "alignment" << static_cast<int>(alignment);
+    noise.writeFields(fs);
     fs << "}";
 }
 
@@ -790,9 +935,7 @@ RandomScenePolicy RandomScenePolicy::read(const FileNode& node)
     field("geometry_probability", p.geometryProbability);
     field("max_shift", p.maxShift);
     field("max_scale", p.maxScale);
-    double alignmentValue = static_cast<double>(p.alignment);
-    field("alignment", alignmentValue);
-    p.alignment = static_cast<NoiseAlignment>(static_cast<int>(alignmentValue));
+    p.noise = NoiseOptions::readFields(node);
     p.validate();
     return p;
 }

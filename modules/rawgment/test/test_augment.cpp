@@ -432,7 +432,18 @@ TEST(Augment, badArgumentsGiveClearErrors)
                              "NaN");
     EXPECT_CV_ERROR_CONTAINS(
         colorJitter(src, fmt, model, ColorJitter(), static_cast<NoiseAlignment>(7), 0, out, f),
-        "NoiseAlignment 7");
+        "unknown alignment 7");
+    NoiseOptions badSampling;
+    badSampling.shotSampling = static_cast<ShotNoiseSampling>(3);
+    EXPECT_CV_ERROR_CONTAINS(motionBlur(src, fmt, model, Mat::ones(3, 3, CV_32F), badSampling, 0, out),
+                             "unknown shotSampling 3");
+    NoiseOptions badPrior;
+    badPrior.priorMean = static_cast<PriorMeanEstimate>(-1);
+    EXPECT_CV_ERROR_CONTAINS(scaleMosaic(src, fmt, model, 1.5, badPrior, 0, out), "unknown priorMean -1");
+    FileStorage fs("%YAML:1.0\nscene_policy: {blur_noise_sum: 0.5}\n",
+                   FileStorage::READ | FileStorage::MEMORY);
+    EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy::read(fs["scene_policy"]),
+                             "'blur_noise_sum' must be an integer");
 }
 
 TEST(Augment, shiftKeepsTheCfaPhaseAndMovesBoxes)
@@ -466,6 +477,7 @@ TEST(Augment, randomPolicyDrawsInItsRangesAndRoundTrips)
     RandomScenePolicy policy;
     policy.gainDbMin = 3;
     policy.gainDbMax = 9;
+    policy.noise.shotSampling = ShotNoiseSampling::POISSON;
     int blurred = 0, hue = 0, geometry = 0;
     for (uint64 seed = 0; seed < 400; ++seed) {
         const Scene s = policy.draw(src, fmt, seed);
@@ -495,7 +507,8 @@ TEST(Augment, randomPolicyDrawsInItsRangesAndRoundTrips)
         const RandomScenePolicy back = RandomScenePolicy::load(dir + name);
         EXPECT_EQ(back.gainDbMax, 9);
         EXPECT_EQ(back.contrastMin, 0.01);
-        EXPECT_EQ(back.alignment, NoiseAlignment::ACCOUNT_PRIOR);
+        EXPECT_EQ(back.noise.alignment, NoiseAlignment::ACCOUNT_PRIOR);
+        EXPECT_EQ(back.noise.shotSampling, ShotNoiseSampling::POISSON);
     }
     // p_b = u min(x), with min(x) over black-subtracted pixels of every site.
     RandomScenePolicy fixedBrightness;
@@ -527,7 +540,9 @@ TEST(Augment, sceneRoundTripsThroughFileStorage)
     s.jitter.brightness = -3;
     s.jitter.gainRatio = 8;
     s.motionKernel = linearMotionKernel(7, 20);
-    s.alignment = NoiseAlignment::IGNORE_PRIOR;
+    s.noise.alignment = NoiseAlignment::IGNORE_PRIOR;
+    s.noise.priorMean = PriorMeanEstimate::LOCAL_MEAN;
+    s.noise.blurNoiseSum = BlurNoiseSum::FROM_BLURRED_MEAN;
     FileStorage out("", FileStorage::WRITE | FileStorage::MEMORY | FileStorage::FORMAT_YAML);
     s.write(out, "scene");
     FileStorage in(out.releaseAndGetString(), FileStorage::READ | FileStorage::MEMORY);
@@ -536,7 +551,10 @@ TEST(Augment, sceneRoundTripsThroughFileStorage)
     EXPECT_EQ(r.scale, 1.02);
     EXPECT_EQ(r.jitter.contrast, s.jitter.contrast);
     EXPECT_EQ(r.jitter.gainRatio, 8);
-    EXPECT_EQ(r.alignment, NoiseAlignment::IGNORE_PRIOR);
+    EXPECT_EQ(r.noise.alignment, NoiseAlignment::IGNORE_PRIOR);
+    EXPECT_EQ(r.noise.shotSampling, ShotNoiseSampling::GAUSSIAN);
+    EXPECT_EQ(r.noise.priorMean, PriorMeanEstimate::LOCAL_MEAN);
+    EXPECT_EQ(r.noise.blurNoiseSum, BlurNoiseSum::FROM_BLURRED_MEAN);
     EXPECT_EQ(norm(r.motionKernel, s.motionKernel, NORM_INF), 0);
 }
 

@@ -24,6 +24,64 @@ enum class NoiseAlignment
     ACCOUNT_PRIOR = 2 //!< the paper's method: only the difference between target and prior noise is added
 };
 
+/** @brief How the shot part of the added noise is drawn. */
+enum class ShotNoiseSampling
+{
+    /** The paper's: the whole added variance as one Gaussian. Fast (vectorised); at a few electrons per
+     * pixel the true shot noise is skewed and lives on a lattice of one electron, which a Gaussian is not. */
+    GAUSSIAN = 0,
+    /** The shot part as an electron count: $ q(K - m) $ with $ K \sim 	ext{Poisson}(m) $, q the
+     * output's DN per electron ($ glpha $ at the output gain) and $ m = v_{shot} / q^2 $, so
+     * the variance is the same as with GAUSSIAN and only the shape changes; the read-noise part stays
+     * Gaussian. Exact for the darkening that matters (p_u << 1, where the scaled prior noise is
+     * negligible). Scalar code: several times slower than GAUSSIAN (see the trade-off report). */
+    POISSON = 1
+};
+
+/** @brief Which estimate of the prior mean $ \mu_x $ the added variance uses. */
+enum class PriorMeanEstimate
+{
+    /** The paper's: the noisy value itself, $ \mu_x = \max(x, 0) $. Unbiased except near black,
+     * where the clip at 0 biases it up, and as noisy as the pixel. */
+    PIXEL_VALUE = 0,
+    /** The mean of the 3x3 neighbourhood on the pixel's own CFA plane (same colour, two mosaic pixels
+     * apart), clipped at 0 after averaging: nine times less noisy and less biased at black, but it
+     * smooths the variance across edges. Costs one float32 frame of memory. Used by colour jitter; blur
+     * and scaling already weight many pixels' values in their sums. */
+    LOCAL_MEAN = 1
+};
+
+/** @brief How motion blur computes its shot-noise term $ \sum_k w_k(1-w_k)\max(x_k, 0) $. */
+enum class BlurNoiseSum
+{
+    EXACT = 0, //!< Eq. 15 as written: a second weighted sum per pixel
+    /** $ (1 - \sum_k w_k^2) \max(ar{x}, 0) $ with $ ar{x} $ the blurred value: exact on flat
+     * areas, wrong across edges (where the taps' means differ); saves the second sum. */
+    FROM_BLURRED_MEAN = 1
+};
+
+/** @brief Every choice a noise step makes about accuracy and speed. Defaults are the paper's method
+ * (with the exact blur sum); the trade-off report (`rawgment_tradeoffs`) measures each option.
+ *
+ * Implicitly constructible from a NoiseAlignment, so `colorJitter(..., NoiseAlignment::NONE, ...)`
+ * keeps the other defaults. */
+struct CV_RAWGMENT_EXPORTS NoiseOptions
+{
+    NoiseAlignment alignment = NoiseAlignment::ACCOUNT_PRIOR;     //!< how the prior noise is treated
+    ShotNoiseSampling shotSampling = ShotNoiseSampling::GAUSSIAN; //!< shape of the added shot noise
+    PriorMeanEstimate priorMean = PriorMeanEstimate::PIXEL_VALUE; //!< the estimate of mu_x
+    BlurNoiseSum blurNoiseSum = BlurNoiseSum::EXACT;              //!< motion blur's shot-noise term
+
+    NoiseOptions() {} //!< the defaults above
+    //! The given alignment with the other defaults; implicit on purpose (see above).
+    NoiseOptions(NoiseAlignment a) : alignment(a) {}
+    void validate() const; //!< throws naming an unknown enum value
+    //! Writes the options as fields of the current map (`alignment`, `shot_sampling`, ...).
+    void writeFields(FileStorage& fs) const;
+    //! Reads the fields written by writeFields(); missing ones keep their defaults.
+    static NoiseOptions readFields(const FileNode& map);
+};
+
 /** @brief What augmentation steps did, for logs and for the user's trust. */
 struct CV_RAWGMENT_EXPORTS AugmentReport
 {
@@ -74,7 +132,7 @@ struct CV_RAWGMENT_EXPORTS ColorJitter
  * @param format its format (its gain is g)
  * @param model the calibrated noise model
  * @param jitter the change (a step at identity is skipped: dst shares src's data, no noise is drawn)
- * @param alignment how the prior noise is treated
+ * @param noise how the prior noise is treated (alignment) and how the noise is drawn
  * @param seed the noise seed: the same seed gives the same output on any number of threads
  * @param dst output mosaic
  * @param dstFormat output format (the new gain)
@@ -82,7 +140,7 @@ struct CV_RAWGMENT_EXPORTS ColorJitter
  * @param saturatedMask optional CV_8UC1 output, 255 where the input was at or above white
  */
 CV_RAWGMENT_EXPORTS void colorJitter(InputArray src, const RawFormat& format, const NoiseModel& model,
-                                     const ColorJitter& jitter, NoiseAlignment alignment, uint64 seed,
+                                     const ColorJitter& jitter, const NoiseOptions& noise, uint64 seed,
                                      OutputArray dst, RawFormat& dstFormat, AugmentReport* report = nullptr,
                                      OutputArray saturatedMask = noArray());
 
@@ -106,14 +164,14 @@ CV_RAWGMENT_EXPORTS Mat linearMotionKernel(double length, double angleDegrees);
  * @param model the noise model
  * @param kernel non-negative CV_32FC1/CV_64FC1 kernel on the plane grid, normalised here; a 1x1 kernel
  *        is the identity and the step is skipped
- * @param alignment how the prior noise is treated
+ * @param noise how the prior noise is treated (alignment), how the noise is drawn
  * @param seed noise seed
  * @param dst output, same type
  * @param report optional
  */
 CV_RAWGMENT_EXPORTS void motionBlur(InputArray src, const RawFormat& format, const NoiseModel& model,
-                                    InputArray kernel, NoiseAlignment alignment, uint64 seed, OutputArray dst,
-                                    AugmentReport* report = nullptr);
+                                    InputArray kernel, const NoiseOptions& noise, uint64 seed,
+                                    OutputArray dst, AugmentReport* report = nullptr);
 
 /** @brief Noise-accounted scaling about the mosaic centre, each CFA plane resampled bilinearly.
  *
@@ -131,13 +189,13 @@ CV_RAWGMENT_EXPORTS void motionBlur(InputArray src, const RawFormat& format, con
  * @param model the noise model
  * @param scale magnification, > 0 (1.03 enlarges by 3%); exactly 1 is the identity and the step is
  *        skipped (dst shares src's data)
- * @param alignment how the prior noise is treated
+ * @param noise how the prior noise is treated (alignment), how the noise is drawn
  * @param seed noise seed
  * @param dst output, same type and size
  * @param report optional
  */
 CV_RAWGMENT_EXPORTS void scaleMosaic(InputArray src, const RawFormat& format, const NoiseModel& model,
-                                     double scale, NoiseAlignment alignment, uint64 seed, OutputArray dst,
+                                     double scale, const NoiseOptions& noise, uint64 seed, OutputArray dst,
                                      AugmentReport* report = nullptr);
 
 /** @brief A bounding box (mosaic pixels) after scaleMosaic(): its edges scale about the frame centre,
@@ -156,7 +214,7 @@ struct CV_RAWGMENT_EXPORTS Scene
     double scale = 1;          //!< magnification about the centre (see scaleMosaic()); 1: none
     ColorJitter jitter;        //!< exposure, gain, contrast, brightness, hue
     Mat motionKernel;          //!< blur on the plane grid (empty or 1x1: none)
-    NoiseAlignment alignment = NoiseAlignment::ACCOUNT_PRIOR; //!< for every noise step
+    NoiseOptions noise;        //!< for every noise step
 
     bool isIdentity() const; //!< true when no step would change anything
     //! Writes the scene as a map under `name` (the kernel as a matrix).
@@ -194,7 +252,7 @@ struct CV_RAWGMENT_EXPORTS RandomScenePolicy
     double gainDbMin = 0, gainDbMax = 12;
     double blurProbability = 0.5, blurLengthMax = 13;
     double geometryProbability = 0.8, maxShift = 0.1, maxScale = 0.03;
-    NoiseAlignment alignment = NoiseAlignment::ACCOUNT_PRIOR;
+    NoiseOptions noise; //!< copied into every scene
 
     void validate() const; //!< throws naming the first inconsistent range
     /** @brief A scene for `src` (its minimum sets the brightness scale), from `seed` alone. */
