@@ -50,7 +50,8 @@ void BM_BurstStatistics_rawgment(benchmark::State& state)
 {
     const std::vector<Mat>& f = frames();
     for (auto _ : state) {
-        BurstStatistics stats(format12bit(), static_cast<int>(state.range(0)));
+        BurstStatistics stats(format12bit(), static_cast<int>(state.range(0)),
+                              static_cast<int>(state.range(1)));
         for (int t = 0; t < kFrames; ++t)
             stats.add(f[t % kDistinctFrames]);
         Mat mean, var;
@@ -59,6 +60,7 @@ void BM_BurstStatistics_rawgment(benchmark::State& state)
         benchmark::DoNotOptimize(var.data);
     }
     setBytes(state);
+    state.SetLabel(state.range(1) == CV_64F ? "float64 state" : "float32 state");
 }
 
 void BM_BurstStatistics_memcpy(benchmark::State& state)
@@ -129,11 +131,14 @@ void BM_CalibrationFit(benchmark::State& state)
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(samples.size()));
 }
 
-// The argument is groupFrames: memory (that many buffered frames) against state traffic.
+// The arguments are groupFrames (memory: that many buffered frames, against state traffic) and the
+// state's depth (float64, or float32 with half the traffic).
 BENCHMARK(BM_BurstStatistics_rawgment)
-    ->Arg(8)
-    ->Arg(16)
-    ->Arg(32)
+    ->Args({8, CV_64F})
+    ->Args({16, CV_64F})
+    ->Args({32, CV_64F})
+    ->Args({8, CV_32F})
+    ->Args({16, CV_32F})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(3);

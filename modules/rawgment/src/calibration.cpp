@@ -56,18 +56,34 @@ void groupSums(const float* const* rows, int m, int n, double* s1, double* s2, d
     groupSumsBody(rows, m, n, s1, s2, lo, hi);
 }
 
-// Chan et al.'s pairwise merge of a group's (mean, M2) into the running statistics, n columns.
-RAWGMENT_HOT_KERNEL
-void mergeGroupColumns(const double* first, const double* s1, const double* s2, const double* blackOfColumn,
-                       int m, double wGroup, double wCross, double* mu, double* acc, int n)
+// Chan et al.'s pairwise merge of a group's (mean, M2) into the running statistics, n columns. The
+// state S is float64 (default) or float32 (half the memory and traffic); the merge itself is float64.
+template <typename S>
+inline void mergeGroupColumnsBody(const double* first, const double* s1, const double* s2,
+                                  const double* blackOfColumn, int m, double wGroup, double wCross, S* mu,
+                                  S* acc, int n)
 {
     for (int c = 0; c < n; ++c) {
         const double groupMean = first[c] - blackOfColumn[c] + s1[c] / m;
         const double groupM2 = (m * s2[c] - s1[c] * s1[c]) / m;
-        const double delta = groupMean - mu[c];
-        mu[c] += delta * wGroup;
-        acc[c] += groupM2 + delta * delta * wCross;
+        const double delta = groupMean - static_cast<double>(mu[c]);
+        mu[c] = static_cast<S>(static_cast<double>(mu[c]) + delta * wGroup);
+        acc[c] = static_cast<S>(static_cast<double>(acc[c]) + groupM2 + delta * delta * wCross);
     }
+}
+
+RAWGMENT_HOT_KERNEL
+void mergeGroupColumns(const double* first, const double* s1, const double* s2, const double* blackOfColumn,
+                       int m, double wGroup, double wCross, double* mu, double* acc, int n)
+{
+    mergeGroupColumnsBody(first, s1, s2, blackOfColumn, m, wGroup, wCross, mu, acc, n);
+}
+
+RAWGMENT_HOT_KERNEL
+void mergeGroupColumns(const double* first, const double* s1, const double* s2, const double* blackOfColumn,
+                       int m, double wGroup, double wCross, float* mu, float* acc, int n)
+{
+    mergeGroupColumnsBody(first, s1, s2, blackOfColumn, m, wGroup, wCross, mu, acc, n);
 }
 
 /** Folds a group of frames into the running mean and M2 of each pixel of rows [r0, r1).
@@ -77,7 +93,7 @@ void mergeGroupColumns(const double* first, const double* s1, const double* s2, 
  * merge with the running statistics. For 16-bit input every d, sum and m * sum(d^2) - sum(d)^2 is an
  * integer below 2^53, so the group's mean and M2 are exact; float input keeps full float64 precision
  * because the differences are small next to a large mean. */
-template <typename T>
+template <typename T, typename S>
 void mergeGroupRows(const std::vector<Mat>& group, int merged, const Vec4d& black, double white, Mat& mean,
                     Mat& m2, Mat& clipped, int r0, int r1)
 {
@@ -91,8 +107,8 @@ void mergeGroupRows(const std::vector<Mat>& group, int merged, const Vec4d& blac
         const double b0 = black[2 * (r & 1)], b1 = black[2 * (r & 1) + 1];
         for (int c = 0; c < kBlock; ++c)
             blackOfColumn[c] = (c & 1) ? b1 : b0; // kBlock is even: the phase holds in every block
-        double* mu = mean.ptr<double>(r);
-        double* acc = m2.ptr<double>(r);
+        S* mu = mean.ptr<S>(r);
+        S* acc = m2.ptr<S>(r);
         uchar* clip = clipped.ptr<uchar>(r);
         for (int c0 = 0; c0 < cols; c0 += kBlock) {
             const int n = std::min(kBlock, cols - c0);
@@ -130,6 +146,7 @@ struct BurstStatistics::Impl
 {
     //! Frames buffered before a merge: the float64 state is read once per group instead of per frame.
     int groupFrames = 8;
+    int stateDepth = CV_64F;
     RawFormat format;
     int type = -1;
     int merged = 0; // frames folded into mean/m2
@@ -144,26 +161,37 @@ struct BurstStatistics::Impl
             return;
         const std::vector<Mat> group(buffers.begin(), buffers.begin() + pending);
         parallel_for_(Range(0, mean.rows), [&](const Range& rows) {
-            if (type == CV_16UC1)
-                mergeGroupRows<ushort>(group, merged, format.blackLevel, format.whiteLevel, mean, m2, clipped,
-                                       rows.start, rows.end);
+            const auto merge = [&](auto pixel, auto state) {
+                mergeGroupRows<decltype(pixel), decltype(state)>(group, merged, format.blackLevel,
+                                                                 format.whiteLevel, mean, m2, clipped,
+                                                                 rows.start, rows.end);
+            };
+            if (type == CV_16UC1 && stateDepth == CV_64F)
+                merge(ushort(), double());
+            else if (type == CV_16UC1)
+                merge(ushort(), float());
+            else if (stateDepth == CV_64F)
+                merge(float(), double());
             else
-                mergeGroupRows<float>(group, merged, format.blackLevel, format.whiteLevel, mean, m2, clipped,
-                                      rows.start, rows.end);
+                merge(float(), float());
         });
         merged += pending;
         pending = 0;
     }
 };
 
-BurstStatistics::BurstStatistics(const RawFormat& format, int groupFrames) : impl_(nullptr)
+BurstStatistics::BurstStatistics(const RawFormat& format, int groupFrames, int stateDepth) : impl_(nullptr)
 {
     // Arguments first: a constructor that throws never runs its destructor, so nothing may be owned yet.
     format.validate();
     if (groupFrames < 1 || groupFrames > 256)
         CV_Error(Error::StsBadArg,
                  cv::format("BurstStatistics: groupFrames must lie in [1, 256] (got %d)", groupFrames));
+    if (stateDepth != CV_64F && stateDepth != CV_32F)
+        CV_Error(Error::StsBadArg,
+                 cv::format("BurstStatistics: stateDepth must be CV_64F or CV_32F (got %d)", stateDepth));
     impl_ = new Impl;
+    impl_->stateDepth = stateDepth;
     impl_->format = format;
     impl_->groupFrames = groupFrames;
     impl_->buffers.resize(static_cast<size_t>(groupFrames));
@@ -187,8 +215,8 @@ void BurstStatistics::add(InputArray _frame)
     Impl& d = *impl_;
     if (d.type < 0) {
         d.type = frame.type();
-        d.mean = largeBuffer(frame.size(), CV_64FC1);
-        d.m2 = largeBuffer(frame.size(), CV_64FC1);
+        d.mean = largeBuffer(frame.size(), CV_MAKETYPE(d.stateDepth, 1));
+        d.m2 = largeBuffer(frame.size(), CV_MAKETYPE(d.stateDepth, 1));
         d.clipped = largeBuffer(frame.size(), CV_8UC1);
         d.mean.setTo(0);
         d.m2.setTo(0);
@@ -233,7 +261,7 @@ void BurstStatistics::mean(OutputArray dst) const
     if (frames() < 1)
         CV_Error(Error::StsBadArg, "BurstStatistics::mean: no frame was added");
     impl_->flush();
-    impl_->mean.copyTo(dst);
+    impl_->mean.convertTo(dst, CV_64F);
 }
 
 void BurstStatistics::variance(OutputArray dst) const
@@ -242,8 +270,7 @@ void BurstStatistics::variance(OutputArray dst) const
         CV_Error(Error::StsBadArg,
                  cv::format("BurstStatistics::variance: needs at least 2 frames (got %d)", frames()));
     impl_->flush();
-    Mat v = impl_->m2 / (impl_->merged - 1);
-    dst.assign(v);
+    impl_->m2.convertTo(dst, CV_64F, 1.0 / (impl_->merged - 1));
 }
 
 void BurstStatistics::clippedMask(OutputArray dst) const

@@ -23,8 +23,8 @@ namespace rawgment {
  * which stays exact for large means (60000 DN with a variance of 1) and long bursts. A group of
  * frames is buffered (a copy of each) so that the float64 state, eight times the size of a 16-bit
  * frame, is read and written once per group instead of once per frame; for CV_16UC1 input the group's
- * sums are exact integers. Peak memory for a W x H burst: 17 bytes per pixel of state plus
- * `groupFrames` frames (8 x 24 MB for 12 MP by default). The state traffic per frame falls as
+ * sums are exact integers. Peak memory for a W x H burst: 17 bytes per pixel of state (9 with a float32
+ * state) plus `groupFrames` frames (8 x 24 MB for 12 MP by default). The state traffic per frame falls as
  * 1/groupFrames, but beyond 8-16 frames the buffers' own traffic dominates (see perf_calibration).
  *
  * Values are black-subtracted with the RawFormat (per site). A pixel that is at or above the white
@@ -36,8 +36,13 @@ class CV_RAWGMENT_EXPORTS BurstStatistics
 public:
     /** @param format the burst's format (validated); its black and white levels are used
      *  @param groupFrames frames buffered between merges, in [1, 256]; results differ between group
-     *         sizes only by float64 rounding */
-    explicit BurstStatistics(const RawFormat& format, int groupFrames = 8);
+     *         sizes only by float64 rounding
+     *  @param stateDepth depth of the running mean and M2: CV_64F (default, exact to float64 rounding) or
+     *         CV_32F, which halves the state's memory (8 instead of 16 bytes per pixel) and its traffic.
+     *         Each group is still merged in float64, so float32 only rounds the stored state: about
+     *         1e-7 relative on the mean and, for M2, the rounding of the mean squared over the variance
+     *         (at mean 60000 and variance 1, ~1e-4 relative). The trade-off report measures both. */
+    explicit BurstStatistics(const RawFormat& format, int groupFrames = 8, int stateDepth = CV_64F);
     ~BurstStatistics();
     BurstStatistics(const BurstStatistics&) = delete;
     BurstStatistics& operator=(const BurstStatistics&) = delete;
