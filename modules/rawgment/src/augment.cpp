@@ -532,6 +532,39 @@ struct KernelTap
     float w, shotWeight; // w and w (1 - w)
 };
 
+// Within a kernel radius of the frame's edge, several taps replicate one pixel: its prior noise is then
+// kept with the square of their summed weight, not the sum of their squares. Eq. 15 needs the weight W
+// of each distinct source pixel: shot = sum W (1 - W) max(x, 0), read factor = 1 - sum W^2. `rowOf`
+// gives the (black-subtracted, padded by rx) row of a clamped source row index.
+struct EdgeSource
+{
+    int row, col;
+    float weight, x;
+};
+
+template <typename RowOf>
+void mergedEdgeTerms(const std::vector<KernelTap>& taps, int i, int j, int pw, int ph, int rx, int ry,
+                     RowOf rowOf, std::vector<EdgeSource>& sources, float& shot, float& readFactor)
+{
+    sources.clear();
+    for (const KernelTap& t : taps) {
+        const int si = std::min(std::max(i + t.dy - ry, 0), ph - 1);
+        const int sj = std::min(std::max(j + t.dx - rx, 0), pw - 1);
+        auto same = std::find_if(sources.begin(), sources.end(),
+                                 [&](const EdgeSource& e) { return e.row == si && e.col == sj; });
+        if (same != sources.end())
+            same->weight += t.w;
+        else
+            sources.push_back({si, sj, t.w, rowOf(si)[sj + rx]});
+    }
+    shot = 0;
+    readFactor = 1;
+    for (const EdgeSource& e : sources) {
+        shot += e.weight * (1 - e.weight) * std::max(e.x, 0.0f);
+        readFactor -= e.weight * e.weight;
+    }
+}
+
 // Plane rows come from a ring of kernel-height rows: consecutive output rows share all but one source
 // row, and the rows a window needs are consecutive after clamping, hence distinct modulo the height.
 template <typename T>
@@ -543,9 +576,44 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
     std::vector<float> ring(static_cast<size_t>(ksize.height) * padded);
     std::vector<int> ringRow(static_cast<size_t>(ksize.height), -1);
     std::vector<float> mean(static_cast<size_t>(pw)), shotSum(static_cast<size_t>(pw)),
-        z(static_cast<size_t>(pw));
-    const std::vector<float> readFactors(static_cast<size_t>(pw), readFactor);
-    const bool exactShot = k.alignment == NoiseAlignment::ACCOUNT_PRIOR && !shotFromMean;
+        z(static_cast<size_t>(pw)), readFactors(static_cast<size_t>(pw));
+    const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
+    const bool exactShot = account && !shotFromMean;
+    const auto ringRowOf = [&](int si) {
+        return ring.data() + static_cast<size_t>(si % ksize.height) * padded;
+    };
+    std::vector<EdgeSource> sources;
+    std::vector<KernelTap> clampedTaps;
+    // Taps of each edge column merged per clamped source column (rows that do not clamp).
+    struct MergedColumn
+    {
+        int j;
+        std::vector<KernelTap> taps;
+        float readFactor;
+    };
+    std::vector<MergedColumn> edgeColumns;
+    std::vector<int> edgeColumnIndices;
+    for (int j = 0; j < std::min(rx, pw); ++j)
+        edgeColumnIndices.push_back(j);
+    for (int j = std::max(std::min(rx, pw), pw - rx); j < pw; ++j)
+        edgeColumnIndices.push_back(j);
+    for (int j : edgeColumnIndices) {
+        MergedColumn m{j, {}, 1.0f};
+        for (const KernelTap& t : taps) {
+            const int sj = std::min(std::max(j + t.dx - rx, 0), pw - 1);
+            auto same = std::find_if(m.taps.begin(), m.taps.end(),
+                                     [&](const KernelTap& c) { return c.dy == t.dy && c.dx == sj; });
+            if (same != m.taps.end())
+                same->w += t.w;
+            else
+                m.taps.push_back({t.dy, sj, t.w, 0.0f});
+        }
+        for (KernelTap& c : m.taps) {
+            c.shotWeight = c.w * (1 - c.w);
+            m.readFactor -= c.w * c.w;
+        }
+        edgeColumns.push_back(std::move(m));
+    }
     int ringSite = -1;
     for (int idx = range.start; idx < range.end; ++idx) {
         const int site = idx / ph, i = idx % ph;
@@ -553,9 +621,32 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             std::fill(ringRow.begin(), ringRow.end(), -1);
             ringSite = site;
         }
+        // Rows near the top or bottom: taps that clamp onto one source row merge (per dx), which is
+        // exact for every column whose taps do not also clamp sideways; the row stays vectorised.
+        const std::vector<KernelTap>* rowTaps = &taps;
+        float rowReadFactor = readFactor;
+        if (i < ry || i >= ph - ry) {
+            clampedTaps.clear();
+            for (const KernelTap& t : taps) {
+                const int dy = std::min(std::max(i + t.dy - ry, 0), ph - 1) - i + ry;
+                auto same = std::find_if(clampedTaps.begin(), clampedTaps.end(),
+                                         [&](const KernelTap& c) { return c.dy == dy && c.dx == t.dx; });
+                if (same != clampedTaps.end())
+                    same->w += t.w;
+                else
+                    clampedTaps.push_back({dy, t.dx, t.w, 0.0f});
+            }
+            rowReadFactor = 1;
+            for (KernelTap& c : clampedTaps) {
+                c.shotWeight = c.w * (1 - c.w);
+                rowReadFactor -= c.w * c.w;
+            }
+            rowTaps = &clampedTaps;
+        }
         std::fill(mean.begin(), mean.end(), 0.0f);
         std::fill(shotSum.begin(), shotSum.end(), 0.0f);
-        for (const KernelTap& t : taps) {
+        std::fill(readFactors.begin(), readFactors.end(), rowReadFactor);
+        for (const KernelTap& t : *rowTaps) {
             const int si = std::min(std::max(i + t.dy - ry, 0), ph - 1);
             const size_t slot = static_cast<size_t>(si % ksize.height);
             float* row = ring.data() + slot * padded;
@@ -565,9 +656,27 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             }
             addTapRow(mean.data(), shotSum.data(), row + t.dx, t.w, t.shotWeight, exactShot, pw);
         }
-        if (shotFromMean && k.alignment == NoiseAlignment::ACCOUNT_PRIOR)
+        if (shotFromMean && account)
             for (int j = 0; j < pw; ++j) // sum w (1 - w) = 1 - sum w^2, the read-noise factor
-                shotSum[static_cast<size_t>(j)] = readFactor * std::max(mean[static_cast<size_t>(j)], 0.0f);
+                shotSum[static_cast<size_t>(j)] =
+                    rowReadFactor * std::max(mean[static_cast<size_t>(j)], 0.0f);
+        if (account) {
+            // The columns within a kernel radius of the left and right edges: merged per pixel, from the
+            // per-column lists except where the row clamps too.
+            const bool edgeRow = rowTaps != &taps;
+            for (const MergedColumn& m : edgeColumns) {
+                const size_t jj = static_cast<size_t>(m.j);
+                float shot = 0;
+                if (edgeRow) {
+                    mergedEdgeTerms(taps, i, m.j, pw, ph, rx, ry, ringRowOf, sources, shot, readFactors[jj]);
+                } else {
+                    for (const KernelTap& t : m.taps) // t.dx holds the clamped source column
+                        shot += t.shotWeight * std::max(ringRowOf(i + t.dy - ry)[t.dx + rx], 0.0f);
+                    readFactors[jj] = m.readFactor;
+                }
+                shotSum[jj] = shotFromMean ? readFactors[jj] * std::max(mean[jj], 0.0f) : shot;
+            }
+        }
         finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i);
     }
 }
