@@ -68,22 +68,6 @@ TEST(Normality, matchesRShapiroTestOnEveryReferenceCase)
     std::cout << "largest |W - W_R| = " << worstW << ", largest |p - p_R| / tolerance = " << worstP << "\n";
 }
 
-TEST(Normality, threeValuesHaveTheExactPValue)
-{
-    // Equally spaced values are perfectly normal-looking: W = 1, p = 1.
-    ShapiroWilkResult r = shapiroWilk(std::vector<double>{0, 1, 2});
-    EXPECT_NEAR(r.W, 1.0, 1e-15);
-    EXPECT_NEAR(r.pValue, 1.0, 1e-12);
-    // Two equal values and one other: the smallest possible W for n = 3, 3/4, and p = 0.
-    r = shapiroWilk(std::vector<double>{5, 5, 9});
-    EXPECT_NEAR(r.W, 0.75, 1e-15);
-    EXPECT_NEAR(r.pValue, 0.0, 1e-12);
-    // In between, p = 6/pi (asin(sqrt(W)) - pi/3) by hand: W of {1, 2, 4} is 27/28.
-    r = shapiroWilk(std::vector<double>{4, 1, 2});
-    EXPECT_NEAR(r.W, 27.0 / 28.0, 1e-15);
-    EXPECT_NEAR(r.pValue, 6 / CV_PI * (std::asin(std::sqrt(27.0 / 28.0)) - CV_PI / 3), 1e-14);
-}
-
 TEST(Normality, invariantUnderShiftScaleAndOrder)
 {
     std::mt19937 gen(7);
@@ -100,34 +84,6 @@ TEST(Normality, invariantUnderShiftScaleAndOrder)
     EXPECT_NEAR(shapiroWilk(moved).W, base.W, 1e-10);
     EXPECT_NEAR(shapiroWilk(moved).pValue, base.pValue, 1e-9);
     EXPECT_EQ(shapiroWilk(shuffled).W, base.W);
-}
-
-TEST(Normality, nearlyConstantDataWithLargeOffsetKeepsItsDigits)
-{
-    // A bright pixel: mean 60000, one DN of spread. Centring on the minimum before the sums keeps W
-    // equal to that of the spread alone.
-    std::vector<double> spread = {0, 1, 1, 2, 0, 1, 3, 1, 2, 1, 0, 2, 1, 1, 2, 1, 0, 1, 2, 1};
-    std::vector<double> bright(spread.size());
-    for (size_t i = 0; i < spread.size(); ++i)
-        bright[i] = 60000 + spread[i];
-    EXPECT_EQ(shapiroWilk(bright).W, shapiroWilk(spread).W);
-    std::vector<double> tiny(spread.size());
-    for (size_t i = 0; i < spread.size(); ++i)
-        tiny[i] = 1.0 + spread[i] * 1e-13;
-    // 1 + k 1e-13 is exact to ~1e-16 / 1e-13 = 1e-3 of a step: W moves at that scale, not more.
-    EXPECT_NEAR(shapiroWilk(tiny).W, shapiroWilk(spread).W, 1e-2);
-    EXPECT_FALSE(shapiroWilk(tiny).constant);
-}
-
-TEST(Normality, constantSampleIsFlaggedAndRejected)
-{
-    for (int n : {3, 100, 5000}) {
-        const ShapiroWilkResult r = shapiroWilk(std::vector<double>(n, 42.0));
-        EXPECT_TRUE(r.constant) << n;
-        EXPECT_EQ(r.W, 0.0) << n;
-        EXPECT_EQ(r.pValue, 0.0) << n;
-        EXPECT_EQ(r.n, n);
-    }
 }
 
 TEST(Normality, rejectsBadInputWithTheValidRange)
@@ -234,19 +190,6 @@ TEST(Normality, batchRejectsBadInputNamingTheSeries)
     EXPECT_FALSE(r[0].constant);
     EXPECT_TRUE(r[1].constant);
     EXPECT_FALSE(r[2].constant);
-}
-
-TEST(Normality, largestSampleSize)
-{
-    const Mat data = randomSeries(5000, 2, CV_64F, 3);
-    std::vector<ShapiroWilkResult> r;
-    shapiroWilkBatch(data, r);
-    for (const ShapiroWilkResult& x : r) {
-        EXPECT_GT(x.W, 0.99); // normal data of this size: W is within a few 1e-4 of 1
-        EXPECT_TRUE(std::isfinite(x.pValue));
-        EXPECT_GE(x.pValue, 0.0);
-        EXPECT_LE(x.pValue, 1.0);
-    }
 }
 
 /** A burst of a physical sensor (paper Eq. 1): Poisson photo-electrons, read noise before and after

@@ -1,0 +1,390 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The hard cases of every topic in one place: values below black and at zero, saturation, vanishing
+// and huge exposure and gain ratios, 16-bit extremes, large means with tiny variances, the smallest and
+// largest Shapiro-Wilk samples, degenerate line and cross-gain fits. Each case asserts a correct value
+// or a clear cv::Exception; none may give NaN or Inf silently.
+#include "test_common.hpp"
+
+#include <opencv2/rawgment/augment.hpp>
+#include <opencv2/rawgment/calibration.hpp>
+#include <opencv2/rawgment/normality.hpp>
+#include <opencv2/rawgment/simulate.hpp>
+
+#include <limits>
+
+namespace cv {
+namespace rawgment {
+namespace {
+
+// ---------------------------------------------------------------------------------------------------
+// Augmentation
+
+const double kGain = 2.0;
+
+//! 16x24 12-bit mosaic (black 256) holding the hard values: 0 (far below black), 255 (just below),
+//! exactly black, and white, among uniform values.
+Mat hardMosaic(int type)
+{
+    Mat m(16, 24, CV_16UC1);
+    RNG(17).fill(m, RNG::UNIFORM, 100, 3500);
+    m.at<ushort>(0, 0) = 0;
+    m.at<ushort>(0, 1) = 255;
+    m.at<ushort>(2, 2) = 256;
+    m.at<ushort>(1, 1) = 4095;
+    Mat out;
+    m.convertTo(out, type);
+    return out;
+}
+
+const NoiseAlignment kAlignments[] = {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR,
+                                      NoiseAlignment::ACCOUNT_PRIOR};
+
+//! Every combination of the noise knobs with ACCOUNT_PRIOR: hard cases must hold for each.
+std::vector<NoiseOptions> everyKnob()
+{
+    std::vector<NoiseOptions> all;
+    for (ShotNoiseSampling s : {ShotNoiseSampling::GAUSSIAN, ShotNoiseSampling::POISSON})
+        for (PriorMeanEstimate p : {PriorMeanEstimate::PIXEL_VALUE, PriorMeanEstimate::LOCAL_MEAN})
+            for (BlurNoiseSum b : {BlurNoiseSum::EXACT, BlurNoiseSum::FROM_BLURRED_MEAN}) {
+                NoiseOptions o;
+                o.shotSampling = s;
+                o.priorMean = p;
+                o.blurNoiseSum = b;
+                all.push_back(o);
+            }
+    return all;
+}
+
+TEST(NumericalStability, augmentationHardCasesGiveFiniteCorrectOutput)
+{
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    const Mat src = hardMosaic(CV_32FC1);
+    Mat x;
+    subtractBlackLevel(src, fmt, x);
+    RawFormat outFmt;
+    // Brightening x10: the target is less noisy than the input; nothing can be added, so the output is
+    // exactly ten times the input (clipped to [0, white]), and every pixel is reported.
+    Mat out;
+    for (const NoiseOptions& noise : everyKnob()) {
+        AugmentReport report;
+        Mat mask;
+        colorJitter(src, fmt, model, ColorJitter::exposureChange(10, 1), noise, 1, out, outFmt, &report,
+                    mask);
+        EXPECT_EQ(report.brighteningPixels, static_cast<int64>(src.total()));
+        EXPECT_EQ(report.saturatedPixels, 1);
+        EXPECT_EQ(mask.at<uchar>(1, 1), 255);
+        EXPECT_EQ(countNonZero(mask), 1);
+        for (int r = 0; r < src.rows; ++r)
+            for (int c = 0; c < src.cols; ++c) {
+                const float expected = std::min(std::max(10 * x.at<float>(r, c) + 256.f, 0.f), 4095.f);
+                ASSERT_NEAR(out.at<float>(r, c), expected, 1e-2f) << "at " << r << "," << c;
+            }
+    }
+    // p_u = 1: at the same gain the step is the identity (skipped, the input itself); at four times
+    // the gain the target's read noise after the gain is smaller than the amplified input's, which is
+    // brightening too (reported), and the output is exactly four times the input.
+    colorJitter(src, fmt, model, ColorJitter::exposureChange(1, 1), NoiseAlignment::ACCOUNT_PRIOR, 1, out,
+                outFmt);
+    EXPECT_EQ(out.data, src.data);
+    AugmentReport gained;
+    colorJitter(src, fmt, model, ColorJitter::exposureChange(1, 4), NoiseAlignment::ACCOUNT_PRIOR, 1, out,
+                outFmt, &gained);
+    EXPECT_EQ(gained.brighteningPixels, static_cast<int64>(src.total()));
+    EXPECT_EQ(outFmt.gain, 4 * kGain);
+    EXPECT_NEAR(out.at<float>(3, 3), std::min(4 * x.at<float>(3, 3) + 256.f, 4095.f), 1e-2f);
+    // Knobs at p_u -> 0 and 60 dB: finite everywhere, in range.
+    for (const NoiseOptions& noise : everyKnob()) {
+        for (double pu : {1e-6, 1e-9}) {
+            colorJitter(src, fmt, model, ColorJitter::exposureChange(pu, 1), noise, 2, out, outFmt);
+            EXPECT_EQ(test::countNonFinite(out), 0);
+        }
+        RawFormat loud = fmt;
+        loud.gain = 1000;
+        colorJitter(src, loud, model, ColorJitter::exposureChange(0.01, 1), noise, 3, out, outFmt);
+        EXPECT_EQ(test::countNonFinite(out), 0);
+        motionBlur(src, loud, model, linearMotionKernel(9, 10), noise, 3, out);
+        EXPECT_EQ(test::countNonFinite(out), 0);
+        scaleMosaic(src, loud, model, 0.9, noise, 3, out);
+        EXPECT_EQ(test::countNonFinite(out), 0);
+        double lo = 0, hi = 0;
+        minMaxLoc(out, &lo, &hi);
+        EXPECT_GE(lo, 0);
+        EXPECT_LE(hi, 4095);
+    }
+    // p_u -> 0 (1e-6, 1e-9): only read noise remains, around black; finite everywhere.
+    for (double pu : {1e-6, 1e-9}) {
+        colorJitter(src, fmt, model, ColorJitter::exposureChange(pu, 1), NoiseAlignment::ACCOUNT_PRIOR, 2,
+                    out, outFmt);
+        EXPECT_EQ(test::countNonFinite(out), 0);
+        EXPECT_NEAR(cv::mean(out)[0], 256, 3 * std::sqrt(model.variance(0, kGain)));
+    }
+    // 0 dB and 60 dB inputs; 60 dB target gain.
+    for (double gain : {1.0, 1000.0}) {
+        RawFormat g = fmt;
+        g.gain = gain;
+        for (NoiseAlignment mode : kAlignments) {
+            colorJitter(src, g, model, ColorJitter::exposureChange(0.01, 10), mode, 3, out, outFmt);
+            EXPECT_EQ(test::countNonFinite(out), 0);
+            motionBlur(src, g, model, linearMotionKernel(9, 10), mode, 3, out);
+            EXPECT_EQ(test::countNonFinite(out), 0);
+        }
+    }
+    // A kernel larger than the image.
+    Mat tiny = src(Rect(0, 0, 4, 4)).clone();
+    motionBlur(tiny, fmt, model, Mat::ones(41, 41, CV_32F), NoiseAlignment::ACCOUNT_PRIOR, 4, out);
+    EXPECT_EQ(out.size(), tiny.size());
+    EXPECT_EQ(test::countNonFinite(out), 0);
+    // 16-bit extremes stay in range.
+    Mat extremes(4, 4, CV_16UC1, Scalar(0));
+    extremes.row(1).setTo(65535);
+    RawFormat wide = fmt;
+    wide.whiteLevel = 65535;
+    colorJitter(extremes, wide, model, ColorJitter::exposureChange(0.5, 3), NoiseAlignment::ACCOUNT_PRIOR, 5,
+                out, outFmt);
+    EXPECT_EQ(out.type(), CV_16UC1);
+    // x1.5 of 65535 clips at white instead of wrapping around; 0 (far below black) stays at 0 or near it.
+    double lo = 0, hi = 0;
+    minMaxLoc(out.row(1), &lo, &hi);
+    EXPECT_EQ(lo, 65535);
+    minMaxLoc(out.row(0), &lo, &hi);
+    EXPECT_LT(hi, 256 + 6 * std::sqrt(model.variance(0, 3 * wide.gain)));
+    // Brightening 16-bit extremes by 10x: white stays white, no wrap-around anywhere.
+    colorJitter(extremes, wide, model, ColorJitter::exposureChange(10, 1), NoiseAlignment::ACCOUNT_PRIOR, 5,
+                out, outFmt);
+    minMaxLoc(out.row(1), &lo, &hi);
+    EXPECT_EQ(lo, 65535);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Burst statistics
+
+//! Largest errors of BurstStatistics' mean and variance against a long-double two-pass reference, for
+//! a burst of 6x10 float frames with mean 60000 (59900 above black) and variance 1.
+Vec2d burstStatisticsErrorsAtLargeMean(const RawFormat& fmt, int depth, int group, int frames)
+{
+    BurstStatistics stats(fmt, group, depth);
+    RNG rng(frames);
+    std::vector<Mat> burst;
+    for (int t = 0; t < frames; ++t) {
+        Mat f(6, 10, CV_32FC1);
+        rng.fill(f, RNG::NORMAL, 60000, 1);
+        stats.add(f);
+        burst.push_back(f);
+    }
+    EXPECT_EQ(stats.frames(), frames);
+    Mat mean, var;
+    stats.mean(mean);
+    stats.variance(var);
+    Vec2d worst(0, 0);
+    for (int r = 0; r < 6; ++r)
+        for (int c = 0; c < 10; ++c) {
+            long double m = 0, v = 0;
+            for (const Mat& f : burst)
+                m += f.at<float>(r, c);
+            m /= frames;
+            for (const Mat& f : burst)
+                v += (f.at<float>(r, c) - m) * (f.at<float>(r, c) - m);
+            v /= frames - 1;
+            worst[0] = std::max(worst[0], std::abs(mean.at<double>(r, c) - (static_cast<double>(m) - 100)));
+            worst[1] = std::max(worst[1], std::abs(var.at<double>(r, c) - static_cast<double>(v)));
+        }
+    return worst;
+}
+
+TEST(NumericalStability, burstStatisticsAreExactForLargeMeansAndAnyFrameCount)
+{
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d::all(100);
+    fmt.whiteLevel = 65535;
+    for (int group : {1, 3, 8, 16})
+        for (int frames : {2, 7, 8, 13, 100}) {
+            SCOPED_TRACE(testing::Message() << "group " << group << ", frames " << frames);
+            // Float64 state: errors of order 1e-16 x 60000 on the mean, far below 1e-9.
+            const Vec2d exact = burstStatisticsErrorsAtLargeMean(fmt, CV_64F, group, frames);
+            EXPECT_LT(exact[0], 1e-9);
+            EXPECT_LT(exact[1], 1e-9);
+            // The float32 state (a documented knob) rounds the stored mean at every merge: an error
+            // uniform in half an ulp of 59900 (2^-8), standard deviation 2^-8 / sqrt(12) = 0.0011, adding
+            // up over K merges (the update (1 - w) old + w new hardly damps it): 5 x 0.0011 sqrt(K). That
+            // error enters each merge's delta^2 n_a m / n as 2 delta eps m with delta ~ 1 / sqrt(m) (a
+            // group mean's spread), of random sign: over K = frames / m merges about 2 sqrt(m) K 0.0011
+            // in M2, i.e. 5 x 2 x 0.0011 frames / sqrt(m) / (frames - 1) in the variance (~1% at worst).
+            const double rounding = 0.00390625 / std::sqrt(12.0);
+            const double merges = std::ceil(static_cast<double>(frames) / group);
+            const double m = std::min(group, frames);
+            const Vec2d single = burstStatisticsErrorsAtLargeMean(fmt, CV_32F, group, frames);
+            EXPECT_LT(single[0], 5 * rounding * std::sqrt(merges));
+            EXPECT_LT(single[1], 5 * 2 * rounding * frames / std::sqrt(m) / (frames - 1));
+        }
+    EXPECT_CV_ERROR_CONTAINS(BurstStatistics(fmt, 0), "groupFrames");
+    EXPECT_CV_ERROR_CONTAINS(BurstStatistics(fmt, 257), "groupFrames");
+    EXPECT_CV_ERROR_CONTAINS(BurstStatistics stats(fmt, 8, CV_16U), "stateDepth");
+    RawFormat badWhite = fmt;
+    badWhite.whiteLevel = std::numeric_limits<double>::infinity();
+    EXPECT_CV_ERROR_CONTAINS(BurstStatistics stats(badWhite), "whiteLevel"); // and leaks nothing (ASan build)
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Shapiro-Wilk
+
+TEST(NumericalStability, shapiroWilkThreeValuesHaveTheExactPValue)
+{
+    // Equally spaced values are perfectly normal-looking: W = 1, p = 1.
+    ShapiroWilkResult r = shapiroWilk(std::vector<double>{0, 1, 2});
+    EXPECT_NEAR(r.W, 1.0, 1e-15);
+    EXPECT_NEAR(r.pValue, 1.0, 1e-12);
+    // Two equal values and one other: the smallest possible W for n = 3, 3/4, and p = 0.
+    r = shapiroWilk(std::vector<double>{5, 5, 9});
+    EXPECT_NEAR(r.W, 0.75, 1e-15);
+    EXPECT_NEAR(r.pValue, 0.0, 1e-12);
+    // In between, p = 6/pi (asin(sqrt(W)) - pi/3) by hand: W of {1, 2, 4} is 27/28.
+    r = shapiroWilk(std::vector<double>{4, 1, 2});
+    EXPECT_NEAR(r.W, 27.0 / 28.0, 1e-15);
+    EXPECT_NEAR(r.pValue, 6 / CV_PI * (std::asin(std::sqrt(27.0 / 28.0)) - CV_PI / 3), 1e-14);
+}
+
+TEST(NumericalStability, shapiroWilkNearlyConstantDataWithLargeOffsetKeepsItsDigits)
+{
+    // A bright pixel: mean 60000, one DN of spread. Centring on the minimum before the sums keeps W
+    // equal to that of the spread alone.
+    std::vector<double> spread = {0, 1, 1, 2, 0, 1, 3, 1, 2, 1, 0, 2, 1, 1, 2, 1, 0, 1, 2, 1};
+    std::vector<double> bright(spread.size());
+    for (size_t i = 0; i < spread.size(); ++i)
+        bright[i] = 60000 + spread[i];
+    EXPECT_EQ(shapiroWilk(bright).W, shapiroWilk(spread).W);
+    std::vector<double> tiny(spread.size());
+    for (size_t i = 0; i < spread.size(); ++i)
+        tiny[i] = 1.0 + spread[i] * 1e-13;
+    // 1 + k 1e-13 is exact to ~1e-16 / 1e-13 = 1e-3 of a step: W moves at that scale, not more.
+    EXPECT_NEAR(shapiroWilk(tiny).W, shapiroWilk(spread).W, 1e-2);
+    EXPECT_FALSE(shapiroWilk(tiny).constant);
+}
+
+TEST(NumericalStability, shapiroWilkConstantSampleIsFlaggedAndRejected)
+{
+    for (int n : {3, 100, 5000}) {
+        const ShapiroWilkResult r = shapiroWilk(std::vector<double>(n, 42.0));
+        EXPECT_TRUE(r.constant) << n;
+        EXPECT_EQ(r.W, 0.0) << n;
+        EXPECT_EQ(r.pValue, 0.0) << n;
+        EXPECT_EQ(r.n, n);
+    }
+}
+
+TEST(NumericalStability, shapiroWilkLargestSampleSize)
+{
+    Mat data(5000, 2, CV_64FC1);
+    RNG(3).fill(data, RNG::NORMAL, 200, 15);
+    std::vector<ShapiroWilkResult> r;
+    shapiroWilkBatch(data, r);
+    for (const ShapiroWilkResult& x : r) {
+        EXPECT_GT(x.W, 0.99); // normal data of this size: W is within a few 1e-4 of 1
+        EXPECT_TRUE(std::isfinite(x.pValue));
+        EXPECT_GE(x.pValue, 0.0);
+        EXPECT_LE(x.pValue, 1.0);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Line and cross-gain fits
+
+std::vector<NoiseSample> linePoints(const std::vector<Point2d>& pts, double gain = 1.0)
+{
+    std::vector<NoiseSample> s;
+    for (const Point2d& p : pts) {
+        NoiseSample n;
+        n.mean = p.x;
+        n.variance = p.y;
+        n.gain = gain;
+        n.dof = 99;
+        s.push_back(n);
+    }
+    return s;
+}
+
+TEST(NumericalStability, lineFitHardCases)
+{
+    // Collinear: exact, R^2 = 1, every point an inlier.
+    const NoiseLineFit exact = fitNoiseLine(linePoints({{0, 2}, {10, 7}, {100, 52}, {1000, 502}}));
+    EXPECT_NEAR(exact.line.a, 0.5, 1e-12);
+    EXPECT_NEAR(exact.line.b, 2, 1e-9);
+    EXPECT_NEAR(exact.rSquared, 1, 1e-12);
+    EXPECT_EQ(exact.inliers, 4);
+    // Vertical: one mean only.
+    EXPECT_CV_ERROR_CONTAINS(fitNoiseLine(linePoints({{5, 1}, {5, 2}, {5, 3}})), "share one mean");
+    // All outliers: no three points on a line; the fit stays finite and says how few agree.
+    const NoiseLineFit scattered =
+        fitNoiseLine(linePoints({{1, 100}, {2, 1}, {3, 5000}, {4, 3}, {5, 900}, {6, 0.01}, {7, 40000}}));
+    EXPECT_TRUE(std::isfinite(scattered.line.a) && std::isfinite(scattered.line.b));
+    EXPECT_LT(scattered.inliers, 7);
+    // Zero variance everywhere: a flat line at 0, and a calibration that reports its bounds.
+    std::vector<NoiseSample> zero = linePoints({{1, 0}, {50, 0}, {900, 0}}, 2.0);
+    const std::vector<NoiseSample> zero4 = linePoints({{1, 0}, {50, 0}, {900, 0}}, 4.0);
+    zero.insert(zero.end(), zero4.begin(), zero4.end());
+    const CalibrationReport flat = calibrateNoiseModel(zero);
+    EXPECT_EQ(flat.model.alpha, 0);
+    EXPECT_EQ(flat.model.sigmaR2, 0);
+    EXPECT_FALSE(flat.notes.empty());
+    // Negative slope data: reported as is, with a note.
+    std::vector<NoiseSample> falling = linePoints({{0, 100}, {100, 50}, {200, 0.5}}, 2.0);
+    const std::vector<NoiseSample> rising = linePoints({{0, 10}, {100, 60}, {200, 110}}, 8.0);
+    falling.insert(falling.end(), rising.begin(), rising.end());
+    const CalibrationReport neg = calibrateNoiseModel(falling);
+    EXPECT_LT(neg.perGain[0].line.a, 0);
+    EXPECT_NE(neg.notes[0].find("negative slope"), std::string::npos);
+    // Bad samples.
+    std::vector<NoiseSample> bad = linePoints({{1, 1}, {2, std::numeric_limits<double>::quiet_NaN()}});
+    EXPECT_CV_ERROR_CONTAINS(fitNoiseLine(bad), "sample 1 is invalid");
+    EXPECT_CV_ERROR_CONTAINS(fitNoiseLine(linePoints({{1, 1}})), "at least 2 samples");
+    std::vector<NoiseSample> mixed = linePoints({{1, 1}, {2, 2}});
+    mixed[1].gain = 2;
+    EXPECT_CV_ERROR_CONTAINS(fitNoiseLine(mixed), "fit one gain at a time");
+}
+
+//! Samples of one gain drawn from a model: means uniform in [5, 2500], sample variances of 100 frames
+//! (relative spread sqrt(2 / 99)).
+std::vector<NoiseSample> samplesOfOneGain(const NoiseModel& model, double gain, int count, uint64 seed)
+{
+    RNG rng(seed);
+    std::vector<NoiseSample> out;
+    for (int i = 0; i < count; ++i) {
+        NoiseSample s;
+        s.gain = gain;
+        s.dof = 99;
+        s.mean = rng.uniform(5.0, 2500.0);
+        s.variance = model.variance(s.mean, gain) * (1 + std::sqrt(2.0 / 99) * rng.gaussian(1.0));
+        out.push_back(s);
+    }
+    return out;
+}
+
+TEST(NumericalStability, oneGainReportsAlphaButDoesNotInventReadNoise)
+{
+    const NoiseModel truth(0.4, 0.5, 2.0 + 1.0 / 12);
+    const double g = dbToLinearGain(12);
+    const std::vector<NoiseSample> oneGain = samplesOfOneGain(truth, g, 10000, 4);
+    const CalibrationReport r = calibrateNoiseModel(oneGain);
+    EXPECT_FALSE(r.separable);
+    // 10000 samples of 14% relative spread over means 5..2500: the slope's standard error is ~0.2%.
+    EXPECT_NEAR(r.model.alpha, truth.alpha, 0.01 * truth.alpha);
+    EXPECT_EQ(r.model.sigmaD2, 0.0);
+    EXPECT_EQ(r.model.sigmaR2, 0.0);
+    ASSERT_EQ(r.perGain.size(), 1u);
+    EXPECT_NEAR(r.perGain[0].line.b, truth.lineAtGain(g).b, 0.05 * truth.lineAtGain(g).b);
+    ASSERT_FALSE(r.notes.empty());
+    EXPECT_NE(r.notes.back().find("not separable"), std::string::npos);
+
+    // Two gains 0.01 dB apart cannot separate the two read noises either.
+    std::vector<NoiseSample> close = oneGain;
+    const std::vector<NoiseSample> other = samplesOfOneGain(truth, dbToLinearGain(12.01), 10000, 5);
+    close.insert(close.end(), other.begin(), other.end());
+    const CalibrationReport c = calibrateNoiseModel(close);
+    EXPECT_FALSE(c.separable);
+    EXPECT_TRUE(std::isfinite(c.model.alpha));
+    EXPECT_EQ(c.model.sigmaD2, 0.0);
+}
+
+} // namespace
+} // namespace rawgment
+} // namespace cv
