@@ -488,9 +488,14 @@ int main(int argc, char** argv)
         progress.finish();
 
         rawgment_apps::CsvTable table({"knob", "setting", "measure", "error", "ms_per_mp"});
+        // CsvTable does not quote: text cells keep their commas out of the way as semicolons.
+        const auto cell = [](std::string text) {
+            std::replace(text.begin(), text.end(), ',', ';');
+            return text;
+        };
         for (const Row& r : rows)
-            table.addRow(std::vector<std::string>{r.knob, r.setting, r.measure, formatNumber(r.error),
-                                                  formatNumber(r.msPerMp)});
+            table.addRow(std::vector<std::string>{cell(r.knob), cell(r.setting), cell(r.measure),
+                                                  formatNumber(r.error), formatNumber(r.msPerMp)});
         std::ostringstream text;
         text << "# What accuracy costs in time\n\n"
              << "Measured by `rawgment_tradeoffs" << (parser.get<bool>("quick") ? " --quick" : "") << "` on "
@@ -519,10 +524,8 @@ int main(int argc, char** argv)
             script += block + " << EOD\n";
             for (const Row& r : rows)
                 if (r.knob == knobs[k]) {
-                    std::string label = r.setting;
-                    std::replace(label.begin(), label.end(), ',', ';');
                     // A log axis cannot show 0: an exact match is drawn at 1e-17.
-                    script += label + "," + formatNumber(std::max(r.error, 1e-17)) + "," +
+                    script += cell(r.setting) + "," + formatNumber(std::max(r.error, 1e-17)) + "," +
                               formatNumber(r.msPerMp) + "\n";
                 }
             script += "EOD\nset title '" + knobs[k] + "' noenhanced\nplot " + block +

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -63,7 +64,7 @@ void expectPngDecodes(const std::string& path)
 TEST(Apps, everyAppHasHelpAndRejectsBadArguments)
 {
     for (const char* app : {"rawgment_demo", "rawgment_simulate", "rawgment_calibrate", "rawgment_validate",
-                            "rawgment_augment"}) {
+                            "rawgment_augment", "rawgment_tradeoffs"}) {
         const AppRun help = runApp(app, "--help");
         EXPECT_EQ(0, help.status) << app;
         EXPECT_NE(std::string::npos, help.output.find(app)) << app << " --help:\n" << help.output;
@@ -204,6 +205,47 @@ TEST(Apps, demoWritesAReportAndAGallery)
     EXPECT_NE(std::string::npos, report.find("gallery.png"));
     expectPngDecodes(dir + "/demo/gallery.png");
     r = runApp("rawgment_demo", "--out='" + dir + "/demo' --frames=8");
+    EXPECT_EQ(1, r.status) << "an existing report is never overwritten";
+}
+
+TEST(Apps, tradeoffReportMeasuresEveryKnob)
+{
+    const std::string dir = freshDir("tradeoffs");
+    AppRun r = runApp("rawgment_tradeoffs", "--quick --out='" + dir + "/t'");
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string md = readText(dir + "/t/tradeoffs.md");
+    for (const char* knob : {"Shot-noise sampling", "Prior mean", "Motion-blur noise sum", "Arithmetic",
+                             "Calibration burst length", "Calibration patch size",
+                             "Calibration RANSAC iterations", "Shapiro-Wilk"})
+        EXPECT_NE(std::string::npos, md.find(knob)) << knob;
+    expectPngDecodes(dir + "/t/tradeoffs.png");
+    // error and time of each (knob, setting) from the CSV: finite, and the orderings the knobs promise.
+    std::map<std::string, double> error;
+    std::istringstream csv(readText(dir + "/t/tradeoffs.csv"));
+    std::string line;
+    std::getline(csv, line);
+    int rows = 0;
+    while (std::getline(csv, line)) {
+        std::vector<std::string> cells;
+        std::stringstream cellStream(line);
+        for (std::string cell; std::getline(cellStream, cell, ',');)
+            cells.push_back(cell);
+        ASSERT_EQ(cells.size(), 5u) << line;
+        const double e = std::stod(cells[3]), t = std::stod(cells[4]);
+        EXPECT_TRUE(std::isfinite(e) && e >= 0) << line;
+        EXPECT_TRUE(std::isfinite(t) && t > 0) << line;
+        error[cells[1]] = e;
+        ++rows;
+    }
+    EXPECT_EQ(rows, 20); // 2 settings of 2 knobs, 4 blur rows, 2 burst lengths (--quick), 3 + 3, 2
+    // Text cells hold semicolons where the report has commas.
+    EXPECT_LT(error["POISSON"], error["GAUSSIAN (paper)"] / 10) << "the lattice of a dark capture";
+    EXPECT_LT(error["EXACT (Eq. 15); peaked 1x5 (1 4 6 4 1)"],
+              error["FROM_BLURRED_MEAN; peaked 1x5 (1 4 6 4 1)"]);
+    EXPECT_LT(error["LOCAL_MEAN"], error["PIXEL_VALUE (paper)"]) << "less clip bias at black";
+    EXPECT_LT(error["float64 (default)"], error["float32"]);
+    EXPECT_EQ(error["batched"], 0) << "batched Shapiro-Wilk gives the single form's numbers";
+    r = runApp("rawgment_tradeoffs", "--quick --out='" + dir + "/t'");
     EXPECT_EQ(1, r.status) << "an existing report is never overwritten";
 }
 
