@@ -408,6 +408,15 @@ void measureShapiroWilk(const Settings& set, std::vector<Row>& rows)
                     singleMs / mValues, "the same numbers, slower"});
 }
 
+//! A pipe inside a table cell would end the cell.
+std::string markdownCell(const std::string& text)
+{
+    std::string out;
+    for (char c : text)
+        out += c == '|' ? std::string("\\|") : std::string(1, c);
+    return out;
+}
+
 std::string markdownTable(const std::vector<Row>& rows)
 {
     std::ostringstream md;
@@ -416,8 +425,8 @@ std::string markdownTable(const std::vector<Row>& rows)
         char error[32], time[32];
         std::snprintf(error, sizeof(error), "%.3g", r.error);
         std::snprintf(time, sizeof(time), "%.3g ms", r.msPerMp);
-        md << "| " << r.knob << " | " << r.setting << " | " << r.measure << " | " << error << " | " << time
-           << " |\n";
+        md << "| " << r.knob << " | " << r.setting << " | " << markdownCell(r.measure) << " | " << error
+           << " | " << time << " |\n";
     }
     return md.str();
 }
@@ -515,10 +524,11 @@ int main(int argc, char** argv)
         for (const Row& r : rows)
             if (std::find(knobs.begin(), knobs.end(), r.knob) == knobs.end())
                 knobs.push_back(r.knob);
-        std::string script = "set multiplot layout 3," + std::to_string((knobs.size() + 2) / 3) +
-                             " title 'error against time per MP (log-log)'\nset logscale xy\nset grid\n"
-                             "set key off\nset xlabel 'ms per MP'\nset ylabel 'error'\n"
-                             "set offsets graph 0.2, graph 0.2, graph 0.3, graph 0.2\n";
+        std::string script =
+            "set multiplot layout 3," + std::to_string((knobs.size() + 2) / 3) +
+            " title 'error against time per MP (log-log)'\nset logscale xy\nset grid\n"
+            "set termoption noenhanced\nset key off\nset xlabel 'ms per MP'\nset ylabel 'error'\n"
+            "set offsets graph 0.2, graph 0.2, graph 0.3, graph 0.2\n";
         for (size_t k = 0; k < knobs.size(); ++k) {
             const std::string block = "$knob" + std::to_string(k);
             script += block + " << EOD\n";
