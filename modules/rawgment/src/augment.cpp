@@ -35,6 +35,19 @@ void checkMosaicInput(const Mat& src, const char* who)
         CV_Error(Error::StsBadArg, format("%s: src contains NaN or Inf", who));
 }
 
+// Blur and scale resample each CFA plane: they need whole 2x2 blocks, hence even sides.
+void checkResampleInput(const Mat& src, const RawFormat& format, const NoiseModel& model,
+                        const NoiseOptions& noise, const char* who)
+{
+    checkMosaicInput(src, who);
+    format.validate();
+    model.validate();
+    noise.validate();
+    if (src.rows % 2 || src.cols % 2)
+        CV_Error(Error::StsBadArg,
+                 cv::format("%s: both sides must be even (got %dx%d)", who, src.cols, src.rows));
+}
+
 struct JitterConstants
 {
     float pc[4], black[4];
@@ -257,8 +270,8 @@ NoiseOptions NoiseOptions::readFields(const FileNode& map)
         const FileNode f = map[name];
         if (f.empty() || f.isNone())
             return current;
-        const double value = f.isInt() || f.isReal() ? static_cast<double>(f) : 0.5;
-        if (value != std::floor(value))
+        const double value = f.isInt() || f.isReal() ? static_cast<double>(f) : 0.0;
+        if ((!f.isInt() && !f.isReal()) || value != std::floor(value))
             CV_Error(Error::StsParseError, format("noise options: field '%s' must be an integer", name));
         return static_cast<int>(value);
     };
@@ -533,45 +546,47 @@ struct KernelTap
 };
 
 // Within a kernel radius of the frame's edge, several taps replicate one pixel: its prior noise is then
-// kept with the square of their summed weight, not the sum of their squares. Eq. 15 needs the weight W
-// of each distinct source pixel: shot = sum W (1 - W) max(x, 0), read factor = 1 - sum W^2. `rowOf`
-// gives the (black-subtracted, padded by rx) row of a clamped source row index.
-struct EdgeSource
+// kept with the square of their summed weight, not the sum of their squares, so Eq. 15 needs the
+// weight W of each distinct source pixel. The taps of output pixel (i, j), clamped along the chosen
+// axes and merged per source, with offsets that still read i + dy - ry, j + dx - rx; shotWeight is
+// W (1 - W) and the return value the read-noise factor 1 - sum W^2.
+float mergeClampedTaps(const std::vector<KernelTap>& taps, int i, int j, Size plane, Size radius,
+                       bool clampRows, bool clampCols, std::vector<KernelTap>& merged)
 {
-    int row, col;
-    float weight, x;
-};
-
-template <typename RowOf>
-void mergedEdgeTerms(const std::vector<KernelTap>& taps, int i, int j, int pw, int ph, int rx, int ry,
-                     RowOf rowOf, std::vector<EdgeSource>& sources, float& shot, float& readFactor)
-{
-    sources.clear();
+    merged.clear();
     for (const KernelTap& t : taps) {
-        const int si = std::min(std::max(i + t.dy - ry, 0), ph - 1);
-        const int sj = std::min(std::max(j + t.dx - rx, 0), pw - 1);
-        auto same = std::find_if(sources.begin(), sources.end(),
-                                 [&](const EdgeSource& e) { return e.row == si && e.col == sj; });
-        if (same != sources.end())
-            same->weight += t.w;
+        const int dy =
+            clampRows ? std::min(std::max(i + t.dy - radius.height, 0), plane.height - 1) - i + radius.height
+                      : t.dy;
+        const int dx =
+            clampCols ? std::min(std::max(j + t.dx - radius.width, 0), plane.width - 1) - j + radius.width
+                      : t.dx;
+        auto same = std::find_if(merged.begin(), merged.end(),
+                                 [&](const KernelTap& m) { return m.dy == dy && m.dx == dx; });
+        if (same != merged.end())
+            same->w += t.w;
         else
-            sources.push_back({si, sj, t.w, rowOf(si)[sj + rx]});
+            merged.push_back({dy, dx, t.w, 0.0f});
     }
-    shot = 0;
-    readFactor = 1;
-    for (const EdgeSource& e : sources) {
-        shot += e.weight * (1 - e.weight) * std::max(e.x, 0.0f);
-        readFactor -= e.weight * e.weight;
+    float readFactor = 1;
+    for (KernelTap& m : merged) {
+        m.shotWeight = m.w * (1 - m.w);
+        readFactor -= m.w * m.w;
     }
+    return readFactor;
 }
 
 // Plane rows come from a ring of kernel-height rows: consecutive output rows share all but one source
 // row, and the rows a window needs are consecutive after clamping, hence distinct modulo the height.
+// Rows near the top or bottom use their taps merged per clamped row (exact for every column whose taps
+// do not also clamp sideways, and still vectorised); the columns within a kernel radius of the sides
+// use taps merged per clamped column (precomputed), or per pixel where the row clamps too.
 template <typename T>
 void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps, Size ksize, float readFactor,
                    bool shotFromMean, const ResampleConstants& k, const Range& range)
 {
     const int pw = src.cols / 2, ph = src.rows / 2, rx = ksize.width / 2, ry = ksize.height / 2;
+    const Size plane(pw, ph), radius(rx, ry);
     const int padded = pw + 2 * rx;
     std::vector<float> ring(static_cast<size_t>(ksize.height) * padded);
     std::vector<int> ringRow(static_cast<size_t>(ksize.height), -1);
@@ -579,41 +594,20 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
         z(static_cast<size_t>(pw)), readFactors(static_cast<size_t>(pw));
     const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
     const bool exactShot = account && !shotFromMean;
-    const auto ringRowOf = [&](int si) {
-        return ring.data() + static_cast<size_t>(si % ksize.height) * padded;
-    };
-    std::vector<EdgeSource> sources;
-    std::vector<KernelTap> clampedTaps;
-    // Taps of each edge column merged per clamped source column (rows that do not clamp).
-    struct MergedColumn
+    struct EdgeColumn
     {
         int j;
         std::vector<KernelTap> taps;
         float readFactor;
     };
-    std::vector<MergedColumn> edgeColumns;
-    std::vector<int> edgeColumnIndices;
-    for (int j = 0; j < std::min(rx, pw); ++j)
-        edgeColumnIndices.push_back(j);
-    for (int j = std::max(std::min(rx, pw), pw - rx); j < pw; ++j)
-        edgeColumnIndices.push_back(j);
-    for (int j : edgeColumnIndices) {
-        MergedColumn m{j, {}, 1.0f};
-        for (const KernelTap& t : taps) {
-            const int sj = std::min(std::max(j + t.dx - rx, 0), pw - 1);
-            auto same = std::find_if(m.taps.begin(), m.taps.end(),
-                                     [&](const KernelTap& c) { return c.dy == t.dy && c.dx == sj; });
-            if (same != m.taps.end())
-                same->w += t.w;
-            else
-                m.taps.push_back({t.dy, sj, t.w, 0.0f});
+    std::vector<EdgeColumn> edgeColumns;
+    for (int j = 0; j < pw; ++j)
+        if (j < rx || j >= pw - rx) {
+            EdgeColumn e{j, {}, 0.0f};
+            e.readFactor = mergeClampedTaps(taps, 0, j, plane, radius, false, true, e.taps);
+            edgeColumns.push_back(std::move(e));
         }
-        for (KernelTap& c : m.taps) {
-            c.shotWeight = c.w * (1 - c.w);
-            m.readFactor -= c.w * c.w;
-        }
-        edgeColumns.push_back(std::move(m));
-    }
+    std::vector<KernelTap> rowTaps, pixelTaps;
     int ringSite = -1;
     for (int idx = range.start; idx < range.end; ++idx) {
         const int site = idx / ph, i = idx % ph;
@@ -621,32 +615,13 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             std::fill(ringRow.begin(), ringRow.end(), -1);
             ringSite = site;
         }
-        // Rows near the top or bottom: taps that clamp onto one source row merge (per dx), which is
-        // exact for every column whose taps do not also clamp sideways; the row stays vectorised.
-        const std::vector<KernelTap>* rowTaps = &taps;
-        float rowReadFactor = readFactor;
-        if (i < ry || i >= ph - ry) {
-            clampedTaps.clear();
-            for (const KernelTap& t : taps) {
-                const int dy = std::min(std::max(i + t.dy - ry, 0), ph - 1) - i + ry;
-                auto same = std::find_if(clampedTaps.begin(), clampedTaps.end(),
-                                         [&](const KernelTap& c) { return c.dy == dy && c.dx == t.dx; });
-                if (same != clampedTaps.end())
-                    same->w += t.w;
-                else
-                    clampedTaps.push_back({dy, t.dx, t.w, 0.0f});
-            }
-            rowReadFactor = 1;
-            for (KernelTap& c : clampedTaps) {
-                c.shotWeight = c.w * (1 - c.w);
-                rowReadFactor -= c.w * c.w;
-            }
-            rowTaps = &clampedTaps;
-        }
+        const bool edgeRow = i < ry || i >= ph - ry;
+        const float rowReadFactor =
+            edgeRow ? mergeClampedTaps(taps, i, 0, plane, radius, true, false, rowTaps) : readFactor;
         std::fill(mean.begin(), mean.end(), 0.0f);
         std::fill(shotSum.begin(), shotSum.end(), 0.0f);
         std::fill(readFactors.begin(), readFactors.end(), rowReadFactor);
-        for (const KernelTap& t : *rowTaps) {
+        for (const KernelTap& t : edgeRow ? rowTaps : taps) {
             const int si = std::min(std::max(i + t.dy - ry, 0), ph - 1);
             const size_t slot = static_cast<size_t>(si % ksize.height);
             float* row = ring.data() + slot * padded;
@@ -656,27 +631,30 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             }
             addTapRow(mean.data(), shotSum.data(), row + t.dx, t.w, t.shotWeight, exactShot, pw);
         }
-        if (shotFromMean && account)
-            for (int j = 0; j < pw; ++j) // sum w (1 - w) = 1 - sum w^2, the read-noise factor
-                shotSum[static_cast<size_t>(j)] =
-                    rowReadFactor * std::max(mean[static_cast<size_t>(j)], 0.0f);
-        if (account) {
-            // The columns within a kernel radius of the left and right edges: merged per pixel, from the
-            // per-column lists except where the row clamps too.
-            const bool edgeRow = rowTaps != &taps;
-            for (const MergedColumn& m : edgeColumns) {
-                const size_t jj = static_cast<size_t>(m.j);
-                float shot = 0;
-                if (edgeRow) {
-                    mergedEdgeTerms(taps, i, m.j, pw, ph, rx, ry, ringRowOf, sources, shot, readFactors[jj]);
-                } else {
-                    for (const KernelTap& t : m.taps) // t.dx holds the clamped source column
-                        shot += t.shotWeight * std::max(ringRowOf(i + t.dy - ry)[t.dx + rx], 0.0f);
-                    readFactors[jj] = m.readFactor;
-                }
-                shotSum[jj] = shotFromMean ? readFactors[jj] * std::max(mean[jj], 0.0f) : shot;
-            }
+        if (!account) {
+            finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i);
+            continue;
         }
+        for (const EdgeColumn& e : edgeColumns) {
+            const std::vector<KernelTap>* merged = &e.taps;
+            readFactors[static_cast<size_t>(e.j)] = e.readFactor;
+            if (edgeRow) {
+                readFactors[static_cast<size_t>(e.j)] =
+                    mergeClampedTaps(taps, i, e.j, plane, radius, true, true, pixelTaps);
+                merged = &pixelTaps;
+            }
+            float shot = 0;
+            for (const KernelTap& t : *merged)
+                shot +=
+                    t.shotWeight *
+                    std::max(ring[static_cast<size_t>((i + t.dy - ry) % ksize.height) * padded + e.j + t.dx],
+                             0.0f);
+            shotSum[static_cast<size_t>(e.j)] = shot;
+        }
+        if (shotFromMean) // sum w (1 - w) = 1 - sum w^2, the read-noise factor
+            for (int j = 0; j < pw; ++j)
+                shotSum[static_cast<size_t>(j)] =
+                    readFactors[static_cast<size_t>(j)] * std::max(mean[static_cast<size_t>(j)], 0.0f);
         finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i);
     }
 }
@@ -752,15 +730,9 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
                  const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
 {
     const Mat src = _src.getMat();
-    checkMosaicInput(src, "scaleMosaic");
-    format.validate();
-    model.validate();
-    noise.validate();
+    checkResampleInput(src, format, model, noise, "scaleMosaic");
     if (!std::isfinite(scale) || !(scale > 0))
         CV_Error(Error::StsBadArg, cv::format("scaleMosaic: scale must be finite and > 0 (got %g)", scale));
-    if (src.rows % 2 || src.cols % 2)
-        CV_Error(Error::StsBadArg,
-                 cv::format("scaleMosaic: both sides must be even (got %dx%d)", src.cols, src.rows));
     if (scale == 1) {
         _dst.assign(src);
         return;
@@ -797,13 +769,7 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
                 const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
 {
     const Mat src = _src.getMat();
-    checkMosaicInput(src, "motionBlur");
-    format.validate();
-    model.validate();
-    noise.validate();
-    if (src.rows % 2 || src.cols % 2)
-        CV_Error(Error::StsBadArg,
-                 cv::format("motionBlur: both sides must be even (got %dx%d)", src.cols, src.rows));
+    checkResampleInput(src, format, model, noise, "motionBlur");
     const Mat w = normalisedKernel(_kernel, "motionBlur");
     if (w.total() == 1) {
         _dst.assign(src);

@@ -634,8 +634,6 @@ TEST(Augment, poissonShotNoiseGivesTheElectronLatticeOfARealDarkCapture)
     // the truth's own 0.5 DN read noise. An order of magnitude between them is the claim.
     EXPECT_GT(kl[0], 0.3);
     EXPECT_LT(kl[1], kl[0] / 10);
-    EXPECT_GT(kl[1], 0.0);
-    EXPECT_GE(kl[1], klFloor / 10) << "the augmented frame cannot beat a second true capture by far";
 }
 
 //! The 3x3 same-site mean of each pixel of a float mosaic (offsets -2, 0, 2), mirrored at the edges.

@@ -46,8 +46,8 @@ enum class PriorMeanEstimate
     PIXEL_VALUE = 0,
     /** The mean of the 3x3 neighbourhood on the pixel's own CFA plane (same colour, two mosaic pixels
      * apart), clipped at 0 after averaging: nine times less noisy and less biased at black, but it
-     * smooths the variance across edges. Costs one float32 frame of memory. Used by colour jitter; blur
-     * and scaling already weight many pixels' values in their sums. */
+     * smooths the variance across edges. Costs two float32 frames of temporary memory. Used by colour jitter;
+     * blur and scaling already weight many pixels' values in their sums. */
     LOCAL_MEAN = 1
 };
 
