@@ -23,6 +23,20 @@ void checkFiniteNonNegative(double value, const char* what)
         CV_Error(Error::StsBadArg, format("%s must be finite and >= 0 (got %g)", what, value));
 }
 
+Mat normalisedKernel(InputArray _kernel, const char* who)
+{
+    Mat kernel;
+    _kernel.getMat().convertTo(kernel, CV_64F);
+    if (kernel.empty() || !checkRange(kernel, true))
+        CV_Error(Error::StsBadArg, format("%s: kernel must be non-empty and finite", who));
+    double lo = 0;
+    minMaxLoc(kernel, &lo);
+    const double total = sum(kernel)[0];
+    if (lo < 0 || !(total > 0))
+        CV_Error(Error::StsBadArg, format("%s: kernel must be non-negative with a positive sum", who));
+    return kernel / total;
+}
+
 double readRealField(const FileNode& node, const char* field)
 {
     const FileNode f = node[field];

@@ -18,6 +18,19 @@ void checkFinitePositive(double value, const char* what);
 //! Throws StsBadArg "<what> must be finite and >= 0 (got <value>)" unless value is finite and >= 0.
 void checkFiniteNonNegative(double value, const char* what);
 
+/** A blur kernel as float64 normalised to sum 1: the one check of motion blur and the simulator's
+ * blurred captures. Throws StsBadArg naming `who` unless it is non-empty, finite, non-negative and of
+ * positive sum. */
+Mat normalisedKernel(InputArray kernel, const char* who);
+
+/** The border rule of every blur: BORDER_REPLICATE, the nearest visible pixel stands for the light just
+ * outside the frame. A motion blur at the edge integrates light the sensor never saw; the nearest
+ * recorded value is the estimate of it that assumes least (a reflection would invent structure that
+ * moves the wrong way), and it is the rule the augmentation's noise accounting implements exactly
+ * (taps that replicate one pixel are merged, resample.cpp). The simulator uses it too, so a blurred
+ * capture and a blurred augmentation agree up to the frame's edge. */
+constexpr int kBlurBorder = BORDER_REPLICATE;
+
 //! Reads a required real field of a FileStorage map, naming it when it is missing or not a number.
 double readRealField(const FileNode& node, const char* field);
 

@@ -84,6 +84,78 @@ inline void philox8Blocks(uint32_t firstBlock, uint64_t stream, const std::array
     }
 }
 
+/** @name The registry of random streams
+ *
+ * Every random number of the library is drawn from a CounterRng or fillGaussian() keyed by
+ * (key, stream). This is the one list of how keys and streams are derived; a new use of random
+ * numbers gets an entry here, never a literal id or an ad-hoc constant at the call site.
+ *
+ * | family | key | stream |
+ * |---|---|---|
+ * | augmentation steps (RandomStream below) | stepKey(user seed, family) | jitter: row; blur and scale: (site
+ * << 32) | plane row; policy draw: 0 | | simulator captures | the capture's seed | captureStream(frame, row)
+ * | | simulator fixed pattern (PRNU, DSNU, defects) | SensorParams::fixedPatternSeed |
+ * fixedPatternStream(row) | | RANSAC of fitNoiseLine | LineFitParams::seed | ransacStream(iteration) | |
+ * apps: bursts, outputs, conversions (public SeedPurpose) | deriveSeed(user seed, purpose, index) | as the
+ * library call they feed |
+ *
+ * Capture streams keep the top bit clear and fixed-pattern streams set it, so a user who gives one
+ * seed to both never sees the two share numbers. */
+//! @{
+
+//! The augmentation families: each step's Gaussian and Poisson draws, and the policy's scene draws.
+enum class RandomStream : uint64_t
+{
+    JITTER_GAUSSIAN = 1,
+    BLUR_GAUSSIAN = 2,
+    POLICY_DRAW = 3,
+    SCALE_GAUSSIAN = 4,
+    JITTER_POISSON = 5,
+    BLUR_POISSON = 6,
+    SCALE_POISSON = 8,
+};
+
+/** The key of one family under a user's seed: the SplitMix64 finaliser of seed + golden * (id + 1),
+ * distinct and well mixed for nearby (seed, id), so that the steps of one call never share numbers. */
+inline uint64_t stepKey(uint64_t seed, uint64_t id)
+{
+    uint64_t z = seed + 0x9E3779B97F4A7C15ull * (id + 1);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+inline uint64_t stepKey(uint64_t seed, RandomStream family)
+{
+    return stepKey(seed, static_cast<uint64_t>(family));
+}
+
+//! Stream of one row of one simulated frame.
+inline uint64_t captureStream(int frame, int row)
+{
+    return (static_cast<uint64_t>(frame) << 32) | static_cast<uint64_t>(row);
+}
+
+//! Stream of one row of the simulator's fixed pattern: the top bit set, never a capture stream.
+inline uint64_t fixedPatternStream(int row)
+{
+    return (uint64_t(1) << 63) | static_cast<uint64_t>(row);
+}
+
+//! Stream of one RANSAC iteration (the pair of samples it draws).
+inline uint64_t ransacStream(int iteration)
+{
+    return static_cast<uint64_t>(iteration);
+}
+
+//! Stream of one row of one CFA plane in the resampling steps.
+inline uint64_t planeRowStream(int site, int planeRow)
+{
+    return (static_cast<uint64_t>(site) << 32) | static_cast<uint64_t>(planeRow);
+}
+
+//! @}
+
 /** A stream of random numbers identified by (seed, stream). Cheap to construct: make one per row or
  * per pixel. */
 class CounterRng

@@ -10,10 +10,6 @@ namespace rawgment {
 
 namespace {
 
-// Streams: captures use (frame << 32 | row); the fixed pattern uses streams with the top bit set, so
-// that the two never share random numbers even when a user picks the same seed for both.
-const uint64_t kFixedPatternStream = uint64_t(1) << 63;
-
 enum DefectCode : uchar
 {
     DEFECT_NONE = 0,
@@ -72,7 +68,7 @@ SensorSimulator::SensorSimulator(const SensorParams& params, Size size) : params
     const double noisy = dead + params_.noisyPixelFraction;
     parallel_for_(Range(0, size.height), [&](const Range& rows) {
         for (int r = rows.start; r < rows.end; ++r) {
-            detail::CounterRng rng(params_.fixedPatternSeed, kFixedPatternStream | static_cast<uint64_t>(r));
+            detail::CounterRng rng(params_.fixedPatternSeed, detail::fixedPatternStream(r));
             float* g = prnu_.ptr<float>(r);
             float* o = dsnu_.ptr<float>(r);
             uchar* d = defects_.ptr<uchar>(r);
@@ -133,8 +129,7 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
     Mat raw(size_, p.quantize ? CV_16UC1 : CV_32FC1);
     parallel_for_(Range(0, size_.height), [&](const Range& rows) {
         for (int r = rows.start; r < rows.end; ++r) {
-            detail::CounterRng rng(seed,
-                                   (static_cast<uint64_t>(frameIndex) << 32) | static_cast<uint64_t>(r));
+            detail::CounterRng rng(seed, detail::captureStream(frameIndex, r));
             const float* m = mean.ptr<float>(r);
             const float* prnu = prnu_.ptr<float>(r);
             const float* dsnu = dsnu_.ptr<float>(r);
@@ -182,21 +177,11 @@ void SensorSimulator::captureBurst(InputArray mean, double gain, double exposure
 void SensorSimulator::captureBlurred(InputArray _mean, InputArray _kernel, double gain, double exposure,
                                      uint64 seed, int frameIndex, OutputArray raw) const
 {
-    Mat kernel;
-    _kernel.getMat().convertTo(kernel, CV_64F);
-    if (kernel.empty() || !checkRange(kernel, true))
-        CV_Error(Error::StsBadArg, "SensorSimulator::captureBlurred: kernel must be non-empty and finite");
-    double lo = 0;
-    minMaxLoc(kernel, &lo);
-    const double total = sum(kernel)[0];
-    if (lo < 0 || !(total > 0))
-        CV_Error(Error::StsBadArg,
-                 "SensorSimulator::captureBlurred: kernel must be non-negative with a positive sum");
-    kernel /= total;
+    const Mat kernel = detail::normalisedKernel(_kernel, "SensorSimulator::captureBlurred");
     std::vector<Mat> planes;
     splitCfaPlanes(_mean, planes);
     for (Mat& plane : planes)
-        filter2D(plane, plane, CV_32F, kernel, Point(-1, -1), 0, BORDER_REFLECT);
+        filter2D(plane, plane, CV_32F, kernel, Point(-1, -1), 0, detail::kBlurBorder);
     Mat blurred;
     mergeCfaPlanes(planes, blurred);
     capture(blurred, gain, exposure, seed, frameIndex, raw);

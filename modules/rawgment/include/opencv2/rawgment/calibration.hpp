@@ -7,6 +7,7 @@
 #include <opencv2/rawgment/export.hpp>
 #include <opencv2/rawgment/noise_model.hpp>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -63,7 +64,7 @@ public:
 
 private:
     struct Impl;
-    Impl* impl_;
+    std::unique_ptr<Impl> impl_;
 };
 
 /** @brief One (mean, variance) observation of the noise: a pixel's temporal statistics over a burst,

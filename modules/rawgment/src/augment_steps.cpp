@@ -1,0 +1,93 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Noise options and the checks that every noise step of the augment topic shares.
+#include "augment_steps.hpp"
+
+namespace cv {
+namespace rawgment {
+namespace detail {
+
+void checkMosaicInput(const Mat& src, const char* who)
+{
+    if (src.empty())
+        CV_Error(Error::StsBadArg, format("%s: src is empty", who));
+    if (src.type() != CV_16UC1 && src.type() != CV_32FC1)
+        CV_Error(Error::StsBadArg, format("%s: src type %s is not supported; expected CV_16UC1 or CV_32FC1",
+                                          who, typeToString(src.type()).c_str()));
+    if (src.type() == CV_32FC1 && !checkRange(src, true))
+        CV_Error(Error::StsBadArg, format("%s: src contains NaN or Inf", who));
+}
+
+void checkResampleInput(const Mat& src, const RawFormat& format, const NoiseModel& model,
+                        const NoiseOptions& noise, const char* who)
+{
+    checkMosaicInput(src, who);
+    format.validate();
+    model.validate();
+    noise.validate();
+    if (src.rows % 2 || src.cols % 2)
+        CV_Error(Error::StsBadArg,
+                 cv::format("%s: both sides must be even (got %dx%d)", who, src.cols, src.rows));
+}
+
+void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* report, OutputArray mask)
+{
+    if (!report && !mask.needed())
+        return;
+    Mat saturated;
+    compare(src, format.whiteLevel, saturated, CMP_GE);
+    if (report)
+        report->saturatedPixels += countNonZero(saturated);
+    if (mask.needed())
+        mask.assign(saturated);
+}
+
+bool isIdentityKernel(const Mat& kernel)
+{
+    return kernel.empty() || kernel.total() == 1;
+}
+
+} // namespace detail
+
+void NoiseOptions::validate() const
+{
+    if (alignment != NoiseAlignment::NONE && alignment != NoiseAlignment::IGNORE_PRIOR &&
+        alignment != NoiseAlignment::ACCOUNT_PRIOR)
+        CV_Error(Error::StsBadArg, format("NoiseOptions: unknown alignment %d", static_cast<int>(alignment)));
+    if (shotSampling != ShotNoiseSampling::GAUSSIAN && shotSampling != ShotNoiseSampling::POISSON)
+        CV_Error(Error::StsBadArg,
+                 format("NoiseOptions: unknown shotSampling %d", static_cast<int>(shotSampling)));
+    if (priorMean != PriorMeanEstimate::PIXEL_VALUE && priorMean != PriorMeanEstimate::LOCAL_MEAN)
+        CV_Error(Error::StsBadArg, format("NoiseOptions: unknown priorMean %d", static_cast<int>(priorMean)));
+    if (blurNoiseSum != BlurNoiseSum::EXACT && blurNoiseSum != BlurNoiseSum::FROM_BLURRED_MEAN)
+        CV_Error(Error::StsBadArg,
+                 format("NoiseOptions: unknown blurNoiseSum %d", static_cast<int>(blurNoiseSum)));
+}
+
+void NoiseOptions::writeFields(FileStorage& fs) const
+{
+    fs << "alignment" << static_cast<int>(alignment) << "shot_sampling" << static_cast<int>(shotSampling)
+       << "prior_mean" << static_cast<int>(priorMean) << "blur_noise_sum" << static_cast<int>(blurNoiseSum);
+}
+
+NoiseOptions NoiseOptions::readFields(const FileNode& map)
+{
+    NoiseOptions o;
+    const auto field = [&](const char* name, int current) {
+        const FileNode f = map[name];
+        if (f.empty() || f.isNone())
+            return current;
+        const double value = f.isInt() || f.isReal() ? static_cast<double>(f) : 0.0;
+        if ((!f.isInt() && !f.isReal()) || value != std::floor(value))
+            CV_Error(Error::StsParseError, format("noise options: field '%s' must be an integer", name));
+        return static_cast<int>(value);
+    };
+    o.alignment = static_cast<NoiseAlignment>(field("alignment", static_cast<int>(o.alignment)));
+    o.shotSampling = static_cast<ShotNoiseSampling>(field("shot_sampling", static_cast<int>(o.shotSampling)));
+    o.priorMean = static_cast<PriorMeanEstimate>(field("prior_mean", static_cast<int>(o.priorMean)));
+    o.blurNoiseSum = static_cast<BlurNoiseSum>(field("blur_noise_sum", static_cast<int>(o.blurNoiseSum)));
+    o.validate();
+    return o;
+}
+
+} // namespace rawgment
+} // namespace cv

@@ -1,0 +1,65 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The machinery that the augment topic's noise steps share (color_jitter.cpp, resample.cpp, scene.cpp):
+// input checks, the split of an added variance into shot and read parts, its sampling, and the store.
+// Private to the module.
+#ifndef OPENCV_RAWGMENT_SRC_AUGMENT_STEPS_HPP
+#define OPENCV_RAWGMENT_SRC_AUGMENT_STEPS_HPP
+
+#include "opencv2/rawgment/augment.hpp"
+#include "precomp.hpp"
+#include "random.hpp"
+
+#include <algorithm>
+#include <type_traits>
+
+namespace cv {
+namespace rawgment {
+namespace detail {
+
+//! Throws StsBadArg naming `who` unless src is a non-empty CV_16UC1 or finite CV_32FC1 mosaic.
+void checkMosaicInput(const Mat& src, const char* who);
+
+//! checkMosaicInput() plus the format, model and options, and even sides: blur and scale resample each
+//! CFA plane, so they need whole 2x2 blocks.
+void checkResampleInput(const Mat& src, const RawFormat& format, const NoiseModel& model,
+                        const NoiseOptions& noise, const char* who);
+
+//! Counts or masks saturated input pixels, only when the caller asks: the hot loops do not pay for it.
+void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* report, OutputArray mask);
+
+//! Whether a motion kernel leaves the mosaic as it is (empty or a single tap).
+bool isIdentityKernel(const Mat& kernel);
+
+// The variance to add to a pixel, split into its shot part and the rest (read noise, and for
+// ACCOUNT_PRIOR the correction of the scaled prior), before any clipping.
+struct AddedVariance
+{
+    float shot, rest;
+};
+
+// Gaussian noise of variance `rest` plus the shot part as an electron count: q (K - m) with
+// K ~ Poisson(m), m = shot / q^2 (ShotNoiseSampling::POISSON). A negative total (brightening) adds
+// nothing; a negative rest (the gain grew) is taken from the Poisson part, so the variance added is
+// always max(shot + rest, 0), the same as the Gaussian path.
+inline float sampledNoise(AddedVariance v, float q, float z, detail::CounterRng& rng)
+{
+    const float total = std::max(v.shot + v.rest, 0.0f);
+    const float shot = q > 0 ? std::min(std::max(v.shot, 0.0f), total) : 0.0f;
+    const double m = static_cast<double>(shot) / (static_cast<double>(q) * q);
+    const float count = shot > 0 ? static_cast<float>(static_cast<double>(rng.poisson(m)) - m) : 0.0f;
+    return q * count + std::sqrt(total - shot) * z;
+}
+
+// Clipped to [0, white]; 16-bit output adds 0.5 and truncates: the same bits in every vector width.
+template <typename T> inline T storeValue(float out, float white)
+{
+    out = std::min(std::max(out, 0.0f), white);
+    return std::is_same<T, ushort>::value ? static_cast<T>(static_cast<int>(out + 0.5f))
+                                          : static_cast<T>(out);
+}
+
+} // namespace detail
+} // namespace rawgment
+} // namespace cv
+
+#endif // OPENCV_RAWGMENT_SRC_AUGMENT_STEPS_HPP

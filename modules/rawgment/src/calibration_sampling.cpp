@@ -1,0 +1,130 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Noise samples from bursts and single frames: CFA-aligned squares, per-pixel and per-square samples.
+#include "opencv2/rawgment/calibration.hpp"
+#include "precomp.hpp"
+
+namespace cv {
+namespace rawgment {
+
+std::vector<Rect> cfaAlignedSquares(const std::vector<Rect>& patches, int side)
+{
+    if (side < 2 || side % 2)
+        CV_Error(Error::StsBadArg, format("cfaAlignedSquares: side must be even and >= 2 (got %d)", side));
+    std::vector<Rect> out;
+    for (size_t i = 0; i < patches.size(); ++i) {
+        const Rect& p = patches[i];
+        // The largest even corner that keeps the square inside the patch, nearest to centred.
+        int x = p.x + (p.width - side) / 2, y = p.y + (p.height - side) / 2;
+        x += x & 1;
+        y += y & 1;
+        if (x + side > p.x + p.width)
+            x -= 2;
+        if (y + side > p.y + p.height)
+            y -= 2;
+        if (p.width < side || p.height < side || x < p.x || y < p.y)
+            CV_Error(Error::StsBadArg,
+                     format("cfaAlignedSquares: patch %d (%dx%d at %d,%d) cannot hold a CFA-aligned "
+                            "%dx%d square",
+                            static_cast<int>(i), p.width, p.height, p.x, p.y, side, side));
+        out.emplace_back(x, y, side, side);
+    }
+    return out;
+}
+
+namespace {
+
+void checkSquares(const std::vector<Rect>& squares, Size size, const char* who)
+{
+    const Rect frame(Point(0, 0), size);
+    for (size_t i = 0; i < squares.size(); ++i)
+        if ((squares[i] & frame) != squares[i] || squares[i].area() == 0)
+            CV_Error(Error::StsBadArg,
+                     format("%s: square %d (%dx%d at %d,%d) is empty or outside the %dx%d frame", who,
+                            static_cast<int>(i), squares[i].width, squares[i].height, squares[i].x,
+                            squares[i].y, size.width, size.height));
+}
+
+} // namespace
+
+std::vector<NoiseSample> sampleBurstPatches(const BurstStatistics& stats, const std::vector<Rect>& squares,
+                                            double gain)
+{
+    detail::checkFinitePositive(gain, "sampleBurstPatches: gain");
+    Mat mean, var, clipped;
+    stats.mean(mean);
+    stats.variance(var);
+    stats.clippedMask(clipped);
+    checkSquares(squares, stats.size(), "sampleBurstPatches");
+    std::vector<NoiseSample> out;
+    for (const Rect& sq : squares)
+        for (int r = sq.y; r < sq.y + sq.height; ++r)
+            for (int c = sq.x; c < sq.x + sq.width; ++c) {
+                if (clipped.at<uchar>(r, c))
+                    continue;
+                NoiseSample s;
+                s.mean = mean.at<double>(r, c);
+                s.variance = var.at<double>(r, c);
+                s.gain = gain;
+                s.dof = stats.frames() - 1;
+                s.channel = cfaChannelAt(stats.format().pattern, r, c);
+                out.push_back(s);
+            }
+    return out;
+}
+
+std::vector<NoiseSample> sampleSingleFramePatches(InputArray _raw, const RawFormat& format,
+                                                  const std::vector<Rect>& squares, double gain)
+{
+    detail::checkFinitePositive(gain, "sampleSingleFramePatches: gain");
+    format.validate();
+    const Mat raw = _raw.getMat();
+    if (raw.type() != CV_16UC1 && raw.type() != CV_32FC1)
+        CV_Error(Error::StsBadArg, "sampleSingleFramePatches: raw must be CV_16UC1 or CV_32FC1");
+    checkSquares(squares, raw.size(), "sampleSingleFramePatches");
+    Mat raw64;
+    raw.convertTo(raw64, CV_64F);
+    if (!checkRange(raw64, true))
+        CV_Error(Error::StsBadArg, "sampleSingleFramePatches: raw contains NaN or Inf");
+    std::vector<NoiseSample> out;
+    for (const Rect& sq : squares) {
+        for (int site = 0; site < 4; ++site) {
+            // Least squares of v = p0 + p1 x + p2 y over the site's pixels: 3x3 normal equations.
+            Matx33d A = Matx33d::zeros();
+            Vec3d rhs(0, 0, 0);
+            std::vector<Vec3d> points;
+            bool isClipped = false;
+            for (int r = sq.y + (site / 2 + sq.y) % 2; r < sq.y + sq.height; r += 2)
+                for (int c = sq.x + (site % 2 + sq.x) % 2; c < sq.x + sq.width; c += 2) {
+                    const double v = raw64.at<double>(r, c);
+                    isClipped = isClipped || v <= 0 || v >= format.whiteLevel;
+                    const Vec3d f(1.0, c - sq.x, r - sq.y);
+                    points.emplace_back(f[1], f[2], v - format.blackAt(r, c));
+                    A += f * f.t();
+                    rhs += f * (v - format.blackAt(r, c));
+                }
+            const int n = static_cast<int>(points.size());
+            if (isClipped || n < 4)
+                continue;
+            Vec3d p;
+            if (!solve(A, rhs, p, DECOMP_SVD))
+                continue;
+            double ss = 0, mean = 0;
+            for (const Vec3d& q : points) {
+                const double fit = p[0] + p[1] * q[0] + p[2] * q[1];
+                ss += (q[2] - fit) * (q[2] - fit);
+                mean += fit;
+            }
+            NoiseSample s;
+            s.mean = mean / n;
+            s.variance = ss / (n - 3);
+            s.gain = gain;
+            s.dof = n - 3;
+            s.channel = cfaChannelAt(format.pattern, sq.y + site / 2, sq.x + site % 2);
+            out.push_back(s);
+        }
+    }
+    return out;
+}
+
+} // namespace rawgment
+} // namespace cv

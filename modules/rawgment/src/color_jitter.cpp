@@ -1,0 +1,253 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Colour jitter: noise-accounted exposure, gain, contrast, brightness and hue (paper Eq. 11 and 13).
+#include "augment_steps.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <atomic>
+
+namespace cv {
+namespace rawgment {
+
+namespace {
+
+using detail::AddedVariance;
+using detail::sampledNoise;
+using detail::storeValue;
+
+struct JitterConstants
+{
+    float pc[4], black[4];
+    float pb, pg, white;
+    float shot, read, post; // g alpha, g^2 sigma_d^2, sigma_r^2 at the input gain
+    NoiseAlignment alignment;
+    ShotNoiseSampling sampling;
+};
+
+// The variance to add to a pixel, split into its shot part and the rest (read noise, and for
+// ACCOUNT_PRIOR the correction of the scaled prior), before any clipping. xm is the prior-mean estimate
+// (black-subtracted), pc the pixel's contrast. Eq. 13 for ACCOUNT_PRIOR; the model at the new mean and
+// gain for IGNORE_PRIOR.
+template <NoiseAlignment A> inline AddedVariance jitterVariance(float xm, float pc, const JitterConstants& k)
+{
+    const float pg = k.pg, pg2 = k.pg * k.pg;
+    if (A == NoiseAlignment::ACCOUNT_PRIOR) {
+        const float xf = std::max(xm, 1.0f);
+        const float pu = std::max((pc * xf + k.pb) / (xf * pg), 0.0f);
+        const float mu = std::max(xm, 0.0f);
+        return {pu * (1 - pu) * (pg2 * k.shot) * mu,
+                (1 - pu * pu) * (pg2 * k.read) + (1 - pu * pu * pg2) * k.post};
+    }
+    if (A == NoiseAlignment::IGNORE_PRIOR)
+        return {pg * k.shot * std::max(pc * xm + k.pb, 0.0f), pg2 * k.read + k.post};
+    return {0.0f, 0.0f};
+}
+
+// One row of Eq. 11/13, written so that the compiler vectorises it: no branches, per-column constants
+// in arrays (the CFA site alternates along the row), float arithmetic in a fixed order. `prior` is the
+// local-mean row, or null to use the pixel's own value. Returns the number of brightening pixels.
+// Rounding to 16 bits adds 0.5 and truncates (the value is clipped to [0, white] first): the same bits
+// in every vector width.
+template <typename T, NoiseAlignment A, bool kLocalMean>
+inline int jitterRowBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
+                         const float* black, const JitterConstants& k, int cols)
+{
+    int bright = 0;
+    for (int c = 0; c < cols; ++c) {
+        const float x = static_cast<float>(s[c]) - black[c];
+        float out = pc[c] * x + k.pb;
+        if (A != NoiseAlignment::NONE) {
+            const AddedVariance v = jitterVariance<A>(kLocalMean ? prior[c] : x, pc[c], k);
+            const float total = v.shot + v.rest;
+            bright += total < 0 ? 1 : 0;
+            out += std::sqrt(std::max(total, 0.0f)) * z[c];
+        }
+        d[c] = storeValue<T>(out + black[c], k.white);
+    }
+    return bright;
+}
+
+template <typename T, bool kLocalMean>
+inline int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* prior, const float* pc,
+                                 const float* black, const JitterConstants& k, int cols)
+{
+    switch (k.alignment) {
+    case NoiseAlignment::ACCOUNT_PRIOR:
+        return jitterRowBody<T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean>(s, d, z, prior, pc, black, k,
+                                                                           cols);
+    case NoiseAlignment::IGNORE_PRIOR:
+        return jitterRowBody<T, NoiseAlignment::IGNORE_PRIOR, kLocalMean>(s, d, z, prior, pc, black, k, cols);
+    default:
+        return jitterRowBody<T, NoiseAlignment::NONE, kLocalMean>(s, d, z, prior, pc, black, k, cols);
+    }
+}
+
+// One multi-versioned entry point per pixel type: GCC cannot clone a template.
+RAWGMENT_HOT_KERNEL
+int jitterRow(const ushort* s, ushort* d, const float* z, const float* prior, const float* pc,
+              const float* black, const JitterConstants& k, int cols)
+{
+    return prior ? jitterRowAnyAlignment<ushort, true>(s, d, z, prior, pc, black, k, cols)
+                 : jitterRowAnyAlignment<ushort, false>(s, d, z, prior, pc, black, k, cols);
+}
+
+RAWGMENT_HOT_KERNEL
+int jitterRow(const float* s, float* d, const float* z, const float* prior, const float* pc,
+              const float* black, const JitterConstants& k, int cols)
+{
+    return prior ? jitterRowAnyAlignment<float, true>(s, d, z, prior, pc, black, k, cols)
+                 : jitterRowAnyAlignment<float, false>(s, d, z, prior, pc, black, k, cols);
+}
+
+template <typename T, NoiseAlignment A>
+int jitterRowPoissonBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
+                         const float* black, const JitterConstants& k, detail::CounterRng& rng, int cols)
+{
+    const float q = k.pg * k.shot; // DN per electron at the output gain: g alpha p_g
+    int bright = 0;
+    for (int c = 0; c < cols; ++c) {
+        const float x = static_cast<float>(s[c]) - black[c];
+        const AddedVariance v = jitterVariance<A>(prior ? prior[c] : x, pc[c], k);
+        bright += v.shot + v.rest < 0 ? 1 : 0;
+        d[c] = storeValue<T>(pc[c] * x + k.pb + sampledNoise(v, q, z[c], rng) + black[c], k.white);
+    }
+    return bright;
+}
+
+template <typename T>
+int jitterRowPoisson(const T* s, T* d, const float* z, const float* prior, const float* pc,
+                     const float* black, const JitterConstants& k, detail::CounterRng& rng, int cols)
+{
+    if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR)
+        return jitterRowPoissonBody<T, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, prior, pc, black, k, rng,
+                                                                      cols);
+    return jitterRowPoissonBody<T, NoiseAlignment::IGNORE_PRIOR>(s, d, z, prior, pc, black, k, rng, cols);
+}
+
+template <typename T>
+void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstants& k, uint64_t seed,
+                uint64_t poissonSeed, const Range& rows, std::atomic<int64>& brightening)
+{
+    const int cols = src.cols;
+    std::vector<float> z(static_cast<size_t>(cols));
+    // Per-column constants for even rows (sites 0, 1) and odd rows (sites 2, 3).
+    std::vector<float> pcByParity(2 * static_cast<size_t>(cols)),
+        blackByParity(2 * static_cast<size_t>(cols));
+    for (int parity = 0; parity < 2; ++parity)
+        for (int c = 0; c < cols; ++c) {
+            pcByParity[static_cast<size_t>(parity * cols + c)] = k.pc[2 * parity + (c & 1)];
+            blackByParity[static_cast<size_t>(parity * cols + c)] = k.black[2 * parity + (c & 1)];
+        }
+    const bool poisson = k.sampling == ShotNoiseSampling::POISSON && k.alignment != NoiseAlignment::NONE;
+    int64 localBright = 0;
+    for (int r = rows.start; r < rows.end; ++r) {
+        if (k.alignment != NoiseAlignment::NONE)
+            detail::fillGaussian(seed, static_cast<uint64_t>(r), z.data(), cols);
+        const float* pc = pcByParity.data() + (r & 1) * cols;
+        const float* black = blackByParity.data() + (r & 1) * cols;
+        const float* priorRow = prior.empty() ? nullptr : prior.ptr<float>(r);
+        if (poisson) {
+            detail::CounterRng rng(poissonSeed, static_cast<uint64_t>(r));
+            localBright +=
+                jitterRowPoisson(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, pc, black, k, rng, cols);
+        } else {
+            localBright += jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, pc, black, k, cols);
+        }
+    }
+    brightening += localBright;
+}
+
+// PriorMeanEstimate::LOCAL_MEAN: the black-subtracted mean of each pixel's 3x3 neighbourhood on its own
+// CFA plane. On the mosaic that is a separable [1 0 1 0 1] / 3 filter; reflecting about the edge pixel
+// maps an offset of -2 to +2, so the border also averages pixels of the same site.
+Mat localPriorMean(const Mat& src, const RawFormat& format)
+{
+    Mat x, mean;
+    subtractBlackLevel(src, format, x, false);
+    const Matx<float, 1, 5> taps(1.0f / 3, 0, 1.0f / 3, 0, 1.0f / 3);
+    sepFilter2D(x, mean, CV_32F, taps, taps.t(), Point(-1, -1), 0, BORDER_REFLECT_101);
+    return mean;
+}
+
+} // namespace
+
+ColorJitter ColorJitter::exposureChange(double photonRatio, double gainRatio)
+{
+    detail::checkFinitePositive(photonRatio, "exposureChange: photonRatio");
+    detail::checkFinitePositive(gainRatio, "exposureChange: gainRatio");
+    ColorJitter j;
+    j.contrast = Vec4d::all(photonRatio * gainRatio);
+    j.gainRatio = gainRatio;
+    return j;
+}
+
+bool ColorJitter::isIdentity() const
+{
+    return contrast == Vec4d::all(1) && brightness == 0 && gainRatio == 1;
+}
+
+void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& model, const ColorJitter& jitter,
+                 const NoiseOptions& noise, uint64 seed, OutputArray _dst, RawFormat& dstFormat,
+                 AugmentReport* report, OutputArray saturatedMask)
+{
+    const Mat src = _src.getMat();
+    detail::checkMosaicInput(src, "colorJitter");
+    format.validate();
+    model.validate();
+    noise.validate();
+    for (int s = 0; s < 4; ++s)
+        detail::checkFinitePositive(jitter.contrast[s], "colorJitter: contrast");
+    if (!std::isfinite(jitter.brightness))
+        CV_Error(Error::StsBadArg, "colorJitter: brightness must be finite");
+    detail::checkFinitePositive(jitter.gainRatio, "colorJitter: gainRatio");
+    const double newGain = format.gain * jitter.gainRatio;
+    detail::checkFinitePositive(newGain, "colorJitter: the new gain");
+
+    if (jitter.isIdentity()) {
+        // Skipped entirely: no copy, no random draw.
+        detail::reportSaturation(src, format, report, saturatedMask);
+        _dst.assign(src);
+        dstFormat = format;
+        return;
+    }
+    const NoiseLine line = model.lineAtGain(format.gain);
+    JitterConstants k;
+    for (int s = 0; s < 4; ++s) {
+        k.pc[s] = static_cast<float>(jitter.contrast[s]);
+        k.black[s] = static_cast<float>(format.blackLevel[s]);
+    }
+    k.pb = static_cast<float>(jitter.brightness);
+    k.pg = static_cast<float>(jitter.gainRatio);
+    k.white = static_cast<float>(format.whiteLevel);
+    k.shot = static_cast<float>(line.a);
+    k.read = static_cast<float>(format.gain * format.gain * model.sigmaD2);
+    k.post = static_cast<float>(model.sigmaR2);
+    k.alignment = noise.alignment;
+    k.sampling = noise.shotSampling;
+
+    const Mat prior =
+        noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && noise.alignment != NoiseAlignment::NONE
+            ? localPriorMean(src, format)
+            : Mat();
+    Mat dst(src.size(), src.type());
+    std::atomic<int64> brightening{0};
+    const uint64_t key = detail::stepKey(seed, detail::RandomStream::JITTER_GAUSSIAN),
+                   poissonKey = detail::stepKey(seed, detail::RandomStream::JITTER_POISSON);
+    parallel_for_(Range(0, src.rows), [&](const Range& rows) {
+        if (src.depth() == CV_16U)
+            jitterRows<ushort>(src, prior, dst, k, key, poissonKey, rows, brightening);
+        else
+            jitterRows<float>(src, prior, dst, k, key, poissonKey, rows, brightening);
+    });
+    detail::reportSaturation(src, format, report, saturatedMask);
+    _dst.assign(dst);
+    dstFormat = format;
+    dstFormat.gain = newGain;
+    if (report) {
+        report->brighteningPixels += brightening.load();
+        report->steps.push_back("colorJitter");
+    }
+}
+
+} // namespace rawgment
+} // namespace cv

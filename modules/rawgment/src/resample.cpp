@@ -1,0 +1,438 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Resampling steps: noise-accounted motion blur and scaling (paper Eq. 15 with the step's weights).
+#include "augment_steps.hpp"
+
+#include <algorithm>
+
+namespace cv {
+namespace rawgment {
+
+Mat linearMotionKernel(double length, double angleDegrees)
+{
+    if (!std::isfinite(length) || length < 0)
+        CV_Error(Error::StsBadArg,
+                 format("linearMotionKernel: length must be finite and >= 0 (got %g)", length));
+    if (!std::isfinite(angleDegrees))
+        CV_Error(Error::StsBadArg, "linearMotionKernel: angle must be finite");
+    const double planeLength = length / 2; // the CFA planes have half the resolution
+    if (planeLength <= 1)
+        return Mat::ones(1, 1, CV_32FC1);
+    const int radius = static_cast<int>(std::ceil(planeLength / 2));
+    const int size = 2 * radius + 1;
+    Mat k = Mat::zeros(size, size, CV_64FC1);
+    const double a = angleDegrees * CV_PI / 180, ca = std::cos(a), sa = -std::sin(a); // image y points down
+    // The segment, supersampled and splatted bilinearly.
+    const int samples = std::max(64, static_cast<int>(16 * planeLength));
+    for (int i = 0; i < samples; ++i) {
+        const double t = ((i + 0.5) / samples - 0.5) * planeLength;
+        const double x = radius + t * ca, y = radius + t * sa;
+        const int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+        const double fx = x - x0, fy = y - y0;
+        for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx) {
+                const int yy = std::min(size - 1, std::max(0, y0 + dy)),
+                          xx = std::min(size - 1, std::max(0, x0 + dx));
+                k.at<double>(yy, xx) += (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy);
+            }
+    }
+    k /= sum(k)[0];
+    Mat out;
+    k.convertTo(out, CV_32F);
+    return out;
+}
+
+namespace {
+
+using detail::AddedVariance;
+using detail::sampledNoise;
+
+// Constants of a resampling step (blur or scale) on one mosaic: Eq. 15 with the step's weights.
+struct ResampleConstants
+{
+    float black[4];
+    float white;
+    float shot;     // g alpha
+    float floorVar; // g^2 sigma_d^2 + sigma_r^2: the read noise a weighted sum removes, (1 - sum w^2) of it
+    NoiseAlignment alignment;
+    ShotNoiseSampling sampling;
+    uint64_t key, poissonKey; // the step's Gaussian and Poisson streams
+};
+
+// Plane row `planeRow` of site `site`, black-subtracted, into out[0..pad + width + pad) with the plane's
+// edge replicated `pad` columns on each side.
+template <typename T>
+void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, float* out)
+{
+    const T* s = src.ptr<T>(2 * planeRow + site / 2) + site % 2;
+    const int width = src.cols / 2;
+    for (int j = 0; j < width; ++j)
+        out[pad + j] = static_cast<float>(s[2 * j]) - black;
+    for (int j = 0; j < pad; ++j) {
+        out[j] = out[pad];
+        out[pad + width + j] = out[pad + width - 1];
+    }
+}
+
+// One kernel tap over a row: mean += w x, and for ACCOUNT_PRIOR shot += w (1 - w) max(x, 0) (the prior
+// mean is never negative), in one pass over the source row.
+RAWGMENT_HOT_KERNEL
+void addTapRow(float* mean, float* shot, const float* x, float w, float shotWeight, bool withShot, int n)
+{
+    if (withShot) {
+        for (int j = 0; j < n; ++j) {
+            mean[j] += w * x[j];
+            shot[j] += shotWeight * std::max(x[j], 0.0f);
+        }
+    } else {
+        for (int j = 0; j < n; ++j)
+            mean[j] += w * x[j];
+    }
+}
+
+// mean[j] + N(0, v): v from the per-pixel shot sum and read-noise factor (ACCOUNT_PRIOR), from the
+// mean (IGNORE_PRIOR), or none; black added back, clipped to [0, white].
+RAWGMENT_HOT_KERNEL
+void finishResampledRow(float* mean, const float* shotSum, const float* readFactor, const float* z,
+                        const ResampleConstants& k, float black, int n)
+{
+    if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR) {
+        for (int j = 0; j < n; ++j) {
+            const float v = k.shot * shotSum[j] + readFactor[j] * k.floorVar;
+            mean[j] =
+                std::min(std::max(mean[j] + std::sqrt(std::max(v, 0.0f)) * z[j] + black, 0.0f), k.white);
+        }
+    } else if (k.alignment == NoiseAlignment::IGNORE_PRIOR) {
+        for (int j = 0; j < n; ++j) {
+            const float v = k.shot * std::max(mean[j], 0.0f) + k.floorVar;
+            mean[j] = std::min(std::max(mean[j] + std::sqrt(v) * z[j] + black, 0.0f), k.white);
+        }
+    } else {
+        for (int j = 0; j < n; ++j)
+            mean[j] = std::min(std::max(mean[j] + black, 0.0f), k.white);
+    }
+}
+
+template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int planeRow)
+{
+    T* d = dst.ptr<T>(2 * planeRow + site / 2) + site % 2;
+    const int width = dst.cols / 2;
+    for (int j = 0; j < width; ++j)
+        d[2 * j] = std::is_same<T, ushort>::value ? static_cast<T>(static_cast<int>(v[j] + 0.5f))
+                                                  : static_cast<T>(v[j]);
+}
+
+// ShotNoiseSampling::POISSON for a resampled row: the shot part of Eq. 15 (or of the model, for
+// IGNORE_PRIOR) as an electron count at the input gain (see sampledNoise), the rest Gaussian.
+void finishResampledRowPoisson(float* mean, const float* shotSum, const float* readFactor, const float* z,
+                               const ResampleConstants& k, float black, detail::CounterRng& rng, int n)
+{
+    for (int j = 0; j < n; ++j) {
+        const AddedVariance v = k.alignment == NoiseAlignment::ACCOUNT_PRIOR
+                                    ? AddedVariance{k.shot * shotSum[j], readFactor[j] * k.floorVar}
+                                    : AddedVariance{k.shot * std::max(mean[j], 0.0f), k.floorVar};
+        mean[j] = std::min(std::max(mean[j] + sampledNoise(v, k.shot, z[j], rng) + black, 0.0f), k.white);
+    }
+}
+
+// The end of every resampled row: its noise streams (site, row), the noise, the black level, the store.
+template <typename T>
+void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float* readFactor,
+                    std::vector<float>& z, const ResampleConstants& k, Mat& dst, int site, int planeRow)
+{
+    const int n = static_cast<int>(mean.size());
+    const uint64_t stream = detail::planeRowStream(site, planeRow);
+    if (k.alignment != NoiseAlignment::NONE)
+        detail::fillGaussian(k.key, stream, z.data(), n);
+    if (k.alignment != NoiseAlignment::NONE && k.sampling == ShotNoiseSampling::POISSON) {
+        detail::CounterRng rng(k.poissonKey, stream);
+        finishResampledRowPoisson(mean.data(), shotSum, readFactor, z.data(), k, k.black[site], rng, n);
+    } else {
+        finishResampledRow(mean.data(), shotSum, readFactor, z.data(), k, k.black[site], n);
+    }
+    storePlaneRow<T>(mean.data(), dst, site, planeRow);
+}
+
+ResampleConstants resampleConstants(const RawFormat& format, const NoiseModel& model,
+                                    const NoiseOptions& noise, uint64 seed, detail::RandomStream gaussian,
+                                    detail::RandomStream poisson)
+{
+    const NoiseLine line = model.lineAtGain(format.gain);
+    ResampleConstants k;
+    for (int s = 0; s < 4; ++s)
+        k.black[s] = static_cast<float>(format.blackLevel[s]);
+    k.white = static_cast<float>(format.whiteLevel);
+    k.shot = static_cast<float>(line.a);
+    k.floorVar = static_cast<float>(line.b);
+    k.alignment = noise.alignment;
+    k.sampling = noise.shotSampling;
+    k.key = detail::stepKey(seed, gaussian);
+    k.poissonKey = detail::stepKey(seed, poisson);
+    return k;
+}
+
+struct KernelTap
+{
+    int dy, dx;
+    float w, shotWeight; // w and w (1 - w)
+};
+
+static_assert(detail::kBlurBorder == BORDER_REPLICATE, "the tap merging below implements BORDER_REPLICATE");
+
+// Within a kernel radius of the frame's edge, several taps replicate one pixel: its prior noise is then
+// kept with the square of their summed weight, not the sum of their squares, so Eq. 15 needs the
+// weight W of each distinct source pixel. The taps of output pixel (i, j), clamped along the chosen
+// axes and merged per source, with offsets that still read i + dy - ry, j + dx - rx; shotWeight is
+// W (1 - W) and the return value the read-noise factor 1 - sum W^2.
+float mergeClampedTaps(const std::vector<KernelTap>& taps, int i, int j, Size plane, Size radius,
+                       bool clampRows, bool clampCols, std::vector<KernelTap>& merged)
+{
+    merged.clear();
+    for (const KernelTap& t : taps) {
+        const int dy =
+            clampRows ? std::min(std::max(i + t.dy - radius.height, 0), plane.height - 1) - i + radius.height
+                      : t.dy;
+        const int dx =
+            clampCols ? std::min(std::max(j + t.dx - radius.width, 0), plane.width - 1) - j + radius.width
+                      : t.dx;
+        auto same = std::find_if(merged.begin(), merged.end(),
+                                 [&](const KernelTap& m) { return m.dy == dy && m.dx == dx; });
+        if (same != merged.end())
+            same->w += t.w;
+        else
+            merged.push_back({dy, dx, t.w, 0.0f});
+    }
+    float readFactor = 1;
+    for (KernelTap& m : merged) {
+        m.shotWeight = m.w * (1 - m.w);
+        readFactor -= m.w * m.w;
+    }
+    return readFactor;
+}
+
+// Plane rows come from a ring of kernel-height rows: consecutive output rows share all but one source
+// row, and the rows a window needs are consecutive after clamping, hence distinct modulo the height.
+// Rows near the top or bottom use their taps merged per clamped row (exact for every column whose taps
+// do not also clamp sideways, and still vectorised); the columns within a kernel radius of the sides
+// use taps merged per clamped column (precomputed), or per pixel where the row clamps too.
+template <typename T>
+void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps, Size ksize, float readFactor,
+                   bool shotFromMean, const ResampleConstants& k, const Range& range)
+{
+    const int pw = src.cols / 2, ph = src.rows / 2, rx = ksize.width / 2, ry = ksize.height / 2;
+    const Size plane(pw, ph), radius(rx, ry);
+    const int padded = pw + 2 * rx;
+    std::vector<float> ring(static_cast<size_t>(ksize.height) * padded);
+    std::vector<int> ringRow(static_cast<size_t>(ksize.height), -1);
+    std::vector<float> mean(static_cast<size_t>(pw)), shotSum(static_cast<size_t>(pw)),
+        z(static_cast<size_t>(pw)), readFactors(static_cast<size_t>(pw));
+    const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
+    const bool exactShot = account && !shotFromMean;
+    struct EdgeColumn
+    {
+        int j;
+        std::vector<KernelTap> taps;
+        float readFactor;
+    };
+    std::vector<EdgeColumn> edgeColumns;
+    for (int j = 0; j < pw; ++j)
+        if (j < rx || j >= pw - rx) {
+            EdgeColumn e{j, {}, 0.0f};
+            e.readFactor = mergeClampedTaps(taps, 0, j, plane, radius, false, true, e.taps);
+            edgeColumns.push_back(std::move(e));
+        }
+    std::vector<KernelTap> rowTaps, pixelTaps;
+    int ringSite = -1;
+    for (int idx = range.start; idx < range.end; ++idx) {
+        const int site = idx / ph, i = idx % ph;
+        if (site != ringSite) {
+            std::fill(ringRow.begin(), ringRow.end(), -1);
+            ringSite = site;
+        }
+        const bool edgeRow = i < ry || i >= ph - ry;
+        const float rowReadFactor =
+            edgeRow ? mergeClampedTaps(taps, i, 0, plane, radius, true, false, rowTaps) : readFactor;
+        std::fill(mean.begin(), mean.end(), 0.0f);
+        std::fill(shotSum.begin(), shotSum.end(), 0.0f);
+        std::fill(readFactors.begin(), readFactors.end(), rowReadFactor);
+        for (const KernelTap& t : edgeRow ? rowTaps : taps) {
+            const int si = std::min(std::max(i + t.dy - ry, 0), ph - 1);
+            const size_t slot = static_cast<size_t>(si % ksize.height);
+            float* row = ring.data() + slot * padded;
+            if (ringRow[slot] != si) {
+                loadPlaneRow<T>(src, site, si, rx, k.black[site], row);
+                ringRow[slot] = si;
+            }
+            addTapRow(mean.data(), shotSum.data(), row + t.dx, t.w, t.shotWeight, exactShot, pw);
+        }
+        if (!account) {
+            finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i);
+            continue;
+        }
+        for (const EdgeColumn& e : edgeColumns) {
+            const std::vector<KernelTap>* merged = &e.taps;
+            readFactors[static_cast<size_t>(e.j)] = e.readFactor;
+            if (edgeRow) {
+                readFactors[static_cast<size_t>(e.j)] =
+                    mergeClampedTaps(taps, i, e.j, plane, radius, true, true, pixelTaps);
+                merged = &pixelTaps;
+            }
+            float shot = 0;
+            for (const KernelTap& t : *merged)
+                shot +=
+                    t.shotWeight *
+                    std::max(ring[static_cast<size_t>((i + t.dy - ry) % ksize.height) * padded + e.j + t.dx],
+                             0.0f);
+            shotSum[static_cast<size_t>(e.j)] = shot;
+        }
+        if (shotFromMean) // sum w (1 - w) = 1 - sum w^2, the read-noise factor
+            for (int j = 0; j < pw; ++j)
+                shotSum[static_cast<size_t>(j)] =
+                    readFactors[static_cast<size_t>(j)] * std::max(mean[static_cast<size_t>(j)], 0.0f);
+        finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i);
+    }
+}
+
+// Source position on the plane grid of each output plane pixel for a scale about the mosaic centre:
+// plane index j of site column px sits at mosaic x = 2 j + px; its source is C + (x - C) / scale.
+struct BilinearAxis
+{
+    std::vector<int> i0, i1;
+    std::vector<float> f; // weight of i1; 0 when the two clamp onto the same pixel
+};
+
+BilinearAxis bilinearAxis(int planeSize, int phase, double scale)
+{
+    BilinearAxis a;
+    a.i0.resize(static_cast<size_t>(planeSize));
+    a.i1.resize(static_cast<size_t>(planeSize));
+    a.f.resize(static_cast<size_t>(planeSize));
+    const double centre = (2.0 * planeSize - 1) / 2;
+    for (int j = 0; j < planeSize; ++j) {
+        const double x = centre + (2.0 * j + phase - centre) / scale;
+        const double planeX = (x - phase) / 2;
+        const double lo = std::floor(planeX);
+        const int i0 = static_cast<int>(std::min(std::max(lo, 0.0), planeSize - 1.0));
+        const int i1 = static_cast<int>(std::min(std::max(lo + 1, 0.0), planeSize - 1.0));
+        a.i0[static_cast<size_t>(j)] = i0;
+        a.i1[static_cast<size_t>(j)] = i1;
+        a.f[static_cast<size_t>(j)] = i0 == i1 ? 0.0f : static_cast<float>(planeX - lo);
+    }
+    return a;
+}
+
+// Bilinear taps of one output row: mean, Eq. 15's shot sum and the read-noise factor 1 - sum w^2,
+// all per pixel because the weights change along the row.
+RAWGMENT_HOT_KERNEL
+void bilinearRow(const float* row0, const float* row1, float fy, const int* c0, const int* c1,
+                 const float* fx, float* mean, float* shot, float* readFactor, int n)
+{
+    for (int j = 0; j < n; ++j) {
+        const float a = row0[c0[j]], b = row0[c1[j]], c = row1[c0[j]], d = row1[c1[j]];
+        const float w00 = (1 - fx[j]) * (1 - fy), w01 = fx[j] * (1 - fy), w10 = (1 - fx[j]) * fy,
+                    w11 = fx[j] * fy;
+        mean[j] = w00 * a + w01 * b + w10 * c + w11 * d;
+        shot[j] = w00 * (1 - w00) * std::max(a, 0.0f) + w01 * (1 - w01) * std::max(b, 0.0f) +
+                  w10 * (1 - w10) * std::max(c, 0.0f) + w11 * (1 - w11) * std::max(d, 0.0f);
+        readFactor[j] = 1 - (w00 * w00 + w01 * w01 + w10 * w10 + w11 * w11);
+    }
+}
+
+template <typename T>
+void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const BilinearAxis* rows,
+                    const ResampleConstants& k, const Range& range)
+{
+    const int pw = src.cols / 2, ph = src.rows / 2;
+    std::vector<float> row0(static_cast<size_t>(pw)), row1(static_cast<size_t>(pw));
+    std::vector<float> mean(static_cast<size_t>(pw)), shot(static_cast<size_t>(pw)),
+        readFactor(static_cast<size_t>(pw)), z(static_cast<size_t>(pw));
+    for (int idx = range.start; idx < range.end; ++idx) {
+        const int site = idx / ph, i = idx % ph;
+        const BilinearAxis& ax = cols[site % 2];
+        const BilinearAxis& ay = rows[site / 2];
+        loadPlaneRow<T>(src, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site], row0.data());
+        loadPlaneRow<T>(src, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data());
+        bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
+                    ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
+        finishPlaneRow<T>(mean, shot.data(), readFactor.data(), z, k, dst, site, i);
+    }
+}
+
+} // namespace
+
+void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& model, double scale,
+                 const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
+{
+    const Mat src = _src.getMat();
+    detail::checkResampleInput(src, format, model, noise, "scaleMosaic");
+    if (!std::isfinite(scale) || !(scale > 0))
+        CV_Error(Error::StsBadArg, cv::format("scaleMosaic: scale must be finite and > 0 (got %g)", scale));
+    if (scale == 1) {
+        _dst.assign(src);
+        return;
+    }
+    const BilinearAxis cols[2] = {bilinearAxis(src.cols / 2, 0, scale), bilinearAxis(src.cols / 2, 1, scale)};
+    const BilinearAxis rows[2] = {bilinearAxis(src.rows / 2, 0, scale), bilinearAxis(src.rows / 2, 1, scale)};
+    const ResampleConstants k =
+        resampleConstants(format, model, noise, seed, detail::RandomStream::SCALE_GAUSSIAN,
+                          detail::RandomStream::SCALE_POISSON);
+    Mat dst(src.size(), src.type());
+    parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
+        if (src.depth() == CV_16U)
+            scalePlaneRows<ushort>(src, dst, cols, rows, k, range);
+        else
+            scalePlaneRows<float>(src, dst, cols, rows, k, range);
+    });
+    _dst.assign(dst);
+    if (report)
+        report->steps.push_back("scale");
+}
+
+Rect scaleBox(const Rect& box, Size size, double scale)
+{
+    // Edges in continuous coordinates (pixel k covers [k, k + 1)); the box grows to whole pixels.
+    const double cx = size.width / 2.0, cy = size.height / 2.0;
+    const int x0 = static_cast<int>(std::floor(cx + (box.x - cx) * scale));
+    const int y0 = static_cast<int>(std::floor(cy + (box.y - cy) * scale));
+    const int x1 = static_cast<int>(std::ceil(cx + (box.x + box.width - cx) * scale));
+    const int y1 = static_cast<int>(std::ceil(cy + (box.y + box.height - cy) * scale));
+    if (box.area() == 0)
+        return Rect();
+    return Rect(Point(x0, y0), Point(x1, y1)) & Rect(Point(0, 0), size);
+}
+
+void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& model, InputArray _kernel,
+                const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
+{
+    const Mat src = _src.getMat();
+    detail::checkResampleInput(src, format, model, noise, "motionBlur");
+    const Mat w = detail::normalisedKernel(_kernel, "motionBlur");
+    if (w.total() == 1) {
+        _dst.assign(src);
+        return;
+    }
+    // Sparse: a motion kernel is a line, so most of its box is zero and costs nothing.
+    std::vector<KernelTap> taps;
+    for (int y = 0; y < w.rows; ++y)
+        for (int x = 0; x < w.cols; ++x) {
+            const double wk = w.at<double>(y, x);
+            if (wk > 0)
+                taps.push_back({y, x, static_cast<float>(wk), static_cast<float>(wk * (1 - wk))});
+        }
+    const ResampleConstants k = resampleConstants(
+        format, model, noise, seed, detail::RandomStream::BLUR_GAUSSIAN, detail::RandomStream::BLUR_POISSON);
+    const float readFactor = static_cast<float>(1 - w.dot(w));
+    const bool shotFromMean = noise.blurNoiseSum == BlurNoiseSum::FROM_BLURRED_MEAN;
+    Mat dst(src.size(), src.type());
+    parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
+        if (src.depth() == CV_16U)
+            blurPlaneRows<ushort>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
+        else
+            blurPlaneRows<float>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
+    });
+    _dst.assign(dst);
+    if (report)
+        report->steps.push_back("motionBlur");
+}
+
+} // namespace rawgment
+} // namespace cv

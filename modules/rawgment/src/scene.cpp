@@ -1,0 +1,238 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Scenes (what one augmentation simulates, applied step by step) and the random scene policy.
+#include "augment_steps.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <limits>
+
+namespace cv {
+namespace rawgment {
+
+using detail::isIdentityKernel;
+
+bool Scene::isIdentity() const
+{
+    return shift == Point(0, 0) && scale == 1 && jitter.isIdentity() && isIdentityKernel(motionKernel);
+}
+
+void Scene::write(FileStorage& fs, const String& name) const
+{
+    fs << name << "{";
+    fs << "shift" << shift << "scale" << scale;
+    fs << "contrast"
+       << "[" << jitter.contrast[0] << jitter.contrast[1] << jitter.contrast[2] << jitter.contrast[3] << "]";
+    fs << "brightness" << jitter.brightness << "gain_ratio" << jitter.gainRatio;
+    noise.writeFields(fs);
+    fs << "motion_kernel" << (motionKernel.empty() ? Mat::ones(1, 1, CV_32F) : motionKernel);
+    fs << "}";
+}
+
+Scene Scene::read(const FileNode& node)
+{
+    if (node.empty() || !node.isMap())
+        CV_Error(Error::StsParseError, "scene: expected a map");
+    Scene s;
+    node["shift"] >> s.shift;
+    if (!node["scale"].empty())
+        s.scale = detail::readRealField(node, "scale");
+    if (!std::isfinite(s.scale) || !(s.scale > 0))
+        CV_Error(Error::StsParseError, "scene: field 'scale' must be a finite number > 0");
+    const FileNode c = node["contrast"];
+    if (!c.isSeq() || c.size() != 4)
+        CV_Error(Error::StsParseError, "scene: field 'contrast' must be a list of 4 numbers (one per site)");
+    for (int i = 0; i < 4; ++i)
+        s.jitter.contrast[i] = static_cast<double>(c[i]);
+    s.jitter.brightness = detail::readRealField(node, "brightness");
+    s.jitter.gainRatio = detail::readRealField(node, "gain_ratio");
+    s.noise = NoiseOptions::readFields(node);
+    node["motion_kernel"] >> s.motionKernel;
+    return s;
+}
+
+void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& model, const Scene& scene,
+                uint64 seed, OutputArray _dst, RawFormat& dstFormat, AugmentReport* report,
+                std::vector<Rect>* boxes)
+{
+    Mat current = _src.getMat();
+    detail::checkMosaicInput(current, "applyScene");
+    format.validate();
+    model.validate();
+    if (current.rows % 2 || current.cols % 2)
+        CV_Error(Error::StsBadArg, "applyScene: the mosaic needs even sides");
+    RawFormat fmt = format;
+    const Point shift(2 * cvRound(scene.shift.x / 2.0), 2 * cvRound(scene.shift.y / 2.0));
+    if (shift != Point(0, 0)) {
+        // Shift each CFA plane by half the (even) offset: the phase of the mosaic is kept.
+        std::vector<Mat> planes;
+        splitCfaPlanes(current, planes);
+        const Matx23d m(1, 0, shift.x / 2, 0, 1, shift.y / 2);
+        for (Mat& p : planes) {
+            Mat moved;
+            warpAffine(p, moved, m, p.size(), INTER_NEAREST, BORDER_REPLICATE);
+            p = moved;
+        }
+        // Into a new Mat: `current` still shares the caller's data, which must never be written.
+        Mat shifted;
+        mergeCfaPlanes(planes, shifted);
+        current = shifted;
+        if (boxes)
+            for (Rect& b : *boxes)
+                b = (b + shift) & Rect(0, 0, current.cols, current.rows);
+        if (report)
+            report->steps.push_back("shift");
+    }
+    if (scene.scale != 1) {
+        scaleMosaic(current, fmt, model, scene.scale, scene.noise, seed, current, report);
+        if (boxes)
+            for (Rect& b : *boxes)
+                b = scaleBox(b, current.size(), scene.scale);
+    }
+    colorJitter(current, fmt, model, scene.jitter, scene.noise, seed, current, fmt, report);
+    if (!isIdentityKernel(scene.motionKernel))
+        motionBlur(current, fmt, model, scene.motionKernel, scene.noise, seed, current, report);
+    _dst.assign(current);
+    dstFormat = fmt;
+}
+
+namespace {
+
+// min over pixels of (value - black of its site), without a black-subtracted copy of the frame.
+template <typename T> double minimumAboveBlackOf(const Mat& src, const RawFormat& format)
+{
+    double lowest = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < src.rows; ++r) {
+        const T* p = src.ptr<T>(r);
+        T lo[2] = {std::numeric_limits<T>::max(), std::numeric_limits<T>::max()};
+        for (int c = 0; c < src.cols; ++c)
+            lo[c & 1] = std::min(lo[c & 1], p[c]);
+        for (int phase = 0; phase < std::min(2, src.cols); ++phase)
+            lowest = std::min(lowest, static_cast<double>(lo[phase]) - format.blackAt(r, phase));
+    }
+    return lowest;
+}
+
+double minimumAboveBlack(const Mat& src, const RawFormat& format)
+{
+    return src.depth() == CV_16U ? minimumAboveBlackOf<ushort>(src, format)
+                                 : minimumAboveBlackOf<float>(src, format);
+}
+
+} // namespace
+
+void RandomScenePolicy::validate() const
+{
+    const auto range = [](double lo, double hi, const char* what) {
+        if (!std::isfinite(lo) || !std::isfinite(hi) || lo > hi)
+            CV_Error(Error::StsBadArg,
+                     format("RandomScenePolicy: %s range [%g, %g] is not a finite interval", what, lo, hi));
+    };
+    const auto probability = [](double p, const char* what) {
+        if (!(p >= 0 && p <= 1))
+            CV_Error(Error::StsBadArg, format("RandomScenePolicy: %s must lie in [0, 1] (got %g)", what, p));
+    };
+    range(contrastMin, contrastMax, "contrast");
+    if (!(contrastMin > 0))
+        CV_Error(Error::StsBadArg, "RandomScenePolicy: contrastMin must be > 0");
+    range(brightnessMin, brightnessMax, "brightness");
+    range(hueMin, hueMax, "hue");
+    if (!(hueMin > 0))
+        CV_Error(Error::StsBadArg, "RandomScenePolicy: hueMin must be > 0");
+    range(gainDbMin, gainDbMax, "gain (dB)");
+    range(0, blurLengthMax, "blur length");
+    range(0, maxShift, "shift");
+    if (!(maxScale >= 0 && maxScale < 1))
+        CV_Error(Error::StsBadArg,
+                 format("RandomScenePolicy: maxScale must lie in [0, 1) (got %g)", maxScale));
+    probability(hueProbability, "hueProbability");
+    probability(blurProbability, "blurProbability");
+    probability(geometryProbability, "geometryProbability");
+    noise.validate();
+}
+
+Scene RandomScenePolicy::draw(InputArray _src, const RawFormat& format, uint64 seed) const
+{
+    validate();
+    const Mat src = _src.getMat();
+    detail::checkMosaicInput(src, "RandomScenePolicy::draw");
+    const double minX = minimumAboveBlack(src, format);
+    detail::CounterRng rng(detail::stepKey(seed, detail::RandomStream::POLICY_DRAW), 0);
+    const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * rng.uniform(); };
+    Scene s;
+    s.noise = noise;
+    if (rng.uniform() < geometryProbability) {
+        s.shift = Point(cvRound(uniform(-maxShift, maxShift) * src.cols),
+                        cvRound(uniform(-maxShift, maxShift) * src.rows));
+        s.scale = uniform(1 - maxScale, 1 + maxScale);
+    }
+    const double contrast = std::exp(uniform(std::log(contrastMin), std::log(contrastMax)));
+    s.jitter.contrast = Vec4d::all(contrast);
+    if (rng.uniform() < hueProbability)
+        for (int i = 0; i < 4; ++i)
+            s.jitter.contrast[i] *= uniform(hueMin, hueMax);
+    s.jitter.brightness = uniform(brightnessMin, brightnessMax) * minX;
+    s.jitter.gainRatio = dbToLinearGain(uniform(gainDbMin, gainDbMax));
+    if (rng.uniform() < blurProbability)
+        s.motionKernel = linearMotionKernel(uniform(0, blurLengthMax), uniform(0, 180));
+    return s;
+}
+
+void RandomScenePolicy::write(FileStorage& fs, const String& name) const
+{
+    fs << name << "{";
+    fs << "contrast_min" << contrastMin << "contrast_max" << contrastMax;
+    fs << "brightness_min" << brightnessMin << "brightness_max" << brightnessMax;
+    fs << "hue_probability" << hueProbability << "hue_min" << hueMin << "hue_max" << hueMax;
+    fs << "gain_db_min" << gainDbMin << "gain_db_max" << gainDbMax;
+    fs << "blur_probability" << blurProbability << "blur_length_max" << blurLengthMax;
+    fs << "geometry_probability" << geometryProbability << "max_shift" << maxShift << "max_scale" << maxScale;
+    noise.writeFields(fs);
+    fs << "}";
+}
+
+RandomScenePolicy RandomScenePolicy::read(const FileNode& node)
+{
+    if (node.empty() || !node.isMap())
+        CV_Error(Error::StsParseError, "random scene policy: expected a map");
+    RandomScenePolicy p;
+    const auto field = [&](const char* name, double& value) {
+        const FileNode f = node[name];
+        if (f.empty() || f.isNone())
+            return;
+        if (!f.isReal() && !f.isInt())
+            CV_Error(Error::StsParseError, format("random scene policy: field '%s' is not a number", name));
+        value = static_cast<double>(f);
+    };
+    field("contrast_min", p.contrastMin);
+    field("contrast_max", p.contrastMax);
+    field("brightness_min", p.brightnessMin);
+    field("brightness_max", p.brightnessMax);
+    field("hue_probability", p.hueProbability);
+    field("hue_min", p.hueMin);
+    field("hue_max", p.hueMax);
+    field("gain_db_min", p.gainDbMin);
+    field("gain_db_max", p.gainDbMax);
+    field("blur_probability", p.blurProbability);
+    field("blur_length_max", p.blurLengthMax);
+    field("geometry_probability", p.geometryProbability);
+    field("max_shift", p.maxShift);
+    field("max_scale", p.maxScale);
+    p.noise = NoiseOptions::readFields(node);
+    p.validate();
+    return p;
+}
+
+void RandomScenePolicy::save(const String& path) const
+{
+    validate();
+    detail::writeFileStorageAtomically(path, [&](FileStorage& fs) { write(fs, "random_scene_policy"); });
+}
+
+RandomScenePolicy RandomScenePolicy::load(const String& path)
+{
+    return detail::loadFileStorage(path, "random_scene_policy", "random scene policy",
+                                   [](const FileNode& n) { return read(n); });
+}
+
+} // namespace rawgment
+} // namespace cv
