@@ -1,5 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "opencv2/rawgment/calibration.hpp"
+#include "noise_terms.hpp"
 #include "precomp.hpp"
 #include "random.hpp"
 
@@ -77,12 +78,12 @@ bool weightedNoiseLine(const std::vector<NoiseSample>& s, const std::vector<int>
     for (int round = 0; round < 4; ++round) {
         double largest = 0;
         for (int i : idx)
-            largest = std::max(largest, out.a * std::max(s[i].mean, 0.0) + out.b);
-        // A floor keeps a line that dips to 0 at the darkest mean from giving one sample all the weight.
-        const double floor = std::max(1e-6 * largest, 1e-12);
+            largest = std::max(largest, detail::lineVariance(out.a, out.b, s[i].mean));
+        const double floor = detail::varianceFloor(largest);
         for (int i : idx) {
-            const double v = std::max(out.a * std::max(s[i].mean, 0.0) + out.b, floor);
-            w[i] = s[i].dof / (2.0 * v * v);
+            const double se = detail::sampleVarianceStdError(detail::lineVariance(out.a, out.b, s[i].mean),
+                                                             s[i].dof, floor);
+            w[i] = 1.0 / (se * se);
         }
         LineLS next;
         if (!leastSquaresLine(s, idx, w, next))
@@ -92,19 +93,42 @@ bool weightedNoiseLine(const std::vector<NoiseSample>& s, const std::vector<int>
     return true;
 }
 
-//! Residual in standard errors of a sample variance around the line at the sample's mean.
-double standardizedResidual(const NoiseSample& s, double a, double b)
+//! The lowest and highest mean of a set of samples: where a line's largest prediction lies.
+struct MeanRange
 {
-    const double predicted = a * std::max(s.mean, 0.0) + b;
-    const double scale = std::sqrt(2.0 / std::max(s.dof, 1)) * std::max(std::abs(predicted), 1e-12);
-    return (s.variance - predicted) / scale;
+    double lo = 0, hi = 0;
+};
+
+MeanRange meanRangeOf(const std::vector<NoiseSample>& s)
+{
+    MeanRange r{s.front().mean, s.front().mean};
+    for (const NoiseSample& x : s) {
+        r.lo = std::min(r.lo, x.mean);
+        r.hi = std::max(r.hi, x.mean);
+    }
+    return r;
+}
+
+//! varianceFloor() of a line over samples whose means span `range` (a line peaks at an end).
+double lineVarianceFloor(double a, double b, const MeanRange& range)
+{
+    return detail::varianceFloor(
+        std::max(detail::lineVariance(a, b, range.lo), detail::lineVariance(a, b, range.hi)));
+}
+
+//! Residual in standard errors of a sample variance around the line at the sample's mean.
+double standardizedResidual(const NoiseSample& s, double a, double b, double floor)
+{
+    const double predicted = detail::lineVariance(a, b, s.mean);
+    return (s.variance - predicted) / detail::sampleVarianceStdError(predicted, s.dof, floor);
 }
 
 std::vector<int> inliersOf(const std::vector<NoiseSample>& s, double a, double b, double threshold)
 {
+    const double floor = lineVarianceFloor(a, b, meanRangeOf(s));
     std::vector<int> idx;
     for (int i = 0; i < static_cast<int>(s.size()); ++i)
-        if (std::abs(standardizedResidual(s[i], a, b)) <= threshold)
+        if (std::abs(standardizedResidual(s[i], a, b, floor)) <= threshold)
             idx.push_back(i);
     return idx;
 }
@@ -149,6 +173,7 @@ NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples, const LineFit
     std::vector<int> chosen = all;
     if (params.robust) {
         const int n = static_cast<int>(samples.size());
+        const MeanRange range = meanRangeOf(samples);
         size_t bestCount = 0;
         double bestA = ls.a, bestB = ls.b;
         for (int it = 0; it < params.ransacIterations; ++it) {
@@ -160,9 +185,10 @@ NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples, const LineFit
                 continue;
             const double a = (samples[j].variance - samples[i].variance) / dm;
             const double b = samples[i].variance - a * samples[i].mean;
+            const double floor = lineVarianceFloor(a, b, range);
             size_t count = 0;
             for (const NoiseSample& s : samples)
-                count += std::abs(standardizedResidual(s, a, b)) <= params.inlierThreshold ? 1 : 0;
+                count += std::abs(standardizedResidual(s, a, b, floor)) <= params.inlierThreshold ? 1 : 0;
             if (count > bestCount) {
                 bestCount = count;
                 bestA = a;
@@ -196,29 +222,29 @@ namespace {
 //! b_g = g^2 sigma_d^2 + sigma_r^2 (paper Eq. 8).
 struct OffsetResidual
 {
-    OffsetResidual(double gain, double offset) : g2(gain * gain), b(offset) {}
+    OffsetResidual(double gain, double offset) : g(gain), b(offset) {}
     template <typename T> bool operator()(const T* sigmaD2, const T* sigmaR2, T* r) const
     {
-        r[0] = T(b) - (T(g2) * sigmaD2[0] + sigmaR2[0]);
+        r[0] = T(b) - detail::noiseTermsAt(T(g), T(0), sigmaD2[0], sigmaR2[0]).read();
         return true;
     }
     static ceres::CostFunction* Create(double gain, double offset)
     {
         return new ceres::AutoDiffCostFunction<OffsetResidual, 1, 1, 1>(new OffsetResidual(gain, offset));
     }
-    double g2, b;
+    double g, b;
 };
 
 //! (v - (g alpha mu + g^2 sigma_d^2 + sigma_r^2)) / scale: one sample of the joint fit.
 struct JointResidual
 {
     JointResidual(double mean, double variance, double gain, double invScale)
-        : mu(std::max(mean, 0.0)), v(variance), g(gain), w(invScale)
+        : mu(mean), v(variance), g(gain), w(invScale)
     {
     }
     template <typename T> bool operator()(const T* p, T* r) const
     {
-        r[0] = (T(v) - (T(g * mu) * p[0] + T(g * g) * p[1] + p[2])) * T(w);
+        r[0] = (T(v) - detail::noiseTermsAt(T(g), p[0], p[1], p[2]).variance(mu)) * T(w);
         return true;
     }
     static ceres::CostFunction* Create(double mean, double variance, double gain, double invScale)
@@ -352,14 +378,15 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
     if (params.method == NOISE_FIT_JOINT) {
         double p[3] = {alpha, sigmaD2, sigmaR2};
         for (int round = 0; round < params.reweightIterations; ++round) {
-            // Weights from the previous fit: the standard deviation of a sample variance is
-            // sqrt(2 / dof) times its expectation.
-            double prev[3] = {p[0], p[1], p[2]};
+            // Weights from the previous fit: the standard error of each sample variance.
+            std::vector<double> predicted;
+            for (const NoiseSample& s : inlierSamples)
+                predicted.push_back(detail::noiseTermsAt(s.gain, p[0], p[1], p[2]).variance(s.mean));
+            const double floor = detail::varianceFloor(*std::max_element(predicted.begin(), predicted.end()));
             ceres::Problem problem;
-            for (const NoiseSample& s : inlierSamples) {
-                const double predicted =
-                    s.gain * prev[0] * std::max(s.mean, 0.0) + s.gain * s.gain * prev[1] + prev[2];
-                const double scale = std::sqrt(2.0 / s.dof) * std::max(predicted, 1e-9);
+            for (size_t i = 0; i < inlierSamples.size(); ++i) {
+                const NoiseSample& s = inlierSamples[i];
+                const double scale = detail::sampleVarianceStdError(predicted[i], s.dof, floor);
                 ceres::LossFunction* loss =
                     params.line.robust ? new ceres::HuberLoss(params.lossScale) : nullptr;
                 problem.AddResidualBlock(JointResidual::Create(s.mean, s.variance, s.gain, 1.0 / scale), loss,
@@ -389,9 +416,10 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
     std::vector<double> a, aFit, b, bFit;
     for (const NoiseLineFit& f : report.perGain) {
         a.push_back(f.line.a);
-        aFit.push_back(f.gain * alpha);
+        const detail::NoiseTerms<double> t = detail::noiseTermsAt(f.gain, alpha, sigmaD2, sigmaR2);
+        aFit.push_back(t.shot);
         b.push_back(f.line.b);
-        bFit.push_back(f.gain * f.gain * sigmaD2 + sigmaR2);
+        bFit.push_back(t.read());
     }
     report.rSquaredSlope = rSquared(a, aFit);
     report.rSquaredOffset = rSquared(b, bFit);

@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Colour jitter: noise-accounted exposure, gain, contrast, brightness and hue (paper Eq. 11 and 13).
 #include "augment_steps.hpp"
+#include "noise_terms.hpp"
 
 #include <opencv2/imgproc.hpp>
 
@@ -19,7 +20,7 @@ struct JitterConstants
 {
     float pc[4], black[4];
     float pb, pg, white;
-    float shot, read, post; // g alpha, g^2 sigma_d^2, sigma_r^2 at the input gain
+    detail::NoiseTerms<float> in; // the model's terms at the input gain
     NoiseAlignment alignment;
     ShotNoiseSampling sampling;
 };
@@ -35,11 +36,12 @@ template <NoiseAlignment A> inline AddedVariance jitterVariance(float xm, float 
         const float xf = std::max(xm, 1.0f);
         const float pu = std::max((pc * xf + k.pb) / (xf * pg), 0.0f);
         const float mu = std::max(xm, 0.0f);
-        return {pu * (1 - pu) * (pg2 * k.shot) * mu,
-                (1 - pu * pu) * (pg2 * k.read) + (1 - pu * pu * pg2) * k.post};
+        return {pu * (1 - pu) * (pg2 * k.in.shot) * mu,
+                (1 - pu * pu) * (pg2 * k.in.readBeforeGain) + (1 - pu * pu * pg2) * k.in.readAfterGain};
     }
     if (A == NoiseAlignment::IGNORE_PRIOR)
-        return {pg * k.shot * std::max(pc * xm + k.pb, 0.0f), pg2 * k.read + k.post};
+        return {pg * k.in.shot * std::max(pc * xm + k.pb, 0.0f),
+                pg2 * k.in.readBeforeGain + k.in.readAfterGain};
     return {0.0f, 0.0f};
 }
 
@@ -103,7 +105,7 @@ template <typename T, NoiseAlignment A>
 int jitterRowPoissonBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
                          const float* black, const JitterConstants& k, detail::CounterRng& rng, int cols)
 {
-    const float q = k.pg * k.shot; // DN per electron at the output gain: g alpha p_g
+    const float q = k.pg * k.in.shot; // DN per electron at the output gain: g alpha p_g
     int bright = 0;
     for (int c = 0; c < cols; ++c) {
         const float x = static_cast<float>(s[c]) - black[c];
@@ -210,7 +212,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
         dstFormat = format;
         return;
     }
-    const NoiseLine line = model.lineAtGain(format.gain);
+    const detail::NoiseTerms<double> terms = detail::checkedNoiseTerms(model, format.gain);
     JitterConstants k;
     for (int s = 0; s < 4; ++s) {
         k.pc[s] = static_cast<float>(jitter.contrast[s]);
@@ -219,9 +221,8 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     k.pb = static_cast<float>(jitter.brightness);
     k.pg = static_cast<float>(jitter.gainRatio);
     k.white = static_cast<float>(format.whiteLevel);
-    k.shot = static_cast<float>(line.a);
-    k.read = static_cast<float>(format.gain * format.gain * model.sigmaD2);
-    k.post = static_cast<float>(model.sigmaR2);
+    k.in = {static_cast<float>(terms.shot), static_cast<float>(terms.readBeforeGain),
+            static_cast<float>(terms.readAfterGain)};
     k.alignment = noise.alignment;
     k.sampling = noise.shotSampling;
 

@@ -1,5 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "opencv2/rawgment/noise_model.hpp"
+#include "noise_terms.hpp"
 #include "precomp.hpp"
 
 namespace cv {
@@ -17,7 +18,7 @@ template <typename T> void varianceOfMeans(const Mat& mean, Mat& dst, const Nois
             const T* m = mean.ptr<T>(r);
             T* d = dst.ptr<T>(r);
             for (int c = 0; c < mean.cols; ++c)
-                d[c] = a * std::max(m[c], T(0)) + b;
+                d[c] = detail::lineVariance(a, b, m[c]);
         }
     });
 }
@@ -50,16 +51,27 @@ void NoiseModel::validate() const
     detail::checkFiniteNonNegative(sigmaR2, "NoiseModel.sigmaR2");
 }
 
+namespace detail {
+
+NoiseTerms<double> checkedNoiseTerms(const NoiseModel& model, double gain)
+{
+    model.validate();
+    checkFinitePositive(gain, "gain");
+    const NoiseTerms<double> t = noiseTermsAt(gain, model.alpha, model.sigmaD2, model.sigmaR2);
+    if (!std::isfinite(t.shot) || !std::isfinite(t.read()))
+        CV_Error(Error::StsBadArg,
+                 format("noise line at gain %g overflows (a = %g, b = %g)", gain, t.shot, t.read()));
+    return t;
+}
+
+} // namespace detail
+
 NoiseLine NoiseModel::lineAtGain(double gain) const
 {
-    validate();
-    detail::checkFinitePositive(gain, "gain");
+    const detail::NoiseTerms<double> t = detail::checkedNoiseTerms(*this, gain);
     NoiseLine line;
-    line.a = gain * alpha;
-    line.b = gain * gain * sigmaD2 + sigmaR2;
-    if (!std::isfinite(line.a) || !std::isfinite(line.b))
-        CV_Error(Error::StsBadArg,
-                 format("noise line at gain %g overflows (a = %g, b = %g)", gain, line.a, line.b));
+    line.a = t.shot;
+    line.b = t.read();
     return line;
 }
 
@@ -67,8 +79,7 @@ double NoiseModel::variance(double mean, double gain) const
 {
     if (!std::isfinite(mean))
         CV_Error(Error::StsBadArg, format("NoiseModel::variance: mean must be finite (got %g)", mean));
-    const NoiseLine line = lineAtGain(gain);
-    return line.a * std::max(mean, 0.0) + line.b;
+    return detail::checkedNoiseTerms(*this, gain).variance(mean);
 }
 
 void NoiseModel::variance(InputArray _mean, double gain, OutputArray _dst) const

@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Resampling steps: noise-accounted motion blur and scaling (paper Eq. 15 with the step's weights).
 #include "augment_steps.hpp"
+#include "noise_terms.hpp"
 
 #include <algorithm>
 
@@ -156,13 +157,13 @@ ResampleConstants resampleConstants(const RawFormat& format, const NoiseModel& m
                                     const NoiseOptions& noise, uint64 seed, detail::RandomStream gaussian,
                                     detail::RandomStream poisson)
 {
-    const NoiseLine line = model.lineAtGain(format.gain);
+    const detail::NoiseTerms<double> terms = detail::checkedNoiseTerms(model, format.gain);
     ResampleConstants k;
     for (int s = 0; s < 4; ++s)
         k.black[s] = static_cast<float>(format.blackLevel[s]);
     k.white = static_cast<float>(format.whiteLevel);
-    k.shot = static_cast<float>(line.a);
-    k.floorVar = static_cast<float>(line.b);
+    k.shot = static_cast<float>(terms.shot);
+    k.floorVar = static_cast<float>(terms.read());
     k.alignment = noise.alignment;
     k.sampling = noise.shotSampling;
     k.key = detail::stepKey(seed, gaussian);

@@ -1,5 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "opencv2/rawgment/simulate.hpp"
+#include "noise_terms.hpp"
 #include "precomp.hpp"
 #include "random.hpp"
 
@@ -122,8 +123,12 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
 
     const SensorParams& p = params_;
     const double white = std::ldexp(1.0, p.bitDepth) - 1;
-    const double alpha = p.noise.alpha, sigmaD = std::sqrt(p.noise.sigmaD2),
-                 sigmaR = std::sqrt(p.noise.sigmaR2);
+    // Each term of the model drawn where it arises: photons (shot), read noise before the gain, noise
+    // after it; the terms at gain 1 are the model's parameters, the gain is applied in the loop below.
+    const detail::NoiseTerms<double> unit =
+        detail::noiseTermsAt(1.0, p.noise.alpha, p.noise.sigmaD2, p.noise.sigmaR2);
+    const double alpha = unit.shot, sigmaD = std::sqrt(unit.readBeforeGain),
+                 sigmaR = std::sqrt(unit.readAfterGain);
     const double noisySigma = std::sqrt(p.noisyPixelVariance);
     const double hotLevel = std::round(0.9 * white);
     Mat raw(size_, p.quantize ? CV_16UC1 : CV_32FC1);

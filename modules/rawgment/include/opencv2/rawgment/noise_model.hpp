@@ -11,6 +11,21 @@ namespace rawgment {
 //! @addtogroup rawgment_noise_model
 //! @{
 
+// Adding a noise component (row noise, a fixed pattern, ...) touches one declared place per topic:
+//  1. noise_model: a field of NoiseModel (absent by default), validate(), write()/read() with a new
+//     FORMAT_VERSION (older files keep loading), and its term in detail::NoiseTerms
+//     (src/noise_terms.hpp), the one home of the model's terms and of variance().
+//  2. simulate: SensorSimulator::capture() draws it where it arises (src/simulate.cpp), the ground
+//     truth of every test.
+//  3. calibration: its estimator in src/calibration.cpp (the joint residual uses NoiseTerms, so a term
+//     that depends on the mean enters the fit there).
+//  4. augment: what a target lacks of it, in detail::AddedVariance (src/augment_steps.hpp) as
+//     computed by jitterVariance() (src/color_jitter.cpp) and finishResampledRow()
+//     (src/resample.cpp); nothing is computed when the model lacks it.
+//  5. tests: test_noise_model (file round trip, old version), test_simulate (its statistics),
+//     test_calibration (recovery), test_augment (against a capture simulated at the target), and a
+//     row of apps/rawgment_tradeoffs. docs/mathematics.md gets its equation.
+
 /** @brief Linear analog gain of a gain in decibels: \f$ g = 10^{dB/20} \f$ (0 dB = 1).
  * @throws cv::Exception when dB is not finite.
  */

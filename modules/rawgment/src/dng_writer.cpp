@@ -1,0 +1,262 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// writeDng(): one little-endian TIFF IFD with an uncompressed 16-bit CFA strip (raw_io topic).
+#include "precomp.hpp"
+
+#include <opencv2/rawgment/raw_io.hpp>
+
+#include <cstring>
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+
+namespace {
+
+enum TiffType : uint16_t
+{
+    TIFF_BYTE = 1,
+    TIFF_ASCII = 2,
+    TIFF_SHORT = 3,
+    TIFF_LONG = 4,
+    TIFF_RATIONAL = 5,
+    TIFF_SRATIONAL = 10
+};
+
+struct TiffEntry
+{
+    uint16_t tag;
+    uint16_t type;
+    uint32_t count;
+    std::vector<uint8_t> bytes; // the value, little-endian
+};
+
+class TiffBuilder
+{
+public:
+    void add(uint16_t tag, uint16_t type, uint32_t count, std::vector<uint8_t> bytes)
+    {
+        entries_.push_back({tag, type, count, std::move(bytes)});
+    }
+    void shorts(uint16_t tag, std::initializer_list<uint16_t> v)
+    {
+        std::vector<uint8_t> b;
+        for (uint16_t x : v)
+            put16(b, x);
+        add(tag, TIFF_SHORT, uint32_t(v.size()), b);
+    }
+    void longs(uint16_t tag, std::initializer_list<uint32_t> v)
+    {
+        std::vector<uint8_t> b;
+        for (uint32_t x : v)
+            put32(b, x);
+        add(tag, TIFF_LONG, uint32_t(v.size()), b);
+    }
+    void bytes(uint16_t tag, std::initializer_list<uint8_t> v) { add(tag, TIFF_BYTE, uint32_t(v.size()), v); }
+    void ascii(uint16_t tag, const String& s)
+    {
+        std::vector<uint8_t> b(s.begin(), s.end());
+        b.push_back(0);
+        add(tag, TIFF_ASCII, uint32_t(b.size()), b);
+    }
+    void rationals(uint16_t tag, const std::vector<double>& v, bool isSigned)
+    {
+        std::vector<uint8_t> b;
+        for (double x : v) {
+            // A fixed denominator keeps 6 significant digits for the values DNG stores here.
+            const uint32_t den = 1000000;
+            const int64_t num = static_cast<int64_t>(std::llround(x * den));
+            put32(b,
+                  isSigned ? static_cast<uint32_t>(static_cast<int32_t>(num)) : static_cast<uint32_t>(num));
+            put32(b, den);
+        }
+        add(tag, isSigned ? TIFF_SRATIONAL : TIFF_RATIONAL, uint32_t(v.size()), b);
+    }
+
+    //! Moves the entries with these tags into the EXIF sub-IFD (where LibRaw looks for the ISO).
+    void moveToExif(std::initializer_list<uint16_t> tags)
+    {
+        for (uint16_t tag : tags)
+            for (size_t i = 0; i < entries_.size(); ++i)
+                if (entries_[i].tag == tag) {
+                    exif_.push_back(entries_[i]);
+                    entries_.erase(entries_.begin() + static_cast<std::ptrdiff_t>(i));
+                    break;
+                }
+    }
+
+    //! The file: header, main IFD and its values, EXIF IFD and its values, then the image strip.
+    std::vector<uint8_t> build(const Mat& mosaic)
+    {
+        const size_t stripBytes = mosaic.total() * 2;
+        if (stripBytes > 0xF0000000u)
+            CV_Error(Error::StsBadArg, "writeDng: the mosaic is too large for a baseline TIFF (4 GB)");
+        longs(273, {0}); // StripOffsets, patched below
+        longs(279, {uint32_t(stripBytes)});
+        if (!exif_.empty())
+            longs(34665, {0}); // ExifIFD, patched below
+        std::vector<uint8_t> out = {'I', 'I', 42, 0};
+        put32(out, 8);
+        std::vector<std::pair<uint16_t, size_t>> fields = appendIfd(out, entries_);
+        if (!exif_.empty()) {
+            patch32(out, fieldOf(fields, 34665), uint32_t(out.size()));
+            appendIfd(out, exif_);
+        }
+        patch32(out, fieldOf(fields, 273), uint32_t(out.size()));
+        out.reserve(out.size() + stripBytes);
+        for (int r = 0; r < mosaic.rows; ++r) {
+            const ushort* p = mosaic.ptr<ushort>(r);
+            for (int c = 0; c < mosaic.cols; ++c)
+                put16(out, p[c]);
+        }
+        return out;
+    }
+
+private:
+    static void put16(std::vector<uint8_t>& b, uint16_t v)
+    {
+        b.push_back(uint8_t(v));
+        b.push_back(uint8_t(v >> 8));
+    }
+    static void put32(std::vector<uint8_t>& b, uint32_t v)
+    {
+        for (int k = 0; k < 4; ++k)
+            b.push_back(uint8_t(v >> (8 * k)));
+    }
+    //! Appends an IFD at the end of `out` (absolute offsets) with its out-of-line values after it;
+    //! returns where each tag's value field is.
+    static std::vector<std::pair<uint16_t, size_t>> appendIfd(std::vector<uint8_t>& out,
+                                                              std::vector<TiffEntry> entries)
+    {
+        std::sort(entries.begin(), entries.end(),
+                  [](const TiffEntry& a, const TiffEntry& b) { return a.tag < b.tag; });
+        const size_t ifdSize = 2 + 12 * entries.size() + 4;
+        const size_t dataOffset = out.size() + ifdSize;
+        std::vector<uint8_t> data;
+        std::vector<std::pair<uint16_t, size_t>> fields;
+        put16(out, uint16_t(entries.size()));
+        for (const TiffEntry& e : entries) {
+            put16(out, e.tag);
+            put16(out, e.type);
+            put32(out, e.count);
+            fields.emplace_back(e.tag, out.size());
+            if (e.bytes.size() <= 4) {
+                std::vector<uint8_t> v = e.bytes;
+                v.resize(4, 0);
+                out.insert(out.end(), v.begin(), v.end());
+            } else {
+                put32(out, uint32_t(dataOffset + data.size()));
+                data.insert(data.end(), e.bytes.begin(), e.bytes.end());
+                if (data.size() % 2)
+                    data.push_back(0); // TIFF values start on word boundaries
+            }
+        }
+        put32(out, 0); // no next IFD
+        out.insert(out.end(), data.begin(), data.end());
+        return fields;
+    }
+    static size_t fieldOf(const std::vector<std::pair<uint16_t, size_t>>& fields, uint16_t tag)
+    {
+        for (const auto& f : fields)
+            if (f.first == tag)
+                return f.second;
+        CV_Error(Error::StsInternal, "writeDng: missing TIFF tag");
+    }
+    static void patch32(std::vector<uint8_t>& b, size_t at, uint32_t v)
+    {
+        for (int k = 0; k < 4; ++k)
+            b[at + k] = uint8_t(v >> (8 * k));
+    }
+    std::vector<TiffEntry> entries_;
+    std::vector<TiffEntry> exif_;
+};
+
+uint8_t dngColourOf(CfaChannel ch)
+{
+    return ch == CFA_R ? 0 : (ch == CFA_B ? 2 : 1);
+}
+
+} // namespace
+
+void writeDng(const String& path, const RawImage& image)
+{
+    image.format.validate();
+    const Mat& m = image.mosaic;
+    if (m.empty() || m.type() != CV_16UC1)
+        CV_Error(Error::StsBadArg, format("writeDng: '%s': the mosaic must be a non-empty CV_16UC1 (got %s)",
+                                          path.c_str(), typeToString(m.type()).c_str()));
+    if (m.rows % 2 || m.cols % 2)
+        CV_Error(Error::StsBadArg, format("writeDng: '%s': the mosaic is %dx%d; both sides must be even",
+                                          path.c_str(), m.cols, m.rows));
+    std::vector<uint32_t> blacks(4);
+    for (int s = 0; s < 4; ++s) {
+        const double b = image.format.blackLevel[s];
+        if (std::abs(b - std::round(b)) > 1e-9)
+            CV_Error(Error::StsBadArg, format("writeDng: '%s': black level %g of site %d is not an integer; "
+                                              "DNG stores integer levels for 16-bit data",
+                                              path.c_str(), b, s));
+        blacks[s] = static_cast<uint32_t>(std::llround(b));
+    }
+    if (detail::fileExists(path))
+        CV_Error(Error::StsError, "writeDng: '" + path + "' already exists; it is never overwritten");
+
+    TiffBuilder t;
+    t.longs(254, {0});
+    t.longs(256, {uint32_t(m.cols)});
+    t.longs(257, {uint32_t(m.rows)});
+    t.shorts(258, {16});
+    t.shorts(259, {1});
+    t.shorts(262, {32803}); // CFA
+    if (!image.make.empty())
+        t.ascii(271, image.make);
+    if (!image.model.empty())
+        t.ascii(272, image.model);
+    t.shorts(274, {1});
+    t.shorts(277, {1});
+    t.longs(278, {uint32_t(m.rows)});
+    t.shorts(284, {1});
+    t.ascii(305, "cv::rawgment");
+    t.shorts(33421, {2, 2});
+    const CfaPattern p = image.format.pattern;
+    t.bytes(33422, {dngColourOf(cfaChannelAt(p, 0, 0)), dngColourOf(cfaChannelAt(p, 0, 1)),
+                    dngColourOf(cfaChannelAt(p, 1, 0)), dngColourOf(cfaChannelAt(p, 1, 1))});
+    if (image.exposureTime > 0)
+        t.rationals(33434, {image.exposureTime}, false);
+    if (image.iso > 0)
+        t.shorts(34855, {static_cast<uint16_t>(std::min(65535.0, std::round(image.iso)))});
+    t.bytes(50706, {1, 4, 0, 0});
+    t.bytes(50707, {1, 1, 0, 0});
+    t.ascii(50708, image.make.empty() && image.model.empty() ? String("cv::rawgment")
+                                                             : image.make + " " + image.model);
+    t.bytes(50710, {0, 1, 2}); // CFAPlaneColor
+    t.shorts(50711, {1});      // CFALayout: rectangular
+    t.shorts(50713, {2, 2});
+    {
+        std::vector<uint8_t> b;
+        for (uint32_t v : blacks)
+            for (int k = 0; k < 4; ++k)
+                b.push_back(uint8_t(v >> (8 * k)));
+        t.add(50714, TIFF_LONG, 4, b);
+    }
+    t.longs(50717, {static_cast<uint32_t>(std::llround(image.format.whiteLevel))});
+    // ColorMatrix1 maps XYZ to camera RGB: camera = inverse(cameraToSrgb) * (XYZ to linear sRGB, D65).
+    const Matx33d xyzToSrgb(3.2404542, -1.5371385, -0.4985314, -0.9692660, 1.8760108, 0.0415560, 0.0556434,
+                            -0.2040259, 1.0572252);
+    Matx33d inv;
+    if (cv::invert(image.cameraToSrgb, inv, DECOMP_SVD) == 0)
+        CV_Error(Error::StsBadArg, "writeDng: cameraToSrgb is singular");
+    const Matx33d colorMatrix = inv * xyzToSrgb;
+    t.rationals(50721, std::vector<double>(colorMatrix.val, colorMatrix.val + 9), true);
+    t.shorts(50778, {21}); // CalibrationIlluminant1: D65
+    std::vector<double> neutral(3);
+    for (int c = 0; c < 3; ++c) {
+        detail::checkFinitePositive(image.whiteBalance[c], "writeDng: whiteBalance");
+        neutral[c] = image.whiteBalance[1] / image.whiteBalance[c];
+    }
+    t.rationals(50728, neutral, false);
+    t.moveToExif({33434, 34855});
+    const std::vector<uint8_t> bytes = t.build(m);
+    detail::writeBytesAtomically(path, bytes.data(), bytes.size(), false);
+}
+
+} // namespace rawgment
+} // namespace cv

@@ -1,0 +1,72 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The one home of the noise model's terms (paper Eq. 5) and of the standard error of a sample
+// variance. The simulator draws these terms, calibration fits them, augmentation adds what a target
+// lacks of them: each uses this header, so a term is written once. Private to the module.
+#ifndef OPENCV_RAWGMENT_SRC_NOISE_TERMS_HPP
+#define OPENCV_RAWGMENT_SRC_NOISE_TERMS_HPP
+
+#include <opencv2/rawgment/noise_model.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace cv {
+namespace rawgment {
+namespace detail {
+
+//! The variance of a line \f$ a\max(\mu, 0) + b \f$ at a black-subtracted mean: no shot noise below black.
+template <typename T> inline T lineVariance(T a, T b, T mean)
+{
+    return a * std::max(mean, T(0)) + b;
+}
+
+/** The variance of one gain split into the parts that a change of exposure or gain scales differently
+ * (paper Eq. 5 and 13). T is double, float or a Ceres Jet. */
+template <typename T> struct NoiseTerms
+{
+    T shot;           //!< \f$ g\alpha \f$: variance per DN of mean, from the photon count
+    T readBeforeGain; //!< \f$ g^2\sigma_d^2 \f$: read noise amplified by the gain
+    T readAfterGain;  //!< \f$ \sigma_r^2 \f$: noise added after the gain (quantisation included)
+
+    //! The offset b of the per-gain line: all the variance that does not depend on the mean.
+    T read() const { return readBeforeGain + readAfterGain; }
+    //! The variance at a black-subtracted mean (double: a data value, never a parameter).
+    T variance(double mean) const { return shot * std::max(mean, 0.0) + read(); }
+};
+
+//! The terms at linear gain g of a model (alpha, sigma_d^2, sigma_r^2).
+template <typename T> inline NoiseTerms<T> noiseTermsAt(T gain, T alpha, T sigmaD2, T sigmaR2)
+{
+    return {gain * alpha, gain * gain * sigmaD2, sigmaR2};
+}
+
+/** The terms of a model at linear gain g, after checking both: throws StsBadArg when the model is
+ * invalid, the gain is not finite and positive, or a term overflows. NoiseModel::lineAtGain() is
+ * built from it. */
+NoiseTerms<double> checkedNoiseTerms(const NoiseModel& model, double gain);
+
+/** The smallest variance a sample's expectation is taken to have when it is weighted or standardised:
+ * zero to double precision next to the largest variance the line or model predicts over the samples
+ * (1e-15 of it, and > 0). It only keeps a prediction of 0 from dividing by 0. A larger floor would be
+ * wrong, not safer: samples of exactly zero variance (dead or stuck pixels) would then count as
+ * inliers of any line whose offset is near 0 and pull it there (the 5%-outlier calibration test
+ * fails with a floor of 1e-9 of the largest prediction). Relative to the prediction, not to the data,
+ * so that outliers with huge variances cannot lift it. */
+inline double varianceFloor(double largestPredictedVariance)
+{
+    return std::max(1e-15 * largestPredictedVariance, 1e-300);
+}
+
+/** Standard error of an unbiased sample variance of `dof` degrees of freedom whose expectation is
+ * `expected`, for Gaussian data: \f$ \sqrt{2/dof}\,v \f$ (the variance of a scaled chi-square). The
+ * expectation is floored at `floor` (varianceFloor()); dof below 1 counts as 1. */
+inline double sampleVarianceStdError(double expected, int dof, double floor)
+{
+    return std::sqrt(2.0 / std::max(dof, 1)) * std::max(expected, floor);
+}
+
+} // namespace detail
+} // namespace rawgment
+} // namespace cv
+
+#endif // OPENCV_RAWGMENT_SRC_NOISE_TERMS_HPP
