@@ -2,8 +2,8 @@
 #include "app_tools.hpp"
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/rawgment/raw_io.hpp>
 
-#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -19,30 +19,13 @@ namespace rawgment_apps {
 
 namespace {
 
-std::string temporaryBeside(const std::string& path)
+// The library's writer (checked, synced, atomic); its errors become the apps' plain messages.
+void writeBytesAtomically(const std::string& path, const void* data, size_t size)
 {
-    static std::atomic<unsigned> counter{0};
-    const std::string dir = directoryOf(path), name = path.substr(path.find_last_of('/') + 1);
-    // The temporary keeps the extension so that encoders that look at it still work.
-    return dir + "/.tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + "-" + name;
-}
-
-void writeBytesAtomically(const std::string& path, const char* data, size_t size)
-{
-    const std::string tmp = temporaryBeside(path);
-    FILE* f = std::fopen(tmp.c_str(), "wb");
-    if (!f)
-        throw std::runtime_error("cannot open '" + tmp + "' for writing: " + std::strerror(errno));
-    const bool ok = std::fwrite(data, 1, size, f) == size && std::fflush(f) == 0;
-    const int err = errno;
-    if (std::fclose(f) != 0 || !ok) {
-        std::remove(tmp.c_str());
-        throw std::runtime_error("cannot write '" + path + "': " + std::strerror(ok ? errno : err));
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        const int e = errno;
-        std::remove(tmp.c_str());
-        throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "': " + std::strerror(e));
+    try {
+        cv::rawgment::writeFileAtomically(path, data, size, true);
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error(e.err);
     }
 }
 
@@ -110,7 +93,7 @@ void writeImageAtomically(const std::string& path, const cv::Mat& image)
     std::vector<uchar> bytes;
     if (!cv::imencode(path.substr(dot), image, bytes))
         throw std::runtime_error("cannot encode '" + path + "'");
-    writeBytesAtomically(path, reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    writeBytesAtomically(path, bytes.data(), bytes.size());
 }
 
 std::vector<double> parseNumberList(const std::string& text)
@@ -216,42 +199,35 @@ bool gnuplotAvailable()
 bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, std::string& message)
 {
     const std::string scriptPath = pngPath + ".gp";
-    const std::string tmpPng = temporaryBeside(pngPath);
-    std::string script = "set terminal pngcairo size 1100,750 enhanced font 'DejaVu Sans,11'\n";
-    script += "set datafile separator ','\n";
-    script += "set output '" + tmpPng + "'\n" + scriptBody + "\nunset output\n";
-    // The saved script writes the final name, so that a user can re-run it as it is.
-    std::string saved = script;
-    saved.replace(saved.find(tmpPng), tmpPng.size(), pngPath);
-    writeTextAtomically(scriptPath, saved);
-    const std::string tmpScript = temporaryBeside(scriptPath);
-    writeTextAtomically(tmpScript, script);
+    const std::string preamble = "set terminal pngcairo size 1100,750 enhanced font 'DejaVu Sans,11'\n"
+                                 "set datafile separator ','\n";
+    // The saved script writes the PNG itself, so that a user can re-run it as it is; the run writes
+    // to standard output, and the PNG reaches its name through the one atomic writer.
+    writeTextAtomically(scriptPath,
+                        preamble + "set output '" + pngPath + "'\n" + scriptBody + "\nunset output\n");
     if (!gnuplotAvailable()) {
-        std::remove(tmpScript.c_str());
         message =
             "gnuplot is not installed (apt-get install gnuplot-nox); plot with: gnuplot '" + scriptPath + "'";
         return false;
     }
-    const std::string command = "gnuplot '" + tmpScript + "' 2>&1";
+    const std::string runScript = scriptPath + "." + std::to_string(::getpid()) + ".run";
+    writeTextAtomically(runScript, preamble + scriptBody + "\n");
+    const std::string command = "gnuplot '" + runScript + "'";
     FILE* pipe = ::popen(command.c_str(), "r");
-    std::string output;
+    std::vector<char> png;
     if (pipe) {
-        char buf[512];
-        while (std::fgets(buf, sizeof buf, pipe))
-            output += buf;
+        char buf[65536];
+        size_t n;
+        while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0)
+            png.insert(png.end(), buf, buf + n);
     }
     const int status = pipe ? ::pclose(pipe) : -1;
-    std::remove(tmpScript.c_str());
-    if (status != 0 || !pathExists(tmpPng)) {
-        std::remove(tmpPng.c_str());
-        message = "gnuplot failed on '" + scriptPath + "': " + output;
+    std::remove(runScript.c_str());
+    if (status != 0 || png.empty()) {
+        message = "gnuplot failed on '" + scriptPath + "' (its messages are above)";
         return false;
     }
-    if (std::rename(tmpPng.c_str(), pngPath.c_str()) != 0) {
-        std::remove(tmpPng.c_str());
-        message = "cannot rename the plot to '" + pngPath + "': " + std::strerror(errno);
-        return false;
-    }
+    writeBytesAtomically(pngPath, png.data(), png.size());
     message.clear();
     return true;
 }

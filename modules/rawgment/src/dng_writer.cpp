@@ -255,7 +255,7 @@ void writeDng(const String& path, const RawImage& image)
     t.rationals(50728, neutral, false);
     t.moveToExif({33434, 34855});
     const std::vector<uint8_t> bytes = t.build(m);
-    detail::writeBytesAtomically(path, bytes.data(), bytes.size(), false);
+    writeFileAtomically(path, bytes.data(), bytes.size(), false);
 }
 
 } // namespace rawgment

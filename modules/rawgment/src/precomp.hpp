@@ -5,6 +5,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/rawgment/raw_io.hpp>
 
 #include <cmath>
 #include <string>
@@ -34,32 +35,22 @@ constexpr int kBlurBorder = BORDER_REPLICATE;
 //! Reads a required real field of a FileStorage map, naming it when it is missing or not a number.
 double readRealField(const FileNode& node, const char* field);
 
-//! Writes `path` atomically with a FileStorage: a temporary file beside it, then rename().
-//! The format follows the extension of `path` (.yml/.yaml or .json); other extensions are rejected.
+/** Writes `path` with a FileStorage, replacing it: the text is built in memory, then written by
+ * writeFileAtomically() (checked, synced, atomic). The format follows the extension of `path`
+ * (.yml/.yaml or .json); other extensions are rejected. */
 template <typename Writer> void writeFileStorageAtomically(const String& path, Writer&& writeBody);
 int fileStorageFormatOf(const String& path);
-void commitTemporaryFile(const String& tmpPath, const String& path);
-String temporaryPathFor(const String& path);
-//! Like commitTemporaryFile(), but fails (removing the temporary) when `path` already exists.
-void commitTemporaryFileNoReplace(const String& tmpPath, const String& path);
-//! Writes bytes to a temporary file beside `path`, syncs it, then commits it (replacing or not).
-//! Every I/O call is checked; errors name the file and the reason.
-void writeBytesAtomically(const String& path, const void* data, size_t size, bool replace);
 //! Whether anything exists at `path`.
 bool fileExists(const String& path);
 
 template <typename Writer> void writeFileStorageAtomically(const String& path, Writer&& writeBody)
 {
     const int format = fileStorageFormatOf(path);
-    const String tmp = temporaryPathFor(path);
-    {
-        FileStorage fs(tmp, FileStorage::WRITE | format);
-        if (!fs.isOpened())
-            CV_Error(Error::StsError, "cannot open '" + tmp + "' for writing (next to '" + path + "')");
-        writeBody(fs);
-        fs.release();
-    }
-    commitTemporaryFile(tmp, path);
+    FileStorage fs(format == FileStorage::FORMAT_JSON ? ".json" : ".yml",
+                   FileStorage::WRITE | FileStorage::MEMORY | format);
+    writeBody(fs);
+    const std::string text = fs.releaseAndGetString();
+    writeFileAtomically(path, text.data(), text.size(), true);
 }
 
 /** Reads the map `topLevel` of a YAML/JSON file with `read(node)`. Errors name the file: a missing or

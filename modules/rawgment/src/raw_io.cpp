@@ -6,9 +6,13 @@
 
 #include <libraw/libraw.h>
 
+#include <atomic>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
+#include <fcntl.h>
 #include <memory>
+#include <unistd.h>
 #include <vector>
 
 namespace cv {
@@ -254,6 +258,94 @@ String lowerExtensionOf(const String& path)
 
 } // namespace
 
+namespace {
+
+String temporaryPathFor(const String& path)
+{
+    // Unique per process and call, so concurrent writers never share a temporary file.
+    static std::atomic<unsigned> counter{0};
+    return format("%s.tmp-%d-%u", path.c_str(), static_cast<int>(::getpid()), counter++);
+}
+
+// Syncs the directory that holds `path`, so that a rename or link in it survives a power cut. Some
+// file systems cannot sync a directory (EINVAL): the file itself is synced already, so that is no error.
+void syncDirectoryOf(const String& path)
+{
+    const size_t slash = path.find_last_of('/');
+    const String dir = slash == String::npos ? String(".") : slash == 0 ? String("/") : path.substr(0, slash);
+    const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
+    if (fd < 0)
+        CV_Error(Error::StsError, "cannot open the directory of '" + path + "': " + std::strerror(errno));
+    const bool synced = ::fsync(fd) == 0 || errno == EINVAL;
+    const int err = errno;
+    ::close(fd);
+    if (!synced)
+        CV_Error(Error::StsError, "cannot sync the directory of '" + path + "': " + std::strerror(err));
+}
+
+void commitTemporaryFile(const String& tmpPath, const String& path)
+{
+    if (std::rename(tmpPath.c_str(), path.c_str()) != 0) {
+        const int err = errno;
+        std::remove(tmpPath.c_str());
+        CV_Error(Error::StsError, "cannot rename '" + tmpPath + "' to '" + path + "': " + std::strerror(err));
+    }
+}
+
+// Like commitTemporaryFile(), but fails (removing the temporary) when `path` already exists.
+void commitTemporaryFileNoReplace(const String& tmpPath, const String& path)
+{
+    // link() fails with EEXIST instead of replacing, which makes "never overwrite" atomic too.
+    if (::link(tmpPath.c_str(), path.c_str()) == 0) {
+        std::remove(tmpPath.c_str());
+        return;
+    }
+    const int err = errno;
+    if (err == EEXIST) {
+        std::remove(tmpPath.c_str());
+        CV_Error(Error::StsError, "'" + path + "' already exists; it is never overwritten");
+    }
+    // Some file systems (FAT, some network mounts) have no hard links: fall back to check-then-rename.
+    if (err == EPERM || err == ENOTSUP || err == EXDEV || err == ENOSYS) {
+        if (::access(path.c_str(), F_OK) == 0) {
+            std::remove(tmpPath.c_str());
+            CV_Error(Error::StsError, "'" + path + "' already exists; it is never overwritten");
+        }
+        commitTemporaryFile(tmpPath, path);
+        return;
+    }
+    std::remove(tmpPath.c_str());
+    CV_Error(Error::StsError, "cannot create '" + path + "': " + std::strerror(err));
+}
+
+} // namespace
+
+void writeFileAtomically(const String& path, const void* data, size_t size, bool replace)
+{
+    if (path.empty())
+        CV_Error(Error::StsBadArg, "writeFileAtomically: the path is empty");
+    if (!data && size > 0)
+        CV_Error(Error::StsBadArg, "writeFileAtomically: no data for " + std::to_string(size) + " bytes");
+    const String tmp = temporaryPathFor(path);
+    FILE* f = std::fopen(tmp.c_str(), "wb");
+    if (!f)
+        CV_Error(Error::StsError, "cannot open '" + tmp + "' for writing: " + std::strerror(errno));
+    const bool written = (size == 0 || std::fwrite(data, 1, size, f) == size) && std::fflush(f) == 0 &&
+                         ::fsync(::fileno(f)) == 0;
+    const int err = errno;
+    if (std::fclose(f) != 0 || !written) {
+        const int closeErr = errno;
+        std::remove(tmp.c_str());
+        CV_Error(Error::StsError, "cannot write '" + path + "': " + std::strerror(written ? closeErr : err) +
+                                      " (nothing was replaced)");
+    }
+    if (replace)
+        commitTemporaryFile(tmp, path);
+    else
+        commitTemporaryFileNoReplace(tmp, path);
+    syncDirectoryOf(path);
+}
+
 void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& metadata)
 {
     const Mat mosaic = _mosaic.getMat();
@@ -293,7 +385,7 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
     if (!encoded)
         CV_Error(Error::StsError,
                  "writeMosaic: '" + path + "': OpenCV could not encode the mosaic as " + ext);
-    detail::writeBytesAtomically(path, bytes.data(), bytes.size(), false);
+    writeFileAtomically(path, bytes.data(), bytes.size(), false);
 }
 
 MosaicMetadata readMosaic(const String& path, OutputArray _mosaic)

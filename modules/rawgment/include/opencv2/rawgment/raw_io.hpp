@@ -55,6 +55,24 @@ CV_RAWGMENT_EXPORTS RawImage readRaw(const String& path);
  */
 CV_RAWGMENT_EXPORTS void writeDng(const String& path, const RawImage& image);
 
+/** @brief Writes bytes to a file so that a reader, a crash or a full disk never leaves a partial file
+ * under `path`: the one writer of the library and its apps.
+ *
+ * The bytes go to a temporary file beside `path` (same directory, so the move is atomic); every write,
+ * the flush and an fsync are checked (a full disk is an error, not a short file); then the temporary
+ * is moved into place and the directory is synced, so the new name survives a power cut. With
+ * `replace` false the move fails when `path` exists, atomically too (a hard link), so an existing file
+ * is never overwritten; with `replace` true it replaces `path`. On any error the temporary is removed
+ * and `path` is left as it was.
+ * @param path destination file
+ * @param data the bytes (may be null when size is 0)
+ * @param size number of bytes
+ * @param replace whether an existing `path` may be replaced
+ * @throws cv::Exception naming the file and the system's reason.
+ */
+CV_RAWGMENT_EXPORTS void writeFileAtomically(const String& path, const void* data, size_t size,
+                                             bool replace = false);
+
 /** @brief What a sidecar file says about a mosaic written by writeMosaic(). */
 struct CV_RAWGMENT_EXPORTS MosaicMetadata
 {
