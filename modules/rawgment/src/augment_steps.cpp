@@ -73,13 +73,11 @@ NoiseOptions NoiseOptions::readFields(const FileNode& map)
 {
     NoiseOptions o;
     const auto field = [&](const char* name, int current) {
-        const FileNode f = map[name];
-        if (f.empty() || f.isNone())
-            return current;
-        const double value = f.isInt() || f.isReal() ? static_cast<double>(f) : 0.0;
-        if ((!f.isInt() && !f.isReal()) || value != std::floor(value))
-            CV_Error(Error::StsParseError, format("noise options: field '%s' must be an integer", name));
-        return static_cast<int>(value);
+        try {
+            return detail::readOptionalIntField(map, name, current);
+        } catch (const Exception& e) {
+            CV_Error(e.code, "noise options: " + e.err);
+        }
     };
     o.alignment = static_cast<NoiseAlignment>(field("alignment", static_cast<int>(o.alignment)));
     o.shotSampling = static_cast<ShotNoiseSampling>(field("shot_sampling", static_cast<int>(o.shotSampling)));

@@ -190,17 +190,15 @@ RawFormat RawFormat::read(const FileNode& node)
     if (!patternNode.isString())
         CV_Error(Error::StsParseError, "raw format: field 'pattern' is missing or not a string");
     f.pattern = cfaPatternFromName(patternNode.string());
-    const FileNode black = node["black_level"];
-    if (!black.isSeq() || black.size() != 4)
-        CV_Error(Error::StsParseError,
-                 "raw format: field 'black_level' must be a list of 4 numbers (one per site)");
-    for (int s = 0; s < 4; ++s) {
-        if (!black[s].isReal() && !black[s].isInt())
-            CV_Error(Error::StsParseError, format("raw format: black_level[%d] is not a number", s));
-        f.blackLevel[s] = static_cast<double>(black[s]);
+    try {
+        const std::vector<double> black = detail::readRealList(node, "black_level", 4);
+        for (int s = 0; s < 4; ++s)
+            f.blackLevel[s] = black[static_cast<size_t>(s)];
+        f.whiteLevel = detail::readRealField(node, "white_level");
+        f.gain = detail::readRealField(node, "gain");
+    } catch (const Exception& e) {
+        CV_Error(e.code, "raw format: " + e.err);
     }
-    f.whiteLevel = detail::readRealField(node, "white_level");
-    f.gain = detail::readRealField(node, "gain");
     f.validate();
     return f;
 }

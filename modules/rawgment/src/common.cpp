@@ -2,6 +2,7 @@
 #include "precomp.hpp"
 
 #include <cerrno>
+#include <climits>
 #include <cstring>
 #include <unistd.h>
 
@@ -35,14 +36,56 @@ Mat normalisedKernel(InputArray _kernel, const char* who)
     return kernel / total;
 }
 
+namespace {
+
+bool isAbsent(const FileNode& f)
+{
+    return f.empty() || f.isNone();
+}
+
+double numberOf(const FileNode& f, const String& name)
+{
+    if (!f.isReal() && !f.isInt())
+        CV_Error(Error::StsParseError, format("field '%s' is not a number", name.c_str()));
+    return static_cast<double>(f);
+}
+
+} // namespace
+
 double readRealField(const FileNode& node, const char* field)
 {
     const FileNode f = node[field];
-    if (f.empty() || f.isNone())
+    if (isAbsent(f))
         CV_Error(Error::StsParseError, format("field '%s' is missing", field));
-    if (!f.isReal() && !f.isInt())
-        CV_Error(Error::StsParseError, format("field '%s' is not a number", field));
-    return static_cast<double>(f);
+    return numberOf(f, field);
+}
+
+double readOptionalRealField(const FileNode& node, const char* field, double fallback)
+{
+    const FileNode f = node[field];
+    return isAbsent(f) ? fallback : numberOf(f, field);
+}
+
+int readOptionalIntField(const FileNode& node, const char* field, int fallback)
+{
+    const FileNode f = node[field];
+    if (isAbsent(f))
+        return fallback;
+    const double value = f.isInt() || f.isReal() ? static_cast<double>(f) : 0.5;
+    if (value != std::floor(value) || value < INT_MIN || value > INT_MAX)
+        CV_Error(Error::StsParseError, format("field '%s' must be an integer", field));
+    return static_cast<int>(value);
+}
+
+std::vector<double> readRealList(const FileNode& node, const char* field, int n)
+{
+    const FileNode list = node[field];
+    if (!list.isSeq() || static_cast<int>(list.size()) != n)
+        CV_Error(Error::StsParseError, format("field '%s' must be a list of %d numbers", field, n));
+    std::vector<double> values;
+    for (int i = 0; i < n; ++i)
+        values.push_back(numberOf(list[i], format("%s[%d]", field, i)));
+    return values;
 }
 
 int fileStorageFormatOf(const String& path)

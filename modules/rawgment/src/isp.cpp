@@ -74,8 +74,8 @@ ToneCurve ToneCurve::read(const FileNode& node)
         CV_Error(Error::StsParseError, "tone curve: expected a map with gamma, break_point, toe_slope");
     ToneCurve c;
     c.gamma = detail::readRealField(node, "gamma");
-    c.breakPoint = node["break_point"].empty() ? 0.0 : detail::readRealField(node, "break_point");
-    c.toeSlope = node["toe_slope"].empty() ? 0.0 : detail::readRealField(node, "toe_slope");
+    c.breakPoint = detail::readOptionalRealField(node, "break_point", 0.0);
+    c.toeSlope = detail::readOptionalRealField(node, "toe_slope", 0.0);
     c.validate();
     return c;
 }

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace cv {
 namespace rawgment {
@@ -32,8 +33,16 @@ Mat normalisedKernel(InputArray kernel, const char* who);
  * capture and a blurred augmentation agree up to the frame's edge. */
 constexpr int kBlurBorder = BORDER_REPLICATE;
 
-//! Reads a required real field of a FileStorage map, naming it when it is missing or not a number.
+/* The one reader of numeric fields in YAML/JSON files: a field is a number or an error naming it. */
+//! A required real field of a FileStorage map, named in the error when it is missing or not a number.
 double readRealField(const FileNode& node, const char* field);
+//! An optional real field: `fallback` when absent (or null), an error naming it when not a number.
+double readOptionalRealField(const FileNode& node, const char* field, double fallback);
+//! An optional integer field: as readOptionalRealField(), and an error when it has a fraction or does
+//! not fit an int.
+int readOptionalIntField(const FileNode& node, const char* field, int fallback);
+//! A required list of exactly `n` numbers, named (and the element) in the error.
+std::vector<double> readRealList(const FileNode& node, const char* field, int n);
 
 /** Writes `path` with a FileStorage, replacing it: the text is built in memory, then written by
  * writeFileAtomically() (checked, synced, atomic). The format follows the extension of `path`

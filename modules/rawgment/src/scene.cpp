@@ -34,17 +34,18 @@ Scene Scene::read(const FileNode& node)
         CV_Error(Error::StsParseError, "scene: expected a map");
     Scene s;
     node["shift"] >> s.shift;
-    if (!node["scale"].empty())
-        s.scale = detail::readRealField(node, "scale");
+    try {
+        s.scale = detail::readOptionalRealField(node, "scale", s.scale);
+        const std::vector<double> contrast = detail::readRealList(node, "contrast", 4);
+        for (int i = 0; i < 4; ++i)
+            s.jitter.contrast[i] = contrast[static_cast<size_t>(i)];
+        s.jitter.brightness = detail::readRealField(node, "brightness");
+        s.jitter.gainRatio = detail::readRealField(node, "gain_ratio");
+    } catch (const Exception& e) {
+        CV_Error(e.code, "scene: " + e.err);
+    }
     if (!std::isfinite(s.scale) || !(s.scale > 0))
         CV_Error(Error::StsParseError, "scene: field 'scale' must be a finite number > 0");
-    const FileNode c = node["contrast"];
-    if (!c.isSeq() || c.size() != 4)
-        CV_Error(Error::StsParseError, "scene: field 'contrast' must be a list of 4 numbers (one per site)");
-    for (int i = 0; i < 4; ++i)
-        s.jitter.contrast[i] = static_cast<double>(c[i]);
-    s.jitter.brightness = detail::readRealField(node, "brightness");
-    s.jitter.gainRatio = detail::readRealField(node, "gain_ratio");
     s.noise = NoiseOptions::readFields(node);
     node["motion_kernel"] >> s.motionKernel;
     return s;
@@ -196,12 +197,11 @@ RandomScenePolicy RandomScenePolicy::read(const FileNode& node)
         CV_Error(Error::StsParseError, "random scene policy: expected a map");
     RandomScenePolicy p;
     const auto field = [&](const char* name, double& value) {
-        const FileNode f = node[name];
-        if (f.empty() || f.isNone())
-            return;
-        if (!f.isReal() && !f.isInt())
-            CV_Error(Error::StsParseError, format("random scene policy: field '%s' is not a number", name));
-        value = static_cast<double>(f);
+        try {
+            value = detail::readOptionalRealField(node, name, value);
+        } catch (const Exception& e) {
+            CV_Error(e.code, "random scene policy: " + e.err);
+        }
     };
     field("contrast_min", p.contrastMin);
     field("contrast_max", p.contrastMax);

@@ -546,6 +546,28 @@ TEST(Augment, sceneRoundTripsThroughFileStorage)
     EXPECT_EQ(norm(r.motionKernel, s.motionKernel, NORM_INF), 0);
 }
 
+TEST(Augment, sceneAndPolicyFilesRejectWhatIsNotANumber)
+{
+    // Every numeric field goes through one reader: a word where a number belongs is an error naming
+    // the field, never a default or a wrapped value.
+    const auto readScene = [](const std::string& fields) {
+        FileStorage fs("%YAML:1.0\nscene: {contrast: [1, 1, 1, 1], brightness: 0, gain_ratio: 1" + fields +
+                           "}\n",
+                       FileStorage::READ | FileStorage::MEMORY);
+        return Scene::read(fs["scene"]);
+    };
+    EXPECT_EQ(readScene("").jitter.contrast, Vec4d::all(1));
+    FileStorage badContrast("%YAML:1.0\nscene: {contrast: [1, abc, 1, 1], brightness: 0, gain_ratio: 1}\n",
+                            FileStorage::READ | FileStorage::MEMORY);
+    EXPECT_CV_ERROR_CONTAINS(Scene::read(badContrast["scene"]), "scene: field 'contrast[1]' is not a number");
+    EXPECT_CV_ERROR_CONTAINS(readScene(", scale: big"), "scene: field 'scale' is not a number");
+    EXPECT_CV_ERROR_CONTAINS(readScene(", alignment: 1e10"), "'alignment' must be an integer");
+    FileStorage policy("%YAML:1.0\nscene_policy: {gain_db_max: loud}\n",
+                       FileStorage::READ | FileStorage::MEMORY);
+    EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy::read(policy["scene_policy"]),
+                             "random scene policy: field 'gain_db_max' is not a number");
+}
+
 //! Counts of the integer values v - black in [lo, hi] of a CV_16UC1 frame.
 std::vector<double> valueHistogram(const Mat& raw, double black, int lo, int hi)
 {
