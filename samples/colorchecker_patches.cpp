@@ -6,12 +6,12 @@
 #include "chart_patches.hpp"
 
 #include <opencv2/core/utility.hpp>
+#include <opencv2/core/utils/filesystem.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/rawgment.hpp>
 
 #include <cstdio>
 #include <iostream>
-
-#include "../apps/common/app_tools.hpp"
 
 int main(int argc, char** argv)
 {
@@ -42,11 +42,11 @@ int main(int argc, char** argv)
     try {
         // 1. Read the mosaic and render a preview in the mosaic's own coordinates.
         const cv::rawgment::RawImage image = cv::rawgment::readRaw(rawPath);
-        const cv::Mat preview = rawgment_samples::renderDetectionPreview(image, exposure);
+        const cv::Mat preview = rawgment_helpers::renderDetectionPreview(image, exposure);
         // 2. Detect the chart and place one square in the middle of each patch.
-        rawgment_samples::ChartPatches patches;
+        rawgment_helpers::ChartPatches patches;
         std::string why;
-        if (!rawgment_samples::findChartPatches(preview, side, patches, why)) {
+        if (!rawgment_helpers::findChartPatches(preview, side, patches, why)) {
             std::cerr << rawPath << ": " << why << "\n";
             return 1;
         }
@@ -56,15 +56,24 @@ int main(int argc, char** argv)
         for (size_t i = 0; i < patches.squares.size(); ++i)
             std::printf("patch %2zu  square %4d,%4d %dx%d  mean %.1f DN\n", i + 1, patches.squares[i].x,
                         patches.squares[i].y, side, side, cv::mean(signal(patches.squares[i]))[0]);
-        if (rawgment_apps::pathExists(outPath) ||
-            (!annotatedPath.empty() && rawgment_apps::pathExists(annotatedPath))) {
+        if (cv::utils::fs::exists(outPath) ||
+            (!annotatedPath.empty() && cv::utils::fs::exists(annotatedPath))) {
             std::cerr << "an output already exists; it is never overwritten\n";
             return 1;
         }
-        rawgment_samples::writeChartPatches(outPath, patches);
-        if (!annotatedPath.empty())
-            rawgment_apps::writeImageAtomically(annotatedPath,
-                                                rawgment_samples::drawChartPatches(preview, patches));
+        rawgment_helpers::writeChartPatches(outPath, patches);
+        if (!annotatedPath.empty()) {
+            // Encoded by the path's extension, then written atomically without replacing a file.
+            const size_t dot = annotatedPath.find_last_of('.');
+            std::vector<uchar> image;
+            if (dot == std::string::npos ||
+                !cv::imencode(annotatedPath.substr(dot), rawgment_helpers::drawChartPatches(preview, patches),
+                              image)) {
+                std::cerr << annotatedPath << ": cannot encode an image with this extension\n";
+                return 1;
+            }
+            cv::rawgment::writeFileAtomically(annotatedPath, image.data(), image.size());
+        }
         std::printf("wrote %s%s%s\n", outPath.c_str(), annotatedPath.empty() ? "" : " and ",
                     annotatedPath.c_str());
         return 0;

@@ -22,11 +22,11 @@ TEST(ChartPatches, colorchartDngGivesTwentyFourDisjointSquaresInsideTheChartWith
     if (path.empty())
         GTEST_SKIP() << "test data file 'colorchart.dng' not found beside the checkout (../shared/data)";
     const cv::rawgment::RawImage image = cv::rawgment::readRaw(path);
-    const cv::Mat preview = rawgment_samples::renderDetectionPreview(image);
+    const cv::Mat preview = rawgment_helpers::renderDetectionPreview(image);
     ASSERT_EQ(image.mosaic.size(), preview.size()) << "preview and mosaic share coordinates";
-    rawgment_samples::ChartPatches patches;
+    rawgment_helpers::ChartPatches patches;
     std::string why;
-    ASSERT_TRUE(rawgment_samples::findChartPatches(preview, 24, patches, why)) << why;
+    ASSERT_TRUE(rawgment_helpers::findChartPatches(preview, 24, patches, why)) << why;
     ASSERT_EQ(24u, patches.squares.size());
     ASSERT_EQ(4u, patches.gridCorners.size());
     for (size_t i = 0; i < patches.squares.size(); ++i) {
@@ -59,14 +59,14 @@ TEST(ChartPatches, colorchartDngGivesTwentyFourDisjointSquaresInsideTheChartWith
 
 TEST(ChartPatches, squaresRoundTripThroughYaml)
 {
-    rawgment_samples::ChartPatches p;
+    rawgment_helpers::ChartPatches p;
     p.gridCorners = {{0, 0}, {100, 0}, {100, 60}, {0, 60}};
     for (int i = 0; i < 24; ++i)
         p.squares.emplace_back(2 * i, 4, 8, 8);
     const std::string path = ::testing::TempDir() + "/chart_patches_roundtrip.yml";
     std::remove(path.c_str());
-    rawgment_samples::writeChartPatches(path, p);
-    const rawgment_samples::ChartPatches back = rawgment_samples::readChartPatches(path);
+    rawgment_helpers::writeChartPatches(path, p);
+    const rawgment_helpers::ChartPatches back = rawgment_helpers::readChartPatches(path);
     EXPECT_EQ(p.squares, back.squares);
     EXPECT_EQ(p.gridCorners, back.gridCorners);
 }

@@ -65,7 +65,7 @@ std::vector<cv::Rect> manifestSquares(const cv::FileNode& node, const std::strin
 {
     const std::string value = node.empty() ? std::string("detect") : std::string(node);
     if (value != "detect")
-        return rawgment_samples::readChartPatches(resolvePath(base, value)).squares;
+        return rawgment_helpers::readChartPatches(resolvePath(base, value)).squares;
     const LoadedMosaic m = loadMosaicFile(firstFrame);
     RawImage image;
     image.mosaic = m.mosaic;
@@ -77,9 +77,9 @@ std::vector<cv::Rect> manifestSquares(const cv::FileNode& node, const std::strin
     cv::sort(sorted, sorted, cv::SORT_ASCENDING);
     const float p99 = sorted.at<float>(static_cast<int>(sorted.total() * 0.99));
     const double exposure = p99 > 0 ? std::min(64.0, std::max(1.0, 0.9 / p99)) : 1.0;
-    rawgment_samples::ChartPatches patches;
+    rawgment_helpers::ChartPatches patches;
     std::string why;
-    if (!rawgment_samples::findChartPatches(rawgment_samples::renderDetectionPreview(image, exposure), side,
+    if (!rawgment_helpers::findChartPatches(rawgment_helpers::renderDetectionPreview(image, exposure), side,
                                             patches, why))
         throw std::runtime_error("'" + firstFrame + "': " + why);
     notes.push_back(
@@ -163,7 +163,7 @@ SimulateResult simulateBursts(const SimulateOptions& o)
     const RawFormat unit = sensor.rawFormat(1.0);
     const double range = unit.whiteLevel - *std::max_element(unit.blackLevel.val, unit.blackLevel.val + 4);
 
-    rawgment_samples::ChartPatches patches;
+    rawgment_helpers::ChartPatches patches;
     const int side = std::max(2, std::min(24, (o.patchSize - 8) & ~1));
     patches.squares = cfaAlignedSquares(scene.patches, side);
     const cv::Rect& first = scene.patches.front();
@@ -226,7 +226,7 @@ SimulateResult simulateBursts(const SimulateOptions& o)
     }
     progress.finish();
 
-    rawgment_samples::writeChartPatches(patchesPath, patches);
+    rawgment_helpers::writeChartPatches(patchesPath, patches);
     sensor.effectiveModel().save(result.truthModel);
     if (o.validation) {
         result.validationManifest = o.outDir + "/validation_manifest.yml";
@@ -513,7 +513,7 @@ ValidateResult validateConversion(const ValidateOptions& o)
     cv::Mat mask(bright.front().mosaic.size(), CV_8U, cv::Scalar(root["patches"].empty() ? 255 : 0));
     if (!root["patches"].empty())
         for (const cv::Rect& s :
-             rawgment_samples::readChartPatches(resolvePath(base, root["patches"])).squares)
+             rawgment_helpers::readChartPatches(resolvePath(base, root["patches"])).squares)
             mask(s & cv::Rect(cv::Point(), mask.size())).setTo(255);
 
     const auto statsOf = [&](const std::function<cv::Mat(size_t)>& frameAt, size_t frames, cv::Mat& mean,

@@ -1,8 +1,9 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// Colour-checker patch extraction from a RAW mosaic: the method of samples/colorchecker_patches.cpp,
-// shared with apps/rawgment_calibrate.
-#ifndef RAWGMENT_SAMPLES_CHART_PATCHES_HPP
-#define RAWGMENT_SAMPLES_CHART_PATCHES_HPP
+// Colour-checker patch extraction from a RAW mosaic with cv::mcc: the one helper that the samples
+// (samples/colorchecker_patches.cpp) and the apps (rawgment_calibrate, rawgment_simulate) share. It
+// depends on the installed library and OpenCV only, never on the apps.
+#ifndef RAWGMENT_HELPERS_CHART_PATCHES_HPP
+#define RAWGMENT_HELPERS_CHART_PATCHES_HPP
 
 #include <opencv2/core.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
@@ -10,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace rawgment_samples {
+namespace rawgment_helpers {
 
 /** Where the 24 patches of a classic colour checker are in a mosaic. */
 struct ChartPatches
@@ -42,6 +43,6 @@ void writeChartPatches(const std::string& path, const ChartPatches& patches);
 /** Reads what writeChartPatches() wrote. @throws cv::Exception naming the file and the field. */
 ChartPatches readChartPatches(const std::string& path);
 
-} // namespace rawgment_samples
+} // namespace rawgment_helpers
 
-#endif // RAWGMENT_SAMPLES_CHART_PATCHES_HPP
+#endif // RAWGMENT_HELPERS_CHART_PATCHES_HPP

@@ -1,16 +1,16 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "chart_patches.hpp"
 
-#include "../apps/common/app_tools.hpp"
-
+#include <opencv2/core/utils/filesystem.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/mcc.hpp>
 #include <opencv2/rawgment/isp.hpp>
+#include <opencv2/rawgment/raw_io.hpp>
 
 #include <algorithm>
 #include <cmath>
 
-namespace rawgment_samples {
+namespace rawgment_helpers {
 
 namespace {
 
@@ -130,12 +130,13 @@ void writeChartPatches(const std::string& path, const ChartPatches& patches)
         fs << s;
     fs << "]";
     fs << "}";
-    rawgment_apps::writeTextAtomically(path, fs.releaseAndGetString());
+    const std::string text = fs.releaseAndGetString();
+    cv::rawgment::writeFileAtomically(path, text.data(), text.size(), true);
 }
 
 ChartPatches readChartPatches(const std::string& path)
 {
-    if (!rawgment_apps::pathExists(path))
+    if (!cv::utils::fs::exists(path))
         CV_Error(cv::Error::StsError, "cannot open chart patches '" + path + "': no such file");
     cv::FileStorage fs(path, cv::FileStorage::READ);
     if (!fs.isOpened())
@@ -160,4 +161,4 @@ ChartPatches readChartPatches(const std::string& path)
     return p;
 }
 
-} // namespace rawgment_samples
+} // namespace rawgment_helpers
