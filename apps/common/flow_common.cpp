@@ -1,0 +1,108 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "pipeline.hpp"
+
+#include "app_tools.hpp"
+#include "chart_patches.hpp"
+#include "flow_common.hpp"
+
+#include <opencv2/core/utility.hpp>
+
+#include <algorithm>
+#include <functional>
+#include <stdexcept>
+
+namespace rawgment_apps {
+
+using namespace cv::rawgment;
+
+std::string yamlToString(const std::function<void(cv::FileStorage&)>& body)
+{
+    cv::FileStorage fs(".yml",
+                       cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+    body(fs);
+    return fs.releaseAndGetString();
+}
+
+cv::FileStorage openYaml(const std::string& path, const char* what)
+{
+    if (!pathExists(path))
+        throw std::runtime_error(std::string("cannot open ") + what + " '" + path + "': no such file");
+    cv::FileStorage fs(path, cv::FileStorage::READ);
+    if (!fs.isOpened())
+        throw std::runtime_error(std::string("cannot open ") + what + " '" + path + "'");
+    return fs;
+}
+
+std::vector<std::string> readFileList(const cv::FileNode& node, const std::string& base,
+                                      const std::string& where)
+{
+    if (!node.isSeq() || node.size() == 0)
+        throw std::runtime_error(where + ": 'files' must be a non-empty list");
+    std::vector<std::string> files;
+    for (const cv::FileNode& f : node)
+        files.push_back(resolvePath(base, std::string(f)));
+    return files;
+}
+
+void refuseExisting(const std::vector<std::string>& outputs)
+{
+    for (const std::string& p : outputs)
+        if (pathExists(p))
+            throw std::runtime_error(
+                "'" + p + "' already exists; outputs are never overwritten (choose another --out)");
+}
+
+// Squares from a manifest's `patches` entry: a file written by writeChartPatches(), or "detect".
+std::vector<cv::Rect> manifestSquares(const cv::FileNode& node, const std::string& base,
+                                      const std::string& firstFrame, int side,
+                                      std::vector<std::string>& notes)
+{
+    const std::string value = node.empty() ? std::string("detect") : std::string(node);
+    if (value != "detect")
+        return rawgment_helpers::readChartPatches(resolvePath(base, value)).squares;
+    const LoadedMosaic m = loadMosaicFile(firstFrame);
+    RawImage image;
+    image.mosaic = m.mosaic;
+    image.format = m.format;
+    // Detection needs a visible chart: expose the preview so that the brightest 1% reaches 90%.
+    cv::Mat signal;
+    subtractBlackLevel(m.mosaic, m.format, signal, true);
+    cv::Mat sorted = signal.reshape(1, 1).clone();
+    cv::sort(sorted, sorted, cv::SORT_ASCENDING);
+    const float p99 = sorted.at<float>(static_cast<int>(sorted.total() * 0.99));
+    const double exposure = p99 > 0 ? std::min(64.0, std::max(1.0, 0.9 / p99)) : 1.0;
+    rawgment_helpers::ChartPatches patches;
+    std::string why;
+    if (!rawgment_helpers::findChartPatches(rawgment_helpers::renderDetectionPreview(image, exposure), side,
+                                            patches, why))
+        throw std::runtime_error("'" + firstFrame + "': " + why);
+    notes.push_back(
+        cv::format("patches detected with cv::mcc on %s (exposure x%.2f)", firstFrame.c_str(), exposure));
+    return patches.squares;
+}
+
+LoadedMosaic loadMosaicFile(const std::string& path)
+{
+    LoadedMosaic out;
+    if (pathExists(sidecarPathOf(path))) {
+        const MosaicMetadata meta = readMosaic(path, out.mosaic);
+        out.format = meta.format;
+    } else {
+        RawImage image = readRaw(path);
+        out.mosaic = image.mosaic;
+        out.format = image.format;
+    }
+    return out;
+}
+
+cv::Mat previewOf(const cv::Mat& mosaic, const RawFormat& format, double exposure)
+{
+    IspParams isp;
+    isp.tone = ToneCurve::srgb();
+    isp.exposure = exposure;
+    cv::Mat bgr;
+    renderSimpleIsp(mosaic, format, bgr, isp);
+    return bgr;
+}
+
+} // namespace rawgment_apps

@@ -1,0 +1,32 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// What the app flows (simulate, calibrate, validate, augment) share: manifests, file lists, the
+// refusal to overwrite, chart squares. Private to apps/common.
+#ifndef RAWGMENT_APPS_FLOW_COMMON_HPP
+#define RAWGMENT_APPS_FLOW_COMMON_HPP
+
+#include <opencv2/core.hpp>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace rawgment_apps {
+
+//! A YAML document built with a FileStorage, as text.
+std::string yamlToString(const std::function<void(cv::FileStorage&)>& body);
+//! Opens a YAML/JSON file for reading; throws std::runtime_error naming `what` and the path.
+cv::FileStorage openYaml(const std::string& path, const char* what);
+//! A manifest's non-empty list of files, resolved against `base`; errors name `where`.
+std::vector<std::string> readFileList(const cv::FileNode& node, const std::string& base,
+                                      const std::string& where);
+//! Throws when any of the outputs exists: outputs are never overwritten.
+void refuseExisting(const std::vector<std::string>& outputs);
+/** Squares from a manifest's `patches` entry: a file written by writeChartPatches(), or "detect" (cv::mcc
+ * on the first frame, noted in `notes`). */
+std::vector<cv::Rect> manifestSquares(const cv::FileNode& node, const std::string& base,
+                                      const std::string& firstFrame, int side,
+                                      std::vector<std::string>& notes);
+
+} // namespace rawgment_apps
+
+#endif // RAWGMENT_APPS_FLOW_COMMON_HPP

@@ -1,0 +1,130 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "plots.hpp"
+
+#include "app_tools.hpp"
+
+namespace rawgment_apps {
+
+using namespace cv::rawgment;
+
+namespace {
+
+const char* const kSeriesColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
+                                      "#ff7f0e", "#8c564b", "#17becf"};
+
+void plotOrNote(const std::string& png, const std::string& script, std::vector<std::string>& pngs,
+                std::vector<std::string>& notes)
+{
+    std::string message;
+    if (plotWithGnuplot(png, script, message))
+        pngs.push_back(png);
+    else
+        notes.push_back(message);
+}
+
+} // namespace
+
+void plotCalibration(const std::string& outDir, const CalibrationReport& report,
+                     const CalibrationPlotFiles& files, size_t histogramSeries,
+                     const std::vector<double>& gainsDb, std::vector<std::string>& pngs,
+                     std::vector<std::string>& notes)
+{
+    const NoiseModel& model = report.model;
+    std::string s;
+    s += "set title 'Noise calibration: temporal variance against mean at each gain'\n";
+    s += "set xlabel 'mean signal above black (DN)'\nset ylabel 'temporal variance (DN^2)'\n";
+    s += "set key left top box opaque\nset grid\n";
+    s += "plot ";
+    for (size_t i = 0; i < report.perGain.size(); ++i) {
+        const NoiseLineFit& l = report.perGain[i];
+        const double gDb = linearGainToDb(l.gain);
+        const std::string colour = kSeriesColours[i % 7];
+        s += cv::format("'%s' every ::1 using ($3 > %.6f && $3 < %.6f ? $1 : 1/0):2 with points pt 7 ps 0.25 "
+                        "lc rgb '%s' title '%.1f dB samples', ",
+                        files.samplesCsv.c_str(), gDb - 0.01, gDb + 0.01, colour.c_str(), gDb);
+        s += cv::format(
+            "%.10g*x + %.10g with lines lw 2 lc rgb '%s' dt 2 title 'line fit: %.4f {/Symbol m} + %.3f "
+            "(R^2 %.4f)', ",
+            l.line.a, l.line.b, colour.c_str(), l.line.a, l.line.b, l.rSquared);
+    }
+    s += cv::format("1/0 title 'model: {/Symbol a} %.4f, {/Symbol s}_d^2 %.4f, {/Symbol s}_r^2 %.4f'\n",
+                    model.alpha, model.sigmaD2, model.sigmaR2);
+    plotOrNote(outDir + "/calib_mean_variance.png", s, pngs, notes);
+
+    s = "set title 'Sample variance over model variance, per gain (ideal: centred on 1)'\n";
+    s += "set xlabel 'variance / model variance'\nset ylabel 'samples'\nset key right top\nset grid\nplot ";
+    for (size_t i = 0; i < histogramSeries; ++i)
+        s += cv::format("%s'%s' every ::1 using 1:%zu with steps lw 2 lc rgb '%s' title columnhead(%zu)",
+                        i ? ", " : "", files.histogramCsv.c_str(), i + 2, kSeriesColours[i % 7], i + 2);
+    plotOrNote(outDir + "/calib_histograms.png", s, pngs, notes);
+
+    s = "set multiplot layout 1,2 title 'Cross-gain fit of the per-gain lines'\nset grid\nset key left top\n";
+    s += cv::format("set title 'slope a_g = g {/Symbol a}   (R^2 %.4f)'\nset xlabel 'linear gain g'\n"
+                    "set ylabel 'a_g (DN per DN)'\n",
+                    report.rSquaredSlope);
+    s += cv::format(
+        "plot '%s' every ::1 using 2:3 with points pt 7 ps 1.5 title 'per-gain fits', %.10g*x with lines "
+        "lw 2 title 'g {/Symbol a}'\n",
+        files.linesCsv.c_str(), model.alpha);
+    s += cv::format("set title 'offset b_g = g^2 {/Symbol s}_d^2 + {/Symbol s}_r^2   (R^2 %.4f)'\n"
+                    "set xlabel 'g^2'\nset ylabel 'b_g (DN^2)'\n",
+                    report.rSquaredOffset);
+    s += cv::format(
+        "plot '%s' every ::1 using ($2*$2):4 with points pt 7 ps 1.5 title 'per-gain fits', "
+        "%.10g*x + %.10g with lines lw 2 title 'g^2 {/Symbol s}_d^2 + {/Symbol s}_r^2'\nunset multiplot\n",
+        files.linesCsv.c_str(), model.sigmaD2, model.sigmaR2);
+    plotOrNote(outDir + "/calib_cross_gain.png", s, pngs, notes);
+
+    s = "set title 'Shapiro-Wilk test of each pixel''s temporal series (Gaussian noise: p spread evenly on "
+        "[0, 1])'\n";
+    s += "set xlabel 'mean signal above black (DN)'\nset ylabel 'p-value'\nset logscale y\nset yrange "
+         "[1e-6:1]\n";
+    s += "set key right bottom box opaque\nset grid\nplot ";
+    for (size_t i = 0; i < gainsDb.size(); ++i)
+        s += cv::format(
+            "'%s' every ::1 using ($1 > %.6f && $1 < %.6f ? $2 : 1/0):($3 < 1e-6 ? 1e-6 : $3) with points "
+            "pt 7 ps 0.3 lc rgb '%s' title '%.1f dB', ",
+            files.shapiroCsv.c_str(), gainsDb[i] - 0.01, gainsDb[i] + 0.01, kSeriesColours[i % 7],
+            gainsDb[i]);
+    s += "0.05 with lines lw 2 lc rgb 'black' dt 2 title 'p = 0.05'\n";
+    plotOrNote(outDir + "/shapiro_pvalue.png", s, pngs, notes);
+}
+
+void plotValidation(const std::string& outDir, const std::string& csvPath,
+                    const std::vector<ValidationPanel>& panels, std::vector<std::string>& pngs,
+                    std::vector<std::string>& notes)
+{
+    std::string s =
+        cv::format("set multiplot layout 1,%zu title 'Bright burst converted to darker exposures against "
+                   "real darker bursts (per-pixel temporal variance, averaged per mean bin)'\n",
+                   panels.size());
+    s += "set grid\nset key left top box opaque\nset xlabel 'mean signal above black (DN)'\n"
+         "set ylabel 'temporal variance (DN^2)'\n";
+    for (size_t i = 0; i < panels.size(); ++i) {
+        const double f = panels[i].factor;
+        const std::string sel = cv::format("($1 > %.6f && $1 < %.6f ? $4 : 1/0)", f - 1e-6, f + 1e-6);
+        s += cv::format("set title 'x%.2f exposure'\nset xrange [0:%.6g]\nset yrange [0:*]\n", f,
+                        panels[i].largestMean * 1.05);
+        s += cv::format(
+            "plot '%s' every ::1 using %s:6 with points pt 7 ps 1.6 lc rgb 'black' title 'real darker "
+            "burst', ",
+            csvPath.c_str(), sel.c_str());
+        s += cv::format(
+            "'' every ::1 using %s:9 with linespoints lw 2 pt 5 lc rgb '#2ca02c' title 'ACCOUNT\\_PRIOR "
+            "(ours)', ",
+            sel.c_str());
+        s += cv::format(
+            "'' every ::1 using %s:8 with linespoints lw 2 pt 9 lc rgb '#ff7f0e' title 'IGNORE\\_PRIOR', ",
+            sel.c_str());
+        s += cv::format("'' every ::1 using %s:7 with linespoints lw 2 pt 11 lc rgb '#d62728' title 'NONE', ",
+                        sel.c_str());
+        s += cv::format(
+            "'' every ::1 using ($1 > %.6f && $1 < %.6f ? $10 : 1/0):11 with points pt 6 ps 1.2 lc rgb "
+            "'#7f7f7f' title 'bright burst (before)'\n",
+            f - 1e-6, f + 1e-6);
+    }
+    s += "unset multiplot\n";
+    plotOrNote(outDir + "/validation.png", s, pngs, notes);
+}
+
+} // namespace rawgment_apps

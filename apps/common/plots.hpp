@@ -1,0 +1,41 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The apps' plots: gnuplot scripts over the CSV tables the flows write. Private to apps/common.
+#ifndef RAWGMENT_APPS_PLOTS_HPP
+#define RAWGMENT_APPS_PLOTS_HPP
+
+#include <opencv2/rawgment/calibration.hpp>
+
+#include <string>
+#include <vector>
+
+namespace rawgment_apps {
+
+//! The CSV tables that rawgment_calibrate writes and its plots read.
+struct CalibrationPlotFiles
+{
+    std::string samplesCsv, linesCsv, histogramCsv, shapiroCsv;
+};
+
+/** calib_mean_variance.png, calib_histograms.png (histogramSeries columns after the first),
+ * calib_cross_gain.png and shapiro_pvalue.png (one series per gain in gainsDb) in outDir. Each PNG
+ * written goes to `pngs`; a plot that could not be made leaves its reason in `notes`. */
+void plotCalibration(const std::string& outDir, const cv::rawgment::CalibrationReport& report,
+                     const CalibrationPlotFiles& files, size_t histogramSeries,
+                     const std::vector<double>& gainsDb, std::vector<std::string>& pngs,
+                     std::vector<std::string>& notes);
+
+//! One panel of the validation plot: an exposure factor and the largest mean of its bins.
+struct ValidationPanel
+{
+    double factor;
+    double largestMean;
+};
+
+//! validation.png in outDir from the validation CSV, one panel per target (see plotCalibration()).
+void plotValidation(const std::string& outDir, const std::string& csvPath,
+                    const std::vector<ValidationPanel>& panels, std::vector<std::string>& pngs,
+                    std::vector<std::string>& notes);
+
+} // namespace rawgment_apps
+
+#endif // RAWGMENT_APPS_PLOTS_HPP

@@ -1,0 +1,147 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// rawgment_simulate: simulated colour-checker bursts, their manifests, the truth model.
+#include "pipeline.hpp"
+
+#include "app_tools.hpp"
+#include "chart_patches.hpp"
+#include "flow_common.hpp"
+
+#include <opencv2/core/utility.hpp>
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace rawgment_apps {
+
+using namespace cv::rawgment;
+
+SimulateResult simulateBursts(const SimulateOptions& o)
+{
+    if (o.outDir.empty())
+        throw std::runtime_error("no output directory");
+    if (o.frames < 2 || o.gainsDb.empty() || o.levels.empty())
+        throw std::runtime_error("need at least 2 frames, one gain and one level");
+    for (double level : o.levels)
+        if (!(level > 0 && level <= 1))
+            throw std::runtime_error(cv::format("level %g is outside (0, 1]", level));
+    makeDirectories(o.outDir);
+    SimulateResult result;
+    result.manifest = o.outDir + "/manifest.yml";
+    result.truthModel = o.outDir + "/truth_noise_model.yml";
+    const std::string patchesPath = o.outDir + "/patches.yml";
+    refuseExisting({result.manifest, result.truthModel, patchesPath});
+
+    ColorCheckerOptions co;
+    co.pattern = o.sensor.pattern;
+    co.patchSize = o.patchSize;
+    const ColorCheckerScene scene = makeColorCheckerScene(co);
+    const SensorSimulator sensor(o.sensor, scene.meanAtUnitGain.size());
+    double sceneMax = 0;
+    cv::minMaxLoc(scene.meanAtUnitGain, nullptr, &sceneMax);
+    const RawFormat unit = sensor.rawFormat(1.0);
+    const double range = unit.whiteLevel - *std::max_element(unit.blackLevel.val, unit.blackLevel.val + 4);
+
+    rawgment_helpers::ChartPatches patches;
+    const int side = std::max(2, std::min(24, (o.patchSize - 8) & ~1));
+    patches.squares = cfaAlignedSquares(scene.patches, side);
+    const cv::Rect& first = scene.patches.front();
+    const cv::Rect& last = scene.patches.back();
+    patches.gridCorners = {
+        cv::Point2f(float(first.x), float(first.y)), cv::Point2f(float(last.br().x), float(first.y)),
+        cv::Point2f(float(last.br().x), float(last.br().y)), cv::Point2f(float(first.x), float(last.br().y))};
+
+    struct Burst
+    {
+        std::string dir;
+        double gainDb, exposure, level;
+        int frames;
+        uint64_t seed;
+    };
+    std::vector<Burst> bursts;
+    uint64_t burstSeed = o.seed;
+    for (double gDb : o.gainsDb)
+        for (double level : o.levels) {
+            const double g = dbToLinearGain(gDb);
+            bursts.push_back({cv::format("g%02.0fdB_level%.2f", gDb, level), gDb,
+                              level * range / (g * sceneMax), level, o.frames, ++burstSeed * 1000003ull});
+        }
+    const size_t calibrationBursts = bursts.size();
+    if (o.validation) {
+        const double g = dbToLinearGain(o.validationGainDb);
+        const double bright = 0.9 * range / (g * sceneMax);
+        bursts.push_back({"validation/bright", o.validationGainDb, bright, 0.9, o.validationFrames, 17});
+        bursts.push_back(
+            {"validation/x0.50", o.validationGainDb, 0.5 * bright, 0.45, o.validationFrames, 18});
+        bursts.push_back(
+            {"validation/x0.10", o.validationGainDb, 0.1 * bright, 0.09, o.validationFrames, 19});
+    }
+    size_t totalFrames = 0;
+    for (const Burst& b : bursts)
+        totalFrames += size_t(b.frames);
+    ProgressBar progress("simulate", totalFrames);
+    std::vector<std::vector<std::string>> files(bursts.size());
+    for (size_t i = 0; i < bursts.size(); ++i) {
+        const Burst& b = bursts[i];
+        makeDirectories(o.outDir + "/" + b.dir);
+        const double g = dbToLinearGain(b.gainDb);
+        MosaicMetadata meta;
+        meta.format = sensor.rawFormat(g);
+        meta.source =
+            cv::format("simulated colour checker, gain %.2f dB, exposure %.6g", b.gainDb, b.exposure);
+        for (int t = 0; t < b.frames; ++t) {
+            const std::string name = b.dir + cv::format("/frame_%03d", t) + o.extension;
+            files[i].push_back(name);
+            const std::string path = o.outDir + "/" + name;
+            // Frames are deterministic: a frame left by an interrupted run is already right.
+            if (!pathExists(path)) {
+                cv::Mat raw;
+                sensor.capture(scene.meanAtUnitGain, g, b.exposure, b.seed, t, raw);
+                writeMosaic(path, raw, meta);
+            }
+            ++result.files;
+            progress.advance();
+        }
+    }
+    progress.finish();
+
+    rawgment_helpers::writeChartPatches(patchesPath, patches);
+    sensor.effectiveModel().save(result.truthModel);
+    if (o.validation) {
+        result.validationManifest = o.outDir + "/validation_manifest.yml";
+        writeTextAtomically(result.validationManifest, yamlToString([&](cv::FileStorage& fs) {
+                                fs << "validation_manifest"
+                                   << "{";
+                                fs << "patches"
+                                   << "patches.yml";
+                                fs << "gain_db" << o.validationGainDb;
+                                fs << "bright" << files[calibrationBursts];
+                                fs << "targets"
+                                   << "[";
+                                for (size_t k = 1; k <= 2; ++k) {
+                                    fs << "{"
+                                       << "factor" << (k == 1 ? 0.5 : 0.1);
+                                    fs << "files" << files[calibrationBursts + k] << "}";
+                                }
+                                fs << "]"
+                                   << "}";
+                            }));
+    }
+    // The manifest last: its presence marks a complete simulation.
+    writeTextAtomically(result.manifest, yamlToString([&](cv::FileStorage& fs) {
+                            fs << "calibration_manifest"
+                               << "{";
+                            fs << "patches"
+                               << "patches.yml";
+                            fs << "bursts"
+                               << "[";
+                            for (size_t i = 0; i < calibrationBursts; ++i)
+                                fs << "{"
+                                   << "gain_db" << bursts[i].gainDb << "level" << bursts[i].level << "files"
+                                   << files[i] << "}";
+                            fs << "]"
+                               << "}";
+                        }));
+    return result;
+}
+
+} // namespace rawgment_apps

@@ -1,0 +1,175 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// rawgment_validate: a bright burst converted to darker exposures against real darker bursts.
+#include "pipeline.hpp"
+
+#include "app_tools.hpp"
+#include "chart_patches.hpp"
+#include "flow_common.hpp"
+#include "plots.hpp"
+
+#include <opencv2/core/utility.hpp>
+
+#include <algorithm>
+#include <functional>
+#include <stdexcept>
+
+namespace rawgment_apps {
+
+using namespace cv::rawgment;
+
+ValidateResult validateConversion(const ValidateOptions& o)
+{
+    cv::FileStorage fs = openYaml(o.manifest, "validation manifest");
+    const cv::FileNode root = fs["validation_manifest"];
+    if (!root.isMap() || !root["targets"].isSeq())
+        throw std::runtime_error("'" + o.manifest +
+                                 "': expected a map 'validation_manifest' with 'bright' and "
+                                 "'targets'");
+    const std::string base = directoryOf(o.manifest);
+    const NoiseModel model = NoiseModel::load(o.model);
+    makeDirectories(o.outDir);
+    const std::string csvPath = o.outDir + "/validation.csv", mdPath = o.outDir + "/validation.md";
+    refuseExisting({csvPath, mdPath});
+
+    const std::vector<std::string> brightFiles =
+        readFileList(root["bright"], base, "'" + o.manifest + "' bright");
+    std::vector<LoadedMosaic> bright;
+    for (const std::string& f : brightFiles)
+        bright.push_back(loadMosaicFile(f));
+    RawFormat format = bright.front().format;
+    if (!root["gain_db"].empty())
+        format.gain = dbToLinearGain(double(root["gain_db"]));
+    cv::Mat mask(bright.front().mosaic.size(), CV_8U, cv::Scalar(root["patches"].empty() ? 255 : 0));
+    if (!root["patches"].empty())
+        for (const cv::Rect& s :
+             rawgment_helpers::readChartPatches(resolvePath(base, root["patches"])).squares)
+            mask(s & cv::Rect(cv::Point(), mask.size())).setTo(255);
+
+    const auto statsOf = [&](const std::function<cv::Mat(size_t)>& frameAt, size_t frames, cv::Mat& mean,
+                             cv::Mat& variance, cv::Mat& clipped) {
+        BurstStatistics stats(format);
+        for (size_t t = 0; t < frames; ++t)
+            stats.add(frameAt(t));
+        stats.mean(mean);
+        stats.variance(variance);
+        stats.clippedMask(clipped);
+    };
+    cv::Mat brightMean, brightVar, brightClip;
+    statsOf([&](size_t t) { return bright[t].mosaic; }, bright.size(), brightMean, brightVar, brightClip);
+
+    ValidateResult result;
+    struct Target
+    {
+        double factor;
+        std::vector<ValidationRow> rows;
+    };
+    std::vector<Target> targets;
+    const NoiseAlignment alignments[3] = {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR,
+                                          NoiseAlignment::ACCOUNT_PRIOR};
+    ProgressBar progress("validate", root["targets"].size() * (3 + 1) * bright.size());
+    CsvTable csv({"factor", "mean_low", "mean_high", "mean", "pixels", "real_variance", "none_variance",
+                  "ignore_prior_variance", "account_prior_variance", "bright_mean", "bright_variance"});
+    for (const cv::FileNode& t : root["targets"]) {
+        const double factor = double(t["factor"]);
+        if (!(factor > 0 && factor <= 1))
+            throw std::runtime_error(
+                cv::format("'%s': target factor %g is outside (0, 1]", o.manifest.c_str(), factor));
+        const std::vector<std::string> files = readFileList(t["files"], base, "'" + o.manifest + "' target");
+        cv::Mat realMean, realVar, realClip;
+        statsOf(
+            [&](size_t k) {
+                progress.advance();
+                return loadMosaicFile(files[k]).mosaic;
+            },
+            files.size(), realMean, realVar, realClip);
+        cv::Mat convVar[3];
+        for (int a = 0; a < 3; ++a) {
+            cv::Mat m, c;
+            statsOf(
+                [&](size_t k) {
+                    cv::Mat out;
+                    RawFormat outFormat;
+                    colorJitter(bright[k].mosaic, format, model, ColorJitter::exposureChange(factor, 1.0),
+                                alignments[a], o.seed * 1000003ull + k, out, outFormat);
+                    progress.advance();
+                    return out;
+                },
+                bright.size(), m, convVar[a], c);
+        }
+        // Bins of the real burst's mean (BurstStatistics subtracts the black) over the unclipped masked
+        // pixels.
+        double lo = 1e300, hi = -1e300;
+        for (int y = 0; y < mask.rows; ++y)
+            for (int x = 0; x < mask.cols; ++x)
+                if (mask.at<uchar>(y, x) && !realClip.at<uchar>(y, x) && !brightClip.at<uchar>(y, x)) {
+                    lo = std::min(lo, realMean.at<double>(y, x));
+                    hi = std::max(hi, realMean.at<double>(y, x));
+                }
+        if (!(hi > lo))
+            throw std::runtime_error("the target burst has no unclipped pixels with distinct means");
+        std::vector<ValidationRow> rows(size_t(o.bins));
+        std::vector<double> meanSum(size_t(o.bins), 0), brightMeanSum(size_t(o.bins), 0),
+            brightVarSum(size_t(o.bins), 0);
+        for (int b = 0; b < o.bins; ++b) {
+            rows[size_t(b)].factor = factor;
+            rows[size_t(b)].meanLow = lo + (hi - lo) * b / o.bins;
+            rows[size_t(b)].meanHigh = lo + (hi - lo) * (b + 1) / o.bins;
+        }
+        for (int y = 0; y < mask.rows; ++y)
+            for (int x = 0; x < mask.cols; ++x) {
+                if (!mask.at<uchar>(y, x) || realClip.at<uchar>(y, x) || brightClip.at<uchar>(y, x))
+                    continue;
+                const double mu = realMean.at<double>(y, x);
+                const int b = std::min(o.bins - 1, static_cast<int>((mu - lo) / (hi - lo) * o.bins));
+                ValidationRow& r = rows[size_t(b)];
+                ++r.pixels;
+                meanSum[size_t(b)] += mu;
+                r.realVariance += realVar.at<double>(y, x);
+                r.noneVariance += convVar[0].at<double>(y, x);
+                r.ignoreVariance += convVar[1].at<double>(y, x);
+                r.accountVariance += convVar[2].at<double>(y, x);
+                brightMeanSum[size_t(b)] += brightMean.at<double>(y, x);
+                brightVarSum[size_t(b)] += brightVar.at<double>(y, x);
+            }
+        Target target{factor, {}};
+        for (int b = 0; b < o.bins; ++b) {
+            ValidationRow r = rows[size_t(b)];
+            if (r.pixels == 0)
+                continue;
+            const double n = r.pixels;
+            r.realVariance /= n;
+            r.noneVariance /= n;
+            r.ignoreVariance /= n;
+            r.accountVariance /= n;
+            csv.addRow(std::vector<double>{factor, r.meanLow, r.meanHigh, meanSum[size_t(b)] / n, n,
+                                           r.realVariance, r.noneVariance, r.ignoreVariance,
+                                           r.accountVariance, brightMeanSum[size_t(b)] / n,
+                                           brightVarSum[size_t(b)] / n});
+            target.rows.push_back(r);
+            result.rows.push_back(r);
+        }
+        targets.push_back(target);
+    }
+    progress.finish();
+    csv.write(csvPath);
+
+    std::string md =
+        "| factor | mean bin (DN) | pixels | real variance | NONE | IGNORE_PRIOR | ACCOUNT_PRIOR | "
+        "ACCOUNT_PRIOR / real |\n|---|---|---|---|---|---|---|---|\n";
+    for (const ValidationRow& r : result.rows)
+        md += cv::format("| x%.2f | %.1f-%.1f | %d | %.3f | %.3f | %.3f | %.3f | %.3f |\n", r.factor,
+                         r.meanLow, r.meanHigh, r.pixels, r.realVariance, r.noneVariance, r.ignoreVariance,
+                         r.accountVariance, r.accountVariance / r.realVariance);
+    result.table = md;
+    writeTextAtomically(mdPath, md);
+
+    if (!o.plots)
+        return result;
+    std::vector<ValidationPanel> panels;
+    for (const Target& t : targets)
+        panels.push_back({t.factor, t.rows.empty() ? 1.0 : t.rows.back().meanHigh});
+    plotValidation(o.outDir, csvPath, panels, result.pngs, result.notes);
+    return result;
+}
+
+} // namespace rawgment_apps
