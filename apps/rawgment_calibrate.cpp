@@ -17,6 +17,7 @@ int main(int argc, char** argv)
         "{method         | joint | joint (default, beyond the paper) or two-stage (the paper) }"
         "{side           | 24    | square side when the manifest says patches: detect }"
         "{shapiro        | 2000  | pixels per burst tested with Shapiro-Wilk }"
+        "{seed           | 0     | seed of the robust line fits (RANSAC) }"
         "{plots          | true  | write PNG plots with gnuplot }";
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about("rawgment_calibrate: alpha, sigma_d^2, sigma_r^2 from bursts of a colour checker\n\n"
@@ -38,6 +39,7 @@ int main(int argc, char** argv)
     o.side = parser.get<int>("side");
     o.shapiroPixels = parser.get<int>("shapiro");
     o.plots = parser.get<bool>("plots");
+    o.seed = parser.get<uint64_t>("seed");
     if (!parser.check() || o.manifest.empty() || o.outDir.empty() ||
         (method != "joint" && method != "two-stage")) {
         parser.printErrors();

@@ -102,6 +102,7 @@ int main(int argc, char** argv)
         rawgment_apps::CalibrateOptions cal;
         cal.manifest = simulated.manifest;
         cal.outDir = out + "/calibration";
+        cal.seed = seed;
         const rawgment_apps::CalibrateResult joint = rawgment_apps::calibrateFromManifest(cal);
         cal.outDir = out + "/calibration_two_stage";
         cal.method = NOISE_FIT_TWO_STAGE;
@@ -152,7 +153,7 @@ int main(int argc, char** argv)
         val.manifest = simulated.validationManifest;
         val.model = out + "/calibration/noise_model.yml";
         val.outDir = out + "/validation";
-        val.seed = seed + 11;
+        val.seed = seed;
         const rawgment_apps::ValidateResult validated = rawgment_apps::validateConversion(val);
         const double validateSeconds = secondsSince(t);
         md += "## Statistical validation (paper Fig. \"statistical_val\")\n\n";
@@ -180,7 +181,8 @@ int main(int argc, char** argv)
         const RawFormat format = sensor.rawFormat(1.0);
         cv::Mat bright;
         sensor.capture(sceneMean.meanAtUnitGain, 1.0,
-                       0.85 * (format.whiteLevel - format.blackLevel[0]) / sceneMax, seed + 99, 0, bright);
+                       0.85 * (format.whiteLevel - format.blackLevel[0]) / sceneMax,
+                       deriveSeed(seed, SEED_DEMO, 0), 0, bright);
         std::vector<GalleryEntry> entries(4);
         entries[0] = {"dark", "dark: x0.125 light, +6 dB gain", Scene()};
         entries[0].scene.jitter = ColorJitter::exposureChange(0.125, 2.0);
@@ -203,13 +205,14 @@ int main(int argc, char** argv)
             cv::Mat augmented;
             RawFormat augmentedFormat;
             AugmentReport report;
-            applyScene(bright, format, model, entries[i].scene, seed + 1000 + i, augmented, augmentedFormat,
+            const uint64_t sceneSeed = deriveSeed(seed, SEED_DEMO, 1 + i);
+            applyScene(bright, format, model, entries[i].scene, sceneSeed, augmented, augmentedFormat,
                        &report);
             MosaicMetadata meta;
             meta.format = augmentedFormat;
             meta.hasScene = true;
             meta.scene = entries[i].scene;
-            meta.seed = seed + 1000 + i;
+            meta.seed = sceneSeed;
             meta.source = "simulated bright colour checker";
             writeMosaic(out + "/gallery/" + entries[i].name + ".dng", augmented, meta);
             const ColorJitter& j = entries[i].scene.jitter;

@@ -30,7 +30,31 @@ struct Settings
     int seeds = 3;               // calibration errors are RMS over this many simulated campaigns
     std::vector<int> burstLengths{8, 16, 32, 100};
     int shapiroSeries = 100000; // series of 64 values in the Shapiro-Wilk timing
+    uint64 seed = 1;            // every simulated capture and noise draw derives from it
 };
+
+// What each seed of the study drives: deriveSeed(seed, SEED_STUDY, draw << 32 | sub-index).
+enum StudyDraw : uint64
+{
+    DRAW_TIMING_FRAME,
+    DRAW_TIMED_STEP,
+    DRAW_LATTICE_BRIGHT,
+    DRAW_LATTICE_TRUTH,
+    DRAW_LATTICE_JITTER,
+    DRAW_BLACK_FRAME,
+    DRAW_BLACK_TRUTH,
+    DRAW_BLACK_JITTER,
+    DRAW_BLUR_BURST,
+    DRAW_BLUR_STEP,
+    DRAW_STATE_BURST,
+    DRAW_SHAPIRO_DATA,
+    DRAW_CAMPAIGN_BURST
+};
+
+uint64 studySeed(const Settings& set, StudyDraw draw, uint64 sub = 0)
+{
+    return deriveSeed(set.seed, SEED_STUDY, (static_cast<uint64>(draw) << 32) | sub);
+}
 
 struct Row
 {
@@ -118,8 +142,10 @@ void measureColorJitterKnobs(const Settings& set, const Mat& timingRaw, const Ra
     const SensorSimulator latticeSensor(lattice, flat);
     const RawFormat latticeFmt = latticeSensor.rawFormat(4);
     Mat bright, truth;
-    latticeSensor.capture(Mat(flat, CV_32FC1, Scalar(200)), 4, 1.0, 1, 0, bright);
-    latticeSensor.capture(Mat(flat, CV_32FC1, Scalar(200)), 4, 0.01, 2, 0, truth);
+    latticeSensor.capture(Mat(flat, CV_32FC1, Scalar(200)), 4, 1.0, studySeed(set, DRAW_LATTICE_BRIGHT), 0,
+                          bright);
+    latticeSensor.capture(Mat(flat, CV_32FC1, Scalar(200)), 4, 0.01, studySeed(set, DRAW_LATTICE_TRUTH), 0,
+                          truth);
     const int black = static_cast<int>(latticeFmt.blackLevel[0]);
     const std::vector<double> truthDistribution = valueDistribution(truth, black, -24, 64);
 
@@ -127,8 +153,8 @@ void measureColorJitterKnobs(const Settings& set, const Mat& timingRaw, const Ra
     const SensorSimulator dark(SensorParams(), flat);
     const RawFormat darkFmt = dark.rawFormat(8);
     Mat darkRaw, darkTruth;
-    dark.capture(Mat::zeros(flat, CV_32FC1), 8, 1.0, 3, 0, darkRaw);
-    dark.capture(Mat::zeros(flat, CV_32FC1), 8, 0.5, 4, 0, darkTruth);
+    dark.capture(Mat::zeros(flat, CV_32FC1), 8, 1.0, studySeed(set, DRAW_BLACK_FRAME), 0, darkRaw);
+    dark.capture(Mat::zeros(flat, CV_32FC1), 8, 0.5, studySeed(set, DRAW_BLACK_TRUTH), 0, darkTruth);
     const double darkTruthVar = spatialVariance(darkTruth, darkFmt);
 
     const auto time = [&](const NoiseOptions& noise) {
@@ -137,7 +163,8 @@ void measureColorJitterKnobs(const Settings& set, const Mat& timingRaw, const Ra
         return fastestMs(set.repeats,
                          [&] {
                              colorJitter(timingRaw, timingFmt, timingModel,
-                                         ColorJitter::exposureChange(0.1, 1.0), noise, 1, out, f);
+                                         ColorJitter::exposureChange(0.1, 1.0), noise,
+                                         studySeed(set, DRAW_TIMED_STEP), out, f);
                          }) /
                megapixels(timingRaw.size());
     };
@@ -147,7 +174,8 @@ void measureColorJitterKnobs(const Settings& set, const Mat& timingRaw, const Ra
         Mat out;
         RawFormat f;
         colorJitter(bright, latticeFmt, latticeSensor.effectiveModel(),
-                    ColorJitter::exposureChange(0.01, 1.0), noise, 5, out, f);
+                    ColorJitter::exposureChange(0.01, 1.0), noise, studySeed(set, DRAW_LATTICE_JITTER), out,
+                    f);
         const bool poisson = sampling == ShotNoiseSampling::POISSON;
         rows.push_back({"Shot-noise sampling (colour jitter)", poisson ? "POISSON" : "GAUSSIAN (paper)",
                         "KL(true || augmented) of the values at 2 e-",
@@ -161,8 +189,8 @@ void measureColorJitterKnobs(const Settings& set, const Mat& timingRaw, const Ra
         noise.priorMean = prior;
         Mat out;
         RawFormat f;
-        colorJitter(darkRaw, darkFmt, dark.effectiveModel(), ColorJitter::exposureChange(0.5, 1.0), noise, 6,
-                    out, f);
+        colorJitter(darkRaw, darkFmt, dark.effectiveModel(), ColorJitter::exposureChange(0.5, 1.0), noise,
+                    studySeed(set, DRAW_BLACK_JITTER), out, f);
         const bool local = prior == PriorMeanEstimate::LOCAL_MEAN;
         rows.push_back({"Prior mean mu_x (colour jitter)", local ? "LOCAL_MEAN" : "PIXEL_VALUE (paper)",
                         "|variance / true variance - 1| at black, x0.5",
@@ -189,7 +217,7 @@ void measureBlurKnob(const Settings& set, const Mat& timingRaw, const RawFormat&
     const int frames = 48;
     std::vector<Mat> burst(static_cast<size_t>(frames));
     for (int t = 0; t < frames; ++t) {
-        sensor.capture(scene, gain, 1.0, 21, t, burst[static_cast<size_t>(t)]);
+        sensor.capture(scene, gain, 1.0, studySeed(set, DRAW_BLUR_BURST), t, burst[static_cast<size_t>(t)]);
         burst[static_cast<size_t>(t)].convertTo(burst[static_cast<size_t>(t)], CV_32F);
     }
     const Mat peaked = (Mat_<float>(1, 5) << 1, 4, 6, 4, 1) / 16.0f;
@@ -212,7 +240,8 @@ void measureBlurKnob(const Settings& set, const Mat& timingRaw, const RawFormat&
             Mat sum1(size, CV_64FC1, Scalar(0)), sum2 = sum1.clone();
             for (int t = 0; t < frames; ++t) {
                 Mat out, x;
-                motionBlur(burst[static_cast<size_t>(t)], fmt, model, named.second, noise, 100 + t, out);
+                motionBlur(burst[static_cast<size_t>(t)], fmt, model, named.second, noise,
+                           studySeed(set, DRAW_BLUR_STEP, static_cast<uint64>(t)), out);
                 subtractBlackLevel(out, fmt, x);
                 x.convertTo(x, CV_64F);
                 sum1 += x;
@@ -231,7 +260,8 @@ void measureBlurKnob(const Settings& set, const Mat& timingRaw, const RawFormat&
             }
             Mat out;
             const double ms = fastestMs(set.repeats, [&] {
-                motionBlur(timingRaw, timingFmt, timingModel, linearMotionKernel(13, 30), noise, 1, out);
+                motionBlur(timingRaw, timingFmt, timingModel, linearMotionKernel(13, 30), noise,
+                           studySeed(set, DRAW_TIMED_STEP), out);
             });
             const bool exact = method == BlurNoiseSum::EXACT;
             rows.push_back(
@@ -254,7 +284,7 @@ void measureStatisticsPrecision(const Settings& set, const Mat& timingRaw, const
     fmt.whiteLevel = 65535;
     const int frames = 100;
     std::vector<Mat> burst(static_cast<size_t>(frames));
-    RNG rng(5);
+    RNG rng(studySeed(set, DRAW_STATE_BURST));
     for (Mat& f : burst) {
         f.create(64, 64, CV_32FC1);
         rng.fill(f, RNG::NORMAL, 60000, 1);
@@ -325,11 +355,11 @@ void measureCalibrationKnobs(const Settings& set, std::vector<Row>& rows,
         settings.push_back({"Calibration RANSAC iterations", std::to_string(it), maxFrames, 24, it});
     std::vector<double> squaredError(settings.size(), 0), ms(settings.size(), 0);
     double statsMsPerFrame = 0;
-    for (int seed = 0; seed < set.seeds; ++seed) {
+    for (int campaign = 0; campaign < set.seeds; ++campaign) {
         // Statistics of each burst after f frames, for every burst length; sampled for every side.
         std::map<std::pair<int, int>, std::vector<NoiseSample>> samples; // (frames, side)
         std::map<std::pair<int, int>, double> samplingMs;
-        uint64 stream = 5000 * (seed + 1);
+        uint64 burstIndex = 0;
         for (double db : {6.0, 12.0, 24.0}) {
             const double g = dbToLinearGain(db);
             const RawFormat fmt = sensor.rawFormat(g);
@@ -337,7 +367,10 @@ void measureCalibrationKnobs(const Settings& set, std::vector<Row>& rows,
                 BurstStatistics stats(fmt);
                 for (int t = 0; t < maxFrames; ++t) {
                     Mat raw;
-                    sensor.capture(scene.meanAtUnitGain, g, level * 3839 / (g * 1000), stream, t, raw);
+                    sensor.capture(
+                        scene.meanAtUnitGain, g, level * 3839 / (g * 1000),
+                        studySeed(set, DRAW_CAMPAIGN_BURST, 100 * static_cast<uint64>(campaign) + burstIndex),
+                        t, raw);
                     statsMsPerFrame += fastestMs(1, [&] { stats.add(raw); });
                     if (std::find(set.burstLengths.begin(), set.burstLengths.end(), t + 1) ==
                         set.burstLengths.end())
@@ -351,7 +384,7 @@ void measureCalibrationKnobs(const Settings& set, std::vector<Row>& rows,
                         });
                     }
                 }
-                ++stream;
+                ++burstIndex;
                 progress.advance();
             }
         }
@@ -388,7 +421,7 @@ void measureShapiroWilk(const Settings& set, std::vector<Row>& rows)
 {
     const int n = 64, series = set.shapiroSeries;
     Mat data(n, series, CV_32FC1);
-    RNG(9).fill(data, RNG::NORMAL, 0, 1);
+    RNG(studySeed(set, DRAW_SHAPIRO_DATA)).fill(data, RNG::NORMAL, 0, 1);
     std::vector<ShapiroWilkResult> batch;
     const double batchMs = fastestMs(set.repeats, [&] { shapiroWilkBatch(data, batch); });
     std::vector<ShapiroWilkResult> single(static_cast<size_t>(series));
@@ -441,6 +474,7 @@ int main(int argc, char** argv)
         "{quick          | false | a small timing frame and short bursts (a smoke run, seconds) }"
         "{seeds          | 3     | simulated calibration campaigns averaged per setting }"
         "{repeats        | 3     | timings keep the fastest of this many runs }"
+        "{seed           | 1     | seed of every simulated capture and noise draw }"
         "{plots          | true  | write tradeoffs.png with gnuplot }";
     CommandLineParser parser(argc, argv, keys);
     parser.about(
@@ -456,6 +490,7 @@ int main(int argc, char** argv)
     Settings set;
     set.seeds = parser.get<int>("seeds");
     set.repeats = parser.get<int>("repeats");
+    set.seed = parser.get<uint64>("seed");
     const bool plots = parser.get<bool>("plots");
     if (parser.get<bool>("quick")) {
         set.timingSize = Size(800, 600);
@@ -481,7 +516,8 @@ int main(int argc, char** argv)
         const SensorSimulator timingSensor(SensorParams(), set.timingSize);
         const RawFormat timingFmt = timingSensor.rawFormat(2);
         Mat timingRaw;
-        timingSensor.capture(timingScene(set.timingSize), 2, 1.0, 1, 0, timingRaw);
+        timingSensor.capture(timingScene(set.timingSize), 2, 1.0, studySeed(set, DRAW_TIMING_FRAME), 0,
+                             timingRaw);
         const NoiseModel timingModel = timingSensor.effectiveModel();
         progress.advance();
         std::vector<Row> rows;

@@ -16,20 +16,6 @@ namespace rawgment_apps {
 
 using namespace cv::rawgment;
 
-namespace {
-
-uint64_t fnv1a(const std::string& text, uint64_t seed)
-{
-    uint64_t h = 1469598103934665603ull ^ seed;
-    for (unsigned char c : text) {
-        h ^= c;
-        h *= 1099511628211ull;
-    }
-    return h;
-}
-
-} // namespace
-
 AugmentResult augmentFiles(const AugmentOptions& o)
 {
     if (o.inputs.empty())
@@ -93,19 +79,17 @@ AugmentResult augmentFiles(const AugmentOptions& o)
             try {
                 const LoadedMosaic m = loadMosaicFile(o.inputs[job.input]);
                 // The seed depends on the file name and the variant, not on the order of the inputs.
-                const uint64_t seed = fnv1a(stemOf(o.inputs[job.input]), o.seed) +
-                                      uint64_t(job.variant) * 0x9E3779B97F4A7C15ull;
+                const uint64_t seed = augmentedOutputSeed(o.seed, stemOf(o.inputs[job.input]), job.variant);
                 const Scene scene = o.scene.empty() ? policy.draw(m.mosaic, m.format, seed) : fixedScene;
                 cv::Mat out;
                 RawFormat outFormat;
                 AugmentReport report;
-                applyScene(m.mosaic, m.format, model, scene, seed ^ 0xA5A5A5A5A5A5A5A5ull, out, outFormat,
-                           &report);
+                applyScene(m.mosaic, m.format, model, scene, seed, out, outFormat, &report);
                 MosaicMetadata meta;
                 meta.format = outFormat;
                 meta.hasScene = true;
                 meta.scene = scene;
-                meta.seed = seed ^ 0xA5A5A5A5A5A5A5A5ull;
+                meta.seed = seed;
                 meta.source = o.inputs[job.input];
                 if (!job.preview.empty())
                     writeImageAtomically(job.preview, previewOf(out, outFormat));

@@ -114,6 +114,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
 
     CalibrationParams params;
     params.method = o.method;
+    params.line.seed = o.seed;
     result.report = calibrateNoiseModel(samples, params);
     const CalibrationReport& report = result.report;
     report.save(reportPath);

@@ -56,6 +56,7 @@ struct CalibrateOptions
     int side = 24;            //!< square side used when the manifest asks for detection
     int shapiroPixels = 2000; //!< pixels per burst tested by Shapiro-Wilk (spread over the squares)
     bool plots = true;
+    uint64_t seed = 0; //!< seed of the RANSAC draws of the per-gain line fits
 };
 
 struct CalibrateResult

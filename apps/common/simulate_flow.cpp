@@ -58,22 +58,26 @@ SimulateResult simulateBursts(const SimulateOptions& o)
         uint64_t seed;
     };
     std::vector<Burst> bursts;
-    uint64_t burstSeed = o.seed;
     for (double gDb : o.gainsDb)
         for (double level : o.levels) {
             const double g = dbToLinearGain(gDb);
             bursts.push_back({cv::format("g%02.0fdB_level%.2f", gDb, level), gDb,
-                              level * range / (g * sceneMax), level, o.frames, ++burstSeed * 1000003ull});
+                              level * range / (g * sceneMax), level, o.frames,
+                              deriveSeed(o.seed, SEED_SIMULATED_BURST, bursts.size())});
         }
     const size_t calibrationBursts = bursts.size();
     if (o.validation) {
         const double g = dbToLinearGain(o.validationGainDb);
         const double bright = 0.9 * range / (g * sceneMax);
-        bursts.push_back({"validation/bright", o.validationGainDb, bright, 0.9, o.validationFrames, 17});
+        const uint64_t seeds[3] = {deriveSeed(o.seed, SEED_SIMULATED_VALIDATION_BURST, 0),
+                                   deriveSeed(o.seed, SEED_SIMULATED_VALIDATION_BURST, 1),
+                                   deriveSeed(o.seed, SEED_SIMULATED_VALIDATION_BURST, 2)};
         bursts.push_back(
-            {"validation/x0.50", o.validationGainDb, 0.5 * bright, 0.45, o.validationFrames, 18});
+            {"validation/bright", o.validationGainDb, bright, 0.9, o.validationFrames, seeds[0]});
         bursts.push_back(
-            {"validation/x0.10", o.validationGainDb, 0.1 * bright, 0.09, o.validationFrames, 19});
+            {"validation/x0.50", o.validationGainDb, 0.5 * bright, 0.45, o.validationFrames, seeds[1]});
+        bursts.push_back(
+            {"validation/x0.10", o.validationGainDb, 0.1 * bright, 0.09, o.validationFrames, seeds[2]});
     }
     size_t totalFrames = 0;
     for (const Burst& b : bursts)

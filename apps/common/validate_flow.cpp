@@ -90,7 +90,8 @@ ValidateResult validateConversion(const ValidateOptions& o)
                     cv::Mat out;
                     RawFormat outFormat;
                     colorJitter(bright[k].mosaic, format, model, ColorJitter::exposureChange(factor, 1.0),
-                                alignments[a], o.seed * 1000003ull + k, out, outFormat);
+                                alignments[a], deriveSeed(o.seed, SEED_VALIDATION_CONVERSION, k), out,
+                                outFormat);
                     progress.advance();
                     return out;
                 },

@@ -84,23 +84,26 @@ inline void philox8Blocks(uint32_t firstBlock, uint64_t stream, const std::array
     }
 }
 
+// clang-format off
 /** @name The registry of random streams
  *
  * Every random number of the library is drawn from a CounterRng or fillGaussian() keyed by
  * (key, stream). This is the one list of how keys and streams are derived; a new use of random
  * numbers gets an entry here, never a literal id or an ad-hoc constant at the call site.
  *
- * | family | key | stream |
- * |---|---|---|
- * | augmentation steps (RandomStream below) | stepKey(user seed, family) | jitter: row; blur and scale: (site
- * << 32) | plane row; policy draw: 0 | | simulator captures | the capture's seed | captureStream(frame, row)
- * | | simulator fixed pattern (PRNU, DSNU, defects) | SensorParams::fixedPatternSeed |
- * fixedPatternStream(row) | | RANSAC of fitNoiseLine | LineFitParams::seed | ransacStream(iteration) | |
- * apps: bursts, outputs, conversions (public SeedPurpose) | deriveSeed(user seed, purpose, index) | as the
- * library call they feed |
+ * - augmentation steps (RandomStream below): key stepKey(user seed, family); stream: the row (jitter),
+ *   planeRowStream(site, plane row) (blur, scale), 0 (policy draw).
+ * - simulator captures: key the capture's seed; stream captureStream(frame, row).
+ * - simulator fixed pattern (PRNU, DSNU, defects): key SensorParams::fixedPatternSeed; stream
+ *   fixedPatternStream(row).
+ * - RANSAC of fitNoiseLine(): key LineFitParams::seed; stream ransacStream(iteration).
+ * - apps and programs on the library: the public SeedPurpose (ids 16 and up, never a RandomStream id):
+ *   deriveSeed(user seed, purpose, index) = stepKey(stepKey(seed, purpose), index), given to the
+ *   library call it drives; augmented outputs: augmentedOutputSeed(user seed, input stem, variant).
  *
  * Capture streams keep the top bit clear and fixed-pattern streams set it, so a user who gives one
  * seed to both never sees the two share numbers. */
+// clang-format on
 //! @{
 
 //! The augmentation families: each step's Gaussian and Poisson draws, and the policy's scene draws.

@@ -3,6 +3,7 @@
 #include "augment_steps.hpp"
 
 #include <opencv2/imgproc.hpp>
+#include <opencv2/rawgment/simulate.hpp>
 
 #include <limits>
 
@@ -120,6 +121,20 @@ double minimumAboveBlack(const Mat& src, const RawFormat& format)
 }
 
 } // namespace
+
+uint64 augmentedOutputSeed(uint64 seed, const String& inputName, int variant)
+{
+    if (variant < 0)
+        CV_Error(Error::StsBadArg, format("augmentedOutputSeed: variant must be >= 0 (got %d)", variant));
+    // FNV-1a of the name: a stable 64-bit key for any string, then the registered derivation.
+    uint64_t nameKey = 1469598103934665603ull;
+    for (unsigned char c : inputName) {
+        nameKey ^= c;
+        nameKey *= 1099511628211ull;
+    }
+    return deriveSeed(deriveSeed(seed, SEED_AUGMENTED_OUTPUT, nameKey), SEED_AUGMENTED_OUTPUT,
+                      static_cast<uint64_t>(variant));
+}
 
 void RandomScenePolicy::validate() const
 {

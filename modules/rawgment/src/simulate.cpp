@@ -199,6 +199,16 @@ void SensorSimulator::fixedPattern(OutputArray gainFactor, OutputArray offset, O
     defects.assign(defects_);
 }
 
+static_assert(SEED_SIMULATED_BURST > static_cast<int>(detail::RandomStream::SCALE_POISSON),
+              "the apps' seed purposes and the library's streams are one registry: their ids never meet");
+
+uint64 deriveSeed(uint64 seed, SeedPurpose purpose, uint64 index)
+{
+    if (purpose < SEED_SIMULATED_BURST || purpose > SEED_STUDY)
+        CV_Error(Error::StsBadArg, format("deriveSeed: unknown purpose %d", static_cast<int>(purpose)));
+    return detail::stepKey(detail::stepKey(seed, static_cast<uint64_t>(purpose)), index);
+}
+
 std::vector<Vec3d> colorCheckerReflectances()
 {
     // Published sRGB (8-bit) values of the classic chart, row by row.

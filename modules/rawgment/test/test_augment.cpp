@@ -804,6 +804,16 @@ TEST(Augment, poissonSamplingKeepsTheVarianceOfBlurAndScale)
     }
 }
 
+TEST(Augment, augmentedOutputSeedDependsOnlyOnSeedNameAndVariant)
+{
+    const uint64 s = augmentedOutputSeed(7, "frame_000", 2);
+    EXPECT_EQ(s, augmentedOutputSeed(7, "frame_000", 2));
+    EXPECT_NE(s, augmentedOutputSeed(7, "frame_000", 3));
+    EXPECT_NE(s, augmentedOutputSeed(7, "frame_001", 2));
+    EXPECT_NE(s, augmentedOutputSeed(8, "frame_000", 2));
+    EXPECT_CV_ERROR_CONTAINS(augmentedOutputSeed(7, "frame_000", -1), "variant must be >= 0");
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv

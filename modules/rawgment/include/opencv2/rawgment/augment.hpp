@@ -244,6 +244,16 @@ CV_RAWGMENT_EXPORTS void applyScene(InputArray src, const RawFormat& format, con
  * paper's 0.8): a shift uniform in [-maxShift, maxShift] of each side and a scale uniform in
  * [1 - maxScale, 1 + maxScale].
  */
+/** @brief The seed of one augmented output: a function of (seed, input name, variant) only, so that
+ * any order of inputs, any number of processes and the C++ and Python front ends give the same file.
+ * The same seed draws the scene (RandomScenePolicy::draw()) and applies it (applyScene()): the two
+ * use separate random streams.
+ * @param seed the user's seed
+ * @param inputName the input's file name without directory and extension (its stem)
+ * @param variant the variant number, 0 for the first
+ */
+CV_RAWGMENT_EXPORTS uint64 augmentedOutputSeed(uint64 seed, const String& inputName, int variant);
+
 struct CV_RAWGMENT_EXPORTS RandomScenePolicy
 {
     double contrastMin = 0.01, contrastMax = 1.0;
