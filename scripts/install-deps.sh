@@ -15,6 +15,8 @@ packages=(
   libgtest-dev      # GoogleTest
   libbenchmark-dev  # Google Benchmark
   gnuplot-nox       # PNG plots in apps and the demo
+  doxygen           # the API reference (target doc), built without warnings by the tests
+  texlive-binaries  # bibtex, which doxygen runs for @cite
 )
 
 missing=()

@@ -30,18 +30,18 @@ enum class ShotNoiseSampling
     /** The paper's: the whole added variance as one Gaussian. Fast (vectorised); at a few electrons per
      * pixel the true shot noise is skewed and lives on a lattice of one electron, which a Gaussian is not. */
     GAUSSIAN = 0,
-    /** The shot part as an electron count: $ q(K - m) $ with $ K \sim 	ext{Poisson}(m) $, q the
-     * output's DN per electron ($ glpha $ at the output gain) and $ m = v_{shot} / q^2 $, so
+    /** The shot part as an electron count: \f$ q(K - m) \f$ with \f$ K \sim \text{Poisson}(m) \f$, q the
+     * output's DN per electron (\f$ g\alpha \f$ at the output gain) and \f$ m = v_{shot} / q^2 \f$, so
      * the variance is the same as with GAUSSIAN and only the shape changes; the read-noise part stays
      * Gaussian. Exact for the darkening that matters (p_u << 1, where the scaled prior noise is
      * negligible). Scalar code: about 25x the time of GAUSSIAN for colour jitter (rawgment_tradeoffs). */
     POISSON = 1
 };
 
-/** @brief Which estimate of the prior mean $ \mu_x $ the added variance uses. */
+/** @brief Which estimate of the prior mean \f$ \mu_x \f$ the added variance uses. */
 enum class PriorMeanEstimate
 {
-    /** The paper's: the noisy value itself, $ \mu_x = \max(x, 0) $. Unbiased except near black,
+    /** The paper's: the noisy value itself, \f$ \mu_x = \max(x, 0) \f$. Unbiased except near black,
      * where the clip at 0 biases it up, and as noisy as the pixel. */
     PIXEL_VALUE = 0,
     /** The mean of the 3x3 neighbourhood on the pixel's own CFA plane (same colour, two mosaic pixels
@@ -51,11 +51,11 @@ enum class PriorMeanEstimate
     LOCAL_MEAN = 1
 };
 
-/** @brief How motion blur computes its shot-noise term $ \sum_k w_k(1-w_k)\max(x_k, 0) $. */
+/** @brief How motion blur computes its shot-noise term \f$ \sum_k w_k(1-w_k)\max(x_k, 0) \f$. */
 enum class BlurNoiseSum
 {
     EXACT = 0, //!< Eq. 15 as written: a second weighted sum per pixel
-    /** $ (1 - \sum_k w_k^2) \max(ar{x}, 0) $ with $ ar{x} $ the blurred value: exact on flat
+    /** \f$ (1 - \sum_k w_k^2) \max(\bar{x}, 0) \f$ with \f$ \bar{x} \f$ the blurred value: exact on flat
      * areas, wrong across edges (where the taps' means differ); saves the second sum. */
     FROM_BLURRED_MEAN = 1
 };
@@ -254,22 +254,42 @@ CV_RAWGMENT_EXPORTS void applyScene(InputArray src, const RawFormat& format, con
  */
 CV_RAWGMENT_EXPORTS uint64 augmentedOutputSeed(uint64 seed, const String& inputName, int variant);
 
+/** @brief Draws random scenes with the paper's augmentation ranges (its defaults)
+ * @cite yoshimura2023rawgment.
+ *
+ * A scene's contrast is log-uniform in [contrastMin, contrastMax]; with probability hueProbability each
+ * CFA site's contrast is further scaled by a uniform factor in [hueMin, hueMax]; the brightness is a
+ * uniform fraction in [brightnessMin, brightnessMax] of the input's minimum above black; the target gain
+ * is uniform in dB; with probability blurProbability a linear motion kernel of uniform length in
+ * [0, blurLengthMax] and uniform angle; with probability geometryProbability a shift of up to maxShift
+ * of each side and a scale within 1 +- maxScale. File keys are the snake_case names (contrast_min, ...).
+ */
 struct CV_RAWGMENT_EXPORTS RandomScenePolicy
 {
-    double contrastMin = 0.01, contrastMax = 1.0;
-    double brightnessMin = -0.1, brightnessMax = 0.1;
-    double hueProbability = 0.5, hueMin = 0.8, hueMax = 1.2;
-    double gainDbMin = 0, gainDbMax = 12;
-    double blurProbability = 0.5, blurLengthMax = 13;
-    double geometryProbability = 0.8, maxShift = 0.1, maxScale = 0.03;
-    NoiseOptions noise; //!< copied into every scene
+    double contrastMin = 0.01;        //!< lowest contrast (photon and gain ratio), > 0
+    double contrastMax = 1.0;         //!< highest contrast
+    double brightnessMin = -0.1;      //!< lowest brightness, as a fraction of the input's minimum
+    double brightnessMax = 0.1;       //!< highest brightness, as a fraction of the input's minimum
+    double hueProbability = 0.5;      //!< probability of a per-site contrast factor (a hue shift)
+    double hueMin = 0.8;              //!< lowest per-site factor, > 0
+    double hueMax = 1.2;              //!< highest per-site factor
+    double gainDbMin = 0;             //!< lowest gain change in dB
+    double gainDbMax = 12;            //!< highest gain change in dB
+    double blurProbability = 0.5;     //!< probability of a motion blur
+    double blurLengthMax = 13;        //!< longest motion, in mosaic pixels
+    double geometryProbability = 0.8; //!< probability of a shift and a scale
+    double maxShift = 0.1;            //!< largest shift, as a fraction of each side
+    double maxScale = 0.03;           //!< largest relative scale change, in [0, 1)
+    NoiseOptions noise;               //!< copied into every scene
 
     void validate() const; //!< throws naming the first inconsistent range
     /** @brief A scene for `src` (its minimum sets the brightness scale), from `seed` alone. */
     Scene draw(InputArray src, const RawFormat& format, uint64 seed) const;
+    //! Writes the policy as a map under `name` (snake_case keys, the noise options included).
     void write(FileStorage& fs, const String& name) const;
     static RandomScenePolicy read(const FileNode& node); //!< missing fields keep their defaults
     void save(const String& path) const;                 //!< .yml/.yaml/.json, atomically
+    //! Loads a policy saved by save() (top-level map `random_scene_policy`); errors name the file.
     static RandomScenePolicy load(const String& path);
 };
 

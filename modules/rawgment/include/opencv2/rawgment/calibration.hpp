@@ -52,9 +52,9 @@ public:
     /** @brief Adds a frame: CV_16UC1 or CV_32FC1 raw mosaic (black level included). The first frame
      * fixes the size and type; later frames must match. NaN or Inf in a CV_32FC1 frame is rejected. */
     void add(InputArray frame);
-    int frames() const; //!< frames added so far
-    Size size() const;  //!< size of the frames (empty before the first)
-    const RawFormat& format() const;
+    int frames() const;              //!< frames added so far
+    Size size() const;               //!< size of the frames (empty before the first)
+    const RawFormat& format() const; //!< the format given to the constructor
     /** @brief Temporal mean, black-subtracted, CV_64FC1. Needs at least one frame. */
     void mean(OutputArray dst) const;
     /** @brief Unbiased temporal variance (divided by frames - 1), CV_64FC1. Needs at least 2 frames. */

@@ -18,6 +18,7 @@
 #define CV_RAWGMENT_EXPORTS __declspec(dllimport)
 #endif
 #else
+//! Marks a public class or function of cv::rawgment: exported from the shared library.
 #define CV_RAWGMENT_EXPORTS __attribute__((visibility("default")))
 #endif
 

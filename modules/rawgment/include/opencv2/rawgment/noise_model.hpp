@@ -36,8 +36,8 @@ CV_RAWGMENT_EXPORTS double dbToLinearGain(double db);
  */
 CV_RAWGMENT_EXPORTS double linearGainToDb(double gain);
 
-/** @brief The noise of one gain as a line in the mean: \f$ \sigma^2 = a\,\mu + b \f$ @cite
- * yoshimura2023rawgment. */
+/** @brief The noise of one gain as a line in the mean: \f$ \sigma^2 = a\,\mu + b \f$
+ * @cite yoshimura2023rawgment. */
 struct CV_RAWGMENT_EXPORTS NoiseLine
 {
     double a = 0; //!< slope, \f$ a = g\alpha \f$

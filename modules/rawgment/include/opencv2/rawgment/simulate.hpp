@@ -57,8 +57,8 @@ public:
     /** @brief A sensor of the given size (even width and height) and parameters (validated). */
     SensorSimulator(const SensorParams& params, Size size);
 
-    const SensorParams& params() const { return params_; }
-    Size size() const { return size_; }
+    const SensorParams& params() const { return params_; } //!< the validated parameters
+    Size size() const { return size_; }                    //!< the size of every capture
 
     /** @brief The format of this sensor's captures at a linear gain. */
     RawFormat rawFormat(double gain) const;
@@ -86,7 +86,15 @@ public:
 
     /** @brief A capture during motion: the kernel blurs the photon image of each CFA plane *before*
      * the noise, as a real exposure does (the ground truth for noise-accounted blur, paper Eq. 14).
+     * Beyond the frame, the border rule of every blur of the library applies: the nearest pixel
+     * (BORDER_REPLICATE), as in motionBlur().
+     * @param meanAtUnitGain as in capture()
      * @param kernel CV_32FC1 or CV_64FC1 kernel on the CFA-plane grid; normalised to sum 1 here
+     * @param gain as in capture()
+     * @param exposure as in capture()
+     * @param seed as in capture()
+     * @param frameIndex as in capture()
+     * @param raw as in capture()
      */
     void captureBlurred(InputArray meanAtUnitGain, InputArray kernel, double gain, double exposure,
                         uint64 seed, int frameIndex, OutputArray raw) const;
