@@ -1,6 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// What the apps and samples share and the library must not hold (DESIGN.md): file output, progress,
-// command-line lists, CSV and plots.
+// What the apps share and the library must not hold (docs/architecture.md): progress, command-line
+// lists, CSV and plots; files go through the library's writeFileAtomically().
 #ifndef RAWGMENT_APPS_APP_TOOLS_HPP
 #define RAWGMENT_APPS_APP_TOOLS_HPP
 
