@@ -1,0 +1,449 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#include "tradeoff_measures.hpp"
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/rawgment/augment.hpp>
+#include <opencv2/rawgment/calibration.hpp>
+#include <opencv2/rawgment/normality.hpp>
+#include <opencv2/rawgment/simulate.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <limits>
+#include <map>
+#include <sstream>
+
+namespace rawgment_apps {
+
+using namespace cv;
+using namespace cv::rawgment;
+
+namespace {
+
+// What each seed of the study drives: deriveSeed(seed, SEED_STUDY, draw << 32 | sub-index).
+enum StudyDraw : uint64
+{
+    DRAW_TIMING_FRAME,
+    DRAW_TIMED_STEP,
+    DRAW_LATTICE_BRIGHT,
+    DRAW_LATTICE_TRUTH,
+    DRAW_LATTICE_JITTER,
+    DRAW_BLACK_FRAME,
+    DRAW_BLACK_TRUTH,
+    DRAW_BLACK_JITTER,
+    DRAW_BLUR_BURST,
+    DRAW_BLUR_STEP,
+    DRAW_STATE_BURST,
+    DRAW_SHAPIRO_DATA,
+    DRAW_CAMPAIGN_BURST
+};
+
+uint64 studySeed(const TradeoffSettings& set, StudyDraw draw, uint64 sub = 0)
+{
+    return deriveSeed(set.seed, SEED_STUDY, (static_cast<uint64>(draw) << 32) | sub);
+}
+
+//! Fastest wall time of `repeats` runs of `work`, in milliseconds.
+double fastestMs(int repeats, const std::function<void()>& work)
+{
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < repeats; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        work();
+        best = std::min(
+            best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    return best;
+}
+
+double megapixels(Size s)
+{
+    return s.area() / 1e6;
+}
+
+//! A scene of bars and a ramp: edges for the blur, every level from near black to bright.
+Mat timingScene(Size size)
+{
+    Mat scene(size, CV_32FC1);
+    for (int r = 0; r < size.height; ++r)
+        for (int c = 0; c < size.width; ++c)
+            scene.at<float>(r, c) =
+                static_cast<float>(((c / 64) % 2 ? 1500.0 : 60.0) * (0.2 + 0.8 * r / size.height));
+    return scene;
+}
+
+//! Histogram of the integer DN above black of a CV_16UC1 frame in [lo, hi], as probabilities
+//! (half a count in every bin, so that an empty bin of a model is not an infinite divergence).
+std::vector<double> valueDistribution(const Mat& raw, int black, int lo, int hi)
+{
+    std::vector<double> p(static_cast<size_t>(hi - lo + 1), 0.5);
+    double total = 0.5 * static_cast<double>(p.size());
+    for (int r = 0; r < raw.rows; ++r)
+        for (const ushort* v = raw.ptr<ushort>(r); v != raw.ptr<ushort>(r) + raw.cols; ++v) {
+            const int k = static_cast<int>(*v) - black;
+            if (k >= lo && k <= hi) {
+                p[static_cast<size_t>(k - lo)] += 1;
+                total += 1;
+            }
+        }
+    for (double& x : p)
+        x /= total;
+    return p;
+}
+
+double kullbackLeibler(const std::vector<double>& truth, const std::vector<double>& model)
+{
+    double kl = 0;
+    for (size_t i = 0; i < truth.size(); ++i)
+        kl += truth[i] * std::log(truth[i] / model[i]);
+    return kl;
+}
+
+double spatialVariance(const Mat& raw, const RawFormat& fmt)
+{
+    Mat x;
+    subtractBlackLevel(raw, fmt, x);
+    Scalar m, s;
+    meanStdDev(x, m, s);
+    return s[0] * s[0];
+}
+
+// Shot-noise sampling and prior-mean estimate: colour jitter's accuracy at very low light and at black.
+void measureColorJitterKnobs(const TradeoffSettings& set, const Mat& timingRaw, const RawFormat& timingFmt,
+                             const NoiseModel& timingModel, std::vector<TradeoffRow>& rows)
+{
+    // Two electrons per pixel on a sensor with 4 DN per electron and 0.5 DN of read noise: the value
+    // distribution of a true capture is a lattice; KL(true || augmented) measures how well a sampling
+    // reproduces it.
+    SensorParams lattice;
+    lattice.noise = NoiseModel(1.0, 0.01, 0.05);
+    const Size flat(512, 512);
+    const SensorSimulator latticeSensor(lattice, flat);
+    const RawFormat latticeFmt = latticeSensor.rawFormat(4);
+    Mat bright, truth;
+    latticeSensor.capture(Mat(flat, CV_32FC1, Scalar(200)), 4, 1.0, studySeed(set, DRAW_LATTICE_BRIGHT), 0,
+                          bright);
+    latticeSensor.capture(Mat(flat, CV_32FC1, Scalar(200)), 4, 0.01, studySeed(set, DRAW_LATTICE_TRUTH), 0,
+                          truth);
+    const int black = static_cast<int>(latticeFmt.blackLevel[0]);
+    const std::vector<double> truthDistribution = valueDistribution(truth, black, -24, 64);
+
+    // A black frame at 18 dB darkened to x0.5: the truth has no shot noise, only read noise.
+    const SensorSimulator dark(SensorParams(), flat);
+    const RawFormat darkFmt = dark.rawFormat(8);
+    Mat darkRaw, darkTruth;
+    dark.capture(Mat::zeros(flat, CV_32FC1), 8, 1.0, studySeed(set, DRAW_BLACK_FRAME), 0, darkRaw);
+    dark.capture(Mat::zeros(flat, CV_32FC1), 8, 0.5, studySeed(set, DRAW_BLACK_TRUTH), 0, darkTruth);
+    const double darkTruthVar = spatialVariance(darkTruth, darkFmt);
+
+    const auto time = [&](const NoiseOptions& noise) {
+        Mat out;
+        RawFormat f;
+        return fastestMs(set.repeats,
+                         [&] {
+                             colorJitter(timingRaw, timingFmt, timingModel,
+                                         ColorJitter::exposureChange(0.1, 1.0), noise,
+                                         studySeed(set, DRAW_TIMED_STEP), out, f);
+                         }) /
+               megapixels(timingRaw.size());
+    };
+    for (ShotNoiseSampling sampling : {ShotNoiseSampling::GAUSSIAN, ShotNoiseSampling::POISSON}) {
+        NoiseOptions noise;
+        noise.shotSampling = sampling;
+        Mat out;
+        RawFormat f;
+        colorJitter(bright, latticeFmt, latticeSensor.effectiveModel(),
+                    ColorJitter::exposureChange(0.01, 1.0), noise, studySeed(set, DRAW_LATTICE_JITTER), out,
+                    f);
+        const bool poisson = sampling == ShotNoiseSampling::POISSON;
+        rows.push_back({"Shot-noise sampling (colour jitter)", poisson ? "POISSON" : "GAUSSIAN (paper)",
+                        "KL(true || augmented) of the values at 2 e-",
+                        kullbackLeibler(truthDistribution, valueDistribution(out, black, -24, 64)),
+                        time(noise),
+                        poisson ? "the electron lattice of a real dark capture; pays per pixel"
+                                : "right variance, wrong shape below ~10 e-"});
+    }
+    for (PriorMeanEstimate prior : {PriorMeanEstimate::PIXEL_VALUE, PriorMeanEstimate::LOCAL_MEAN}) {
+        NoiseOptions noise;
+        noise.priorMean = prior;
+        Mat out;
+        RawFormat f;
+        colorJitter(darkRaw, darkFmt, dark.effectiveModel(), ColorJitter::exposureChange(0.5, 1.0), noise,
+                    studySeed(set, DRAW_BLACK_JITTER), out, f);
+        const bool local = prior == PriorMeanEstimate::LOCAL_MEAN;
+        rows.push_back({"Prior mean mu_x (colour jitter)", local ? "LOCAL_MEAN" : "PIXEL_VALUE (paper)",
+                        "|variance / true variance - 1| at black, x0.5",
+                        std::abs(spatialVariance(out, darkFmt) / darkTruthVar - 1), time(noise),
+                        local ? "a third of the clip bias at black; smooths across edges"
+                              : "max(x, 0) of a noisy pixel adds shot noise at black"});
+    }
+}
+
+// Motion blur: the exact Eq. 15 sum against the one from the blurred mean, on bars blurred by a motion
+// (nearly equal taps) and by a peaked kernel (very unequal taps), against the variance of a true
+// capture blurred before the noise (the simulator's model at the blurred photon mean).
+void measureBlurKnob(const TradeoffSettings& set, const Mat& timingRaw, const RawFormat& timingFmt,
+                     const NoiseModel& timingModel, std::vector<TradeoffRow>& rows)
+{
+    const Size size(256, 128);
+    const SensorSimulator sensor(SensorParams(), size);
+    const NoiseModel model = sensor.effectiveModel();
+    const double gain = 2;
+    const RawFormat fmt = sensor.rawFormat(gain);
+    Mat scene(size, CV_32FC1);
+    for (int c = 0; c < size.width; ++c)
+        scene.col(c).setTo((c / 16) % 2 ? 1500.0 : 40.0); // 3000 DN at gain 2: below white
+    const int frames = 48;
+    std::vector<Mat> burst(static_cast<size_t>(frames));
+    for (int t = 0; t < frames; ++t) {
+        sensor.capture(scene, gain, 1.0, studySeed(set, DRAW_BLUR_BURST), t, burst[static_cast<size_t>(t)]);
+        burst[static_cast<size_t>(t)].convertTo(burst[static_cast<size_t>(t)], CV_32F);
+    }
+    const Mat peaked = (Mat_<float>(1, 5) << 1, 4, 6, 4, 1) / 16.0f;
+    const std::pair<std::string, Mat> kernels[2] = {{"motion 13 px at 30 deg", linearMotionKernel(13, 30)},
+                                                    {"peaked 1x5 (1 4 6 4 1)", peaked}};
+    for (const auto& named : kernels) {
+        // The truth: the photon image blurred on each CFA plane, then the simulator's noise model.
+        Mat truthMean;
+        {
+            Mat x = scene * gain;
+            std::vector<Mat> planes;
+            splitCfaPlanes(x, planes);
+            for (Mat& p : planes)
+                filter2D(p, p, -1, named.second / sum(named.second)[0], Point(-1, -1), 0, BORDER_REPLICATE);
+            mergeCfaPlanes(planes, truthMean);
+        }
+        for (BlurNoiseSum method : {BlurNoiseSum::EXACT, BlurNoiseSum::FROM_BLURRED_MEAN}) {
+            NoiseOptions noise;
+            noise.blurNoiseSum = method;
+            Mat sum1(size, CV_64FC1, Scalar(0)), sum2 = sum1.clone();
+            for (int t = 0; t < frames; ++t) {
+                Mat out, x;
+                motionBlur(burst[static_cast<size_t>(t)], fmt, model, named.second, noise,
+                           studySeed(set, DRAW_BLUR_STEP, static_cast<uint64>(t)), out);
+                subtractBlackLevel(out, fmt, x);
+                x.convertTo(x, CV_64F);
+                sum1 += x;
+                sum2 += x.mul(x);
+            }
+            const Mat var = (sum2 - sum1.mul(sum1) / frames) / (frames - 1);
+            // Per column, the average over rows of measured / true variance; the error is the RMS of its
+            // deviation from 1 over the columns (sampling floor: sqrt(2 / 47) / sqrt(128) = 1.8%).
+            double squares = 0;
+            for (int c = 0; c < size.width; ++c) {
+                double ratio = 0;
+                for (int r = 0; r < size.height; ++r)
+                    ratio += var.at<double>(r, c) / model.variance(truthMean.at<float>(r, c), gain);
+                ratio /= size.height;
+                squares += (ratio - 1) * (ratio - 1);
+            }
+            Mat out;
+            const double ms = fastestMs(set.repeats, [&] {
+                motionBlur(timingRaw, timingFmt, timingModel, linearMotionKernel(13, 30), noise,
+                           studySeed(set, DRAW_TIMED_STEP), out);
+            });
+            const bool exact = method == BlurNoiseSum::EXACT;
+            rows.push_back(
+                {"Motion-blur noise sum",
+                 std::string(exact ? "EXACT (Eq. 15)" : "FROM_BLURRED_MEAN") + ", " + named.first,
+                 "RMS over columns of variance / true variance - 1 (floor 1.8%)",
+                 std::sqrt(squares / size.width), ms / megapixels(timingRaw.size()),
+                 exact ? "exact at every edge"
+                       : "exact when the taps are equal (a motion); off at edges of a peaked kernel"});
+        }
+    }
+}
+
+// Burst statistics: float64 against float32 state.
+void measureStatisticsPrecision(const TradeoffSettings& set, const Mat& timingRaw, const RawFormat& timingFmt,
+                                std::vector<TradeoffRow>& rows)
+{
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d::all(100);
+    fmt.whiteLevel = 65535;
+    const int frames = 100;
+    std::vector<Mat> burst(static_cast<size_t>(frames));
+    RNG rng(studySeed(set, DRAW_STATE_BURST));
+    for (Mat& f : burst) {
+        f.create(64, 64, CV_32FC1);
+        rng.fill(f, RNG::NORMAL, 60000, 1);
+    }
+    for (int depth : {CV_64F, CV_32F}) {
+        BurstStatistics stats(fmt, 8, depth);
+        for (const Mat& f : burst)
+            stats.add(f);
+        Mat var;
+        stats.variance(var);
+        double worst = 0;
+        for (int r = 0; r < 64; ++r)
+            for (int c = 0; c < 64; ++c) {
+                long double m = 0, v = 0;
+                for (const Mat& f : burst)
+                    m += f.at<float>(r, c);
+                m /= frames;
+                for (const Mat& f : burst)
+                    v += (f.at<float>(r, c) - m) * (f.at<float>(r, c) - m);
+                v /= frames - 1;
+                worst = std::max(worst, std::abs(var.at<double>(r, c) / static_cast<double>(v) - 1));
+            }
+        const int timedFrames = 24;
+        const double ms = fastestMs(set.repeats, [&] {
+            BurstStatistics timed(timingFmt, 8, depth);
+            for (int t = 0; t < timedFrames; ++t)
+                timed.add(timingRaw);
+            Mat v;
+            timed.variance(v);
+        });
+        const bool wide = depth == CV_64F;
+        rows.push_back(
+            {"Arithmetic (burst statistics state)", wide ? "float64 (default)" : "float32",
+             "max |variance / long-double reference - 1|, mean 60000, variance 1", worst,
+             ms / (timedFrames * megapixels(timingRaw.size())),
+             wide ? "exact to float64 rounding" : "half the state memory; ~1e-4 at extreme means"});
+    }
+}
+
+// Calibration: burst length, patch size and RANSAC iterations on the paper's protocol.
+void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRow>& rows,
+                             rawgment_apps::ProgressBar& progress)
+{
+    ColorCheckerOptions chart;
+    chart.patchSize = 32;
+    chart.border = 8;
+    chart.illumination = 1000;
+    const ColorCheckerScene scene = makeColorCheckerScene(chart);
+    SensorParams params;
+    params.noise = NoiseModel(0.4, 0.5, 2.0);
+    const SensorSimulator sensor(params, scene.meanAtUnitGain.size());
+    const NoiseModel truth = sensor.effectiveModel();
+    const int maxFrames = set.burstLengths.back();
+    const double frameMp = megapixels(scene.meanAtUnitGain.size());
+    struct Setting
+    {
+        std::string knob, name;
+        int frames, side, ransac;
+    };
+    std::vector<Setting> settings;
+    for (int f : set.burstLengths)
+        settings.push_back({"Calibration burst length", std::to_string(f) + " frames", f, 24, 500});
+    for (int side : {8, 16})
+        settings.push_back({"Calibration patch size", std::to_string(side) + "x" + std::to_string(side),
+                            maxFrames, side, 500});
+    settings.push_back({"Calibration patch size", "24x24 (paper)", maxFrames, 24, 500});
+    for (int it : {20, 100, 2000})
+        settings.push_back({"Calibration RANSAC iterations", std::to_string(it), maxFrames, 24, it});
+    std::vector<double> squaredError(settings.size(), 0), ms(settings.size(), 0);
+    double statsMsPerFrame = 0;
+    for (int campaign = 0; campaign < set.seeds; ++campaign) {
+        // Statistics of each burst after f frames, for every burst length; sampled for every side.
+        std::map<std::pair<int, int>, std::vector<NoiseSample>> samples; // (frames, side)
+        std::map<std::pair<int, int>, double> samplingMs;
+        uint64 burstIndex = 0;
+        for (double db : {6.0, 12.0, 24.0}) {
+            const double g = dbToLinearGain(db);
+            const RawFormat fmt = sensor.rawFormat(g);
+            for (double level : {0.2, 0.65}) {
+                BurstStatistics stats(fmt);
+                for (int t = 0; t < maxFrames; ++t) {
+                    Mat raw;
+                    sensor.capture(
+                        scene.meanAtUnitGain, g, level * 3839 / (g * 1000),
+                        studySeed(set, DRAW_CAMPAIGN_BURST, 100 * static_cast<uint64>(campaign) + burstIndex),
+                        t, raw);
+                    statsMsPerFrame += fastestMs(1, [&] { stats.add(raw); });
+                    if (std::find(set.burstLengths.begin(), set.burstLengths.end(), t + 1) ==
+                        set.burstLengths.end())
+                        continue;
+                    for (int side : {8, 16, 24}) {
+                        std::vector<NoiseSample>& out = samples[{t + 1, side}];
+                        samplingMs[{t + 1, side}] += fastestMs(1, [&] {
+                            const std::vector<NoiseSample> s =
+                                sampleBurstPatches(stats, cfaAlignedSquares(scene.patches, side), g);
+                            out.insert(out.end(), s.begin(), s.end());
+                        });
+                    }
+                }
+                ++burstIndex;
+                progress.advance();
+            }
+        }
+        for (size_t i = 0; i < settings.size(); ++i) {
+            const Setting& s = settings[i];
+            CalibrationParams p;
+            p.line.ransacIterations = s.ransac;
+            CalibrationReport r;
+            const double fitMs = fastestMs(1, [&] {
+                r = calibrateNoiseModel(samples[{s.frames, s.side}], p);
+            });
+            ms[i] += fitMs + samplingMs[{s.frames, s.side}];
+            const double e = std::max({std::abs(r.model.alpha / truth.alpha - 1),
+                                       std::abs(r.model.sigmaD2 / truth.sigmaD2 - 1),
+                                       std::abs(r.model.sigmaR2 / truth.sigmaR2 - 1)});
+            squaredError[i] += e * e;
+        }
+    }
+    statsMsPerFrame /= set.seeds * 6.0 * maxFrames;
+    for (size_t i = 0; i < settings.size(); ++i) {
+        const Setting& s = settings[i];
+        // Time of the whole calibration (statistics of every frame, sampling, fit) per MP of burst input.
+        const double totalMs = 6 * s.frames * statsMsPerFrame + ms[i] / set.seeds;
+        rows.push_back({s.knob, s.name,
+                        "RMS over campaigns of the worst relative error of alpha, sigma_d^2, sigma_r^2",
+                        std::sqrt(squaredError[i] / set.seeds), totalMs / (6 * s.frames * frameMp),
+                        s.knob == "Calibration RANSAC iterations" ? "the fit is a small part of the time"
+                                                                  : "more data, smaller error, linear cost"});
+    }
+}
+
+// Shapiro-Wilk, batched against one call per series: the same numbers, a different price.
+void measureShapiroWilk(const TradeoffSettings& set, std::vector<TradeoffRow>& rows)
+{
+    const int n = 64, series = set.shapiroSeries;
+    Mat data(n, series, CV_32FC1);
+    RNG(studySeed(set, DRAW_SHAPIRO_DATA)).fill(data, RNG::NORMAL, 0, 1);
+    std::vector<ShapiroWilkResult> batch;
+    const double batchMs = fastestMs(set.repeats, [&] { shapiroWilkBatch(data, batch); });
+    std::vector<ShapiroWilkResult> single(static_cast<size_t>(series));
+    const Mat byRow = data.t();
+    const double singleMs = fastestMs(set.repeats, [&] {
+        for (int i = 0; i < series; ++i)
+            single[static_cast<size_t>(i)] = shapiroWilk(byRow.row(i));
+    });
+    double worst = 0;
+    for (int i = 0; i < series; ++i)
+        worst = std::max(
+            worst, std::abs(batch[static_cast<size_t>(i)].pValue - single[static_cast<size_t>(i)].pValue));
+    const double mValues = static_cast<double>(n) * series / 1e6;
+    rows.push_back({"Shapiro-Wilk", "batched", "max |p batched - p single|", worst, batchMs / mValues,
+                    "coefficients once, series in parallel"});
+    rows.push_back({"Shapiro-Wilk", "one call per series", "max |p batched - p single|", worst,
+                    singleMs / mValues, "the same numbers, slower"});
+}
+
+//! A pipe inside a table cell would end the cell.
+
+} // namespace
+
+void measureTradeoffs(const TradeoffSettings& set, ProgressBar& progress, std::vector<TradeoffRow>& rows)
+{
+    const SensorSimulator timingSensor(SensorParams(), set.timingSize);
+    const RawFormat timingFmt = timingSensor.rawFormat(2);
+    Mat timingRaw;
+    timingSensor.capture(timingScene(set.timingSize), 2, 1.0, studySeed(set, DRAW_TIMING_FRAME), 0,
+                         timingRaw);
+    const NoiseModel timingModel = timingSensor.effectiveModel();
+    progress.advance();
+    measureColorJitterKnobs(set, timingRaw, timingFmt, timingModel, rows);
+    progress.advance();
+    measureBlurKnob(set, timingRaw, timingFmt, timingModel, rows);
+    progress.advance();
+    measureStatisticsPrecision(set, timingRaw, timingFmt, rows);
+    progress.advance();
+    measureCalibrationKnobs(set, rows, progress);
+    measureShapiroWilk(set, rows);
+    progress.advance();
+}
+
+} // namespace rawgment_apps

@@ -1,0 +1,43 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// rawgment_tradeoffs' measurements: every knob of the library that trades accuracy for time, measured
+// against the sensor simulator's ground truth. Private to the apps.
+#ifndef RAWGMENT_APPS_TRADEOFF_MEASURES_HPP
+#define RAWGMENT_APPS_TRADEOFF_MEASURES_HPP
+
+#include "app_tools.hpp"
+
+#include <opencv2/core.hpp>
+
+#include <string>
+#include <vector>
+
+namespace rawgment_apps {
+
+/** What rawgment_tradeoffs measures and how long it may take (--quick shrinks it). */
+struct TradeoffSettings
+{
+    cv::Size timingSize{4000, 3000}; // the frame every augmentation and statistics time is measured on
+    int repeats = 3;                 // timings keep the fastest of this many runs
+    int seeds = 3;                   // calibration errors are RMS over this many simulated campaigns
+    std::vector<int> burstLengths{8, 16, 32, 100};
+    int shapiroSeries = 100000; // series of 64 values in the Shapiro-Wilk timing
+    uint64_t seed = 1;          // every simulated capture and noise draw derives from it
+};
+
+/** One setting of one knob: its error against the simulator's truth and its time. */
+struct TradeoffRow
+{
+    std::string knob, setting, measure;
+    double error = 0;   // of the measure, against the simulator's truth (smaller is better)
+    double msPerMp = 0; // wall time per megapixel of input (per million values for Shapiro-Wilk)
+    std::string meaning;
+};
+
+/** Measures every knob in one run (colour jitter, blur, burst statistics, calibration, Shapiro-Wilk)
+ * and appends one row per setting; `progress` advances by 5 + 6 * settings.seeds. */
+void measureTradeoffs(const TradeoffSettings& settings, ProgressBar& progress,
+                      std::vector<TradeoffRow>& rows);
+
+} // namespace rawgment_apps
+
+#endif // RAWGMENT_APPS_TRADEOFF_MEASURES_HPP
