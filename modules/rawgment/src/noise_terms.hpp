@@ -1,7 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // The one home of the noise model's terms (paper Eq. 5) and of the standard error of a sample
 // variance. The simulator draws these terms, calibration fits them, augmentation adds what a target
-// lacks of them: each uses this header, so a term is written once. Private to the module.
+// lacks of them: each uses this header, so a term is written once. Private to the module. The
+// equations, with the paper's numbers: docs/mathematics.md.
 #ifndef OPENCV_RAWGMENT_SRC_NOISE_TERMS_HPP
 #define OPENCV_RAWGMENT_SRC_NOISE_TERMS_HPP
 

@@ -1,5 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// Private helpers shared by the module's sources; never installed.
+// Private helpers shared by the module's sources; never installed. The rules they carry out (errors,
+// files, atomic writes) are in docs/conventions.md.
 #ifndef OPENCV_RAWGMENT_SRC_PRECOMP_HPP
 #define OPENCV_RAWGMENT_SRC_PRECOMP_HPP
 

@@ -1,5 +1,5 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// Counter-based random numbers: private to the module.
+// Counter-based random numbers: private to the module (docs/conventions.md, "Randomness").
 //
 // Every random value is a pure function of (seed, stream, position in the stream). A parallel loop
 // gives each row, tile or pixel its own stream, so the output does not depend on how the work is split
