@@ -1,12 +1,18 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "test_common.hpp"
 
+#include <opencv2/rawgment/augment.hpp>
+#include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <dirent.h>
 #include <fstream>
 #include <iterator>
+#include <sys/mount.h>
+#include <unistd.h>
 #include <vector>
 
 namespace cv {
@@ -40,6 +46,82 @@ std::vector<std::string> filesIn(const std::string& dir)
     closedir(d);
     std::sort(names.begin(), names.end());
     return names;
+}
+
+//! A tmpfs of `bytes` mounted for the test's lifetime (root only), or an empty path with the reason.
+class SmallDisk
+{
+public:
+    explicit SmallDisk(size_t bytes)
+    {
+        if (::geteuid() != 0) {
+            why_ = "not root: a small tmpfs cannot be mounted";
+            return;
+        }
+        const std::string dir = makeTempDir("small_disk_" + std::to_string(::getpid()));
+        if (::mount("tmpfs", dir.c_str(), "tmpfs", 0, ("size=" + std::to_string(bytes)).c_str()) != 0) {
+            why_ = "mount of a tmpfs refused here: " + std::string(std::strerror(errno));
+            return;
+        }
+        path_ = dir;
+    }
+    ~SmallDisk()
+    {
+        if (!path_.empty())
+            ::umount(path_.c_str());
+    }
+    const std::string& path() const { return path_; }
+    const std::string& why() const { return why_; }
+
+    //! Fills the disk up to the last byte with a file of its own.
+    void fill() const
+    {
+        FILE* f = std::fopen((path_ + "/filler").c_str(), "wb");
+        ASSERT_NE(f, nullptr);
+        const std::vector<char> block(4096, 'x');
+        while (std::fwrite(block.data(), 1, block.size(), f) == block.size() && std::fflush(f) == 0) {
+        }
+        std::fclose(f);
+        // Whatever fits in the last partial page too, byte by byte.
+        f = std::fopen((path_ + "/filler2").c_str(), "wb");
+        ASSERT_NE(f, nullptr);
+        while (std::fputc('x', f) != EOF && std::fflush(f) == 0) {
+        }
+        std::fclose(f);
+    }
+
+private:
+    std::string path_, why_;
+};
+
+TEST(RawIo, aFullDiskIsAnErrorAndNeverReplacesAGoodFile)
+{
+    // OpenCV's FileStorage reports no write error: every file goes through writeFileAtomically, whose
+    // checked writes and fsync see ENOSPC, remove the temporary and leave the target as it was.
+    const SmallDisk disk(256 * 1024);
+    if (disk.path().empty())
+        GTEST_SKIP() << disk.why();
+    const std::string model = disk.path() + "/noise_model.yml", report = disk.path() + "/report.yml",
+                      policy = disk.path() + "/policy.yml", mosaic = disk.path() + "/mosaic.png";
+    NoiseModel(1, 2, 3).save(model);
+    const std::vector<char> good = readBytes(model);
+    ASSERT_FALSE(good.empty());
+    disk.fill();
+
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel(4, 5, 6).save(model), "nothing was replaced");
+    EXPECT_EQ(readBytes(model), good) << "the good model must survive a full disk";
+    EXPECT_NO_THROW(NoiseModel::load(model));
+    EXPECT_CV_ERROR_CONTAINS(CalibrationReport().save(report), "No space left on device");
+    EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy().save(policy), "No space left on device");
+    MosaicMetadata meta;
+    meta.format.whiteLevel = 65535;
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(mosaic, Mat(64, 64, CV_16UC1, Scalar(1000)), meta),
+                             "No space left on device");
+    const std::vector<char> bytes(100000, 'y');
+    EXPECT_CV_ERROR_CONTAINS(writeFileAtomically(disk.path() + "/blob.bin", bytes.data(), bytes.size()),
+                             "No space left on device");
+    // Nothing new is left behind: no empty report, no half sidecar, no temporary.
+    EXPECT_EQ(filesIn(disk.path()), (std::vector<std::string>{"filler", "filler2", "noise_model.yml"}));
 }
 
 TEST(RawIo, colorchartDngHasTheLevelsLibRawReports)
