@@ -12,6 +12,8 @@ function(run step)
 endfunction()
 
 run("install" ${CMAKE_COMMAND} --install "${RAWGMENT_BUILD_DIR}" --prefix "${prefix}")
+# An installed app starts from the prefix alone (its RPATH finds the installed library).
+run("installed app" env -u LD_LIBRARY_PATH "${prefix}/bin/rawgment_simulate" --help)
 run("configure" ${CMAKE_COMMAND} -S "${DOWNSTREAM_SOURCE_DIR}" -B "${WORK_DIR}/build"
     -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_BUILD_TYPE=Release)
 run("build" ${CMAKE_COMMAND} --build "${WORK_DIR}/build")
