@@ -5,6 +5,7 @@
 #include <opencv2/rawgment.hpp>
 
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -106,6 +107,31 @@ TEST(Apps, simulateHonoursTheSeedInEveryBurst)
         EXPECT_EQ(a, readText(dir + "/b/" + frame)) << frame << ": same seed, other bytes";
         EXPECT_NE(a, readText(dir + "/c/" + frame)) << frame << ": another seed, the same bytes";
     }
+}
+
+TEST(Apps, validateRefusesFramesOfAnotherSizeNamingTheFiles)
+{
+    // Target frames smaller than the bright ones were read out of bounds (ASan: heap-buffer-overflow).
+    const std::string dir = freshDir("validate_sizes");
+    for (const char* run : {"big --patch=40", "small --patch=20"}) {
+        const std::string name(run, std::string(run).find(' '));
+        const AppRun r =
+            runApp("rawgment_simulate", "--out='" + dir + "/" + name + "' --frames=2 --gains=12 " +
+                                            "--levels=0.5 --format=png " + (std::strchr(run, ' ') + 1));
+        ASSERT_EQ(0, r.status) << r.output;
+    }
+    std::ofstream(dir + "/mixed.yml")
+        << "%YAML:1.0\nvalidation_manifest:\n  gain_db: 12\n"
+        << "  bright: [big/validation/bright/frame_000.png, "
+           "big/validation/bright/frame_001.png]\n"
+        << "  targets:\n    - { factor: 0.5, files: [small/validation/x0.50/frame_000.png, "
+           "small/validation/x0.50/frame_001.png] }\n";
+    const AppRun r =
+        runApp("rawgment_validate", "'" + dir + "/mixed.yml' --model='" + dir +
+                                        "/big/truth_noise_model.yml' --out='" + dir + "/val' --plots=false");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("small/validation/x0.50/frame_000.png")) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("one size and type")) << r.output;
 }
 
 TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)

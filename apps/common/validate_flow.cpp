@@ -34,8 +34,22 @@ ValidateResult validateConversion(const ValidateOptions& o)
     const std::vector<std::string> brightFiles =
         readFileList(root["bright"], base, "'" + o.manifest + "' bright");
     std::vector<LoadedMosaic> bright;
+    // Every frame of every burst must have the bright burst's size and type: the comparison reads them
+    // pixel by pixel.
+    const auto loadMatching = [&](const std::string& file) {
+        LoadedMosaic m = loadMosaicFile(file);
+        if (!bright.empty() && (m.mosaic.size() != bright.front().mosaic.size() ||
+                                m.mosaic.type() != bright.front().mosaic.type()))
+            throw std::runtime_error(cv::format(
+                "'%s' is %dx%d %s, but '%s' is %dx%d %s: all frames of a "
+                "validation must have one size and type",
+                file.c_str(), m.mosaic.cols, m.mosaic.rows, cv::typeToString(m.mosaic.type()).c_str(),
+                brightFiles.front().c_str(), bright.front().mosaic.cols, bright.front().mosaic.rows,
+                cv::typeToString(bright.front().mosaic.type()).c_str()));
+        return m;
+    };
     for (const std::string& f : brightFiles)
-        bright.push_back(loadMosaicFile(f));
+        bright.push_back(loadMatching(f));
     RawFormat format = bright.front().format;
     if (!root["gain_db"].empty())
         format.gain = dbToLinearGain(double(root["gain_db"]));
@@ -79,7 +93,7 @@ ValidateResult validateConversion(const ValidateOptions& o)
         statsOf(
             [&](size_t k) {
                 progress.advance();
-                return loadMosaicFile(files[k]).mosaic;
+                return loadMatching(files[k]).mosaic;
             },
             files.size(), realMean, realVar, realClip);
         cv::Mat convVar[3];
