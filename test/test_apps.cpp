@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <set>
 #include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -243,6 +244,60 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
     ASSERT_EQ(0, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("skipped 4")) << r.output;
     EXPECT_EQ(inputBytes, readText(in0)) << "inputs are never modified";
+}
+
+TEST(Apps, augmentKeepsInputsWithOneStemApartAndNeverTakesAnotherInputsOutput)
+{
+    // a/frame_000 and b/frame_000 used to race for one output name, so that one input's image could end
+    // up with the other's sidecar and a rerun "skipped" an input that was never augmented.
+    const std::string dir = freshDir("augment_stems");
+    AppRun r =
+        runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=2 --gains=6 --levels=0.5 --format=png");
+    ASSERT_EQ(0, r.status) << r.output;
+    {
+        cv::rawgment::Scene scene;
+        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 1.0);
+        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
+        scene.write(fs, "scene");
+    }
+    const std::string a = dir + "/sim/g06dB_level0.50/frame_000.png",
+                      b = dir + "/sim/validation/bright/frame_000.png";
+    const std::string common =
+        "--model='" + dir + "/sim/truth_noise_model.yml' --scene='" + dir + "/scene.yml' ";
+    r = runApp("rawgment_augment",
+               common + "--out='" + dir + "/both' --preview=true '" + a + "' '" + b + "'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("wrote 2 outputs")) << r.output;
+    std::set<std::string> sources;
+    for (const std::string& f : {a, b}) {
+        const std::string name =
+            "frame_000-" + cv::format("%08llx", static_cast<unsigned long long>(
+                                                    cv::rawgment::augmentedOutputSeed(0, f, 0) >> 32));
+        cv::Mat out;
+        sources.insert(cv::rawgment::readMosaic(dir + "/both/" + name + "_v00.png", out).source);
+        expectPngDecodes(dir + "/both/" + name + "_v00_preview.png");
+    }
+    EXPECT_EQ(sources, (std::set<std::string>{a, b})) << "each output carries its own input's sidecar";
+    r = runApp("rawgment_augment",
+               common + "--out='" + dir + "/both' --preview=true '" + a + "' '" + b + "'");
+    EXPECT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("skipped 2")) << r.output;
+
+    // One stem at a time into one folder: b must not be "skipped" on a's output.
+    r = runApp("rawgment_augment", common + "--out='" + dir + "/single' '" + a + "'");
+    ASSERT_EQ(0, r.status) << r.output;
+    r = runApp("rawgment_augment", common + "--out='" + dir + "/single' '" + b + "'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("was made from")) << r.output;
+    EXPECT_EQ(1, runApp("rawgment_augment", common + "--out='" + dir + "/x' '" + a + "' '" + a + "'").status)
+        << "the same input twice";
+
+    // A preview that is not this job's is never replaced.
+    std::ofstream(dir + "/single/frame_000_v01_preview.png") << "not a preview";
+    r = runApp("rawgment_augment",
+               common + "--out='" + dir + "/single' --variants=2 --preview=true '" + a + "'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_EQ("not a preview", readText(dir + "/single/frame_000_v01_preview.png"));
 }
 
 TEST(Apps, demoWritesAReportAndAGallery)

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 #include <sys/stat.h>
@@ -94,6 +95,29 @@ void writeImageAtomically(const std::string& path, const cv::Mat& image)
     if (!cv::imencode(path.substr(dot), image, bytes))
         throw std::runtime_error("cannot encode '" + path + "'");
     writeBytesAtomically(path, bytes.data(), bytes.size());
+}
+
+void writeNewImage(const std::string& path, const cv::Mat& image)
+{
+    const size_t dot = path.find_last_of('.');
+    if (dot == std::string::npos)
+        throw std::runtime_error("'" + path + "': no image extension");
+    std::vector<uchar> bytes;
+    if (!cv::imencode(path.substr(dot), image, bytes))
+        throw std::runtime_error("cannot encode '" + path + "'");
+    if (pathExists(path)) {
+        std::ifstream f(path, std::ios::binary);
+        const std::vector<uchar> existing((std::istreambuf_iterator<char>(f)),
+                                          std::istreambuf_iterator<char>());
+        if (existing == bytes)
+            return; // left by an interrupted run of the same job
+        throw std::runtime_error("'" + path + "' already exists; it is never overwritten");
+    }
+    try {
+        cv::rawgment::writeFileAtomically(path, bytes.data(), bytes.size(), false);
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error(e.err);
+    }
 }
 
 std::vector<double> parseNumberList(const std::string& text)

@@ -30,6 +30,9 @@ std::string resolvePath(const std::string& base, const std::string& path);
 void writeTextAtomically(const std::string& path, const std::string& text);
 /** Encodes an image by the extension of `path` and writes it atomically (see writeTextAtomically). */
 void writeImageAtomically(const std::string& path, const cv::Mat& image);
+/** Like writeImageAtomically(), but never replaces a file: an existing file with exactly these bytes
+ * (an interrupted run of the same job) is kept, any other is an error. */
+void writeNewImage(const std::string& path, const cv::Mat& image);
 
 //! Comma-separated numbers ("0,6,12"); throws std::invalid_argument naming the bad item.
 std::vector<double> parseNumberList(const std::string& text);

@@ -9,12 +9,63 @@
 
 #include <algorithm>
 #include <atomic>
+#include <map>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 
 namespace rawgment_apps {
 
 using namespace cv::rawgment;
+
+namespace {
+
+/** The name of each input's outputs: its stem, unique per input. Inputs that share a stem (a/x.dng and
+ * b/x.dng) each add 8 hex digits of a hash of their path, so that no output or sidecar of one can be
+ * taken for the other's. The same file given twice is an error. */
+std::vector<std::string> outputNames(const std::vector<std::string>& inputs)
+{
+    std::map<std::string, int> stems;
+    std::set<std::string> seen;
+    for (const std::string& in : inputs) {
+        if (!seen.insert(in).second)
+            throw std::runtime_error("input '" + in + "' is given twice");
+        ++stems[stemOf(in)];
+    }
+    std::vector<std::string> names;
+    for (const std::string& in : inputs) {
+        const std::string stem = stemOf(in);
+        names.push_back(stems[stem] == 1
+                            ? stem
+                            : stem + cv::format("-%08llx", static_cast<unsigned long long>(
+                                                               augmentedOutputSeed(0, in, 0) >> 32)));
+    }
+    return names;
+}
+
+//! Throws unless `out`'s sidecar says it was made from `input` with `seed`: only then is it skipped.
+void requireFinishedBy(const std::string& out, const std::string& input, uint64_t seed)
+{
+    const std::string sidecar = sidecarPathOf(out);
+    if (!pathExists(sidecar))
+        throw std::runtime_error("'" + out +
+                                 "' exists without its sidecar; it is never overwritten (choose "
+                                 "another --out)");
+    cv::FileStorage fs = openYaml(sidecar, "sidecar");
+    MosaicMetadata meta;
+    try {
+        meta = MosaicMetadata::read(fs["mosaic_metadata"]);
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error("'" + sidecar + "': " + e.err);
+    }
+    if (meta.source != input || !meta.hasScene || meta.seed != seed)
+        throw std::runtime_error("'" + out + "' exists but was made from '" + meta.source + "', not from '" +
+                                 input +
+                                 "' with this seed; it is never overwritten (choose "
+                                 "another --out)");
+}
+
+} // namespace
 
 AugmentResult augmentFiles(const AugmentOptions& o)
 {
@@ -50,12 +101,14 @@ AugmentResult augmentFiles(const AugmentOptions& o)
     };
     std::vector<Job> jobs;
     AugmentResult result;
+    const std::vector<std::string> names = outputNames(o.inputs);
     for (size_t i = 0; i < o.inputs.size(); ++i) {
-        const std::string inExt = o.inputs[i].substr(o.inputs[i].find_last_of('.'));
+        const size_t dot = o.inputs[i].find_last_of('.');
+        const std::string inExt = dot == std::string::npos ? std::string() : o.inputs[i].substr(dot);
         const bool ours = pathExists(sidecarPathOf(o.inputs[i]));
         const std::string ext = !o.extension.empty() ? o.extension : (ours ? inExt : std::string(".dng"));
         for (int v = 0; v < o.variants; ++v) {
-            const std::string stem = o.outDir + "/" + stemOf(o.inputs[i]) + cv::format("_v%02d", v);
+            const std::string stem = o.outDir + "/" + names[i] + cv::format("_v%02d", v);
             Job job{i, v, stem + ext, o.previews ? stem + "_preview.png" : std::string()};
             for (const std::string& in : o.inputs)
                 if (in == job.out)
@@ -63,7 +116,9 @@ AugmentResult augmentFiles(const AugmentOptions& o)
                                              "' would replace an input; choose another --out");
             result.outputs.push_back(job.out);
             if (pathExists(job.out)) {
-                ++result.skipped; // resumable: a finished output stays
+                // Resumable: a finished output of this very job stays; anything else there is refused.
+                requireFinishedBy(job.out, o.inputs[i], augmentedOutputSeed(o.seed, names[i], v));
+                ++result.skipped;
                 continue;
             }
             jobs.push_back(job);
@@ -79,7 +134,7 @@ AugmentResult augmentFiles(const AugmentOptions& o)
             try {
                 const LoadedMosaic m = loadMosaicFile(o.inputs[job.input]);
                 // The seed depends on the file name and the variant, not on the order of the inputs.
-                const uint64_t seed = augmentedOutputSeed(o.seed, stemOf(o.inputs[job.input]), job.variant);
+                const uint64_t seed = augmentedOutputSeed(o.seed, names[job.input], job.variant);
                 const Scene scene = o.scene.empty() ? policy.draw(m.mosaic, m.format, seed) : fixedScene;
                 cv::Mat out;
                 RawFormat outFormat;
@@ -92,7 +147,7 @@ AugmentResult augmentFiles(const AugmentOptions& o)
                 meta.seed = seed;
                 meta.source = o.inputs[job.input];
                 if (!job.preview.empty())
-                    writeImageAtomically(job.preview, previewOf(out, outFormat));
+                    writeNewImage(job.preview, previewOf(out, outFormat));
                 writeMosaic(job.out, out, meta);
                 ++written;
             } catch (const std::exception& e) {

@@ -4,6 +4,8 @@
 #include <cerrno>
 #include <climits>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 #include <unistd.h>
 
 namespace cv {
@@ -104,6 +106,17 @@ int fileStorageFormatOf(const String& path)
 bool fileExists(const String& path)
 {
     return ::access(path.c_str(), F_OK) == 0;
+}
+
+std::string readTextFile(const String& path)
+{
+    std::ifstream f(path, std::ios::binary);
+    if (!f)
+        CV_Error(Error::StsError, "cannot open '" + path + "': " + std::strerror(errno));
+    std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    if (f.bad())
+        CV_Error(Error::StsError, "cannot read '" + path + "'");
+    return text;
 }
 
 } // namespace detail

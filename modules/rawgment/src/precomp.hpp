@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cv {
@@ -52,14 +53,22 @@ template <typename Writer> void writeFileStorageAtomically(const String& path, W
 int fileStorageFormatOf(const String& path);
 //! Whether anything exists at `path`.
 bool fileExists(const String& path);
+//! The whole content of a file; throws StsError naming it when it cannot be read.
+std::string readTextFile(const String& path);
 
-template <typename Writer> void writeFileStorageAtomically(const String& path, Writer&& writeBody)
+//! The text that writeFileStorageAtomically() would write to `path`.
+template <typename Writer> std::string fileStorageText(const String& path, Writer&& writeBody)
 {
     const int format = fileStorageFormatOf(path);
     FileStorage fs(format == FileStorage::FORMAT_JSON ? ".json" : ".yml",
                    FileStorage::WRITE | FileStorage::MEMORY | format);
     writeBody(fs);
-    const std::string text = fs.releaseAndGetString();
+    return fs.releaseAndGetString();
+}
+
+template <typename Writer> void writeFileStorageAtomically(const String& path, Writer&& writeBody)
+{
+    const std::string text = fileStorageText(path, std::forward<Writer>(writeBody));
     writeFileAtomically(path, text.data(), text.size(), true);
 }
 

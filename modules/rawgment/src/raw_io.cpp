@@ -366,26 +366,47 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
     meta.size = mosaic.size();
     meta.type = mosaic.type();
     const String sidecar = sidecarPathOf(path);
-    detail::writeFileStorageAtomically(sidecar, [&](FileStorage& fs) { meta.write(fs, "mosaic_metadata"); });
-    if (ext == ".dng") {
-        RawImage image;
-        image.mosaic = mosaic;
-        image.format = meta.format;
-        writeDng(path, image);
-        return;
+    const std::string text =
+        detail::fileStorageText(sidecar, [&](FileStorage& fs) { meta.write(fs, "mosaic_metadata"); });
+    // The sidecar is never replaced either. One left by an interrupted run of the same job (the image
+    // missing, the same text) is kept; any other is another mosaic's and stops the write.
+    bool createdSidecar = false;
+    if (detail::fileExists(sidecar)) {
+        if (detail::readTextFile(sidecar) != text)
+            CV_Error(Error::StsError, "writeMosaic: '" + sidecar +
+                                          "' exists and describes another mosaic; it is never overwritten "
+                                          "(remove it if an interrupted run left it)");
+    } else {
+        writeFileAtomically(sidecar, text.data(), text.size(), false);
+        createdSidecar = true;
     }
-    std::vector<uchar> bytes;
-    const std::vector<int> params = tiff ? std::vector<int>{IMWRITE_TIFF_COMPRESSION, 1} : std::vector<int>{};
-    bool encoded = false;
     try {
-        encoded = imencode(ext, mosaic, bytes, params);
-    } catch (const Exception& e) {
-        CV_Error(Error::StsError, "writeMosaic: '" + path + "': encoding failed: " + e.err);
+        if (ext == ".dng") {
+            RawImage image;
+            image.mosaic = mosaic;
+            image.format = meta.format;
+            writeDng(path, image);
+            return;
+        }
+        std::vector<uchar> bytes;
+        const std::vector<int> params =
+            tiff ? std::vector<int>{IMWRITE_TIFF_COMPRESSION, 1} : std::vector<int>{};
+        bool encoded = false;
+        try {
+            encoded = imencode(ext, mosaic, bytes, params);
+        } catch (const Exception& e) {
+            CV_Error(Error::StsError, "writeMosaic: '" + path + "': encoding failed: " + e.err);
+        }
+        if (!encoded)
+            CV_Error(Error::StsError,
+                     "writeMosaic: '" + path + "': OpenCV could not encode the mosaic as " + ext);
+        writeFileAtomically(path, bytes.data(), bytes.size(), false);
+    } catch (...) {
+        // No sidecar without its image: a sidecar this call made goes with the failed image.
+        if (createdSidecar)
+            std::remove(sidecar.c_str());
+        throw;
     }
-    if (!encoded)
-        CV_Error(Error::StsError,
-                 "writeMosaic: '" + path + "': OpenCV could not encode the mosaic as " + ext);
-    writeFileAtomically(path, bytes.data(), bytes.size(), false);
 }
 
 MosaicMetadata readMosaic(const String& path, OutputArray _mosaic)

@@ -335,6 +335,32 @@ TEST(RawIo, mosaicRoundTripsWithItsSidecarInEveryContainer)
     EXPECT_EQ(expected, filesIn(dir)) << "no temporary files are left behind";
 }
 
+TEST(RawIo, writeMosaicNeverReplacesASidecarAndLeavesNoneWithoutItsImage)
+{
+    const std::string dir = makeTempDir("raw_io_sidecar_safety");
+    Mat m16(32, 48, CV_16UC1, Scalar(500));
+    MosaicMetadata meta;
+    meta.format.whiteLevel = 65535;
+    meta.source = "a/frame_000.dng";
+    // Another mosaic's sidecar whose image is missing: kept as it is, and the write refused.
+    const std::string other = dir + "/other.png";
+    writeBytes(sidecarPathOf(other), {'x', '\n'});
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(other, m16, meta), "describes another mosaic");
+    EXPECT_EQ(readBytes(sidecarPathOf(other)), (std::vector<char>{'x', '\n'}));
+    EXPECT_FALSE(std::ifstream(other).good());
+    // The sidecar an interrupted run of the same job left: the write completes.
+    const std::string same = dir + "/same.png";
+    writeMosaic(same, m16, meta);
+    std::remove(same.c_str());
+    writeMosaic(same, m16, meta);
+    Mat back;
+    EXPECT_EQ(readMosaic(same, back).source, "a/frame_000.dng");
+    // An image that cannot be written takes its new sidecar with it (odd sides do not fit a DNG).
+    const std::string odd = dir + "/odd.dng";
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(odd, Mat(31, 48, CV_16UC1, Scalar(1)), meta), "even");
+    EXPECT_FALSE(std::ifstream(sidecarPathOf(odd)).good()) << "no sidecar without its image";
+}
+
 TEST(RawIo, readMosaicChecksTheSidecar)
 {
     const std::string dir = makeTempDir("raw_io_sidecar");

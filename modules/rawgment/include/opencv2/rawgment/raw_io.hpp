@@ -97,9 +97,11 @@ CV_RAWGMENT_EXPORTS String sidecarPathOf(const String& path);
 /** @brief Writes a mosaic and its sidecar YAML (top-level map `mosaic_metadata`).
  *
  * The container follows the extension: `.png` (16-bit), `.tif`/`.tiff` (16-bit or 32-bit float) or
- * `.dng` (16-bit, see writeDng()). The sidecar is written first and the image last, each atomically;
- * the image never replaces an existing file, so an existing image marks a finished output and an input
- * can never be overwritten.
+ * `.dng` (16-bit, see writeDng()). The sidecar is written first and the image last, each atomically,
+ * and neither replaces an existing file: an existing image marks a finished output, and an input can
+ * never be overwritten. An existing sidecar without its image is kept when it holds exactly the text
+ * this call would write (an interrupted run of the same job) and is an error otherwise. When the image
+ * cannot be written, the sidecar this call wrote is removed: no sidecar is left without its image.
  * @param path destination image, which must not exist
  * @param mosaic CV_16UC1 (any container) or CV_32FC1 (TIFF only)
  * @param metadata the format, and optionally the scene and seed that made the mosaic (validated)
