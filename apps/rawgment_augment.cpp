@@ -20,6 +20,8 @@ int main(int argc, char** argv)
         "{format         |      | output container: dng, png or tif (default: dng for RAW inputs) }"
         "{preview        | false| also write an sRGB preview PNG of each output }"
         "{@inputs        |      | input files (RAW files, or mosaics with a .yml sidecar) }";
+    if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_augment"))
+        return 2;
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about(
         "rawgment_augment: darker, noisier, blurred RAW variants with the noise a real sensor would give.\n"

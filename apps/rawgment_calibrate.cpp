@@ -19,6 +19,8 @@ int main(int argc, char** argv)
         "{shapiro        | 2000  | pixels per burst tested with Shapiro-Wilk }"
         "{seed           | 0     | seed of the robust line fits (RANSAC) }"
         "{plots          | true  | write PNG plots with gnuplot }";
+    if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_calibrate"))
+        return 2;
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about("rawgment_calibrate: alpha, sigma_d^2, sigma_r^2 from bursts of a colour checker\n\n"
                  "Manifest:\n"

@@ -56,6 +56,8 @@ int main(int argc, char** argv)
         "{sigma_d2       | 1.5         | simulated sensor: read-noise variance before the gain (DN^2) }"
         "{sigma_r2       | 0.8         | simulated sensor: noise variance after the gain (DN^2) }"
         "{seed           | 1           | seed of everything random }";
+    if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_demo"))
+        return 2;
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about(
         "rawgment_demo: simulate colour-checker bursts at 3 gains and 2 light levels, calibrate the noise\n"

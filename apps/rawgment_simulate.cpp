@@ -25,6 +25,8 @@ int main(int argc, char** argv)
         "{seed           | 1        | noise seed }"
         "{format         | dng      | frame container: dng, png or tif }"
         "{validation     | true     | also write the bright and x0.5, x0.1 bursts for rawgment_validate }";
+    if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_simulate"))
+        return 2;
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about("rawgment_simulate: simulated colour-checker bursts with a known noise model");
     if (parser.has("help")) {

@@ -49,6 +49,8 @@ int main(int argc, char** argv)
         "{repeats        | 3     | timings keep the fastest of this many runs }"
         "{seed           | 1     | seed of every simulated capture and noise draw }"
         "{plots          | true  | write tradeoffs.png with gnuplot }";
+    if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_tradeoffs"))
+        return 2;
     CommandLineParser parser(argc, argv, keys);
     parser.about(
         "rawgment_tradeoffs: measures what each accuracy knob of cv::rawgment costs in time.\n"

@@ -16,6 +16,8 @@ int main(int argc, char** argv)
                        "{bins           | 10   | mean bins of the table }"
                        "{seed           | 7    | noise seed of the conversions }"
                        "{plots          | true | write a PNG plot with gnuplot }";
+    if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_validate"))
+        return 2;
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about(
         "rawgment_validate: converts a bright burst by each target factor with NONE, IGNORE_PRIOR and\n"

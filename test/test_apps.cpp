@@ -86,6 +86,31 @@ TEST(Apps, everyAppHasHelpAndRejectsBadArguments)
     EXPECT_NE(std::string::npos, missing.output.find("no such file")) << missing.output;
 }
 
+TEST(Apps, unknownOrMalformedOptionsAreErrorsNamingThem)
+{
+    // cv::CommandLineParser ignores what it does not know: every app checks its command line first.
+    const struct
+    {
+        const char* app;
+        const char* args;
+        const char* says;
+    } cases[] = {
+        {"rawgment_demo", "--bogus=3", "unknown option '--bogus=3'"},
+        {"rawgment_simulate", "--out=/nonexistent/x --frames=abc", "'--frames': 'abc' is not a number"},
+        {"rawgment_augment", "--model m.yml --scene=s.yml --out=/nonexistent/y a.dng",
+         "'--model' needs a value"},
+        {"rawgment_calibrate", "m.yml --out=/nonexistent/z --plots=maybe", "'--plots' is true or false"},
+        {"rawgment_validate", "m.yml --modle=x.yml --out=/nonexistent/v", "unknown option '--modle=x.yml'"},
+        {"rawgment_tradeoffs", "--out=/nonexistent/t --quik", "unknown option '--quik'"},
+    };
+    for (const auto& c : cases) {
+        const AppRun r = runApp(c.app, c.args);
+        EXPECT_EQ(2, r.status) << c.app << " " << c.args << "\n" << r.output;
+        EXPECT_NE(std::string::npos, r.output.find(c.says)) << c.app << ": " << r.output;
+        EXPECT_NE(std::string::npos, r.output.find("valid options: --help")) << r.output;
+    }
+}
+
 TEST(Apps, simulateHonoursTheSeedInEveryBurst)
 {
     // Every burst, the validation bursts included, derives its seed from --seed: the same seed gives the

@@ -4,11 +4,13 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <sstream>
 #include <stdexcept>
@@ -118,6 +120,75 @@ void writeNewImage(const std::string& path, const cv::Mat& image)
     } catch (const cv::Exception& e) {
         throw std::runtime_error(e.err);
     }
+}
+
+bool checkCommandLine(int argc, char** argv, const char* keys, const char* app)
+{
+    struct Option
+    {
+        std::vector<std::string> names;
+        std::string value;
+        bool flag; // takes no value (help, or a true/false default)
+    };
+    const auto trim = [](std::string s) {
+        const size_t b = s.find_first_not_of(' '), e = s.find_last_not_of(' ');
+        return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+    };
+    std::vector<Option> options;
+    const std::string text(keys);
+    for (size_t open = text.find('{'); open != std::string::npos; open = text.find('{', open + 1)) {
+        const size_t bar1 = text.find('|', open), bar2 = text.find('|', bar1 + 1);
+        if (bar1 == std::string::npos || bar2 == std::string::npos)
+            break;
+        Option o;
+        std::stringstream names(text.substr(open + 1, bar1 - open - 1));
+        for (std::string n; names >> n;)
+            o.names.push_back(n);
+        o.value = trim(text.substr(bar1 + 1, bar2 - bar1 - 1));
+        const bool help = std::find(o.names.begin(), o.names.end(), "help") != o.names.end();
+        o.flag = help || o.value == "true" || o.value == "false";
+        if (!o.names.empty() && o.names.front()[0] != '@')
+            options.push_back(o);
+    }
+    const auto fail = [&](const std::string& why) {
+        std::string valid;
+        for (const Option& o : options)
+            valid += (valid.empty() ? "--" : ", --") + o.names.front();
+        std::cerr << app << ": " << why << " (valid options: " << valid << "; see --help)\n";
+        return false;
+    };
+    for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg.size() < 2 || arg[0] != '-')
+            continue;
+        const std::string body = arg.substr(arg[1] == '-' ? 2 : 1);
+        const size_t eq = body.find('=');
+        const std::string name = body.substr(0, eq);
+        const auto it = std::find_if(options.begin(), options.end(), [&](const Option& o) {
+            return std::find(o.names.begin(), o.names.end(), name) != o.names.end();
+        });
+        if (it == options.end())
+            return fail("unknown option '" + arg + "'");
+        if (eq == std::string::npos) {
+            if (!it->flag)
+                return fail("option '--" + name + "' needs a value: --" + name + "=<value>");
+            continue;
+        }
+        const std::string value = body.substr(eq + 1);
+        if (it->flag && !it->names.empty() && it->names.front() == "help")
+            return fail("option '--help' takes no value");
+        if (it->flag && value != "true" && value != "false")
+            return fail("option '--" + name + "' is true or false (got '" + value + "')");
+        char* end = nullptr;
+        const bool numericDefault =
+            !it->value.empty() && (std::strtod(it->value.c_str(), &end), *end == '\0');
+        if (numericDefault) {
+            std::strtod(value.c_str(), &end);
+            if (value.empty() || *end != '\0')
+                return fail("option '--" + name + "': '" + value + "' is not a number");
+        }
+    }
+    return true;
 }
 
 std::vector<double> parseNumberList(const std::string& text)

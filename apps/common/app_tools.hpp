@@ -34,6 +34,11 @@ void writeImageAtomically(const std::string& path, const cv::Mat& image);
  * (an interrupted run of the same job) is kept, any other is an error. */
 void writeNewImage(const std::string& path, const cv::Mat& image);
 
+/** What cv::CommandLineParser lets through: an option that `keys` does not name, a valued option
+ * without `=<value>` (`--model m.yml` would read "true"), a number option whose value is not a number.
+ * Prints the first problem, naming the option and the valid ones, to stderr and returns false. */
+bool checkCommandLine(int argc, char** argv, const char* keys, const char* app);
+
 //! Comma-separated numbers ("0,6,12"); throws std::invalid_argument naming the bad item.
 std::vector<double> parseNumberList(const std::string& text);
 
