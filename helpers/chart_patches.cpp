@@ -144,6 +144,10 @@ ChartPatches readChartPatches(const std::string& path)
     const cv::FileNode node = fs["chart_patches"];
     if (!node.isMap())
         CV_Error(cv::Error::StsParseError, "'" + path + "': no map 'chart_patches'");
+    for (const cv::FileNode& entry : node)
+        if (entry.name() != "grid_corners" && entry.name() != "squares")
+            CV_Error(cv::Error::StsParseError, "'" + path + "': unknown key '" + entry.name() +
+                                                   "' (valid keys: grid_corners, squares)");
     ChartPatches p;
     node["grid_corners"] >> p.gridCorners;
     const cv::FileNode squares = node["squares"];

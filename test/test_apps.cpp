@@ -111,6 +111,22 @@ TEST(Apps, unknownOrMalformedOptionsAreErrorsNamingThem)
     }
 }
 
+TEST(Apps, misspelledManifestKeysAreErrorsNamingThem)
+{
+    const std::string dir = freshDir("manifest_keys");
+    std::ofstream(dir + "/m.yml") << "%YAML:1.0\ncalibration_manifest:\n  patchs: detect\n"
+                                  << "  bursts:\n    - { gain_db: 6, files: [a.dng] }\n";
+    AppRun r = runApp("rawgment_calibrate", "'" + dir + "/m.yml' --out='" + dir + "/cal'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("unknown key 'patchs' (valid keys: patches, bursts)"))
+        << r.output;
+    std::ofstream(dir + "/b.yml")
+        << "%YAML:1.0\ncalibration_manifest:\n  bursts:\n    - { gain: 6, files: [a.dng] }\n";
+    r = runApp("rawgment_calibrate", "'" + dir + "/b.yml' --out='" + dir + "/cal2'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("unknown key 'gain'")) << r.output;
+}
+
 TEST(Apps, simulateHonoursTheSeedInEveryBurst)
 {
     // Every burst, the validation bursts included, derives its seed from --seed: the same seed gives the

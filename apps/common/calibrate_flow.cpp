@@ -42,8 +42,10 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     };
     std::vector<BurstSpec> specs;
     size_t totalFrames = 0;
+    requireKnownKeys(root, {"patches", "bursts"}, "'" + o.manifest + "'");
     for (const cv::FileNode& b : root["bursts"]) {
         const std::string where = cv::format("'%s' burst %zu", o.manifest.c_str(), specs.size() + 1);
+        requireKnownKeys(b, {"gain_db", "level", "files"}, where);
         if (b["gain_db"].empty() || !(b["gain_db"].isReal() || b["gain_db"].isInt()))
             throw std::runtime_error(where + ": 'gain_db' is missing or not a number");
         specs.push_back({double(b["gain_db"]), readFileList(b["files"], base, where)});

@@ -44,6 +44,21 @@ std::vector<std::string> readFileList(const cv::FileNode& node, const std::strin
     return files;
 }
 
+void requireKnownKeys(const cv::FileNode& map, const std::vector<std::string>& valid,
+                      const std::string& where)
+{
+    if (!map.isMap())
+        return;
+    for (const cv::FileNode& entry : map)
+        if (std::find(valid.begin(), valid.end(), entry.name()) == valid.end()) {
+            std::string list;
+            for (const std::string& v : valid)
+                list += (list.empty() ? "" : ", ") + v;
+            throw std::runtime_error(where + ": unknown key '" + entry.name() + "' (valid keys: " + list +
+                                     ")");
+        }
+}
+
 void refuseExisting(const std::vector<std::string>& outputs)
 {
     for (const std::string& p : outputs)

@@ -19,6 +19,9 @@ cv::FileStorage openYaml(const std::string& path, const char* what);
 //! A manifest's non-empty list of files, resolved against `base`; errors name `where`.
 std::vector<std::string> readFileList(const cv::FileNode& node, const std::string& base,
                                       const std::string& where);
+//! Throws std::runtime_error naming `where`, the first key of `map` not in `valid`, and the valid ones.
+void requireKnownKeys(const cv::FileNode& map, const std::vector<std::string>& valid,
+                      const std::string& where);
 //! Throws when any of the outputs exists: outputs are never overwritten.
 void refuseExisting(const std::vector<std::string>& outputs);
 /** Squares from a manifest's `patches` entry: a file written by writeChartPatches(), or "detect" (cv::mcc

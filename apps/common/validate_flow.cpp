@@ -25,6 +25,7 @@ ValidateResult validateConversion(const ValidateOptions& o)
         throw std::runtime_error("'" + o.manifest +
                                  "': expected a map 'validation_manifest' with 'bright' and "
                                  "'targets'");
+    requireKnownKeys(root, {"patches", "gain_db", "bright", "targets"}, "'" + o.manifest + "'");
     const std::string base = directoryOf(o.manifest);
     const NoiseModel model = NoiseModel::load(o.model);
     makeDirectories(o.outDir);
@@ -84,6 +85,7 @@ ValidateResult validateConversion(const ValidateOptions& o)
     CsvTable csv({"factor", "mean_low", "mean_high", "mean", "pixels", "real_variance", "none_variance",
                   "ignore_prior_variance", "account_prior_variance", "bright_mean", "bright_variance"});
     for (const cv::FileNode& t : root["targets"]) {
+        requireKnownKeys(t, {"factor", "files"}, "'" + o.manifest + "' target");
         const double factor = double(t["factor"]);
         if (!(factor > 0 && factor <= 1))
             throw std::runtime_error(

@@ -466,6 +466,15 @@ CalibrationReport CalibrationReport::read(const FileNode& node)
         CV_Error(Error::StsParseError,
                  format("calibration report: format_version is missing or newer than %d", FORMAT_VERSION));
     CalibrationReport r;
+    try {
+        detail::rejectUnknownKeys(node,
+                                  {"format_version", "method", "separable", "noise_model", "r_squared_slope",
+                                   "r_squared_offset", "samples", "samples_used", "per_gain", "notes"});
+        for (const FileNode& g : node["per_gain"])
+            detail::rejectUnknownKeys(g, {"gain", "gain_db", "a", "b", "r_squared", "inliers", "samples"});
+    } catch (const Exception& e) {
+        CV_Error(e.code, "calibration report: " + e.err);
+    }
     const FileNode method = node["method"];
     if (!method.isString() || (method.string() != "joint" && method.string() != "two_stage"))
         CV_Error(Error::StsParseError, "calibration report: field 'method' must be 'joint' or 'two_stage'");

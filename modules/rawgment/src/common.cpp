@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "precomp.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
 #include <cstring>
@@ -77,6 +78,22 @@ int readOptionalIntField(const FileNode& node, const char* field, int fallback)
     if (value != std::floor(value) || value < INT_MIN || value > INT_MAX)
         CV_Error(Error::StsParseError, format("field '%s' must be an integer", field));
     return static_cast<int>(value);
+}
+
+void rejectUnknownKeys(const FileNode& map, const std::vector<const char*>& valid)
+{
+    if (!map.isMap())
+        return;
+    for (const FileNode& entry : map) {
+        const std::string key = entry.name();
+        if (std::none_of(valid.begin(), valid.end(), [&](const char* v) { return key == v; })) {
+            std::string list;
+            for (const char* v : valid)
+                list += (list.empty() ? "" : ", ") + std::string(v);
+            CV_Error(Error::StsParseError,
+                     format("unknown key '%s' (valid keys: %s)", key.c_str(), list.c_str()));
+        }
+    }
 }
 
 std::vector<double> readRealList(const FileNode& node, const char* field, int n)

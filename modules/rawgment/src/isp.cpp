@@ -73,9 +73,14 @@ ToneCurve ToneCurve::read(const FileNode& node)
     if (node.empty() || !node.isMap())
         CV_Error(Error::StsParseError, "tone curve: expected a map with gamma, break_point, toe_slope");
     ToneCurve c;
-    c.gamma = detail::readRealField(node, "gamma");
-    c.breakPoint = detail::readOptionalRealField(node, "break_point", 0.0);
-    c.toeSlope = detail::readOptionalRealField(node, "toe_slope", 0.0);
+    try {
+        detail::rejectUnknownKeys(node, {"gamma", "break_point", "toe_slope"});
+        c.gamma = detail::readRealField(node, "gamma");
+        c.breakPoint = detail::readOptionalRealField(node, "break_point", 0.0);
+        c.toeSlope = detail::readOptionalRealField(node, "toe_slope", 0.0);
+    } catch (const Exception& e) {
+        CV_Error(e.code, "tone curve: " + e.err);
+    }
     c.validate();
     return c;
 }

@@ -127,6 +127,11 @@ NoiseModel NoiseModel::read(const FileNode& node)
                  format("noise model: format_version %d is not supported; this build reads versions 1 to %d "
                         "(a newer cv::rawgment wrote the file)",
                         version, FORMAT_VERSION));
+    try {
+        detail::rejectUnknownKeys(node, {"format_version", "alpha", "sigma_d2", "sigma_r2"});
+    } catch (const Exception& e) {
+        CV_Error(e.code, "noise model: " + e.err);
+    }
     NoiseModel m;
     double* const targets[] = {&m.alpha, &m.sigmaD2, &m.sigmaR2};
     const char* const fields[] = {"alpha", "sigma_d2", "sigma_r2"};

@@ -814,6 +814,17 @@ TEST(Augment, augmentedOutputSeedDependsOnlyOnSeedNameAndVariant)
     EXPECT_CV_ERROR_CONTAINS(augmentedOutputSeed(7, "frame_000", -1), "variant must be >= 0");
 }
 
+TEST(Augment, misspelledKeysInSceneAndPolicyFilesAreErrorsNamingThem)
+{
+    FileStorage policy("%YAML:1.0\nscene_policy: {contrst_min: 0.1}\n",
+                       FileStorage::READ | FileStorage::MEMORY);
+    EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy::read(policy["scene_policy"]),
+                             "random scene policy: unknown key 'contrst_min' (valid keys: contrast_min,");
+    FileStorage scene("%YAML:1.0\nscene: {contrast: [1, 1, 1, 1], brightness: 0, gain_ratio: 1, sclae: 2}\n",
+                      FileStorage::READ | FileStorage::MEMORY);
+    EXPECT_CV_ERROR_CONTAINS(Scene::read(scene["scene"]), "scene: unknown key 'sclae'");
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv

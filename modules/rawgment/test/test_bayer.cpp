@@ -296,6 +296,14 @@ TEST(Bayer, subtractBlackLevelInPlaceKeepsSourceSemantics)
     EXPECT_EQ(a.at<float>(1, 1), 33.f);
 }
 
+TEST(Bayer, rawFormatRejectsAMisspelledKey)
+{
+    FileStorage fs("%YAML:1.0\nf: {pattern: RGGB, black_level: [0, 0, 0, 0], white_level: 1023, gain: 1, "
+                   "white: 4095}\n",
+                   FileStorage::READ | FileStorage::MEMORY);
+    EXPECT_CV_ERROR_CONTAINS(RawFormat::read(fs["f"]), "raw format: unknown key 'white'");
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv

@@ -179,6 +179,15 @@ TEST(NoiseModel, saveIsAtomicAndLeavesNoTemporaryFiles)
     EXPECT_EQ(files, 1);
 }
 
+TEST(NoiseModel, aMisspelledKeyIsAnErrorNamingIt)
+{
+    FileStorage fs(
+        "%YAML:1.0\nnoise_model: {format_version: 1, alpha: 1, sigma_d2: 2, sigma_r2: 3, sigma_r: 4}\n",
+        FileStorage::READ | FileStorage::MEMORY);
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel::read(fs["noise_model"]),
+                             "noise model: unknown key 'sigma_r' (valid keys: format_version, alpha");
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv
