@@ -46,6 +46,10 @@ inline float sampledNoise(AddedVariance v, float q, float z, detail::CounterRng&
     const float total = std::max(v.shot + v.rest, 0.0f);
     const float shot = q > 0 ? std::min(std::max(v.shot, 0.0f), total) : 0.0f;
     const double m = static_cast<double>(shot) / (static_cast<double>(q) * q);
+    // Beyond kMaxPoissonMean electrons the count is Gaussian to double precision: the whole variance
+    // is drawn as one Gaussian then (with a tiny q, m can be any size).
+    if (!(m <= detail::kMaxPoissonMean))
+        return std::sqrt(total) * z;
     const float count = shot > 0 ? static_cast<float>(static_cast<double>(rng.poisson(m)) - m) : 0.0f;
     return q * count + std::sqrt(total - shot) * z;
 }

@@ -31,6 +31,7 @@ int64_t CounterRng::poisson(double lambda)
 {
     if (!(lambda > 0))
         return 0;
+    CV_Assert(lambda <= kMaxPoissonMean);
     if (lambda < 10) {
         // Inversion by sequential search over the CDF; the tail beyond 200 has mass below 1e-200.
         const double u = uniform();

@@ -159,6 +159,9 @@ inline uint64_t planeRowStream(int site, int planeRow)
 
 //! @}
 
+//! The largest mean poisson() takes: 2^52, where doubles stop holding every integer.
+constexpr double kMaxPoissonMean = 4503599627370496.0;
+
 /** A stream of random numbers identified by (seed, stream). Cheap to construct: make one per row or
  * per pixel. */
 class CounterRng
@@ -204,7 +207,9 @@ public:
 
     /** Exact Poisson variate of mean lambda >= 0: inversion below 10, Hormann's transformed rejection
      * (PTRS, 1993) above. Both are exact up to floating-point rounding, unlike a Gaussian
-     * approximation, which matters at the few-electron counts of dark pixels. */
+     * approximation, which matters at the few-electron counts of dark pixels. lambda must not exceed
+     * kMaxPoissonMean (callers check before their loops: above it, a count no longer fits the integers
+     * that a double holds exactly, and a Gaussian is exact to double precision anyway). */
     int64_t poisson(double lambda);
 
 private:

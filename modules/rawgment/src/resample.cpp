@@ -10,9 +10,10 @@ namespace rawgment {
 
 Mat linearMotionKernel(double length, double angleDegrees)
 {
-    if (!std::isfinite(length) || length < 0)
+    if (!(length >= 0 && length <= MAX_MOTION_LENGTH))
         CV_Error(Error::StsBadArg,
-                 format("linearMotionKernel: length must be finite and >= 0 (got %g)", length));
+                 format("linearMotionKernel: length must lie in [0, %g] mosaic pixels (got %g)",
+                        MAX_MOTION_LENGTH, length));
     if (!std::isfinite(angleDegrees))
         CV_Error(Error::StsBadArg, "linearMotionKernel: angle must be finite");
     const double planeLength = length / 2; // the CFA planes have half the resolution

@@ -12,6 +12,33 @@ namespace rawgment {
 
 using detail::isIdentityKernel;
 
+namespace {
+
+/* A kernel from a file, checked before OpenCV allocates it: a hostile `cols: ~` or `rows: 1e9` would
+ * otherwise ask for gigabytes. A motion kernel is at most (MAX_MOTION_LENGTH / 2 + 1) plane pixels on a
+ * side; the data must hold rows x cols numbers. */
+void readMotionKernel(const FileNode& node, Mat& kernel)
+{
+    kernel.release();
+    if (node.empty() || node.isNone())
+        return;
+    const int maxSide = static_cast<int>(MAX_MOTION_LENGTH / 2) + 1;
+    const FileNode rows = node["rows"], cols = node["cols"], data = node["data"];
+    if (!node.isMap() || !rows.isInt() || !cols.isInt() || !data.isSeq() || static_cast<int>(rows) < 1 ||
+        static_cast<int>(cols) < 1 || static_cast<int>(rows) > maxSide || static_cast<int>(cols) > maxSide ||
+        data.size() !=
+            static_cast<size_t>(static_cast<int>(rows)) * static_cast<size_t>(static_cast<int>(cols)))
+        CV_Error(Error::StsParseError,
+                 format("scene: field 'motion_kernel' must be a matrix of 1 to %d rows and columns with "
+                        "rows x cols numbers",
+                        maxSide));
+    node >> kernel;
+    if (kernel.channels() != 1)
+        CV_Error(Error::StsParseError, "scene: field 'motion_kernel' must have one channel");
+}
+
+} // namespace
+
 bool Scene::isIdentity() const
 {
     return shift == Point(0, 0) && scale == 1 && jitter.isIdentity() && isIdentityKernel(motionKernel);
@@ -51,7 +78,7 @@ Scene Scene::read(const FileNode& node)
     if (!std::isfinite(s.scale) || !(s.scale > 0))
         CV_Error(Error::StsParseError, "scene: field 'scale' must be a finite number > 0");
     s.noise = NoiseOptions::readFields(node);
-    node["motion_kernel"] >> s.motionKernel;
+    readMotionKernel(node["motion_kernel"], s.motionKernel);
     return s;
 }
 
@@ -66,6 +93,10 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
     if (current.rows % 2 || current.cols % 2)
         CV_Error(Error::StsBadArg, "applyScene: the mosaic needs even sides");
     RawFormat fmt = format;
+    if (std::abs(static_cast<double>(scene.shift.x)) > current.cols ||
+        std::abs(static_cast<double>(scene.shift.y)) > current.rows)
+        CV_Error(Error::StsBadArg, cv::format("applyScene: shift (%d, %d) is larger than the %dx%d mosaic",
+                                              scene.shift.x, scene.shift.y, current.cols, current.rows));
     const Point shift(2 * cvRound(scene.shift.x / 2.0), 2 * cvRound(scene.shift.y / 2.0));
     if (shift != Point(0, 0)) {
         // Shift each CFA plane by half the (even) offset: the phase of the mosaic is kept.
@@ -159,6 +190,10 @@ void RandomScenePolicy::validate() const
         CV_Error(Error::StsBadArg, "RandomScenePolicy: hueMin must be > 0");
     range(gainDbMin, gainDbMax, "gain (dB)");
     range(0, blurLengthMax, "blur length");
+    if (blurLengthMax > MAX_MOTION_LENGTH)
+        CV_Error(Error::StsBadArg,
+                 format("RandomScenePolicy: blurLengthMax must be <= %g mosaic pixels (got %g)",
+                        MAX_MOTION_LENGTH, blurLengthMax));
     range(0, maxShift, "shift");
     if (!(maxScale >= 0 && maxScale < 1))
         CV_Error(Error::StsBadArg,

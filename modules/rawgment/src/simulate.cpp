@@ -122,6 +122,16 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
                  format("SensorSimulator::capture: frameIndex must be >= 0 (got %d)", frameIndex));
 
     const SensorParams& p = params_;
+    double prnuMax = 0, meanMax = 0;
+    minMaxLoc(prnu_, nullptr, &prnuMax);
+    minMaxLoc(mean, nullptr, &meanMax);
+    if (p.noise.alpha > 0 && !(meanMax * exposure * prnuMax / p.noise.alpha <= detail::kMaxPoissonMean))
+        CV_Error(
+            Error::StsBadArg,
+            format("SensorSimulator::capture: %g electrons per pixel (signal %g DN x exposure %g / alpha %g) "
+                   "exceed the simulator's %g: alpha is too small for this signal",
+                   meanMax * exposure * prnuMax / p.noise.alpha, meanMax, exposure, p.noise.alpha,
+                   detail::kMaxPoissonMean));
     const double white = std::ldexp(1.0, p.bitDepth) - 1;
     // Each term of the model drawn where it arises: photons (shot), read noise before the gain, noise
     // after it; the terms at gain 1 are the model's parameters, the gain is applied in the loop below.

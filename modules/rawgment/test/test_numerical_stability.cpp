@@ -385,6 +385,51 @@ TEST(NumericalStability, oneGainReportsAlphaButDoesNotInventReadNoise)
     EXPECT_EQ(c.model.sigmaD2, 0.0);
 }
 
+TEST(NumericalStability, sizesLengthsAndShiftsFromArgumentsOrFilesHaveBounds)
+{
+    // Each used to overflow an int, allocate gigabytes or take many seconds.
+    EXPECT_CV_ERROR_CONTAINS(linearMotionKernel(1e300, 0), "must lie in [0, 1024]");
+    EXPECT_CV_ERROR_CONTAINS(linearMotionKernel(1e5, 0), "must lie in [0, 1024]");
+    EXPECT_EQ(linearMotionKernel(MAX_MOTION_LENGTH, 0).cols, 513);
+    RandomScenePolicy policy;
+    policy.blurLengthMax = 30000;
+    EXPECT_CV_ERROR_CONTAINS(policy.validate(), "blurLengthMax must be <= 1024");
+
+    const Mat mosaic(16, 16, CV_16UC1, Scalar(500));
+    RawFormat fmt;
+    fmt.whiteLevel = 4095;
+    Scene far;
+    far.shift = Point(std::numeric_limits<int>::max(), 0);
+    Mat out;
+    RawFormat outFmt;
+    EXPECT_CV_ERROR_CONTAINS(applyScene(mosaic, fmt, NoiseModel(1, 1, 1), far, 1, out, outFmt),
+                             "larger than the 16x16 mosaic");
+
+    for (const char* kernel :
+         {"{rows: 3, cols: ~, dt: f, data: [1, 1, 1]}", "{rows: 100000, cols: 100000, dt: f, data: [1]}",
+          "{rows: 1, cols: 3, dt: f, data: [1]}"}) {
+        SCOPED_TRACE(kernel);
+        FileStorage fs(std::string("%YAML:1.0\nscene: {contrast: [1, 1, 1, 1], brightness: 0, gain_ratio: 1, "
+                                   "motion_kernel: !!opencv-matrix ") +
+                           kernel + "}\n",
+                       FileStorage::READ | FileStorage::MEMORY);
+        EXPECT_CV_ERROR_CONTAINS(Scene::read(fs["scene"]), "'motion_kernel' must be a matrix");
+    }
+
+    // 1e-16 DN per electron: 1e19 electrons per pixel do not fit the simulator's exact integers.
+    SensorParams tiny;
+    tiny.noise = NoiseModel(1e-16, 1, 1);
+    const SensorSimulator sensor(tiny, Size(4, 4));
+    EXPECT_CV_ERROR_CONTAINS(sensor.capture(Mat(4, 4, CV_32FC1, Scalar(1000)), 1, 1, 1, 0, out),
+                             "alpha is too small");
+    // In the augmentation such a count is drawn as the Gaussian it is to double precision.
+    NoiseOptions poisson;
+    poisson.shotSampling = ShotNoiseSampling::POISSON;
+    colorJitter(Mat(16, 16, CV_16UC1, Scalar(3000)), fmt, NoiseModel(1e-16, 0.5, 0.5),
+                ColorJitter::exposureChange(0.5, 1), poisson, 1, out, outFmt);
+    EXPECT_EQ(countNonZero(out == 0), 0);
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv

@@ -144,9 +144,13 @@ CV_RAWGMENT_EXPORTS void colorJitter(InputArray src, const RawFormat& format, co
                                      OutputArray dst, RawFormat& dstFormat, AugmentReport* report = nullptr,
                                      OutputArray saturatedMask = noArray());
 
+//! The longest motion linearMotionKernel() and RandomScenePolicy take, in mosaic pixels: a kernel of
+//! up to 513 x 513 plane pixels (the paper's longest is 13).
+constexpr double MAX_MOTION_LENGTH = 1024;
+
 /** @brief A linear motion-blur kernel on the CFA-plane grid (half the mosaic's resolution).
- * @param length length of the motion in full-resolution mosaic pixels (>= 0); up to 2 pixels (one plane
- *        pixel) the kernel is the identity 1x1
+ * @param length length of the motion in full-resolution mosaic pixels, in [0, MAX_MOTION_LENGTH]; up
+ *        to 2 pixels (one plane pixel) the kernel is the identity 1x1
  * @param angleDegrees direction of the motion, counter-clockwise from the x axis
  * @return CV_32FC1 kernel, odd size, sum 1
  */
