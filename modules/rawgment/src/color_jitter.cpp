@@ -204,6 +204,23 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     detail::checkFinitePositive(jitter.gainRatio, "colorJitter: gainRatio");
     const double newGain = format.gain * jitter.gainRatio;
     detail::checkFinitePositive(newGain, "colorJitter: the new gain");
+    {
+        // The row loops run in float: the largest value and variance they can form must fit one.
+        const detail::NoiseTerms<double> t = detail::checkedNoiseTerms(model, format.gain);
+        double largestContrast = 0;
+        for (int s = 0; s < 4; ++s)
+            largestContrast = std::max(largestContrast, jitter.contrast[s]);
+        const double g2 = jitter.gainRatio * jitter.gainRatio;
+        const double largestValue = largestContrast * format.whiteLevel + std::abs(jitter.brightness);
+        const double largestVariance = g2 * (t.shot * format.whiteLevel + t.readBeforeGain) + t.readAfterGain;
+        if (!(largestValue < 1e30 && largestVariance < 1e30 && largestContrast * jitter.gainRatio < 1e30))
+            CV_Error(Error::StsBadArg,
+                     cv::format(
+                         "colorJitter: contrast %g, brightness %g and gain ratio %g make values or variances "
+                         "beyond float range (%g, %g)",
+                         largestContrast, jitter.brightness, jitter.gainRatio, largestValue,
+                         largestVariance));
+    }
 
     if (jitter.isIdentity()) {
         // Skipped entirely: no copy, no random draw.

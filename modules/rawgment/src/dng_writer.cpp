@@ -62,8 +62,15 @@ public:
     {
         std::vector<uint8_t> b;
         for (double x : v) {
-            // A fixed denominator keeps 6 significant digits for the values DNG stores here.
-            const uint32_t den = 1000000;
+            // The largest power-of-ten denominator up to 10^6 whose numerator still fits 32 bits: six
+            // decimals for ordinary values, fewer for large ones, an error for what no rational holds.
+            const double limit = isSigned ? 2147483647.0 : 4294967295.0;
+            if (!std::isfinite(x) || std::abs(x) > limit || (!isSigned && x < 0))
+                CV_Error(Error::StsBadArg, format("writeDng: tag %d: %g does not fit a TIFF %s", int(tag), x,
+                                                  isSigned ? "SRATIONAL" : "RATIONAL"));
+            uint32_t den = 1000000;
+            while (den > 1 && std::abs(x) * den > limit)
+                den /= 10;
             const int64_t num = static_cast<int64_t>(std::llround(x * den));
             put32(b,
                   isSigned ? static_cast<uint32_t>(static_cast<int32_t>(num)) : static_cast<uint32_t>(num));
@@ -196,6 +203,14 @@ void writeDng(const String& path, const RawImage& image)
                                               path.c_str(), b, s));
         blacks[s] = static_cast<uint32_t>(std::llround(b));
     }
+    if (image.format.whiteLevel > 65535)
+        CV_Error(Error::StsBadArg,
+                 format("writeDng: '%s': white level %g does not fit 16-bit data (<= 65535)", path.c_str(),
+                        image.format.whiteLevel));
+    if (!(image.exposureTime >= 0 && image.exposureTime <= 4294967295.0))
+        CV_Error(Error::StsBadArg, format("writeDng: '%s': exposure time %g s does not fit its DNG tag "
+                                          "(a rational of at most 4294967295 s)",
+                                          path.c_str(), image.exposureTime));
     if (detail::fileExists(path))
         CV_Error(Error::StsError, "writeDng: '" + path + "' already exists; it is never overwritten");
 

@@ -281,10 +281,17 @@ void renderSimpleIsp(InputArray _mosaic, const RawFormat& format, OutputArray _b
         normaliseMosaic<float>(mosaic, format, siteGain, codes);
 
     Mat bgr16;
-    if (params.demosaic == DEMOSAIC_HALF_SIZE)
+    if (params.demosaic == DEMOSAIC_HALF_SIZE) {
         halfSizeBgr(codes, format.pattern, bgr16);
-    else
+    } else if (codes.rows < 4 || codes.cols < 4) {
+        // OpenCV's Bayer conversions return black below 3 pixels on a side: each 2x2 block then gets its
+        // own colour, at full size.
+        Mat half;
+        halfSizeBgr(codes, format.pattern, half);
+        resize(half, bgr16, codes.size(), 0, 0, INTER_NEAREST);
+    } else {
         cvtColor(codes, bgr16, bayerToBgrCode(format.pattern, params.demosaic == DEMOSAIC_EDGE_AWARE));
+    }
     codes.release();
 
     Mat dst(bgr16.size(), CV_MAKETYPE(params.outputDepth, 3));

@@ -29,7 +29,11 @@ double dbToLinearGain(double db)
 {
     if (!std::isfinite(db))
         CV_Error(Error::StsBadArg, format("gain in dB must be finite (got %g)", db));
-    return std::pow(10.0, db / 20.0);
+    const double g = std::pow(10.0, db / 20.0);
+    if (!std::isfinite(g) || !(g > 0))
+        CV_Error(Error::StsBadArg,
+                 format("gain of %g dB is outside what a double holds (about +-6000 dB)", db));
+    return g;
 }
 
 double linearGainToDb(double gain)

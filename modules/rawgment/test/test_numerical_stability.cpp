@@ -7,7 +7,9 @@
 
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/calibration.hpp>
+#include <opencv2/rawgment/isp.hpp>
 #include <opencv2/rawgment/normality.hpp>
+#include <opencv2/rawgment/raw_io.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
 #include <limits>
@@ -428,6 +430,43 @@ TEST(NumericalStability, sizesLengthsAndShiftsFromArgumentsOrFilesHaveBounds)
     colorJitter(Mat(16, 16, CV_16UC1, Scalar(3000)), fmt, NoiseModel(1e-16, 0.5, 0.5),
                 ColorJitter::exposureChange(0.5, 1), poisson, 1, out, outFmt);
     EXPECT_EQ(countNonZero(out == 0), 0);
+}
+
+TEST(NumericalStability, extremeValuesAreErrorsOrRightNeverSilentlyWrong)
+{
+    EXPECT_CV_ERROR_CONTAINS(dbToLinearGain(7000), "outside what a double holds");
+    EXPECT_NEAR(dbToLinearGain(-6000), 1e-300, 1e-310);
+
+    RawFormat fmt;
+    fmt.whiteLevel = 65535;
+    Mat out;
+    RawFormat outFmt;
+    const Mat flat(8, 8, CV_32FC1, Scalar(1000));
+    ColorJitter huge = ColorJitter::exposureChange(1.0, 1e150);
+    EXPECT_CV_ERROR_CONTAINS(
+        colorJitter(flat, fmt, NoiseModel(1, 1, 1), huge, NoiseAlignment::ACCOUNT_PRIOR, 1, out, outFmt),
+        "beyond float range");
+
+    // OpenCV's Bayer conversions return black below 3 pixels a side; the ISP renders every size.
+    for (Size size : {Size(2, 2), Size(6, 2), Size(2, 6)}) {
+        Mat bgr;
+        renderSimpleIsp(Mat(size, CV_16UC1, Scalar(30000)), fmt, bgr, IspParams());
+        EXPECT_EQ(bgr.size(), size);
+        EXPECT_GT(cv::mean(bgr)[1], 100) << size;
+    }
+
+    // DNG holds 16-bit levels and 32-bit rationals: what does not fit is an error, not a wrapped value.
+    const std::string dir = test::makeTempDir("stability_dng");
+    RawImage image;
+    image.mosaic = Mat(64, 64, CV_16UC1, Scalar(100)); // LibRaw reads no smaller DNG
+    image.format.whiteLevel = 1e12;
+    EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/white.dng", image), "does not fit 16-bit data");
+    image.format.whiteLevel = 65535;
+    image.exposureTime = 1e12;
+    EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/exposure.dng", image), "does not fit its DNG tag");
+    image.exposureTime = 3000; // beyond the 4294 s that a denominator of 10^6 allows: fewer decimals
+    writeDng(dir + "/long.dng", image);
+    EXPECT_NEAR(readRaw(dir + "/long.dng").exposureTime, 3000, 1e-3);
 }
 
 } // namespace
