@@ -111,7 +111,14 @@ public:
     {
         ShapiroWilkResult r;
         r.n = n_;
-        const double lo = x[0], range = x[n_ - 1] - x[0];
+        // W does not depend on the scale. A power of two is an exact scale: it changes no bit of an
+        // ordinary sample's W and brings both ends of a huge (+-1.7e308) or denormal sample to about 1,
+        // where their range and squares exist.
+        const double big = std::max(std::abs(x[0]), std::abs(x[n_ - 1]));
+        // (in two factors: 2^1029 for a denormal sample is itself beyond a double).
+        const int shift = big > 0 ? -std::ilogb(big) : 0;
+        const double s1 = std::ldexp(1.0, shift / 2), s2 = std::ldexp(1.0, shift - shift / 2);
+        const double lo = x[0] * s1 * s2, range = x[n_ - 1] * s1 * s2 - lo;
         if (!(range > 0)) {
             r.constant = true;
             return r;
@@ -122,20 +129,20 @@ public:
         int i = 0;
         for (; i + 3 < n_; i += 4)
             for (int k = 0; k < 4; ++k)
-                s[k] += (x[i + k] - lo) * inv;
+                s[k] += (x[i + k] * s1 * s2 - lo) * inv;
         for (; i < n_; ++i)
-            s[0] += (x[i] - lo) * inv;
+            s[0] += (x[i] * s1 * s2 - lo) * inv;
         const double mean = ((s[0] + s[1]) + (s[2] + s[3])) / n_;
         double sxx[4] = {0, 0, 0, 0}, sax[4] = {0, 0, 0, 0};
         i = 0;
         for (; i + 3 < n_; i += 4)
             for (int k = 0; k < 4; ++k) {
-                const double d = (x[i + k] - lo) * inv - mean;
+                const double d = (x[i + k] * s1 * s2 - lo) * inv - mean;
                 sxx[k] += d * d;
                 sax[k] += a_[i + k] * d;
             }
         for (; i < n_; ++i) {
-            const double d = (x[i] - lo) * inv - mean;
+            const double d = (x[i] * s1 * s2 - lo) * inv - mean;
             sxx[0] += d * d;
             sax[0] += a_[i] * d;
         }

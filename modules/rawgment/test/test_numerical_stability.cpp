@@ -469,6 +469,27 @@ TEST(NumericalStability, extremeValuesAreErrorsOrRightNeverSilentlyWrong)
     EXPECT_NEAR(readRaw(dir + "/long.dng").exposureTime, 3000, 1e-3);
 }
 
+TEST(NumericalStability, shapiroWilkIsScaleFreeFromDenormalsToTheLargestDoubles)
+{
+    // W and p do not depend on the scale: the same sample times 2^-1070 (denormal) or 1e300 must give
+    // the same numbers (W = 1 and p = 1 before, from an underflowed or overflowed range).
+    const std::vector<double> base = {0, 0, 0, 1, 2};
+    const ShapiroWilkResult ref = shapiroWilk(base);
+    EXPECT_NEAR(ref.W, 0.7709, 5e-5); // R 4.2: shapiro.test(c(0, 0, 0, 1, 2)), 4 digits
+    for (double scale : {std::ldexp(1.0, -1070), 1e-300, 1e300}) {
+        std::vector<double> scaled;
+        for (double v : base)
+            scaled.push_back(v * scale);
+        const ShapiroWilkResult r = shapiroWilk(scaled);
+        EXPECT_NEAR(r.W, ref.W, 1e-12) << scale;
+        EXPECT_NEAR(r.pValue, ref.pValue, 1e-12) << scale;
+    }
+    // Both ends at the largest doubles: R 4.2 gives W = 0.9447, p = 0.683 (printed to 4 digits).
+    const ShapiroWilkResult huge = shapiroWilk(std::vector<double>{-1.7e308, 0, 1, 1.7e308});
+    EXPECT_NEAR(huge.W, 0.9447, 5e-5);
+    EXPECT_NEAR(huge.pValue, 0.683, 5e-4);
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv
