@@ -60,9 +60,11 @@ int main(int argc, char** argv)
         o.extension = "." + format;
     }
     try {
+        rawgment_apps::OutputDirectory outputDirectory(o.outDir);
         const rawgment_apps::AugmentResult r = rawgment_apps::augmentFiles(o);
         std::cout << "wrote " << r.written << " outputs, skipped " << r.skipped
                   << " that already existed, in " << o.outDir << "\n";
+        outputDirectory.keep();
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "rawgment_augment: " << e.what() << "\n";

@@ -43,13 +43,16 @@ int main(int argc, char** argv)
     o.plots = parser.get<bool>("plots");
     o.seed = parser.get<uint64_t>("seed");
     if (!parser.check() || o.manifest.empty() || o.outDir.empty() ||
-        (method != "joint" && method != "two-stage")) {
+        (method != "joint" && method != "two-stage") || o.shapiroPixels < 1 || o.shapiroPixels > 1000000 ||
+        o.side < 2 || o.side % 2) {
         parser.printErrors();
-        std::cerr << "usage: rawgment_calibrate <manifest.yml> --out=<dir> [--method=joint|two-stage]\n";
+        std::cerr << "usage: rawgment_calibrate <manifest.yml> --out=<dir> [--method=joint|two-stage] "
+                     "[--shapiro=1..1000000] [--side=even >= 2]\n";
         return 2;
     }
     o.method = method == "joint" ? cv::rawgment::NOISE_FIT_JOINT : cv::rawgment::NOISE_FIT_TWO_STAGE;
     try {
+        rawgment_apps::OutputDirectory outputDirectory(o.outDir);
         const rawgment_apps::CalibrateResult r = rawgment_apps::calibrateFromManifest(o);
         const cv::rawgment::CalibrationReport& rep = r.report;
         std::printf("method %s, %d of %d samples used\n", method.c_str(), rep.samplesUsed, rep.samples);
@@ -68,6 +71,7 @@ int main(int argc, char** argv)
             std::printf("note: %s\n", n.c_str());
         for (const std::string& p : r.pngs)
             std::printf("plot: %s\n", p.c_str());
+        outputDirectory.keep();
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "rawgment_calibrate: " << e.what() << "\n";

@@ -78,6 +78,7 @@ int main(int argc, char** argv)
         return 2;
     }
     try {
+        rawgment_apps::OutputDirectory outputDirectory(out);
         const Clock::time_point start = Clock::now();
         if (rawgment_apps::pathExists(out + "/report.md"))
             throw std::runtime_error("'" + out +
@@ -256,6 +257,7 @@ int main(int argc, char** argv)
                     joint.report.model.alpha, truth.alpha, joint.report.model.sigmaD2, truth.sigmaD2,
                     joint.report.model.sigmaR2, truth.sigmaR2);
         std::printf("Done in %.1f s. Open %s/report.md\n", secondsSince(start), out.c_str());
+        outputDirectory.keep();
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "rawgment_demo: " << e.what() << "\n";

@@ -15,7 +15,7 @@ int main(int argc, char** argv)
         "{out o          |          | output directory (required) }"
         "{gains          | 6,12,24  | analog gains in dB }"
         "{levels         | 0.3,0.9  | white-patch level of each burst, fraction of the range }"
-        "{frames         | 100      | frames per burst (>= 2) }"
+        "{frames         | 100      | frames per burst (>= 3) }"
         "{patch          | 40       | patch side in pixels (even) }"
         "{alpha          | 0.25     | sensor: shot-noise slope at gain 1 }"
         "{sigma_d2       | 1.5      | sensor: read-noise variance before the gain (DN^2) }"
@@ -59,11 +59,13 @@ int main(int argc, char** argv)
             return 2;
         }
         o.sensor.validate();
+        rawgment_apps::OutputDirectory outputDirectory(o.outDir);
         const rawgment_apps::SimulateResult r = rawgment_apps::simulateBursts(o);
         std::cout << "wrote " << r.files << " frames\n  calibration manifest: " << r.manifest << "\n";
         if (!r.validationManifest.empty())
             std::cout << "  validation manifest:  " << r.validationManifest << "\n";
         std::cout << "  true noise model:     " << r.truthModel << "\n";
+        outputDirectory.keep();
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "rawgment_simulate: " << e.what() << "\n";

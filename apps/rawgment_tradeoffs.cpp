@@ -80,6 +80,7 @@ int main(int argc, char** argv)
         return 2;
     }
     try {
+        rawgment_apps::OutputDirectory outputDirectory(outDir);
         rawgment_apps::makeDirectories(outDir);
         const std::string md = outDir + "/tradeoffs.md", csv = outDir + "/tradeoffs.csv",
                           png = outDir + "/tradeoffs.png";
@@ -148,6 +149,7 @@ int main(int argc, char** argv)
                 std::cout << "note: " << message << "\n";
         }
         std::cout << "table: " << md << "\n";
+        outputDirectory.keep();
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "rawgment_tradeoffs: " << e.what() << "\n";

@@ -47,12 +47,14 @@ int main(int argc, char** argv)
         return 2;
     }
     try {
+        rawgment_apps::OutputDirectory outputDirectory(o.outDir);
         const rawgment_apps::ValidateResult r = rawgment_apps::validateConversion(o);
         std::cout << r.table;
         for (const std::string& n : r.notes)
             std::cout << "note: " << n << "\n";
         for (const std::string& p : r.pngs)
             std::cout << "plot: " << p << "\n";
+        outputDirectory.keep();
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "rawgment_validate: " << e.what() << "\n";

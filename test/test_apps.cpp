@@ -127,6 +127,27 @@ TEST(Apps, misspelledManifestKeysAreErrorsNamingThem)
     EXPECT_NE(std::string::npos, r.output.find("unknown key 'gain'")) << r.output;
 }
 
+TEST(Apps, unusableValuesAreRefusedAndFailedRunsLeaveNoEmptyFolder)
+{
+    const std::string dir = freshDir("refusals");
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir + "/two' --frames=2");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("at least 3 frames")) << r.output;
+    EXPECT_FALSE(exists(dir + "/two")) << "a failed run leaves no empty output folder";
+    EXPECT_EQ(2, runApp("rawgment_calibrate", "m.yml --out='" + dir + "/c' --shapiro=-10").status);
+    r = runApp("rawgment_calibrate", "'" + dir + "/missing.yml' --out='" + dir + "/cal'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_FALSE(exists(dir + "/cal")) << "a failed run leaves no empty output folder";
+    std::ofstream(dir + "/model.yml")
+        << "%YAML:1.0\nnoise_model: {format_version: 1, alpha: 1, sigma_d2: 1, sigma_r2: 1}\n";
+    std::ofstream(dir + "/scene.yml")
+        << "%YAML:1.0\nscene: {contrast: [1, 1, 1, 1], brightness: 0, gain_ratio: 1}\n";
+    r = runApp("rawgment_augment", "--model='" + dir + "/model.yml' --scene='" + dir + "/scene.yml' --out='" +
+                                       dir + "/aug' '" + dir + "'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("is not a file")) << r.output;
+}
+
 TEST(Apps, simulateHonoursTheSeedInEveryBurst)
 {
     // Every burst, the validation bursts included, derives its seed from --seed: the same seed gives the
@@ -136,7 +157,7 @@ TEST(Apps, simulateHonoursTheSeedInEveryBurst)
         const AppRun r =
             runApp("rawgment_simulate",
                    "--out='" + dir + "/" + name +
-                       "' --frames=2 --gains=6 --levels=0.5 --format=png --seed=" + std::to_string(seed));
+                       "' --frames=3 --gains=6 --levels=0.5 --format=png --seed=" + std::to_string(seed));
         EXPECT_EQ(0, r.status) << r.output;
     };
     simulate("a", 5);
@@ -158,7 +179,7 @@ TEST(Apps, validateRefusesFramesOfAnotherSizeNamingTheFiles)
     for (const char* run : {"big --patch=40", "small --patch=20"}) {
         const std::string name(run, std::string(run).find(' '));
         const AppRun r =
-            runApp("rawgment_simulate", "--out='" + dir + "/" + name + "' --frames=2 --gains=12 " +
+            runApp("rawgment_simulate", "--out='" + dir + "/" + name + "' --frames=3 --gains=12 " +
                                             "--levels=0.5 --format=png " + (std::strchr(run, ' ') + 1));
         ASSERT_EQ(0, r.status) << r.output;
     }
@@ -293,7 +314,7 @@ TEST(Apps, augmentKeepsInputsWithOneStemApartAndNeverTakesAnotherInputsOutput)
     // up with the other's sidecar and a rerun "skipped" an input that was never augmented.
     const std::string dir = freshDir("augment_stems");
     AppRun r =
-        runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=2 --gains=6 --levels=0.5 --format=png");
+        runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=3 --gains=6 --levels=0.5 --format=png");
     ASSERT_EQ(0, r.status) << r.output;
     {
         cv::rawgment::Scene scene;
@@ -356,6 +377,11 @@ TEST(Apps, demoWritesAReportAndAGallery)
 
 TEST(Apps, tradeoffReportMeasuresEveryKnob)
 {
+#ifdef RAWGMENT_SANITIZED_BUILD
+    // Its simulated calibration campaigns take over 7 minutes under ASan on 2 cores (20 s in Release);
+    // the library code it runs is covered by the unit tests under the sanitizers.
+    GTEST_SKIP() << "the trade-off report runs in the Release build only";
+#endif
     const std::string dir = freshDir("tradeoffs");
     AppRun r = runApp("rawgment_tradeoffs", "--quick --out='" + dir + "/t'");
     ASSERT_EQ(0, r.status) << r.output;

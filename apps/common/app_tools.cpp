@@ -17,6 +17,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <utility>
 
 namespace rawgment_apps {
 
@@ -37,6 +38,20 @@ void writeBytesAtomically(const std::string& path, const void* data, size_t size
 bool pathExists(const std::string& path)
 {
     return ::access(path.c_str(), F_OK) == 0;
+}
+
+bool isRegularFile(const std::string& path)
+{
+    struct stat st;
+    return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+OutputDirectory::OutputDirectory(std::string path) : path_(std::move(path)), existed_(pathExists(path_)) {}
+
+OutputDirectory::~OutputDirectory()
+{
+    if (!kept_ && !existed_ && !path_.empty())
+        ::rmdir(path_.c_str()); // fails, as it should, when the run left anything inside
 }
 
 void makeDirectories(const std::string& path)

@@ -16,6 +16,25 @@ namespace rawgment_apps {
 
 //! Whether a file or directory exists.
 bool pathExists(const std::string& path);
+//! Whether `path` is a regular file (or a link to one).
+bool isRegularFile(const std::string& path);
+
+/** The output directory of one run: removed at the end of a run that created it and failed before
+ * writing anything into it (an empty folder is no result). Call keep() when the run succeeded. */
+class OutputDirectory
+{
+public:
+    explicit OutputDirectory(std::string path);
+    ~OutputDirectory();
+    OutputDirectory(const OutputDirectory&) = delete;
+    OutputDirectory& operator=(const OutputDirectory&) = delete;
+    void keep() { kept_ = true; }
+
+private:
+    std::string path_;
+    bool existed_, kept_ = false;
+};
+
 //! Creates a directory and its parents (like mkdir -p); throws std::runtime_error naming the path.
 void makeDirectories(const std::string& path);
 //! The directory part of a path ("." when there is none).

@@ -88,9 +88,12 @@ AugmentResult augmentFiles(const AugmentOptions& o)
     } else {
         policy = RandomScenePolicy::load(o.policy);
     }
-    for (const std::string& in : o.inputs)
+    for (const std::string& in : o.inputs) {
         if (!pathExists(in))
             throw std::runtime_error("input '" + in + "': no such file");
+        if (!isRegularFile(in))
+            throw std::runtime_error("input '" + in + "' is not a file (a directory?)");
+    }
     makeDirectories(o.outDir);
 
     struct Job

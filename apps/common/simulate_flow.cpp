@@ -19,8 +19,9 @@ SimulateResult simulateBursts(const SimulateOptions& o)
 {
     if (o.outDir.empty())
         throw std::runtime_error("no output directory");
-    if (o.frames < 2 || o.gainsDb.empty() || o.levels.empty())
-        throw std::runtime_error("need at least 2 frames, one gain and one level");
+    // Three frames at least: rawgment_calibrate tests each pixel's series with Shapiro-Wilk (n >= 3).
+    if (o.frames < 3 || o.validationFrames < 3 || o.gainsDb.empty() || o.levels.empty())
+        throw std::runtime_error("need at least 3 frames per burst, one gain and one level");
     for (double level : o.levels)
         if (!(level > 0 && level <= 1))
             throw std::runtime_error(cv::format("level %g is outside (0, 1]", level));

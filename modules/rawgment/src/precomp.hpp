@@ -90,6 +90,8 @@ auto loadFileStorage(const String& path, const char* topLevel, const char* what,
         fs.open(path, FileStorage::READ);
     } catch (const Exception& e) {
         CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.err);
+    } catch (const std::exception& e) {
+        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.what());
     }
     if (!fs.isOpened())
         CV_Error(Error::StsError, String("cannot open ") + what + " '" + path + "'");
@@ -97,6 +99,9 @@ auto loadFileStorage(const String& path, const char* topLevel, const char* what,
         return read(fs[topLevel]);
     } catch (const Exception& e) {
         CV_Error(e.code, "'" + path + "': " + e.err);
+    } catch (const std::exception& e) {
+        // OpenCV's reader throws std::length_error and friends on some malformed files.
+        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.what());
     }
 }
 
