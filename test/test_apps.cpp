@@ -120,6 +120,11 @@ TEST(Apps, misspelledManifestKeysAreErrorsNamingThem)
     EXPECT_EQ(1, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("unknown key 'patchs' (valid keys: patches, bursts)"))
         << r.output;
+    std::ofstream(dir + "/twice.yml") << "%YAML:1.0\ncalibration_manifest:\n  bursts:\n"
+                                      << "    - { gain_db: 6, files: [a.dng, b.dng, a.dng] }\n";
+    r = runApp("rawgment_calibrate", "'" + dir + "/twice.yml' --out='" + dir + "/cal3'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("a.dng' is listed twice")) << r.output;
     std::ofstream(dir + "/b.yml")
         << "%YAML:1.0\ncalibration_manifest:\n  bursts:\n    - { gain: 6, files: [a.dng] }\n";
     r = runApp("rawgment_calibrate", "'" + dir + "/b.yml' --out='" + dir + "/cal2'");

@@ -39,8 +39,12 @@ std::vector<std::string> readFileList(const cv::FileNode& node, const std::strin
     if (!node.isSeq() || node.size() == 0)
         throw std::runtime_error(where + ": 'files' must be a non-empty list");
     std::vector<std::string> files;
-    for (const cv::FileNode& f : node)
+    for (const cv::FileNode& f : node) {
         files.push_back(resolvePath(base, std::string(f)));
+        // A frame listed twice would count as two identical captures: zero variance, a wrong model.
+        if (std::find(files.begin(), files.end() - 1, files.back()) != files.end() - 1)
+            throw std::runtime_error(where + ": '" + files.back() + "' is listed twice");
+    }
     return files;
 }
 

@@ -424,10 +424,25 @@ MosaicMetadata readMosaic(const String& path, OutputArray _mosaic)
         detail::loadFileStorage(sidecar, "mosaic_metadata", "mosaic sidecar",
                                 [](const FileNode& n) { return MosaicMetadata::read(n); });
     Mat mosaic;
-    if (lowerExtensionOf(path) == ".dng")
-        mosaic = readRaw(path).mosaic;
-    else
+    if (lowerExtensionOf(path) == ".dng") {
+        // A DNG states its own levels and pattern: a sidecar that contradicts them describes another file.
+        const RawImage raw = readRaw(path);
+        const RawFormat& f = raw.format;
+        if (f.pattern != meta.format.pattern || f.blackLevel != meta.format.blackLevel ||
+            f.whiteLevel != meta.format.whiteLevel)
+            CV_Error(
+                Error::StsError,
+                cv::format("readMosaic: '%s' is %s with black %g %g %g %g and white %g, but its sidecar says "
+                           "%s with black %g %g %g %g and white %g",
+                           path.c_str(), cfaPatternName(f.pattern).c_str(), f.blackLevel[0], f.blackLevel[1],
+                           f.blackLevel[2], f.blackLevel[3], f.whiteLevel,
+                           cfaPatternName(meta.format.pattern).c_str(), meta.format.blackLevel[0],
+                           meta.format.blackLevel[1], meta.format.blackLevel[2], meta.format.blackLevel[3],
+                           meta.format.whiteLevel));
+        mosaic = raw.mosaic;
+    } else {
         mosaic = imread(path, IMREAD_UNCHANGED);
+    }
     if (mosaic.empty())
         CV_Error(Error::StsError, "readMosaic: '" + path + "': OpenCV cannot decode it");
     if (mosaic.size() != meta.size || mosaic.type() != meta.type)

@@ -378,6 +378,24 @@ TEST(RawIo, readMosaicChecksTheSidecar)
     EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/a.png", back), "but its sidecar says 4x4");
 }
 
+TEST(RawIo, readMosaicRefusesASidecarThatContradictsItsDng)
+{
+    const std::string dir = makeTempDir("raw_io_sidecar_dng");
+    MosaicMetadata meta;
+    meta.format.blackLevel = Vec4d::all(64);
+    meta.format.whiteLevel = 4095;
+    writeMosaic(dir + "/m.dng", Mat(64, 64, CV_16UC1, Scalar(500)), meta);
+    std::vector<char> text = readBytes(dir + "/m.dng.yml");
+    std::string s(text.begin(), text.end());
+    const size_t at = s.find("white_level: 4095.");
+    ASSERT_NE(at, std::string::npos) << s;
+    s.replace(at, 18, "white_level: 1023.");
+    writeBytes(dir + "/m.dng.yml", std::vector<char>(s.begin(), s.end()));
+    Mat back;
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/m.dng", back),
+                             "but its sidecar says RGGB with black 64 64 64 64 and white 1023");
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv
