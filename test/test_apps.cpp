@@ -111,7 +111,7 @@ TEST(Apps, unknownOrMalformedOptionsAreErrorsNamingThem)
     }
 }
 
-TEST(Apps, misspelledManifestKeysAreErrorsNamingThem)
+TEST(Apps, badManifestsAreErrorsNamingTheKeyOrTheFile)
 {
     const std::string dir = freshDir("manifest_keys");
     std::ofstream(dir + "/m.yml") << "%YAML:1.0\ncalibration_manifest:\n  patchs: detect\n"
@@ -151,6 +151,33 @@ TEST(Apps, unusableValuesAreRefusedAndFailedRunsLeaveNoEmptyFolder)
                                        dir + "/aug' '" + dir + "'");
     EXPECT_EQ(1, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("is not a file")) << r.output;
+}
+
+TEST(Apps, simulateResumesOnlyTheSameJobAndKeepsGainsApart)
+{
+    const std::string dir = freshDir("simulate_job");
+    const std::string base = "--frames=3 --levels=0.5 --format=png --validation=false ";
+    // An interrupted run (its manifest not yet written) is resumed by the same command...
+    AppRun r = runApp("rawgment_simulate", base + "--gains=6 --out='" + dir + "/a'");
+    ASSERT_EQ(0, r.status) << r.output;
+    for (const char* f : {"manifest.yml", "truth_noise_model.yml", "patches.yml"})
+        std::remove((dir + "/a/" + f).c_str());
+    r = runApp("rawgment_simulate", base + "--gains=6 --out='" + dir + "/a'");
+    EXPECT_EQ(0, r.status) << r.output;
+    // ...and refused by another one, whose truth would not match the frames left there.
+    for (const char* f : {"manifest.yml", "truth_noise_model.yml", "patches.yml"})
+        std::remove((dir + "/a/" + f).c_str());
+    r = runApp("rawgment_simulate", base + "--gains=6 --alpha=2 --out='" + dir + "/a'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("describes another simulation")) << r.output;
+    // 12 and 12.4 dB used to share one folder (g12dB): now g12dB and g12.40dB.
+    r = runApp("rawgment_simulate", base + "--gains=12,12.4 --out='" + dir + "/b'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_TRUE(exists(dir + "/b/g12dB_level0.50/frame_002.png"));
+    EXPECT_TRUE(exists(dir + "/b/g12.40dB_level0.50/frame_002.png"));
+    r = runApp("rawgment_simulate", base + "--gains=12.001,12.004 --out='" + dir + "/c'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("share the folder")) << r.output;
 }
 
 TEST(Apps, simulateHonoursTheSeedInEveryBurst)

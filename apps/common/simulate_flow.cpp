@@ -9,11 +9,52 @@
 #include <opencv2/core/utility.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iterator>
 #include <stdexcept>
 
 namespace rawgment_apps {
 
 using namespace cv::rawgment;
+
+namespace {
+
+//! A burst's folder: whole gains keep the short name (g06dB), others carry two decimals (g12.40dB).
+std::string burstFolder(double gainDb, double level)
+{
+    const std::string gain =
+        gainDb == std::round(gainDb) ? cv::format("g%02.0fdB", gainDb) : cv::format("g%.2fdB", gainDb);
+    return gain + cv::format("_level%.2f", level);
+}
+
+/** Everything that decides the frames of a run, as YAML: a run that finds another job's description in
+ * its folder refuses, so an interrupted run is only ever resumed by the same job. */
+std::string jobDescription(const SimulateOptions& o)
+{
+    return yamlToString([&](cv::FileStorage& fs) {
+        fs << "simulation_job"
+           << "{";
+        fs << "gains_db" << o.gainsDb << "levels" << o.levels << "frames" << o.frames << "patch_size"
+           << o.patchSize;
+        o.sensor.noise.write(fs, "noise_model");
+        fs << "bit_depth" << o.sensor.bitDepth << "pattern" << cfaPatternName(o.sensor.pattern);
+        fs << "black_level" << std::vector<double>(o.sensor.blackLevel.val, o.sensor.blackLevel.val + 4);
+        fs << "hot" << o.sensor.hotPixelFraction << "dead" << o.sensor.deadPixelFraction << "noisy"
+           << o.sensor.noisyPixelFraction << "noisy_variance" << o.sensor.noisyPixelVariance;
+        fs << "prnu" << o.sensor.prnu << "dsnu" << o.sensor.dsnu;
+        fs << "fixed_pattern_seed"
+           << cv::format("%llu", static_cast<unsigned long long>(o.sensor.fixedPatternSeed));
+        fs << "quantize" << int(o.sensor.quantize);
+        fs << "seed" << cv::format("%llu", static_cast<unsigned long long>(o.seed)) << "extension"
+           << o.extension;
+        fs << "validation" << int(o.validation) << "validation_gain_db" << o.validationGainDb
+           << "validation_frames" << o.validationFrames;
+        fs << "}";
+    });
+}
+
+} // namespace
 
 SimulateResult simulateBursts(const SimulateOptions& o)
 {
@@ -62,10 +103,17 @@ SimulateResult simulateBursts(const SimulateOptions& o)
     for (double gDb : o.gainsDb)
         for (double level : o.levels) {
             const double g = dbToLinearGain(gDb);
-            bursts.push_back({cv::format("g%02.0fdB_level%.2f", gDb, level), gDb,
-                              level * range / (g * sceneMax), level, o.frames,
+            bursts.push_back({burstFolder(gDb, level), gDb, level * range / (g * sceneMax), level, o.frames,
                               deriveSeed(o.seed, SEED_SIMULATED_BURST, bursts.size())});
         }
+    for (size_t i = 0; i < bursts.size(); ++i)
+        for (size_t j = 0; j < i; ++j)
+            if (bursts[i].dir == bursts[j].dir)
+                throw std::runtime_error(
+                    cv::format("gains %g and %g dB at levels %g and %g share the folder '%s': "
+                               "give gains and levels that differ by at least 0.01",
+                               bursts[j].gainDb, bursts[i].gainDb, bursts[j].level, bursts[i].level,
+                               bursts[i].dir.c_str()));
     const size_t calibrationBursts = bursts.size();
     if (o.validation) {
         const double g = dbToLinearGain(o.validationGainDb);
@@ -79,6 +127,18 @@ SimulateResult simulateBursts(const SimulateOptions& o)
             {"validation/x0.50", o.validationGainDb, 0.5 * bright, 0.45, o.validationFrames, seeds[1]});
         bursts.push_back(
             {"validation/x0.10", o.validationGainDb, 0.1 * bright, 0.09, o.validationFrames, seeds[2]});
+    }
+    // The job before any frame: a folder holds the frames of one job, and a rerun continues only that job.
+    const std::string jobPath = o.outDir + "/simulation_job.yml", job = jobDescription(o);
+    if (pathExists(jobPath)) {
+        std::ifstream f(jobPath, std::ios::binary);
+        const std::string existing((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+        if (existing != job)
+            throw std::runtime_error("'" + jobPath +
+                                     "' describes another simulation (other gains, levels, frames, "
+                                     "sensor or seed): its frames are not this job's; choose another --out");
+    } else {
+        writeTextAtomically(jobPath, job);
     }
     size_t totalFrames = 0;
     for (const Burst& b : bursts)
