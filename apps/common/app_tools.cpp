@@ -33,6 +33,18 @@ void writeBytesAtomically(const std::string& path, const void* data, size_t size
     }
 }
 
+//! The image encoded by the extension of `path`.
+std::vector<uchar> encodeByExtension(const std::string& path, const cv::Mat& image)
+{
+    const size_t dot = path.find_last_of('.');
+    if (dot == std::string::npos)
+        throw std::runtime_error("'" + path + "': no image extension");
+    std::vector<uchar> bytes;
+    if (!cv::imencode(path.substr(dot), image, bytes))
+        throw std::runtime_error("cannot encode '" + path + "'");
+    return bytes;
+}
+
 } // namespace
 
 bool pathExists(const std::string& path)
@@ -105,23 +117,13 @@ void writeTextAtomically(const std::string& path, const std::string& text)
 
 void writeImageAtomically(const std::string& path, const cv::Mat& image)
 {
-    const size_t dot = path.find_last_of('.');
-    if (dot == std::string::npos)
-        throw std::runtime_error("'" + path + "': no image extension");
-    std::vector<uchar> bytes;
-    if (!cv::imencode(path.substr(dot), image, bytes))
-        throw std::runtime_error("cannot encode '" + path + "'");
+    const std::vector<uchar> bytes = encodeByExtension(path, image);
     writeBytesAtomically(path, bytes.data(), bytes.size());
 }
 
 void writeNewImage(const std::string& path, const cv::Mat& image)
 {
-    const size_t dot = path.find_last_of('.');
-    if (dot == std::string::npos)
-        throw std::runtime_error("'" + path + "': no image extension");
-    std::vector<uchar> bytes;
-    if (!cv::imencode(path.substr(dot), image, bytes))
-        throw std::runtime_error("cannot encode '" + path + "'");
+    const std::vector<uchar> bytes = encodeByExtension(path, image);
     if (pathExists(path)) {
         std::ifstream f(path, std::ios::binary);
         const std::vector<uchar> existing((std::istreambuf_iterator<char>(f)),
