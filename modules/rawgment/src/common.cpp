@@ -7,6 +7,8 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <regex>
+#include <sstream>
 #include <unistd.h>
 
 namespace cv {
@@ -123,6 +125,41 @@ int fileStorageFormatOf(const String& path)
 bool fileExists(const String& path)
 {
     return ::access(path.c_str(), F_OK) == 0;
+}
+
+void rejectWrappingIntegers(const String& path)
+{
+    // A plain integer scalar: after a key's colon, a list's bracket or comma, or a block list's dash,
+    // and before the end of the line, a comma, a closing bracket or a comment. Quoted text is skipped.
+    static const std::regex integer(R"((?:^|[:\[,{]|^\s*-)\s*([-+]?\d+)\s*(?=$|[,\]}#]))");
+    std::istringstream lines(readTextFile(path));
+    std::string line;
+    for (int number = 1; std::getline(lines, line); ++number) {
+        std::string unquoted;
+        char quote = 0;
+        for (char c : line) {
+            if (quote) {
+                quote = c == quote ? 0 : quote;
+                continue;
+            }
+            if (c == '"' || c == '\'') {
+                quote = c;
+                continue;
+            }
+            unquoted += c;
+        }
+        for (std::sregex_iterator it(unquoted.begin(), unquoted.end(), integer), end; it != end; ++it) {
+            const std::string digits = (*it)[1];
+            errno = 0;
+            const long long value = std::strtoll(digits.c_str(), nullptr, 10);
+            if (errno == ERANGE || value > INT_MAX || value < INT_MIN)
+                CV_Error(
+                    Error::StsParseError,
+                    format("'%s' line %d: the integer %s does not fit 32 bits (OpenCV's reader would wrap "
+                           "it); write it as a real (%s.0) if that is the value meant",
+                           path.c_str(), number, digits.c_str(), digits.c_str()));
+        }
+    }
 }
 
 std::string readTextFile(const String& path)

@@ -58,6 +58,9 @@ int fileStorageFormatOf(const String& path);
 bool fileExists(const String& path);
 //! The whole content of a file; throws StsError naming it when it cannot be read.
 std::string readTextFile(const String& path);
+/** Throws StsParseError naming the file and line of an integer literal beyond 32 bits: OpenCV's YAML and
+ * JSON readers keep integers in an int and silently wrap them (4294967297 reads as 1). */
+void rejectWrappingIntegers(const String& path);
 
 //! The text that writeFileStorageAtomically() would write to `path`.
 template <typename Writer> std::string fileStorageText(const String& path, Writer&& writeBody)
@@ -85,6 +88,7 @@ auto loadFileStorage(const String& path, const char* topLevel, const char* what,
     // Checked first so that OpenCV does not log its own error for a missing file.
     if (!fileExists(path))
         CV_Error(Error::StsError, String("cannot open ") + what + " '" + path + "': no such file");
+    rejectWrappingIntegers(path);
     FileStorage fs;
     try {
         fs.open(path, FileStorage::READ);

@@ -188,6 +188,25 @@ TEST(NoiseModel, aMisspelledKeyIsAnErrorNamingIt)
                              "noise model: unknown key 'sigma_r' (valid keys: format_version, alpha");
 }
 
+TEST(NoiseModel, integersBeyond32BitsAreRefusedNotWrapped)
+{
+    // OpenCV's reader keeps integers in an int: alpha 4294967297 would load as 1.
+    const std::string dir = test::makeTempDir("noise_model_wrap");
+    const auto writeText = [](const std::string& path, const std::string& text) {
+        std::ofstream(path) << text;
+    };
+    writeText(dir + "/alpha.yml", "%YAML:1.0\nnoise_model:\n  format_version: 1\n  alpha: 4294967297\n"
+                                  "  sigma_d2: 1\n  sigma_r2: 1\n");
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/alpha.yml"),
+                             "line 4: the integer 4294967297 does not fit");
+    writeText(dir + "/version.json", "{\"noise_model\": {\"format_version\": 4294967297, \"alpha\": 1, "
+                                     "\"sigma_d2\": 1, \"sigma_r2\": 1}}");
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/version.json"), "the integer 4294967297 does not fit");
+    writeText(dir + "/real.yml", "%YAML:1.0\nnoise_model:\n  format_version: 1\n  alpha: 4294967297.0\n"
+                                 "  sigma_d2: 1\n  sigma_r2: 1\n");
+    EXPECT_EQ(NoiseModel::load(dir + "/real.yml").alpha, 4294967297.0);
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv
