@@ -261,6 +261,20 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
     EXPECT_EQ(1, r.status);
     EXPECT_EQ(modelBefore, readText(dir + "/cal/noise_model.yml"))
         << "an existing output is never overwritten";
+    // A run that died before its plots and its last table is completed by the same command.
+    std::remove((dir + "/cal/shapiro_pvalue.png").c_str());
+    std::remove((dir + "/cal/variance_ratio_histogram.csv").c_str());
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + dir + "/cal'");
+    EXPECT_EQ(0, r.status) << r.output;
+    expectPngDecodes(dir + "/cal/shapiro_pvalue.png");
+    EXPECT_TRUE(exists(dir + "/cal/variance_ratio_histogram.csv"));
+    EXPECT_EQ(modelBefore, readText(dir + "/cal/noise_model.yml"));
+    // ...but never over an output that is not what it computes.
+    std::remove((dir + "/cal/shapiro_pvalue.png").c_str());
+    std::ofstream(dir + "/cal/lines.csv") << "not these lines\n";
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + dir + "/cal'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_EQ("not these lines\n", readText(dir + "/cal/lines.csv"));
 
     // 2b. The same bursts with the patches detected by cv::mcc (the sample's method) instead of given.
     std::string manifest = readText(dir + "/sim/manifest.yml");

@@ -45,6 +45,25 @@ std::vector<uchar> encodeByExtension(const std::string& path, const cv::Mat& ima
     return bytes;
 }
 
+// Never replaces: an existing file with exactly these bytes (an interrupted run of the same job) is
+// kept, any other is an error.
+void writeNewBytes(const std::string& path, const std::vector<uchar>& bytes)
+{
+    if (pathExists(path)) {
+        std::ifstream f(path, std::ios::binary);
+        const std::vector<uchar> existing((std::istreambuf_iterator<char>(f)),
+                                          std::istreambuf_iterator<char>());
+        if (existing == bytes)
+            return;
+        throw std::runtime_error("'" + path + "' already exists; it is never overwritten");
+    }
+    try {
+        cv::rawgment::writeFileAtomically(path, bytes.data(), bytes.size(), false);
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error(e.err);
+    }
+}
+
 } // namespace
 
 bool pathExists(const std::string& path)
@@ -121,22 +140,14 @@ void writeImageAtomically(const std::string& path, const cv::Mat& image)
     writeBytesAtomically(path, bytes.data(), bytes.size());
 }
 
+void writeNewText(const std::string& path, const std::string& text)
+{
+    writeNewBytes(path, std::vector<uchar>(text.begin(), text.end()));
+}
+
 void writeNewImage(const std::string& path, const cv::Mat& image)
 {
-    const std::vector<uchar> bytes = encodeByExtension(path, image);
-    if (pathExists(path)) {
-        std::ifstream f(path, std::ios::binary);
-        const std::vector<uchar> existing((std::istreambuf_iterator<char>(f)),
-                                          std::istreambuf_iterator<char>());
-        if (existing == bytes)
-            return; // left by an interrupted run of the same job
-        throw std::runtime_error("'" + path + "' already exists; it is never overwritten");
-    }
-    try {
-        cv::rawgment::writeFileAtomically(path, bytes.data(), bytes.size(), false);
-    } catch (const cv::Exception& e) {
-        throw std::runtime_error(e.err);
-    }
+    writeNewBytes(path, encodeByExtension(path, image));
 }
 
 bool checkCommandLine(int argc, char** argv, const char* keys, const char* app)
@@ -293,7 +304,7 @@ void CsvTable::write(const std::string& path) const
     text += "\n";
     for (const std::string& row : rows_)
         text += row + "\n";
-    writeTextAtomically(path, text);
+    writeNewText(path, text);
 }
 
 std::string formatNumber(double value)

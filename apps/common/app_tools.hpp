@@ -52,6 +52,8 @@ void writeImageAtomically(const std::string& path, const cv::Mat& image);
 /** Like writeImageAtomically(), but never replaces a file: an existing file with exactly these bytes
  * (an interrupted run of the same job) is kept, any other is an error. */
 void writeNewImage(const std::string& path, const cv::Mat& image);
+//! writeNewImage() for text.
+void writeNewText(const std::string& path, const std::string& text);
 
 /** What cv::CommandLineParser lets through: an option that `keys` does not name, a valued option
  * without `=<value>` (`--model m.yml` would read "true"), a number option whose value is not a number.
@@ -79,7 +81,8 @@ private:
     std::chrono::steady_clock::time_point start_, lastDraw_;
 };
 
-/** A CSV table written atomically: a header, then rows of numbers or text. */
+/** A CSV table written atomically and never over another file (see writeNewText()): a header, then
+ * rows of numbers or text. */
 class CsvTable
 {
 public:

@@ -32,7 +32,16 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                       samplesCsv = o.outDir + "/samples.csv", linesCsv = o.outDir + "/lines.csv",
                       shapiroCsv = o.outDir + "/shapiro.csv",
                       histCsv = o.outDir + "/variance_ratio_histogram.csv";
-    refuseExisting({modelPath, reportPath, samplesCsv, linesCsv, shapiroCsv, histCsv});
+    // A finished calibration is never redone into its folder. A run that died before its end is
+    // completed: the calibration is deterministic, outputs already there must be what this run writes
+    // (writeNewText refuses anything else) and the missing ones are added.
+    std::vector<std::string> finished = {reportPath, samplesCsv, linesCsv, shapiroCsv, histCsv};
+    if (o.plots)
+        for (const char* png : {"calib_mean_variance.png", "calib_histograms.png", "calib_cross_gain.png",
+                                "shapiro_pvalue.png"})
+            finished.push_back(o.outDir + "/" + png);
+    if (std::all_of(finished.begin(), finished.end(), [](const std::string& p) { return pathExists(p); }))
+        refuseExisting(finished);
 
     CalibrateResult result;
     struct BurstSpec
@@ -119,9 +128,11 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     params.line.seed = o.seed;
     result.report = calibrateNoiseModel(samples, params);
     const CalibrationReport& report = result.report;
-    report.save(reportPath);
+    writeNewText(reportPath,
+                 yamlToString([&](cv::FileStorage& fs) { report.write(fs, "calibration_report"); }));
     if (report.separable)
-        report.model.save(modelPath);
+        writeNewText(modelPath,
+                     yamlToString([&](cv::FileStorage& fs) { report.model.write(fs, "noise_model"); }));
     else
         result.notes.push_back(
             "sigma_d^2 and sigma_r^2 are not separable with these gains: no noise_model.yml "

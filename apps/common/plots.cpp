@@ -15,6 +15,11 @@ const char* const kSeriesColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"
 void plotOrNote(const std::string& png, const std::string& script, std::vector<std::string>& pngs,
                 std::vector<std::string>& notes)
 {
+    // A plot an interrupted run of the same job already made is kept, never redrawn over.
+    if (pathExists(png)) {
+        pngs.push_back(png);
+        return;
+    }
     std::string message;
     if (plotWithGnuplot(png, script, message))
         pngs.push_back(png);
