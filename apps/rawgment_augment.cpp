@@ -22,6 +22,7 @@ int main(int argc, char** argv)
         "{@inputs        |      | input files (RAW files, or mosaics with a .yml sidecar) }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_augment"))
         return 2;
+    rawgment_apps::installInterruptCleanup();
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about(
         "rawgment_augment: darker, noisier, blurred RAW variants with the noise a real sensor would give.\n"

@@ -21,6 +21,7 @@ int main(int argc, char** argv)
         "{plots          | true  | write PNG plots with gnuplot }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_calibrate"))
         return 2;
+    rawgment_apps::installInterruptCleanup();
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about("rawgment_calibrate: alpha, sigma_d^2, sigma_r^2 from bursts of a colour checker\n\n"
                  "Manifest:\n"

@@ -58,6 +58,7 @@ int main(int argc, char** argv)
         "{seed           | 1           | seed of everything random }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_demo"))
         return 2;
+    rawgment_apps::installInterruptCleanup();
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about(
         "rawgment_demo: simulate colour-checker bursts at 3 gains and 2 light levels, calibrate the noise\n"

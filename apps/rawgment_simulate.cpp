@@ -27,6 +27,7 @@ int main(int argc, char** argv)
         "{validation     | true     | also write the bright and x0.5, x0.1 bursts for rawgment_validate }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_simulate"))
         return 2;
+    rawgment_apps::installInterruptCleanup();
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about("rawgment_simulate: simulated colour-checker bursts with a known noise model");
     if (parser.has("help")) {

@@ -51,6 +51,7 @@ int main(int argc, char** argv)
         "{plots          | true  | write tradeoffs.png with gnuplot }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_tradeoffs"))
         return 2;
+    rawgment_apps::installInterruptCleanup();
     CommandLineParser parser(argc, argv, keys);
     parser.about(
         "rawgment_tradeoffs: measures what each accuracy knob of cv::rawgment costs in time.\n"
@@ -81,7 +82,7 @@ int main(int argc, char** argv)
     }
     try {
         rawgment_apps::OutputDirectory outputDirectory(outDir);
-        rawgment_apps::makeDirectories(outDir);
+        rawgment_apps::prepareOutputDirectory(outDir);
         const std::string md = outDir + "/tradeoffs.md", csv = outDir + "/tradeoffs.csv",
                           png = outDir + "/tradeoffs.png";
         for (const std::string& p : {md, csv, png, png + ".gp"})

@@ -18,6 +18,7 @@ int main(int argc, char** argv)
                        "{plots          | true | write a PNG plot with gnuplot }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_validate"))
         return 2;
+    rawgment_apps::installInterruptCleanup();
     cv::CommandLineParser parser(argc, argv, keys);
     parser.about(
         "rawgment_validate: converts a bright burst by each target factor with NONE, IGNORE_PRIOR and\n"

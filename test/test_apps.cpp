@@ -4,6 +4,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/rawgment.hpp>
 
+#include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -178,6 +180,21 @@ TEST(Apps, simulateResumesOnlyTheSameJobAndKeepsGainsApart)
     r = runApp("rawgment_simulate", base + "--gains=12.001,12.004 --out='" + dir + "/c'");
     EXPECT_EQ(1, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("share the folder")) << r.output;
+}
+
+TEST(Apps, aRunRemovesTheTemporariesThatKilledRunsLeft)
+{
+    const std::string dir = freshDir("interrupts");
+    // A temporary that a killed run (a pid that is gone) left is removed by the next run in that folder.
+    pid_t gone = 4194000;
+    while (::kill(gone, 0) == 0 || errno != ESRCH)
+        --gone;
+    std::ofstream(dir + "/manifest.yml.tmp-" + std::to_string(gone) + "-0") << "half a file";
+    AppRun r =
+        runApp("rawgment_simulate", "--out='" + dir + "' --frames=3 --gains=6 --levels=0.5 --format=png");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("removed 1 temporary file(s)")) << r.output;
+    EXPECT_FALSE(exists(dir + "/manifest.yml.tmp-" + std::to_string(gone) + "-0"));
 }
 
 TEST(Apps, simulateHonoursTheSeedInEveryBurst)

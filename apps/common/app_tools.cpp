@@ -7,11 +7,14 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 #include <sys/stat.h>
@@ -69,6 +72,57 @@ void writeNewBytes(const std::string& path, const std::vector<uchar>& bytes)
 bool pathExists(const std::string& path)
 {
     return ::access(path.c_str(), F_OK) == 0;
+}
+
+void prepareOutputDirectory(const std::string& dir)
+{
+    makeDirectories(dir);
+    static const std::regex leftover(R"(\.(?:tmp-(\d+)-\d+|gp\.(\d+)\.run)$)");
+    int removed = 0;
+    std::error_code error;
+    for (auto it = std::filesystem::recursive_directory_iterator(dir, error);
+         !error && it != std::filesystem::recursive_directory_iterator(); it.increment(error)) {
+        const std::string name = it->path().filename().string();
+        std::smatch m;
+        if (!it->is_regular_file(error) || !std::regex_search(name, m, leftover))
+            continue;
+        const pid_t pid = static_cast<pid_t>(std::stol(m[1].matched ? m[1].str() : m[2].str()));
+        if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH &&
+            std::remove(it->path().c_str()) == 0)
+            ++removed;
+    }
+    if (removed > 0)
+        std::cerr << "removed " << removed << " temporary file(s) that interrupted runs left in " << dir
+                  << "\n";
+    const std::string probe = dir + "/.rawgment-write-test-" + std::to_string(::getpid());
+    try {
+        cv::rawgment::writeFileAtomically(probe, "ok", 2, true);
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error("the output folder '" + dir + "' cannot be written: " + e.err);
+    }
+    std::remove(probe.c_str());
+}
+
+namespace {
+
+void removeTemporariesAndStop(int signal)
+{
+    cv::rawgment::removeTemporaryFilesInProgress();
+    ::signal(signal, SIG_DFL);
+    ::raise(signal);
+}
+
+} // namespace
+
+void installInterruptCleanup()
+{
+    struct sigaction action;
+    std::memset(&action, 0, sizeof action);
+    action.sa_handler = removeTemporariesAndStop;
+    sigemptyset(&action.sa_mask);
+    for (int signal : {SIGINT, SIGTERM, SIGHUP})
+        if (::sigaction(signal, &action, nullptr) != 0)
+            std::cerr << "warning: cannot install the cleanup on signal " << signal << "\n";
 }
 
 bool isRegularFile(const std::string& path)

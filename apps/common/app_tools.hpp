@@ -35,6 +35,15 @@ private:
     bool existed_, kept_ = false;
 };
 
+/** Makes `dir` (and its parents), removes the temporaries that interrupted runs left in it (files
+ * `*.tmp-<pid>-<n>` and `*.gp.<pid>.run` of processes that are gone, saying how many), and checks that a
+ * file can be written there: before any computation, not after it. Throws std::runtime_error. */
+void prepareOutputDirectory(const std::string& dir);
+
+/** On SIGINT, SIGTERM or SIGHUP, removes the temporaries of the writes in progress, then ends the
+ * process as the signal would have. */
+void installInterruptCleanup();
+
 //! Creates a directory and its parents (like mkdir -p); throws std::runtime_error naming the path.
 void makeDirectories(const std::string& path);
 //! The directory part of a path ("." when there is none).

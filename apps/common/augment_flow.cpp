@@ -94,7 +94,7 @@ AugmentResult augmentFiles(const AugmentOptions& o)
         if (!isRegularFile(in))
             throw std::runtime_error("input '" + in + "' is not a file (a directory?)");
     }
-    makeDirectories(o.outDir);
+    prepareOutputDirectory(o.outDir);
 
     struct Job
     {

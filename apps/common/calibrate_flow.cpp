@@ -26,7 +26,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         throw std::runtime_error("'" + o.manifest +
                                  "': expected a map 'calibration_manifest' with a list 'bursts'");
     const std::string base = directoryOf(o.manifest);
-    makeDirectories(o.outDir);
+    prepareOutputDirectory(o.outDir);
     const std::string modelPath = o.outDir + "/noise_model.yml",
                       reportPath = o.outDir + "/calibration_report.yml",
                       samplesCsv = o.outDir + "/samples.csv", linesCsv = o.outDir + "/lines.csv",

@@ -66,7 +66,7 @@ SimulateResult simulateBursts(const SimulateOptions& o)
     for (double level : o.levels)
         if (!(level > 0 && level <= 1))
             throw std::runtime_error(cv::format("level %g is outside (0, 1]", level));
-    makeDirectories(o.outDir);
+    prepareOutputDirectory(o.outDir);
     SimulateResult result;
     result.manifest = o.outDir + "/manifest.yml";
     result.truthModel = o.outDir + "/truth_noise_model.yml";

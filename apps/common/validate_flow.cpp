@@ -28,7 +28,7 @@ ValidateResult validateConversion(const ValidateOptions& o)
     requireKnownKeys(root, {"patches", "gain_db", "bright", "targets"}, "'" + o.manifest + "'");
     const std::string base = directoryOf(o.manifest);
     const NoiseModel model = NoiseModel::load(o.model);
-    makeDirectories(o.outDir);
+    prepareOutputDirectory(o.outDir);
     const std::string csvPath = o.outDir + "/validation.csv", mdPath = o.outDir + "/validation.md";
     refuseExisting({csvPath, mdPath});
 

@@ -266,6 +266,46 @@ String lowerExtensionOf(const String& path)
 
 namespace {
 
+// The temporaries of writes in progress, for removeTemporaryFilesInProgress() in a signal handler: a
+// fixed table of lock-free slots (0 free, 1 being filled, 2 holds a path), no allocation, no lock.
+struct TemporarySlot
+{
+    std::atomic<int> state{0};
+    char path[4096];
+};
+TemporarySlot temporarySlots[64];
+
+// Registers a temporary for the lifetime of the guard (a path too long or a full table: not registered,
+// the write goes on; only a signal's cleanup misses it).
+class TemporaryRegistration
+{
+public:
+    explicit TemporaryRegistration(const String& tmp)
+    {
+        if (tmp.size() >= sizeof(temporarySlots[0].path))
+            return;
+        for (int i = 0; i < 64; ++i) {
+            int expected = 0;
+            if (temporarySlots[i].state.compare_exchange_strong(expected, 1)) {
+                std::memcpy(temporarySlots[i].path, tmp.c_str(), tmp.size() + 1);
+                temporarySlots[i].state.store(2);
+                slot_ = i;
+                return;
+            }
+        }
+    }
+    ~TemporaryRegistration()
+    {
+        if (slot_ >= 0)
+            temporarySlots[slot_].state.store(0);
+    }
+    TemporaryRegistration(const TemporaryRegistration&) = delete;
+    TemporaryRegistration& operator=(const TemporaryRegistration&) = delete;
+
+private:
+    int slot_ = -1;
+};
+
 String temporaryPathFor(const String& path)
 {
     // Unique per process and call, so concurrent writers never share a temporary file.
@@ -326,6 +366,13 @@ void commitTemporaryFileNoReplace(const String& tmpPath, const String& path)
 
 } // namespace
 
+void removeTemporaryFilesInProgress()
+{
+    for (TemporarySlot& slot : temporarySlots)
+        if (slot.state.load() == 2)
+            ::unlink(slot.path);
+}
+
 void writeFileAtomically(const String& path, const void* data, size_t size, bool replace)
 {
     if (path.empty())
@@ -333,6 +380,7 @@ void writeFileAtomically(const String& path, const void* data, size_t size, bool
     if (!data && size > 0)
         CV_Error(Error::StsBadArg, "writeFileAtomically: no data for " + std::to_string(size) + " bytes");
     const String tmp = temporaryPathFor(path);
+    const TemporaryRegistration registration(tmp);
     FILE* f = std::fopen(tmp.c_str(), "wb");
     if (!f)
         CV_Error(Error::StsError, "cannot open '" + tmp + "' for writing: " + std::strerror(errno));

@@ -5,6 +5,7 @@
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
 
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -12,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <sys/mount.h>
+#include <thread>
 #include <unistd.h>
 #include <vector>
 
@@ -394,6 +396,34 @@ TEST(RawIo, readMosaicRefusesASidecarThatContradictsItsDng)
     Mat back;
     EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/m.dng", back),
                              "but its sidecar says RGGB with black 64 64 64 64 and white 1023");
+}
+
+TEST(RawIo, removeTemporaryFilesInProgressRemovesAWriteInFlight)
+{
+    // What the apps' SIGINT/SIGTERM handler calls: the temporary of a write in progress disappears, the
+    // write fails, and the target never appears.
+    const std::string dir = makeTempDir("raw_io_in_flight");
+    const std::vector<char> big(size_t(256) << 20, 'x'); // long enough to be seen in flight
+    std::atomic<bool> done{false};
+    std::string error;
+    std::thread writer([&] {
+        try {
+            writeFileAtomically(dir + "/big.bin", big.data(), big.size());
+        } catch (const Exception& e) {
+            error = e.err;
+        }
+        done = true;
+    });
+    bool seen = false;
+    while (!done && !seen)
+        for (const std::string& name : filesIn(dir))
+            seen = seen || name.find(".tmp-") != std::string::npos;
+    if (seen)
+        removeTemporaryFilesInProgress();
+    writer.join();
+    ASSERT_TRUE(seen) << "the 256 MB write ended before its temporary was seen";
+    EXPECT_NE(error.find("big.bin"), std::string::npos) << error;
+    EXPECT_TRUE(filesIn(dir).empty()) << "neither the temporary nor the target may remain";
 }
 
 } // namespace

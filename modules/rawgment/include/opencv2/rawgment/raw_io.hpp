@@ -73,6 +73,15 @@ CV_RAWGMENT_EXPORTS void writeDng(const String& path, const RawImage& image);
 CV_RAWGMENT_EXPORTS void writeFileAtomically(const String& path, const void* data, size_t size,
                                              bool replace = false);
 
+/** @brief Removes the temporary files of writeFileAtomically() calls still in progress in this process.
+ *
+ * Async-signal-safe: meant for a SIGINT or SIGTERM handler of a program that must leave no partial
+ * file behind when it is stopped (the apps install one). The target files are untouched: a write in
+ * progress simply never happened. Temporaries are named `<target>.tmp-<pid>-<n>`; a process killed
+ * with SIGKILL leaves its own, which a later run may remove once that pid is gone.
+ */
+CV_RAWGMENT_EXPORTS void removeTemporaryFilesInProgress();
+
 /** @brief What a sidecar file says about a mosaic written by writeMosaic(). */
 struct CV_RAWGMENT_EXPORTS MosaicMetadata
 {
