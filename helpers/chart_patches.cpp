@@ -136,26 +136,56 @@ void writeChartPatches(const std::string& path, const ChartPatches& patches)
 
 ChartPatches readChartPatches(const std::string& path)
 {
-    if (!cv::utils::fs::exists(path))
-        CV_Error(cv::Error::StsError, "cannot open chart patches '" + path + "': no such file");
-    cv::FileStorage fs(path, cv::FileStorage::READ);
-    if (!fs.isOpened())
-        CV_Error(cv::Error::StsError, "cannot open chart patches '" + path + "'");
+    cv::FileStorage fs = cv::rawgment::openFileStorageForReading(path, "chart patches");
     const cv::FileNode node = fs["chart_patches"];
     if (!node.isMap())
         CV_Error(cv::Error::StsParseError, "'" + path + "': no map 'chart_patches'");
-    for (const cv::FileNode& entry : node)
+    std::vector<std::string> keys;
+    for (const cv::FileNode& entry : node) {
         if (entry.name() != "grid_corners" && entry.name() != "squares")
             CV_Error(cv::Error::StsParseError, "'" + path + "': unknown key '" + entry.name() +
                                                    "' (valid keys: grid_corners, squares)");
+        if (std::find(keys.begin(), keys.end(), entry.name()) != keys.end())
+            CV_Error(cv::Error::StsParseError, "'" + path + "': key '" + entry.name() + "' appears twice");
+        keys.push_back(entry.name());
+    }
     ChartPatches p;
-    node["grid_corners"] >> p.gridCorners;
+    const cv::FileNode corners = node["grid_corners"];
+    if (!corners.empty()) {
+        // Read number by number (x0, y0, ..., x3, y3): OpenCV's vector reader trusts the node's shape.
+        if (!corners.isSeq() || (corners.size() != 0 && corners.size() != 8))
+            CV_Error(cv::Error::StsParseError,
+                     "'" + path + "': field 'grid_corners' must be empty or 8 numbers (4 points x, y)");
+        for (size_t k = 0; k < corners.size(); k += 2) {
+            const cv::FileNode x = corners[int(k)], y = corners[int(k + 1)];
+            if (!(x.isReal() || x.isInt()) || !(y.isReal() || y.isInt()) || !std::isfinite(double(x)) ||
+                !std::isfinite(double(y)))
+                CV_Error(cv::Error::StsParseError, "'" + path + "': 'grid_corners' must be finite numbers");
+            p.gridCorners.emplace_back(float(double(x)), float(double(y)));
+        }
+    }
     const cv::FileNode squares = node["squares"];
     if (!squares.isSeq() || squares.size() == 0)
         CV_Error(cv::Error::StsParseError, "'" + path + "': field 'squares' is missing or empty");
     for (const cv::FileNode& s : squares) {
-        cv::Rect r;
-        s >> r;
+        if (!s.isSeq() || s.size() != 4)
+            CV_Error(cv::Error::StsParseError,
+                     cv::format("'%s': square %d must be a list of 4 integers (x, y, width, height)",
+                                path.c_str(), int(p.squares.size()) + 1));
+        int v[4];
+        for (int k = 0; k < 4; ++k) {
+            if (!s[k].isInt())
+                CV_Error(cv::Error::StsParseError,
+                         cv::format("'%s': square %d must be a list of 4 integers (x, y, width, height)",
+                                    path.c_str(), int(p.squares.size()) + 1));
+            v[k] = int(s[k]);
+        }
+        const cv::Rect r(v[0], v[1], v[2], v[3]);
+        // Far beyond any sensor, and small enough that corner + side cannot overflow an int.
+        const int limit = 1 << 20;
+        if (r.x < 0 || r.y < 0 || r.x > limit || r.y > limit || r.width > limit || r.height > limit)
+            CV_Error(cv::Error::StsParseError, cv::format("'%s': square %d lies outside [0, %d]",
+                                                          path.c_str(), int(p.squares.size()) + 1, limit));
         if (r.width <= 0 || r.height <= 0 || r.x % 2 || r.y % 2 || r.width % 2 || r.height % 2)
             CV_Error(cv::Error::StsParseError,
                      cv::format("'%s': square %d is empty or not CFA-aligned (even corner and sides)",

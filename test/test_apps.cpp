@@ -51,11 +51,31 @@ AppRun runApp(const std::string& app, const std::string& args)
     return r;
 }
 
+//! Removes the folders of freshDir() when the test passed; a failed test leaves them for a look.
+class ScratchFolders : public ::testing::Environment
+{
+public:
+    void add(const std::string& dir) { dirs_.push_back(dir); }
+    void TearDown() override
+    {
+        if (!::testing::UnitTest::GetInstance()->Passed())
+            return;
+        for (const std::string& dir : dirs_)
+            EXPECT_EQ(0, std::system(("rm -rf '" + dir + "'").c_str())) << dir;
+    }
+
+private:
+    std::vector<std::string> dirs_;
+};
+ScratchFolders* const scratchFolders =
+    static_cast<ScratchFolders*>(::testing::AddGlobalTestEnvironment(new ScratchFolders));
+
 std::string freshDir(const std::string& name)
 {
     const std::string dir = ::testing::TempDir() + "/rawgment_e2e_" + name + "_" + std::to_string(::getpid());
     const std::string command = "rm -rf '" + dir + "' && mkdir -p '" + dir + "'";
     EXPECT_EQ(0, std::system(command.c_str()));
+    scratchFolders->add(dir);
     return dir;
 }
 

@@ -8,6 +8,8 @@
 
 #include <unistd.h>
 
+#include <fstream>
+
 namespace {
 
 std::string sharedDataFile(const std::string& name)
@@ -69,6 +71,34 @@ TEST(ChartPatches, squaresRoundTripThroughYaml)
     const rawgment_helpers::ChartPatches back = rawgment_helpers::readChartPatches(path);
     EXPECT_EQ(p.squares, back.squares);
     EXPECT_EQ(p.gridCorners, back.gridCorners);
+}
+
+TEST(ChartPatches, malformedFilesAreErrorsNamingTheFile)
+{
+    const std::string path = ::testing::TempDir() + "/chart_patches_malformed.yml";
+    const auto readText = [&](const std::string& body) {
+        std::ofstream(path, std::ios::trunc) << "%YAML:1.0\n---\nchart_patches:\n" << body;
+        return rawgment_helpers::readChartPatches(path);
+    };
+    const auto expectError = [&](const std::string& body, const std::string& fragment) {
+        try {
+            readText(body);
+            ADD_FAILURE() << "accepted:\n" << body;
+        } catch (const cv::Exception& e) {
+            EXPECT_NE(e.err.find(fragment), std::string::npos) << e.err;
+            EXPECT_NE(e.err.find(path), std::string::npos) << e.err;
+        }
+    };
+    EXPECT_EQ(1u, readText("   squares:\n      - [ 2, 4, 8, 8 ]\n").squares.size());
+    // A corner plus a side beyond an int would overflow every later intersection.
+    expectError("   squares:\n      - [ 2147483646, 4, 8, 8 ]\n", "lies outside");
+    expectError("   squares:\n      - [ 2, 4, 8 ]\n", "must be a list of 4 integers");
+    expectError("   squares:\n      - [ 2, 4, 8.5, 8 ]\n", "must be a list of 4 integers");
+    expectError("   squares:\n      - [ 1, 4, 8, 8 ]\n", "not CFA-aligned");
+    expectError("   grid_corners: [ 1, 2, 3 ]\n   squares:\n      - [ 2, 4, 8, 8 ]\n", "grid_corners");
+    expectError("   grid_corners: hello\n   squares:\n      - [ 2, 4, 8, 8 ]\n", "grid_corners");
+    expectError("   squares:\n      - [ 2, 4, 8, 8 ]\n   squares:\n      - [ 2, 4, 8, 8 ]\n",
+                "appears twice");
 }
 
 } // namespace

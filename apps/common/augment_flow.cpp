@@ -67,6 +67,16 @@ void requireFinishedBy(const std::string& out, const std::string& input, uint64_
 
 } // namespace
 
+Scene readSceneFile(const std::string& path)
+{
+    cv::FileStorage fs = openYaml(path, "scene");
+    try {
+        return Scene::read(fs["scene"]);
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error("'" + path + "': " + e.err);
+    }
+}
+
 AugmentResult augmentFiles(const AugmentOptions& o)
 {
     if (o.inputs.empty())
@@ -79,12 +89,7 @@ AugmentResult augmentFiles(const AugmentOptions& o)
     Scene fixedScene;
     RandomScenePolicy policy;
     if (!o.scene.empty()) {
-        cv::FileStorage fs = openYaml(o.scene, "scene");
-        try {
-            fixedScene = Scene::read(fs["scene"]);
-        } catch (const cv::Exception& e) {
-            throw std::runtime_error("'" + o.scene + "': " + e.err);
-        }
+        fixedScene = readSceneFile(o.scene);
     } else {
         policy = RandomScenePolicy::load(o.policy);
     }

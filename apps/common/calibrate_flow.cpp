@@ -18,14 +18,39 @@ namespace rawgment_apps {
 
 using namespace cv::rawgment;
 
-CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
+CalibrationManifest readCalibrationManifest(const std::string& path)
 {
-    cv::FileStorage fs = openYaml(o.manifest, "calibration manifest");
+    cv::FileStorage fs = openYaml(path, "calibration manifest");
     const cv::FileNode root = fs["calibration_manifest"];
     if (!root.isMap() || !root["bursts"].isSeq() || root["bursts"].size() == 0)
-        throw std::runtime_error("'" + o.manifest +
+        throw std::runtime_error("'" + path +
                                  "': expected a map 'calibration_manifest' with a list 'bursts'");
-    const std::string base = directoryOf(o.manifest);
+    requireKnownKeys(root, {"patches", "bursts"}, "'" + path + "'");
+    const std::string base = directoryOf(path);
+    CalibrationManifest manifest;
+    const cv::FileNode patches = root["patches"];
+    if (!patches.empty() && !patches.isString())
+        throw std::runtime_error("'" + path +
+                                 "': 'patches' must be \"detect\" or the path of a chart patches "
+                                 "file");
+    const std::string value = patches.empty() ? std::string("detect") : std::string(patches);
+    manifest.patches = value == "detect" ? value : resolvePath(base, value);
+    for (const cv::FileNode& b : root["bursts"]) {
+        const std::string where = cv::format("'%s' burst %zu", path.c_str(), manifest.bursts.size() + 1);
+        requireKnownKeys(b, {"gain_db", "level", "files"}, where);
+        if (b["gain_db"].empty() || !(b["gain_db"].isReal() || b["gain_db"].isInt()))
+            throw std::runtime_error(where + ": 'gain_db' is missing or not a number");
+        const double gainDb = double(b["gain_db"]);
+        if (!std::isfinite(gainDb))
+            throw std::runtime_error(where + ": 'gain_db' is not finite");
+        manifest.bursts.push_back({gainDb, readFileList(b["files"], base, where)});
+    }
+    return manifest;
+}
+
+CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
+{
+    const CalibrationManifest manifest = readCalibrationManifest(o.manifest);
     prepareOutputDirectory(o.outDir);
     const std::string modelPath = o.outDir + "/noise_model.yml",
                       reportPath = o.outDir + "/calibration_report.yml",
@@ -44,24 +69,12 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         refuseExisting(finished);
 
     CalibrateResult result;
-    struct BurstSpec
-    {
-        double gainDb;
-        std::vector<std::string> files;
-    };
-    std::vector<BurstSpec> specs;
+    const std::vector<CalibrationManifest::Burst>& specs = manifest.bursts;
     size_t totalFrames = 0;
-    requireKnownKeys(root, {"patches", "bursts"}, "'" + o.manifest + "'");
-    for (const cv::FileNode& b : root["bursts"]) {
-        const std::string where = cv::format("'%s' burst %zu", o.manifest.c_str(), specs.size() + 1);
-        requireKnownKeys(b, {"gain_db", "level", "files"}, where);
-        if (b["gain_db"].empty() || !(b["gain_db"].isReal() || b["gain_db"].isInt()))
-            throw std::runtime_error(where + ": 'gain_db' is missing or not a number");
-        specs.push_back({double(b["gain_db"]), readFileList(b["files"], base, where)});
-        totalFrames += specs.back().files.size();
-    }
+    for (const CalibrationManifest::Burst& spec : specs)
+        totalFrames += spec.files.size();
     const std::vector<cv::Rect> squares =
-        manifestSquares(root["patches"], base, specs.front().files.front(), o.side, result.notes);
+        manifestSquares(manifest.patches, specs.front().files.front(), o.side, result.notes);
 
     // Shapiro-Wilk positions, the same in every burst: every k-th pixel of the squares, at most
     // shapiroPixels of them.
@@ -79,7 +92,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     CsvTable shapiro({"gain_db", "mean", "p_value", "W"});
     int gaussian = 0;
     ProgressBar progress("calibrate", totalFrames);
-    for (const BurstSpec& spec : specs) {
+    for (const CalibrationManifest::Burst& spec : specs) {
         const double gain = dbToLinearGain(spec.gainDb);
         std::unique_ptr<BurstStatistics> stats;
         cv::Mat series(int(spec.files.size()), int(tested.size()), CV_64F);
@@ -182,7 +195,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     if (!o.plots)
         return result;
     std::vector<double> gainsDb;
-    for (const BurstSpec& spec : specs)
+    for (const CalibrationManifest::Burst& spec : specs)
         if (std::none_of(gainsDb.begin(), gainsDb.end(),
                          [&](double g) { return std::abs(g - spec.gainDb) < 1e-9; }))
             gainsDb.push_back(spec.gainDb);

@@ -25,12 +25,7 @@ std::string yamlToString(const std::function<void(cv::FileStorage&)>& body)
 
 cv::FileStorage openYaml(const std::string& path, const char* what)
 {
-    if (!pathExists(path))
-        throw std::runtime_error(std::string("cannot open ") + what + " '" + path + "': no such file");
-    cv::FileStorage fs(path, cv::FileStorage::READ);
-    if (!fs.isOpened())
-        throw std::runtime_error(std::string("cannot open ") + what + " '" + path + "'");
-    return fs;
+    return openFileStorageForReading(path, what);
 }
 
 std::vector<std::string> readFileList(const cv::FileNode& node, const std::string& base,
@@ -53,7 +48,11 @@ void requireKnownKeys(const cv::FileNode& map, const std::vector<std::string>& v
 {
     if (!map.isMap())
         return;
-    for (const cv::FileNode& entry : map)
+    std::vector<std::string> seen;
+    for (const cv::FileNode& entry : map) {
+        if (std::find(seen.begin(), seen.end(), entry.name()) != seen.end())
+            throw std::runtime_error(where + ": key '" + entry.name() + "' appears twice");
+        seen.push_back(entry.name());
         if (std::find(valid.begin(), valid.end(), entry.name()) == valid.end()) {
             std::string list;
             for (const std::string& v : valid)
@@ -61,6 +60,7 @@ void requireKnownKeys(const cv::FileNode& map, const std::vector<std::string>& v
             throw std::runtime_error(where + ": unknown key '" + entry.name() + "' (valid keys: " + list +
                                      ")");
         }
+    }
 }
 
 void refuseExisting(const std::vector<std::string>& outputs)
@@ -71,14 +71,11 @@ void refuseExisting(const std::vector<std::string>& outputs)
                 "'" + p + "' already exists; outputs are never overwritten (choose another --out)");
 }
 
-// Squares from a manifest's `patches` entry: a file written by writeChartPatches(), or "detect".
-std::vector<cv::Rect> manifestSquares(const cv::FileNode& node, const std::string& base,
-                                      const std::string& firstFrame, int side,
+std::vector<cv::Rect> manifestSquares(const std::string& patches, const std::string& firstFrame, int side,
                                       std::vector<std::string>& notes)
 {
-    const std::string value = node.empty() ? std::string("detect") : std::string(node);
-    if (value != "detect")
-        return rawgment_helpers::readChartPatches(resolvePath(base, value)).squares;
+    if (patches != "detect")
+        return rawgment_helpers::readChartPatches(patches).squares;
     const LoadedMosaic m = loadMosaicFile(firstFrame);
     RawImage image;
     image.mosaic = m.mosaic;
@@ -90,14 +87,14 @@ std::vector<cv::Rect> manifestSquares(const cv::FileNode& node, const std::strin
     cv::sort(sorted, sorted, cv::SORT_ASCENDING);
     const float p99 = sorted.at<float>(static_cast<int>(sorted.total() * 0.99));
     const double exposure = p99 > 0 ? std::min(64.0, std::max(1.0, 0.9 / p99)) : 1.0;
-    rawgment_helpers::ChartPatches patches;
+    rawgment_helpers::ChartPatches found;
     std::string why;
     if (!rawgment_helpers::findChartPatches(rawgment_helpers::renderDetectionPreview(image, exposure), side,
-                                            patches, why))
+                                            found, why))
         throw std::runtime_error("'" + firstFrame + "': " + why);
     notes.push_back(
         cv::format("patches detected with cv::mcc on %s (exposure x%.2f)", firstFrame.c_str(), exposure));
-    return patches.squares;
+    return found.squares;
 }
 
 LoadedMosaic loadMosaicFile(const std::string& path)

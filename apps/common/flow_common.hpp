@@ -14,7 +14,7 @@ namespace rawgment_apps {
 
 //! A YAML document built with a FileStorage, as text.
 std::string yamlToString(const std::function<void(cv::FileStorage&)>& body);
-//! Opens a YAML/JSON file for reading; throws std::runtime_error naming `what` and the path.
+//! Opens a YAML/JSON file for reading (cv::rawgment::openFileStorageForReading: errors name the file).
 cv::FileStorage openYaml(const std::string& path, const char* what);
 //! A manifest's non-empty list of files, resolved against `base`; errors name `where`.
 std::vector<std::string> readFileList(const cv::FileNode& node, const std::string& base,
@@ -24,10 +24,9 @@ void requireKnownKeys(const cv::FileNode& map, const std::vector<std::string>& v
                       const std::string& where);
 //! Throws when any of the outputs exists: outputs are never overwritten.
 void refuseExisting(const std::vector<std::string>& outputs);
-/** Squares from a manifest's `patches` entry: a file written by writeChartPatches(), or "detect" (cv::mcc
- * on the first frame, noted in `notes`). */
-std::vector<cv::Rect> manifestSquares(const cv::FileNode& node, const std::string& base,
-                                      const std::string& firstFrame, int side,
+/** Squares from a manifest's `patches` entry: the path of a file written by writeChartPatches(), or
+ * "detect" (cv::mcc on the first frame, noted in `notes`). */
+std::vector<cv::Rect> manifestSquares(const std::string& patches, const std::string& firstFrame, int side,
                                       std::vector<std::string>& notes);
 
 } // namespace rawgment_apps

@@ -68,6 +68,20 @@ struct CalibrateResult
     int shapiroTested = 0;
 };
 
+//! What a calibration manifest says, checked: every key known, gains finite, no file listed twice.
+struct CalibrationManifest
+{
+    struct Burst
+    {
+        double gainDb;
+        std::vector<std::string> files; //!< resolved against the manifest's folder
+    };
+    std::vector<Burst> bursts; //!< at least one, each with at least one file
+    std::string patches;       //!< "detect", or the resolved path of a chart patches file
+};
+//! Reads a calibration manifest; throws std::runtime_error or cv::Exception naming the file.
+CalibrationManifest readCalibrationManifest(const std::string& path);
+
 CalibrateResult calibrateFromManifest(const CalibrateOptions& options);
 
 // ---------------------------------------------------------------------------------------------------
@@ -122,6 +136,8 @@ struct AugmentResult
 };
 
 AugmentResult augmentFiles(const AugmentOptions& options);
+//! The scene of a scene file (a map `scene`, as Scene::write() writes it); errors name the file.
+cv::rawgment::Scene readSceneFile(const std::string& path);
 
 //! An sRGB-like 8-bit preview of a mosaic (tone curve gamma 2.2 with the sRGB toe, white balance 1).
 cv::Mat previewOf(const cv::Mat& mosaic, const cv::rawgment::RawFormat& format, double exposure = 1.0);

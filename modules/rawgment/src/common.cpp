@@ -7,8 +7,8 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
-#include <regex>
 #include <sstream>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace cv {
@@ -86,8 +86,14 @@ void rejectUnknownKeys(const FileNode& map, const std::vector<const char*>& vali
 {
     if (!map.isMap())
         return;
+    std::vector<std::string> seen;
     for (const FileNode& entry : map) {
         const std::string key = entry.name();
+        // OpenCV keeps both entries of a repeated key and a lookup finds one: which value counts would be
+        // a guess.
+        if (std::find(seen.begin(), seen.end(), key) != seen.end())
+            CV_Error(Error::StsParseError, format("key '%s' appears twice", key.c_str()));
+        seen.push_back(key);
         if (std::none_of(valid.begin(), valid.end(), [&](const char* v) { return key == v; })) {
             std::string list;
             for (const char* v : valid)
@@ -127,12 +133,57 @@ bool fileExists(const String& path)
     return ::access(path.c_str(), F_OK) == 0;
 }
 
-void rejectWrappingIntegers(const String& path)
+namespace {
+
+bool isBlank(char c)
 {
-    // A plain integer scalar: after a key's colon, a list's bracket or comma, or a block list's dash,
-    // and before the end of the line, a comma, a closing bracket or a comment. Quoted text is skipped.
-    static const std::regex integer(R"((?:^|[:\[,{]|^\s*-)\s*([-+]?\d+)\s*(?=$|[,\]}#]))");
-    std::istringstream lines(readTextFile(path));
+    return c == ' ' || c == '\t' || c == '\r';
+}
+
+/** The integer literal that starts at `line[i]` (after blanks, an optional sign and digits) when it is
+ * a whole scalar: followed by blanks and then the end of the line, a comma, a closing bracket or a
+ * comment. Empty otherwise. */
+std::string scalarIntegerAt(const std::string& line, size_t i)
+{
+    while (i < line.size() && isBlank(line[i]))
+        ++i;
+    const size_t start = i;
+    if (i < line.size() && (line[i] == '-' || line[i] == '+'))
+        ++i;
+    const size_t digits = i;
+    while (i < line.size() && line[i] >= '0' && line[i] <= '9')
+        ++i;
+    if (i == digits)
+        return std::string();
+    const size_t stop = i;
+    while (i < line.size() && isBlank(line[i]))
+        ++i;
+    if (i < line.size() && line[i] != ',' && line[i] != ']' && line[i] != '}' && line[i] != '#')
+        return std::string();
+    return line.substr(start, stop - start);
+}
+
+bool fitsInt(const std::string& literal)
+{
+    // More than ten significant digits never fit; fewer are parsed exactly.
+    size_t first = literal.find_first_not_of("+-");
+    first = literal.find_first_not_of('0', first);
+    if (first == std::string::npos)
+        return true;
+    if (literal.size() - first > 10)
+        return false;
+    const long long value = std::strtoll(literal.c_str(), nullptr, 10);
+    return value >= INT_MIN && value <= INT_MAX;
+}
+
+} // namespace
+
+void rejectWrappingIntegers(const String& path, const std::string& text)
+{
+    // A plain integer scalar follows the start of a line, a block list's dash, a key's colon, or a flow
+    // list's or map's bracket or comma. Quoted text is skipped. A hand-written scan, not std::regex,
+    // whose recursion overflows the stack on a long line.
+    std::istringstream lines(text);
     std::string line;
     for (int number = 1; std::getline(lines, line); ++number) {
         std::string unquoted;
@@ -148,17 +199,71 @@ void rejectWrappingIntegers(const String& path)
             }
             unquoted += c;
         }
-        for (std::sregex_iterator it(unquoted.begin(), unquoted.end(), integer), end; it != end; ++it) {
-            const std::string digits = (*it)[1];
-            errno = 0;
-            const long long value = std::strtoll(digits.c_str(), nullptr, 10);
-            if (errno == ERANGE || value > INT_MAX || value < INT_MIN)
-                CV_Error(
-                    Error::StsParseError,
-                    format("'%s' line %d: the integer %s does not fit 32 bits (OpenCV's reader would wrap "
-                           "it); write it as a real (%s.0) if that is the value meant",
-                           path.c_str(), number, digits.c_str(), digits.c_str()));
+        std::vector<size_t> starts = {0};
+        const size_t firstNonBlank = unquoted.find_first_not_of(" \t");
+        if (firstNonBlank != std::string::npos && unquoted[firstNonBlank] == '-')
+            starts.push_back(firstNonBlank + 1);
+        for (size_t i = 0; i < unquoted.size(); ++i)
+            if (unquoted[i] == ':' || unquoted[i] == '[' || unquoted[i] == ',' || unquoted[i] == '{')
+                starts.push_back(i + 1);
+        for (size_t start : starts) {
+            const std::string literal = scalarIntegerAt(unquoted, start);
+            if (!literal.empty() && !fitsInt(literal))
+                CV_Error(Error::StsParseError,
+                         format("'%s' line %d: the integer %s does not fit 32 bits (OpenCV's reader would "
+                                "wrap it); write it as a real (%s.0) if that is the value meant",
+                                path.c_str(), number, literal.c_str(), literal.c_str()));
         }
+    }
+}
+
+void rejectUnsupportedStructure(const String& path, const std::string& text)
+{
+    const size_t first = text.find_first_not_of(" \t\r\n");
+    if (first == std::string::npos)
+        CV_Error(Error::StsParseError, "'" + path + "' is empty");
+    if (text[first] == '<')
+        CV_Error(Error::StsParseError, "'" + path + "' looks like XML; this module reads YAML and JSON");
+    if (text[first] == '{')
+        return; // JSON
+    // OpenCV 4.6's YAML parser never returns when a stream goes on after its first document with a '-'
+    // that does not start '---' (test/fuzz found three such files, for example "---[][  -"). The files
+    // of this module hold one document whose root is a block collection starting a line of its own at
+    // column 0, which ends only at the end of the file: anything else is refused before OpenCV sees it.
+    std::istringstream lines(text);
+    std::string line;
+    bool header = false, content = false;
+    for (int number = 1; std::getline(lines, line); ++number) {
+        const size_t start = line.find_first_not_of(" \r");
+        if (start == std::string::npos || line[start] == '#')
+            continue;
+        const auto refuse = [&](const char* why) {
+            CV_Error(Error::StsParseError, format("'%s' line %d: %s (this module reads single-document YAML "
+                                                  "files whose root is a block map or list at column 0)",
+                                                  path.c_str(), number, why));
+        };
+        const bool marker = line.compare(start, 3, "---") == 0 || line.compare(start, 3, "...") == 0;
+        if (!content) {
+            if (line[start] == '%')
+                continue;
+            if (line.compare(start, 3, "---") == 0 && !header) {
+                const size_t rest = line.find_first_not_of(" \r", start + 3);
+                if (start != 0 || (rest != std::string::npos && line[rest] != '#'))
+                    refuse("content on the document's '---' line");
+                header = true;
+                continue;
+            }
+            if (marker)
+                refuse("a second document marker");
+            if (start != 0)
+                refuse("the root collection does not start at column 0");
+            if (line[start] == '[' || line[start] == '{')
+                refuse("the root is a flow collection");
+            content = true;
+            continue;
+        }
+        if (marker)
+            refuse("a document marker after the first document's content");
     }
 }
 
@@ -174,5 +279,49 @@ std::string readTextFile(const String& path)
 }
 
 } // namespace detail
+
+FileStorage openFileStorageForReading(const String& path, const String& what)
+{
+    if (path.empty())
+        CV_Error(Error::StsBadArg, "cannot open " + what + ": the path is empty");
+    // Checked first so that OpenCV does not log its own error for a missing file.
+    struct stat status;
+    if (::stat(path.c_str(), &status) != 0)
+        CV_Error(Error::StsError, "cannot open " + what + " '" + path +
+                                      "': " + (errno == ENOENT ? "no such file" : std::strerror(errno)));
+    if (S_ISDIR(status.st_mode))
+        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': it is a directory");
+    if (status.st_size > MAX_TEXT_FILE_BYTES)
+        CV_Error(Error::StsError, format("cannot open %s '%s': %lld bytes, more than the %lld a YAML or "
+                                         "JSON file of this module may have",
+                                         what.c_str(), path.c_str(), static_cast<long long>(status.st_size),
+                                         static_cast<long long>(MAX_TEXT_FILE_BYTES)));
+    // Read once and parsed from memory: the integer check and OpenCV's parser see the same bytes.
+    const std::string text = detail::readTextFile(path);
+    if (text.size() > size_t(MAX_TEXT_FILE_BYTES))
+        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': it grew while being read");
+    detail::rejectUnsupportedStructure(path, text);
+    detail::rejectWrappingIntegers(path, text);
+    FileStorage fs;
+    try {
+        // OpenCV tells YAML from JSON by the first bytes only: JSON must start with its brace, and YAML
+        // with a %YAML line, which hand-written files often lack.
+        const size_t first = text.find_first_not_of(" \t\r\n");
+        if (text[first] == '{')
+            fs.open(text.substr(first), FileStorage::READ | FileStorage::MEMORY);
+        else if (text.compare(0, 5, "%YAML") == 0)
+            fs.open(text, FileStorage::READ | FileStorage::MEMORY);
+        else
+            fs.open("%YAML:1.0\n" + text, FileStorage::READ | FileStorage::MEMORY);
+    } catch (const Exception& e) {
+        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.err);
+    } catch (const std::exception& e) {
+        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.what());
+    }
+    if (!fs.isOpened())
+        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "'");
+    return fs;
+}
+
 } // namespace rawgment
 } // namespace cv

@@ -46,7 +46,8 @@ int readOptionalIntField(const FileNode& node, const char* field, int fallback);
 //! A required list of exactly `n` numbers, named (and the element) in the error.
 std::vector<double> readRealList(const FileNode& node, const char* field, int n);
 /** Throws StsParseError naming the first key of `map` that is not in `valid`, and the valid ones: a
- * misspelled key (contrst_min) must not fall back to a default silently. */
+ * misspelled key (contrst_min) must not fall back to a default silently. A key that appears twice is an
+ * error too. */
 void rejectUnknownKeys(const FileNode& map, const std::vector<const char*>& valid);
 
 /** Writes `path` with a FileStorage, replacing it: the text is built in memory, then written by
@@ -58,9 +59,13 @@ int fileStorageFormatOf(const String& path);
 bool fileExists(const String& path);
 //! The whole content of a file; throws StsError naming it when it cannot be read.
 std::string readTextFile(const String& path);
-/** Throws StsParseError naming the file and line of an integer literal beyond 32 bits: OpenCV's YAML and
- * JSON readers keep integers in an int and silently wrap them (4294967297 reads as 1). */
-void rejectWrappingIntegers(const String& path);
+/** Throws StsParseError naming the file (`path`) and line of an integer literal of `text` beyond 32 bits:
+ * OpenCV's YAML and JSON readers keep integers in an int and silently wrap them (4294967297 reads as 1). */
+void rejectWrappingIntegers(const String& path, const std::string& text);
+/** Throws StsParseError naming the file (`path`) unless `text` is JSON or a single-document YAML stream
+ * whose root collection starts a line at column 0 (empty text and XML are refused too): OpenCV 4.6's
+ * YAML parser loops forever on some streams with more than one document. */
+void rejectUnsupportedStructure(const String& path, const std::string& text);
 
 //! The text that writeFileStorageAtomically() would write to `path`.
 template <typename Writer> std::string fileStorageText(const String& path, Writer&& writeBody)
@@ -85,20 +90,7 @@ template <typename Reader>
 auto loadFileStorage(const String& path, const char* topLevel, const char* what, Reader&& read)
     -> decltype(read(FileNode()))
 {
-    // Checked first so that OpenCV does not log its own error for a missing file.
-    if (!fileExists(path))
-        CV_Error(Error::StsError, String("cannot open ") + what + " '" + path + "': no such file");
-    rejectWrappingIntegers(path);
-    FileStorage fs;
-    try {
-        fs.open(path, FileStorage::READ);
-    } catch (const Exception& e) {
-        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.err);
-    } catch (const std::exception& e) {
-        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.what());
-    }
-    if (!fs.isOpened())
-        CV_Error(Error::StsError, String("cannot open ") + what + " '" + path + "'");
+    FileStorage fs = openFileStorageForReading(path, what);
     try {
         return read(fs[topLevel]);
     } catch (const Exception& e) {

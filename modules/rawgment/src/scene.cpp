@@ -32,9 +32,18 @@ void readMotionKernel(const FileNode& node, Mat& kernel)
                  format("scene: field 'motion_kernel' must be a matrix of 1 to %d rows and columns with "
                         "rows x cols numbers",
                         maxSide));
+    // One channel of floats, decided before OpenCV's reader sizes the matrix from `dt`.
+    const FileNode dt = node["dt"];
+    if (!dt.isString() || (dt.string() != "f" && dt.string() != "d"))
+        CV_Error(Error::StsParseError, "scene: field 'motion_kernel' must have dt 'f' or 'd' (one channel)");
     node >> kernel;
-    if (kernel.channels() != 1)
-        CV_Error(Error::StsParseError, "scene: field 'motion_kernel' must have one channel");
+    double lo = 0;
+    if (kernel.channels() != 1 || !checkRange(kernel))
+        CV_Error(Error::StsParseError, "scene: field 'motion_kernel' must be one channel of finite numbers");
+    minMaxLoc(kernel, &lo);
+    if (lo < 0 || !(sum(kernel)[0] > 0))
+        CV_Error(Error::StsParseError,
+                 "scene: field 'motion_kernel' must be non-negative with a positive sum");
 }
 
 } // namespace
@@ -61,8 +70,13 @@ Scene Scene::read(const FileNode& node)
     if (node.empty() || !node.isMap())
         CV_Error(Error::StsParseError, "scene: expected a map");
     Scene s;
-    node["shift"] >> s.shift;
     try {
+        const FileNode shift = node["shift"];
+        if (!shift.empty()) {
+            if (!shift.isSeq() || shift.size() != 2 || !shift[0].isInt() || !shift[1].isInt())
+                CV_Error(Error::StsParseError, "field 'shift' must be a list of two integers (x, y)");
+            s.shift = Point(static_cast<int>(shift[0]), static_cast<int>(shift[1]));
+        }
         detail::rejectUnknownKeys(node,
                                   {"shift", "scale", "contrast", "brightness", "gain_ratio", "motion_kernel",
                                    "alignment", "shot_sampling", "prior_mean", "blur_noise_sum"});

@@ -562,6 +562,19 @@ TEST(Augment, sceneAndPolicyFilesRejectWhatIsNotANumber)
     EXPECT_CV_ERROR_CONTAINS(Scene::read(badContrast["scene"]), "scene: field 'contrast[1]' is not a number");
     EXPECT_CV_ERROR_CONTAINS(readScene(", scale: big"), "scene: field 'scale' is not a number");
     EXPECT_CV_ERROR_CONTAINS(readScene(", alignment: 1e10"), "'alignment' must be an integer");
+    EXPECT_CV_ERROR_CONTAINS(readScene(", shift: here"), "field 'shift' must be a list of two integers");
+    EXPECT_CV_ERROR_CONTAINS(readScene(", shift: [ 1.5, 2 ]"),
+                             "field 'shift' must be a list of two integers");
+    // A kernel weight the reader cannot use (found by test/fuzz: -1e308 stored as a float is -inf).
+    const auto kernel = [](const char* dt, const char* data) {
+        return cv::format(", motion_kernel: !!opencv-matrix { rows: 1, cols: 3, dt: %s, data: [ %s ] }", dt,
+                          data);
+    };
+    EXPECT_EQ(readScene(kernel("f", "0.5, 1, 0.5")).motionKernel.cols, 3);
+    EXPECT_CV_ERROR_CONTAINS(readScene(kernel("f", "0.5, -1e308, 0.5")), "one channel of finite numbers");
+    EXPECT_CV_ERROR_CONTAINS(readScene(kernel("d", "0.5, -1, 0.5")), "non-negative with a positive sum");
+    EXPECT_CV_ERROR_CONTAINS(readScene(kernel("d", "0, 0, 0")), "non-negative with a positive sum");
+    EXPECT_CV_ERROR_CONTAINS(readScene(kernel("u", "1, 1, 1")), "must have dt 'f' or 'd'");
     FileStorage policy("%YAML:1.0\nscene_policy: {gain_db_max: loud}\n",
                        FileStorage::READ | FileStorage::MEMORY);
     EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy::read(policy["scene_policy"]),

@@ -69,8 +69,8 @@ public:
     }
     ~SmallDisk()
     {
-        if (!path_.empty())
-            ::umount(path_.c_str());
+        if (!path_.empty() && ::umount(path_.c_str()) == 0)
+            ::rmdir(path_.c_str());
     }
     const std::string& path() const { return path_; }
     const std::string& why() const { return why_; }
@@ -424,6 +424,80 @@ TEST(RawIo, removeTemporaryFilesInProgressRemovesAWriteInFlight)
     ASSERT_TRUE(seen) << "the 256 MB write ended before its temporary was seen";
     EXPECT_NE(error.find("big.bin"), std::string::npos) << error;
     EXPECT_TRUE(filesIn(dir).empty()) << "neither the temporary nor the target may remain";
+}
+
+//! Writes `text` to a file of the test's folder and returns its path.
+std::string textFile(const std::string& dir, const std::string& name, const std::string& text)
+{
+    const std::string path = dir + "/" + name;
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+    return path;
+}
+
+TEST(RawIo, openFileStorageForReadingRefusesStreamsOpenCvNeverFinishes)
+{
+    // Found by test/fuzz (minimised): OpenCV 4.6's YAML parser loops forever on each of these. Before the
+    // structure check this test hung until ctest's timeout.
+    const std::string dir = makeTempDir("raw_io_yaml_structure");
+    const char* const streams[] = {"%YAML:1.0\n---[][  -\n", "%YAML:1.0\n---%:1\n-\n-",
+                                   "%YAML:1.0\n s:0\n:  -\n"};
+    for (const char* text : streams)
+        EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(textFile(dir, "loop.yml", text), "test file"),
+                                 "single-document YAML");
+    // What the module writes still opens: a header, a block map at column 0, comments, flow lists.
+    EXPECT_TRUE(
+        openFileStorageForReading(
+            textFile(dir, "good.yml", "%YAML:1.0\n---\n# a comment\nm:\n   a: [ 1, 2 ]\n"), "test file")
+            .isOpened());
+    EXPECT_TRUE(
+        openFileStorageForReading(textFile(dir, "good.json", "{ \"m\": { \"a\": [ 1, 2 ] } }\n"), "test file")
+            .isOpened());
+    EXPECT_CV_ERROR_CONTAINS(
+        openFileStorageForReading(textFile(dir, "two.yml", "%YAML:1.0\n---\nm: 1\n...\n---\nn: 2\n"), "x"),
+        "a document marker after");
+    EXPECT_CV_ERROR_CONTAINS(
+        openFileStorageForReading(textFile(dir, "x.yml", "<?xml version=\"1.0\"?>\n"), "x"), "XML");
+    EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(textFile(dir, "empty.yml", " \n\n"), "x"), "is empty");
+    EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(dir, "x"), "it is a directory");
+    EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(dir + "/none.yml", "scene"),
+                             "cannot open scene '" + dir + "/none.yml': no such file");
+}
+
+TEST(RawIo, openFileStorageForReadingBoundsTheFileAndScansLongLines)
+{
+    const std::string dir = makeTempDir("raw_io_yaml_bounds");
+    // A sparse file one byte over the bound: refused from its size, before anything is read.
+    const std::string big = dir + "/big.yml";
+    {
+        std::ofstream f(big, std::ios::binary);
+        f.seekp(MAX_TEXT_FILE_BYTES);
+        f.put('\n');
+    }
+    EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(big, "x"), "more than the");
+    // Long lines, in files without the %YAML line (hand-written files often lack it). The integer scan
+    // must not recurse per character: std::regex did, and 300,000 blanks before a number crashed it.
+    const FileStorage blanks = openFileStorageForReading(
+        textFile(dir, "blanks.yml", "m:\n   a: " + std::string(300000, ' ') + "1\n"), "x");
+    EXPECT_EQ(1, int(blanks["m"]["a"]));
+    std::string line = "m:\n   a: [ 1";
+    for (int k = 0; k < 100000; ++k)
+        line += ", 7";
+    line += " ]\n";
+    const FileStorage fs = openFileStorageForReading(textFile(dir, "long.yml", line), "x");
+    EXPECT_EQ(100001u, fs["m"]["a"].size());
+    line.replace(line.size() - 4, 1, "4294967297"); // the last 7
+    EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(textFile(dir, "wrap.yml", line), "x"),
+                             "line 2: the integer 4294967297 does not fit 32 bits");
+}
+
+TEST(RawIo, aKeyThatAppearsTwiceIsAnError)
+{
+    // OpenCV keeps both entries and a lookup finds one of them: which value counts would be a guess.
+    const std::string dir = makeTempDir("raw_io_repeated_key");
+    const std::string path = textFile(dir, "model.yml",
+                                      "%YAML:1.0\n---\nnoise_model:\n   format_version: 1\n   alpha: 1.5\n"
+                                      "   sigma_d2: 0.7\n   sigma_d2: 2.5\n   sigma_r2: 0.8\n");
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(path), "key 'sigma_d2' appears twice");
 }
 
 } // namespace

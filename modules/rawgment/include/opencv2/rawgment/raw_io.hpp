@@ -82,6 +82,26 @@ CV_RAWGMENT_EXPORTS void writeFileAtomically(const String& path, const void* dat
  */
 CV_RAWGMENT_EXPORTS void removeTemporaryFilesInProgress();
 
+//! The largest YAML or JSON file openFileStorageForReading() (and so every reader of this module) opens.
+static constexpr long long MAX_TEXT_FILE_BYTES = 64LL << 20;
+
+/** @brief Opens a YAML or JSON file for reading the way every reader of this module does.
+ *
+ * What it adds to cv::FileStorage, which readers of your own files (manifests, job files) can use too:
+ * the file is at most MAX_TEXT_FILE_BYTES; an integer literal beyond 32 bits is an error naming the line
+ * (OpenCV's reader would wrap 4294967297 to 1); whatever OpenCV's parser throws, including the
+ * std::length_error of some malformed files, becomes a cv::Exception; and every error names the file.
+ *
+ * @param path the file (.yml, .yaml or .json; the content decides how it is parsed)
+ * @param what what the file is, for the messages ("scene", "calibration manifest")
+ * @return an opened storage
+ * @throws cv::Exception StsError for a missing, unreadable, oversized file or a directory;
+ * StsParseError for an empty file, XML, text that is not YAML or JSON, or a YAML stream that is not one
+ * document whose root collection starts a line at column 0 (OpenCV 4.6's parser never returns on some
+ * multi-document streams).
+ */
+CV_RAWGMENT_EXPORTS FileStorage openFileStorageForReading(const String& path, const String& what);
+
 /** @brief What a sidecar file says about a mosaic written by writeMosaic(). */
 struct CV_RAWGMENT_EXPORTS MosaicMetadata
 {

@@ -1,0 +1,787 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// A mutation fuzzer for every file reader of the module and the apps: it mutates valid files (made by
+// the module's own writers, plus the files of a corpus folder) for a bounded time and fails on anything
+// but a clean rejection: a crash or a sanitizer report (the process dies), an exception other than the
+// reader's documented one, an accepted file that breaks the reader's promises, or an input that takes
+// longer than a stated time. The allocation cap is the sanitizer's (max_allocation_size_mb, set by the
+// test). Deterministic: a seed and an iteration number name an input; --replay reads one file.
+#include "chart_patches.hpp"
+#include "flow_common.hpp"
+#include "pipeline.hpp"
+
+#include <opencv2/core/utils/logger.hpp>
+#include <opencv2/rawgment.hpp>
+
+#include <cxxabi.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <random>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <typeinfo>
+#include <vector>
+
+#if defined(__SANITIZE_ADDRESS__)
+#include <sanitizer/common_interface_defs.h>
+#endif
+
+namespace {
+
+using namespace cv::rawgment;
+namespace fs = std::filesystem;
+
+// ---------------------------------------------------------------------------------------------------
+// Files.
+
+std::string readBytes(const std::string& path)
+{
+    std::ifstream f(path, std::ios::binary);
+    if (!f)
+        throw std::runtime_error("cannot read '" + path + "'");
+    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+void writeBytes(const std::string& path, const std::string& bytes)
+{
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    f.write(bytes.data(), std::streamsize(bytes.size()));
+    f.close();
+    if (!f)
+        throw std::runtime_error("cannot write '" + path + "'");
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Targets: what a reader is given, what it may throw, and what an accepted file must satisfy.
+
+enum class Errors
+{
+    LIBRARY, //!< cv::Exception only
+    APP,     //!< cv::Exception or a plain std::runtime_error (the apps' message for bad input)
+};
+
+struct Target
+{
+    std::string name;
+    std::string inputName; //!< the mutated file's name in the work folder (its extension matters)
+    bool binary;
+    Errors errors;
+    //! Makes the seeds (valid files) and whatever the reader needs beside the input, in `work`.
+    std::function<std::vector<std::string>(const std::string& work)> seeds;
+    //! Reads `input`; throws on rejection; returns a complaint when an accepted file breaks a promise.
+    std::function<std::string(const std::string& input)> read;
+};
+
+std::string checkModel(const NoiseModel& m)
+{
+    if (!(std::isfinite(m.alpha) && m.alpha >= 0 && std::isfinite(m.sigmaD2) && m.sigmaD2 >= 0 &&
+          std::isfinite(m.sigmaR2) && m.sigmaR2 >= 0))
+        return cv::format("accepted a model with alpha %g, sigma_d^2 %g, sigma_r^2 %g", m.alpha, m.sigmaD2,
+                          m.sigmaR2);
+    return std::string();
+}
+
+std::string checkFormat(const RawFormat& f)
+{
+    try {
+        f.validate();
+    } catch (const cv::Exception& e) {
+        return "accepted a format that does not validate: " + e.err;
+    }
+    return std::string();
+}
+
+std::string checkScene(const Scene& s)
+{
+    if (!std::isfinite(s.scale) || s.scale <= 0)
+        return cv::format("accepted a scene with scale %g", s.scale);
+    if (!s.motionKernel.empty() &&
+        (s.motionKernel.rows > MAX_MOTION_LENGTH || s.motionKernel.cols > MAX_MOTION_LENGTH ||
+         !cv::checkRange(s.motionKernel)))
+        return cv::format("accepted a %dx%d or non-finite motion kernel", s.motionKernel.cols,
+                          s.motionKernel.rows);
+    return std::string();
+}
+
+cv::Mat seedMosaic(cv::Size size, double white, uint64_t seed)
+{
+    cv::Mat m(size, CV_16UC1);
+    cv::RNG rng(seed);
+    rng.fill(m, cv::RNG::UNIFORM, 64, white);
+    return m;
+}
+
+std::vector<std::string> textSeeds(const std::string& work, const std::string& stem,
+                                   const std::function<void(const std::string&)>& save)
+{
+    std::vector<std::string> seeds;
+    for (const char* ext : {".yml", ".json"}) {
+        const std::string path = work + "/seed_" + stem + ext;
+        fs::remove(path);
+        save(path);
+        seeds.push_back(readBytes(path));
+    }
+    return seeds;
+}
+
+NoiseModel seedModel()
+{
+    return NoiseModel(1.7, 2.5, 0.8);
+}
+
+std::vector<NoiseSample> seedSamples()
+{
+    // Three gains, means spread over the range, variances on the model's lines with a deterministic
+    // scatter: a report with every field filled.
+    const NoiseModel model = seedModel();
+    std::vector<NoiseSample> samples;
+    cv::RNG rng(5);
+    for (double gain : {1.0, 2.0, 4.0})
+        for (int k = 0; k < 120; ++k) {
+            NoiseSample s;
+            s.gain = gain;
+            s.mean = 20.0 + 30.0 * k;
+            s.variance = model.variance(s.mean, gain) * (1.0 + 0.05 * rng.gaussian(1.0));
+            s.dof = 99;
+            s.channel = k % 4;
+            samples.push_back(s);
+        }
+    return samples;
+}
+
+Scene seedScene()
+{
+    Scene scene;
+    scene.shift = cv::Point(4, -2);
+    scene.scale = 1.02;
+    scene.jitter.contrast = cv::Vec4d(0.3, 0.31, 0.29, 0.3);
+    scene.jitter.brightness = 2.5;
+    scene.jitter.gainRatio = 2.0;
+    scene.motionKernel = linearMotionKernel(5, 30);
+    return scene;
+}
+
+std::vector<Target> targets(const std::string& dataDir)
+{
+    std::vector<Target> t;
+    t.push_back({"model", "input.yml", false, Errors::LIBRARY,
+                 [](const std::string& work) {
+                     return textSeeds(work, "model", [](const std::string& p) { seedModel().save(p); });
+                 },
+                 [](const std::string& in) { return checkModel(NoiseModel::load(in)); }});
+    t.push_back({"report", "input.yml", false, Errors::LIBRARY,
+                 [](const std::string& work) {
+                     const CalibrationReport report = calibrateNoiseModel(seedSamples());
+                     return textSeeds(work, "report", [&](const std::string& p) { report.save(p); });
+                 },
+                 [](const std::string& in) { return checkModel(CalibrationReport::load(in).model); }});
+    t.push_back({"policy", "input.yml", false, Errors::LIBRARY,
+                 [](const std::string& work) {
+                     RandomScenePolicy policy;
+                     policy.blurProbability = 1;
+                     return textSeeds(work, "policy", [&](const std::string& p) { policy.save(p); });
+                 },
+                 [](const std::string& in) {
+                     const RandomScenePolicy policy = RandomScenePolicy::load(in);
+                     // A loaded policy must draw a valid scene, quickly, for a small mosaic.
+                     const RawFormat format;
+                     const Scene scene = policy.draw(seedMosaic(cv::Size(16, 16), 4000, 1), format, 3);
+                     return checkScene(scene);
+                 }});
+    t.push_back({"scene", "input.yml", false, Errors::APP,
+                 [](const std::string&) {
+                     std::vector<std::string> seeds;
+                     for (int format : {cv::FileStorage::FORMAT_YAML, cv::FileStorage::FORMAT_JSON}) {
+                         cv::FileStorage out(format == cv::FileStorage::FORMAT_JSON ? ".json" : ".yml",
+                                             cv::FileStorage::WRITE | cv::FileStorage::MEMORY | format);
+                         seedScene().write(out, "scene");
+                         seeds.push_back(out.releaseAndGetString());
+                     }
+                     return seeds;
+                 },
+                 [](const std::string& in) { return checkScene(rawgment_apps::readSceneFile(in)); }});
+    t.push_back({"sidecar", "mosaic.png.yml", false, Errors::LIBRARY,
+                 [](const std::string& work) {
+                     // The mosaic stays; its sidecar is the input.
+                     const std::string seedDir = work + "/sidecar_seed";
+                     fs::remove_all(seedDir);
+                     fs::create_directories(seedDir);
+                     MosaicMetadata meta;
+                     meta.format.whiteLevel = 4095;
+                     meta.format.blackLevel = cv::Vec4d(64, 64, 64, 64);
+                     meta.hasScene = true;
+                     meta.scene = seedScene();
+                     meta.seed = 77;
+                     meta.source = "frame_000.dng";
+                     const cv::Mat mosaic = seedMosaic(cv::Size(16, 12), 4095, 2);
+                     writeMosaic(seedDir + "/mosaic.png", mosaic, meta);
+                     fs::copy_file(seedDir + "/mosaic.png", work + "/mosaic.png",
+                                   fs::copy_options::overwrite_existing);
+                     return std::vector<std::string>{readBytes(seedDir + "/mosaic.png.yml")};
+                 },
+                 [](const std::string& in) {
+                     cv::Mat mosaic;
+                     const MosaicMetadata meta = readMosaic(in.substr(0, in.size() - 4), mosaic);
+                     std::string why = checkFormat(meta.format);
+                     if (why.empty() && meta.hasScene)
+                         why = checkScene(meta.scene);
+                     return why;
+                 }});
+    t.push_back({"chart_patches", "input.yml", false, Errors::LIBRARY,
+                 [](const std::string& work) {
+                     rawgment_helpers::ChartPatches patches;
+                     patches.gridCorners = {{0, 0}, {100, 0}, {100, 60}, {0, 60}};
+                     patches.squares = {{2, 2, 8, 8}, {20, 2, 8, 8}, {2, 20, 24, 24}};
+                     const std::string path = work + "/seed_patches.yml";
+                     fs::remove(path);
+                     rawgment_helpers::writeChartPatches(path, patches);
+                     return std::vector<std::string>{readBytes(path)};
+                 },
+                 [](const std::string& in) {
+                     const rawgment_helpers::ChartPatches p = rawgment_helpers::readChartPatches(in);
+                     for (const cv::Rect& r : p.squares)
+                         if (r.width <= 0 || r.height <= 0 || r.x < 0 || r.y < 0)
+                             return std::string("accepted a square outside the first quadrant");
+                     return std::string();
+                 }});
+    t.push_back({"manifest", "input.yml", false, Errors::APP,
+                 [](const std::string& work) {
+                     rawgment_helpers::ChartPatches patches;
+                     patches.squares = {{2, 2, 8, 8}, {20, 2, 8, 8}};
+                     const std::string path = work + "/patches.yml";
+                     fs::remove(path);
+                     rawgment_helpers::writeChartPatches(path, patches);
+                     const std::string yaml =
+                         "%YAML:1.0\n---\ncalibration_manifest:\n"
+                         "   patches: patches.yml\n"
+                         "   bursts:\n"
+                         "      - { gain_db: 6., level: 0.3, files: [ a/f0.dng, a/f1.dng, "
+                         "a/f2.dng ] }\n"
+                         "      - gain_db: 12\n"
+                         "        files:\n"
+                         "           - b/f0.dng\n"
+                         "           - b/f1.dng\n"
+                         "           - b/f2.dng\n";
+                     const std::string json =
+                         "{\n  \"calibration_manifest\": {\n    \"patches\": \"detect\",\n"
+                         "    \"bursts\": [ { \"gain_db\": 24.0, \"files\": [ \"c/f0.png\", "
+                         "\"c/f1.png\", \"c/f2.png\" ] } ]\n  }\n}\n";
+                     return std::vector<std::string>{yaml, json};
+                 },
+                 [](const std::string& in) {
+                     const rawgment_apps::CalibrationManifest m = rawgment_apps::readCalibrationManifest(in);
+                     if (m.bursts.empty())
+                         return std::string("accepted a manifest without bursts");
+                     for (const auto& b : m.bursts)
+                         if (b.files.empty() || !std::isfinite(b.gainDb))
+                             return std::string("accepted a burst without files or with a non-finite gain");
+                     if (m.patches != "detect") {
+                         std::vector<std::string> notes;
+                         rawgment_apps::manifestSquares(m.patches, m.bursts.front().files.front(), 24, notes);
+                     }
+                     return std::string();
+                 }});
+    t.push_back({"raw", "input.dng", true, Errors::LIBRARY,
+                 [dataDir](const std::string& work) {
+                     std::vector<std::string> seeds;
+                     const CfaPattern patterns[] = {CFA_RGGB, CFA_GBRG};
+                     for (int k = 0; k < 2; ++k) {
+                         RawImage image;
+                         image.format.pattern = patterns[k];
+                         image.format.whiteLevel = k == 0 ? 65535 : 4095;
+                         image.format.blackLevel = cv::Vec4d::all(k == 0 ? 512 : 64);
+                         image.mosaic = seedMosaic(k == 0 ? cv::Size(32, 32) : cv::Size(40, 24),
+                                                   image.format.whiteLevel, 10 + k);
+                         image.iso = 400;
+                         image.exposureTime = 0.01;
+                         image.make = "Rawgment";
+                         image.model = "Fuzz seed";
+                         const std::string path = work + cv::format("/seed_%d.dng", k);
+                         fs::remove(path);
+                         writeDng(path, image);
+                         seeds.push_back(readBytes(path));
+                     }
+                     // Camera files, when the shared data is there: other containers, other decoders.
+                     if (!dataDir.empty() && fs::is_directory(dataDir))
+                         for (const char* name : {"RAW_KODAK_DC50.KDC", "RAW_CANON_D30_SRGB.CRW",
+                                                  "RAW_NIKON_D1.NEF", "colorchart.dng"})
+                             if (fs::exists(dataDir + "/" + name))
+                                 seeds.push_back(readBytes(dataDir + "/" + name));
+                     return seeds;
+                 },
+                 [](const std::string& in) {
+                     const RawImage image = readRaw(in);
+                     if (image.mosaic.empty() || image.mosaic.type() != CV_16UC1 || image.mosaic.rows % 2 ||
+                         image.mosaic.cols % 2)
+                         return std::string("accepted a file whose mosaic is empty, odd or not 16-bit");
+                     return checkFormat(image.format);
+                 }});
+    // A reader with a planted bug, so that a test proves the fuzzer reports what it must: it throws a
+    // std::out_of_range (not a cv::Exception) for any file shorter than its seed.
+    t.push_back({"canary", "input.txt", false, Errors::LIBRARY,
+                 [](const std::string&) {
+                     return std::vector<std::string>{"a canary: any shorter file is a planted bug\n"};
+                 },
+                 [](const std::string& in) {
+                     if (readBytes(in).size() < 44)
+                         throw std::out_of_range("the planted bug");
+                     return std::string();
+                 }});
+    return t;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Mutations.
+
+const std::vector<std::string>& textDictionary()
+{
+    static const std::vector<std::string> words = {"0",
+                                                   "-0",
+                                                   "1",
+                                                   "-1",
+                                                   "2",
+                                                   "3",
+                                                   "7",
+                                                   "1.5",
+                                                   "-2.5",
+                                                   "1e308",
+                                                   "-1e308",
+                                                   "1e-320",
+                                                   "4.9e-324",
+                                                   "nan",
+                                                   ".nan",
+                                                   ".NaN",
+                                                   "inf",
+                                                   ".inf",
+                                                   "-.inf",
+                                                   "Infinity",
+                                                   "4294967297",
+                                                   "2147483647",
+                                                   "-2147483648",
+                                                   "2147483648",
+                                                   "65535",
+                                                   "65536",
+                                                   "1048577",
+                                                   "46341",
+                                                   "1e9",
+                                                   "~",
+                                                   "null",
+                                                   "true",
+                                                   "\"\"",
+                                                   "\"x\"",
+                                                   "[]",
+                                                   "{}",
+                                                   "[ 1, 2 ]",
+                                                   "[ [ 1 ] ]",
+                                                   "{ a: 1 }",
+                                                   "!!opencv-matrix",
+                                                   "rows",
+                                                   "cols",
+                                                   "dt",
+                                                   "data",
+                                                   "d",
+                                                   "f",
+                                                   "u",
+                                                   "i",
+                                                   "format_version",
+                                                   "version",
+                                                   "%YAML:1.0",
+                                                   "---",
+                                                   ":",
+                                                   "- ",
+                                                   ",",
+                                                   "\n",
+                                                   "'"};
+    return words;
+}
+
+bool isTokenChar(char c)
+{
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-' || c == '+';
+}
+
+class Mutator
+{
+public:
+    Mutator(uint64_t seed, bool binary) : rng_(seed), binary_(binary) {}
+
+    std::string mutate(std::string data, const std::vector<std::string>& corpus)
+    {
+        const int count = 1 + int(below(4));
+        for (int k = 0; k < count; ++k)
+            data = mutateOnce(std::move(data), corpus);
+        return data;
+    }
+
+private:
+    uint64_t below(uint64_t n) { return n == 0 ? 0 : rng_() % n; }
+
+    std::string mutateOnce(std::string d, const std::vector<std::string>& corpus)
+    {
+        if (d.empty())
+            return binary_ ? std::string(1, char(below(256)))
+                           : textDictionary()[below(textDictionary().size())];
+        const size_t pos = below(d.size());
+        switch (below(binary_ ? 8 : 10)) {
+        case 0: // flip a bit
+            d[pos] = char(d[pos] ^ (1 << below(8)));
+            break;
+        case 1: // a random or boundary byte
+        {
+            static const unsigned char edge[] = {0, 1, 0x7f, 0x80, 0xff, ' ', '\n', '"', '[', '{'};
+            d[pos] = below(2) ? char(below(256)) : char(edge[below(sizeof edge)]);
+            break;
+        }
+        case 2: // delete a range
+            d.erase(pos, 1 + below(std::min<uint64_t>(64, d.size() - pos)));
+            break;
+        case 3: // duplicate a range elsewhere
+        {
+            const std::string piece = d.substr(pos, 1 + below(64));
+            d.insert(below(d.size() + 1), piece);
+            break;
+        }
+        case 4: // truncate
+            d.resize(pos);
+            break;
+        case 5: // splice with another corpus entry
+        {
+            const std::string& other = corpus[below(corpus.size())];
+            if (!other.empty())
+                d = d.substr(0, pos) + other.substr(below(other.size()));
+            break;
+        }
+        case 6: // binary: a boundary integer of 1, 2 or 4 bytes at any offset (sizes, offsets, counts)
+        case 7: {
+            if (!binary_) {
+                d.insert(pos, textDictionary()[below(textDictionary().size())]);
+                break;
+            }
+            static const uint32_t values[] = {
+                0,           1,           2,           0x7f,       0x80,    0xff,
+                0x100,       0x7fff,      0x8000,      0xffff,     0x10000, 0x7fffffff,
+                0x80000000u, 0xffffffffu, 0xfffffffeu, 0x40000000, 0x1000,  3};
+            const uint32_t v = values[below(sizeof values / sizeof values[0])];
+            const int width = 1 << below(3);
+            const bool bigEndian = below(2) == 1;
+            for (int b = 0; b < width && pos + size_t(b) < d.size(); ++b) {
+                const int shift = 8 * (bigEndian ? width - 1 - b : b);
+                d[pos + size_t(b)] = char((v >> shift) & 0xff);
+            }
+            break;
+        }
+        case 8: // text: replace a token by a dictionary word or a token of the same file
+        {
+            size_t start = pos;
+            while (start > 0 && isTokenChar(d[start - 1]))
+                --start;
+            size_t end = pos;
+            while (end < d.size() && isTokenChar(d[end]))
+                ++end;
+            std::string word;
+            if (below(3) == 0) {
+                const size_t at = below(d.size());
+                size_t a = at, b = at;
+                while (a > 0 && isTokenChar(d[a - 1]))
+                    --a;
+                while (b < d.size() && isTokenChar(d[b]))
+                    ++b;
+                word = d.substr(a, b - a);
+            } else {
+                word = textDictionary()[below(textDictionary().size())];
+            }
+            d.replace(start, end - start, word);
+            break;
+        }
+        default: // text: duplicate, drop or move a whole line
+        {
+            const size_t before = d.rfind('\n', pos);
+            const size_t lineStart = before == std::string::npos ? 0 : before + 1;
+            const size_t after = d.find('\n', pos);
+            const size_t lineEnd = after == std::string::npos ? d.size() : after + 1;
+            const std::string line = d.substr(lineStart, lineEnd - lineStart);
+            const int what = int(below(3)); // 0: duplicate, 1: drop, 2: move
+            if (what != 0)
+                d.erase(lineStart, lineEnd - lineStart);
+            if (what != 1) {
+                const size_t next = d.find('\n', below(d.size() + 1));
+                d.insert(next == std::string::npos ? d.size() : next + 1, line);
+            }
+            break;
+        }
+        }
+        return d;
+    }
+
+    std::mt19937_64 rng_;
+    bool binary_;
+};
+
+// ---------------------------------------------------------------------------------------------------
+// Running.
+
+char g_inputPath[4096];
+unsigned g_inputSeconds = 20;
+
+void reportHang(int)
+{
+    static const char a[] = "\nrawgment_fuzz: FAIL: one input took longer than the per-input limit; it is "
+                            "kept at ";
+    ssize_t ignored = ::write(2, a, sizeof a - 1);
+    ignored = ::write(2, g_inputPath, std::strlen(g_inputPath));
+    ignored = ::write(2, "\n", 1);
+    (void)ignored;
+    _exit(3);
+}
+
+#if defined(__SANITIZE_ADDRESS__)
+void reportDeath()
+{
+    std::fprintf(stderr, "\nrawgment_fuzz: FAIL: the process died reading the input kept at %s\n",
+                 g_inputPath);
+}
+#endif
+
+std::string typeName(const std::type_info& type)
+{
+    int status = 0;
+    char* name = abi::__cxa_demangle(type.name(), nullptr, nullptr, &status);
+    const std::string out = status == 0 && name ? name : type.name();
+    std::free(name);
+    return out;
+}
+
+//! The message of a rejection with the digits and paths blurred: distinct messages stand for distinct
+//! checks reached, which is what makes an input worth keeping as a new seed.
+std::string errorClass(const std::string& message)
+{
+    std::string out;
+    bool inQuote = false;
+    for (char c : message) {
+        if (c == '\'') {
+            inQuote = !inQuote;
+            out += c;
+            continue;
+        }
+        if (inQuote)
+            continue;
+        out += (c >= '0' && c <= '9') ? '#' : c;
+    }
+    return out.substr(0, 160);
+}
+
+enum class Outcome
+{
+    ACCEPTED,
+    REJECTED,
+    FAILED
+};
+
+Outcome runOne(const Target& target, const std::string& input, std::string& detail)
+{
+    try {
+        detail = target.read(input);
+        return detail.empty() ? Outcome::ACCEPTED : Outcome::FAILED;
+    } catch (const cv::Exception& e) {
+        detail = e.err;
+        return Outcome::REJECTED;
+    } catch (const std::exception& e) {
+        if (target.errors == Errors::APP && typeid(e) == typeid(std::runtime_error)) {
+            detail = e.what();
+            return Outcome::REJECTED;
+        }
+        detail = "threw " + typeName(typeid(e)) + " (" + e.what() + "), not " +
+                 (target.errors == Errors::APP ? "cv::Exception or std::runtime_error" : "cv::Exception");
+        return Outcome::FAILED;
+    } catch (...) {
+        detail = "threw something that is not a std::exception";
+        return Outcome::FAILED;
+    }
+}
+
+struct Options
+{
+    std::string target, work, corpus, dataDir, replay;
+    double seconds = 20;
+    long long iterations = -1;
+    uint64_t seed = 1;
+};
+
+void usage()
+{
+    std::cout << "rawgment_fuzz: mutates valid files and feeds them to one reader of cv::rawgment.\n"
+                 "  --target=NAME      model, report, policy, scene, sidecar, chart_patches, manifest, raw\n"
+                 "  --work=DIR         scratch folder (created; the input being read is kept there)\n"
+                 "  --seconds=S        time budget (default 20)\n"
+                 "  --iterations=N     stop after N inputs instead (for replaying a seed's sequence)\n"
+                 "  --seed=N           mutation seed (default 1): seed and iteration name an input\n"
+                 "  --corpus=DIR       more seeds: every file of DIR (regression inputs)\n"
+                 "  --data=DIR         camera RAW files for the raw target's seeds, when present\n"
+                 "  --input-seconds=S  longest time one input may take (default 20)\n"
+                 "  --replay=FILE      read FILE once with the target's reader and report (a sidecar\n"
+                 "                     must sit beside its mosaic, as in the work folder)\n"
+                 "Exit 0: every input was rejected with the documented exception or accepted intact.\n";
+}
+
+bool parse(int argc, char** argv, Options& o)
+{
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        const size_t eq = a.find('=');
+        const std::string key = a.substr(0, eq), value = eq == std::string::npos ? "" : a.substr(eq + 1);
+        if (key == "--help" || key == "-h") {
+            usage();
+            std::exit(0);
+        }
+        if (eq == std::string::npos) {
+            std::cerr << "rawgment_fuzz: '" << a << "' is not --key=value (see --help)\n";
+            return false;
+        }
+        try {
+            if (key == "--target")
+                o.target = value;
+            else if (key == "--work")
+                o.work = value;
+            else if (key == "--seconds")
+                o.seconds = std::stod(value);
+            else if (key == "--iterations")
+                o.iterations = std::stoll(value);
+            else if (key == "--seed")
+                o.seed = std::stoull(value);
+            else if (key == "--corpus")
+                o.corpus = value;
+            else if (key == "--data")
+                o.dataDir = value;
+            else if (key == "--input-seconds")
+                g_inputSeconds = unsigned(std::stoul(value));
+            else if (key == "--replay")
+                o.replay = value;
+            else {
+                std::cerr << "rawgment_fuzz: unknown option '" << key << "' (see --help)\n";
+                return false;
+            }
+        } catch (const std::exception&) {
+            std::cerr << "rawgment_fuzz: '" << value << "' is not a valid value for " << key << "\n";
+            return false;
+        }
+    }
+    if (o.target.empty() || (o.work.empty() && o.replay.empty())) {
+        std::cerr << "rawgment_fuzz: --target and --work (or --replay) are required (see --help)\n";
+        return false;
+    }
+    return true;
+}
+
+int fuzz(const Target& target, const Options& o)
+{
+    const std::string work = o.work + "/" + target.name;
+    fs::remove_all(work);
+    fs::create_directories(work);
+    std::vector<std::string> corpus = target.seeds(work);
+    const size_t generated = corpus.size();
+    if (!o.corpus.empty() && fs::is_directory(o.corpus))
+        for (const auto& entry : fs::directory_iterator(o.corpus))
+            if (entry.is_regular_file())
+                corpus.push_back(readBytes(entry.path().string()));
+    const std::string input = work + "/" + target.inputName;
+    std::snprintf(g_inputPath, sizeof g_inputPath, "%s", input.c_str());
+
+    // Every seed must be accepted: a reader that rejects its own writer's files tests nothing.
+    std::set<std::string> seen;
+    for (size_t k = 0; k < generated; ++k) {
+        writeBytes(input, corpus[k]);
+        std::string detail;
+        if (runOne(target, input, detail) != Outcome::ACCEPTED) {
+            std::cerr << "rawgment_fuzz: FAIL: " << target.name << " seed " << k
+                      << " is not accepted: " << detail << "\n";
+            return 1;
+        }
+    }
+    std::cout << "rawgment_fuzz: " << target.name << ": " << corpus.size() << " seeds (" << generated
+              << " made by the writers), budget " << o.seconds << " s, seed " << o.seed
+              << "; the input being "
+              << "read is always " << input << "\n"
+              << std::flush;
+
+    Mutator mutator(o.seed, target.binary);
+    const auto start = std::chrono::steady_clock::now();
+    long long iteration = 0, accepted = 0, rejected = 0;
+    const size_t maxCorpus = 400;
+    for (;; ++iteration) {
+        if (o.iterations >= 0
+                ? iteration >= o.iterations
+                : std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >=
+                      o.seconds)
+            break;
+        const std::string data = mutator.mutate(corpus[size_t(iteration) % corpus.size()], corpus);
+        writeBytes(input, data);
+        std::string detail;
+        ::alarm(g_inputSeconds);
+        const Outcome outcome = runOne(target, input, detail);
+        ::alarm(0);
+        if (outcome == Outcome::FAILED) {
+            const std::string kept = work + "/failure_" + target.inputName;
+            writeBytes(kept, data);
+            std::cerr << "rawgment_fuzz: FAIL: " << target.name << ", seed " << o.seed << ", iteration "
+                      << iteration << ": " << detail << "\n  the input is kept at " << kept << "\n";
+            return 1;
+        }
+        (outcome == Outcome::ACCEPTED ? accepted : rejected) += 1;
+        const std::string key = outcome == Outcome::ACCEPTED ? std::string("accepted") : errorClass(detail);
+        if (seen.insert(key).second || (outcome == Outcome::ACCEPTED && corpus.size() < maxCorpus))
+            if (corpus.size() < maxCorpus)
+                corpus.push_back(data);
+    }
+    std::cout << "rawgment_fuzz: " << target.name << ": PASS, " << iteration << " inputs (" << accepted
+              << " accepted, " << rejected << " rejected with " << seen.size()
+              << " distinct outcomes), corpus grew to " << corpus.size() << "\n";
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    Options o;
+    if (!parse(argc, argv, o))
+        return 2;
+    // The readers' own diagnostics would drown the summary.
+    cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+    const std::vector<Target> all = targets(o.dataDir);
+    const auto it = std::find_if(all.begin(), all.end(), [&](const Target& t) { return t.name == o.target; });
+    if (it == all.end()) {
+        std::cerr << "rawgment_fuzz: unknown target '" << o.target << "' (see --help)\n";
+        return 2;
+    }
+    ::signal(SIGALRM, reportHang);
+#if defined(__SANITIZE_ADDRESS__)
+    __sanitizer_set_death_callback(reportDeath);
+#endif
+    if (!o.replay.empty()) {
+        std::snprintf(g_inputPath, sizeof g_inputPath, "%s", o.replay.c_str());
+        std::string detail;
+        const Outcome outcome = runOne(*it, o.replay, detail);
+        std::cout << (outcome == Outcome::ACCEPTED   ? "accepted"
+                      : outcome == Outcome::REJECTED ? "rejected: "
+                                                     : "FAIL: ")
+                  << detail << "\n";
+        return outcome == Outcome::FAILED ? 1 : 0;
+    }
+    try {
+        return fuzz(*it, o);
+    } catch (const std::exception& e) {
+        std::cerr << "rawgment_fuzz: cannot set up the target: " << e.what() << "\n";
+        return 1;
+    }
+}
