@@ -13,6 +13,8 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <sys/mount.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -215,6 +217,41 @@ TEST(Apps, aRunRemovesTheTemporariesThatKilledRunsLeft)
     ASSERT_EQ(0, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("removed 1 temporary file(s)")) << r.output;
     EXPECT_FALSE(exists(dir + "/manifest.yml.tmp-" + std::to_string(gone) + "-0"));
+}
+
+TEST(Apps, anOutputFolderThatCannotBeWrittenIsRefusedBeforeAnyWork)
+{
+    const std::string dir = freshDir("unwritable");
+    const AppRun sim =
+        runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=3 --gains=6 --levels=0.5 --format=png");
+    ASSERT_EQ(0, sim.status) << sim.output;
+    // Root writes through permission bits: a read-only tmpfs is the folder root cannot write.
+    const std::string locked = dir + "/locked";
+    ASSERT_EQ(0, ::mkdir(locked.c_str(), 0755));
+    bool mounted = false;
+    if (::geteuid() == 0) {
+        if (::mount("tmpfs", locked.c_str(), "tmpfs", MS_RDONLY, "size=64k") != 0)
+            GTEST_SKIP() << "a read-only tmpfs cannot be mounted here: " << std::strerror(errno);
+        mounted = true;
+    } else {
+        ASSERT_EQ(0, ::chmod(locked.c_str(), 0555));
+    }
+    const AppRun calibrate =
+        runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + locked + "'");
+    cv::rawgment::RandomScenePolicy().save(dir + "/policy.yml");
+    const AppRun augment =
+        runApp("rawgment_augment", "--model='" + dir + "/sim/truth_noise_model.yml' --policy='" + dir +
+                                       "/policy.yml' --out='" + locked + "' '" + dir +
+                                       "/sim/g06dB_level0.50/frame_000.png'");
+    if (mounted)
+        ::umount(locked.c_str());
+    for (const AppRun* r : {&calibrate, &augment}) {
+        EXPECT_NE(0, r->status) << r->output;
+        EXPECT_NE(std::string::npos, r->output.find("the output folder '" + locked + "' cannot be written"))
+            << r->output;
+        // Refused before the work: no progress bar was drawn.
+        EXPECT_EQ(std::string::npos, r->output.find("1/")) << r->output;
+    }
 }
 
 TEST(Apps, simulateHonoursTheSeedInEveryBurst)

@@ -432,7 +432,10 @@ private:
         if (d.empty())
             return binary_ ? std::string(1, char(below(256)))
                            : textDictionary()[below(textDictionary().size())];
-        const size_t pos = below(d.size());
+        // Binary files: most mutations go to the first 4 KiB, where RAW containers keep their headers and
+        // directories; pixel data past them only changes pixel values.
+        const size_t pos =
+            binary_ && below(4) != 0 ? below(std::min<size_t>(d.size(), 4096)) : below(d.size());
         switch (below(binary_ ? 8 : 10)) {
         case 0: // flip a bit
             d[pos] = char(d[pos] ^ (1 << below(8)));
@@ -613,6 +616,7 @@ Outcome runOne(const Target& target, const std::string& input, std::string& deta
 struct Options
 {
     std::string target, work, corpus, dataDir, replay;
+    bool verbose = false;
     double seconds = 20;
     long long iterations = -1;
     uint64_t seed = 1;
@@ -629,6 +633,7 @@ void usage()
                  "  --corpus=DIR       more seeds: every file of DIR (regression inputs)\n"
                  "  --data=DIR         camera RAW files for the raw target's seeds, when present\n"
                  "  --input-seconds=S  longest time one input may take (default 20)\n"
+                 "  --verbose=1        print each new kind of outcome (what the reader said)\n"
                  "  --replay=FILE      read FILE once with the target's reader and report (a sidecar\n"
                  "                     must sit beside its mosaic, as in the work folder)\n"
                  "Exit 0: every input was rejected with the documented exception or accepted intact.\n";
@@ -665,6 +670,8 @@ bool parse(int argc, char** argv, Options& o)
                 o.dataDir = value;
             else if (key == "--input-seconds")
                 g_inputSeconds = unsigned(std::stoul(value));
+            else if (key == "--verbose")
+                o.verbose = value != "0";
             else if (key == "--replay")
                 o.replay = value;
             else {
@@ -690,6 +697,7 @@ int fuzz(const Target& target, const Options& o)
     fs::create_directories(work);
     std::vector<std::string> corpus = target.seeds(work);
     const size_t generated = corpus.size();
+    std::vector<std::string> accepted = corpus;
     if (!o.corpus.empty() && fs::is_directory(o.corpus))
         for (const auto& entry : fs::directory_iterator(o.corpus))
             if (entry.is_regular_file())
@@ -716,7 +724,7 @@ int fuzz(const Target& target, const Options& o)
 
     Mutator mutator(o.seed, target.binary);
     const auto start = std::chrono::steady_clock::now();
-    long long iteration = 0, accepted = 0, rejected = 0;
+    long long iteration = 0, acceptedCount = 0, rejectedCount = 0;
     const size_t maxCorpus = 400;
     for (;; ++iteration) {
         if (o.iterations >= 0
@@ -724,7 +732,10 @@ int fuzz(const Target& target, const Options& o)
                 : std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >=
                       o.seconds)
             break;
-        const std::string data = mutator.mutate(corpus[size_t(iteration) % corpus.size()], corpus);
+        // Half the inputs start from a file the reader accepts (a seed or an accepted mutant), so that
+        // mutations reach the checks behind the parser; the rest from any kept input.
+        const std::vector<std::string>& pool = iteration % 2 == 0 ? accepted : corpus;
+        const std::string data = mutator.mutate(pool[size_t(iteration / 2) % pool.size()], corpus);
         writeBytes(input, data);
         std::string detail;
         ::alarm(g_inputSeconds);
@@ -737,14 +748,18 @@ int fuzz(const Target& target, const Options& o)
                       << iteration << ": " << detail << "\n  the input is kept at " << kept << "\n";
             return 1;
         }
-        (outcome == Outcome::ACCEPTED ? accepted : rejected) += 1;
+        (outcome == Outcome::ACCEPTED ? acceptedCount : rejectedCount) += 1;
         const std::string key = outcome == Outcome::ACCEPTED ? std::string("accepted") : errorClass(detail);
-        if (seen.insert(key).second || (outcome == Outcome::ACCEPTED && corpus.size() < maxCorpus))
-            if (corpus.size() < maxCorpus)
-                corpus.push_back(data);
+        const bool novel = seen.insert(key).second;
+        if (novel && o.verbose)
+            std::cout << "  new outcome at iteration " << iteration << ": " << key << "\n";
+        if ((novel || outcome == Outcome::ACCEPTED) && corpus.size() < maxCorpus)
+            corpus.push_back(data);
+        if (outcome == Outcome::ACCEPTED && accepted.size() < maxCorpus)
+            accepted.push_back(data);
     }
-    std::cout << "rawgment_fuzz: " << target.name << ": PASS, " << iteration << " inputs (" << accepted
-              << " accepted, " << rejected << " rejected with " << seen.size()
+    std::cout << "rawgment_fuzz: " << target.name << ": PASS, " << iteration << " inputs (" << acceptedCount
+              << " accepted, " << rejectedCount << " rejected with " << seen.size()
               << " distinct outcomes), corpus grew to " << corpus.size() << "\n";
     return 0;
 }

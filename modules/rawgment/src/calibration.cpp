@@ -431,6 +431,10 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
 
 void CalibrationReport::write(FileStorage& fs, const String& name) const
 {
+    // Any other value would be written as one of the two and read back as a method that never ran.
+    if (method != NOISE_FIT_JOINT && method != NOISE_FIT_TWO_STAGE)
+        CV_Error(Error::StsBadArg,
+                 format("CalibrationReport::write: method %d is not a NoiseFitMethod", int(method)));
     fs << name << "{";
     fs << "format_version" << FORMAT_VERSION;
     fs << "method" << (method == NOISE_FIT_JOINT ? "joint" : "two_stage");

@@ -4,6 +4,10 @@
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
 namespace cv {
 namespace rawgment {
 namespace {
@@ -275,6 +279,23 @@ TEST(Calibration, reportRoundTripsThroughYamlAndJson)
         EXPECT_EQ(back.notes, r.notes);
     }
     EXPECT_CV_ERROR_CONTAINS(CalibrationReport::load(dir + "/missing.yml"), "cannot open");
+    // A method outside the enumeration is neither written as one of the two nor read back as one.
+    CalibrationReport invalid = r;
+    invalid.method = static_cast<NoiseFitMethod>(7);
+    EXPECT_CV_ERROR_CONTAINS(invalid.save(dir + "/invalid.yml"), "method 7 is not a NoiseFitMethod");
+    std::string text;
+    {
+        std::ifstream f(dir + "/report.yml");
+        text.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+    }
+    const size_t at = text.find("method: joint");
+    ASSERT_NE(at, std::string::npos);
+    for (const char* value : {"method: 2", "method: JOINT", "method: [ joint ]"}) {
+        std::ofstream(dir + "/method.yml", std::ios::trunc)
+            << text.substr(0, at) << value << text.substr(at + std::strlen("method: joint"));
+        EXPECT_CV_ERROR_CONTAINS(CalibrationReport::load(dir + "/method.yml"),
+                                 "field 'method' must be 'joint'");
+    }
 }
 
 } // namespace
