@@ -113,6 +113,23 @@ struct ValidateResult
     std::string table; //!< Markdown
 };
 
+//! What a validation manifest says, checked: every key known, numbers where numbers belong.
+struct ValidationManifest
+{
+    struct Target
+    {
+        double factor;                  //!< exposure of the target relative to the bright burst, in (0, 1]
+        std::vector<std::string> files; //!< resolved against the manifest's folder
+    };
+    std::vector<std::string> bright; //!< the bright burst
+    std::vector<Target> targets;     //!< at least one
+    bool hasGainDb = false;          //!< whether the manifest gives the bursts' gain
+    double gainDb = 0;
+    std::string patches; //!< resolved path of a chart patches file; empty: every pixel
+};
+//! Reads a validation manifest; throws std::runtime_error or cv::Exception naming the file.
+ValidationManifest readValidationManifest(const std::string& path);
+
 ValidateResult validateConversion(const ValidateOptions& options);
 
 // ---------------------------------------------------------------------------------------------------

@@ -10,6 +10,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <stdexcept>
 
@@ -17,23 +18,51 @@ namespace rawgment_apps {
 
 using namespace cv::rawgment;
 
+ValidationManifest readValidationManifest(const std::string& path)
+{
+    cv::FileStorage fs = openYaml(path, "validation manifest");
+    const cv::FileNode root = fs["validation_manifest"];
+    if (!root.isMap() || !root["targets"].isSeq() || root["targets"].size() == 0)
+        throw std::runtime_error("'" + path +
+                                 "': expected a map 'validation_manifest' with 'bright' and a non-empty list "
+                                 "'targets'");
+    requireKnownKeys(root, {"patches", "gain_db", "bright", "targets"}, "'" + path + "'");
+    const std::string base = directoryOf(path);
+    ValidationManifest m;
+    const cv::FileNode gain = root["gain_db"];
+    if (!gain.empty()) {
+        if (!(gain.isReal() || gain.isInt()) || !std::isfinite(double(gain)))
+            throw std::runtime_error("'" + path + "': 'gain_db' must be a finite number");
+        m.hasGainDb = true;
+        m.gainDb = double(gain);
+    }
+    const cv::FileNode patches = root["patches"];
+    if (!patches.empty()) {
+        if (!patches.isString())
+            throw std::runtime_error("'" + path + "': 'patches' must be the path of a chart patches file");
+        m.patches = resolvePath(base, std::string(patches));
+    }
+    m.bright = readFileList(root["bright"], base, "'" + path + "' bright");
+    for (const cv::FileNode& t : root["targets"]) {
+        const std::string where = cv::format("'%s' target %zu", path.c_str(), m.targets.size() + 1);
+        requireKnownKeys(t, {"factor", "files"}, where);
+        const cv::FileNode factor = t["factor"];
+        if (!(factor.isReal() || factor.isInt()) || !(double(factor) > 0 && double(factor) <= 1))
+            throw std::runtime_error(where + ": 'factor' must be a number in (0, 1]");
+        m.targets.push_back({double(factor), readFileList(t["files"], base, where)});
+    }
+    return m;
+}
+
 ValidateResult validateConversion(const ValidateOptions& o)
 {
-    cv::FileStorage fs = openYaml(o.manifest, "validation manifest");
-    const cv::FileNode root = fs["validation_manifest"];
-    if (!root.isMap() || !root["targets"].isSeq())
-        throw std::runtime_error("'" + o.manifest +
-                                 "': expected a map 'validation_manifest' with 'bright' and "
-                                 "'targets'");
-    requireKnownKeys(root, {"patches", "gain_db", "bright", "targets"}, "'" + o.manifest + "'");
-    const std::string base = directoryOf(o.manifest);
+    const ValidationManifest manifest = readValidationManifest(o.manifest);
     const NoiseModel model = NoiseModel::load(o.model);
     prepareOutputDirectory(o.outDir);
     const std::string csvPath = o.outDir + "/validation.csv", mdPath = o.outDir + "/validation.md";
     refuseExisting({csvPath, mdPath});
 
-    const std::vector<std::string> brightFiles =
-        readFileList(root["bright"], base, "'" + o.manifest + "' bright");
+    const std::vector<std::string>& brightFiles = manifest.bright;
     std::vector<LoadedMosaic> bright;
     // Every frame of every burst must have the bright burst's size and type: the comparison reads them
     // pixel by pixel.
@@ -52,12 +81,11 @@ ValidateResult validateConversion(const ValidateOptions& o)
     for (const std::string& f : brightFiles)
         bright.push_back(loadMatching(f));
     RawFormat format = bright.front().format;
-    if (!root["gain_db"].empty())
-        format.gain = dbToLinearGain(double(root["gain_db"]));
-    cv::Mat mask(bright.front().mosaic.size(), CV_8U, cv::Scalar(root["patches"].empty() ? 255 : 0));
-    if (!root["patches"].empty())
-        for (const cv::Rect& s :
-             rawgment_helpers::readChartPatches(resolvePath(base, root["patches"])).squares)
+    if (manifest.hasGainDb)
+        format.gain = dbToLinearGain(manifest.gainDb);
+    cv::Mat mask(bright.front().mosaic.size(), CV_8U, cv::Scalar(manifest.patches.empty() ? 255 : 0));
+    if (!manifest.patches.empty())
+        for (const cv::Rect& s : rawgment_helpers::readChartPatches(manifest.patches).squares)
             mask(s & cv::Rect(cv::Point(), mask.size())).setTo(255);
 
     const auto statsOf = [&](const std::function<cv::Mat(size_t)>& frameAt, size_t frames, cv::Mat& mean,
@@ -81,16 +109,12 @@ ValidateResult validateConversion(const ValidateOptions& o)
     std::vector<Target> targets;
     const NoiseAlignment alignments[3] = {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR,
                                           NoiseAlignment::ACCOUNT_PRIOR};
-    ProgressBar progress("validate", root["targets"].size() * (3 + 1) * bright.size());
+    ProgressBar progress("validate", manifest.targets.size() * (3 + 1) * bright.size());
     CsvTable csv({"factor", "mean_low", "mean_high", "mean", "pixels", "real_variance", "none_variance",
                   "ignore_prior_variance", "account_prior_variance", "bright_mean", "bright_variance"});
-    for (const cv::FileNode& t : root["targets"]) {
-        requireKnownKeys(t, {"factor", "files"}, "'" + o.manifest + "' target");
-        const double factor = double(t["factor"]);
-        if (!(factor > 0 && factor <= 1))
-            throw std::runtime_error(
-                cv::format("'%s': target factor %g is outside (0, 1]", o.manifest.c_str(), factor));
-        const std::vector<std::string> files = readFileList(t["files"], base, "'" + o.manifest + "' target");
+    for (const ValidationManifest::Target& t : manifest.targets) {
+        const double factor = t.factor;
+        const std::vector<std::string>& files = t.files;
         cv::Mat realMean, realVar, realClip;
         statsOf(
             [&](size_t k) {

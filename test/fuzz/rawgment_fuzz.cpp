@@ -292,6 +292,42 @@ std::vector<Target> targets(const std::string& dataDir)
                      }
                      return std::string();
                  }});
+    t.push_back(
+        {"validation_manifest", "input.yml", false, Errors::APP,
+         [](const std::string& work) {
+             rawgment_helpers::ChartPatches patches;
+             patches.squares = {{2, 2, 8, 8}};
+             const std::string path = work + "/patches.yml";
+             fs::remove(path);
+             rawgment_helpers::writeChartPatches(path, patches);
+             const std::string yaml = "%YAML:1.0\n---\nvalidation_manifest:\n"
+                                      "   patches: patches.yml\n"
+                                      "   gain_db: 12.\n"
+                                      "   bright: [ bright/f0.dng, bright/f1.dng, bright/f2.dng ]\n"
+                                      "   targets:\n"
+                                      "      - { factor: 0.5, files: [ h/f0.dng, h/f1.dng, h/f2.dng ] }\n"
+                                      "      - factor: 1.0000000000000001e-01\n"
+                                      "        files:\n"
+                                      "           - t/f0.dng\n"
+                                      "           - t/f1.dng\n";
+             const std::string json = "{\n  \"validation_manifest\": {\n    \"bright\": [ \"b/0.png\", "
+                                      "\"b/1.png\" ],\n    \"targets\": [ { \"factor\": 0.2, \"files\": "
+                                      "[ \"t/0.png\", \"t/1.png\" ] } ]\n  }\n}\n";
+             return std::vector<std::string>{yaml, json};
+         },
+         [](const std::string& in) {
+             const rawgment_apps::ValidationManifest m = rawgment_apps::readValidationManifest(in);
+             if (m.bright.empty() || m.targets.empty())
+                 return std::string("accepted a manifest without a bright burst or targets");
+             for (const auto& t : m.targets)
+                 if (t.files.empty() || !(t.factor > 0 && t.factor <= 1))
+                     return std::string("accepted a target without files or with a factor outside (0, 1]");
+             if (m.hasGainDb && !std::isfinite(m.gainDb))
+                 return std::string("accepted a non-finite gain");
+             if (!m.patches.empty())
+                 rawgment_helpers::readChartPatches(m.patches);
+             return std::string();
+         }});
     t.push_back({"raw", "input.dng", true, Errors::LIBRARY,
                  [dataDir](const std::string& work) {
                      std::vector<std::string> seeds;
@@ -625,7 +661,8 @@ struct Options
 void usage()
 {
     std::cout << "rawgment_fuzz: mutates valid files and feeds them to one reader of cv::rawgment.\n"
-                 "  --target=NAME      model, report, policy, scene, sidecar, chart_patches, manifest, raw\n"
+                 "  --target=NAME      model, report, policy, scene, sidecar, chart_patches, manifest,\n"
+                 "                     validation_manifest, raw (canary: a planted bug)\n"
                  "  --work=DIR         scratch folder (created; the input being read is kept there)\n"
                  "  --seconds=S        time budget (default 20)\n"
                  "  --iterations=N     stop after N inputs instead (for replaying a seed's sequence)\n"

@@ -283,6 +283,9 @@ TEST(Calibration, reportRoundTripsThroughYamlAndJson)
     CalibrationReport invalid = r;
     invalid.method = static_cast<NoiseFitMethod>(7);
     EXPECT_CV_ERROR_CONTAINS(invalid.save(dir + "/invalid.yml"), "method 7 is not a NoiseFitMethod");
+    CalibrationParams params;
+    params.method = static_cast<NoiseFitMethod>(7); // defined: the enum's underlying type is int
+    EXPECT_CV_ERROR_CONTAINS(calibrateNoiseModel(cleanProtocol(), params), "method");
     std::string text;
     {
         std::ifstream f(dir + "/report.yml");

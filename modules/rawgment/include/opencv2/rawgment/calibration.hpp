@@ -139,7 +139,7 @@ CV_RAWGMENT_EXPORTS NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& sa
                                               const LineFitParams& params = LineFitParams());
 
 /** @brief How the cross-gain parameters are estimated. */
-enum NoiseFitMethod
+enum NoiseFitMethod : int
 {
     /** One fit of \f$ \sigma^2 = g\alpha\mu + g^2\sigma_d^2 + \sigma_r^2 \f$ over all samples of all gains,
      * each weighted by the inverse standard deviation of a sample variance, \f$ \sqrt{2/dof}\,\sigma^2 \f$

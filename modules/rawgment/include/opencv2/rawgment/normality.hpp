@@ -55,7 +55,7 @@ struct CV_RAWGMENT_EXPORTS ShapiroWilkResult
 CV_RAWGMENT_EXPORTS ShapiroWilkResult shapiroWilk(InputArray samples);
 
 /** @brief Where the series of a batch lie in its Mat. */
-enum ShapiroWilkLayout
+enum ShapiroWilkLayout : int
 {
     SW_SERIES_IN_COLUMNS = 0, //!< each column is one series of `rows` values
     SW_SERIES_IN_ROWS = 1     //!< each row is one series of `cols` values

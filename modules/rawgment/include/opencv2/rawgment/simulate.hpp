@@ -142,7 +142,7 @@ CV_RAWGMENT_EXPORTS ColorCheckerScene makeColorCheckerScene(const ColorCheckerOp
  * Every random number of the library comes from a registered family of counter-based streams; these
  * are the families of the apps and of programs built on the library, so that one seed reproduces a
  * whole run and no two uses of it share random numbers. */
-enum SeedPurpose
+enum SeedPurpose : int
 {
     SEED_SIMULATED_BURST = 16,            //!< a simulated burst; index: the burst's number in the run
     SEED_SIMULATED_VALIDATION_BURST = 17, //!< a validation burst; index: 0 bright, 1 and 2 the darker ones
