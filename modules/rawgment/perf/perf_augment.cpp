@@ -2,12 +2,16 @@
 // Augmentation of a 4000x3000 CV_16UC1 mosaic, all in one run:
 //   colour jitter (ACCOUNT_PRIOR), motion blur (length 13), scaling by 3%, a full random scene,
 //   the same colour jitter composed naively with OpenCV calls (convertTo, RNG::fill NORMAL, Mat
-//   arithmetic, sqrt), and a memcpy of the frame (the floor).
+//   arithmetic, sqrt), and a memcpy of the frame (the floor); and standard normals alone
+//   (fillStandardNormal). Every benchmark of the library runs once per CpuPath this CPU has
+//   (name suffix /baseline, /sse4.2, /avx2, /avx512), so the paths are compared in one run.
 #include "perf_common.hpp"
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
 #include <opencv2/rawgment/augment.hpp>
+#include <opencv2/rawgment/cpu.hpp>
+#include <opencv2/rawgment/simulate.hpp>
 
 #include <cstring>
 
@@ -105,6 +109,17 @@ void BM_Augment_randomScene(benchmark::State& state)
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
 }
 
+void BM_Augment_standardNormals(benchmark::State& state)
+{
+    Mat z(frame().size(), CV_32FC1);
+    uint64 seed = 0;
+    for (auto _ : state) {
+        fillStandardNormal(z, Size(), ++seed);
+        benchmark::DoNotOptimize(z.data);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(z.total()));
+}
+
 void BM_Augment_memcpy(benchmark::State& state)
 {
     Mat out(frame().size(), frame().type());
@@ -116,13 +131,38 @@ void BM_Augment_memcpy(benchmark::State& state)
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
 }
 
-BENCHMARK(BM_Augment_memcpy)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Augment_colorJitter)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Augment_colorJitterNaiveOpenCV)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Augment_motionBlur13)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Augment_scale103)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_Augment_randomScene)->Unit(benchmark::kMillisecond)->UseRealTime();
-
 } // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv)
+{
+    benchmark::RegisterBenchmark("BM_Augment_memcpy", BM_Augment_memcpy)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark("BM_Augment_colorJitterNaiveOpenCV", BM_Augment_colorJitterNaiveOpenCV)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    const std::pair<const char*, void (*)(benchmark::State&)> library[] = {
+        {"BM_Augment_standardNormals", BM_Augment_standardNormals},
+        {"BM_Augment_colorJitter", BM_Augment_colorJitter},
+        {"BM_Augment_motionBlur13", BM_Augment_motionBlur13},
+        {"BM_Augment_scale103", BM_Augment_scale103},
+        {"BM_Augment_randomScene", BM_Augment_randomScene}};
+    for (const auto& b : library)
+        for (CpuPath path : availableCpuPaths()) {
+            const auto run = b.second;
+            benchmark::RegisterBenchmark((std::string(b.first) + "/" + cpuPathName(path)).c_str(),
+                                         [run, path](benchmark::State& state) {
+                                             setCpuPath(path);
+                                             run(state);
+                                             setCpuPath(CpuPath::AUTO);
+                                         })
+                ->Unit(benchmark::kMillisecond)
+                ->UseRealTime();
+        }
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv))
+        return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}

@@ -55,7 +55,7 @@ inline float sampledNoise(AddedVariance v, float q, float z, detail::CounterRng&
 }
 
 // Clipped to [0, white]; 16-bit output adds 0.5 and truncates: the same bits in every vector width.
-template <typename T> inline T storeValue(float out, float white)
+template <typename T> inline __attribute__((always_inline)) T storeValue(float out, float white)
 {
     out = std::min(std::max(out, 0.0f), white);
     return std::is_same<T, ushort>::value ? static_cast<T>(static_cast<int>(out + 0.5f))

@@ -1,5 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // BurstStatistics: streaming per-pixel mean and variance of a burst (calibration topic).
+#include "cpu_dispatch.hpp"
 #include "opencv2/rawgment/calibration.hpp"
 #include "precomp.hpp"
 #include "random.hpp"
@@ -18,7 +19,8 @@ namespace {
 // Sums of d = v_k - v_0 and d^2 over frames 1..m-1 of a group, and min/max of the raw values, for n
 // columns. Multi-versioned (see random.hpp): these loops are the whole cost of burst statistics.
 template <typename T>
-inline void groupSumsBody(const T* const* rows, int m, int n, double* s1, double* s2, double* lo, double* hi)
+RAWGMENT_KERNEL void groupSumsBody(const T* const* rows, int m, int n, double* s1, double* s2, double* lo,
+                                   double* hi)
 {
     const T* first = rows[0];
     for (int c = 0; c < n; ++c) {
@@ -38,24 +40,30 @@ inline void groupSumsBody(const T* const* rows, int m, int n, double* s1, double
     }
 }
 
-RAWGMENT_HOT_KERNEL
-void groupSums(const ushort* const* rows, int m, int n, double* s1, double* s2, double* lo, double* hi)
+RAWGMENT_KERNEL void groupSumsKernel(const ushort* const* rows, int m, int n, double* s1, double* s2,
+                                     double* lo, double* hi)
 {
     groupSumsBody(rows, m, n, s1, s2, lo, hi);
 }
+RAWGMENT_DISPATCHED(void, groupSums,
+                    (const ushort* const* rows, int m, int n, double* s1, double* s2, double* lo, double* hi),
+                    (rows, m, n, s1, s2, lo, hi))
 
-RAWGMENT_HOT_KERNEL
-void groupSums(const float* const* rows, int m, int n, double* s1, double* s2, double* lo, double* hi)
+RAWGMENT_KERNEL void groupSumsKernel(const float* const* rows, int m, int n, double* s1, double* s2,
+                                     double* lo, double* hi)
 {
     groupSumsBody(rows, m, n, s1, s2, lo, hi);
 }
+RAWGMENT_DISPATCHED(void, groupSums,
+                    (const float* const* rows, int m, int n, double* s1, double* s2, double* lo, double* hi),
+                    (rows, m, n, s1, s2, lo, hi))
 
 // Chan et al.'s pairwise merge of a group's (mean, M2) into the running statistics, n columns. The
 // state S is float64 (default) or float32 (half the memory and traffic); the merge itself is float64.
 template <typename S>
-inline void mergeGroupColumnsBody(const double* first, const double* s1, const double* s2,
-                                  const double* blackOfColumn, int m, double wGroup, double wCross, S* mu,
-                                  S* acc, int n)
+RAWGMENT_KERNEL void mergeGroupColumnsBody(const double* first, const double* s1, const double* s2,
+                                           const double* blackOfColumn, int m, double wGroup, double wCross,
+                                           S* mu, S* acc, int n)
 {
     for (int c = 0; c < n; ++c) {
         const double groupMean = first[c] - blackOfColumn[c] + s1[c] / m;
@@ -66,19 +74,27 @@ inline void mergeGroupColumnsBody(const double* first, const double* s1, const d
     }
 }
 
-RAWGMENT_HOT_KERNEL
-void mergeGroupColumns(const double* first, const double* s1, const double* s2, const double* blackOfColumn,
-                       int m, double wGroup, double wCross, double* mu, double* acc, int n)
+RAWGMENT_KERNEL void mergeGroupColumnsKernel(const double* first, const double* s1, const double* s2,
+                                             const double* blackOfColumn, int m, double wGroup, double wCross,
+                                             double* mu, double* acc, int n)
 {
     mergeGroupColumnsBody(first, s1, s2, blackOfColumn, m, wGroup, wCross, mu, acc, n);
 }
+RAWGMENT_DISPATCHED(void, mergeGroupColumns,
+                    (const double* first, const double* s1, const double* s2, const double* blackOfColumn,
+                     int m, double wGroup, double wCross, double* mu, double* acc, int n),
+                    (first, s1, s2, blackOfColumn, m, wGroup, wCross, mu, acc, n))
 
-RAWGMENT_HOT_KERNEL
-void mergeGroupColumns(const double* first, const double* s1, const double* s2, const double* blackOfColumn,
-                       int m, double wGroup, double wCross, float* mu, float* acc, int n)
+RAWGMENT_KERNEL void mergeGroupColumnsKernel(const double* first, const double* s1, const double* s2,
+                                             const double* blackOfColumn, int m, double wGroup, double wCross,
+                                             float* mu, float* acc, int n)
 {
     mergeGroupColumnsBody(first, s1, s2, blackOfColumn, m, wGroup, wCross, mu, acc, n);
 }
+RAWGMENT_DISPATCHED(void, mergeGroupColumns,
+                    (const double* first, const double* s1, const double* s2, const double* blackOfColumn,
+                     int m, double wGroup, double wCross, float* mu, float* acc, int n),
+                    (first, s1, s2, blackOfColumn, m, wGroup, wCross, mu, acc, n))
 
 /** Folds a group of frames into the running mean and M2 of each pixel of rows [r0, r1).
  *

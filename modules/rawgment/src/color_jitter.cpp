@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Colour jitter: noise-accounted exposure, gain, contrast, brightness and hue (paper Eq. 11 and 13).
 #include "augment_steps.hpp"
+#include "cpu_dispatch.hpp"
 #include "noise_terms.hpp"
 
 #include <opencv2/imgproc.hpp>
@@ -29,7 +30,8 @@ struct JitterConstants
 // ACCOUNT_PRIOR the correction of the scaled prior), before any clipping. xm is the prior-mean estimate
 // (black-subtracted), pc the pixel's contrast. Eq. 13 for ACCOUNT_PRIOR; the model at the new mean and
 // gain for IGNORE_PRIOR.
-template <NoiseAlignment A> inline AddedVariance jitterVariance(float xm, float pc, const JitterConstants& k)
+template <NoiseAlignment A>
+RAWGMENT_KERNEL AddedVariance jitterVariance(float xm, float pc, const JitterConstants& k)
 {
     const float pg = k.pg, pg2 = k.pg * k.pg;
     if (A == NoiseAlignment::ACCOUNT_PRIOR) {
@@ -51,8 +53,8 @@ template <NoiseAlignment A> inline AddedVariance jitterVariance(float xm, float 
 // Rounding to 16 bits adds 0.5 and truncates (the value is clipped to [0, white] first): the same bits
 // in every vector width.
 template <typename T, NoiseAlignment A, bool kLocalMean>
-inline int jitterRowBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
-                         const float* black, const JitterConstants& k, int cols)
+RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
+                                  const float* black, const JitterConstants& k, int cols)
 {
     int bright = 0;
     for (int c = 0; c < cols; ++c) {
@@ -70,8 +72,9 @@ inline int jitterRowBody(const T* s, T* d, const float* z, const float* prior, c
 }
 
 template <typename T, bool kLocalMean>
-inline int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* prior, const float* pc,
-                                 const float* black, const JitterConstants& k, int cols)
+RAWGMENT_KERNEL int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* prior,
+                                          const float* pc, const float* black, const JitterConstants& k,
+                                          int cols)
 {
     switch (k.alignment) {
     case NoiseAlignment::ACCOUNT_PRIOR:
@@ -84,22 +87,29 @@ inline int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* 
     }
 }
 
-// One multi-versioned entry point per pixel type: GCC cannot clone a template.
-RAWGMENT_HOT_KERNEL
-int jitterRow(const ushort* s, ushort* d, const float* z, const float* prior, const float* pc,
-              const float* black, const JitterConstants& k, int cols)
+RAWGMENT_KERNEL int jitterRowKernel(const ushort* s, ushort* d, const float* z, const float* prior,
+                                    const float* pc, const float* black, const JitterConstants& k, int cols)
 {
     return prior ? jitterRowAnyAlignment<ushort, true>(s, d, z, prior, pc, black, k, cols)
                  : jitterRowAnyAlignment<ushort, false>(s, d, z, prior, pc, black, k, cols);
 }
 
-RAWGMENT_HOT_KERNEL
-int jitterRow(const float* s, float* d, const float* z, const float* prior, const float* pc,
-              const float* black, const JitterConstants& k, int cols)
+RAWGMENT_KERNEL int jitterRowKernel(const float* s, float* d, const float* z, const float* prior,
+                                    const float* pc, const float* black, const JitterConstants& k, int cols)
 {
     return prior ? jitterRowAnyAlignment<float, true>(s, d, z, prior, pc, black, k, cols)
                  : jitterRowAnyAlignment<float, false>(s, d, z, prior, pc, black, k, cols);
 }
+
+// One dispatched entry point per pixel type (cpu_dispatch.hpp).
+RAWGMENT_DISPATCHED(int, jitterRow,
+                    (const ushort* s, ushort* d, const float* z, const float* prior, const float* pc,
+                     const float* black, const JitterConstants& k, int cols),
+                    (s, d, z, prior, pc, black, k, cols))
+RAWGMENT_DISPATCHED(int, jitterRow,
+                    (const float* s, float* d, const float* z, const float* prior, const float* pc,
+                     const float* black, const JitterConstants& k, int cols),
+                    (s, d, z, prior, pc, black, k, cols))
 
 template <typename T, NoiseAlignment A>
 int jitterRowPoissonBody(const T* s, T* d, const float* z, const float* prior, const float* pc,

@@ -1,6 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "random.hpp"
 
+#include "cpu_dispatch.hpp"
+
 #include <algorithm>
 #include <cstring>
 #include <limits>
@@ -67,22 +69,43 @@ int64_t CounterRng::poisson(double lambda)
 
 namespace {
 
-// ln(x) for x in (0, 1], float32: exponent and mantissa split, then the Cephes polynomial for
-// ln(1 + f) on [sqrt(1/2) - 1, sqrt(2) - 1].
-inline float logPositive(float x)
+// The transform of Philox words into normals, W lanes at a time, W the native width of the path
+// (cpu_dispatch.hpp: 16 for AVX-512, 8 for AVX2, 4 below): every operation, the logarithm, the square
+// root and the sine and cosine polynomials included, is a vector operation at full width, and each
+// lane does the same operations on every path, so all give the same bits.
+
+template <int W> struct Lanes
 {
-    int32_t bits;
-    std::memcpy(&bits, &x, sizeof(bits));
-    int32_t e = ((bits >> 23) & 0xff) - 126;
-    bits = (bits & 0x007fffff) | 0x3f000000; // mantissa in [0.5, 1)
-    float m;
-    std::memcpy(&m, &bits, sizeof(m));
-    const bool small = m < 0.70710678f;
-    e -= small ? 1 : 0;
-    const float f = (small ? m + m : m) - 1.0f;
-    const float z = f * f;
-    float y = 7.0376836292e-2f;
-    y = y * f - 1.1514610310e-1f;
+    typedef float F __attribute__((vector_size(4 * W)));
+    typedef int32_t I __attribute__((vector_size(4 * W)));
+    typedef uint32_t U __attribute__((vector_size(4 * W)));
+};
+
+template <int W> RAWGMENT_KERNEL typename Lanes<W>::F sqrtLanes(typename Lanes<W>::F v)
+{
+    // IEEE square roots are exact to the rounding on every path; written per lane, compiled to
+    // (v)sqrtps.
+    typename Lanes<W>::F r;
+    for (int i = 0; i < W; ++i)
+        r[i] = __builtin_sqrtf(v[i]);
+    return r;
+}
+
+// ln(x) for x in (0, 1]: exponent and mantissa split, then the Cephes polynomial for ln(1 + f) on
+// [sqrt(1/2) - 1, sqrt(2) - 1].
+template <int W> RAWGMENT_KERNEL typename Lanes<W>::F logPositiveLanes(typename Lanes<W>::F x)
+{
+    typedef typename Lanes<W>::F F;
+    typedef typename Lanes<W>::I I;
+    const I bits = (I)x;
+    I e = ((bits >> 23) & 0xff) - 126;
+    const I mantissaBits = (bits & 0x007fffff) | 0x3f000000; // mantissa in [0.5, 1)
+    const F m = (F)mantissaBits;
+    const I small = m < 0.70710678f; // -1 where true
+    e += small;
+    const F f = (small ? m + m : m) - 1.0f;
+    const F z = f * f;
+    F y = f * 7.0376836292e-2f - 1.1514610310e-1f;
     y = y * f + 1.1676998740e-1f;
     y = y * f - 1.2420140846e-1f;
     y = y * f + 1.4249322787e-1f;
@@ -91,53 +114,69 @@ inline float logPositive(float x)
     y = y * f - 2.4999993993e-1f;
     y = y * f + 3.3333331174e-1f;
     y = y * f * z - 0.5f * z + f;
-    return y + static_cast<float>(e) * 0.693147180559945f;
+    return y + __builtin_convertvector(e, F) * 0.693147180559945f;
 }
 
-} // namespace
-
-RAWGMENT_HOT_KERNEL
-void fillGaussian(uint64_t seed, uint64_t stream, float* out, int n)
+/* W Box-Muller pairs from W words for the radius (w1) and W for the angle (w2). u1 in (0, 1] from 24
+ * bits (never 0: the logarithm is finite), through int32 (x86 before AVX-512 has no vector
+ * uint32 -> float). The angle: quadrant from the top 2 bits of w2, phi in [-pi/4, pi/4) from the next
+ * 22; any uniform angle serves Box-Muller, and this one needs only the short polynomials of
+ * |phi| <= pi/4. */
+template <int W>
+RAWGMENT_KERNEL void boxMullerLanes(const uint32_t* radiusWords, const uint32_t* angleWords, float* cosOut,
+                                    float* sinOut)
 {
-    // 64 values per chunk: 16 Philox blocks (two groups of 8), 32 Box-Muller pairs.
+    typedef typename Lanes<W>::F F;
+    typedef typename Lanes<W>::I I;
+    typedef typename Lanes<W>::U U;
+    U w1, w2;
+    std::memcpy(&w1, radiusWords, sizeof(w1));
+    std::memcpy(&w2, angleWords, sizeof(w2));
+    const F u1 = (__builtin_convertvector((I)(w1 >> 8), F) + 1.0f) * (1.0f / 16777216.0f);
+    const F radius = sqrtLanes<W>(-2.0f * logPositiveLanes<W>(u1));
+    const I q = (I)(w2 >> 30);
+    const F phi =
+        (__builtin_convertvector((I)((w2 >> 8) & 0x3fffff), F) * (1.0f / 4194304.0f) - 0.5f) * 1.5707963268f;
+    const F p2 = phi * phi;
+    const F s = phi + phi * p2 * (-1.6666654611e-1f + p2 * (8.3321608736e-3f + p2 * -1.9515295891e-4f));
+    const F c =
+        1.0f - 0.5f * p2 +
+        p2 * p2 * (4.166664568298827e-2f + p2 * (-1.388731625493765e-3f + p2 * 2.443315711809948e-5f));
+    // Rotate (c, s) by q quarter turns: (c, s), (-s, c), (-c, -s), (s, -c): swap on odd q, then flip
+    // the sign bits (q 1 and 2 negate the cosine, q 2 and 3 the sine), exactly as multiplying by -1.
+    const I odd = (q & 1) != 0;
+    const I signBit = I{} + std::numeric_limits<int32_t>::min();
+    const I cosSign = ((q == 1) | (q == 2)) & signBit;
+    const I sinSign = (q >= 2) & signBit;
+    const F cosRot = (F)((I)(odd ? s : c) ^ cosSign);
+    const F sinRot = (F)((I)(odd ? c : s) ^ sinSign);
+    const F zc = radius * cosRot, zs = radius * sinRot;
+    std::memcpy(cosOut, &zc, sizeof(zc));
+    std::memcpy(sinOut, &zs, sizeof(zs));
+}
+
+template <int W> RAWGMENT_KERNEL void fillGaussianKernel(uint64_t seed, uint64_t stream, float* out, int n)
+{
+    // 64 values per chunk: 16 Philox blocks (two groups of 8), 32 Box-Muller pairs: the first 32 words
+    // give the radii, the last 32 the angles; the cosines fill z[0..32), the sines z[32..64).
     const int kChunk = 64, kPairs = kChunk / 2;
-    uint32_t words[kChunk];
+    alignas(64) uint32_t words[kChunk];
+    alignas(64) float z[kChunk];
     const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
     for (int base = 0; base < n; base += kChunk) {
         const uint32_t block0 = static_cast<uint32_t>(base / 4);
         philox8Blocks(block0, stream, key, words);
         philox8Blocks(block0 + 8, stream, key, words + 32);
-        float z[kChunk];
-        for (int i = 0; i < kPairs; ++i) {
-            // u1 in (0, 1] from 24 bits (never 0: log is finite), through int32 (x86 before AVX-512
-            // has no vector uint32->float); the other word picks the angle.
-            const float u1 =
-                (static_cast<float>(static_cast<int32_t>(words[i] >> 8)) + 1.0f) * (1.0f / 16777216.0f);
-            const uint32_t a = words[kPairs + i];
-            const float radius = std::sqrt(-2.0f * logPositive(u1));
-            // The angle: quadrant from the top 2 bits, phi in [-pi/4, pi/4) from the next 22. Any
-            // uniform angle serves Box-Muller; this one needs only the short polynomials of |phi| <= pi/4.
-            const uint32_t q = a >> 30;
-            const float phi =
-                (static_cast<float>(static_cast<int32_t>((a >> 8) & 0x3fffff)) * (1.0f / 4194304.0f) - 0.5f) *
-                1.5707963268f;
-            const float p2 = phi * phi;
-            const float s =
-                phi + phi * p2 * (-1.6666654611e-1f + p2 * (8.3321608736e-3f + p2 * -1.9515295891e-4f));
-            const float c =
-                1.0f - 0.5f * p2 +
-                p2 * p2 *
-                    (4.166664568298827e-2f + p2 * (-1.388731625493765e-3f + p2 * 2.443315711809948e-5f));
-            // Rotate (c, s) by q quarter turns: (c, s), (-s, c), (-c, -s), (s, -c).
-            const bool odd = (q & 1) != 0;
-            const float cosRot = (odd ? s : c) * ((q == 1 || q == 2) ? -1.0f : 1.0f);
-            const float sinRot = (odd ? c : s) * (q >= 2 ? -1.0f : 1.0f);
-            z[i] = radius * cosRot;
-            z[kPairs + i] = radius * sinRot;
-        }
+        for (int h = 0; h < kPairs; h += W)
+            boxMullerLanes<W>(words + h, words + kPairs + h, z + h, z + kPairs + h);
         std::memcpy(out + base, z, sizeof(float) * static_cast<size_t>(std::min(kChunk, n - base)));
     }
 }
+
+} // namespace
+
+RAWGMENT_DISPATCHED_BY_WIDTH(void, fillGaussian, (uint64_t seed, uint64_t stream, float* out, int n),
+                             (seed, stream, out, n))
 
 } // namespace detail
 } // namespace rawgment

@@ -13,17 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-
-/* Hot loops are compiled for x86-64-v4 (AVX-512), x86-64-v3 (AVX2, FMA) and the baseline, and the
- * loader picks the best the CPU has (GCC function multi-versioning). The library is built with
- * -ffp-contract=off, and the loops never reassociate, so every version gives the same bits: output
- * depends on the seed only, not on the machine. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__) &&                 \
-    !defined(RAWGMENT_NO_MULTIVERSIONING)
-#define RAWGMENT_HOT_KERNEL __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define RAWGMENT_HOT_KERNEL
-#endif
+#include <cstring>
 
 namespace cv {
 namespace rawgment {
@@ -55,16 +45,15 @@ typedef uint64_t U64x8 __attribute__((vector_size(64)));
 
 /** The blocks (firstBlock + b, 0, stream) for b in 0..7, as philox4x32() computes them one by one:
  * word j of block b goes to words[8 j + b]. */
-inline void philox8Blocks(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key,
-                          uint32_t* words)
+inline __attribute__((always_inline)) void philox8Blocks(uint32_t firstBlock, uint64_t stream,
+                                                         const std::array<uint32_t, 2>& key, uint32_t* words)
 {
     const U64x8 low = {0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu,
                        0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu};
     const U64x8 zero = {};
-    U64x8 c0 = zero, c1 = zero, c2 = zero + static_cast<uint32_t>(stream),
+    const U64x8 lanes = {0, 1, 2, 3, 4, 5, 6, 7};
+    U64x8 c0 = (lanes + firstBlock) & low, c1 = zero, c2 = zero + static_cast<uint32_t>(stream),
           c3 = zero + static_cast<uint32_t>(stream >> 32);
-    for (int b = 0; b < 8; ++b)
-        c0[b] = firstBlock + static_cast<uint32_t>(b);
     uint64_t k0 = key[0], k1 = key[1];
     for (int round = 0; round < kPhiloxRounds; ++round) {
         const U64x8 p0 = (c0 & low) * kPhiloxM0;
@@ -76,12 +65,14 @@ inline void philox8Blocks(uint32_t firstBlock, uint64_t stream, const std::array
         k0 = (k0 + kPhiloxW0) & 0xffffffffu;
         k1 = (k1 + kPhiloxW1) & 0xffffffffu;
     }
-    for (int b = 0; b < 8; ++b) {
-        words[b] = static_cast<uint32_t>(c0[b]);
-        words[8 + b] = static_cast<uint32_t>(c1[b]);
-        words[16 + b] = static_cast<uint32_t>(c2[b]);
-        words[24 + b] = static_cast<uint32_t>(c3[b]);
-    }
+    // Narrowed as whole vectors (one vpmovqd, or shuffles), not lane by lane.
+    typedef uint32_t U32x8 __attribute__((vector_size(32)));
+    const U32x8 w0 = __builtin_convertvector(c0, U32x8), w1 = __builtin_convertvector(c1, U32x8),
+                w2 = __builtin_convertvector(c2, U32x8), w3 = __builtin_convertvector(c3, U32x8);
+    std::memcpy(words, &w0, sizeof(w0));
+    std::memcpy(words + 8, &w1, sizeof(w1));
+    std::memcpy(words + 16, &w2, sizeof(w2));
+    std::memcpy(words + 24, &w3, sizeof(w3));
 }
 
 // clang-format off

@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Resampling steps: noise-accounted motion blur and scaling (paper Eq. 15 with the step's weights).
 #include "augment_steps.hpp"
+#include "cpu_dispatch.hpp"
 #include "noise_terms.hpp"
 
 #include <algorithm>
@@ -77,8 +78,8 @@ void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, 
 
 // One kernel tap over a row: mean += w x, and for ACCOUNT_PRIOR shot += w (1 - w) max(x, 0) (the prior
 // mean is never negative), in one pass over the source row.
-RAWGMENT_HOT_KERNEL
-void addTapRow(float* mean, float* shot, const float* x, float w, float shotWeight, bool withShot, int n)
+RAWGMENT_KERNEL void addTapRowKernel(float* mean, float* shot, const float* x, float w, float shotWeight,
+                                     bool withShot, int n)
 {
     if (withShot) {
         for (int j = 0; j < n; ++j) {
@@ -90,12 +91,15 @@ void addTapRow(float* mean, float* shot, const float* x, float w, float shotWeig
             mean[j] += w * x[j];
     }
 }
+RAWGMENT_DISPATCHED(void, addTapRow,
+                    (float* mean, float* shot, const float* x, float w, float shotWeight, bool withShot,
+                     int n),
+                    (mean, shot, x, w, shotWeight, withShot, n))
 
 // mean[j] + N(0, v): v from the per-pixel shot sum and read-noise factor (ACCOUNT_PRIOR), from the
 // mean (IGNORE_PRIOR), or none; black added back, clipped to [0, white].
-RAWGMENT_HOT_KERNEL
-void finishResampledRow(float* mean, const float* shotSum, const float* readFactor, const float* z,
-                        const ResampleConstants& k, float black, int n)
+RAWGMENT_KERNEL void finishResampledRowKernel(float* mean, const float* shotSum, const float* readFactor,
+                                              const float* z, const ResampleConstants& k, float black, int n)
 {
     if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR) {
         for (int j = 0; j < n; ++j) {
@@ -113,6 +117,10 @@ void finishResampledRow(float* mean, const float* shotSum, const float* readFact
             mean[j] = std::min(std::max(mean[j] + black, 0.0f), k.white);
     }
 }
+RAWGMENT_DISPATCHED(void, finishResampledRow,
+                    (float* mean, const float* shotSum, const float* readFactor, const float* z,
+                     const ResampleConstants& k, float black, int n),
+                    (mean, shotSum, readFactor, z, k, black, n))
 
 template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int planeRow)
 {
@@ -324,9 +332,9 @@ BilinearAxis bilinearAxis(int planeSize, int phase, double scale)
 
 // Bilinear taps of one output row: mean, Eq. 15's shot sum and the read-noise factor 1 - sum w^2,
 // all per pixel because the weights change along the row.
-RAWGMENT_HOT_KERNEL
-void bilinearRow(const float* row0, const float* row1, float fy, const int* c0, const int* c1,
-                 const float* fx, float* mean, float* shot, float* readFactor, int n)
+RAWGMENT_KERNEL void bilinearRowKernel(const float* row0, const float* row1, float fy, const int* c0,
+                                       const int* c1, const float* fx, float* mean, float* shot,
+                                       float* readFactor, int n)
 {
     for (int j = 0; j < n; ++j) {
         const float a = row0[c0[j]], b = row0[c1[j]], c = row1[c0[j]], d = row1[c1[j]];
@@ -338,6 +346,10 @@ void bilinearRow(const float* row0, const float* row1, float fy, const int* c0, 
         readFactor[j] = 1 - (w00 * w00 + w01 * w01 + w10 * w10 + w11 * w11);
     }
 }
+RAWGMENT_DISPATCHED(void, bilinearRow,
+                    (const float* row0, const float* row1, float fy, const int* c0, const int* c1,
+                     const float* fx, float* mean, float* shot, float* readFactor, int n),
+                    (row0, row1, fy, c0, c1, fx, mean, shot, readFactor, n))
 
 template <typename T>
 void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const BilinearAxis* rows,

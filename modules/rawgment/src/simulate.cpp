@@ -212,6 +212,24 @@ void SensorSimulator::fixedPattern(OutputArray gainFactor, OutputArray offset, O
 static_assert(SEED_SIMULATED_BURST > static_cast<int>(detail::RandomStream::SCALE_POISSON),
               "the apps' seed purposes and the library's streams are one registry: their ids never meet");
 
+void fillStandardNormal(InputOutputArray _dst, Size size, uint64 seed)
+{
+    if (_dst.empty()) {
+        if (size.width <= 0 || size.height <= 0)
+            CV_Error(Error::StsBadArg,
+                     format("fillStandardNormal: size %dx%d is empty", size.width, size.height));
+        _dst.create(size, CV_32FC1);
+    }
+    if (_dst.type() != CV_32FC1)
+        CV_Error(Error::StsBadArg, "fillStandardNormal: dst type " + typeToString(_dst.type()) +
+                                       " is not supported; expected CV_32FC1");
+    Mat dst = _dst.getMat();
+    parallel_for_(Range(0, dst.rows), [&](const Range& rows) {
+        for (int r = rows.start; r < rows.end; ++r)
+            detail::fillGaussian(seed, static_cast<uint64_t>(r), dst.ptr<float>(r), dst.cols);
+    });
+}
+
 uint64 deriveSeed(uint64 seed, SeedPurpose purpose, uint64 index)
 {
     if (purpose < SEED_SIMULATED_BURST || purpose > SEED_STUDY)

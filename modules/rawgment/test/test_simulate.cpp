@@ -358,6 +358,33 @@ TEST(Simulate, derivedSeedsAreStableAndDistinctPerPurposeAndIndex)
     EXPECT_CV_ERROR_CONTAINS(deriveSeed(1, static_cast<SeedPurpose>(3), 0), "unknown purpose 3");
 }
 
+TEST(Simulate, fillStandardNormalIsStandardAndReproducible)
+{
+    Mat z;
+    fillStandardNormal(z, Size(512, 512), 42);
+    ASSERT_EQ(z.type(), CV_32FC1);
+    Scalar mean, stddev;
+    meanStdDev(z, mean, stddev);
+    // N = 2^18: the mean's standard error is 1/sqrt(N) = 0.002 and the variance's sqrt(2/N) = 0.0028;
+    // five of each.
+    EXPECT_NEAR(mean[0], 0.0, 0.01);
+    EXPECT_NEAR(stddev[0] * stddev[0], 1.0, 0.014);
+    const int saved = getNumThreads();
+    setNumThreads(1);
+    Mat again(512, 512, CV_32FC1);
+    fillStandardNormal(again, Size(), 42);
+    setNumThreads(saved);
+    EXPECT_EQ(0, norm(z, again, NORM_INF)) << "the same seed, other numbers on one thread";
+    // A row is its own stream: a narrower matrix holds the first numbers of each row.
+    Mat narrow;
+    fillStandardNormal(narrow, Size(100, 3), 42);
+    EXPECT_EQ(0, norm(narrow, z(Rect(0, 0, 100, 3)), NORM_INF));
+    Mat wrong(4, 4, CV_64F);
+    EXPECT_CV_ERROR_CONTAINS(fillStandardNormal(wrong, Size(), 1), "expected CV_32FC1");
+    Mat none;
+    EXPECT_CV_ERROR_CONTAINS(fillStandardNormal(none, Size(), 1), "is empty");
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv

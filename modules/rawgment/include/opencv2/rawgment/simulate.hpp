@@ -160,6 +160,15 @@ enum SeedPurpose : int
  */
 CV_RAWGMENT_EXPORTS uint64 deriveSeed(uint64 seed, SeedPurpose purpose, uint64 index = 0);
 
+/** @brief Fills a CV_32FC1 matrix with standard normal numbers from the module's own generator: row r is
+ * stream r of `seed` (Philox4x32-10, Box-Muller), the numbers the noise steps draw. The same seed gives
+ * the same bits on every thread count and CpuPath.
+ * @param dst a CV_32FC1 matrix, filled in place (created as `size` when empty)
+ * @param size the size when `dst` is empty
+ * @param seed the generator's key
+ */
+CV_RAWGMENT_EXPORTS void fillStandardNormal(InputOutputArray dst, Size size, uint64 seed);
+
 //! @}
 
 } // namespace rawgment

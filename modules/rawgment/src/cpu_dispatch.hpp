@@ -1,0 +1,117 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Run-time dispatch of the hot loops to the instruction sets of opencv2/rawgment/cpu.hpp.
+//
+// A hot loop is written once, as an always-inline kernel on GCC vector extensions (or plain loops), and
+// RAWGMENT_DISPATCHED compiles that one source four times, for x86-64, x86-64-v2, -v3 and -v4, and
+// defines the entry point that calls the version of the active CpuPath. The vectors are written at one
+// width (16 floats, 64 bytes) in every version: the compiler splits them into 4 SSE, 2 AVX2 or 1 AVX-512
+// register, so every version runs full-width vector code and performs the same operations lane by lane.
+// With -ffp-contract=off (the module's CMakeLists.txt) no version fuses a multiply and an add, so all
+// give the same bits.
+#ifndef OPENCV_RAWGMENT_SRC_CPU_DISPATCH_HPP
+#define OPENCV_RAWGMENT_SRC_CPU_DISPATCH_HPP
+
+#include <opencv2/rawgment/cpu.hpp>
+
+#include <cstdint>
+
+namespace cv {
+namespace rawgment {
+namespace detail {
+
+//! The active path without the checks of activeCpuPath(): for the dispatchers, after the first check.
+CpuPath dispatchPath();
+
+//! 16 floats, 16 int32 and 16 uint32: the one vector width of the kernels (see above).
+typedef float F32x16 __attribute__((vector_size(64)));
+typedef int32_t I32x16 __attribute__((vector_size(64)));
+typedef uint32_t U32x16 __attribute__((vector_size(64)));
+
+} // namespace detail
+} // namespace rawgment
+} // namespace cv
+
+#define RAWGMENT_KERNEL static inline __attribute__((always_inline))
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(RAWGMENT_NO_MULTIVERSIONING)
+#define RAWGMENT_HAVE_CPU_PATHS 1
+/** Defines `ret name params` running `name##Kernel args` compiled for the active CpuPath. */
+#define RAWGMENT_DISPATCHED(ret, name, params, args)                                                         \
+    __attribute__((target("arch=x86-64-v4"))) static ret name##Avx512 params                                 \
+    {                                                                                                        \
+        return name##Kernel args;                                                                            \
+    }                                                                                                        \
+    __attribute__((target("arch=x86-64-v3"))) static ret name##Avx2 params                                   \
+    {                                                                                                        \
+        return name##Kernel args;                                                                            \
+    }                                                                                                        \
+    __attribute__((target("arch=x86-64-v2"))) static ret name##Sse42 params                                  \
+    {                                                                                                        \
+        return name##Kernel args;                                                                            \
+    }                                                                                                        \
+    static ret name##Baseline params                                                                         \
+    {                                                                                                        \
+        return name##Kernel args;                                                                            \
+    }                                                                                                        \
+    ret name params                                                                                          \
+    {                                                                                                        \
+        switch (::cv::rawgment::detail::dispatchPath()) {                                                    \
+        case ::cv::rawgment::CpuPath::AVX512:                                                                \
+            return name##Avx512 args;                                                                        \
+        case ::cv::rawgment::CpuPath::AVX2:                                                                  \
+            return name##Avx2 args;                                                                          \
+        case ::cv::rawgment::CpuPath::SSE42:                                                                 \
+            return name##Sse42 args;                                                                         \
+        default:                                                                                             \
+            return name##Baseline args;                                                                      \
+        }                                                                                                    \
+    }
+/** As RAWGMENT_DISPATCHED, for a kernel template on its vector width in floats: `name##Kernel<W> args`
+ * with W = 16 (AVX-512), 8 (AVX2) or 4 (SSE). GCC lowers vectors wider than the registers piecewise,
+ * and their comparisons and selections lane by lane in scalar code: a kernel with those runs at the
+ * native width of each path. */
+#define RAWGMENT_DISPATCHED_BY_WIDTH(ret, name, params, args)                                                \
+    __attribute__((target("arch=x86-64-v4"))) static ret name##Avx512 params                                 \
+    {                                                                                                        \
+        return name##Kernel<16> args;                                                                        \
+    }                                                                                                        \
+    __attribute__((target("arch=x86-64-v3"))) static ret name##Avx2 params                                   \
+    {                                                                                                        \
+        return name##Kernel<8> args;                                                                         \
+    }                                                                                                        \
+    __attribute__((target("arch=x86-64-v2"))) static ret name##Sse42 params                                  \
+    {                                                                                                        \
+        return name##Kernel<4> args;                                                                         \
+    }                                                                                                        \
+    static ret name##Baseline params                                                                         \
+    {                                                                                                        \
+        return name##Kernel<4> args;                                                                         \
+    }                                                                                                        \
+    ret name params                                                                                          \
+    {                                                                                                        \
+        switch (::cv::rawgment::detail::dispatchPath()) {                                                    \
+        case ::cv::rawgment::CpuPath::AVX512:                                                                \
+            return name##Avx512 args;                                                                        \
+        case ::cv::rawgment::CpuPath::AVX2:                                                                  \
+            return name##Avx2 args;                                                                          \
+        case ::cv::rawgment::CpuPath::SSE42:                                                                 \
+            return name##Sse42 args;                                                                         \
+        default:                                                                                             \
+            return name##Baseline args;                                                                      \
+        }                                                                                                    \
+    }
+#else
+#define RAWGMENT_HAVE_CPU_PATHS 0
+#define RAWGMENT_DISPATCHED_BY_WIDTH(ret, name, params, args)                                                \
+    ret name params                                                                                          \
+    {                                                                                                        \
+        return name##Kernel<4> args;                                                                         \
+    }
+#define RAWGMENT_DISPATCHED(ret, name, params, args)                                                         \
+    ret name params                                                                                          \
+    {                                                                                                        \
+        return name##Kernel args;                                                                            \
+    }
+#endif
+
+#endif // OPENCV_RAWGMENT_SRC_CPU_DISPATCH_HPP
