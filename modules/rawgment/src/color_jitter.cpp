@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <atomic>
+#include <cstring>
 
 namespace cv {
 namespace rawgment {
@@ -47,69 +48,168 @@ RAWGMENT_KERNEL AddedVariance jitterVariance(float xm, float pc, const JitterCon
     return {0.0f, 0.0f};
 }
 
-// One row of Eq. 11/13, written so that the compiler vectorises it: no branches, per-column constants
-// in arrays (the CFA site alternates along the row), float arithmetic in a fixed order. `prior` is the
-// local-mean row, or null to use the pixel's own value. Returns the number of brightening pixels.
-// Rounding to 16 bits adds 0.5 and truncates (the value is clipped to [0, white] first): the same bits
-// in every vector width.
-template <typename T, NoiseAlignment A, bool kLocalMean>
+// One row of Eq. 11/13 on explicit vectors of W lanes (cpu_dispatch.hpp). `prior` is the local-mean
+// row, or null to use the pixel's own value; per-column constants come in arrays (the CFA site
+// alternates along the row). The last partial block runs through the same vector code on padded
+// copies, so every pixel goes through the same operations on every path. Rounding to 16 bits adds 0.5
+// and truncates after clipping to [0, white]. Returns the number of brightening pixels (a negative
+// added variance, which adds no noise).
+template <int W, typename T> struct PixelLanes;
+template <int W> struct PixelLanes<W, ushort>
+{
+    typedef typename detail::Lanes<W>::F F;
+    static F load(const ushort* p)
+    {
+        typename detail::Lanes<W>::U16 v;
+        std::memcpy(&v, p, sizeof(v));
+        return __builtin_convertvector(v, F);
+    }
+    static void store(ushort* p, F out, F white)
+    {
+        out = detail::minLanes(detail::maxLanes(out, F{}), white) + 0.5f;
+        const typename detail::Lanes<W>::U16 v = __builtin_convertvector(
+            __builtin_convertvector(out, typename detail::Lanes<W>::I), typename detail::Lanes<W>::U16);
+        std::memcpy(p, &v, sizeof(v));
+    }
+};
+template <int W> struct PixelLanes<W, float>
+{
+    typedef typename detail::Lanes<W>::F F;
+    static F load(const float* p)
+    {
+        F v;
+        std::memcpy(&v, p, sizeof(v));
+        return v;
+    }
+    static void store(float* p, F out, F white)
+    {
+        out = detail::minLanes(detail::maxLanes(out, F{}), white);
+        std::memcpy(p, &out, sizeof(out));
+    }
+};
+
+template <int W, NoiseAlignment A>
+RAWGMENT_KERNEL typename detail::Lanes<W>::F jitterVarianceLanes(typename detail::Lanes<W>::F xm,
+                                                                 typename detail::Lanes<W>::F pc,
+                                                                 const JitterConstants& k)
+{
+    // jitterVariance() on lanes, the same operations in the same order; returns shot + rest.
+    typedef typename detail::Lanes<W>::F F;
+    const F zero = F{}, one = zero + 1.0f;
+    const float pg = k.pg, pg2 = k.pg * k.pg;
+    if (A == NoiseAlignment::ACCOUNT_PRIOR) {
+        const F xf = detail::maxLanes(xm, one);
+        const F pu = detail::maxLanes((pc * xf + k.pb) / (xf * pg), zero);
+        const F mu = detail::maxLanes(xm, zero);
+        const F shot = pu * (1 - pu) * (pg2 * k.in.shot) * mu;
+        const F rest = (1 - pu * pu) * (pg2 * k.in.readBeforeGain) + (1 - pu * pu * pg2) * k.in.readAfterGain;
+        return shot + rest;
+    }
+    const F shot = pg * k.in.shot * detail::maxLanes(pc * xm + k.pb, zero);
+    const F rest = zero + (pg2 * k.in.readBeforeGain + k.in.readAfterGain);
+    return shot + rest;
+}
+
+template <int W, typename T, NoiseAlignment A, bool kLocalMean>
+RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* prior, const float* pc,
+                                 const float* black, const JitterConstants& k,
+                                 typename detail::Lanes<W>::I& bright)
+{
+    typedef typename detail::Lanes<W>::F F;
+    typedef PixelLanes<W, T> P;
+    F pcv, blackv;
+    std::memcpy(&pcv, pc, sizeof(pcv));
+    std::memcpy(&blackv, black, sizeof(blackv));
+    const F x = P::load(s) - blackv;
+    F out = pcv * x + k.pb;
+    if (A != NoiseAlignment::NONE) {
+        F xm = x, zv;
+        if (kLocalMean)
+            std::memcpy(&xm, prior, sizeof(xm));
+        std::memcpy(&zv, z, sizeof(zv));
+        const F total = jitterVarianceLanes<W, A>(xm, pcv, k);
+        bright -= total < 0; // -1 per brightening lane
+        out += detail::sqrtLanes(detail::maxLanes(total, F{})) * zv;
+    }
+    P::store(d, out + blackv, F{} + k.white);
+}
+
+template <int W, typename T, NoiseAlignment A, bool kLocalMean>
 RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
                                   const float* black, const JitterConstants& k, int cols)
 {
-    int bright = 0;
-    for (int c = 0; c < cols; ++c) {
-        const float x = static_cast<float>(s[c]) - black[c];
-        float out = pc[c] * x + k.pb;
-        if (A != NoiseAlignment::NONE) {
-            const AddedVariance v = jitterVariance<A>(kLocalMean ? prior[c] : x, pc[c], k);
-            const float total = v.shot + v.rest;
-            bright += total < 0 ? 1 : 0;
-            out += std::sqrt(std::max(total, 0.0f)) * z[c];
+    typename detail::Lanes<W>::I bright = {};
+    int c = 0;
+    for (; c + W <= cols; c += W)
+        jitterBlock<W, T, A, kLocalMean>(s + c, d + c, z + c, kLocalMean ? prior + c : nullptr, pc + c,
+                                         black + c, k, bright);
+    int total = 0;
+    for (int i = 0; i < W; ++i)
+        total += bright[i];
+    const int rest = cols - c;
+    if (rest > 0) {
+        // Padded copies: the extra lanes compute on zeros and are neither stored nor counted.
+        T sPad[W] = {}, dPad[W];
+        float zPad[W] = {}, priorPad[W] = {}, pcPad[W] = {}, blackPad[W] = {};
+        for (int i = 0; i < rest; ++i) {
+            sPad[i] = s[c + i];
+            zPad[i] = z ? z[c + i] : 0.0f;
+            priorPad[i] = kLocalMean ? prior[c + i] : 0.0f;
+            pcPad[i] = pc[c + i];
+            blackPad[i] = black[c + i];
         }
-        d[c] = storeValue<T>(out + black[c], k.white);
+        typename detail::Lanes<W>::I tail = {};
+        jitterBlock<W, T, A, kLocalMean>(sPad, dPad, zPad, priorPad, pcPad, blackPad, k, tail);
+        for (int i = 0; i < rest; ++i) {
+            d[c + i] = dPad[i];
+            total += tail[i];
+        }
     }
-    return bright;
+    return total;
 }
 
-template <typename T, bool kLocalMean>
+template <int W, typename T, bool kLocalMean>
 RAWGMENT_KERNEL int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* prior,
                                           const float* pc, const float* black, const JitterConstants& k,
                                           int cols)
 {
     switch (k.alignment) {
     case NoiseAlignment::ACCOUNT_PRIOR:
-        return jitterRowBody<T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean>(s, d, z, prior, pc, black, k,
-                                                                           cols);
+        return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean>(s, d, z, prior, pc, black, k,
+                                                                              cols);
     case NoiseAlignment::IGNORE_PRIOR:
-        return jitterRowBody<T, NoiseAlignment::IGNORE_PRIOR, kLocalMean>(s, d, z, prior, pc, black, k, cols);
+        return jitterRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, kLocalMean>(s, d, z, prior, pc, black, k,
+                                                                             cols);
     default:
-        return jitterRowBody<T, NoiseAlignment::NONE, kLocalMean>(s, d, z, prior, pc, black, k, cols);
+        return jitterRowBody<W, T, NoiseAlignment::NONE, kLocalMean>(s, d, z, prior, pc, black, k, cols);
     }
 }
 
+template <int W>
 RAWGMENT_KERNEL int jitterRowKernel(const ushort* s, ushort* d, const float* z, const float* prior,
                                     const float* pc, const float* black, const JitterConstants& k, int cols)
 {
-    return prior ? jitterRowAnyAlignment<ushort, true>(s, d, z, prior, pc, black, k, cols)
-                 : jitterRowAnyAlignment<ushort, false>(s, d, z, prior, pc, black, k, cols);
+    return prior ? jitterRowAnyAlignment<W, ushort, true>(s, d, z, prior, pc, black, k, cols)
+                 : jitterRowAnyAlignment<W, ushort, false>(s, d, z, prior, pc, black, k, cols);
 }
 
+template <int W>
 RAWGMENT_KERNEL int jitterRowKernel(const float* s, float* d, const float* z, const float* prior,
                                     const float* pc, const float* black, const JitterConstants& k, int cols)
 {
-    return prior ? jitterRowAnyAlignment<float, true>(s, d, z, prior, pc, black, k, cols)
-                 : jitterRowAnyAlignment<float, false>(s, d, z, prior, pc, black, k, cols);
+    return prior ? jitterRowAnyAlignment<W, float, true>(s, d, z, prior, pc, black, k, cols)
+                 : jitterRowAnyAlignment<W, float, false>(s, d, z, prior, pc, black, k, cols);
 }
 
 // One dispatched entry point per pixel type (cpu_dispatch.hpp).
-RAWGMENT_DISPATCHED(int, jitterRow,
-                    (const ushort* s, ushort* d, const float* z, const float* prior, const float* pc,
-                     const float* black, const JitterConstants& k, int cols),
-                    (s, d, z, prior, pc, black, k, cols))
-RAWGMENT_DISPATCHED(int, jitterRow,
-                    (const float* s, float* d, const float* z, const float* prior, const float* pc,
-                     const float* black, const JitterConstants& k, int cols),
-                    (s, d, z, prior, pc, black, k, cols))
+RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
+                             (const ushort* s, ushort* d, const float* z, const float* prior, const float* pc,
+                              const float* black, const JitterConstants& k, int cols),
+                             (s, d, z, prior, pc, black, k, cols))
+RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
+                             (const float* s, float* d, const float* z, const float* prior, const float* pc,
+                              const float* black, const JitterConstants& k, int cols),
+                             (s, d, z, prior, pc, black, k, cols))
 
 template <typename T, NoiseAlignment A>
 int jitterRowPoissonBody(const T* s, T* d, const float* z, const float* prior, const float* pc,

@@ -4,8 +4,9 @@
 // A hot loop is written once, as an always-inline kernel on GCC vector extensions (or plain loops), and
 // RAWGMENT_DISPATCHED compiles that one source four times, for x86-64, x86-64-v2, -v3 and -v4, and
 // defines the entry point that calls the version of the active CpuPath. The vectors are written at one
-// width (16 floats, 64 bytes) in every version: the compiler splits them into 4 SSE, 2 AVX2 or 1 AVX-512
-// register, so every version runs full-width vector code and performs the same operations lane by lane.
+// width in every version (the compiler splits them into registers), or, for kernels that compare and
+// select, at the native width of each path (RAWGMENT_DISPATCHED_BY_WIDTH); either way every version runs
+// full-width vector code and performs the same operations lane by lane.
 // With -ffp-contract=off (the module's CMakeLists.txt) no version fuses a multiply and an add, so all
 // give the same bits.
 #ifndef OPENCV_RAWGMENT_SRC_CPU_DISPATCH_HPP
@@ -22,10 +23,33 @@ namespace detail {
 //! The active path without the checks of activeCpuPath(): for the dispatchers, after the first check.
 CpuPath dispatchPath();
 
-//! 16 floats, 16 int32 and 16 uint32: the one vector width of the kernels (see above).
-typedef float F32x16 __attribute__((vector_size(64)));
-typedef int32_t I32x16 __attribute__((vector_size(64)));
-typedef uint32_t U32x16 __attribute__((vector_size(64)));
+//! The vectors of a kernel of width W (RAWGMENT_DISPATCHED_BY_WIDTH): W floats, int32, uint32, uint16.
+template <int W> struct Lanes
+{
+    typedef float F __attribute__((vector_size(4 * W)));
+    typedef int32_t I __attribute__((vector_size(4 * W)));
+    typedef uint32_t U __attribute__((vector_size(4 * W)));
+    typedef uint16_t U16 __attribute__((vector_size(2 * W)));
+};
+
+//! Lane-wise std::max and std::min (the same operand chosen when one is NaN).
+template <typename V> inline __attribute__((always_inline)) V maxLanes(V a, V b)
+{
+    return a < b ? b : a;
+}
+template <typename V> inline __attribute__((always_inline)) V minLanes(V a, V b)
+{
+    return b < a ? b : a;
+}
+
+//! IEEE square roots lane by lane: exact to the rounding on every path, compiled to (v)sqrtps.
+template <typename V> inline __attribute__((always_inline)) V sqrtLanes(V v)
+{
+    V r;
+    for (int i = 0; i < static_cast<int>(sizeof(V) / sizeof(float)); ++i)
+        r[i] = __builtin_sqrtf(v[i]);
+    return r;
+}
 
 } // namespace detail
 } // namespace rawgment
