@@ -259,12 +259,14 @@ TEST(Apps, anOutputFolderThatCannotBeWrittenIsRefusedBeforeAnyWork)
                                        "/sim/g06dB_level0.50/frame_000.png'");
     if (mounted)
         ::umount(locked.c_str());
-    for (const AppRun* r : {&calibrate, &augment}) {
-        EXPECT_NE(0, r->status) << r->output;
-        EXPECT_NE(std::string::npos, r->output.find("the output folder '" + locked + "' cannot be written"))
-            << r->output;
+    for (const auto& run :
+         {std::make_pair("calibrate [", &calibrate), std::make_pair("augment [", &augment)}) {
+        const AppRun& r = *run.second;
+        EXPECT_NE(0, r.status) << r.output;
+        EXPECT_NE(std::string::npos, r.output.find("the output folder '" + locked + "' cannot be written"))
+            << r.output;
         // Refused before the work: no progress bar was drawn.
-        EXPECT_EQ(std::string::npos, r->output.find("1/")) << r->output;
+        EXPECT_EQ(std::string::npos, r.output.find(run.first)) << r.output;
     }
 }
 
