@@ -4,9 +4,12 @@
 //     - memcpy of the same input bytes (the floor: every byte must be read once),
 //     - a naive OpenCV composition (convertTo, accumulate, accumulateSquare, then mean and variance);
 //   the whole cross-gain fit on the paper-scale patch data (3 gains x 27,648 samples).
+// The burst statistics run on the best CpuPath with every setting, and with the default setting on
+// every path this CPU has (name suffix /baseline, /sse4.2, /avx2, /avx512).
 #include <benchmark/benchmark.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/calibration.hpp>
+#include <opencv2/rawgment/cpu.hpp>
 
 #include <cstring>
 
@@ -131,25 +134,49 @@ void BM_CalibrationFit(benchmark::State& state)
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(samples.size()));
 }
 
-// The arguments are groupFrames (memory: that many buffered frames, against state traffic) and the
-// state's depth (float64, or float32 with half the traffic).
-BENCHMARK(BM_BurstStatistics_rawgment)
-    ->Args({8, CV_64F})
-    ->Args({16, CV_64F})
-    ->Args({32, CV_64F})
-    ->Args({8, CV_32F})
-    ->Args({16, CV_32F})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->Iterations(3);
-BENCHMARK(BM_BurstStatistics_memcpy)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
-BENCHMARK(BM_BurstStatistics_naiveOpenCV)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK(BM_CalibrationFit)
-    ->Arg(NOISE_FIT_JOINT)
-    ->Arg(NOISE_FIT_TWO_STAGE)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-
 } // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv)
+{
+    // The arguments are groupFrames (memory: that many buffered frames, against state traffic) and the
+    // state's depth (float64, or float32 with half the traffic).
+    benchmark::RegisterBenchmark("BM_BurstStatistics_rawgment", BM_BurstStatistics_rawgment)
+        ->Args({8, CV_64F})
+        ->Args({16, CV_64F})
+        ->Args({32, CV_64F})
+        ->Args({8, CV_32F})
+        ->Args({16, CV_32F})
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime()
+        ->Iterations(3);
+    for (CpuPath path : availableCpuPaths())
+        benchmark::RegisterBenchmark(("BM_BurstStatistics_rawgment/" + cpuPathName(path)).c_str(),
+                                     [path](benchmark::State& state) {
+                                         setCpuPath(path);
+                                         BM_BurstStatistics_rawgment(state);
+                                         setCpuPath(CpuPath::AUTO);
+                                     })
+            ->Args({8, CV_64F})
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime()
+            ->Iterations(3);
+    benchmark::RegisterBenchmark("BM_BurstStatistics_memcpy", BM_BurstStatistics_memcpy)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime()
+        ->Iterations(3);
+    benchmark::RegisterBenchmark("BM_BurstStatistics_naiveOpenCV", BM_BurstStatistics_naiveOpenCV)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime()
+        ->Iterations(2);
+    benchmark::RegisterBenchmark("BM_CalibrationFit", BM_CalibrationFit)
+        ->Arg(NOISE_FIT_JOINT)
+        ->Arg(NOISE_FIT_TWO_STAGE)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv))
+        return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}
