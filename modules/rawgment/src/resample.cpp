@@ -5,6 +5,7 @@
 #include "noise_terms.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 namespace cv {
 namespace rawgment {
@@ -330,26 +331,66 @@ BilinearAxis bilinearAxis(int planeSize, int phase, double scale)
     return a;
 }
 
+// One block of W output pixels: the four neighbours gathered lane by lane, then the weights, the mean,
+// Eq. 15's shot sum and the read-noise factor on vectors, in the order of the scalar formula.
+template <int W>
+RAWGMENT_KERNEL void bilinearBlock(const float* row0, const float* row1, float fy, const int* c0,
+                                   const int* c1, const float* fx, float* mean, float* shot,
+                                   float* readFactor)
+{
+    typedef typename detail::Lanes<W>::F F;
+    F a, b, c, d, x;
+    for (int i = 0; i < W; ++i) {
+        a[i] = row0[c0[i]];
+        b[i] = row0[c1[i]];
+        c[i] = row1[c0[i]];
+        d[i] = row1[c1[i]];
+    }
+    std::memcpy(&x, fx, sizeof(x));
+    const F zero = F{};
+    const F w00 = (1 - x) * (1 - fy), w01 = x * (1 - fy), w10 = (1 - x) * fy, w11 = x * fy;
+    const F m = w00 * a + w01 * b + w10 * c + w11 * d;
+    const F sh = w00 * (1 - w00) * detail::maxLanes(a, zero) + w01 * (1 - w01) * detail::maxLanes(b, zero) +
+                 w10 * (1 - w10) * detail::maxLanes(c, zero) + w11 * (1 - w11) * detail::maxLanes(d, zero);
+    const F rf = 1 - (w00 * w00 + w01 * w01 + w10 * w10 + w11 * w11);
+    std::memcpy(mean, &m, sizeof(m));
+    std::memcpy(shot, &sh, sizeof(sh));
+    std::memcpy(readFactor, &rf, sizeof(rf));
+}
+
 // Bilinear taps of one output row: mean, Eq. 15's shot sum and the read-noise factor 1 - sum w^2,
-// all per pixel because the weights change along the row.
+// all per pixel because the weights change along the row. The last partial block runs on padded
+// copies through the same vector code, so every pixel gets the same bits on every path.
+template <int W>
 RAWGMENT_KERNEL void bilinearRowKernel(const float* row0, const float* row1, float fy, const int* c0,
                                        const int* c1, const float* fx, float* mean, float* shot,
                                        float* readFactor, int n)
 {
-    for (int j = 0; j < n; ++j) {
-        const float a = row0[c0[j]], b = row0[c1[j]], c = row1[c0[j]], d = row1[c1[j]];
-        const float w00 = (1 - fx[j]) * (1 - fy), w01 = fx[j] * (1 - fy), w10 = (1 - fx[j]) * fy,
-                    w11 = fx[j] * fy;
-        mean[j] = w00 * a + w01 * b + w10 * c + w11 * d;
-        shot[j] = w00 * (1 - w00) * std::max(a, 0.0f) + w01 * (1 - w01) * std::max(b, 0.0f) +
-                  w10 * (1 - w10) * std::max(c, 0.0f) + w11 * (1 - w11) * std::max(d, 0.0f);
-        readFactor[j] = 1 - (w00 * w00 + w01 * w01 + w10 * w10 + w11 * w11);
+    int j = 0;
+    for (; j + W <= n; j += W)
+        bilinearBlock<W>(row0, row1, fy, c0 + j, c1 + j, fx + j, mean + j, shot + j, readFactor + j);
+    if (j < n) {
+        int c0Pad[W], c1Pad[W];
+        float fxPad[W], meanPad[W], shotPad[W], readPad[W];
+        for (int i = 0; i < W; ++i) {
+            // Extra lanes repeat the last pixel: valid indices, results not stored.
+            const int k = std::min(j + i, n - 1);
+            c0Pad[i] = c0[k];
+            c1Pad[i] = c1[k];
+            fxPad[i] = fx[k];
+        }
+        bilinearBlock<W>(row0, row1, fy, c0Pad, c1Pad, fxPad, meanPad, shotPad, readPad);
+        for (int i = 0; j + i < n; ++i) {
+            mean[j + i] = meanPad[i];
+            shot[j + i] = shotPad[i];
+            readFactor[j + i] = readPad[i];
+        }
     }
 }
-RAWGMENT_DISPATCHED(void, bilinearRow,
-                    (const float* row0, const float* row1, float fy, const int* c0, const int* c1,
-                     const float* fx, float* mean, float* shot, float* readFactor, int n),
-                    (row0, row1, fy, c0, c1, fx, mean, shot, readFactor, n))
+RAWGMENT_DISPATCHED_BY_WIDTH(void, bilinearRow,
+                             (const float* row0, const float* row1, float fy, const int* c0, const int* c1,
+                              const float* fx, float* mean, float* shot, float* readFactor, int n),
+                             (row0, row1, fy, c0, c1, fx, mean, shot, readFactor, n))
 
 template <typename T>
 void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const BilinearAxis* rows,
