@@ -4,6 +4,8 @@
 #include "app_tools.hpp"
 #include "tradeoff_measures.hpp"
 
+#include <opencv2/rawgment/cpu.hpp>
+
 #include <opencv2/core/utility.hpp>
 
 #include <algorithm>
@@ -11,6 +13,10 @@
 #include <sstream>
 
 using namespace cv;
+using cv::rawgment::activeCpuPath;
+using cv::rawgment::availableCpuPaths;
+using cv::rawgment::CpuPath;
+using cv::rawgment::cpuPathName;
 using rawgment_apps::formatNumber;
 
 namespace {
@@ -25,14 +31,32 @@ std::string markdownCell(const std::string& text)
 
 std::string markdownTable(const std::vector<rawgment_apps::TradeoffRow>& rows)
 {
+    // The time on every CPU path this machine has, for the knobs whose loops are dispatched.
+    const std::vector<CpuPath> paths = availableCpuPaths();
     std::ostringstream md;
-    md << "| Knob | Setting | Accuracy measure | Error | Time per MP |\n|---|---|---|---:|---:|\n";
+    md << "| Knob | Setting | Accuracy measure | Error | Time per MP (" << cpuPathName(activeCpuPath())
+       << ") |";
+    for (CpuPath p : paths)
+        md << " " << cpuPathName(p) << " |";
+    md << "\n|---|---|---|---:|---:|";
+    for (size_t k = 0; k < paths.size(); ++k)
+        md << "---:|";
+    md << "\n";
     for (const rawgment_apps::TradeoffRow& r : rows) {
         char error[32], time[32];
         std::snprintf(error, sizeof(error), "%.3g", r.error);
         std::snprintf(time, sizeof(time), "%.3g ms", r.msPerMp);
         md << "| " << r.knob << " | " << r.setting << " | " << markdownCell(r.measure) << " | " << error
-           << " | " << time << " |\n";
+           << " | " << time << " |";
+        for (size_t k = 0; k < paths.size(); ++k) {
+            if (k < r.msPerMpByPath.size()) {
+                std::snprintf(time, sizeof(time), "%.3g ms", r.msPerMpByPath[k]);
+                md << " " << time << " |";
+            } else {
+                md << " |";
+            }
+        }
+        md << "\n";
     }
     return md.str();
 }
@@ -56,7 +80,8 @@ int main(int argc, char** argv)
     parser.about(
         "rawgment_tradeoffs: measures what each accuracy knob of cv::rawgment costs in time.\n"
         "For every setting, an error against the sensor simulator's ground truth and the wall time\n"
-        "per megapixel on a 4000x3000 CV_16UC1 mosaic, in one run. Writes tradeoffs.md (the table),\n"
+        "per megapixel on a 4000x3000 CV_16UC1 mosaic, in one run, on every CPU path this machine has\n"
+        "for the augmentation and statistics knobs. Writes tradeoffs.md (the table),\n"
         "tradeoffs.csv and tradeoffs.png (error against time, one panel per knob).");
     if (parser.has("help")) {
         parser.printMessage();
@@ -94,21 +119,32 @@ int main(int argc, char** argv)
         rawgment_apps::measureTradeoffs(set, progress, rows);
         progress.finish();
 
-        rawgment_apps::CsvTable table({"knob", "setting", "measure", "error", "ms_per_mp"});
+        std::vector<std::string> header = {"knob", "setting", "measure", "error", "ms_per_mp"};
+        for (CpuPath p : availableCpuPaths())
+            header.push_back("ms_per_mp_" + cpuPathName(p));
+        rawgment_apps::CsvTable table(header);
         // CsvTable does not quote: text cells keep their commas out of the way as semicolons.
         const auto cell = [](std::string text) {
             std::replace(text.begin(), text.end(), ',', ';');
             return text;
         };
-        for (const rawgment_apps::TradeoffRow& r : rows)
-            table.addRow(std::vector<std::string>{cell(r.knob), cell(r.setting), cell(r.measure),
-                                                  formatNumber(r.error), formatNumber(r.msPerMp)});
+        for (const rawgment_apps::TradeoffRow& r : rows) {
+            std::vector<std::string> cells = {cell(r.knob), cell(r.setting), cell(r.measure),
+                                              formatNumber(r.error), formatNumber(r.msPerMp)};
+            // Knobs whose loops are not dispatched have one time: the other cells stay empty.
+            for (size_t k = 0; k < availableCpuPaths().size(); ++k)
+                cells.push_back(k < r.msPerMpByPath.size() ? formatNumber(r.msPerMpByPath[k])
+                                                           : std::string());
+            table.addRow(cells);
+        }
         std::ostringstream text;
         text << "# What accuracy costs in time\n\n"
              << "Measured by `rawgment_tradeoffs" << (parser.get<bool>("quick") ? " --quick" : "") << "` on "
              << getNumThreads() << " threads; times per megapixel of a " << set.timingSize.width << "x"
              << set.timingSize.height << " CV_16UC1 mosaic (fastest of " << set.repeats
-             << "), per MP of burst input for calibration, per million values for Shapiro-Wilk. Errors "
+             << "), per MP of burst input for calibration, per million values for Shapiro-Wilk; the "
+                "augmentation and burst-statistics knobs are timed on every CPU path this machine has "
+                "(the same bits on each). Errors "
                 "against "
                 "the sensor simulator's truth; calibration errors are RMS over "
              << set.seeds << " simulated campaigns.\n\n"

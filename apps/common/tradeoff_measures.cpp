@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/calibration.hpp>
+#include <opencv2/rawgment/cpu.hpp>
 #include <opencv2/rawgment/normality.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
@@ -56,6 +57,29 @@ double fastestMs(int repeats, const std::function<void()>& work)
             best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
     return best;
+}
+
+/** fastestMs() on every CPU path this machine has, in the order of availableCpuPaths(), and in `active`
+ * the time on the path that was active, which is restored. */
+std::vector<double> fastestMsOnEveryPath(int repeats, const std::function<void()>& work, double& active)
+{
+    const CpuPath before = activeCpuPath();
+    std::vector<double> ms;
+    for (CpuPath path : availableCpuPaths()) {
+        setCpuPath(path);
+        ms.push_back(fastestMs(repeats, work));
+        if (path == before)
+            active = ms.back();
+    }
+    setCpuPath(before);
+    return ms;
+}
+
+std::vector<double> perMegapixel(std::vector<double> ms, Size s)
+{
+    for (double& m : ms)
+        m /= s.area() / 1e6;
+    return ms;
 }
 
 double megapixels(Size s)
@@ -138,16 +162,21 @@ void measureColorJitterKnobs(const TradeoffSettings& set, const Mat& timingRaw, 
     dark.capture(Mat::zeros(flat, CV_32FC1), 8, 0.5, studySeed(set, DRAW_BLACK_TRUTH), 0, darkTruth);
     const double darkTruthVar = spatialVariance(darkTruth, darkFmt);
 
-    const auto time = [&](const NoiseOptions& noise) {
+    // The time per MP on the active path; every path's in `byPath`.
+    const auto time = [&](const NoiseOptions& noise, std::vector<double>& byPath) {
         Mat out;
         RawFormat f;
-        return fastestMs(set.repeats,
-                         [&] {
-                             colorJitter(timingRaw, timingFmt, timingModel,
-                                         ColorJitter::exposureChange(0.1, 1.0), noise,
-                                         studySeed(set, DRAW_TIMED_STEP), out, f);
-                         }) /
-               megapixels(timingRaw.size());
+        double active = 0;
+        byPath = perMegapixel(fastestMsOnEveryPath(
+                                  set.repeats,
+                                  [&] {
+                                      colorJitter(timingRaw, timingFmt, timingModel,
+                                                  ColorJitter::exposureChange(0.1, 1.0), noise,
+                                                  studySeed(set, DRAW_TIMED_STEP), out, f);
+                                  },
+                                  active),
+                              timingRaw.size());
+        return active / megapixels(timingRaw.size());
     };
     for (ShotNoiseSampling sampling : {ShotNoiseSampling::GAUSSIAN, ShotNoiseSampling::POISSON}) {
         NoiseOptions noise;
@@ -158,12 +187,14 @@ void measureColorJitterKnobs(const TradeoffSettings& set, const Mat& timingRaw, 
                     ColorJitter::exposureChange(0.01, 1.0), noise, studySeed(set, DRAW_LATTICE_JITTER), out,
                     f);
         const bool poisson = sampling == ShotNoiseSampling::POISSON;
+        std::vector<double> byPath;
+        const double msPerMp = time(noise, byPath);
         rows.push_back({"Shot-noise sampling (colour jitter)", poisson ? "POISSON" : "GAUSSIAN (paper)",
                         "KL(true || augmented) of the values at 2 e-",
-                        kullbackLeibler(truthDistribution, valueDistribution(out, black, -24, 64)),
-                        time(noise),
+                        kullbackLeibler(truthDistribution, valueDistribution(out, black, -24, 64)), msPerMp,
                         poisson ? "the electron lattice of a real dark capture; pays per pixel"
-                                : "right variance, wrong shape below ~10 e-"});
+                                : "right variance, wrong shape below ~10 e-",
+                        byPath});
     }
     for (PriorMeanEstimate prior : {PriorMeanEstimate::PIXEL_VALUE, PriorMeanEstimate::LOCAL_MEAN}) {
         NoiseOptions noise;
@@ -173,11 +204,14 @@ void measureColorJitterKnobs(const TradeoffSettings& set, const Mat& timingRaw, 
         colorJitter(darkRaw, darkFmt, dark.effectiveModel(), ColorJitter::exposureChange(0.5, 1.0), noise,
                     studySeed(set, DRAW_BLACK_JITTER), out, f);
         const bool local = prior == PriorMeanEstimate::LOCAL_MEAN;
+        std::vector<double> byPath;
+        const double msPerMp = time(noise, byPath);
         rows.push_back({"Prior mean mu_x (colour jitter)", local ? "LOCAL_MEAN" : "PIXEL_VALUE (paper)",
                         "|variance / true variance - 1| at black, x0.5",
-                        std::abs(spatialVariance(out, darkFmt) / darkTruthVar - 1), time(noise),
+                        std::abs(spatialVariance(out, darkFmt) / darkTruthVar - 1), msPerMp,
                         local ? "a third of the clip bias at black; smooths across edges"
-                              : "max(x, 0) of a noisy pixel adds shot noise at black"});
+                              : "max(x, 0) of a noisy pixel adds shot noise at black",
+                        byPath});
     }
 }
 
@@ -240,18 +274,25 @@ void measureBlurKnob(const TradeoffSettings& set, const Mat& timingRaw, const Ra
                 squares += (ratio - 1) * (ratio - 1);
             }
             Mat out;
-            const double ms = fastestMs(set.repeats, [&] {
-                motionBlur(timingRaw, timingFmt, timingModel, linearMotionKernel(13, 30), noise,
-                           studySeed(set, DRAW_TIMED_STEP), out);
-            });
+            double ms = 0;
+            const std::vector<double> byPath =
+                perMegapixel(fastestMsOnEveryPath(
+                                 set.repeats,
+                                 [&] {
+                                     motionBlur(timingRaw, timingFmt, timingModel, linearMotionKernel(13, 30),
+                                                noise, studySeed(set, DRAW_TIMED_STEP), out);
+                                 },
+                                 ms),
+                             timingRaw.size());
             const bool exact = method == BlurNoiseSum::EXACT;
-            rows.push_back(
-                {"Motion-blur noise sum",
-                 std::string(exact ? "EXACT (Eq. 15)" : "FROM_BLURRED_MEAN") + ", " + named.first,
-                 "RMS over columns of variance / true variance - 1 (floor 1.8%)",
-                 std::sqrt(squares / size.width), ms / megapixels(timingRaw.size()),
-                 exact ? "exact at every edge"
-                       : "exact when the taps are equal (a motion); off at edges of a peaked kernel"});
+            rows.push_back({"Motion-blur noise sum",
+                            std::string(exact ? "EXACT (Eq. 15)" : "FROM_BLURRED_MEAN") + ", " + named.first,
+                            "RMS over columns of variance / true variance - 1 (floor 1.8%)",
+                            std::sqrt(squares / size.width), ms / megapixels(timingRaw.size()),
+                            exact
+                                ? "exact at every edge"
+                                : "exact when the taps are equal (a motion); off at edges of a peaked kernel",
+                            byPath});
         }
     }
 }
@@ -289,19 +330,25 @@ void measureStatisticsPrecision(const TradeoffSettings& set, const Mat& timingRa
                 worst = std::max(worst, std::abs(var.at<double>(r, c) / static_cast<double>(v) - 1));
             }
         const int timedFrames = 24;
-        const double ms = fastestMs(set.repeats, [&] {
-            BurstStatistics timed(timingFmt, 8, depth);
-            for (int t = 0; t < timedFrames; ++t)
-                timed.add(timingRaw);
-            Mat v;
-            timed.variance(v);
-        });
+        double ms = 0;
+        std::vector<double> byPath = fastestMsOnEveryPath(
+            set.repeats,
+            [&] {
+                BurstStatistics timed(timingFmt, 8, depth);
+                for (int t = 0; t < timedFrames; ++t)
+                    timed.add(timingRaw);
+                Mat v;
+                timed.variance(v);
+            },
+            ms);
+        for (double& m : byPath)
+            m /= timedFrames * megapixels(timingRaw.size());
         const bool wide = depth == CV_64F;
-        rows.push_back(
-            {"Arithmetic (burst statistics state)", wide ? "float64 (default)" : "float32",
-             "max |variance / long-double reference - 1|, mean 60000, variance 1", worst,
-             ms / (timedFrames * megapixels(timingRaw.size())),
-             wide ? "exact to float64 rounding" : "half the state memory; ~1e-4 at extreme means"});
+        rows.push_back({"Arithmetic (burst statistics state)", wide ? "float64 (default)" : "float32",
+                        "max |variance / long-double reference - 1|, mean 60000, variance 1", worst,
+                        ms / (timedFrames * megapixels(timingRaw.size())),
+                        wide ? "exact to float64 rounding" : "half the state memory; ~1e-4 at extreme means",
+                        byPath});
     }
 }
 
@@ -389,11 +436,14 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
         const Setting& s = settings[i];
         // Time of the whole calibration (statistics of every frame, sampling, fit) per MP of burst input.
         const double totalMs = 6 * s.frames * statsMsPerFrame + ms[i] / set.seeds;
-        rows.push_back({s.knob, s.name,
+        rows.push_back({s.knob,
+                        s.name,
                         "RMS over campaigns of the worst relative error of alpha, sigma_d^2, sigma_r^2",
-                        std::sqrt(squaredError[i] / set.seeds), totalMs / (6 * s.frames * frameMp),
+                        std::sqrt(squaredError[i] / set.seeds),
+                        totalMs / (6 * s.frames * frameMp),
                         s.knob == "Calibration RANSAC iterations" ? "the fit is a small part of the time"
-                                                                  : "more data, smaller error, linear cost"});
+                                                                  : "more data, smaller error, linear cost",
+                        {}});
     }
 }
 
@@ -416,10 +466,20 @@ void measureShapiroWilk(const TradeoffSettings& set, std::vector<TradeoffRow>& r
         worst = std::max(
             worst, std::abs(batch[static_cast<size_t>(i)].pValue - single[static_cast<size_t>(i)].pValue));
     const double mValues = static_cast<double>(n) * series / 1e6;
-    rows.push_back({"Shapiro-Wilk", "batched", "max |p batched - p single|", worst, batchMs / mValues,
-                    "coefficients once, series in parallel"});
-    rows.push_back({"Shapiro-Wilk", "one call per series", "max |p batched - p single|", worst,
-                    singleMs / mValues, "the same numbers, slower"});
+    rows.push_back({"Shapiro-Wilk",
+                    "batched",
+                    "max |p batched - p single|",
+                    worst,
+                    batchMs / mValues,
+                    "coefficients once, series in parallel",
+                    {}});
+    rows.push_back({"Shapiro-Wilk",
+                    "one call per series",
+                    "max |p batched - p single|",
+                    worst,
+                    singleMs / mValues,
+                    "the same numbers, slower",
+                    {}});
 }
 
 //! A pipe inside a table cell would end the cell.

@@ -31,6 +31,9 @@ struct TradeoffRow
     double error = 0;   // of the measure, against the simulator's truth (smaller is better)
     double msPerMp = 0; // wall time per megapixel of input (per million values for Shapiro-Wilk)
     std::string meaning;
+    /** The time on each CPU path this machine has, in the order of availableCpuPaths(), for the knobs
+     * whose loops are dispatched (cpu.hpp); empty for the others. msPerMp is the active path's. */
+    std::vector<double> msPerMpByPath;
 };
 
 /** Measures every knob in one run (colour jitter, blur, burst statistics, calibration, Shapiro-Wilk)
