@@ -14,7 +14,6 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
-#include <regex>
 #include <sstream>
 #include <stdexcept>
 #include <sys/stat.h>
@@ -69,6 +68,36 @@ void writeNewBytes(const std::string& path, const std::vector<uchar>& bytes)
 
 } // namespace
 
+namespace {
+
+/* The process that wrote a temporary file: "<file>.tmp-<pid>-<n>" (writeFileAtomically) or
+ * "<plot>.gp.<pid>.run" (a gnuplot script); 0 for any other name. */
+pid_t temporaryOwner(const std::string& name)
+{
+    // Digits only, at most 9 of them (pids are far below), so that the number always fits.
+    const auto number = [&](size_t from, size_t to) -> long {
+        if (to <= from || to - from > 9)
+            return 0;
+        for (size_t i = from; i < to; ++i)
+            if (name[i] < '0' || name[i] > '9')
+                return 0;
+        return std::stol(name.substr(from, to - from));
+    };
+    const size_t tmp = name.rfind(".tmp-");
+    if (tmp != std::string::npos) {
+        const size_t dash = name.find('-', tmp + 5);
+        if (dash != std::string::npos && dash + 1 < name.size() &&
+            name.find_first_not_of("0123456789", dash + 1) == std::string::npos)
+            return static_cast<pid_t>(number(tmp + 5, dash));
+    }
+    const size_t gp = name.rfind(".gp.");
+    if (gp != std::string::npos && name.size() >= gp + 8 && name.compare(name.size() - 4, 4, ".run") == 0)
+        return static_cast<pid_t>(number(gp + 4, name.size() - 4));
+    return 0;
+}
+
+} // namespace
+
 bool pathExists(const std::string& path)
 {
     return ::access(path.c_str(), F_OK) == 0;
@@ -77,16 +106,13 @@ bool pathExists(const std::string& path)
 void prepareOutputDirectory(const std::string& dir)
 {
     makeDirectories(dir);
-    static const std::regex leftover(R"(\.(?:tmp-(\d+)-\d+|gp\.(\d+)\.run)$)");
     int removed = 0;
     std::error_code error;
     for (auto it = std::filesystem::recursive_directory_iterator(dir, error);
          !error && it != std::filesystem::recursive_directory_iterator(); it.increment(error)) {
-        const std::string name = it->path().filename().string();
-        std::smatch m;
-        if (!it->is_regular_file(error) || !std::regex_search(name, m, leftover))
+        const pid_t pid = temporaryOwner(it->path().filename().string());
+        if (pid <= 0 || !it->is_regular_file(error))
             continue;
-        const pid_t pid = static_cast<pid_t>(std::stol(m[1].matched ? m[1].str() : m[2].str()));
         if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH &&
             std::remove(it->path().c_str()) == 0)
             ++removed;

@@ -20,7 +20,8 @@ namespace cv {
 namespace rawgment {
 namespace detail {
 
-//! The active path without the checks of activeCpuPath(): for the dispatchers, after the first check.
+//! The path the dispatchers call: activeCpuPath() (an invalid RAWGMENT_CPU_PATH throws from the first
+//! hot loop).
 CpuPath dispatchPath();
 
 //! The vectors of a kernel of width W (RAWGMENT_DISPATCHED_BY_WIDTH): W floats, int32, uint32, uint16.
@@ -59,57 +60,24 @@ template <typename V> inline __attribute__((always_inline)) V sqrtLanes(V v)
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(RAWGMENT_NO_MULTIVERSIONING)
 #define RAWGMENT_HAVE_CPU_PATHS 1
-/** Defines `ret name params` running `name##Kernel args` compiled for the active CpuPath. */
-#define RAWGMENT_DISPATCHED(ret, name, params, args)                                                         \
+/* The four versions of `name##Kernel` (instantiated as `name##Kernel w512`, `w256`, `w128`: empty, or
+ * a template width) and the entry point `ret name params` that calls the active path's. */
+#define RAWGMENT_DISPATCHED_AS(ret, name, params, args, w512, w256, w128)                                    \
     __attribute__((target("arch=x86-64-v4"))) static ret name##Avx512 params                                 \
     {                                                                                                        \
-        return name##Kernel args;                                                                            \
+        return name##Kernel w512 args;                                                                       \
     }                                                                                                        \
     __attribute__((target("arch=x86-64-v3"))) static ret name##Avx2 params                                   \
     {                                                                                                        \
-        return name##Kernel args;                                                                            \
+        return name##Kernel w256 args;                                                                       \
     }                                                                                                        \
     __attribute__((target("arch=x86-64-v2"))) static ret name##Sse42 params                                  \
     {                                                                                                        \
-        return name##Kernel args;                                                                            \
+        return name##Kernel w128 args;                                                                       \
     }                                                                                                        \
     static ret name##Baseline params                                                                         \
     {                                                                                                        \
-        return name##Kernel args;                                                                            \
-    }                                                                                                        \
-    ret name params                                                                                          \
-    {                                                                                                        \
-        switch (::cv::rawgment::detail::dispatchPath()) {                                                    \
-        case ::cv::rawgment::CpuPath::AVX512:                                                                \
-            return name##Avx512 args;                                                                        \
-        case ::cv::rawgment::CpuPath::AVX2:                                                                  \
-            return name##Avx2 args;                                                                          \
-        case ::cv::rawgment::CpuPath::SSE42:                                                                 \
-            return name##Sse42 args;                                                                         \
-        default:                                                                                             \
-            return name##Baseline args;                                                                      \
-        }                                                                                                    \
-    }
-/** As RAWGMENT_DISPATCHED, for a kernel template on its vector width in floats: `name##Kernel<W> args`
- * with W = 16 (AVX-512), 8 (AVX2) or 4 (SSE). GCC lowers vectors wider than the registers piecewise,
- * and their comparisons and selections lane by lane in scalar code: a kernel with those runs at the
- * native width of each path. */
-#define RAWGMENT_DISPATCHED_BY_WIDTH(ret, name, params, args)                                                \
-    __attribute__((target("arch=x86-64-v4"))) static ret name##Avx512 params                                 \
-    {                                                                                                        \
-        return name##Kernel<16> args;                                                                        \
-    }                                                                                                        \
-    __attribute__((target("arch=x86-64-v3"))) static ret name##Avx2 params                                   \
-    {                                                                                                        \
-        return name##Kernel<8> args;                                                                         \
-    }                                                                                                        \
-    __attribute__((target("arch=x86-64-v2"))) static ret name##Sse42 params                                  \
-    {                                                                                                        \
-        return name##Kernel<4> args;                                                                         \
-    }                                                                                                        \
-    static ret name##Baseline params                                                                         \
-    {                                                                                                        \
-        return name##Kernel<4> args;                                                                         \
+        return name##Kernel w128 args;                                                                       \
     }                                                                                                        \
     ret name params                                                                                          \
     {                                                                                                        \
@@ -126,16 +94,21 @@ template <typename V> inline __attribute__((always_inline)) V sqrtLanes(V v)
     }
 #else
 #define RAWGMENT_HAVE_CPU_PATHS 0
-#define RAWGMENT_DISPATCHED_BY_WIDTH(ret, name, params, args)                                                \
+#define RAWGMENT_DISPATCHED_AS(ret, name, params, args, w512, w256, w128)                                    \
     ret name params                                                                                          \
     {                                                                                                        \
-        return name##Kernel<4> args;                                                                         \
-    }
-#define RAWGMENT_DISPATCHED(ret, name, params, args)                                                         \
-    ret name params                                                                                          \
-    {                                                                                                        \
-        return name##Kernel args;                                                                            \
+        return name##Kernel w128 args;                                                                       \
     }
 #endif
+
+/** Defines `ret name params` running `name##Kernel args` compiled for the active CpuPath. */
+#define RAWGMENT_DISPATCHED(ret, name, params, args) RAWGMENT_DISPATCHED_AS(ret, name, params, args, , , )
+
+/** As RAWGMENT_DISPATCHED, for a kernel template on its vector width in floats: `name##Kernel<W> args`
+ * with W = 16 (AVX-512), 8 (AVX2) or 4 (SSE). GCC lowers vectors wider than the registers piecewise,
+ * and their comparisons and selections lane by lane in scalar code: a kernel with those runs at the
+ * native width of each path. */
+#define RAWGMENT_DISPATCHED_BY_WIDTH(ret, name, params, args)                                                \
+    RAWGMENT_DISPATCHED_AS(ret, name, params, args, <16>, <8>, <4>)
 
 #endif // OPENCV_RAWGMENT_SRC_CPU_DISPATCH_HPP
