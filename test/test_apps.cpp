@@ -156,18 +156,17 @@ TEST(Apps, badManifestsAreErrorsNamingTheKeyOrTheFile)
     EXPECT_NE(std::string::npos, r.output.find("unknown key 'gain'")) << r.output;
     // A word where a number belongs was read as 0 (gain 0 dB, factor 0) before the manifest had a reader.
     cv::rawgment::NoiseModel(1, 1, 1).save(dir + "/model.yml");
-    std::ofstream(dir + "/v.yml") << "%YAML:1.0\nvalidation_manifest:\n  gain_db: twelve\n  bright: [a.dng]\n"
-                                  << "  targets:\n    - { factor: 0.5, files: [b.dng] }\n";
-    r = runApp("rawgment_validate",
-               "'" + dir + "/v.yml' --model='" + dir + "/model.yml' --out='" + dir + "/val'");
-    EXPECT_EQ(1, r.status) << r.output;
-    EXPECT_NE(std::string::npos, r.output.find("'gain_db' must be a finite number")) << r.output;
-    std::ofstream(dir + "/v2.yml") << "%YAML:1.0\nvalidation_manifest:\n  bright: [a.dng]\n"
-                                   << "  targets:\n    - { factor: half, files: [b.dng] }\n";
-    r = runApp("rawgment_validate",
-               "'" + dir + "/v2.yml' --model='" + dir + "/model.yml' --out='" + dir + "/val'");
-    EXPECT_EQ(1, r.status) << r.output;
-    EXPECT_NE(std::string::npos, r.output.find("target 1: 'factor' must be a number in (0, 1]")) << r.output;
+    const auto validate = [&](const std::string& fields, const std::string& target, const char* expected) {
+        std::ofstream(dir + "/v.yml", std::ios::trunc)
+            << "%YAML:1.0\nvalidation_manifest:\n"
+            << fields << "  bright: [a.dng]\n  targets:\n    - { " << target << ", files: [b.dng] }\n";
+        const AppRun v = runApp("rawgment_validate", "'" + dir + "/v.yml' --model='" + dir +
+                                                         "/model.yml' --out='" + dir + "/val'");
+        EXPECT_EQ(1, v.status) << v.output;
+        EXPECT_NE(std::string::npos, v.output.find(expected)) << v.output;
+    };
+    validate("  gain_db: twelve\n", "factor: 0.5", "'gain_db' must be a finite number");
+    validate("", "factor: half", "target 1: 'factor' must be a number in (0, 1]");
 }
 
 TEST(Apps, unusableValuesAreRefusedAndFailedRunsLeaveNoEmptyFolder)

@@ -135,8 +135,7 @@ void BM_Augment_memcpy(benchmark::State& state)
 
 int main(int argc, char** argv)
 {
-    // "CPU" is the process's CPU time over all threads (MeasureProcessCPUTime): on 2 cores a fully
-    // parallel loop shows about twice its wall time, and less tells how long a thread waited.
+    // "CPU" is the process's CPU time over all threads (see perf::registerOnEveryCpuPath()).
     benchmark::RegisterBenchmark("BM_Augment_memcpy", BM_Augment_memcpy)
         ->Unit(benchmark::kMillisecond)
         ->MeasureProcessCPUTime()
@@ -152,22 +151,6 @@ int main(int argc, char** argv)
         {"BM_Augment_scale103", BM_Augment_scale103},
         {"BM_Augment_randomScene", BM_Augment_randomScene}};
     for (const auto& b : library)
-        for (CpuPath path : availableCpuPaths()) {
-            const auto run = b.second;
-            benchmark::RegisterBenchmark((std::string(b.first) + "/" + cpuPathName(path)).c_str(),
-                                         [run, path](benchmark::State& state) {
-                                             setCpuPath(path);
-                                             run(state);
-                                             setCpuPath(CpuPath::AUTO);
-                                         })
-                ->Unit(benchmark::kMillisecond)
-                ->MeasureProcessCPUTime()
-                ->UseRealTime();
-        }
-    benchmark::Initialize(&argc, argv);
-    if (benchmark::ReportUnrecognizedArguments(argc, argv))
-        return 1;
-    benchmark::RunSpecifiedBenchmarks();
-    benchmark::Shutdown();
-    return 0;
+        perf::registerOnEveryCpuPath(b.first, b.second);
+    return perf::runRegisteredBenchmarks(argc, argv);
 }

@@ -6,6 +6,8 @@
 //   the whole cross-gain fit on the paper-scale patch data (3 gains x 27,648 samples).
 // The burst statistics run on the best CpuPath with every setting, and with the default setting on
 // every path this CPU has (name suffix /baseline, /sse4.2, /avx2, /avx512).
+#include "perf_common.hpp"
+
 #include <benchmark/benchmark.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/calibration.hpp>
@@ -138,8 +140,7 @@ void BM_CalibrationFit(benchmark::State& state)
 
 int main(int argc, char** argv)
 {
-    // "CPU" is the process's CPU time over all threads (MeasureProcessCPUTime): on 2 cores a fully
-    // parallel loop shows about twice its wall time, and less tells how long a thread waited.
+    // "CPU" is the process's CPU time over all threads (see perf::registerOnEveryCpuPath()).
     // The arguments are groupFrames (memory: that many buffered frames, against state traffic) and the
     // state's depth (float64, or float32 with half the traffic).
     benchmark::RegisterBenchmark("BM_BurstStatistics_rawgment", BM_BurstStatistics_rawgment)
@@ -152,18 +153,9 @@ int main(int argc, char** argv)
         ->MeasureProcessCPUTime()
         ->UseRealTime()
         ->Iterations(3);
-    for (CpuPath path : availableCpuPaths())
-        benchmark::RegisterBenchmark(("BM_BurstStatistics_rawgment/" + cpuPathName(path)).c_str(),
-                                     [path](benchmark::State& state) {
-                                         setCpuPath(path);
-                                         BM_BurstStatistics_rawgment(state);
-                                         setCpuPath(CpuPath::AUTO);
-                                     })
-            ->Args({8, CV_64F})
-            ->Unit(benchmark::kMillisecond)
-            ->MeasureProcessCPUTime()
-            ->UseRealTime()
-            ->Iterations(3);
+    for (benchmark::internal::Benchmark* b :
+         perf::registerOnEveryCpuPath("BM_BurstStatistics_rawgment", BM_BurstStatistics_rawgment))
+        b->Args({8, CV_64F})->Iterations(3);
     benchmark::RegisterBenchmark("BM_BurstStatistics_memcpy", BM_BurstStatistics_memcpy)
         ->Unit(benchmark::kMillisecond)
         ->MeasureProcessCPUTime()
@@ -180,10 +172,5 @@ int main(int argc, char** argv)
         ->Unit(benchmark::kMillisecond)
         ->MeasureProcessCPUTime()
         ->UseRealTime();
-    benchmark::Initialize(&argc, argv);
-    if (benchmark::ReportUnrecognizedArguments(argc, argv))
-        return 1;
-    benchmark::RunSpecifiedBenchmarks();
-    benchmark::Shutdown();
-    return 0;
+    return perf::runRegisteredBenchmarks(argc, argv);
 }

@@ -1,10 +1,16 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// The frame every benchmark works on: a 4000x3000 CV_16UC1 mosaic, 12-bit with black 256.
+// The frame every benchmark works on (a 4000x3000 CV_16UC1 mosaic, 12-bit with black 256), and the
+// registration of a benchmark on every CPU path.
 #ifndef OPENCV_RAWGMENT_PERF_COMMON_HPP
 #define OPENCV_RAWGMENT_PERF_COMMON_HPP
 
+#include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
 #include <opencv2/rawgment/bayer.hpp>
+#include <opencv2/rawgment/cpu.hpp>
+
+#include <string>
+#include <vector>
 
 namespace cv {
 namespace rawgment {
@@ -29,6 +35,37 @@ inline const Mat& perfFrame()
         return f;
     }();
     return m;
+}
+
+/** Registers `run` once per CPU path this machine has, named `name/<path>` and run on that path, in
+ * milliseconds of wall time with the process's CPU time over all threads beside it (on 2 cores a
+ * fully parallel loop shows about twice its wall time; less tells how long a thread waited). */
+inline std::vector<benchmark::internal::Benchmark*> registerOnEveryCpuPath(const std::string& name,
+                                                                           void (*run)(benchmark::State&))
+{
+    std::vector<benchmark::internal::Benchmark*> registered;
+    for (CpuPath path : availableCpuPaths())
+        registered.push_back(benchmark::RegisterBenchmark((name + "/" + cpuPathName(path)).c_str(),
+                                                          [run, path](benchmark::State& state) {
+                                                              setCpuPath(path);
+                                                              run(state);
+                                                              setCpuPath(CpuPath::AUTO);
+                                                          })
+                                 ->Unit(benchmark::kMillisecond)
+                                 ->MeasureProcessCPUTime()
+                                 ->UseRealTime());
+    return registered;
+}
+
+//! What BENCHMARK_MAIN() does, for programs that register their benchmarks in main().
+inline int runRegisteredBenchmarks(int argc, char** argv)
+{
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv))
+        return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
 }
 
 } // namespace perf
