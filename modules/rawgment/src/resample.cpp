@@ -79,49 +79,105 @@ void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, 
 
 // One kernel tap over a row: mean += w x, and for ACCOUNT_PRIOR shot += w (1 - w) max(x, 0) (the prior
 // mean is never negative), in one pass over the source row.
+template <int W>
+RAWGMENT_KERNEL void addTapBlock(float* mean, float* shot, const float* x, float w, float shotWeight,
+                                 bool withShot)
+{
+    typedef typename detail::Lanes<W>::F F;
+    F m, xv;
+    std::memcpy(&m, mean, sizeof(m));
+    std::memcpy(&xv, x, sizeof(xv));
+    m += w * xv;
+    std::memcpy(mean, &m, sizeof(m));
+    if (withShot) {
+        F sh;
+        std::memcpy(&sh, shot, sizeof(sh));
+        sh += shotWeight * detail::maxLanes(xv, F{});
+        std::memcpy(shot, &sh, sizeof(sh));
+    }
+}
+
+template <int W>
 RAWGMENT_KERNEL void addTapRowKernel(float* mean, float* shot, const float* x, float w, float shotWeight,
                                      bool withShot, int n)
 {
-    if (withShot) {
-        for (int j = 0; j < n; ++j) {
-            mean[j] += w * x[j];
-            shot[j] += shotWeight * std::max(x[j], 0.0f);
-        }
-    } else {
-        for (int j = 0; j < n; ++j)
-            mean[j] += w * x[j];
+    int j = 0;
+    for (; j + W <= n; j += W)
+        addTapBlock<W>(mean + j, withShot ? shot + j : nullptr, x + j, w, shotWeight, withShot);
+    if (j < n) {
+        // The last partial block through padded copies, by the same vector code.
+        float meanPad[W] = {}, shotPad[W] = {}, xPad[W] = {};
+        const size_t rest = static_cast<size_t>(n - j) * sizeof(float);
+        std::memcpy(meanPad, mean + j, rest);
+        std::memcpy(xPad, x + j, rest);
+        if (withShot)
+            std::memcpy(shotPad, shot + j, rest);
+        addTapBlock<W>(meanPad, shotPad, xPad, w, shotWeight, withShot);
+        std::memcpy(mean + j, meanPad, rest);
+        if (withShot)
+            std::memcpy(shot + j, shotPad, rest);
     }
 }
-RAWGMENT_DISPATCHED(void, addTapRow,
-                    (float* mean, float* shot, const float* x, float w, float shotWeight, bool withShot,
-                     int n),
-                    (mean, shot, x, w, shotWeight, withShot, n))
+RAWGMENT_DISPATCHED_BY_WIDTH(void, addTapRow,
+                             (float* mean, float* shot, const float* x, float w, float shotWeight,
+                              bool withShot, int n),
+                             (mean, shot, x, w, shotWeight, withShot, n))
+
+template <int W>
+RAWGMENT_KERNEL void finishResampledBlock(float* mean, const float* shotSum, const float* readFactor,
+                                          const float* z, const ResampleConstants& k, float black)
+{
+    typedef typename detail::Lanes<W>::F F;
+    const F zero = F{}, white = zero + k.white;
+    F m;
+    std::memcpy(&m, mean, sizeof(m));
+    if (k.alignment == NoiseAlignment::NONE) {
+        m = detail::minLanes(detail::maxLanes(m + black, zero), white);
+    } else {
+        F zv, v;
+        std::memcpy(&zv, z, sizeof(zv));
+        if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR) {
+            F sh, rf;
+            std::memcpy(&sh, shotSum, sizeof(sh));
+            std::memcpy(&rf, readFactor, sizeof(rf));
+            v = detail::maxLanes(k.shot * sh + rf * k.floorVar, zero);
+        } else {
+            v = k.shot * detail::maxLanes(m, zero) + k.floorVar;
+        }
+        m = detail::minLanes(detail::maxLanes(m + detail::sqrtLanes(v) * zv + black, zero), white);
+    }
+    std::memcpy(mean, &m, sizeof(m));
+}
 
 // mean[j] + N(0, v): v from the per-pixel shot sum and read-noise factor (ACCOUNT_PRIOR), from the
 // mean (IGNORE_PRIOR), or none; black added back, clipped to [0, white].
+template <int W>
 RAWGMENT_KERNEL void finishResampledRowKernel(float* mean, const float* shotSum, const float* readFactor,
                                               const float* z, const ResampleConstants& k, float black, int n)
 {
-    if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR) {
-        for (int j = 0; j < n; ++j) {
-            const float v = k.shot * shotSum[j] + readFactor[j] * k.floorVar;
-            mean[j] =
-                std::min(std::max(mean[j] + std::sqrt(std::max(v, 0.0f)) * z[j] + black, 0.0f), k.white);
+    const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
+    int j = 0;
+    for (; j + W <= n; j += W)
+        finishResampledBlock<W>(mean + j, account ? shotSum + j : nullptr, account ? readFactor + j : nullptr,
+                                z ? z + j : nullptr, k, black);
+    if (j < n) {
+        float meanPad[W] = {}, shotPad[W] = {}, readPad[W] = {}, zPad[W] = {};
+        const size_t rest = static_cast<size_t>(n - j) * sizeof(float);
+        std::memcpy(meanPad, mean + j, rest);
+        if (account) {
+            std::memcpy(shotPad, shotSum + j, rest);
+            std::memcpy(readPad, readFactor + j, rest);
         }
-    } else if (k.alignment == NoiseAlignment::IGNORE_PRIOR) {
-        for (int j = 0; j < n; ++j) {
-            const float v = k.shot * std::max(mean[j], 0.0f) + k.floorVar;
-            mean[j] = std::min(std::max(mean[j] + std::sqrt(v) * z[j] + black, 0.0f), k.white);
-        }
-    } else {
-        for (int j = 0; j < n; ++j)
-            mean[j] = std::min(std::max(mean[j] + black, 0.0f), k.white);
+        if (z)
+            std::memcpy(zPad, z + j, rest);
+        finishResampledBlock<W>(meanPad, shotPad, readPad, zPad, k, black);
+        std::memcpy(mean + j, meanPad, rest);
     }
 }
-RAWGMENT_DISPATCHED(void, finishResampledRow,
-                    (float* mean, const float* shotSum, const float* readFactor, const float* z,
-                     const ResampleConstants& k, float black, int n),
-                    (mean, shotSum, readFactor, z, k, black, n))
+RAWGMENT_DISPATCHED_BY_WIDTH(void, finishResampledRow,
+                             (float* mean, const float* shotSum, const float* readFactor, const float* z,
+                              const ResampleConstants& k, float black, int n),
+                             (mean, shotSum, readFactor, z, k, black, n))
 
 template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int planeRow)
 {
