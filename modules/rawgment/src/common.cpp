@@ -297,7 +297,10 @@ FileStorage openFileStorageForReading(const String& path, const String& what)
                                          what.c_str(), path.c_str(), static_cast<long long>(status.st_size),
                                          static_cast<long long>(MAX_TEXT_FILE_BYTES)));
     // Read once and parsed from memory: the integer check and OpenCV's parser see the same bytes.
-    const std::string text = detail::readTextFile(path);
+    std::string text = detail::readTextFile(path);
+    // A UTF-8 byte-order mark (some Windows editors write one) is not part of the YAML or JSON.
+    if (text.compare(0, 3, "\xEF\xBB\xBF") == 0)
+        text.erase(0, 3);
     if (text.size() > size_t(MAX_TEXT_FILE_BYTES))
         CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': it grew while being read");
     detail::rejectUnsupportedStructure(path, text);

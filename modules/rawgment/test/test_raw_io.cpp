@@ -452,6 +452,10 @@ TEST(RawIo, openFileStorageForReadingRefusesStreamsOpenCvNeverFinishes)
     EXPECT_TRUE(
         openFileStorageForReading(textFile(dir, "good.json", "{ \"m\": { \"a\": [ 1, 2 ] } }\n"), "test file")
             .isOpened());
+    // A byte-order mark before the %YAML line, as some Windows editors save.
+    EXPECT_TRUE(openFileStorageForReading(
+                    textFile(dir, "bom.yml", "\xEF\xBB\xBF%YAML:1.0\n---\nm:\n   a: 1\n"), "test file")
+                    .isOpened());
     EXPECT_CV_ERROR_CONTAINS(
         openFileStorageForReading(textFile(dir, "two.yml", "%YAML:1.0\n---\nm: 1\n...\n---\nn: 2\n"), "x"),
         "a document marker after");
