@@ -58,13 +58,13 @@ template <int W, typename T> struct PixelLanes;
 template <int W> struct PixelLanes<W, ushort>
 {
     typedef typename detail::Lanes<W>::F F;
-    static F load(const ushort* p)
+    RAWGMENT_KERNEL F load(const ushort* p)
     {
         typename detail::Lanes<W>::U16 v;
         std::memcpy(&v, p, sizeof(v));
         return __builtin_convertvector(v, F);
     }
-    static void store(ushort* p, F out, F white)
+    RAWGMENT_KERNEL void store(ushort* p, F out, F white)
     {
         out = detail::minLanes(detail::maxLanes(out, F{}), white) + 0.5f;
         const typename detail::Lanes<W>::U16 v = __builtin_convertvector(
@@ -75,13 +75,13 @@ template <int W> struct PixelLanes<W, ushort>
 template <int W> struct PixelLanes<W, float>
 {
     typedef typename detail::Lanes<W>::F F;
-    static F load(const float* p)
+    RAWGMENT_KERNEL F load(const float* p)
     {
         F v;
         std::memcpy(&v, p, sizeof(v));
         return v;
     }
-    static void store(float* p, F out, F white)
+    RAWGMENT_KERNEL void store(float* p, F out, F white)
     {
         out = detail::minLanes(detail::maxLanes(out, F{}), white);
         std::memcpy(p, &out, sizeof(out));
