@@ -140,37 +140,23 @@ void BM_CalibrationFit(benchmark::State& state)
 
 int main(int argc, char** argv)
 {
-    // "CPU" is the process's CPU time over all threads (see perf::registerOnEveryCpuPath()).
+    // "CPU" is the process's CPU time over all threads; "stolen" the hypervisor's share (perf_common.hpp).
     // The arguments are groupFrames (memory: that many buffered frames, against state traffic) and the
     // state's depth (float64, or float32 with half the traffic).
-    benchmark::RegisterBenchmark("BM_BurstStatistics_rawgment", BM_BurstStatistics_rawgment)
+    perf::registerTimed("BM_BurstStatistics_rawgment", BM_BurstStatistics_rawgment)
         ->Args({8, CV_64F})
         ->Args({16, CV_64F})
         ->Args({32, CV_64F})
         ->Args({8, CV_32F})
         ->Args({16, CV_32F})
-        ->Unit(benchmark::kMillisecond)
-        ->MeasureProcessCPUTime()
-        ->UseRealTime()
         ->Iterations(3);
     for (benchmark::internal::Benchmark* b :
          perf::registerOnEveryCpuPath("BM_BurstStatistics_rawgment", BM_BurstStatistics_rawgment))
         b->Args({8, CV_64F})->Iterations(3);
-    benchmark::RegisterBenchmark("BM_BurstStatistics_memcpy", BM_BurstStatistics_memcpy)
-        ->Unit(benchmark::kMillisecond)
-        ->MeasureProcessCPUTime()
-        ->UseRealTime()
-        ->Iterations(3);
-    benchmark::RegisterBenchmark("BM_BurstStatistics_naiveOpenCV", BM_BurstStatistics_naiveOpenCV)
-        ->Unit(benchmark::kMillisecond)
-        ->MeasureProcessCPUTime()
-        ->UseRealTime()
-        ->Iterations(2);
-    benchmark::RegisterBenchmark("BM_CalibrationFit", BM_CalibrationFit)
+    perf::registerTimed("BM_BurstStatistics_memcpy", BM_BurstStatistics_memcpy)->Iterations(3);
+    perf::registerTimed("BM_BurstStatistics_naiveOpenCV", BM_BurstStatistics_naiveOpenCV)->Iterations(2);
+    perf::registerTimed("BM_CalibrationFit", BM_CalibrationFit)
         ->Arg(NOISE_FIT_JOINT)
-        ->Arg(NOISE_FIT_TWO_STAGE)
-        ->Unit(benchmark::kMillisecond)
-        ->MeasureProcessCPUTime()
-        ->UseRealTime();
+        ->Arg(NOISE_FIT_TWO_STAGE);
     return perf::runRegisteredBenchmarks(argc, argv);
 }

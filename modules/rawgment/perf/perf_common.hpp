@@ -9,7 +9,9 @@
 #include <opencv2/rawgment/bayer.hpp>
 #include <opencv2/rawgment/cpu.hpp>
 
+#include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace cv {
@@ -37,9 +39,50 @@ inline const Mat& perfFrame()
     return m;
 }
 
+/** The machine's CPU time stolen by the hypervisor and its total CPU time, in jiffies, from /proc/stat
+ * (both 0 where it cannot be read). */
+inline std::pair<double, double> stolenAndTotalJiffies()
+{
+    std::ifstream stat("/proc/stat");
+    std::string cpu;
+    double value = 0, total = 0, steal = 0;
+    stat >> cpu;
+    // user nice system idle iowait irq softirq steal (guest times are inside user and nice).
+    for (int field = 0; field < 8 && stat >> value; ++field) {
+        total += value;
+        if (field == 7)
+            steal = value;
+    }
+    return cpu == "cpu" ? std::make_pair(steal, total) : std::make_pair(0.0, 0.0);
+}
+
+/** Runs a benchmark and adds the counter "stolen": the share of the machine's CPU time its hypervisor
+ * took during the run. A virtual machine whose cores are shared shows wall time well above CPU time
+ * for no fault of the code; this counter says when that is the reason. */
+inline void runWithStolenShare(void (*run)(benchmark::State&), benchmark::State& state)
+{
+    const std::pair<double, double> before = stolenAndTotalJiffies();
+    run(state);
+    const std::pair<double, double> after = stolenAndTotalJiffies();
+    const double total = after.second - before.second;
+    state.counters["stolen"] = total > 0 ? (after.first - before.first) / total : 0.0;
+}
+
+/** Registers `run` under `name` in milliseconds of wall time, with the process's CPU time over all
+ * threads beside it and the counter "stolen" (runWithStolenShare()). */
+inline benchmark::internal::Benchmark* registerTimed(const std::string& name, void (*run)(benchmark::State&))
+{
+    return benchmark::RegisterBenchmark(name.c_str(),
+                                        [run](benchmark::State& state) { runWithStolenShare(run, state); })
+        ->Unit(benchmark::kMillisecond)
+        ->MeasureProcessCPUTime()
+        ->UseRealTime();
+}
+
 /** Registers `run` once per CPU path this machine has, named `name/<path>` and run on that path, in
  * milliseconds of wall time with the process's CPU time over all threads beside it (on 2 cores a
- * fully parallel loop shows about twice its wall time; less tells how long a thread waited). */
+ * fully parallel loop shows about twice its wall time; less tells how long a thread waited) and the
+ * counter "stolen" (runWithStolenShare()). */
 inline std::vector<benchmark::internal::Benchmark*> registerOnEveryCpuPath(const std::string& name,
                                                                            void (*run)(benchmark::State&))
 {
@@ -48,7 +91,7 @@ inline std::vector<benchmark::internal::Benchmark*> registerOnEveryCpuPath(const
         registered.push_back(benchmark::RegisterBenchmark((name + "/" + cpuPathName(path)).c_str(),
                                                           [run, path](benchmark::State& state) {
                                                               setCpuPath(path);
-                                                              run(state);
+                                                              runWithStolenShare(run, state);
                                                               setCpuPath(CpuPath::AUTO);
                                                           })
                                  ->Unit(benchmark::kMillisecond)
