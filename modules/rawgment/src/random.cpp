@@ -226,6 +226,7 @@ philox8BlocksAvx2(uint32_t firstBlock, uint64_t stream, const std::array<uint32_
 // pass-through operand, which the full mask never uses.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 __attribute__((target("arch=x86-64-v4"))) void
 philox8BlocksAvx512(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key, uint32_t* words)
 {
