@@ -32,10 +32,12 @@ bool isIdentityKernel(const Mat& kernel);
 
 // The variance to add to a pixel, split into its shot part and the rest (read noise, and for
 // ACCOUNT_PRIOR the correction of the scaled prior), before any clipping.
-struct AddedVariance
+template <typename V> struct AddedVarianceOf
 {
-    float shot, rest;
+    V shot, rest;
 };
+//! One pixel's; the vector kernels use AddedVarianceOf their lanes.
+typedef AddedVarianceOf<float> AddedVariance;
 
 // Gaussian noise of variance `rest` plus the shot part as an electron count: q (K - m) with
 // K ~ Poisson(m), m = shot / q^2 (ShotNoiseSampling::POISSON). A negative total (brightening) adds

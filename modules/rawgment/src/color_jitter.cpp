@@ -31,21 +31,23 @@ struct JitterConstants
 // ACCOUNT_PRIOR the correction of the scaled prior), before any clipping. xm is the prior-mean estimate
 // (black-subtracted), pc the pixel's contrast. Eq. 13 for ACCOUNT_PRIOR; the model at the new mean and
 // gain for IGNORE_PRIOR.
-template <NoiseAlignment A>
-RAWGMENT_KERNEL AddedVariance jitterVariance(float xm, float pc, const JitterConstants& k)
+// V is float (one pixel) or a vector of lanes (cpu_dispatch.hpp): the same operations in the same order.
+template <NoiseAlignment A, typename V>
+RAWGMENT_KERNEL detail::AddedVarianceOf<V> jitterVariance(V xm, V pc, const JitterConstants& k)
 {
+    const V zero = V{} + 0.0f, one = zero + 1.0f;
     const float pg = k.pg, pg2 = k.pg * k.pg;
     if (A == NoiseAlignment::ACCOUNT_PRIOR) {
-        const float xf = std::max(xm, 1.0f);
-        const float pu = std::max((pc * xf + k.pb) / (xf * pg), 0.0f);
-        const float mu = std::max(xm, 0.0f);
+        const V xf = detail::maxLanes(xm, one);
+        const V pu = detail::maxLanes((pc * xf + k.pb) / (xf * pg), zero);
+        const V mu = detail::maxLanes(xm, zero);
         return {pu * (1 - pu) * (pg2 * k.in.shot) * mu,
                 (1 - pu * pu) * (pg2 * k.in.readBeforeGain) + (1 - pu * pu * pg2) * k.in.readAfterGain};
     }
     if (A == NoiseAlignment::IGNORE_PRIOR)
-        return {pg * k.in.shot * std::max(pc * xm + k.pb, 0.0f),
-                pg2 * k.in.readBeforeGain + k.in.readAfterGain};
-    return {0.0f, 0.0f};
+        return {pg * k.in.shot * detail::maxLanes(pc * xm + k.pb, zero),
+                zero + (pg2 * k.in.readBeforeGain + k.in.readAfterGain)};
+    return {zero, zero};
 }
 
 // One row of Eq. 11/13 on explicit vectors of W lanes (cpu_dispatch.hpp). `prior` is the local-mean
@@ -88,28 +90,6 @@ template <int W> struct PixelLanes<W, float>
     }
 };
 
-template <int W, NoiseAlignment A>
-RAWGMENT_KERNEL typename detail::Lanes<W>::F jitterVarianceLanes(typename detail::Lanes<W>::F xm,
-                                                                 typename detail::Lanes<W>::F pc,
-                                                                 const JitterConstants& k)
-{
-    // jitterVariance() on lanes, the same operations in the same order; returns shot + rest.
-    typedef typename detail::Lanes<W>::F F;
-    const F zero = F{}, one = zero + 1.0f;
-    const float pg = k.pg, pg2 = k.pg * k.pg;
-    if (A == NoiseAlignment::ACCOUNT_PRIOR) {
-        const F xf = detail::maxLanes(xm, one);
-        const F pu = detail::maxLanes((pc * xf + k.pb) / (xf * pg), zero);
-        const F mu = detail::maxLanes(xm, zero);
-        const F shot = pu * (1 - pu) * (pg2 * k.in.shot) * mu;
-        const F rest = (1 - pu * pu) * (pg2 * k.in.readBeforeGain) + (1 - pu * pu * pg2) * k.in.readAfterGain;
-        return shot + rest;
-    }
-    const F shot = pg * k.in.shot * detail::maxLanes(pc * xm + k.pb, zero);
-    const F rest = zero + (pg2 * k.in.readBeforeGain + k.in.readAfterGain);
-    return shot + rest;
-}
-
 template <int W, typename T, NoiseAlignment A, bool kLocalMean>
 RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* prior, const float* pc,
                                  const float* black, const JitterConstants& k,
@@ -127,7 +107,8 @@ RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* 
         if (kLocalMean)
             std::memcpy(&xm, prior, sizeof(xm));
         std::memcpy(&zv, z, sizeof(zv));
-        const F total = jitterVarianceLanes<W, A>(xm, pcv, k);
+        const detail::AddedVarianceOf<F> v = jitterVariance<A>(xm, pcv, k);
+        const F total = v.shot + v.rest;
         bright -= total < 0; // -1 per brightening lane
         out += detail::sqrtLanes(detail::maxLanes(total, F{})) * zv;
     }

@@ -33,6 +33,15 @@ template <int W> struct Lanes
     typedef uint16_t U16 __attribute__((vector_size(2 * W)));
 };
 
+//! The widest kernel width, AVX-512's 16 floats. A row buffer of the module sized by wholeBlocks() lets
+//! a kernel of any width run its last block over the row's end (on values it does not store) instead
+//! of handling a partial block.
+constexpr int kWidestLanes = 16;
+inline size_t wholeBlocks(int n)
+{
+    return static_cast<size_t>((n + kWidestLanes - 1) / kWidestLanes * kWidestLanes);
+}
+
 //! Lane-wise std::max and std::min (the same operand chosen when one is NaN).
 template <typename V> inline __attribute__((always_inline)) V maxLanes(V a, V b)
 {

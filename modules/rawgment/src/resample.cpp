@@ -97,26 +97,13 @@ RAWGMENT_KERNEL void addTapBlock(float* mean, float* shot, const float* x, float
     }
 }
 
+// The buffers hold whole blocks (detail::wholeBlocks()): the last block runs over the row's end.
 template <int W>
 RAWGMENT_KERNEL void addTapRowKernel(float* mean, float* shot, const float* x, float w, float shotWeight,
                                      bool withShot, int n)
 {
-    int j = 0;
-    for (; j + W <= n; j += W)
+    for (int j = 0; j < n; j += W)
         addTapBlock<W>(mean + j, withShot ? shot + j : nullptr, x + j, w, shotWeight, withShot);
-    if (j < n) {
-        // The last partial block through padded copies, by the same vector code.
-        float meanPad[W] = {}, shotPad[W] = {}, xPad[W] = {};
-        const size_t rest = static_cast<size_t>(n - j) * sizeof(float);
-        std::memcpy(meanPad, mean + j, rest);
-        std::memcpy(xPad, x + j, rest);
-        if (withShot)
-            std::memcpy(shotPad, shot + j, rest);
-        addTapBlock<W>(meanPad, shotPad, xPad, w, shotWeight, withShot);
-        std::memcpy(mean + j, meanPad, rest);
-        if (withShot)
-            std::memcpy(shot + j, shotPad, rest);
-    }
 }
 RAWGMENT_DISPATCHED_BY_WIDTH(void, addTapRow,
                              (float* mean, float* shot, const float* x, float w, float shotWeight,
@@ -150,29 +137,16 @@ RAWGMENT_KERNEL void finishResampledBlock(float* mean, const float* shotSum, con
 }
 
 // mean[j] + N(0, v): v from the per-pixel shot sum and read-noise factor (ACCOUNT_PRIOR), from the
-// mean (IGNORE_PRIOR), or none; black added back, clipped to [0, white].
+// mean (IGNORE_PRIOR), or none; black added back, clipped to [0, white]. The buffers hold whole blocks
+// (detail::wholeBlocks()).
 template <int W>
 RAWGMENT_KERNEL void finishResampledRowKernel(float* mean, const float* shotSum, const float* readFactor,
                                               const float* z, const ResampleConstants& k, float black, int n)
 {
     const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
-    int j = 0;
-    for (; j + W <= n; j += W)
+    for (int j = 0; j < n; j += W)
         finishResampledBlock<W>(mean + j, account ? shotSum + j : nullptr, account ? readFactor + j : nullptr,
                                 z ? z + j : nullptr, k, black);
-    if (j < n) {
-        float meanPad[W] = {}, shotPad[W] = {}, readPad[W] = {}, zPad[W] = {};
-        const size_t rest = static_cast<size_t>(n - j) * sizeof(float);
-        std::memcpy(meanPad, mean + j, rest);
-        if (account) {
-            std::memcpy(shotPad, shotSum + j, rest);
-            std::memcpy(readPad, readFactor + j, rest);
-        }
-        if (z)
-            std::memcpy(zPad, z + j, rest);
-        finishResampledBlock<W>(meanPad, shotPad, readPad, zPad, k, black);
-        std::memcpy(mean + j, meanPad, rest);
-    }
 }
 RAWGMENT_DISPATCHED_BY_WIDTH(void, finishResampledRow,
                              (float* mean, const float* shotSum, const float* readFactor, const float* z,
@@ -206,7 +180,7 @@ template <typename T>
 void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float* readFactor,
                     std::vector<float>& z, const ResampleConstants& k, Mat& dst, int site, int planeRow)
 {
-    const int n = static_cast<int>(mean.size());
+    const int n = dst.cols / 2;
     const uint64_t stream = detail::planeRowStream(site, planeRow);
     if (k.alignment != NoiseAlignment::NONE)
         detail::fillGaussian(k.key, stream, z.data(), n);
@@ -287,11 +261,13 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
 {
     const int pw = src.cols / 2, ph = src.rows / 2, rx = ksize.width / 2, ry = ksize.height / 2;
     const Size plane(pw, ph), radius(rx, ry);
-    const int padded = pw + 2 * rx;
-    std::vector<float> ring(static_cast<size_t>(ksize.height) * padded);
+    // A ring row holds the plane row with rx columns of edge on each side, and one widest block more,
+    // which addTapRow's last block reads past the row (detail::wholeBlocks()).
+    const int stride = pw + 2 * rx + detail::kWidestLanes;
+    std::vector<float> ring(static_cast<size_t>(ksize.height) * stride);
     std::vector<int> ringRow(static_cast<size_t>(ksize.height), -1);
-    std::vector<float> mean(static_cast<size_t>(pw)), shotSum(static_cast<size_t>(pw)),
-        z(static_cast<size_t>(pw)), readFactors(static_cast<size_t>(pw));
+    std::vector<float> mean(detail::wholeBlocks(pw)), shotSum(detail::wholeBlocks(pw)),
+        z(detail::wholeBlocks(pw)), readFactors(detail::wholeBlocks(pw));
     const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
     const bool exactShot = account && !shotFromMean;
     struct EdgeColumn
@@ -324,7 +300,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
         for (const KernelTap& t : edgeRow ? rowTaps : taps) {
             const int si = std::min(std::max(i + t.dy - ry, 0), ph - 1);
             const size_t slot = static_cast<size_t>(si % ksize.height);
-            float* row = ring.data() + slot * padded;
+            float* row = ring.data() + slot * stride;
             if (ringRow[slot] != si) {
                 loadPlaneRow<T>(src, site, si, rx, k.black[site], row);
                 ringRow[slot] = si;
@@ -347,7 +323,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             for (const KernelTap& t : *merged)
                 shot +=
                     t.shotWeight *
-                    std::max(ring[static_cast<size_t>((i + t.dy - ry) % ksize.height) * padded + e.j + t.dx],
+                    std::max(ring[static_cast<size_t>((i + t.dy - ry) % ksize.height) * stride + e.j + t.dx],
                              0.0f);
             shotSum[static_cast<size_t>(e.j)] = shot;
         }
@@ -369,10 +345,11 @@ struct BilinearAxis
 
 BilinearAxis bilinearAxis(int planeSize, int phase, double scale)
 {
+    // Whole blocks for bilinearRow(): the extra entries read pixel 0 with weight 0.
     BilinearAxis a;
-    a.i0.resize(static_cast<size_t>(planeSize));
-    a.i1.resize(static_cast<size_t>(planeSize));
-    a.f.resize(static_cast<size_t>(planeSize));
+    a.i0.assign(detail::wholeBlocks(planeSize), 0);
+    a.i1.assign(detail::wholeBlocks(planeSize), 0);
+    a.f.assign(detail::wholeBlocks(planeSize), 0.0f);
     const double centre = (2.0 * planeSize - 1) / 2;
     for (int j = 0; j < planeSize; ++j) {
         const double x = centre + (2.0 * j + phase - centre) / scale;
@@ -415,33 +392,15 @@ RAWGMENT_KERNEL void bilinearBlock(const float* row0, const float* row1, float f
 }
 
 // Bilinear taps of one output row: mean, Eq. 15's shot sum and the read-noise factor 1 - sum w^2,
-// all per pixel because the weights change along the row. The last partial block runs on padded
-// copies through the same vector code, so every pixel gets the same bits on every path.
+// all per pixel because the weights change along the row. The outputs and the axis hold whole blocks
+// (detail::wholeBlocks(); the axis's extra entries point at pixel 0).
 template <int W>
 RAWGMENT_KERNEL void bilinearRowKernel(const float* row0, const float* row1, float fy, const int* c0,
                                        const int* c1, const float* fx, float* mean, float* shot,
                                        float* readFactor, int n)
 {
-    int j = 0;
-    for (; j + W <= n; j += W)
+    for (int j = 0; j < n; j += W)
         bilinearBlock<W>(row0, row1, fy, c0 + j, c1 + j, fx + j, mean + j, shot + j, readFactor + j);
-    if (j < n) {
-        int c0Pad[W], c1Pad[W];
-        float fxPad[W], meanPad[W], shotPad[W], readPad[W];
-        for (int i = 0; i < W; ++i) {
-            // Extra lanes repeat the last pixel: valid indices, results not stored.
-            const int k = std::min(j + i, n - 1);
-            c0Pad[i] = c0[k];
-            c1Pad[i] = c1[k];
-            fxPad[i] = fx[k];
-        }
-        bilinearBlock<W>(row0, row1, fy, c0Pad, c1Pad, fxPad, meanPad, shotPad, readPad);
-        for (int i = 0; j + i < n; ++i) {
-            mean[j + i] = meanPad[i];
-            shot[j + i] = shotPad[i];
-            readFactor[j + i] = readPad[i];
-        }
-    }
 }
 RAWGMENT_DISPATCHED_BY_WIDTH(void, bilinearRow,
                              (const float* row0, const float* row1, float fy, const int* c0, const int* c1,
@@ -454,8 +413,8 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
 {
     const int pw = src.cols / 2, ph = src.rows / 2;
     std::vector<float> row0(static_cast<size_t>(pw)), row1(static_cast<size_t>(pw));
-    std::vector<float> mean(static_cast<size_t>(pw)), shot(static_cast<size_t>(pw)),
-        readFactor(static_cast<size_t>(pw)), z(static_cast<size_t>(pw));
+    std::vector<float> mean(detail::wholeBlocks(pw)), shot(detail::wholeBlocks(pw)),
+        readFactor(detail::wholeBlocks(pw)), z(detail::wholeBlocks(pw));
     for (int idx = range.start; idx < range.end; ++idx) {
         const int site = idx / ph, i = idx % ph;
         const BilinearAxis& ax = cols[site % 2];
