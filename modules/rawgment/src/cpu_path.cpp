@@ -120,7 +120,9 @@ CpuPath activeCpuPath()
             CV_Error(Error::StsBadArg, env.error);
         chosen = env.path;
     }
-    return chosen == static_cast<int>(CpuPath::AUTO) ? best() : static_cast<CpuPath>(chosen);
+    // The CPU does not change under a running process: its best path is found once (every hot row asks).
+    static const CpuPath bestPath = best();
+    return chosen == static_cast<int>(CpuPath::AUTO) ? bestPath : static_cast<CpuPath>(chosen);
 }
 
 String cpuPathName(CpuPath path)

@@ -8,12 +8,18 @@
 #ifndef OPENCV_RAWGMENT_SRC_RANDOM_HPP
 #define OPENCV_RAWGMENT_SRC_RANDOM_HPP
 
+#include "cpu_dispatch.hpp"
+
 #include <opencv2/core.hpp>
 
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+
+#if RAWGMENT_HAVE_CPU_PATHS
+#include <immintrin.h>
+#endif
 
 namespace cv {
 namespace rawgment {
@@ -39,8 +45,8 @@ inline std::array<uint32_t, 4> philox4x32(std::array<uint32_t, 4> c, std::array<
 }
 
 // Eight Philox4x32-10 blocks side by side, one per 64-bit lane, each 32-bit word of the state in the
-// low half of a lane: a 32x32->64-bit multiply of the low halves is one vector instruction on every
-// x86 (pmuludq) and needs no shuffles. GCC vector extensions: the same source for SSE2, AVX2, AVX-512.
+// low half of a lane, on GCC vector extensions: the portable version, used where there are no CPU paths
+// (cpu_dispatch.hpp); x86 uses the intrinsic versions below, which compute the same words.
 typedef uint64_t U64x8 __attribute__((vector_size(64)));
 
 /** The blocks (firstBlock + b, 0, stream) for b in 0..7, as philox4x32() computes them one by one:
@@ -73,6 +79,136 @@ inline __attribute__((always_inline)) void philox8Blocks(uint32_t firstBlock, ui
     std::memcpy(words + 8, &w1, sizeof(w1));
     std::memcpy(words + 16, &w2, sizeof(w2));
     std::memcpy(words + 24, &w3, sizeof(w3));
+}
+
+#if RAWGMENT_HAVE_CPU_PATHS
+/* philox8Blocks() with x86 intrinsics: GCC multiplies generic 64-bit lanes with three 32-bit
+ * multiplies and shifts below AVX-512, and with the slow vpmullq on it, although both factors fit 32
+ * bits, which one (v)pmuludq multiplies exactly. The same integers as philox8Blocks(), so the
+ * same bits (Simulate.everyPhiloxVersionGivesTheBlocksOfTheScalarOne). Called, not inlined, from the
+ * kernels of every path, so that each keeps its own target. */
+inline void philox8BlocksSse2(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key,
+                              uint32_t* words)
+{
+    // Eight blocks in four registers of two 64-bit lanes, each 32-bit word in a lane's low half.
+    const __m128i low = _mm_set1_epi64x(0xffffffffLL), m0 = _mm_set1_epi64x(kPhiloxM0),
+                  m1 = _mm_set1_epi64x(kPhiloxM1);
+    __m128i c0[4], c1[4], c2[4], c3[4];
+    for (int p = 0; p < 4; ++p) {
+        c0[p] = _mm_set_epi64x(static_cast<uint32_t>(firstBlock + 2 * p + 1),
+                               static_cast<uint32_t>(firstBlock + 2 * p));
+        c1[p] = _mm_setzero_si128();
+        c2[p] = _mm_set1_epi64x(static_cast<uint32_t>(stream));
+        c3[p] = _mm_set1_epi64x(static_cast<uint32_t>(stream >> 32));
+    }
+    uint32_t k0 = key[0], k1 = key[1];
+    for (int round = 0; round < kPhiloxRounds; ++round) {
+        const __m128i kv0 = _mm_set1_epi64x(k0), kv1 = _mm_set1_epi64x(k1);
+        for (int p = 0; p < 4; ++p) {
+            const __m128i p0 = _mm_mul_epu32(c0[p], m0), p1 = _mm_mul_epu32(c2[p], m1);
+            c0[p] = _mm_xor_si128(_mm_xor_si128(_mm_srli_epi64(p1, 32), c1[p]), kv0);
+            c2[p] = _mm_xor_si128(_mm_xor_si128(_mm_srli_epi64(p0, 32), c3[p]), kv1);
+            c1[p] = _mm_and_si128(p1, low);
+            c3[p] = _mm_and_si128(p0, low);
+        }
+        k0 += kPhiloxW0;
+        k1 += kPhiloxW1;
+    }
+    const __m128i* const state[4] = {c0, c1, c2, c3};
+    for (int j = 0; j < 4; ++j)
+        for (int p = 0; p < 4; ++p) {
+            // The low halves of the two lanes, side by side.
+            const __m128i packed = _mm_shuffle_epi32(state[j][p], _MM_SHUFFLE(3, 1, 2, 0));
+            _mm_storel_epi64(reinterpret_cast<__m128i*>(words + 8 * j + 2 * p), packed);
+        }
+}
+
+__attribute__((target("arch=x86-64-v3"))) inline void
+philox8BlocksAvx2(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key, uint32_t* words)
+{
+    // Eight blocks in two registers of four 64-bit lanes, each 32-bit word in a lane's low half.
+    const __m256i low = _mm256_set1_epi64x(0xffffffffLL), m0 = _mm256_set1_epi64x(kPhiloxM0),
+                  m1 = _mm256_set1_epi64x(kPhiloxM1);
+    __m256i c0[2], c1[2], c2[2], c3[2];
+    for (int p = 0; p < 2; ++p) {
+        const uint32_t b = firstBlock + 4 * p;
+        c0[p] = _mm256_set_epi64x(static_cast<uint32_t>(b + 3), static_cast<uint32_t>(b + 2),
+                                  static_cast<uint32_t>(b + 1), static_cast<uint32_t>(b));
+        c1[p] = _mm256_setzero_si256();
+        c2[p] = _mm256_set1_epi64x(static_cast<uint32_t>(stream));
+        c3[p] = _mm256_set1_epi64x(static_cast<uint32_t>(stream >> 32));
+    }
+    uint32_t k0 = key[0], k1 = key[1];
+    for (int round = 0; round < kPhiloxRounds; ++round) {
+        const __m256i kv0 = _mm256_set1_epi64x(k0), kv1 = _mm256_set1_epi64x(k1);
+        for (int p = 0; p < 2; ++p) {
+            const __m256i p0 = _mm256_mul_epu32(c0[p], m0), p1 = _mm256_mul_epu32(c2[p], m1);
+            c0[p] = _mm256_xor_si256(_mm256_xor_si256(_mm256_srli_epi64(p1, 32), c1[p]), kv0);
+            c2[p] = _mm256_xor_si256(_mm256_xor_si256(_mm256_srli_epi64(p0, 32), c3[p]), kv1);
+            c1[p] = _mm256_and_si256(p1, low);
+            c3[p] = _mm256_and_si256(p0, low);
+        }
+        k0 += kPhiloxW0;
+        k1 += kPhiloxW1;
+    }
+    // The low halves of the eight lanes of a word, in block order.
+    const __m256i gather = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+    const __m256i* const state[4] = {c0, c1, c2, c3};
+    for (int j = 0; j < 4; ++j) {
+        const __m128i lo = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(state[j][0], gather));
+        const __m128i hi = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(state[j][1], gather));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(words + 8 * j), lo);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(words + 8 * j + 4), hi);
+    }
+}
+
+// GCC 12's avx512fintrin.h warns that _mm512_mul_epu32's masked builtin reads an uninitialised
+// pass-through operand, which the full mask never uses.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
+__attribute__((target("arch=x86-64-v4"))) inline void
+philox8BlocksAvx512(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key, uint32_t* words)
+{
+    // Eight blocks in one register of eight 64-bit lanes; vpmuludq, not AVX-512's slower vpmullq.
+    const __m512i low = _mm512_set1_epi64(0xffffffffLL), m0 = _mm512_set1_epi64(kPhiloxM0),
+                  m1 = _mm512_set1_epi64(kPhiloxM1);
+    __m512i c0 = _mm512_and_si512(
+                _mm512_add_epi64(_mm512_set1_epi64(firstBlock), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7)),
+                low),
+            c1 = _mm512_setzero_si512(), c2 = _mm512_set1_epi64(static_cast<uint32_t>(stream)),
+            c3 = _mm512_set1_epi64(static_cast<uint32_t>(stream >> 32));
+    uint32_t k0 = key[0], k1 = key[1];
+    for (int round = 0; round < kPhiloxRounds; ++round) {
+        const __m512i p0 = _mm512_mul_epu32(c0, m0), p1 = _mm512_mul_epu32(c2, m1);
+        c0 = _mm512_xor_si512(_mm512_xor_si512(_mm512_srli_epi64(p1, 32), c1), _mm512_set1_epi64(k0));
+        c2 = _mm512_xor_si512(_mm512_xor_si512(_mm512_srli_epi64(p0, 32), c3), _mm512_set1_epi64(k1));
+        c1 = _mm512_and_si512(p1, low);
+        c3 = _mm512_and_si512(p0, low);
+        k0 += kPhiloxW0;
+        k1 += kPhiloxW1;
+    }
+    const __m512i state[4] = {c0, c1, c2, c3};
+    for (int j = 0; j < 4; ++j)
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(words + 8 * j), _mm512_cvtepi64_epi32(state[j]));
+}
+#pragma GCC diagnostic pop
+#endif
+
+//! Eight Philox blocks by the fastest exact means of a path of width W.
+template <int W>
+RAWGMENT_KERNEL void philox8BlocksFor(uint32_t firstBlock, uint64_t stream,
+                                      const std::array<uint32_t, 2>& key, uint32_t* words)
+{
+#if RAWGMENT_HAVE_CPU_PATHS
+    if (W == 4)
+        return philox8BlocksSse2(firstBlock, stream, key, words);
+    if (W == 8)
+        return philox8BlocksAvx2(firstBlock, stream, key, words);
+    if (W == 16)
+        return philox8BlocksAvx512(firstBlock, stream, key, words);
+#endif
+    philox8Blocks(firstBlock, stream, key, words);
 }
 
 // clang-format off

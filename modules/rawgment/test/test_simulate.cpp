@@ -3,6 +3,7 @@
 
 #include "../src/random.hpp"
 #include <opencv2/core/utility.hpp>
+#include <opencv2/rawgment/cpu.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
 #include <set>
@@ -26,25 +27,37 @@ TEST(Simulate, philoxMatchesTheKnownAnswerVectors)
         (A4{0xd16cfe09, 0x94fdcceb, 0x5001e420, 0x24126ea1}));
 }
 
-TEST(Simulate, vectorisedPhiloxGivesTheBlocksOfTheScalarOne)
+TEST(Simulate, everyPhiloxVersionGivesTheBlocksOfTheScalarOne)
 {
-    // fillGaussian draws from philox8Blocks: it must be Philox4x32-10 itself, word for word.
+    // fillGaussian draws from one of these per CpuPath: each must be Philox4x32-10 itself, word for word.
     using A4 = std::array<uint32_t, 4>;
     using A2 = std::array<uint32_t, 2>;
-    for (const A2 key : {A2{0, 0}, A2{42, 7}, A2{0xffffffff, 0xffffffff}})
-        for (const uint64_t stream : {uint64_t(0), uint64_t(5), uint64_t(0xfedcba9876543210ull)})
-            for (const uint32_t first : {0u, 8u, 0xfffffffcu}) {
-                uint32_t words[32];
-                detail::philox8Blocks(first, stream, key, words);
-                for (uint32_t b = 0; b < 8; ++b) {
-                    const A4 block = detail::philox4x32(
-                        A4{first + b, 0, static_cast<uint32_t>(stream), static_cast<uint32_t>(stream >> 32)},
-                        key);
-                    for (int j = 0; j < 4; ++j)
-                        ASSERT_EQ(words[8 * j + b], block[static_cast<size_t>(j)])
-                            << "block " << b << ", word " << j;
+    typedef void (*EightBlocks)(uint32_t, uint64_t, const A2&, uint32_t*);
+    std::vector<std::pair<const char*, EightBlocks>> versions = {
+        {"vector extensions",
+         [](uint32_t f, uint64_t s, const A2& k, uint32_t* w) { detail::philox8Blocks(f, s, k, w); }}};
+#if RAWGMENT_HAVE_CPU_PATHS
+    versions.push_back({"SSE2", detail::philox8BlocksSse2});
+    if (isCpuPathAvailable(CpuPath::AVX2))
+        versions.push_back({"AVX2", detail::philox8BlocksAvx2});
+    if (isCpuPathAvailable(CpuPath::AVX512))
+        versions.push_back({"AVX-512", detail::philox8BlocksAvx512});
+#endif
+    for (const auto& version : versions)
+        for (const A2 key : {A2{0, 0}, A2{42, 7}, A2{0xffffffff, 0xffffffff}})
+            for (const uint64_t stream : {uint64_t(0), uint64_t(5), uint64_t(0xfedcba9876543210ull)})
+                for (const uint32_t first : {0u, 8u, 0xfffffffcu}) {
+                    uint32_t words[32];
+                    version.second(first, stream, key, words);
+                    for (uint32_t b = 0; b < 8; ++b) {
+                        const A4 block = detail::philox4x32(A4{first + b, 0, static_cast<uint32_t>(stream),
+                                                               static_cast<uint32_t>(stream >> 32)},
+                                                            key);
+                        for (int j = 0; j < 4; ++j)
+                            ASSERT_EQ(words[8 * j + b], block[static_cast<size_t>(j)])
+                                << version.first << ", block " << b << ", word " << j;
+                    }
                 }
-            }
 }
 
 //! A noiseless-readout sensor: with alpha = 1 and no rounding, a capture is Poisson(mean) + black.
