@@ -140,14 +140,10 @@ ChartPatches readChartPatches(const std::string& path)
     const cv::FileNode node = fs["chart_patches"];
     if (!node.isMap())
         CV_Error(cv::Error::StsParseError, "'" + path + "': no map 'chart_patches'");
-    std::vector<std::string> keys;
-    for (const cv::FileNode& entry : node) {
-        if (entry.name() != "grid_corners" && entry.name() != "squares")
-            CV_Error(cv::Error::StsParseError, "'" + path + "': unknown key '" + entry.name() +
-                                                   "' (valid keys: grid_corners, squares)");
-        if (std::find(keys.begin(), keys.end(), entry.name()) != keys.end())
-            CV_Error(cv::Error::StsParseError, "'" + path + "': key '" + entry.name() + "' appears twice");
-        keys.push_back(entry.name());
+    try {
+        cv::rawgment::rejectUnknownKeys(node, {"grid_corners", "squares"});
+    } catch (const cv::Exception& e) {
+        CV_Error(e.code, "'" + path + "': " + e.err);
     }
     ChartPatches p;
     const cv::FileNode corners = node["grid_corners"];

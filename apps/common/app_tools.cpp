@@ -66,10 +66,6 @@ void writeNewBytes(const std::string& path, const std::vector<uchar>& bytes)
     }
 }
 
-} // namespace
-
-namespace {
-
 /* The process that wrote a temporary file: "<file>.tmp-<pid>-<n>" (writeFileAtomically) or
  * "<plot>.gp.<pid>.run" (a gnuplot script); 0 for any other name. */
 pid_t temporaryOwner(const std::string& name)

@@ -51,7 +51,7 @@ void requireFinishedBy(const std::string& out, const std::string& input, uint64_
         throw std::runtime_error("'" + out +
                                  "' exists without its sidecar; it is never overwritten (choose "
                                  "another --out)");
-    cv::FileStorage fs = openYaml(sidecar, "sidecar");
+    cv::FileStorage fs = openFileStorageForReading(sidecar, "sidecar");
     MosaicMetadata meta;
     try {
         meta = MosaicMetadata::read(fs["mosaic_metadata"]);
@@ -69,7 +69,7 @@ void requireFinishedBy(const std::string& out, const std::string& input, uint64_
 
 Scene readSceneFile(const std::string& path)
 {
-    cv::FileStorage fs = openYaml(path, "scene");
+    cv::FileStorage fs = openFileStorageForReading(path, "scene");
     try {
         return Scene::read(fs["scene"]);
     } catch (const cv::Exception& e) {

@@ -20,7 +20,7 @@ using namespace cv::rawgment;
 
 CalibrationManifest readCalibrationManifest(const std::string& path)
 {
-    cv::FileStorage fs = openYaml(path, "calibration manifest");
+    cv::FileStorage fs = openFileStorageForReading(path, "calibration manifest");
     const cv::FileNode root = fs["calibration_manifest"];
     if (!root.isMap() || !root["bursts"].isSeq() || root["bursts"].size() == 0)
         throw std::runtime_error("'" + path +

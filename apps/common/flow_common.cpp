@@ -23,11 +23,6 @@ std::string yamlToString(const std::function<void(cv::FileStorage&)>& body)
     return fs.releaseAndGetString();
 }
 
-cv::FileStorage openYaml(const std::string& path, const char* what)
-{
-    return openFileStorageForReading(path, what);
-}
-
 std::vector<std::string> readFileList(const cv::FileNode& node, const std::string& base,
                                       const std::string& where)
 {
@@ -46,20 +41,10 @@ std::vector<std::string> readFileList(const cv::FileNode& node, const std::strin
 void requireKnownKeys(const cv::FileNode& map, const std::vector<std::string>& valid,
                       const std::string& where)
 {
-    if (!map.isMap())
-        return;
-    std::vector<std::string> seen;
-    for (const cv::FileNode& entry : map) {
-        if (std::find(seen.begin(), seen.end(), entry.name()) != seen.end())
-            throw std::runtime_error(where + ": key '" + entry.name() + "' appears twice");
-        seen.push_back(entry.name());
-        if (std::find(valid.begin(), valid.end(), entry.name()) == valid.end()) {
-            std::string list;
-            for (const std::string& v : valid)
-                list += (list.empty() ? "" : ", ") + v;
-            throw std::runtime_error(where + ": unknown key '" + entry.name() + "' (valid keys: " + list +
-                                     ")");
-        }
+    try {
+        rejectUnknownKeys(map, valid);
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error(where + ": " + e.err);
     }
 }
 

@@ -14,12 +14,10 @@ namespace rawgment_apps {
 
 //! A YAML document built with a FileStorage, as text.
 std::string yamlToString(const std::function<void(cv::FileStorage&)>& body);
-//! Opens a YAML/JSON file for reading (cv::rawgment::openFileStorageForReading: errors name the file).
-cv::FileStorage openYaml(const std::string& path, const char* what);
 //! A manifest's non-empty list of files, resolved against `base`; errors name `where`.
 std::vector<std::string> readFileList(const cv::FileNode& node, const std::string& base,
                                       const std::string& where);
-//! Throws std::runtime_error naming `where`, the first key of `map` not in `valid`, and the valid ones.
+//! cv::rawgment::rejectUnknownKeys(), as a std::runtime_error naming `where`.
 void requireKnownKeys(const cv::FileNode& map, const std::vector<std::string>& valid,
                       const std::string& where);
 //! Throws when any of the outputs exists: outputs are never overwritten.

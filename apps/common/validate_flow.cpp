@@ -20,7 +20,7 @@ using namespace cv::rawgment;
 
 ValidationManifest readValidationManifest(const std::string& path)
 {
-    cv::FileStorage fs = openYaml(path, "validation manifest");
+    cv::FileStorage fs = openFileStorageForReading(path, "validation manifest");
     const cv::FileNode root = fs["validation_manifest"];
     if (!root.isMap() || !root["targets"].isSeq() || root["targets"].size() == 0)
         throw std::runtime_error("'" + path +

@@ -191,7 +191,7 @@ RawFormat RawFormat::read(const FileNode& node)
         CV_Error(Error::StsParseError, "raw format: field 'pattern' is missing or not a string");
     f.pattern = cfaPatternFromName(patternNode.string());
     try {
-        detail::rejectUnknownKeys(node, {"pattern", "black_level", "white_level", "gain"});
+        rejectUnknownKeys(node, {"pattern", "black_level", "white_level", "gain"});
         const std::vector<double> black = detail::readRealList(node, "black_level", 4);
         for (int s = 0; s < 4; ++s)
             f.blackLevel[s] = black[static_cast<size_t>(s)];

@@ -471,11 +471,10 @@ CalibrationReport CalibrationReport::read(const FileNode& node)
                  format("calibration report: format_version is missing or newer than %d", FORMAT_VERSION));
     CalibrationReport r;
     try {
-        detail::rejectUnknownKeys(node,
-                                  {"format_version", "method", "separable", "noise_model", "r_squared_slope",
-                                   "r_squared_offset", "samples", "samples_used", "per_gain", "notes"});
+        rejectUnknownKeys(node, {"format_version", "method", "separable", "noise_model", "r_squared_slope",
+                                 "r_squared_offset", "samples", "samples_used", "per_gain", "notes"});
         for (const FileNode& g : node["per_gain"])
-            detail::rejectUnknownKeys(g, {"gain", "gain_db", "a", "b", "r_squared", "inliers", "samples"});
+            rejectUnknownKeys(g, {"gain", "gain_db", "a", "b", "r_squared", "inliers", "samples"});
     } catch (const Exception& e) {
         CV_Error(e.code, "calibration report: " + e.err);
     }

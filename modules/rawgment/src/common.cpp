@@ -82,28 +82,6 @@ int readOptionalIntField(const FileNode& node, const char* field, int fallback)
     return static_cast<int>(value);
 }
 
-void rejectUnknownKeys(const FileNode& map, const std::vector<const char*>& valid)
-{
-    if (!map.isMap())
-        return;
-    std::vector<std::string> seen;
-    for (const FileNode& entry : map) {
-        const std::string key = entry.name();
-        // OpenCV keeps both entries of a repeated key and a lookup finds one: which value counts would be
-        // a guess.
-        if (std::find(seen.begin(), seen.end(), key) != seen.end())
-            CV_Error(Error::StsParseError, format("key '%s' appears twice", key.c_str()));
-        seen.push_back(key);
-        if (std::none_of(valid.begin(), valid.end(), [&](const char* v) { return key == v; })) {
-            std::string list;
-            for (const char* v : valid)
-                list += (list.empty() ? "" : ", ") + std::string(v);
-            CV_Error(Error::StsParseError,
-                     format("unknown key '%s' (valid keys: %s)", key.c_str(), list.c_str()));
-        }
-    }
-}
-
 std::vector<double> readRealList(const FileNode& node, const char* field, int n)
 {
     const FileNode list = node[field];
@@ -279,6 +257,28 @@ std::string readTextFile(const String& path)
 }
 
 } // namespace detail
+
+void rejectUnknownKeys(const FileNode& map, const std::vector<String>& valid)
+{
+    if (!map.isMap())
+        return;
+    std::vector<std::string> seen;
+    for (const FileNode& entry : map) {
+        const std::string key = entry.name();
+        // OpenCV keeps both entries of a repeated key and a lookup finds one: which value counts would be
+        // a guess.
+        if (std::find(seen.begin(), seen.end(), key) != seen.end())
+            CV_Error(Error::StsParseError, format("key '%s' appears twice", key.c_str()));
+        seen.push_back(key);
+        if (std::none_of(valid.begin(), valid.end(), [&](const String& v) { return key == v; })) {
+            std::string list;
+            for (const String& v : valid)
+                list += (list.empty() ? "" : ", ") + v;
+            CV_Error(Error::StsParseError,
+                     format("unknown key '%s' (valid keys: %s)", key.c_str(), list.c_str()));
+        }
+    }
+}
 
 FileStorage openFileStorageForReading(const String& path, const String& what)
 {

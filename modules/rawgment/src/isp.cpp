@@ -74,7 +74,7 @@ ToneCurve ToneCurve::read(const FileNode& node)
         CV_Error(Error::StsParseError, "tone curve: expected a map with gamma, break_point, toe_slope");
     ToneCurve c;
     try {
-        detail::rejectUnknownKeys(node, {"gamma", "break_point", "toe_slope"});
+        rejectUnknownKeys(node, {"gamma", "break_point", "toe_slope"});
         c.gamma = detail::readRealField(node, "gamma");
         c.breakPoint = detail::readOptionalRealField(node, "break_point", 0.0);
         c.toeSlope = detail::readOptionalRealField(node, "toe_slope", 0.0);

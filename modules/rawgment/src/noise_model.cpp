@@ -132,7 +132,7 @@ NoiseModel NoiseModel::read(const FileNode& node)
                         "(a newer cv::rawgment wrote the file)",
                         version, FORMAT_VERSION));
     try {
-        detail::rejectUnknownKeys(node, {"format_version", "alpha", "sigma_d2", "sigma_r2"});
+        rejectUnknownKeys(node, {"format_version", "alpha", "sigma_d2", "sigma_r2"});
     } catch (const Exception& e) {
         CV_Error(e.code, "noise model: " + e.err);
     }

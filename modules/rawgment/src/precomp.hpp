@@ -45,10 +45,6 @@ double readOptionalRealField(const FileNode& node, const char* field, double fal
 int readOptionalIntField(const FileNode& node, const char* field, int fallback);
 //! A required list of exactly `n` numbers, named (and the element) in the error.
 std::vector<double> readRealList(const FileNode& node, const char* field, int n);
-/** Throws StsParseError naming the first key of `map` that is not in `valid`, and the valid ones: a
- * misspelled key (contrst_min) must not fall back to a default silently. A key that appears twice is an
- * error too. */
-void rejectUnknownKeys(const FileNode& map, const std::vector<const char*>& valid);
 
 /** Writes `path` with a FileStorage, replacing it: the text is built in memory, then written by
  * writeFileAtomically() (checked, synced, atomic). The format follows the extension of `path`

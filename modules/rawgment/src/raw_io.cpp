@@ -209,7 +209,7 @@ MosaicMetadata MosaicMetadata::read(const FileNode& node)
             Error::StsParseError,
             cv::format("mosaic metadata: format_version is missing or not one of 1..%d", FORMAT_VERSION));
     try {
-        detail::rejectUnknownKeys(
+        rejectUnknownKeys(
             node, {"format_version", "raw_format", "size", "type", "source", "has_scene", "scene", "seed"});
     } catch (const Exception& e) {
         CV_Error(e.code, "mosaic metadata: " + e.err);

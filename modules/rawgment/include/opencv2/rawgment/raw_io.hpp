@@ -102,6 +102,15 @@ static constexpr long long MAX_TEXT_FILE_BYTES = 64LL << 20;
  */
 CV_RAWGMENT_EXPORTS FileStorage openFileStorageForReading(const String& path, const String& what);
 
+/** @brief Refuses a map with a key outside `valid` or a key that appears twice: a misspelled key
+ * (`contrst_min`) must not fall back to a default, and of a repeated key OpenCV keeps both entries and a
+ * lookup finds one. Every reader of this module checks its maps so; use it for your own files too.
+ * @param map a map of a file opened with openFileStorageForReading() (anything else is not checked)
+ * @param valid the keys the map may have
+ * @throws cv::Exception StsParseError naming the key (and the valid ones).
+ */
+CV_RAWGMENT_EXPORTS void rejectUnknownKeys(const FileNode& map, const std::vector<String>& valid);
+
 /** @brief What a sidecar file says about a mosaic written by writeMosaic(). */
 struct CV_RAWGMENT_EXPORTS MosaicMetadata
 {
