@@ -77,7 +77,21 @@ Scene readSceneFile(const std::string& path)
     }
 }
 
-AugmentResult augmentFiles(const AugmentOptions& o)
+AugmentRecipe loadAugmentRecipe(const AugmentOptions& o)
+{
+    if (o.scene.empty() == o.policy.empty())
+        throw std::runtime_error("give exactly one of a scene file and a policy file");
+    AugmentRecipe recipe;
+    recipe.model = NoiseModel::load(o.model);
+    recipe.randomScenes = o.scene.empty();
+    if (recipe.randomScenes)
+        recipe.policy = RandomScenePolicy::load(o.policy);
+    else
+        recipe.scene = readSceneFile(o.scene);
+    return recipe;
+}
+
+AugmentPlan planAugmentJobs(const AugmentOptions& o)
 {
     if (o.inputs.empty())
         throw std::runtime_error("no input files");
@@ -85,14 +99,6 @@ AugmentResult augmentFiles(const AugmentOptions& o)
         throw std::runtime_error("give exactly one of a scene file and a policy file");
     if (o.variants < 1)
         throw std::runtime_error("variants must be >= 1");
-    const NoiseModel model = NoiseModel::load(o.model);
-    Scene fixedScene;
-    RandomScenePolicy policy;
-    if (!o.scene.empty()) {
-        fixedScene = readSceneFile(o.scene);
-    } else {
-        policy = RandomScenePolicy::load(o.policy);
-    }
     for (const std::string& in : o.inputs) {
         if (!pathExists(in))
             throw std::runtime_error("input '" + in + "': no such file");
@@ -101,14 +107,7 @@ AugmentResult augmentFiles(const AugmentOptions& o)
     }
     prepareOutputDirectory(o.outDir);
 
-    struct Job
-    {
-        size_t input;
-        int variant;
-        std::string out, preview;
-    };
-    std::vector<Job> jobs;
-    AugmentResult result;
+    AugmentPlan plan;
     const std::vector<std::string> names = outputNames(o.inputs);
     for (size_t i = 0; i < o.inputs.size(); ++i) {
         const size_t dot = o.inputs[i].find_last_of('.');
@@ -117,52 +116,72 @@ AugmentResult augmentFiles(const AugmentOptions& o)
         const std::string ext = !o.extension.empty() ? o.extension : (ours ? inExt : std::string(".dng"));
         for (int v = 0; v < o.variants; ++v) {
             const std::string stem = o.outDir + "/" + names[i] + cv::format("_v%02d", v);
-            Job job{i, v, stem + ext, o.previews ? stem + "_preview.png" : std::string()};
+            AugmentJob job;
+            job.input = o.inputs[i];
+            job.name = names[i];
+            job.variant = v;
+            // The seed depends on the file name and the variant, not on the order of the inputs.
+            job.seed = augmentedOutputSeed(o.seed, names[i], v);
+            job.out = stem + ext;
+            job.preview = o.previews ? stem + "_preview.png" : std::string();
             for (const std::string& in : o.inputs)
                 if (in == job.out)
                     throw std::runtime_error("output '" + job.out +
                                              "' would replace an input; choose another --out");
-            result.outputs.push_back(job.out);
+            plan.outputs.push_back(job.out);
             if (pathExists(job.out)) {
                 // Resumable: a finished output of this very job stays; anything else there is refused.
-                requireFinishedBy(job.out, o.inputs[i], augmentedOutputSeed(o.seed, names[i], v));
-                ++result.skipped;
+                requireFinishedBy(job.out, job.input, job.seed);
+                ++plan.skipped;
                 continue;
             }
-            jobs.push_back(job);
+            plan.jobs.push_back(job);
         }
     }
-    ProgressBar progress("augment", jobs.size());
+    return plan;
+}
+
+void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe)
+{
+    const LoadedMosaic m = loadMosaicFile(job.input);
+    const Scene scene = recipe.randomScenes ? recipe.policy.draw(m.mosaic, m.format, job.seed) : recipe.scene;
+    cv::Mat out;
+    RawFormat outFormat;
+    AugmentReport report;
+    applyScene(m.mosaic, m.format, recipe.model, scene, job.seed, out, outFormat, &report);
+    MosaicMetadata meta;
+    meta.format = outFormat;
+    meta.hasScene = true;
+    meta.scene = scene;
+    meta.seed = job.seed;
+    meta.source = job.input;
+    if (!job.preview.empty())
+        writeNewImage(job.preview, previewOf(out, outFormat));
+    writeMosaic(job.out, out, meta);
+}
+
+AugmentResult augmentFiles(const AugmentOptions& o)
+{
+    const AugmentRecipe recipe = loadAugmentRecipe(o);
+    const AugmentPlan plan = planAugmentJobs(o);
+    AugmentResult result;
+    result.outputs = plan.outputs;
+    result.skipped = plan.skipped;
+    ProgressBar progress("augment", plan.jobs.size());
     std::mutex errorMutex;
     std::string firstError;
     std::atomic<int> written{0};
-    cv::parallel_for_(cv::Range(0, int(jobs.size())), [&](const cv::Range& range) {
+    cv::parallel_for_(cv::Range(0, int(plan.jobs.size())), [&](const cv::Range& range) {
         for (int j = range.start; j < range.end; ++j) {
-            const Job& job = jobs[size_t(j)];
+            const AugmentJob& job = plan.jobs[size_t(j)];
             try {
-                const LoadedMosaic m = loadMosaicFile(o.inputs[job.input]);
-                // The seed depends on the file name and the variant, not on the order of the inputs.
-                const uint64_t seed = augmentedOutputSeed(o.seed, names[job.input], job.variant);
-                const Scene scene = o.scene.empty() ? policy.draw(m.mosaic, m.format, seed) : fixedScene;
-                cv::Mat out;
-                RawFormat outFormat;
-                AugmentReport report;
-                applyScene(m.mosaic, m.format, model, scene, seed, out, outFormat, &report);
-                MosaicMetadata meta;
-                meta.format = outFormat;
-                meta.hasScene = true;
-                meta.scene = scene;
-                meta.seed = seed;
-                meta.source = o.inputs[job.input];
-                if (!job.preview.empty())
-                    writeNewImage(job.preview, previewOf(out, outFormat));
-                writeMosaic(job.out, out, meta);
+                runAugmentJob(job, recipe);
                 ++written;
             } catch (const std::exception& e) {
                 std::lock_guard<std::mutex> lock(errorMutex);
                 if (firstError.empty())
-                    firstError = "'" + o.inputs[job.input] + "' variant " + std::to_string(job.variant) +
-                                 ": " + e.what();
+                    firstError =
+                        "'" + job.input + "' variant " + std::to_string(job.variant) + ": " + e.what();
             }
             progress.advance();
         }

@@ -153,6 +153,42 @@ struct AugmentResult
 };
 
 AugmentResult augmentFiles(const AugmentOptions& options);
+
+/** One output of an augmentation run. Every front end (the app, Python, Dask workers) makes an output
+ * with runAugmentJob(), so the same job gives the same bytes wherever it runs. */
+struct AugmentJob
+{
+    std::string input;   //!< the input file as given
+    std::string name;    //!< the input's output name: its stem, plus a hash of its path if stems collide
+    int variant = 0;     //!< variant number
+    uint64_t seed = 0;   //!< augmentedOutputSeed(options seed, name, variant)
+    std::string out;     //!< the output mosaic (its sidecar beside it)
+    std::string preview; //!< the preview PNG, empty for none
+};
+
+/** The outputs of a run: the jobs still to do, and the outputs that a previous run finished (a finished
+ * output is one whose sidecar says it was made from the same input with the same seed; anything else
+ * at an output's path is an error). Checks the options and the inputs, and creates the output folder. */
+struct AugmentPlan
+{
+    std::vector<AugmentJob> jobs;
+    std::vector<std::string> outputs; //!< every output, finished or not, in input and variant order
+    int skipped = 0;                  //!< outputs already finished
+};
+AugmentPlan planAugmentJobs(const AugmentOptions& options);
+
+//! What every job of a run applies: the model and either one scene or a random policy.
+struct AugmentRecipe
+{
+    cv::rawgment::NoiseModel model;
+    bool randomScenes = false;
+    cv::rawgment::Scene scene;              //!< when !randomScenes
+    cv::rawgment::RandomScenePolicy policy; //!< when randomScenes
+};
+//! Loads the model and the scene or policy files of the options; errors name the file.
+AugmentRecipe loadAugmentRecipe(const AugmentOptions& options);
+//! Makes one output (and its preview); throws on any error. Atomic: a failed job leaves no output.
+void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe);
 //! The scene of a scene file (a map `scene`, as Scene::write() writes it); errors name the file.
 cv::rawgment::Scene readSceneFile(const std::string& path);
 
