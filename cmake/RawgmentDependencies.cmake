@@ -26,3 +26,26 @@ if(RAWGMENT_BUILD_PERF)
   find_package(benchmark QUIET CONFIG)
   rawgment_require(benchmark_FOUND "Google Benchmark" "libbenchmark-dev")
 endif()
+
+# The Python module needs Debian's interpreter (its numpy, torch and dask are Debian packages), its
+# headers, pybind11, NumPy, the apps (rawgment.batch runs their jobs) and Doxygen (its docstrings are the
+# C++ documentation). A sanitizer build has no Python module: an instrumented extension needs the
+# sanitizer runtime preloaded into the interpreter.
+set(RAWGMENT_WITH_PYTHON OFF)
+if(NOT RAWGMENT_BUILD_PYTHON STREQUAL "OFF" AND NOT RAWGMENT_SANITIZE AND RAWGMENT_BUILD_APPS)
+  if(NOT DEFINED Python3_EXECUTABLE AND EXISTS /usr/bin/python3)
+    set(Python3_EXECUTABLE /usr/bin/python3)
+  endif()
+  find_package(Python3 QUIET COMPONENTS Interpreter Development.Module NumPy)
+  set(PYBIND11_FINDPYTHON ON)
+  find_package(pybind11 2.10 QUIET CONFIG)
+  find_package(Doxygen QUIET)
+  if(Python3_FOUND AND Python3_NumPy_FOUND AND pybind11_FOUND AND DOXYGEN_FOUND)
+    set(RAWGMENT_WITH_PYTHON ON)
+  elseif(RAWGMENT_BUILD_PYTHON STREQUAL "ON")
+    rawgment_require(FALSE "Python 3 with its headers, NumPy, pybind11 and Doxygen (for the Python module)"
+                     "python3-dev python3-numpy pybind11-dev python3-pybind11 doxygen")
+  else()
+    message(STATUS "Python module not built: Python 3 headers, NumPy, pybind11 or Doxygen missing")
+  endif()
+endif()

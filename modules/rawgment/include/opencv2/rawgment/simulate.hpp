@@ -149,7 +149,9 @@ enum SeedPurpose : int
     SEED_VALIDATION_CONVERSION = 18,      //!< the conversion of a bright frame; index: the frame
     SEED_AUGMENTED_OUTPUT = 19,           //!< an augmented file: see augmentedOutputSeed()
     SEED_DEMO = 20,                       //!< the demo's own captures and gallery; index: what it draws
-    SEED_STUDY = 21                       //!< accuracy studies (rawgment_tradeoffs); index: the measurement
+    SEED_STUDY = 21,                      //!< accuracy studies (rawgment_tradeoffs); index: the measurement
+    SEED_TRAINING_EPOCH = 22,             //!< a training epoch (Python's rawgment.torch); index: the epoch
+    SEED_TRAINING_SAMPLE = 23             //!< a sample of an epoch's seed; index: the sample's index
 };
 
 /** @brief A seed for one use of a user's seed: a well-mixed (SplitMix64) function of (seed, purpose,

@@ -1,0 +1,202 @@
+"""PyTorch integration: random noise-accounted scenes as a transform, and a dataset of RAW files.
+
+Seeds derive from (base seed, epoch, sample index) only, so a ``DataLoader`` gives the same samples
+for any ``num_workers`` and any order in which workers take samples::
+
+    dataset = rawgment.torch.RawFolderDataset("raws/", model="camera.yml", base_seed=7)
+    loader = torch.utils.data.DataLoader(dataset, batch_size=4, num_workers=2)
+    for epoch in range(10):
+        dataset.set_epoch(epoch)   # before the loader's workers start (they copy the dataset)
+        for batch in loader:
+            ...
+
+Importing this module needs torch; importing ``rawgment`` does not.
+"""
+import collections
+import os
+
+import numpy as np
+import torch
+
+import rawgment as _rg
+
+__all__ = ["sampleSeed", "Augmented", "RandomNoiseScene", "RawFolderDataset", "packCfaPlanes", "loadMosaic"]
+
+RAW_EXTENSIONS = (".dng", ".nef", ".cr2", ".cr3", ".crw", ".arw", ".raf", ".rw2", ".orf", ".pef", ".kdc",
+                  ".srw", ".3fr", ".iiq", ".erf", ".mef", ".mos", ".nrw", ".x3f")
+MOSAIC_EXTENSIONS = (".png", ".tif", ".tiff")
+
+Augmented = collections.namedtuple("Augmented", ["raw", "format", "boxes", "report", "scene"])
+Augmented.__doc__ = """What RandomNoiseScene returns: the augmented mosaic (the input's kind: tensor or
+array), its RawFormat (the new gain), the boxes (the input's kind), the AugmentReport and the Scene."""
+
+
+def sampleSeed(baseSeed, epoch, index):
+    """The seed of sample `index` in `epoch`: deriveSeed(deriveSeed(baseSeed, SEED_TRAINING_EPOCH, epoch),
+    SEED_TRAINING_SAMPLE, index). A pure function, the same in every process."""
+    if epoch < 0 or index < 0:
+        raise ValueError("epoch and index must be >= 0, got epoch=%r, index=%r" % (epoch, index))
+    epochSeed = _rg.deriveSeed(int(baseSeed), _rg.SEED_TRAINING_EPOCH, int(epoch))
+    return _rg.deriveSeed(epochSeed, _rg.SEED_TRAINING_SAMPLE, int(index))
+
+
+def _asModel(model):
+    if isinstance(model, _rg.NoiseModel):
+        return model
+    if isinstance(model, (str, os.PathLike)):
+        return _rg.NoiseModel.load(os.fspath(model))
+    raise TypeError("model must be a rawgment.NoiseModel or the path of a saved model, not %s" %
+                    type(model).__name__)
+
+
+def _asPolicy(policy):
+    if policy is None:
+        return _rg.RandomScenePolicy()
+    if isinstance(policy, _rg.RandomScenePolicy):
+        return policy
+    if isinstance(policy, (str, os.PathLike)):
+        return _rg.RandomScenePolicy.load(os.fspath(policy))
+    raise TypeError("policy must be a rawgment.RandomScenePolicy, the path of a saved policy, or None, not %s" %
+                    type(policy).__name__)
+
+
+def _toArray(raw):
+    """A numpy view of a mosaic given as a tensor (CPU, float32, 2-D) or an array (uint16 or float32)."""
+    if isinstance(raw, torch.Tensor):
+        if raw.device.type != "cpu":
+            raise ValueError("argument 'raw' must be a CPU tensor, got one on %s" % raw.device)
+        if raw.dtype != torch.float32:
+            raise TypeError("argument 'raw' has dtype %s; a tensor mosaic must be torch.float32 (DN with "
+                            "black, as stored)" % raw.dtype)
+        return raw.detach().numpy(), True
+    if isinstance(raw, np.ndarray):
+        return raw, False
+    raise TypeError("argument 'raw' must be a torch.Tensor or a numpy array, not %s" % type(raw).__name__)
+
+
+class RandomNoiseScene:
+    """A transform that applies a random noise-accounted scene (RandomScenePolicy.draw, then
+    applyScene) to a RAW mosaic: darker, noisier, blurred, shifted, with the noise the sensor would
+    have given. Boxes follow the shift and the scale.
+
+    Args:
+        model: the camera's NoiseModel, or the path of a saved one.
+        policy: a RandomScenePolicy, the path of a saved one, or None for the paper's defaults.
+        baseSeed: the seed of the whole run; each sample's seed is sampleSeed(baseSeed, epoch, index).
+    """
+
+    def __init__(self, model, policy=None, baseSeed=0):
+        self.model = _asModel(model)
+        self.policy = _asPolicy(policy)
+        self.policy.validate()
+        self.baseSeed = int(baseSeed)
+
+    def __call__(self, raw, format, boxes=None, *, index, epoch=0):
+        """Augments one mosaic.
+
+        Args:
+            raw: HxW mosaic with its black level: a float32 CPU tensor, or a uint16/float32 array.
+            format: its rawgment.RawFormat.
+            boxes: None, a sequence of (x, y, w, h), an N x 4 array or an N x 4 tensor (mosaic pixels).
+            index: the sample's index in the dataset; epoch: the epoch (both set the seed).
+
+        Returns:
+            Augmented(raw, format, boxes, report, scene), raw and boxes of the kind given.
+        """
+        array, isTensor = _toArray(raw)
+        seed = sampleSeed(self.baseSeed, epoch, index)
+        boxesIn = boxes
+        if isinstance(boxes, torch.Tensor):
+            boxesIn = boxes.detach().cpu().numpy().astype(np.int64).reshape(-1, 4)
+        scene = self.policy.draw(array, format, seed)
+        out, outFormat, report, outBoxes = _rg.applyScene(array, format, self.model, scene, seed=seed, boxes=boxesIn)
+        if isTensor:
+            out = torch.from_numpy(out)
+        if isinstance(boxes, torch.Tensor):
+            outBoxes = torch.tensor(outBoxes, dtype=boxes.dtype).reshape(-1, 4)
+        elif isinstance(boxes, np.ndarray):
+            outBoxes = np.asarray(outBoxes, dtype=boxes.dtype).reshape(-1, 4)
+        elif boxes is None:
+            outBoxes = None
+        return Augmented(out, outFormat, outBoxes, report, scene)
+
+    def __repr__(self):
+        return "RandomNoiseScene(model=%r, policy=%r, baseSeed=%d)" % (self.model, self.policy, self.baseSeed)
+
+
+def packCfaPlanes(signal, format):
+    """A 4 x H/2 x W/2 float32 tensor of the CFA planes of a black-subtracted mosaic, in the order
+    R, G1, G2, B (whatever the pattern): the input layout of most RAW networks."""
+    planes = _rg.splitCfaPlanes(np.ascontiguousarray(signal, dtype=np.float32))
+    order = [_rg.cfaSiteOfChannel(format.pattern, c) for c in (_rg.CFA_R, _rg.CFA_G1, _rg.CFA_G2, _rg.CFA_B)]
+    return torch.from_numpy(np.stack([planes[s] for s in order]))
+
+
+def loadMosaic(path):
+    """(mosaic, format) of a camera RAW file (readRaw) or of a mosaic with a sidecar (readMosaic)."""
+    path = os.fspath(path)
+    if os.path.exists(_rg.sidecarPathOf(path)):
+        mosaic, meta = _rg.readMosaic(path)
+        return mosaic, meta.format
+    image = _rg.readRaw(path)
+    return image.mosaic, image.format
+
+
+class RawFolderDataset(torch.utils.data.Dataset):
+    """The RAW files of a folder (camera RAWs that LibRaw reads, or mosaics with a .yml sidecar), each
+    augmented by RandomNoiseScene.
+
+    Each item is a dict: ``raw`` (float32 tensor: 1 x H x W of the mosaic, or 4 x H/2 x W/2 CFA planes
+    with ``pack=True``; black-subtracted and divided by white - black, so 1 is saturation, unless
+    ``normalize=False``, which keeps DN above black), ``gain`` (the output's linear gain, float), ``index``
+    and ``path``.
+
+    Args:
+        folder: the folder (files sorted by name; sub-folders are not read).
+        model, policy, baseSeed: as RandomNoiseScene.
+        pack: return the four CFA planes instead of the mosaic.
+        normalize: divide by the per-site range white - black.
+        augment: False returns the files as they are (for validation sets).
+    """
+
+    def __init__(self, folder, model, policy=None, baseSeed=0, pack=False, normalize=True, augment=True):
+        folder = os.fspath(folder)
+        if not os.path.isdir(folder):
+            raise FileNotFoundError("RawFolderDataset: '%s' is not a folder" % folder)
+        files = []
+        for name in sorted(os.listdir(folder)):
+            path = os.path.join(folder, name)
+            ext = os.path.splitext(name)[1].lower()
+            if not os.path.isfile(path):
+                continue
+            if ext in RAW_EXTENSIONS or (ext in MOSAIC_EXTENSIONS and os.path.exists(_rg.sidecarPathOf(path))):
+                files.append(path)
+        if not files:
+            raise FileNotFoundError("RawFolderDataset: no RAW file (%s) and no mosaic with a sidecar in '%s'" %
+                                    (", ".join(RAW_EXTENSIONS[:5]) + ", ...", folder))
+        self.files = files
+        self.transform = RandomNoiseScene(model, policy, baseSeed)
+        self.pack = bool(pack)
+        self.normalize = bool(normalize)
+        self.augment = bool(augment)
+        self.epoch = 0
+
+    def set_epoch(self, epoch):
+        """Sets the epoch whose seeds the next iteration uses (call it before creating the iterator)."""
+        if int(epoch) < 0:
+            raise ValueError("epoch must be >= 0, got %r" % epoch)
+        self.epoch = int(epoch)
+
+    def __len__(self):
+        return len(self.files)
+
+    def __getitem__(self, index):
+        if not 0 <= index < len(self.files):
+            raise IndexError("RawFolderDataset index %d out of range (%d files)" % (index, len(self.files)))
+        mosaic, fmt = loadMosaic(self.files[index])
+        if self.augment:
+            result = self.transform(mosaic, fmt, index=index, epoch=self.epoch)
+            mosaic, fmt = result.raw, result.format
+        signal = _rg.subtractBlackLevel(mosaic, fmt, normalize=self.normalize)
+        raw = packCfaPlanes(signal, fmt) if self.pack else torch.from_numpy(signal).unsqueeze(0)
+        return {"raw": raw, "gain": float(fmt.gain), "index": int(index), "path": self.files[index]}

@@ -1,0 +1,317 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Python bindings of augmentation (noise steps, scenes, policies), RAW and mosaic files, and the ISP.
+#include "binding_tools.hpp"
+
+namespace rawgment_python {
+
+using namespace cv::rawgment;
+
+namespace {
+
+const std::vector<int> kMosaicDepths{CV_16U, CV_32F};
+
+//! Boxes as C++ Rects: a sequence of (x, y, w, h), or an N x 4 integer array (what detectors keep).
+std::vector<cv::Rect> boxesFrom(const py::object& boxes)
+{
+    std::vector<cv::Rect> out;
+    if (boxes.is_none())
+        return out;
+    if (py::isinstance<py::array>(boxes)) {
+        const auto a = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(boxes);
+        if (!a || (a.size() > 0 && (a.ndim() != 2 || a.shape(1) != 4)))
+            throw py::value_error("argument 'boxes' must be an N x 4 array of (x, y, w, h)");
+        for (py::ssize_t i = 0; a.size() > 0 && i < a.shape(0); ++i)
+            out.emplace_back(int(a.at(i, 0)), int(a.at(i, 1)), int(a.at(i, 2)), int(a.at(i, 3)));
+        return out;
+    }
+    try {
+        return boxes.cast<std::vector<cv::Rect>>();
+    } catch (const py::cast_error&) {
+        throw py::type_error(
+            "argument 'boxes' must be a sequence of (x, y, w, h) integer tuples or an N x 4 array");
+    }
+}
+
+} // namespace
+
+void bindAugment(py::module_& m)
+{
+    // ---- options -----------------------------------------------------------------------------------
+    py::enum_<NoiseAlignment>(m, "NoiseAlignment", doc("NoiseAlignment"))
+        .value("NONE", NoiseAlignment::NONE, doc("NoiseAlignment::NONE"))
+        .value("IGNORE_PRIOR", NoiseAlignment::IGNORE_PRIOR, doc("NoiseAlignment::IGNORE_PRIOR"))
+        .value("ACCOUNT_PRIOR", NoiseAlignment::ACCOUNT_PRIOR, doc("NoiseAlignment::ACCOUNT_PRIOR"));
+    py::enum_<ShotNoiseSampling>(m, "ShotNoiseSampling", doc("ShotNoiseSampling"))
+        .value("GAUSSIAN", ShotNoiseSampling::GAUSSIAN, doc("ShotNoiseSampling::GAUSSIAN"))
+        .value("POISSON", ShotNoiseSampling::POISSON, doc("ShotNoiseSampling::POISSON"));
+    py::enum_<PriorMeanEstimate>(m, "PriorMeanEstimate", doc("PriorMeanEstimate"))
+        .value("PIXEL_VALUE", PriorMeanEstimate::PIXEL_VALUE, doc("PriorMeanEstimate::PIXEL_VALUE"))
+        .value("LOCAL_MEAN", PriorMeanEstimate::LOCAL_MEAN, doc("PriorMeanEstimate::LOCAL_MEAN"));
+    py::enum_<BlurNoiseSum>(m, "BlurNoiseSum", doc("BlurNoiseSum"))
+        .value("EXACT", BlurNoiseSum::EXACT, doc("BlurNoiseSum::EXACT"))
+        .value("FROM_BLURRED_MEAN", BlurNoiseSum::FROM_BLURRED_MEAN, doc("BlurNoiseSum::FROM_BLURRED_MEAN"));
+
+    py::class_<NoiseOptions>(m, "NoiseOptions",
+                             doc("NoiseOptions",
+                                 "Python: NoiseOptions(alignment=..., shotSampling=..., ...); a "
+                                 "NoiseAlignment is accepted wherever NoiseOptions are."))
+        .def(keywordInit<NoiseOptions>())
+        .def(py::init<NoiseAlignment>(), py::arg("alignment"))
+        .def_readwrite("alignment", &NoiseOptions::alignment, doc("NoiseOptions::alignment"))
+        .def_readwrite("shotSampling", &NoiseOptions::shotSampling, doc("NoiseOptions::shotSampling"))
+        .def_readwrite("priorMean", &NoiseOptions::priorMean, doc("NoiseOptions::priorMean"))
+        .def_readwrite("blurNoiseSum", &NoiseOptions::blurNoiseSum, doc("NoiseOptions::blurNoiseSum"))
+        .def("validate", &NoiseOptions::validate, doc("NoiseOptions::validate"));
+    py::implicitly_convertible<NoiseAlignment, NoiseOptions>();
+
+    py::class_<AugmentReport>(m, "AugmentReport", doc("AugmentReport"))
+        .def(keywordInit<AugmentReport>())
+        .def_readwrite("brighteningPixels", &AugmentReport::brighteningPixels,
+                       doc("AugmentReport::brighteningPixels"))
+        .def_readwrite("saturatedPixels", &AugmentReport::saturatedPixels,
+                       doc("AugmentReport::saturatedPixels"))
+        .def_readwrite("steps", &AugmentReport::steps, doc("AugmentReport::steps"));
+
+    // ---- noise steps -------------------------------------------------------------------------------
+    py::class_<ColorJitter>(m, "ColorJitter", doc("ColorJitter"))
+        .def(keywordInit<ColorJitter>())
+        .def_readwrite("contrast", &ColorJitter::contrast, doc("ColorJitter::contrast"))
+        .def_readwrite("brightness", &ColorJitter::brightness, doc("ColorJitter::brightness"))
+        .def_readwrite("gainRatio", &ColorJitter::gainRatio, doc("ColorJitter::gainRatio"))
+        .def_static("exposureChange", &ColorJitter::exposureChange, py::arg("photonRatio"),
+                    py::arg("gainRatio"), doc("ColorJitter::exposureChange"))
+        .def("isIdentity", &ColorJitter::isIdentity, doc("ColorJitter::isIdentity"));
+    m.def(
+        "colorJitter",
+        [](const py::object& src, const RawFormat& format, const NoiseModel& model, const ColorJitter& jitter,
+           const NoiseOptions& noise, uint64 seed, bool saturatedMask) -> py::tuple {
+            const cv::Mat in = matFromArray(src, "src", kMosaicDepths);
+            cv::Mat dst, mask;
+            RawFormat dstFormat;
+            AugmentReport report;
+            withoutGil("colorJitter", [&] {
+                colorJitter(in, format, model, jitter, noise, seed, dst, dstFormat, &report,
+                            saturatedMask ? cv::_OutputArray(mask) : cv::_OutputArray(cv::noArray()));
+            });
+            if (saturatedMask)
+                return py::make_tuple(arrayFromMat(dst), dstFormat, report, arrayFromMat(mask));
+            return py::make_tuple(arrayFromMat(dst), dstFormat, report);
+        },
+        py::arg("src"), py::arg("format"), py::arg("model"), py::arg("jitter"),
+        py::arg("noise") = NoiseOptions(), py::kw_only(), py::arg("seed"), py::arg("saturatedMask") = false,
+        doc("colorJitter",
+            "Python: colorJitter(src, format, model, jitter, noise=NoiseOptions(), *, seed, "
+            "saturatedMask=False) returns (dst, dstFormat, report), and the mask last when "
+            "saturatedMask is True. dst is a new array (a copy of src for an identity step)."));
+    m.attr("MAX_MOTION_LENGTH") = MAX_MOTION_LENGTH;
+    m.def(
+        "linearMotionKernel",
+        [](double length, double angleDegrees) {
+            return arrayFromMat(linearMotionKernel(length, angleDegrees));
+        },
+        py::arg("length"), py::arg("angleDegrees"),
+        doc("linearMotionKernel", "Python: returns the float32 kernel."));
+    m.def(
+        "motionBlur",
+        [](const py::object& src, const RawFormat& format, const NoiseModel& model, const py::object& kernel,
+           const NoiseOptions& noise, uint64 seed) {
+            const cv::Mat in = matFromArray(src, "src", kMosaicDepths);
+            const cv::Mat k = matFromArray(kernel, "kernel", {CV_32F, CV_64F});
+            cv::Mat dst;
+            AugmentReport report;
+            withoutGil("motionBlur", [&] { motionBlur(in, format, model, k, noise, seed, dst, &report); });
+            return py::make_tuple(arrayFromMat(dst), report);
+        },
+        py::arg("src"), py::arg("format"), py::arg("model"), py::arg("kernel"),
+        py::arg("noise") = NoiseOptions(), py::kw_only(), py::arg("seed"),
+        doc("motionBlur", "Python: returns (dst, report)."));
+    m.def(
+        "scaleMosaic",
+        [](const py::object& src, const RawFormat& format, const NoiseModel& model, double scale,
+           const NoiseOptions& noise, uint64 seed) {
+            const cv::Mat in = matFromArray(src, "src", kMosaicDepths);
+            cv::Mat dst;
+            AugmentReport report;
+            withoutGil("scaleMosaic",
+                       [&] { scaleMosaic(in, format, model, scale, noise, seed, dst, &report); });
+            return py::make_tuple(arrayFromMat(dst), report);
+        },
+        py::arg("src"), py::arg("format"), py::arg("model"), py::arg("scale"),
+        py::arg("noise") = NoiseOptions(), py::kw_only(), py::arg("seed"),
+        doc("scaleMosaic", "Python: returns (dst, report)."));
+    m.def("scaleBox", &scaleBox, py::arg("box"), py::arg("size"), py::arg("scale"), doc("scaleBox"));
+
+    py::class_<Scene> scene(m, "Scene", doc("Scene"));
+    scene.def(keywordInit<Scene>())
+        .def_readwrite("shift", &Scene::shift, doc("Scene::shift"))
+        .def_readwrite("scale", &Scene::scale, doc("Scene::scale"))
+        .def_readwrite("jitter", &Scene::jitter, doc("Scene::jitter"))
+        .def_readwrite("noise", &Scene::noise, doc("Scene::noise"))
+        .def("isIdentity", &Scene::isIdentity, doc("Scene::isIdentity"));
+    defMatProperty(scene, "motionKernel", &Scene::motionKernel, doc("Scene::motionKernel"), {CV_32F, CV_64F});
+    m.def(
+        "applyScene",
+        [](const py::object& src, const RawFormat& format, const NoiseModel& model, const Scene& scene,
+           uint64 seed, const py::object& boxes) {
+            const cv::Mat in = matFromArray(src, "src", kMosaicDepths);
+            std::vector<cv::Rect> rects = boxesFrom(boxes);
+            cv::Mat dst;
+            RawFormat dstFormat;
+            AugmentReport report;
+            withoutGil("applyScene",
+                       [&] { applyScene(in, format, model, scene, seed, dst, dstFormat, &report, &rects); });
+            return py::make_tuple(arrayFromMat(dst), dstFormat, report, rects);
+        },
+        py::arg("src"), py::arg("format"), py::arg("model"), py::arg("scene"), py::kw_only(), py::arg("seed"),
+        py::arg("boxes") = py::none(),
+        doc("applyScene",
+            "Python: applyScene(src, format, model, scene, *, seed, boxes=None) returns (dst, "
+            "dstFormat, report, boxes); boxes are (x, y, w, h) tuples or an N x 4 array, and come "
+            "back as a list of tuples."));
+    m.def("augmentedOutputSeed", &augmentedOutputSeed, py::arg("seed"), py::arg("inputName"),
+          py::arg("variant"), doc("augmentedOutputSeed"));
+
+    py::class_<RandomScenePolicy>(m, "RandomScenePolicy", doc("RandomScenePolicy"))
+        .def(keywordInit<RandomScenePolicy>())
+        .def_readwrite("contrastMin", &RandomScenePolicy::contrastMin, doc("RandomScenePolicy::contrastMin"))
+        .def_readwrite("contrastMax", &RandomScenePolicy::contrastMax, doc("RandomScenePolicy::contrastMax"))
+        .def_readwrite("brightnessMin", &RandomScenePolicy::brightnessMin,
+                       doc("RandomScenePolicy::brightnessMin"))
+        .def_readwrite("brightnessMax", &RandomScenePolicy::brightnessMax,
+                       doc("RandomScenePolicy::brightnessMax"))
+        .def_readwrite("hueProbability", &RandomScenePolicy::hueProbability,
+                       doc("RandomScenePolicy::hueProbability"))
+        .def_readwrite("hueMin", &RandomScenePolicy::hueMin, doc("RandomScenePolicy::hueMin"))
+        .def_readwrite("hueMax", &RandomScenePolicy::hueMax, doc("RandomScenePolicy::hueMax"))
+        .def_readwrite("gainDbMin", &RandomScenePolicy::gainDbMin, doc("RandomScenePolicy::gainDbMin"))
+        .def_readwrite("gainDbMax", &RandomScenePolicy::gainDbMax, doc("RandomScenePolicy::gainDbMax"))
+        .def_readwrite("blurProbability", &RandomScenePolicy::blurProbability,
+                       doc("RandomScenePolicy::blurProbability"))
+        .def_readwrite("blurLengthMax", &RandomScenePolicy::blurLengthMax,
+                       doc("RandomScenePolicy::blurLengthMax"))
+        .def_readwrite("geometryProbability", &RandomScenePolicy::geometryProbability,
+                       doc("RandomScenePolicy::geometryProbability"))
+        .def_readwrite("maxShift", &RandomScenePolicy::maxShift, doc("RandomScenePolicy::maxShift"))
+        .def_readwrite("maxScale", &RandomScenePolicy::maxScale, doc("RandomScenePolicy::maxScale"))
+        .def_readwrite("noise", &RandomScenePolicy::noise, doc("RandomScenePolicy::noise"))
+        .def("validate", &RandomScenePolicy::validate, doc("RandomScenePolicy::validate"))
+        .def(
+            "draw",
+            [](const RandomScenePolicy& self, const py::object& src, const RawFormat& format, uint64 seed) {
+                const cv::Mat in = matFromArray(src, "src", kMosaicDepths);
+                return withoutGil("RandomScenePolicy.draw", [&] { return self.draw(in, format, seed); });
+            },
+            py::arg("src"), py::arg("format"), py::arg("seed"), doc("RandomScenePolicy::draw"))
+        .def("save", &RandomScenePolicy::save, py::arg("path"), doc("RandomScenePolicy::save"))
+        .def_static("load", &RandomScenePolicy::load, py::arg("path"), doc("RandomScenePolicy::load"));
+
+    // ---- raw_io ------------------------------------------------------------------------------------
+    py::class_<RawImage> rawImage(m, "RawImage", doc("RawImage"));
+    rawImage.def(keywordInit<RawImage>())
+        .def_readwrite("format", &RawImage::format, doc("RawImage::format"))
+        .def_readwrite("iso", &RawImage::iso, doc("RawImage::iso"))
+        .def_readwrite("exposureTime", &RawImage::exposureTime, doc("RawImage::exposureTime"))
+        .def_readwrite("make", &RawImage::make, doc("RawImage::make"))
+        .def_readwrite("model", &RawImage::model, doc("RawImage::model"))
+        .def_readwrite("whiteBalance", &RawImage::whiteBalance, doc("RawImage::whiteBalance"))
+        .def_readwrite("cameraToSrgb", &RawImage::cameraToSrgb, doc("RawImage::cameraToSrgb"));
+    defMatProperty(rawImage, "mosaic", &RawImage::mosaic, doc("RawImage::mosaic"), {CV_16U});
+    m.def(
+        "readRaw",
+        [](const std::string& path) { return withoutGil("readRaw", [&] { return readRaw(path); }); },
+        py::arg("path"), doc("readRaw"));
+    m.def(
+        "writeDng",
+        [](const std::string& path, const RawImage& image) {
+            withoutGil("writeDng", [&] { writeDng(path, image); });
+        },
+        py::arg("path"), py::arg("image"), doc("writeDng"));
+    m.def(
+        "writeFileAtomically",
+        [](const std::string& path, const py::bytes& data, bool replace) {
+            const std::string bytes = data;
+            withoutGil("writeFileAtomically",
+                       [&] { writeFileAtomically(path, bytes.data(), bytes.size(), replace); });
+        },
+        py::arg("path"), py::arg("data"), py::arg("replace") = false,
+        doc("writeFileAtomically", "Python: `data` is a bytes object."));
+    m.attr("MAX_TEXT_FILE_BYTES") = MAX_TEXT_FILE_BYTES;
+    py::class_<MosaicMetadata>(m, "MosaicMetadata", doc("MosaicMetadata"))
+        .def(keywordInit<MosaicMetadata>())
+        .def_readonly_static("FORMAT_VERSION", &MosaicMetadata::FORMAT_VERSION,
+                             doc("MosaicMetadata::FORMAT_VERSION"))
+        .def_readwrite("format", &MosaicMetadata::format, doc("MosaicMetadata::format"))
+        .def_readwrite("hasScene", &MosaicMetadata::hasScene, doc("MosaicMetadata::hasScene"))
+        .def_readwrite("scene", &MosaicMetadata::scene, doc("MosaicMetadata::scene"))
+        .def_readwrite("seed", &MosaicMetadata::seed, doc("MosaicMetadata::seed"))
+        .def_readwrite("source", &MosaicMetadata::source, doc("MosaicMetadata::source"))
+        .def_readwrite("size", &MosaicMetadata::size, doc("MosaicMetadata::size"))
+        .def_readwrite("type", &MosaicMetadata::type, doc("MosaicMetadata::type"));
+    m.def("sidecarPathOf", &sidecarPathOf, py::arg("path"), doc("sidecarPathOf"));
+    m.def(
+        "writeMosaic",
+        [](const std::string& path, const py::object& mosaic, const MosaicMetadata& metadata) {
+            const cv::Mat in = matFromArray(mosaic, "mosaic", kMosaicDepths);
+            withoutGil("writeMosaic", [&] { writeMosaic(path, in, metadata); });
+        },
+        py::arg("path"), py::arg("mosaic"), py::arg("metadata"), doc("writeMosaic"));
+    m.def(
+        "readMosaic",
+        [](const std::string& path) {
+            cv::Mat mosaic;
+            MosaicMetadata meta = withoutGil("readMosaic", [&] { return readMosaic(path, mosaic); });
+            return py::make_tuple(arrayFromMat(mosaic), meta);
+        },
+        py::arg("path"), doc("readMosaic", "Python: returns (mosaic, metadata)."));
+
+    // ---- isp ---------------------------------------------------------------------------------------
+    py::class_<ToneCurve>(m, "ToneCurve", doc("ToneCurve"))
+        .def(keywordInit<ToneCurve>())
+        .def_readwrite("gamma", &ToneCurve::gamma, doc("ToneCurve::gamma"))
+        .def_readwrite("breakPoint", &ToneCurve::breakPoint, doc("ToneCurve::breakPoint"))
+        .def_readwrite("toeSlope", &ToneCurve::toeSlope, doc("ToneCurve::toeSlope"))
+        .def_static("simpleGamma", &ToneCurve::simpleGamma, py::arg("gamma") = 5.0,
+                    doc("ToneCurve::simpleGamma"))
+        .def_static("parametric", &ToneCurve::parametric, py::arg("gamma"), py::arg("breakPoint"),
+                    py::arg("toeSlope"), doc("ToneCurve::parametric"))
+        .def_static("srgb", &ToneCurve::srgb, doc("ToneCurve::srgb"))
+        .def("offset", &ToneCurve::offset, doc("ToneCurve::offset"))
+        .def("__call__", &ToneCurve::operator(), py::arg("x"), doc("ToneCurve::operator()"))
+        .def("validate", &ToneCurve::validate, doc("ToneCurve::validate"));
+    m.def(
+        "applyToneCurve",
+        [](const py::object& linear, const ToneCurve& curve, int ddepth) {
+            const cv::Mat in = matFromArray(linear, "linear", {CV_32F, CV_64F}, true);
+            cv::Mat dst;
+            withoutGil("applyToneCurve", [&] { applyToneCurve(in, dst, curve, ddepth); });
+            return arrayFromMat(dst);
+        },
+        py::arg("linear"), py::arg("curve"), py::arg("ddepth") = -1,
+        doc("applyToneCurve", "Python: applyToneCurve(linear, curve, ddepth=-1) returns dst."));
+    py::enum_<DemosaicMethod>(m, "DemosaicMethod", doc("DemosaicMethod"))
+        .value("DEMOSAIC_BILINEAR", DEMOSAIC_BILINEAR, doc("DemosaicMethod::DEMOSAIC_BILINEAR"))
+        .value("DEMOSAIC_EDGE_AWARE", DEMOSAIC_EDGE_AWARE, doc("DemosaicMethod::DEMOSAIC_EDGE_AWARE"))
+        .value("DEMOSAIC_HALF_SIZE", DEMOSAIC_HALF_SIZE, doc("DemosaicMethod::DEMOSAIC_HALF_SIZE"))
+        .export_values();
+    py::class_<IspParams>(m, "IspParams", doc("IspParams"))
+        .def(keywordInit<IspParams>())
+        .def_readwrite("tone", &IspParams::tone, doc("IspParams::tone"))
+        .def_readwrite("whiteBalance", &IspParams::whiteBalance, doc("IspParams::whiteBalance"))
+        .def_readwrite("colorMatrix", &IspParams::colorMatrix, doc("IspParams::colorMatrix"))
+        .def_readwrite("exposure", &IspParams::exposure, doc("IspParams::exposure"))
+        .def_readwrite("demosaic", &IspParams::demosaic, doc("IspParams::demosaic"))
+        .def_readwrite("outputDepth", &IspParams::outputDepth, doc("IspParams::outputDepth"))
+        .def("validate", &IspParams::validate, doc("IspParams::validate"));
+    m.def(
+        "renderSimpleIsp",
+        [](const py::object& mosaic, const RawFormat& format, const IspParams& params) {
+            const cv::Mat in = matFromArray(mosaic, "mosaic", kMosaicDepths);
+            cv::Mat bgr;
+            withoutGil("renderSimpleIsp", [&] { renderSimpleIsp(in, format, bgr, params); });
+            return arrayFromMat(bgr);
+        },
+        py::arg("mosaic"), py::arg("format"), py::arg("params") = IspParams(),
+        doc("renderSimpleIsp", "Python: returns the HxWx3 BGR array (as cv2 images are)."));
+}
+
+} // namespace rawgment_python

@@ -1,0 +1,203 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Python bindings of calibration (burst statistics, samples, fits) and normality (Shapiro-Wilk).
+#include "binding_tools.hpp"
+
+namespace rawgment_python {
+
+using namespace cv::rawgment;
+
+namespace {
+
+const std::vector<int> kNumericDepths{CV_8U, CV_8S, CV_16U, CV_16S, CV_32S, CV_32F, CV_64F};
+
+} // namespace
+
+void bindCalibration(py::module_& m)
+{
+    // ---- calibration -------------------------------------------------------------------------------
+    py::class_<BurstStatistics>(m, "BurstStatistics", doc("BurstStatistics"))
+        .def(py::init<const RawFormat&, int, int>(), py::arg("format"), py::arg("groupFrames") = 8,
+             py::arg("stateDepth") = int(CV_64F), doc("BurstStatistics::BurstStatistics"))
+        .def(
+            "add",
+            [](BurstStatistics& self, const py::object& frame) {
+                const cv::Mat in = matFromArray(frame, "frame", {CV_16U, CV_32F});
+                withoutGil("BurstStatistics.add", [&] { self.add(in); });
+            },
+            py::arg("frame"), doc("BurstStatistics::add"))
+        .def("frames", &BurstStatistics::frames, doc("BurstStatistics::frames"))
+        .def("size", &BurstStatistics::size, doc("BurstStatistics::size"))
+        .def("format", &BurstStatistics::format, doc("BurstStatistics::format"))
+        .def(
+            "mean",
+            [](const BurstStatistics& self) {
+                cv::Mat dst;
+                withoutGil("BurstStatistics.mean", [&] { self.mean(dst); });
+                return arrayFromMat(dst);
+            },
+            doc("BurstStatistics::mean", "Python: returns the float64 array."))
+        .def(
+            "variance",
+            [](const BurstStatistics& self) {
+                cv::Mat dst;
+                withoutGil("BurstStatistics.variance", [&] { self.variance(dst); });
+                return arrayFromMat(dst);
+            },
+            doc("BurstStatistics::variance", "Python: returns the float64 array."))
+        .def(
+            "clippedMask",
+            [](const BurstStatistics& self) {
+                cv::Mat dst;
+                self.clippedMask(dst);
+                return arrayFromMat(dst);
+            },
+            doc("BurstStatistics::clippedMask", "Python: returns the uint8 array."));
+
+    py::class_<NoiseSample>(m, "NoiseSample", doc("NoiseSample"))
+        .def(keywordInit<NoiseSample>())
+        .def_readwrite("mean", &NoiseSample::mean, doc("NoiseSample::mean"))
+        .def_readwrite("variance", &NoiseSample::variance, doc("NoiseSample::variance"))
+        .def_readwrite("gain", &NoiseSample::gain, doc("NoiseSample::gain"))
+        .def_readwrite("dof", &NoiseSample::dof, doc("NoiseSample::dof"))
+        .def_readwrite("channel", &NoiseSample::channel, doc("NoiseSample::channel"));
+    m.def("cfaAlignedSquares", &cfaAlignedSquares, py::arg("patches"), py::arg("side") = 24,
+          doc("cfaAlignedSquares"));
+    m.def(
+        "sampleBurstPatches",
+        [](const BurstStatistics& stats, const std::vector<cv::Rect>& squares, double gain) {
+            return withoutGil("sampleBurstPatches", [&] { return sampleBurstPatches(stats, squares, gain); });
+        },
+        py::arg("stats"), py::arg("squares"), py::arg("gain"), doc("sampleBurstPatches"));
+    m.def(
+        "sampleSingleFramePatches",
+        [](const py::object& raw, const RawFormat& format, const std::vector<cv::Rect>& squares,
+           double gain) {
+            const cv::Mat in = matFromArray(raw, "raw", {CV_16U, CV_32F});
+            return withoutGil("sampleSingleFramePatches",
+                              [&] { return sampleSingleFramePatches(in, format, squares, gain); });
+        },
+        py::arg("raw"), py::arg("format"), py::arg("squares"), py::arg("gain"),
+        doc("sampleSingleFramePatches"));
+
+    py::class_<LineFitParams>(m, "LineFitParams", doc("LineFitParams"))
+        .def(keywordInit<LineFitParams>())
+        .def_readwrite("robust", &LineFitParams::robust, doc("LineFitParams::robust"))
+        .def_readwrite("ransacIterations", &LineFitParams::ransacIterations,
+                       doc("LineFitParams::ransacIterations"))
+        .def_readwrite("inlierThreshold", &LineFitParams::inlierThreshold,
+                       doc("LineFitParams::inlierThreshold"))
+        .def_readwrite("seed", &LineFitParams::seed, doc("LineFitParams::seed"));
+    py::class_<NoiseLineFit>(m, "NoiseLineFit", doc("NoiseLineFit"))
+        .def(keywordInit<NoiseLineFit>())
+        .def_readwrite("gain", &NoiseLineFit::gain, doc("NoiseLineFit::gain"))
+        .def_readwrite("line", &NoiseLineFit::line, doc("NoiseLineFit::line"))
+        .def_readwrite("rSquared", &NoiseLineFit::rSquared, doc("NoiseLineFit::rSquared"))
+        .def_readwrite("inliers", &NoiseLineFit::inliers, doc("NoiseLineFit::inliers"))
+        .def_readwrite("samples", &NoiseLineFit::samples, doc("NoiseLineFit::samples"));
+    m.def(
+        "fitNoiseLine",
+        [](const std::vector<NoiseSample>& samples, const LineFitParams& params) {
+            return withoutGil("fitNoiseLine", [&] { return fitNoiseLine(samples, params); });
+        },
+        py::arg("samples"), py::arg("params") = LineFitParams(), doc("fitNoiseLine"));
+
+    py::enum_<NoiseFitMethod>(m, "NoiseFitMethod", doc("NoiseFitMethod"))
+        .value("NOISE_FIT_JOINT", NOISE_FIT_JOINT, doc("NoiseFitMethod::NOISE_FIT_JOINT"))
+        .value("NOISE_FIT_TWO_STAGE", NOISE_FIT_TWO_STAGE, doc("NoiseFitMethod::NOISE_FIT_TWO_STAGE"))
+        .export_values();
+    py::class_<CalibrationParams>(m, "CalibrationParams", doc("CalibrationParams"))
+        .def(keywordInit<CalibrationParams>())
+        .def_readwrite("method", &CalibrationParams::method, doc("CalibrationParams::method"))
+        .def_readwrite("line", &CalibrationParams::line, doc("CalibrationParams::line"))
+        .def_readwrite("reweightIterations", &CalibrationParams::reweightIterations,
+                       doc("CalibrationParams::reweightIterations"))
+        .def_readwrite("lossScale", &CalibrationParams::lossScale, doc("CalibrationParams::lossScale"))
+        .def_readwrite("minGainRatio", &CalibrationParams::minGainRatio,
+                       doc("CalibrationParams::minGainRatio"));
+    py::class_<CalibrationReport>(m, "CalibrationReport", doc("CalibrationReport"))
+        .def(keywordInit<CalibrationReport>())
+        .def_readonly_static("FORMAT_VERSION", &CalibrationReport::FORMAT_VERSION,
+                             doc("CalibrationReport::FORMAT_VERSION"))
+        .def_readwrite("method", &CalibrationReport::method, doc("CalibrationReport::method"))
+        .def_readwrite("model", &CalibrationReport::model, doc("CalibrationReport::model"))
+        .def_readwrite("separable", &CalibrationReport::separable, doc("CalibrationReport::separable"))
+        .def_readwrite("perGain", &CalibrationReport::perGain, doc("CalibrationReport::perGain"))
+        .def_readwrite("rSquaredSlope", &CalibrationReport::rSquaredSlope,
+                       doc("CalibrationReport::rSquaredSlope"))
+        .def_readwrite("rSquaredOffset", &CalibrationReport::rSquaredOffset,
+                       doc("CalibrationReport::rSquaredOffset"))
+        .def_readwrite("samples", &CalibrationReport::samples, doc("CalibrationReport::samples"))
+        .def_readwrite("samplesUsed", &CalibrationReport::samplesUsed, doc("CalibrationReport::samplesUsed"))
+        .def_readwrite("notes", &CalibrationReport::notes, doc("CalibrationReport::notes"))
+        .def("save", &CalibrationReport::save, py::arg("path"), doc("CalibrationReport::save"))
+        .def_static("load", &CalibrationReport::load, py::arg("path"), doc("CalibrationReport::load"));
+    m.def(
+        "calibrateNoiseModel",
+        [](const std::vector<NoiseSample>& samples, const CalibrationParams& params) {
+            return withoutGil("calibrateNoiseModel", [&] { return calibrateNoiseModel(samples, params); });
+        },
+        py::arg("samples"), py::arg("params") = CalibrationParams(), doc("calibrateNoiseModel"));
+
+    // ---- normality ---------------------------------------------------------------------------------
+    py::class_<ShapiroWilkResult>(m, "ShapiroWilkResult", doc("ShapiroWilkResult"))
+        .def(keywordInit<ShapiroWilkResult>())
+        .def_readwrite("W", &ShapiroWilkResult::W, doc("ShapiroWilkResult::W"))
+        .def_readwrite("pValue", &ShapiroWilkResult::pValue, doc("ShapiroWilkResult::pValue"))
+        .def_readwrite("n", &ShapiroWilkResult::n, doc("ShapiroWilkResult::n"))
+        .def_readwrite("constant", &ShapiroWilkResult::constant, doc("ShapiroWilkResult::constant"));
+    m.def(
+        "shapiroWilk",
+        [](const py::object& samples) {
+            cv::Mat in;
+            if (py::isinstance<py::array>(samples))
+                in = sampleFromArray(samples, "samples");
+            else
+                in = cv::Mat(samples.cast<std::vector<double>>(), true).reshape(1, 1);
+            return withoutGil("shapiroWilk", [&] { return shapiroWilk(in); });
+        },
+        py::arg("samples"),
+        doc("shapiroWilk", "Python: `samples` is a numeric numpy array of any shape (C-contiguous) or a "
+                           "sequence of numbers."));
+    py::enum_<ShapiroWilkLayout>(m, "ShapiroWilkLayout", doc("ShapiroWilkLayout"))
+        .value("SW_SERIES_IN_COLUMNS", SW_SERIES_IN_COLUMNS, doc("ShapiroWilkLayout::SW_SERIES_IN_COLUMNS"))
+        .value("SW_SERIES_IN_ROWS", SW_SERIES_IN_ROWS, doc("ShapiroWilkLayout::SW_SERIES_IN_ROWS"))
+        .export_values();
+    m.def(
+        "shapiroWilkBatch",
+        [](const py::object& series, ShapiroWilkLayout layout) {
+            const cv::Mat in = matFromArray(series, "series", kNumericDepths);
+            std::vector<ShapiroWilkResult> results;
+            withoutGil("shapiroWilkBatch", [&] { shapiroWilkBatch(in, results, layout); });
+            return results;
+        },
+        py::arg("series"), py::arg("layout") = SW_SERIES_IN_COLUMNS,
+        doc("shapiroWilkBatch", "Python: returns the list of results."));
+    py::class_<BurstNormality>(m, "BurstNormality", doc("BurstNormality"))
+        .def(keywordInit<BurstNormality>())
+        .def_readwrite("positions", &BurstNormality::positions, doc("BurstNormality::positions"))
+        .def_readwrite("mean", &BurstNormality::mean, doc("BurstNormality::mean"))
+        .def_readwrite("distinctValues", &BurstNormality::distinctValues,
+                       doc("BurstNormality::distinctValues"))
+        .def_readwrite("results", &BurstNormality::results, doc("BurstNormality::results"));
+    m.def(
+        "shapiroWilkBurst",
+        [](const py::object& frames, const std::vector<cv::Point>& positions) {
+            const std::vector<cv::Mat> in = matsFromList(frames, "frames", kNumericDepths);
+            return withoutGil("shapiroWilkBurst", [&] { return shapiroWilkBurst(in, positions); });
+        },
+        py::arg("frames"), py::arg("positions") = std::vector<cv::Point>(), doc("shapiroWilkBurst"));
+    py::class_<NormalityBin>(m, "NormalityBin", doc("NormalityBin"))
+        .def(keywordInit<NormalityBin>())
+        .def_readwrite("meanLow", &NormalityBin::meanLow, doc("NormalityBin::meanLow"))
+        .def_readwrite("meanHigh", &NormalityBin::meanHigh, doc("NormalityBin::meanHigh"))
+        .def_readwrite("count", &NormalityBin::count, doc("NormalityBin::count"))
+        .def_readwrite("fractionAboveAlpha", &NormalityBin::fractionAboveAlpha,
+                       doc("NormalityBin::fractionAboveAlpha"))
+        .def_readwrite("medianPValue", &NormalityBin::medianPValue, doc("NormalityBin::medianPValue"))
+        .def_readwrite("meanDistinctValues", &NormalityBin::meanDistinctValues,
+                       doc("NormalityBin::meanDistinctValues"));
+    m.def("summarizeNormality", &summarizeNormality, py::arg("burst"), py::arg("bins"),
+          py::arg("alpha") = 0.05, doc("summarizeNormality"));
+}
+
+} // namespace rawgment_python
