@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Configures and builds one flavour of the project.
-#   scripts/build.sh release   -> build/release (Release, tests, benchmarks, apps, samples)
-#   scripts/build.sh asan      -> build/asan    (RelWithDebInfo + AddressSanitizer + UBSan, no benchmarks)
+#   scripts/build.sh release   -> build/release (Release, tests, benchmarks, apps, samples, Python module)
+#   scripts/build.sh asan      -> build/asan    (RelWithDebInfo + AddressSanitizer + UBSan, no benchmarks,
+#                                                no Python module: an instrumented extension needs the
+#                                                sanitizer runtime preloaded into the interpreter)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 flavour=${1:-release}
@@ -11,7 +13,7 @@ generator=()
 command -v ninja >/dev/null 2>&1 && generator=(-G Ninja)
 
 case "$flavour" in
-  release) args=(-DCMAKE_BUILD_TYPE=Release) ;;
+  release) args=(-DCMAKE_BUILD_TYPE=Release -DRAWGMENT_BUILD_PYTHON=ON) ;;
   asan) args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DRAWGMENT_SANITIZE=ON -DRAWGMENT_BUILD_PERF=OFF) ;;
   *) echo "build.sh: unknown flavour '$flavour' (expected release or asan)" >&2; exit 2 ;;
 esac

@@ -17,6 +17,14 @@ packages=(
   gnuplot-nox       # PNG plots in apps and the demo
   doxygen           # the API reference (target doc), built without warnings by the tests
   texlive-binaries  # bibtex, which doxygen runs for @cite
+  python3-dev       # the Python module (rawgment): headers of Debian's Python 3.11
+  pybind11-dev      # its C++ bindings
+  python3-pybind11  # pybind11's CMake package as the Python side sees it
+  python3-numpy     # arrays in and out
+  python3-pytest    # the Python tests
+  python3-torch     # rawgment.torch: transform and dataset (CPU build)
+  python3-dask      # rawgment.batch on a cluster
+  python3-distributed  # Dask's scheduler, workers and LocalCluster
 )
 
 missing=()

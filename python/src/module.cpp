@@ -494,6 +494,8 @@ PYBIND11_MODULE(_rawgment, m)
     // cv::Exception -> rawgment.error, a RuntimeError carrying OpenCV's message (`err`) and the
     // C++ function that raised it; the text is the message alone, which names the bad argument.
     static py::exception<cv::Exception> error(m, "error", PyExc_RuntimeError);
+    error.attr("__doc__") = "A cv::Exception of the C++ library: str() and `err` are its message, `code` its "
+                            "OpenCV error code (-5: bad argument), `func` the C++ function that raised it.";
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p)

@@ -1,0 +1,61 @@
+"""Shared fixtures of the Python tests: the build's apps and reference program, small simulated mosaics."""
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+import rawgment as rg
+
+
+def env_path(name):
+    value = os.environ.get(name)
+    if not value:
+        pytest.fail("%s is not set: run the Python tests through ctest (python_tests)" % name)
+    return value
+
+
+@pytest.fixture(scope="session")
+def app_dir():
+    return env_path("RAWGMENT_APP_DIR")
+
+
+@pytest.fixture(scope="session")
+def source_dir():
+    return env_path("RAWGMENT_SOURCE_DIR")
+
+
+@pytest.fixture(scope="session")
+def cxx_reference(tmp_path_factory):
+    """The folder of the C++ reference results (tests/cxx_reference.cpp)."""
+    folder = tmp_path_factory.mktemp("cxx_reference")
+    subprocess.run([env_path("RAWGMENT_PYTHON_REFERENCE"), str(folder)], check=True)
+    return folder
+
+
+def chart_mean(width=128, height=96):
+    """The colour-checker scene of the reference program, on a frame of the given size."""
+    chart = rg.makeColorCheckerScene(rg.ColorCheckerOptions(patchSize=16, border=4))
+    mean = np.zeros((height, width), np.float32)
+    h, w = chart.meanAtUnitGain.shape
+    mean[:h, :w] = chart.meanAtUnitGain
+    return chart, mean
+
+
+@pytest.fixture(scope="session")
+def sensor():
+    params = rg.SensorParams(blackLevel=(64, 66, 65, 63), bitDepth=12)
+    return rg.SensorSimulator(params, (128, 96))
+
+
+@pytest.fixture(scope="session")
+def capture(sensor):
+    _, mean = chart_mean()
+    return sensor.capture(mean, 2.0, 1.0, seed=11, frameIndex=3)
+
+
+@pytest.fixture
+def scratch(tmp_path):
+    yield tmp_path
+    shutil.rmtree(tmp_path, ignore_errors=True)

@@ -1,0 +1,153 @@
+"""How the module takes and gives arrays, and every bad-argument path: a wrong dtype is a TypeError, a
+wrong shape or layout a ValueError, each naming the argument; a C++ error is rawgment.error with the C++
+message; option structs take keywords and refuse unknown ones."""
+import pickle
+
+import numpy as np
+import pytest
+
+import rawgment as rg
+from conftest import chart_mean
+
+
+def test_inputs_are_read_without_a_copy_including_padded_rows(sensor, capture):
+    fmt, model = sensor.rawFormat(2.0), sensor.effectiveModel()
+    jitter = rg.ColorJitter.exposureChange(0.3, 1.0)
+    expected = rg.colorJitter(capture, fmt, model, jitter, seed=1)[0]
+    # A crop of a wider array has padded rows: wrapped as it is (OpenCV's step), same result.
+    wide = np.zeros((96, 160), np.uint16)
+    wide[:, :128] = capture
+    crop = wide[:, :128]
+    assert not crop.flags.c_contiguous
+    assert np.array_equal(rg.colorJitter(crop, fmt, model, jitter, seed=1)[0], expected)
+    # The statistics read the caller's buffer: what the call sees is the array now, not a stale copy.
+    samples = np.arange(10, dtype=np.float64)
+    before = rg.shapiroWilk(samples).W
+    samples[3] = 7.5
+    assert rg.shapiroWilk(samples).W != before
+
+
+def test_outputs_own_their_memory_and_never_alias_an_input(sensor, capture):
+    fmt, model = sensor.rawFormat(2.0), sensor.effectiveModel()
+    out = rg.colorJitter(capture, fmt, model, rg.ColorJitter.exposureChange(0.5, 1.0), seed=1)[0]
+    assert out.flags.writeable and out.flags.c_contiguous and out.base is not None  # OpenCV's buffer, shared
+    # An identity step returns the input's data in C++; Python gets a copy, never a view of the input.
+    identity = rg.colorJitter(capture, fmt, model, rg.ColorJitter(), seed=1)[0]
+    assert np.array_equal(identity, capture) and not np.shares_memory(identity, capture)
+    scene_out = rg.applyScene(capture, fmt, model, rg.Scene(), seed=1)[0]
+    assert not np.shares_memory(scene_out, capture)
+
+
+@pytest.mark.parametrize("bad, error, words", [
+    ([[1, 2], [3, 4]], TypeError, ["'src'", "numpy array", "list"]),
+    (np.zeros((8, 8), np.int32), TypeError, ["'src'", "int32", "uint16 or float32"]),
+    (np.zeros((8, 8), np.float64), TypeError, ["'src'", "float64"]),
+    (np.zeros((8, 8), np.dtype(">u2")), TypeError, ["'src'", "byte order"]),
+    (np.zeros(64, np.uint16), ValueError, ["'src'", "2-D", "(64,)"]),
+    (np.zeros((2, 8, 8), np.uint16), ValueError, ["'src'", "2-D", "(2, 8, 8)"]),
+    (np.zeros((8, 16), np.uint16)[:, ::2], ValueError, ["'src'", "not contiguous", "ascontiguousarray"]),
+    (np.zeros((16, 8), np.uint16).T, ValueError, ["'src'", "not contiguous"]),
+])
+def test_bad_arrays_name_the_argument(sensor, bad, error, words):
+    with pytest.raises(error) as info:
+        rg.colorJitter(bad, sensor.rawFormat(1.0), sensor.effectiveModel(), rg.ColorJitter(), seed=1)
+    for w in words:
+        assert w in str(info.value)
+
+
+def test_bad_arrays_of_other_arguments():
+    with pytest.raises(TypeError, match="'kernel'"):
+        rg.motionBlur(np.zeros((8, 8), np.uint16), rg.RawFormat(), rg.NoiseModel(1, 1, 1), [[1.0]], seed=1)
+    with pytest.raises(TypeError, match=r"'frames\[1\]'"):
+        rg.shapiroWilkBurst([np.zeros((4, 4), np.uint16), "x", np.zeros((4, 4), np.uint16)])
+    with pytest.raises(ValueError, match="'samples'.*C-contiguous"):
+        rg.shapiroWilk(np.zeros((10, 10))[:, ::2])
+    with pytest.raises(TypeError, match="'meanAtUnitGain'"):
+        rg.SensorSimulator(rg.SensorParams(), (8, 8)).capture(np.zeros((8, 8), np.float64), 1, 1, 1)
+    with pytest.raises(ValueError, match="'boxes'"):
+        rg.applyScene(np.zeros((8, 8), np.uint16), rg.RawFormat(), rg.NoiseModel(1, 1, 1), rg.Scene(), seed=1,
+                      boxes=np.zeros((2, 3)))
+
+
+def test_cxx_errors_are_rawgment_error_with_the_cxx_message(sensor, tmp_path):
+    with pytest.raises(rg.error) as info:
+        rg.NoiseModel(-1, 0, 0)
+    assert isinstance(info.value, RuntimeError)
+    assert "alpha must be finite and >= 0" in str(info.value) and info.value.err == str(info.value)
+    assert info.value.code == -5 and info.value.func  # StsBadArg, and the C++ function
+    with pytest.raises(rg.error, match="must be even"):
+        rg.splitCfaPlanes(np.zeros((5, 4), np.uint16))
+    with pytest.raises(rg.error, match="n < 3|3 <= n|between 3"):
+        rg.shapiroWilk([1.0, 2.0])
+    with pytest.raises(rg.error, match=str(tmp_path / "missing.yml")):
+        rg.NoiseModel.load(str(tmp_path / "missing.yml"))
+    with pytest.raises(rg.error, match="seed|gain|> 0"):
+        rg.colorJitter(np.zeros((8, 8), np.uint16), rg.RawFormat(), rg.NoiseModel(1, 1, 1),
+                       rg.ColorJitter(gainRatio=-1), seed=1)
+
+
+def test_option_structs_take_keywords_and_refuse_unknown_ones():
+    policy = rg.RandomScenePolicy(contrastMin=0.05, gainDbMax=6, noise=rg.NoiseOptions(
+        alignment=rg.NoiseAlignment.IGNORE_PRIOR, shotSampling=rg.ShotNoiseSampling.POISSON))
+    assert policy.contrastMin == 0.05 and policy.gainDbMax == 6 and policy.blurLengthMax == 13
+    assert policy.noise.shotSampling == rg.ShotNoiseSampling.POISSON
+    with pytest.raises(TypeError, match="unexpected keyword argument 'contrst_min'"):
+        rg.RandomScenePolicy(contrst_min=0.1)
+    with pytest.raises(rg.error, match="contrast"):
+        rg.RandomScenePolicy(contrastMin=2, contrastMax=1)  # validated where it is made
+    with pytest.raises(TypeError):
+        rg.RawFormat(blackLevel=(1, 2, 3))  # four sites
+    # A NoiseAlignment is accepted where NoiseOptions are, as in C++.
+    scene = rg.Scene(noise=rg.NoiseAlignment.NONE, shift=(2, 4))
+    assert scene.noise.alignment == rg.NoiseAlignment.NONE and scene.shift == (2, 4)
+    kernel = rg.linearMotionKernel(7, 0)
+    scene.motionKernel = kernel
+    assert np.array_equal(scene.motionKernel, kernel)
+    with pytest.raises(TypeError, match="'motionKernel'"):
+        scene.motionKernel = kernel.astype(np.float16)
+
+
+def test_values_print_compare_and_pickle(tmp_path):
+    for value in (rg.RawFormat(pattern=rg.CFA_GBRG, blackLevel=(1, 2, 3, 4)), rg.NoiseModel(0.5, 2, 1),
+                  rg.RandomScenePolicy(hueMin=0.7), rg.Scene(scale=1.02, motionKernel=rg.linearMotionKernel(5, 45)),
+                  rg.IspParams(colorMatrix=np.eye(3) * 2)):
+        assert pickle.loads(pickle.dumps(value)) == value
+        assert type(value).__name__ + "(" in repr(value)
+    model = rg.NoiseModel(0.5, 2, 1)
+    model.save(str(tmp_path / "m.yml"))
+    assert rg.NoiseModel.load(str(tmp_path / "m.yml")) == model
+    policy = rg.RandomScenePolicy(maxScale=0.01)
+    policy.save(str(tmp_path / "p.json"))
+    assert rg.RandomScenePolicy.load(str(tmp_path / "p.json")) == policy
+
+
+def test_files_round_trip(tmp_path, capture, sensor):
+    meta = rg.MosaicMetadata(format=sensor.rawFormat(2.0), source="test")
+    rg.writeMosaic(str(tmp_path / "a.png"), capture, meta)
+    mosaic, back = rg.readMosaic(str(tmp_path / "a.png"))
+    assert np.array_equal(mosaic, capture) and back.format == meta.format and back.size == (128, 96)
+    with pytest.raises(rg.error, match="never overwritten"):
+        rg.writeMosaic(str(tmp_path / "a.png"), capture, meta)
+    image = rg.RawImage(mosaic=capture, format=sensor.rawFormat(1.0), make="Sim", model="S1", iso=200)
+    rg.writeDng(str(tmp_path / "a.dng"), image)
+    read = rg.readRaw(str(tmp_path / "a.dng"))
+    assert np.array_equal(read.mosaic, capture) and read.make == "Sim" and read.iso == 200
+    rg.writeFileAtomically(str(tmp_path / "t.txt"), b"abc")
+    assert (tmp_path / "t.txt").read_bytes() == b"abc"
+
+
+def test_results_of_the_statistics(sensor):
+    _, mean = chart_mean()
+    burst = sensor.captureBurst(mean, 1.0, 1.0, 8, 1)
+    series = np.stack([f.reshape(-1)[:200] for f in burst]).astype(np.float32)
+    batch = rg.shapiroWilkBatch(series)
+    assert len(batch) == 200 and all(b == rg.shapiroWilk(np.ascontiguousarray(series[:, i])) for i, b in
+                                     enumerate(batch))
+    normality = rg.shapiroWilkBurst(burst, [(3, 4), (40, 30)])
+    assert normality.positions == [(3, 4), (40, 30)] and len(normality.results) == 2
+    assert len(rg.summarizeNormality(normality, 4)) == 4
+    planes = rg.splitCfaPlanes(burst[0])
+    assert len(planes) == 4 and np.array_equal(rg.mergeCfaPlanes(planes), burst[0])
+    signal = rg.subtractBlackLevel(burst[0], sensor.rawFormat(1.0), normalize=True)
+    back = rg.addBlackLevel(signal, sensor.rawFormat(1.0), rg.CV_16U, normalized=True)
+    assert np.array_equal(back, burst[0])

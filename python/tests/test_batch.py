@@ -1,0 +1,117 @@
+"""rawgment.batch: the same files from one process, a 2-worker Dask LocalCluster and the C++ app; a
+rerun after an interrupted run finishes the job without replacing anything."""
+import filecmp
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import rawgment as rg
+import rawgment.batch as batch
+
+
+@pytest.fixture(scope="module")
+def job(tmp_path_factory, sensor):
+    """Inputs (two DNGs sharing a stem, and a PNG mosaic with its sidecar), a model and a policy."""
+    from conftest import chart_mean
+
+    root = tmp_path_factory.mktemp("batch")
+    _, mean = chart_mean()
+    for sub in ("a", "b"):
+        (root / sub).mkdir()
+    inputs = []
+    for i, path in enumerate([root / "a" / "frame.dng", root / "b" / "frame.dng"]):
+        raw = sensor.capture(mean, 1.0, 1.0, seed=60 + i)
+        rg.writeDng(str(path), rg.RawImage(mosaic=raw, format=sensor.rawFormat(1.0)))
+        inputs.append(str(path))
+    png = root / "a" / "chart.png"
+    rg.writeMosaic(str(png), sensor.capture(mean, 2.0, 1.0, seed=70), rg.MosaicMetadata(format=sensor.rawFormat(2.0)))
+    inputs.append(str(png))
+    sensor.effectiveModel().save(str(root / "model.yml"))
+    rg.RandomScenePolicy(blurProbability=0.5, geometryProbability=1).save(str(root / "policy.yml"))
+    return {"root": root, "inputs": inputs, "model": str(root / "model.yml"), "policy": str(root / "policy.yml")}
+
+
+def app_run(app_dir, job, out, extra=()):
+    cmd = [os.path.join(app_dir, "rawgment_augment"), "--model=" + job["model"], "--policy=" + job["policy"],
+           "--out=" + str(out), "--variants=2", "--seed=5", *extra, *job["inputs"]]
+    subprocess.run(cmd, check=True, capture_output=True)
+
+
+def files_of(folder):
+    return sorted(os.listdir(folder))
+
+
+def assert_same_files(a, b):
+    assert files_of(a) == files_of(b)
+    for name in files_of(a):
+        assert filecmp.cmp(os.path.join(a, name), os.path.join(b, name), shallow=False), name
+
+
+def test_one_process_dask_and_the_app_make_the_same_bytes(app_dir, job):
+    root = job["root"]
+    app_run(app_dir, job, root / "app")
+    result = batch.augmentFiles(job["inputs"], job["model"], root / "here", policy=job["policy"], variants=2, seed=5)
+    assert result["written"] == 6 and result["skipped"] == 0 and len(result["outputs"]) == 6
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        assert len(client.scheduler_info()["workers"]) == 2
+        on_dask = batch.augmentFiles(job["inputs"], job["model"], root / "dask", policy=job["policy"], variants=2,
+                                     seed=5, client=client)
+    assert on_dask["written"] == 6
+    assert len(files_of(root / "app")) == 12  # 6 mosaics, each with its sidecar
+    assert_same_files(root / "app", root / "here")
+    assert_same_files(root / "app", root / "dask")
+
+
+def test_a_rerun_resumes_and_replaces_nothing(app_dir, job):
+    root = job["root"]
+    out = root / "resumed"
+    plan = rg._apps.planAugmentJobs(job["inputs"], job["model"], "", job["policy"], str(out), 2, 5, "", False)
+    assert len(plan["jobs"]) == 6 and plan["skipped"] == 0
+    # Two outputs finished, then the run was killed (pid 999999) while writing a third: its temporary
+    # is not an output, and the rerun removes it.
+    for j in plan["jobs"][:2]:
+        rg._apps.runAugmentJob(j, job["model"], "", job["policy"])
+    leftover = plan["jobs"][2]["out"] + ".tmp-999999-0"
+    open(leftover, "wb").write(b"partial")
+    finished = {p: os.path.getmtime(p) for p in (plan["jobs"][0]["out"], plan["jobs"][1]["out"])}
+    result = batch.augmentFiles(job["inputs"], job["model"], out, policy=job["policy"], variants=2, seed=5)
+    assert result["skipped"] == 2 and result["written"] == 4
+    assert all(os.path.getmtime(p) == t for p, t in finished.items())
+    assert not os.path.exists(leftover)
+    app_run(app_dir, job, root / "app_for_resume")
+    assert_same_files(root / "app_for_resume", out)
+    # Another seed into the same folder is refused: its outputs would be different files of one name.
+    with pytest.raises(RuntimeError, match="was made from"):
+        batch.augmentFiles(job["inputs"], job["model"], out, policy=job["policy"], variants=2, seed=6)
+
+
+def test_bad_options_are_errors_before_any_output(job, tmp_path):
+    with pytest.raises(ValueError, match="exactly one of policy and scene"):
+        batch.augmentFiles(job["inputs"], job["model"], tmp_path / "x")
+    with pytest.raises(RuntimeError, match="no such file"):
+        batch.augmentFiles(job["inputs"] + [str(tmp_path / "missing.dng")], job["model"], tmp_path / "y",
+                           policy=job["policy"])
+    assert not (tmp_path / "y").exists() or not os.listdir(tmp_path / "y")
+    with pytest.raises(rg.error, match="model"):
+        batch.augmentFiles(job["inputs"], job["policy"], tmp_path / "z", policy=job["policy"])
+
+
+def test_command_line(job, tmp_path):
+    run = [sys.executable, "-m", "rawgment.batch"]
+    bad = subprocess.run(run + ["--model", job["model"], "--policy", job["policy"], "--out", str(tmp_path),
+                                "--bogus", job["inputs"][0]], capture_output=True, text=True)
+    assert bad.returncode == 2 and "--bogus" in bad.stderr
+    ok = subprocess.run(run + ["--model", job["model"], "--policy", job["policy"], "--out", str(tmp_path / "cli"),
+                               "--variants", "1", job["inputs"][2]], capture_output=True, text=True)
+    assert ok.returncode == 0, ok.stderr
+    assert "wrote 1 outputs" in ok.stdout
+    mosaic, meta = rg.readMosaic(str(tmp_path / "cli" / "chart_v00.png"))
+    assert meta.hasScene and meta.source == job["inputs"][2] and mosaic.dtype == np.uint16
+    help_text = subprocess.run(run + ["--help"], capture_output=True, text=True).stdout
+    assert "--scheduler" in help_text and "--workers" in help_text

@@ -1,0 +1,98 @@
+"""Python gives the C++ API's bits: every result of tests/cxx_reference.cpp, recomputed through the
+module with the same parameters and seeds, is identical (arrays bit for bit, numbers to the last digit)."""
+import numpy as np
+
+import rawgment as rg
+from conftest import chart_mean
+
+
+def numbers(folder):
+    out = {}
+    for line in (folder / "numbers.txt").read_text().splitlines():
+        key, *values = line.split()
+        out[key] = values
+    return out
+
+
+def same(folder, name, array):
+    expected = np.load(folder / (name + ".npy"))
+    assert array.dtype == expected.dtype, name
+    assert array.shape == expected.shape, name
+    assert np.array_equal(array, expected), "%s differs from C++ in %d elements" % (
+        name, int(np.count_nonzero(array != expected)))
+
+
+def test_simulator_and_noise_steps(cxx_reference, sensor, capture):
+    ref = numbers(cxx_reference)
+    same(cxx_reference, "capture", capture)
+    fmt = sensor.rawFormat(2.0)
+    model = sensor.effectiveModel()
+    jitter = rg.ColorJitter.exposureChange(0.2, 2.0)
+    jitter.contrast = (0.4, 0.38, 0.41, 0.5)
+    jitter.brightness = -3
+    out, outFormat, report, mask = rg.colorJitter(capture, fmt, model, jitter, rg.NoiseAlignment.ACCOUNT_PRIOR,
+                                                  seed=5, saturatedMask=True)
+    same(cxx_reference, "jitter", out)
+    same(cxx_reference, "jitter_mask", mask)
+    assert outFormat.gain == float(ref["jitter_gain"][0])
+    assert report.brighteningPixels == int(ref["jitter_brightening"][0])
+
+    blurred, _ = rg.motionBlur(capture, fmt, model, rg.linearMotionKernel(9, 30), rg.NoiseAlignment.ACCOUNT_PRIOR,
+                               seed=6)
+    same(cxx_reference, "blur", blurred)
+    scaled, _ = rg.scaleMosaic(capture, fmt, model, 1.03, rg.NoiseAlignment.IGNORE_PRIOR, seed=7)
+    same(cxx_reference, "scale", scaled)
+
+
+def test_scene_policy_and_boxes(cxx_reference, sensor, capture):
+    ref = numbers(cxx_reference)
+    fmt = sensor.rawFormat(2.0)
+    policy = rg.RandomScenePolicy(blurProbability=1, geometryProbability=1)
+    seed = rg.augmentedOutputSeed(1, "frame", 2)
+    scene = policy.draw(capture, fmt, seed)
+    out, outFormat, _, boxes = rg.applyScene(capture, fmt, sensor.effectiveModel(), scene, seed=seed,
+                                             boxes=[(10, 12, 30, 20), (100, 80, 20, 10)])
+    same(cxx_reference, "scene", out)
+    assert float(ref["scene_gain"][0]) == outFormat.gain
+    assert boxes == [tuple(int(v) for v in ref["scene_box%d" % i]) for i in range(2)]
+
+
+def test_normals_shapiro_wilk_and_isp(cxx_reference, sensor, capture):
+    ref = numbers(cxx_reference)
+    z = rg.fillStandardNormal((33, 17), 9)
+    same(cxx_reference, "normal", z)
+    result = rg.shapiroWilk(z)
+    assert result.W == float(ref["sw_W"][0]) and result.pValue == float(ref["sw_p"][0])
+    same(cxx_reference, "isp", rg.renderSimpleIsp(capture, sensor.rawFormat(2.0)))
+
+
+def test_burst_statistics_and_calibration(cxx_reference, sensor):
+    ref = numbers(cxx_reference)
+    chart, mean = chart_mean()
+    squares = rg.cfaAlignedSquares(chart.patches, 8)
+    samples = []
+    for g in range(3):
+        gain = rg.dbToLinearGain(6.0 * g)
+        stats = rg.BurstStatistics(sensor.rawFormat(gain))
+        for frame in sensor.captureBurst(mean, gain, 1.0, 16, 100 + g):
+            stats.add(frame)
+        if g == 0:
+            same(cxx_reference, "burst_variance", stats.variance())
+        samples += rg.sampleBurstPatches(stats, squares, gain)
+    assert len(samples) == int(ref["calibration_samples"][0])
+    report = rg.calibrateNoiseModel(samples)
+    assert report.model.alpha == float(ref["calibration_alpha"][0])
+    assert report.model.sigmaD2 == float(ref["calibration_sigmaD2"][0])
+    assert report.model.sigmaR2 == float(ref["calibration_sigmaR2"][0])
+
+
+def test_every_cpu_path_gives_the_same_bits(sensor, capture):
+    fmt, model = sensor.rawFormat(2.0), sensor.effectiveModel()
+    results = []
+    try:
+        for path in rg.availableCpuPaths():
+            rg.setCpuPath(path)
+            results.append(rg.colorJitter(capture, fmt, model, rg.ColorJitter.exposureChange(0.1, 4.0), seed=3)[0])
+    finally:
+        rg.setCpuPath(rg.CpuPath.AUTO)
+    assert all(np.array_equal(results[0], r) for r in results[1:])

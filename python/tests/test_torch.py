@@ -1,0 +1,93 @@
+"""rawgment.torch: the transform on tensors and arrays (boxes follow), and a DataLoader over a folder
+that gives the same samples with 0 and 2 workers."""
+import numpy as np
+import pytest
+import torch
+
+import rawgment as rg
+import rawgment.torch as rgt
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory, sensor):
+    """Six small DNGs of the simulated chart, as a camera would give them."""
+    from conftest import chart_mean
+
+    path = tmp_path_factory.mktemp("raws")
+    _, mean = chart_mean()
+    for i in range(6):
+        raw = sensor.capture(mean, 1.0, 1.0 + 0.2 * i, seed=40 + i)
+        rg.writeDng(str(path / ("frame_%02d.dng" % i)), rg.RawImage(mosaic=raw, format=sensor.rawFormat(1.0)))
+    (path / "notes.txt").write_text("not a raw file")
+    return path
+
+
+def test_seeds_depend_on_base_epoch_and_index_only():
+    assert rgt.sampleSeed(7, 2, 5) == rgt.sampleSeed(7, 2, 5)
+    seeds = {rgt.sampleSeed(7, e, i) for e in range(3) for i in range(100)}
+    assert len(seeds) == 300
+    assert rgt.sampleSeed(7, 0, 0) != rgt.sampleSeed(8, 0, 0)
+    with pytest.raises(ValueError):
+        rgt.sampleSeed(7, -1, 0)
+
+
+def test_transform_gives_the_cxx_result_on_tensors_and_arrays(sensor, capture):
+    fmt, model = sensor.rawFormat(2.0), sensor.effectiveModel()
+    transform = rgt.RandomNoiseScene(model, rg.RandomScenePolicy(geometryProbability=1), baseSeed=3)
+    boxes = [(10, 12, 30, 20)]
+    result = transform(capture, fmt, boxes, index=4, epoch=1)
+    seed = rgt.sampleSeed(3, 1, 4)
+    scene = rg.RandomScenePolicy(geometryProbability=1).draw(capture, fmt, seed)
+    expected, expectedFormat, _, expectedBoxes = rg.applyScene(capture, fmt, model, scene, seed=seed, boxes=boxes)
+    assert np.array_equal(result.raw, expected) and result.format == expectedFormat
+    assert result.boxes == expectedBoxes and result.scene == scene
+    # A float32 tensor in, a tensor out; tensor boxes come back as a tensor of their dtype.
+    tensor = torch.from_numpy(capture.astype(np.float32))
+    tboxes = torch.tensor(boxes, dtype=torch.float32)
+    out = transform(tensor, fmt, tboxes, index=4, epoch=1)
+    assert isinstance(out.raw, torch.Tensor) and out.raw.dtype == torch.float32
+    assert isinstance(out.boxes, torch.Tensor) and out.boxes.dtype == torch.float32
+    assert out.boxes.tolist() == [list(map(float, b)) for b in expectedBoxes]
+    with pytest.raises(TypeError, match="torch.float32"):
+        transform(torch.zeros((8, 8), dtype=torch.int32), fmt, index=0)
+    with pytest.raises(TypeError, match="model"):
+        rgt.RandomNoiseScene(3.0)
+
+
+def batches(loader):
+    return [(b["index"].tolist(), b["raw"].clone(), b["gain"].tolist()) for b in loader]
+
+
+def test_dataloader_gives_the_same_samples_with_0_and_2_workers(folder, sensor):
+    model = sensor.effectiveModel()
+    dataset = rgt.RawFolderDataset(folder, model, baseSeed=11, pack=True)
+    assert len(dataset) == 6 and all(f.endswith(".dng") for f in dataset.files)
+    item = dataset[2]
+    assert item["raw"].shape == (4, 48, 64) and item["raw"].dtype == torch.float32
+    results = {}
+    for workers in (0, 2):
+        loader = torch.utils.data.DataLoader(dataset, batch_size=2, num_workers=workers, shuffle=False)
+        results[workers] = batches(loader)
+    assert len(results[0]) == 3
+    for (i0, r0, g0), (i2, r2, g2) in zip(results[0], results[2]):
+        assert i0 == i2 and g0 == g2 and torch.equal(r0, r2)
+    # Another epoch, other samples; the same epoch again, the same samples.
+    dataset.set_epoch(1)
+    other = batches(torch.utils.data.DataLoader(dataset, batch_size=2, num_workers=2))
+    assert not all(torch.equal(a[1], b[1]) for a, b in zip(results[0], other))
+    dataset.set_epoch(0)
+    again = batches(torch.utils.data.DataLoader(dataset, batch_size=2, num_workers=2))
+    assert all(torch.equal(a[1], b[1]) for a, b in zip(results[0], again))
+
+
+def test_dataset_options_and_errors(folder, tmp_path, sensor):
+    plain = rgt.RawFolderDataset(folder, sensor.effectiveModel(), augment=False, normalize=False)
+    raw = plain[0]["raw"]
+    mosaic, fmt = rgt.loadMosaic(plain.files[0])
+    assert torch.equal(raw[0], torch.from_numpy(rg.subtractBlackLevel(mosaic, fmt)))
+    with pytest.raises(IndexError):
+        plain[6]
+    with pytest.raises(FileNotFoundError, match="no RAW file"):
+        rgt.RawFolderDataset(tmp_path, sensor.effectiveModel())
+    with pytest.raises(FileNotFoundError, match="not a folder"):
+        rgt.RawFolderDataset(tmp_path / "missing", sensor.effectiveModel())
