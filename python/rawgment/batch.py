@@ -21,7 +21,11 @@ import time
 
 from . import _rawgment
 
-__all__ = ["augmentFiles", "main"]
+__all__ = ["augmentFiles", "main", "RAW_EXTENSIONS"]
+
+#: File extensions of the camera RAW formats LibRaw reads (lower case), for picking inputs from a folder.
+RAW_EXTENSIONS = (".dng", ".nef", ".cr2", ".cr3", ".crw", ".arw", ".raf", ".rw2", ".orf", ".pef", ".kdc",
+                  ".srw", ".3fr", ".iiq", ".erf", ".mef", ".mos", ".nrw", ".x3f")
 
 
 def _runJob(job, model, scene, policy):

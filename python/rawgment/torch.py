@@ -19,11 +19,10 @@ import numpy as np
 import torch
 
 import rawgment as _rg
+from rawgment.batch import RAW_EXTENSIONS
 
 __all__ = ["sampleSeed", "Augmented", "RandomNoiseScene", "RawFolderDataset", "packCfaPlanes", "loadMosaic"]
 
-RAW_EXTENSIONS = (".dng", ".nef", ".cr2", ".cr3", ".crw", ".arw", ".raf", ".rw2", ".orf", ".pef", ".kdc",
-                  ".srw", ".3fr", ".iiq", ".erf", ".mef", ".mos", ".nrw", ".x3f")
 MOSAIC_EXTENSIONS = (".png", ".tif", ".tiff")
 
 Augmented = collections.namedtuple("Augmented", ["raw", "format", "boxes", "report", "scene"])
