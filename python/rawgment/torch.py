@@ -192,6 +192,10 @@ class RawFolderDataset(torch.utils.data.Dataset):
     def __getitem__(self, index):
         if not 0 <= index < len(self.files):
             raise IndexError("RawFolderDataset index %d out of range (%d files)" % (index, len(self.files)))
+        if torch.utils.data.get_worker_info() is not None and _rg.getNumThreads() > 1:
+            # A worker process is one of several running samples in parallel: OpenCV's own threads
+            # would only oversubscribe the cores (the samples are the same on any thread count).
+            _rg.setNumThreads(1)
         mosaic, fmt = loadMosaic(self.files[index])
         if self.augment:
             result = self.transform(mosaic, fmt, index=index, epoch=self.epoch)

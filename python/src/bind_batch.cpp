@@ -108,10 +108,11 @@ void bindBatch(py::module_& m)
             withoutGil("colorJitterSeconds", [&] {
                 cv::Mat dst;
                 RawFormat dstFormat;
+                AugmentReport report;
                 for (int i = 0; i < repeats; ++i) {
-                    dst.release(); // a fresh output per call, as the Python call gets
+                    dst.release(); // a fresh output per call and a report, as the Python call gets
                     const auto start = std::chrono::steady_clock::now();
-                    colorJitter(in, format, model, jitter, noise, seed, dst, dstFormat);
+                    colorJitter(in, format, model, jitter, noise, seed, dst, dstFormat, &report);
                     seconds.push_back(
                         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
                 }

@@ -355,6 +355,12 @@ void bindCore(py::module_& m)
     m.def("setCpuPath", &setCpuPath, py::arg("path"), doc("setCpuPath"));
     m.def("activeCpuPath", &activeCpuPath, doc("activeCpuPath"));
     m.def("cpuPathName", &cpuPathName, py::arg("path"), doc("cpuPathName"));
+    // OpenCV's own thread count, which every parallel loop of the library uses: worker processes that
+    // already run in parallel (DataLoader workers, Dask workers) set it to 1 instead of oversubscribing.
+    m.def("setNumThreads", &cv::setNumThreads, py::arg("nthreads"),
+          "OpenCV's cv::setNumThreads: the threads of every parallel loop of the library in this process "
+          "(0 or 1: none; negative: OpenCV's default). Results do not depend on it.");
+    m.def("getNumThreads", &cv::getNumThreads, "OpenCV's cv::getNumThreads: the threads a parallel loop uses.");
 
     // ---- simulate ----------------------------------------------------------------------------------
     py::class_<SensorParams>(m, "SensorParams", doc("SensorParams"))
