@@ -151,3 +151,25 @@ def test_results_of_the_statistics(sensor):
     signal = rg.subtractBlackLevel(burst[0], sensor.rawFormat(1.0), normalize=True)
     back = rg.addBlackLevel(signal, sensor.rawFormat(1.0), rg.CV_16U, normalized=True)
     assert np.array_equal(back, burst[0])
+
+
+def test_fits_reports_and_tone_curves(sensor, capture, tmp_path):
+    chart, _ = chart_mean()
+    squares = rg.cfaAlignedSquares(chart.patches, 8)
+    fmt = sensor.rawFormat(2.0)
+    samples = rg.sampleSingleFramePatches(capture, fmt, squares, 2.0)
+    assert samples and all(s.gain == 2.0 for s in samples)
+    fit = rg.fitNoiseLine(samples, rg.LineFitParams(robust=False))
+    assert fit.samples == len(samples) and fit.line.a > 0
+    report = rg.CalibrationReport(model=rg.NoiseModel(0.3, 1, 1), separable=True, perGain=[fit], notes=["n"])
+    report.save(str(tmp_path / "r.yml"))
+    back = rg.CalibrationReport.load(str(tmp_path / "r.yml"))
+    assert back.model == report.model and back.notes == ["n"] and back.perGain[0].line.a == fit.line.a
+    with pytest.raises(rg.error, match="2 samples|fewer"):
+        rg.fitNoiseLine(samples[:1])
+    curve = rg.ToneCurve.srgb()
+    linear = np.linspace(0, 1, 12, dtype=np.float32).reshape(3, 4)
+    toned = rg.applyToneCurve(linear, curve)
+    assert toned.dtype == np.float32 and abs(float(toned[2, 3]) - 1.0) < 1e-6 and abs(curve(0.5) - 0.7353569) < 1e-6
+    rgb = rg.applyToneCurve(np.dstack([linear] * 3), curve, rg.CV_8U)
+    assert rgb.shape == (3, 4, 3) and rgb.dtype == np.uint8

@@ -236,18 +236,6 @@ CV_RAWGMENT_EXPORTS void applyScene(InputArray src, const RawFormat& format, con
                                     const Scene& scene, uint64 seed, OutputArray dst, RawFormat& dstFormat,
                                     AugmentReport* report = nullptr, std::vector<Rect>* boxes = nullptr);
 
-/** @brief Draws random scenes with the paper's training defaults; every range is settable and the
- * policy reads and writes YAML/JSON.
- *
- * Contrast p_c is drawn log-uniformly in [contrastMin, contrastMax] (0.01 to 1 spans two decades of
- * darkening, which a uniform draw would nearly never reach below 0.1); brightness p_b = u min(x) with u
- * uniform in [brightnessMin, brightnessMax]; with probability hueProbability each site's contrast is
- * multiplied by a factor uniform in [hueMin, hueMax]; the gain ratio is uniform in dB in
- * [gainDbMin, gainDbMax]; with probability blurProbability a linear motion of length uniform in
- * [0, blurLengthMax] and uniform angle; with probability geometryProbability a geometric change (the
- * paper's 0.8): a shift uniform in [-maxShift, maxShift] of each side and a scale uniform in
- * [1 - maxScale, 1 + maxScale].
- */
 /** @brief The seed of one augmented output: a function of (seed, input name, variant) only, so that
  * any order of inputs, any number of processes and the C++ and Python front ends give the same file.
  * The same seed draws the scene (RandomScenePolicy::draw()) and applies it (applyScene()): the two
@@ -261,7 +249,8 @@ CV_RAWGMENT_EXPORTS uint64 augmentedOutputSeed(uint64 seed, const String& inputN
 /** @brief Draws random scenes with the paper's augmentation ranges (its defaults)
  * @cite yoshimura2023rawgment.
  *
- * A scene's contrast is log-uniform in [contrastMin, contrastMax]; with probability hueProbability each
+ * A scene's contrast is log-uniform in [contrastMin, contrastMax] (0.01 to 1 spans two decades of
+ * darkening, which a uniform draw would nearly never reach below 0.1); with probability hueProbability each
  * CFA site's contrast is further scaled by a uniform factor in [hueMin, hueMax]; the brightness is a
  * uniform fraction in [brightnessMin, brightnessMax] of the input's minimum above black; the target gain
  * is uniform in dB; with probability blurProbability a linear motion kernel of uniform length in
