@@ -39,24 +39,16 @@ def sampleSeed(baseSeed, epoch, index):
     return _rg.deriveSeed(epochSeed, _rg.SEED_TRAINING_SAMPLE, int(index))
 
 
-def _asModel(model):
-    if isinstance(model, _rg.NoiseModel):
-        return model
-    if isinstance(model, (str, os.PathLike)):
-        return _rg.NoiseModel.load(os.fspath(model))
-    raise TypeError("model must be a rawgment.NoiseModel or the path of a saved model, not %s" %
-                    type(model).__name__)
-
-
-def _asPolicy(policy):
-    if policy is None:
-        return _rg.RandomScenePolicy()
-    if isinstance(policy, _rg.RandomScenePolicy):
-        return policy
-    if isinstance(policy, (str, os.PathLike)):
-        return _rg.RandomScenePolicy.load(os.fspath(policy))
-    raise TypeError("policy must be a rawgment.RandomScenePolicy, the path of a saved policy, or None, not %s" %
-                    type(policy).__name__)
+def _loaded(value, cls, what, default=None):
+    """`value` if it is a `cls`, else the `cls` saved at that path; None gives `default`."""
+    if value is None and default is not None:
+        return default
+    if isinstance(value, cls):
+        return value
+    if isinstance(value, (str, os.PathLike)):
+        return cls.load(os.fspath(value))
+    raise TypeError("%s must be a rawgment.%s or the path of a saved one%s, not %s" % (
+        what, cls.__name__, ", or None" if default is not None else "", type(value).__name__))
 
 
 def _toArray(raw):
@@ -85,8 +77,8 @@ class RandomNoiseScene:
     """
 
     def __init__(self, model, policy=None, baseSeed=0):
-        self.model = _asModel(model)
-        self.policy = _asPolicy(policy)
+        self.model = _loaded(model, _rg.NoiseModel, "model")
+        self.policy = _loaded(policy, _rg.RandomScenePolicy, "policy", _rg.RandomScenePolicy())
         self.policy.validate()
         self.baseSeed = int(baseSeed)
 

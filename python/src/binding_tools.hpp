@@ -12,7 +12,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <initializer_list>
+#include <array>
 #include <memory>
 #include <string>
 #include <utility>
@@ -178,79 +178,58 @@ template <> struct type_caster<cv::Matx33d>
     }
 };
 
-//! Integer tuples of OpenCV's small types: Point (x, y), Size (width, height), Rect (x, y, w, h).
-template <class T, int N> struct int_tuple_caster
+//! How OpenCV's small integer types read as tuples: Point (x, y), Size (width, height), Rect (x, y, w, h).
+template <class T> struct IntTuple
 {
-    static bool loadInts(handle src, int (&out)[N])
+    static constexpr int N = 0;
+};
+template <> struct IntTuple<cv::Point>
+{
+    static constexpr int N = 2;
+    static cv::Point make(const int* v) { return cv::Point(v[0], v[1]); }
+    static std::array<int, N> values(const cv::Point& p) { return {p.x, p.y}; }
+};
+template <> struct IntTuple<cv::Size>
+{
+    static constexpr int N = 2;
+    static cv::Size make(const int* v) { return cv::Size(v[0], v[1]); }
+    static std::array<int, N> values(const cv::Size& s) { return {s.width, s.height}; }
+};
+template <> struct IntTuple<cv::Rect>
+{
+    static constexpr int N = 4;
+    static cv::Rect make(const int* v) { return cv::Rect(v[0], v[1], v[2], v[3]); }
+    static std::array<int, N> values(const cv::Rect& r) { return {r.x, r.y, r.width, r.height}; }
+};
+
+template <class T> struct type_caster<T, enable_if_t<(IntTuple<T>::N > 0)>>
+{
+    static constexpr int N = IntTuple<T>::N;
+    PYBIND11_TYPE_CASTER(T, const_name<N == 2>("Tuple[int, int]", "Tuple[int, int, int, int]"));
+    bool load(handle src, bool)
     {
         if (!src || !PySequence_Check(src.ptr()) || PyUnicode_Check(src.ptr()))
             return false;
         const sequence seq = reinterpret_borrow<sequence>(src);
         if (seq.size() != N)
             return false;
+        int v[N];
         for (int i = 0; i < N; ++i) {
             const object item = seq[static_cast<size_t>(i)];
             if (!PyLong_Check(item.ptr()) && !PyIndex_Check(item.ptr()))
                 return false;
-            out[i] = item.cast<int>();
+            v[i] = item.cast<int>();
         }
+        value = IntTuple<T>::make(v);
         return true;
     }
-    static handle castInts(std::initializer_list<int> values)
+    static handle cast(const T& v, return_value_policy, handle)
     {
-        tuple t(values.size());
-        size_t i = 0;
-        for (int v : values)
-            t[i++] = int_(v);
+        tuple t(N);
+        const std::array<int, N> values = IntTuple<T>::values(v);
+        for (int i = 0; i < N; ++i)
+            t[static_cast<size_t>(i)] = int_(values[static_cast<size_t>(i)]);
         return t.release();
-    }
-};
-
-template <> struct type_caster<cv::Point> : int_tuple_caster<cv::Point, 2>
-{
-    PYBIND11_TYPE_CASTER(cv::Point, const_name("Tuple[int, int]"));
-    bool load(handle src, bool)
-    {
-        int v[2];
-        if (!loadInts(src, v))
-            return false;
-        value = cv::Point(v[0], v[1]);
-        return true;
-    }
-    static handle cast(const cv::Point& p, return_value_policy, handle) { return castInts({p.x, p.y}); }
-};
-
-template <> struct type_caster<cv::Size> : int_tuple_caster<cv::Size, 2>
-{
-    PYBIND11_TYPE_CASTER(cv::Size, const_name("Tuple[int, int]"));
-    bool load(handle src, bool)
-    {
-        int v[2];
-        if (!loadInts(src, v))
-            return false;
-        value = cv::Size(v[0], v[1]);
-        return true;
-    }
-    static handle cast(const cv::Size& s, return_value_policy, handle)
-    {
-        return castInts({s.width, s.height});
-    }
-};
-
-template <> struct type_caster<cv::Rect> : int_tuple_caster<cv::Rect, 4>
-{
-    PYBIND11_TYPE_CASTER(cv::Rect, const_name("Tuple[int, int, int, int]"));
-    bool load(handle src, bool)
-    {
-        int v[4];
-        if (!loadInts(src, v))
-            return false;
-        value = cv::Rect(v[0], v[1], v[2], v[3]);
-        return true;
-    }
-    static handle cast(const cv::Rect& r, return_value_policy, handle)
-    {
-        return castInts({r.x, r.y, r.width, r.height});
     }
 };
 
