@@ -115,3 +115,41 @@ def test_command_line(job, tmp_path):
     assert meta.hasScene and meta.source == job["inputs"][2] and mosaic.dtype == np.uint16
     help_text = subprocess.run(run + ["--help"], capture_output=True, text=True).stdout
     assert "--scheduler" in help_text and "--workers" in help_text
+
+
+def test_the_readme_commands_on_a_scheduler_and_workers(app_dir, job, tmp_path):
+    """dask-scheduler and two dask-worker processes (loopback standing in for machines), then
+    `python3 -m rawgment.batch --scheduler`: the app's bytes."""
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    address = "tcp://127.0.0.1:%d" % port
+    env = dict(os.environ)
+    logs = open(tmp_path / "dask.log", "w")
+    procs = [subprocess.Popen(["dask-scheduler", "--host", "127.0.0.1", "--port", str(port),
+                               "--dashboard-address", ":0"], stdout=logs, stderr=logs, env=env)]
+    try:
+        procs += [subprocess.Popen(["dask-worker", address, "--nthreads", "1", "--no-dashboard"], stdout=logs,
+                                   stderr=logs, env=env) for _ in range(2)]
+        from distributed import Client
+
+        with Client(address, timeout=60) as client:
+            client.wait_for_workers(2, timeout=60)
+        cmd = [sys.executable, "-m", "rawgment.batch", "--scheduler", address, "--model", job["model"], "--policy",
+               job["policy"], "--out", str(tmp_path / "cluster"), "--variants", "2", "--seed", "5", *job["inputs"]]
+        run = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+        assert run.returncode == 0, run.stderr
+        assert "wrote 6 outputs" in run.stdout
+    finally:
+        for p in procs[::-1]:
+            p.terminate()
+        for p in procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                p.kill()
+        logs.close()
+    app_run(app_dir, job, tmp_path / "app")
+    assert_same_files(tmp_path / "app", tmp_path / "cluster")
