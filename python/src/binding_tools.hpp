@@ -105,7 +105,8 @@ void defMatProperty(py::class_<T>& cls, const char* name, cv::Mat T::*field, con
     cls.def_property(
         name, [field](const T& self) { return arrayFromMat(self.*field); },
         [field, name, depths](T& self, const py::object& value) {
-            if (value.is_none())
+            // None or an empty array (what the getter gives for an empty Mat) empties the field.
+            if (value.is_none() || (py::isinstance<py::array>(value) && py::array(value).size() == 0))
                 (self.*field).release();
             else
                 self.*field = matFromArray(value, name, depths).clone();

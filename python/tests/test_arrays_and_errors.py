@@ -110,7 +110,8 @@ def test_option_structs_take_keywords_and_refuse_unknown_ones():
 def test_values_print_compare_and_pickle(tmp_path):
     for value in (rg.RawFormat(pattern=rg.CFA_GBRG, blackLevel=(1, 2, 3, 4)), rg.NoiseModel(0.5, 2, 1),
                   rg.RandomScenePolicy(hueMin=0.7), rg.Scene(scale=1.02, motionKernel=rg.linearMotionKernel(5, 45)),
-                  rg.IspParams(colorMatrix=np.eye(3) * 2)):
+                  rg.IspParams(colorMatrix=np.eye(3) * 2), rg.Scene(), rg.RawImage(), rg.MosaicMetadata(),
+                  rg.CalibrationReport(perGain=[rg.NoiseLineFit(gain=2)])):
         assert pickle.loads(pickle.dumps(value)) == value
         assert type(value).__name__ + "(" in repr(value)
     model = rg.NoiseModel(0.5, 2, 1)
