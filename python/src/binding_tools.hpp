@@ -124,6 +124,15 @@ void bindBatch(py::module_& m);       // the apps' batch jobs and the benchmark 
 namespace pybind11 {
 namespace detail {
 
+//! Whether `src` is a sequence (not a string) of `n` items; `seq` is it then.
+inline bool sequenceOfLength(handle src, size_t n, sequence& seq)
+{
+    if (!src || !PySequence_Check(src.ptr()) || PyUnicode_Check(src.ptr()))
+        return false;
+    seq = reinterpret_borrow<sequence>(src);
+    return seq.size() == n;
+}
+
 //! cv::Vec<double, N> <-> a tuple of N floats (any sequence of N numbers is accepted).
 template <int N> struct type_caster<cv::Vec<double, N>>
 {
@@ -131,10 +140,8 @@ template <int N> struct type_caster<cv::Vec<double, N>>
     PYBIND11_TYPE_CASTER(Vector, const_name("Tuple[float, ...]"));
     bool load(handle src, bool)
     {
-        if (!src || !PySequence_Check(src.ptr()) || PyUnicode_Check(src.ptr()))
-            return false;
-        const sequence seq = reinterpret_borrow<sequence>(src);
-        if (seq.size() != N)
+        sequence seq;
+        if (!sequenceOfLength(src, N, seq))
             return false;
         for (int i = 0; i < N; ++i) {
             const object item = seq[static_cast<size_t>(i)];
@@ -209,10 +216,8 @@ template <class T> struct type_caster<T, enable_if_t<(IntTuple<T>::N > 0)>>
     PYBIND11_TYPE_CASTER(T, const_name<N == 2>("Tuple[int, int]", "Tuple[int, int, int, int]"));
     bool load(handle src, bool)
     {
-        if (!src || !PySequence_Check(src.ptr()) || PyUnicode_Check(src.ptr()))
-            return false;
-        const sequence seq = reinterpret_borrow<sequence>(src);
-        if (seq.size() != N)
+        sequence seq;
+        if (!sequenceOfLength(src, N, seq))
             return false;
         int v[N];
         for (int i = 0; i < N; ++i) {
