@@ -95,8 +95,6 @@ AugmentPlan planAugmentJobs(const AugmentOptions& o)
 {
     if (o.inputs.empty())
         throw std::runtime_error("no input files");
-    if (o.scene.empty() == o.policy.empty())
-        throw std::runtime_error("give exactly one of a scene file and a policy file");
     if (o.variants < 1)
         throw std::runtime_error("variants must be >= 1");
     for (const std::string& in : o.inputs) {

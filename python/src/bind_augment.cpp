@@ -18,9 +18,13 @@ std::vector<cv::Rect> boxesFrom(const py::object& boxes)
         return out;
     if (py::isinstance<py::array>(boxes)) {
         const auto a = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(boxes);
-        if (!a || (a.size() > 0 && (a.ndim() != 2 || a.shape(1) != 4)))
+        if (!a)
             throw py::value_error("argument 'boxes' must be an N x 4 array of (x, y, w, h)");
-        for (py::ssize_t i = 0; a.size() > 0 && i < a.shape(0); ++i)
+        if (a.size() == 0)
+            return out;
+        if (a.ndim() != 2 || a.shape(1) != 4)
+            throw py::value_error("argument 'boxes' must be an N x 4 array of (x, y, w, h)");
+        for (py::ssize_t i = 0; i < a.shape(0); ++i)
             out.emplace_back(int(a.at(i, 0)), int(a.at(i, 1)), int(a.at(i, 2)), int(a.at(i, 3)));
         return out;
     }
@@ -282,9 +286,8 @@ void bindAugment(py::module_& m)
         "applyToneCurve",
         [](const py::object& linear, const ToneCurve& curve, int ddepth) {
             const cv::Mat in = matFromArray(linear, "linear", {CV_32F, CV_64F}, true);
-            cv::Mat dst;
-            withoutGil("applyToneCurve", [&] { applyToneCurve(in, dst, curve, ddepth); });
-            return arrayFromMat(dst);
+            return arrayFromCall("applyToneCurve",
+                                 [&](cv::Mat& dst) { applyToneCurve(in, dst, curve, ddepth); });
         },
         py::arg("linear"), py::arg("curve"), py::arg("ddepth") = -1,
         doc("applyToneCurve", "Python: applyToneCurve(linear, curve, ddepth=-1) returns dst."));
@@ -306,9 +309,8 @@ void bindAugment(py::module_& m)
         "renderSimpleIsp",
         [](const py::object& mosaic, const RawFormat& format, const IspParams& params) {
             const cv::Mat in = matFromArray(mosaic, "mosaic", kMosaicDepths);
-            cv::Mat bgr;
-            withoutGil("renderSimpleIsp", [&] { renderSimpleIsp(in, format, bgr, params); });
-            return arrayFromMat(bgr);
+            return arrayFromCall("renderSimpleIsp",
+                                 [&](cv::Mat& bgr) { renderSimpleIsp(in, format, bgr, params); });
         },
         py::arg("mosaic"), py::arg("format"), py::arg("params") = IspParams(),
         doc("renderSimpleIsp", "Python: returns the HxWx3 BGR array (as cv2 images are)."));

@@ -31,17 +31,13 @@ void bindCalibration(py::module_& m)
         .def(
             "mean",
             [](const BurstStatistics& self) {
-                cv::Mat dst;
-                withoutGil("BurstStatistics.mean", [&] { self.mean(dst); });
-                return arrayFromMat(dst);
+                return arrayFromCall("BurstStatistics.mean", [&](cv::Mat& dst) { self.mean(dst); });
             },
             doc("BurstStatistics::mean", "Python: returns the float64 array."))
         .def(
             "variance",
             [](const BurstStatistics& self) {
-                cv::Mat dst;
-                withoutGil("BurstStatistics.variance", [&] { self.variance(dst); });
-                return arrayFromMat(dst);
+                return arrayFromCall("BurstStatistics.variance", [&](cv::Mat& dst) { self.variance(dst); });
             },
             doc("BurstStatistics::variance", "Python: returns the float64 array."))
         .def(

@@ -61,6 +61,14 @@ template <class F> auto withoutGil(const char* name, F&& f) -> decltype(f())
     return f();
 }
 
+//! The numpy result of a call that fills one Mat, run without the GIL (withoutGil()).
+template <class F> py::array arrayFromCall(const char* name, F&& fill)
+{
+    cv::Mat dst;
+    withoutGil(name, [&] { fill(dst); });
+    return arrayFromMat(dst);
+}
+
 //! True for the names a keyword constructor accepts: the class's data properties.
 bool isDataProperty(const py::handle& type, const std::string& name);
 

@@ -5,6 +5,8 @@
 
 #include "rawgment_docstrings.hpp"
 
+#include <algorithm>
+#include <climits>
 #include <cstring>
 #include <deque>
 #include <mutex>
@@ -24,24 +26,24 @@ std::set<std::string>& callsWithoutGil()
     return calls;
 }
 
+//! The numpy dtypes of OpenCV's single-channel depths: one table for both directions.
+struct DtypeOfDepth
+{
+    int depth;
+    char kind; // numpy's dtype.kind
+    py::ssize_t itemsize;
+    const char* name;
+};
+constexpr DtypeOfDepth kDtypes[] = {{CV_8U, 'u', 1, "uint8"},   {CV_8S, 'i', 1, "int8"},
+                                    {CV_16U, 'u', 2, "uint16"}, {CV_16S, 'i', 2, "int16"},
+                                    {CV_32S, 'i', 4, "int32"},  {CV_32F, 'f', 4, "float32"},
+                                    {CV_64F, 'f', 8, "float64"}};
+
 int depthOfDtype(const py::dtype& dtype)
 {
-    const char kind = dtype.kind();
-    const auto size = dtype.itemsize();
-    if (kind == 'u' && size == 1)
-        return CV_8U;
-    if (kind == 'i' && size == 1)
-        return CV_8S;
-    if (kind == 'u' && size == 2)
-        return CV_16U;
-    if (kind == 'i' && size == 2)
-        return CV_16S;
-    if (kind == 'i' && size == 4)
-        return CV_32S;
-    if (kind == 'f' && size == 4)
-        return CV_32F;
-    if (kind == 'f' && size == 8)
-        return CV_64F;
+    for (const DtypeOfDepth& d : kDtypes)
+        if (d.kind == dtype.kind() && d.itemsize == dtype.itemsize())
+            return d.depth;
     return -1;
 }
 
@@ -90,24 +92,10 @@ const char* doc(const std::string& cxxName, const std::string& pythonNote)
 
 const char* dtypeName(int depth)
 {
-    switch (depth) {
-    case CV_8U:
-        return "uint8";
-    case CV_8S:
-        return "int8";
-    case CV_16U:
-        return "uint16";
-    case CV_16S:
-        return "int16";
-    case CV_32S:
-        return "int32";
-    case CV_32F:
-        return "float32";
-    case CV_64F:
-        return "float64";
-    default:
-        return "unsupported";
-    }
+    for (const DtypeOfDepth& d : kDtypes)
+        if (d.depth == depth)
+            return d.name;
+    return "unsupported";
 }
 
 cv::Mat matFromArray(const py::handle& obj, const char* argument, const std::vector<int>& depths,
@@ -282,18 +270,15 @@ void bindCore(py::module_& m)
         [](const py::object& planes) {
             const std::vector<cv::Mat> in =
                 matsFromList(planes, "planes", {CV_8U, CV_16U, CV_16S, CV_32S, CV_32F, CV_64F});
-            cv::Mat mosaic;
-            withoutGil("mergeCfaPlanes", [&] { mergeCfaPlanes(in, mosaic); });
-            return arrayFromMat(mosaic);
+            return arrayFromCall("mergeCfaPlanes", [&](cv::Mat& mosaic) { mergeCfaPlanes(in, mosaic); });
         },
         py::arg("planes"), doc("mergeCfaPlanes", "Python: returns the mosaic."));
     m.def(
         "subtractBlackLevel",
         [](const py::object& src, const RawFormat& format, bool normalize) {
             const cv::Mat in = matFromArray(src, "src", {CV_16U, CV_32F});
-            cv::Mat dst;
-            withoutGil("subtractBlackLevel", [&] { subtractBlackLevel(in, format, dst, normalize); });
-            return arrayFromMat(dst);
+            return arrayFromCall("subtractBlackLevel",
+                                 [&](cv::Mat& dst) { subtractBlackLevel(in, format, dst, normalize); });
         },
         py::arg("src"), py::arg("format"), py::arg("normalize") = false,
         doc("subtractBlackLevel", "Python: returns dst (float32)."));
@@ -301,9 +286,8 @@ void bindCore(py::module_& m)
         "addBlackLevel",
         [](const py::object& src, const RawFormat& format, int ddepth, bool normalized) {
             const cv::Mat in = matFromArray(src, "src", {CV_32F});
-            cv::Mat dst;
-            withoutGil("addBlackLevel", [&] { addBlackLevel(in, format, dst, ddepth, normalized); });
-            return arrayFromMat(dst);
+            return arrayFromCall("addBlackLevel",
+                                 [&](cv::Mat& dst) { addBlackLevel(in, format, dst, ddepth, normalized); });
         },
         py::arg("src"), py::arg("format"), py::arg("ddepth") = int(CV_16U), py::arg("normalized") = false,
         doc("addBlackLevel", "Python: returns dst; ddepth is rawgment.CV_16U or rawgment.CV_32F."));
@@ -333,9 +317,8 @@ void bindCore(py::module_& m)
                 if (!py::isinstance<py::array>(mean))
                     return py::float_(self.variance(mean.cast<double>(), gain));
                 const cv::Mat in = matFromArray(mean, "mean", {CV_32F, CV_64F});
-                cv::Mat dst;
-                withoutGil("NoiseModel.variance", [&] { self.variance(in, gain, dst); });
-                return arrayFromMat(dst);
+                return arrayFromCall("NoiseModel.variance",
+                                     [&](cv::Mat& dst) { self.variance(in, gain, dst); });
             },
             py::arg("mean"), py::arg("gain"),
             doc("NoiseModel::variance", "Python: `mean` is a number (returns a float) or a float32/float64 "
@@ -360,7 +343,8 @@ void bindCore(py::module_& m)
     m.def("setNumThreads", &cv::setNumThreads, py::arg("nthreads"),
           "OpenCV's cv::setNumThreads: the threads of every parallel loop of the library in this process "
           "(0 or 1: none; negative: OpenCV's default). Results do not depend on it.");
-    m.def("getNumThreads", &cv::getNumThreads, "OpenCV's cv::getNumThreads: the threads a parallel loop uses.");
+    m.def("getNumThreads", &cv::getNumThreads,
+          "OpenCV's cv::getNumThreads: the threads a parallel loop uses.");
 
     // ---- simulate ----------------------------------------------------------------------------------
     py::class_<SensorParams>(m, "SensorParams", doc("SensorParams"))
@@ -394,10 +378,9 @@ void bindCore(py::module_& m)
             [](const SensorSimulator& self, const py::object& meanAtUnitGain, double gain, double exposure,
                uint64 seed, int frameIndex) {
                 const cv::Mat mean = matFromArray(meanAtUnitGain, "meanAtUnitGain", {CV_32F});
-                cv::Mat raw;
-                withoutGil("SensorSimulator.capture",
-                           [&] { self.capture(mean, gain, exposure, seed, frameIndex, raw); });
-                return arrayFromMat(raw);
+                return arrayFromCall("SensorSimulator.capture", [&](cv::Mat& raw) {
+                    self.capture(mean, gain, exposure, seed, frameIndex, raw);
+                });
             },
             py::arg("meanAtUnitGain"), py::arg("gain"), py::arg("exposure"), py::arg("seed"),
             py::arg("frameIndex") = 0, doc("SensorSimulator::capture", "Python: returns raw (uint16)."))
@@ -422,10 +405,9 @@ void bindCore(py::module_& m)
                double gain, double exposure, uint64 seed, int frameIndex) {
                 const cv::Mat mean = matFromArray(meanAtUnitGain, "meanAtUnitGain", {CV_32F});
                 const cv::Mat k = matFromArray(kernel, "kernel", {CV_32F, CV_64F});
-                cv::Mat raw;
-                withoutGil("SensorSimulator.captureBlurred",
-                           [&] { self.captureBlurred(mean, k, gain, exposure, seed, frameIndex, raw); });
-                return arrayFromMat(raw);
+                return arrayFromCall("SensorSimulator.captureBlurred", [&](cv::Mat& raw) {
+                    self.captureBlurred(mean, k, gain, exposure, seed, frameIndex, raw);
+                });
             },
             py::arg("meanAtUnitGain"), py::arg("kernel"), py::arg("gain"), py::arg("exposure"),
             py::arg("seed"), py::arg("frameIndex") = 0,
@@ -476,9 +458,8 @@ void bindCore(py::module_& m)
     m.def(
         "fillStandardNormal",
         [](cv::Size size, uint64 seed) {
-            cv::Mat dst;
-            withoutGil("fillStandardNormal", [&] { fillStandardNormal(dst, size, seed); });
-            return arrayFromMat(dst);
+            return arrayFromCall("fillStandardNormal",
+                                 [&](cv::Mat& dst) { fillStandardNormal(dst, size, seed); });
         },
         py::arg("size"), py::arg("seed"),
         doc("fillStandardNormal",

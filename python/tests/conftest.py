@@ -1,6 +1,5 @@
 """Shared fixtures of the Python tests: the build's apps and reference program, small simulated mosaics."""
 import os
-import shutil
 import subprocess
 
 import numpy as np
@@ -54,8 +53,3 @@ def capture(sensor):
     _, mean = chart_mean()
     return sensor.capture(mean, 2.0, 1.0, seed=11, frameIndex=3)
 
-
-@pytest.fixture
-def scratch(tmp_path):
-    yield tmp_path
-    shutil.rmtree(tmp_path, ignore_errors=True)

@@ -37,4 +37,5 @@ def test_augment_folder(source_dir, tmp_path, sensor, capture):
 def test_torch_training_loop(source_dir):
     out = run_sample(source_dir, "torch_training_loop.py", "--steps", "12", "--workers", "2")
     first, last = [float(v.rstrip(",")) for v in out.splitlines()[-1].split()[2:5:2]]
-    assert "step  12" in out and first > 0 and last > 0
+    # The sample's promise: the loss falls (158 to 134 dB^2 in 12 steps with these seeds on this host).
+    assert "step  12" in out and 0 < last < first

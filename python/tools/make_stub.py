@@ -79,7 +79,7 @@ def docstring(text, indent):
     return pad + 'r"""\n' + body + "\n" + pad + '"""\n'
 
 
-def emit_function(name, func, indent, method=False, static=False):
+def emit_function(name, func, indent, static=False):
     sigs, rest = signatures(name, func)
     if not sigs:
         sigs = [name + "(*args, **kwargs) -> object"]
