@@ -232,7 +232,7 @@ void fillStandardNormal(InputOutputArray _dst, Size size, uint64 seed)
 
 uint64 deriveSeed(uint64 seed, SeedPurpose purpose, uint64 index)
 {
-    if (purpose < SEED_SIMULATED_BURST || purpose > SEED_TRAINING_SAMPLE)
+    if (purpose < SEED_SIMULATED_BURST || purpose > SEED_ABLATION)
         CV_Error(Error::StsBadArg, format("deriveSeed: unknown purpose %d", static_cast<int>(purpose)));
     return detail::stepKey(detail::stepKey(seed, static_cast<uint64_t>(purpose)), index);
 }

@@ -151,7 +151,8 @@ enum SeedPurpose : int
     SEED_DEMO = 20,                       //!< the demo's own captures and gallery; index: what it draws
     SEED_STUDY = 21,                      //!< accuracy studies (rawgment_tradeoffs); index: the measurement
     SEED_TRAINING_EPOCH = 22,             //!< a training epoch (Python's rawgment.torch); index: the epoch
-    SEED_TRAINING_SAMPLE = 23             //!< a sample of an epoch's seed; index: the sample's index
+    SEED_TRAINING_SAMPLE = 23,            //!< a sample of an epoch's seed; index: the sample's index
+    SEED_ABLATION = 24 //!< the ablation study (rawgment.ablation); index: a role, then an item
 };
 
 /** @brief A seed for one use of a user's seed: a well-mixed (SplitMix64) function of (seed, purpose,

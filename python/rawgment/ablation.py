@@ -1,0 +1,750 @@
+"""The ablation study of the paper's claim, on your sensor: a small RAW denoiser trained on darkened
+captures made with each noise alignment, tested on captures simulated directly in the dark.
+
+Run it as ``python3 -m rawgment.ablation [--model camera.yml] [--quick] [--out DIR]``; ``--help`` lists
+every option and docs/ablation.md explains the design and how to read the report.
+
+Arms (each trains the same network with the same budget, seed and data order; only the training
+inputs differ):
+
+* ``NONE``, ``IGNORE_PRIOR``, ``ACCOUNT_PRIOR``: a bright capture of the training scene (its own
+  noise), darkened by the library (motionBlur for the blur condition, then colorJitter) with that
+  NoiseAlignment;
+* ``ORACLE``: a capture simulated directly at the target exposure and gain (the upper bound);
+* ``NOISY``: no network, the test input itself (the lower bound).
+
+Test inputs are always captures simulated at the target (exact Poisson), never the augmentation.
+Every random number derives from ``--seed`` through deriveSeed(deriveSeed(seed, SEED_ABLATION, role),
+SEED_ABLATION, item), so the same seeds give the same numbers.
+"""
+import argparse
+import dataclasses
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+
+import rawgment as _rg
+from rawgment.torch import packCfaPlanes
+
+__all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "defaultConditions", "quickConditions",
+           "renderScene", "mosaicOfScene", "Denoiser", "psnr", "ssim", "runAblation", "summarize",
+           "writeOutputs", "main"]
+
+ARMS = ("NONE", "IGNORE_PRIOR", "ACCOUNT_PRIOR", "ORACLE", "NOISY")
+TRAINED_ARMS = ARMS[:4]
+ALIGNMENTS = {"NONE": _rg.NoiseAlignment.NONE, "IGNORE_PRIOR": _rg.NoiseAlignment.IGNORE_PRIOR,
+              "ACCOUNT_PRIOR": _rg.NoiseAlignment.ACCOUNT_PRIOR}
+
+# Roles of the derived seeds (the high 32 bits of deriveSeed's index under SEED_ABLATION).
+_ROLE_TRAIN_SCENES, _ROLE_TEST_SCENES, _ROLE_TEST_CAPTURE, _ROLE_BATCH, _ROLE_SAMPLE, _ROLE_NETWORK = range(6)
+
+# Relative illumination of the R, G, B sites: a daylight-like white balance, so the red and blue planes
+# are darker (and noisier) than green, as on real sensors.
+_ILLUMINANT = (0.55, 1.0, 0.75)
+# The brightest expected signal of a bright training capture, as a fraction of white - black: headroom
+# so that the bright captures (and the test's clean references) are not clipped.
+_FILL = 0.8
+# The reflectance at which the report states each condition's prior share (mid-grey).
+_MID_GREY = 0.18
+
+
+def _seed(base, role, item):
+    """The seed of one item of a role: deriveSeed(deriveSeed(base, SEED_ABLATION, role), SEED_ABLATION, item)."""
+    return _rg.deriveSeed(_rg.deriveSeed(int(base), _rg.SEED_ABLATION, int(role)), _rg.SEED_ABLATION, int(item))
+
+
+@dataclasses.dataclass(frozen=True)
+class Condition:
+    """One test condition: the photon ratio of the target to the bright capture, its gain ratio, and
+    an optional linear motion blur (length in CFA-plane pixels, angle in degrees; 0 = no blur)."""
+    name: str
+    photonRatio: float
+    gainRatio: float = 1.0
+    blurLength: float = 0.0
+    blurAngle: float = 0.0
+
+
+def defaultConditions():
+    """Photon ratios 0.5, 0.2, 0.05, 0.01 at the bright gain and with the gain raised to keep the
+    brightness (by 1/ratio, at most 4x = +12 dB), and a motion blur of 9 plane pixels at 30 degrees at
+    ratio 0.2."""
+    conditions = []
+    for ratio in (0.5, 0.2, 0.05, 0.01):
+        conditions.append(Condition("x%g" % ratio, ratio))
+        conditions.append(Condition("x%g +%gdB" % (ratio, round(_rg.linearGainToDb(min(4.0, 1.0 / ratio)))),
+                                    ratio, min(4.0, 1.0 / ratio)))
+    conditions.append(Condition("x0.2 blur9", 0.2, 1.0, 9.0, 30.0))
+    return conditions
+
+
+def quickConditions():
+    """The --quick run's two conditions: a moderate darkening and a very dark one with a gain change."""
+    return [Condition("x0.2", 0.2), Condition("x0.01 +12dB", 0.01, 4.0)]
+
+
+@dataclasses.dataclass
+class AblationConfig:
+    """Everything that sets the numbers of a run (all of it is written to results.json)."""
+    model: object = None            # rawgment.NoiseModel of the sensor (effective: quantisation included)
+    bitDepth: int = 12
+    blackLevel: float = 256.0
+    # Linear gain of the bright captures: +12 dB. At unit gain the default sensor's bright captures are
+    # so clean that the mildest darkening still leaves a 46 dB input, where no arm differs; at +12 dB the
+    # bright captures' own noise is a visible share of the target's, which is what the arms disagree on.
+    baseGain: float = 10.0 ** (12.0 / 20.0)
+    conditions: list = dataclasses.field(default_factory=defaultConditions)
+    arms: tuple = ARMS
+    seeds: int = 3                  # training replicates (network initialisation and data order)
+    seed: int = 0                   # the base seed of everything
+    iterations: int = 800
+    batch: int = 16
+    patch: int = 64                 # training crop, mosaic pixels (even)
+    trainScenes: int = 24
+    trainSceneSize: int = 192
+    testScenes: int = 8
+    testSceneSize: int = 256
+    width: int = 16                 # channels of the network's first level
+    learningRate: float = 2e-3
+    threads: int = 0                # torch threads (0: all cores)
+
+    def sensorParams(self):
+        """The simulator's parameters: the model without the rounding's 1/12 DN^2, which the simulator
+        adds back by quantising (so effectiveModel() is the model given)."""
+        model = self.model if self.model is not None else _rg.SensorParams().noise
+        if self.model is None:
+            noise = model
+        else:
+            noise = _rg.NoiseModel(alpha=model.alpha, sigmaD2=model.sigmaD2,
+                                   sigmaR2=max(model.sigmaR2 - 1.0 / 12.0, 0.0))
+        return _rg.SensorParams(noise=noise, bitDepth=int(self.bitDepth),
+                                blackLevel=(float(self.blackLevel),) * 4, quantize=True)
+
+    def validate(self):
+        if not self.conditions:
+            raise ValueError("no condition to run")
+        for c in self.conditions:
+            if not (0.0 < c.photonRatio <= 1.0) or not (c.gainRatio >= 1.0) or c.blurLength < 0:
+                raise ValueError("condition %r: photonRatio must be in (0, 1], gainRatio >= 1, blurLength >= 0"
+                                 % (c,))
+        unknown = [a for a in self.arms if a not in ARMS]
+        if unknown or not self.arms:
+            raise ValueError("unknown arm(s) %s; the arms are %s" % (", ".join(unknown), ", ".join(ARMS)))
+        for name in ("seeds", "iterations", "batch", "trainScenes", "testScenes", "width"):
+            if int(getattr(self, name)) < 1:
+                raise ValueError("%s must be >= 1, got %r" % (name, getattr(self, name)))
+        for name in ("patch", "trainSceneSize", "testSceneSize"):
+            value = int(getattr(self, name))
+            # Even for the CFA, and a multiple of 4 so the network's half-resolution level fits.
+            if value < 16 or value % 4:
+                raise ValueError("%s must be a multiple of 4 and >= 16, got %r" % (name, value))
+        if self.patch > self.trainSceneSize:
+            raise ValueError("patch (%d) is larger than trainSceneSize (%d)" % (self.patch, self.trainSceneSize))
+        if self.baseGain <= 0 or not (self.learningRate > 0):
+            raise ValueError("baseGain and learningRate must be > 0")
+        self.sensorParams().validate()
+
+
+def _randomColour(rng):
+    """Linear RGB reflectance: a log-uniform lightness from 3% to 90% with a random tint."""
+    lightness = math.exp(rng.uniform(math.log(0.03), math.log(0.9)))
+    return np.clip(lightness * rng.uniform(0.5, 1.5, 3), 0.02, 0.95).astype(np.float32)
+
+
+def renderScene(rng, height, width):
+    """A synthetic scene (H x W x 3 linear reflectance in [0.02, 0.95]): a gradient background with
+    flat rectangles and discs (sharp edges), gratings of random frequency and orientation, and smooth
+    random textures, drawn from the numpy Generator `rng`."""
+    y, x = np.mgrid[0:height, 0:width].astype(np.float32)
+    angle = rng.uniform(0.0, 2.0 * math.pi)
+    t = math.cos(angle) * x + math.sin(angle) * y
+    t = (t - t.min()) / max(float(t.max() - t.min()), 1.0)
+    image = _randomColour(rng) * (1.0 - t)[..., None] + _randomColour(rng) * t[..., None]
+    for _ in range(int(rng.integers(8, 16))):
+        kind = int(rng.integers(0, 4))
+        colour = _randomColour(rng)
+        cx, cy = rng.uniform(0, width), rng.uniform(0, height)
+        size = rng.uniform(0.08, 0.4) * min(width, height)
+        if kind == 0:
+            mask = (np.abs(x - cx) < size / 2) & (np.abs(y - cy) < rng.uniform(0.3, 1.0) * size / 2)
+            image[mask] = colour
+        elif kind == 1:
+            mask = (x - cx) ** 2 + (y - cy) ** 2 < (size / 2) ** 2
+            image[mask] = colour
+        elif kind == 2:
+            period = rng.uniform(3.0, 24.0)  # mosaic pixels: from near the planes' Nyquist to coarse
+            theta = rng.uniform(0.0, math.pi)
+            phase = 2.0 * math.pi * (math.cos(theta) * x + math.sin(theta) * y) / period
+            wave = 0.5 + 0.5 * np.sin(phase)
+            mask = (np.abs(x - cx) < size / 2) & (np.abs(y - cy) < size / 2)
+            other = _randomColour(rng)
+            image[mask] = (colour * wave[..., None] + other * (1.0 - wave[..., None]))[mask]
+        else:
+            cells = int(rng.integers(3, 9))
+            coarse = rng.uniform(0.0, 1.0, (cells + 1, cells + 1)).astype(np.float32)
+            gy = np.clip((y - (cy - size / 2)) / size * cells, 0, cells - 1e-3)
+            gx = np.clip((x - (cx - size / 2)) / size * cells, 0, cells - 1e-3)
+            iy, ix = gy.astype(int), gx.astype(int)
+            fy, fx = gy - iy, gx - ix
+            fy, fx = fy * fy * (3 - 2 * fy), fx * fx * (3 - 2 * fx)  # smoothstep: no creases at cells
+            value = (coarse[iy, ix] * (1 - fx) * (1 - fy) + coarse[iy, ix + 1] * fx * (1 - fy) +
+                     coarse[iy + 1, ix] * (1 - fx) * fy + coarse[iy + 1, ix + 1] * fx * fy)
+            mask = (np.abs(x - cx) < size / 2) & (np.abs(y - cy) < size / 2)
+            other = _randomColour(rng)
+            image[mask] = (colour * value[..., None] + other * (1.0 - value[..., None]))[mask]
+    return np.clip(image, 0.02, 0.95).astype(np.float32)
+
+
+def mosaicOfScene(rgb, pattern, level):
+    """The expected signal at gain 1 (DN above black, float32 H x W) of a reflectance scene under the
+    study's illuminant: each CFA site sees its channel, `level` DN for reflectance 1 at white."""
+    h, w, _ = rgb.shape
+    mosaic = np.empty((h, w), np.float32)
+    for row in (0, 1):
+        for col in (0, 1):
+            channel = _rg.cfaChannelAt(pattern, row, col)
+            rgbIndex = {_rg.CFA_R: 0, _rg.CFA_G1: 1, _rg.CFA_G2: 1, _rg.CFA_B: 2}[channel]
+            mosaic[row::2, col::2] = rgb[row::2, col::2, rgbIndex] * (_ILLUMINANT[rgbIndex] * level)
+    return mosaic
+
+
+class Denoiser(torch.nn.Module):
+    """A compact two-level U-Net on the packed R, G1, G2, B planes and their noise-level map that
+    predicts the residual in units of the noise: input 8 x H x W (the planes, then each plane's noise
+    standard deviation; H, W even), output the 4 denoised planes."""
+
+    def __init__(self, width=16):
+        super().__init__()
+        conv = torch.nn.Conv2d
+        self.encode = torch.nn.Sequential(conv(8, width, 3, padding=1), torch.nn.ReLU(),
+                                          conv(width, width, 3, padding=1), torch.nn.ReLU())
+        self.down = torch.nn.Sequential(conv(width, 2 * width, 3, stride=2, padding=1), torch.nn.ReLU(),
+                                        conv(2 * width, 2 * width, 3, padding=1), torch.nn.ReLU(),
+                                        conv(2 * width, 2 * width, 3, padding=1), torch.nn.ReLU())
+        self.up = torch.nn.ConvTranspose2d(2 * width, width, 2, stride=2)
+        self.decode = torch.nn.Sequential(conv(2 * width, width, 3, padding=1), torch.nn.ReLU(),
+                                          conv(width, 4, 3, padding=1))
+        # The residual starts at zero, so an untrained network passes its input through instead of
+        # adding noise of its own; training then departs from the noisy input, the study's floor.
+        torch.nn.init.zeros_(self.decode[-1].weight)
+        torch.nn.init.zeros_(self.decode[-1].bias)
+
+    def forward(self, x):
+        skip = self.encode(x)
+        # The correction is predicted in units of the noise standard deviation: the same network then
+        # serves a 40 dB and an 18 dB input equally well, which a plain residual does not learn in a
+        # short budget (its corrections for the darkest inputs spoil the brightest).
+        return x[:, :4] + x[:, 4:] * self.decode(torch.cat([skip, self.up(self.down(skip))], dim=1))
+
+
+def psnr(output, clean):
+    """PSNR in dB of images in [0, 1] (peak 1): 10 log10(1 / MSE); inf for identical images."""
+    mse = float(torch.mean((output.double() - clean.double()) ** 2))
+    return math.inf if mse == 0 else 10.0 * math.log10(1.0 / mse)
+
+
+def ssim(output, clean):
+    """Mean SSIM of C x H x W images in [0, 1] (data range 1), per channel with the usual 11-tap
+    Gaussian window of sigma 1.5 and constants (0.01)^2, (0.03)^2, over the valid region."""
+    c = output.shape[0]
+    taps = torch.arange(11, dtype=torch.float64) - 5
+    g = torch.exp(-taps ** 2 / (2 * 1.5 ** 2))
+    g = g / g.sum()
+    window = (g[:, None] * g[None, :]).expand(c, 1, 11, 11).contiguous()
+    x, y = output.double()[None], clean.double()[None]
+
+    def blur(v):
+        return F.conv2d(v, window, groups=c)
+
+    mx, my = blur(x), blur(y)
+    vx, vy, cxy = blur(x * x) - mx * mx, blur(y * y) - my * my, blur(x * y) - mx * my
+    c1, c2 = 0.01 ** 2, 0.03 ** 2
+    value = ((2 * mx * my + c1) * (2 * cxy + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2))
+    return float(value.mean())
+
+
+class _Study:
+    """The sensor, the scenes and the test set of one run (shared by every arm and replicate)."""
+
+    def __init__(self, config):
+        self.config = config
+        self.params = config.sensorParams()
+        probe = _rg.SensorSimulator(self.params, (16, 16))
+        self.model = probe.effectiveModel()
+        self.format = probe.rawFormat(config.baseGain)
+        self.range = self.format.whiteLevel - self.format.blackLevel[0]
+        # DN at gain 1 for reflectance 1 under the brightest channel: the bright captures fill _FILL of
+        # the range at the base gain.
+        self.level = _FILL * self.range / config.baseGain
+        self.simulators = {}
+        self.kernels = {}
+
+    def simulator(self, size):
+        if size not in self.simulators:
+            self.simulators[size] = _rg.SensorSimulator(self.params, (size, size))
+        return self.simulators[size]
+
+    def kernel(self, condition):
+        key = (condition.blurLength, condition.blurAngle)
+        if key not in self.kernels:
+            self.kernels[key] = _rg.linearMotionKernel(condition.blurLength, condition.blurAngle)
+        return self.kernels[key]
+
+    def scenes(self, role, count, size):
+        return [mosaicOfScene(renderScene(np.random.default_rng(_seed(self.config.seed, role, i)), size, size),
+                              self.params.pattern, self.level) for i in range(count)]
+
+    def cleanPlanes(self, mean, condition):
+        """The clean reference: the expected bright capture (blurred as the target is), black-subtracted,
+        normalised by white - black and packed."""
+        signal = (mean * self.config.baseGain).astype(np.float32)
+        if condition.blurLength > 0:
+            fmt = self.format
+            withBlack = signal + np.float32(fmt.blackLevel[0])
+            blurred, _ = _rg.motionBlur(withBlack, fmt, self.model, self.kernel(condition),
+                                        _rg.NoiseOptions(_rg.NoiseAlignment.NONE), seed=0)
+            signal = blurred - np.float32(fmt.blackLevel[0])
+        return packCfaPlanes(signal / np.float32(self.range), self.format)
+
+    def targetCapture(self, mean, condition, seed):
+        """A capture simulated directly at the target exposure and gain (exact Poisson)."""
+        sim = self.simulator(mean.shape[0])
+        gain = self.config.baseGain * condition.gainRatio
+        if condition.blurLength > 0:
+            return sim.captureBlurred(mean, self.kernel(condition), gain, condition.photonRatio, seed)
+        return sim.capture(mean, gain, condition.photonRatio, seed)
+
+    def brightCapture(self, mean, seed):
+        """The bright capture of a training crop (its own noise): the input of every augmented arm."""
+        return self.simulator(mean.shape[0]).capture(mean, self.config.baseGain, 1.0, seed)
+
+    def augmented(self, bright, condition, arm, seed):
+        """The bright capture darkened (and blurred) by the library with the arm's alignment."""
+        options = _rg.NoiseOptions(ALIGNMENTS[arm])
+        stepSeeds = [_rg.deriveSeed(seed, _rg.SEED_ABLATION, step) for step in (1, 2)]
+        if condition.blurLength > 0:
+            bright, _ = _rg.motionBlur(bright, self.format, self.model, self.kernel(condition), options,
+                                       seed=stepSeeds[0])
+        change = _rg.ColorJitter.exposureChange(condition.photonRatio, condition.gainRatio)
+        dark, _, _ = _rg.colorJitter(bright, self.format, self.model, change, options, seed=stepSeeds[1])
+        return dark
+
+    def inputPlanes(self, raw, condition):
+        """A dark mosaic as the network sees it: black-subtracted, normalised, packed and brightened by
+        the inverse of the exposure change, so every condition has the bright captures' scale; then the
+        noise-level map the model predicts for it at the target gain (from the noisy value itself, as
+        a camera pipeline would), on the same scale."""
+        gain = self.config.baseGain * condition.gainRatio
+        fmt = self.simulator(raw.shape[0]).rawFormat(gain)
+        scale = self.range * condition.photonRatio * condition.gainRatio
+        signal = _rg.subtractBlackLevel(raw, fmt, normalize=True)
+        planes = packCfaPlanes(signal / np.float32(condition.photonRatio * condition.gainRatio), fmt)
+        m = self.model
+        meanDn = planes.clamp(min=0.0).double() * scale
+        sigma = torch.sqrt(gain * m.alpha * meanDn + gain * gain * m.sigmaD2 + m.sigmaR2) / scale
+        return torch.cat([planes, sigma.float()])
+
+    def trainingInputs(self, mean, condition, arms, seed):
+        """Each trained arm's input for one crop: the augmented arms share one bright capture (so they
+        differ only in their alignment), the oracle gets a capture simulated at the target."""
+        bright = self.brightCapture(mean, seed) if any(a in ALIGNMENTS for a in arms) else None
+        inputs = {}
+        for arm in arms:
+            if arm == "ORACLE":
+                raw = self.targetCapture(mean, condition, _rg.deriveSeed(seed, _rg.SEED_ABLATION, 3))
+            else:
+                raw = self.augmented(bright, condition, arm, seed)
+            inputs[arm] = self.inputPlanes(raw, condition)
+        return inputs
+
+    def targetVariance(self, condition):
+        """The target capture's noise variance at mid-grey green on the network's scale (normalised and
+        brightened back): the training loss divides each crop's squared error by it, so that every
+        condition weighs the same in the pooled training instead of the darkest dominating by 1/ratio."""
+        m, gain = self.model, self.config.baseGain * condition.gainRatio
+        p, g = condition.photonRatio, condition.gainRatio
+        meanDn = _MID_GREY * self.level * self.config.baseGain * p * g
+        scale = self.range * p * g
+        return (gain * m.alpha * meanDn + gain * gain * m.sigmaD2 + m.sigmaR2) / (scale * scale)
+
+    def priorShare(self, condition):
+        """The share of the target's noise variance already present in the darkened prior (mid-grey
+        green, model variance): IGNORE_PRIOR's inputs carry (1 + share) times the target variance."""
+        m, g0 = self.model, self.config.baseGain
+        mean = _MID_GREY * self.level * g0  # DN above black of the bright capture
+        brightVar = g0 * m.alpha * mean + g0 * g0 * m.sigmaD2 + m.sigmaR2
+        if condition.blurLength > 0:
+            brightVar *= float(np.sum(self.kernel(condition).astype(np.float64) ** 2))
+        p, g = condition.photonRatio, condition.gainRatio
+        gt = g0 * g
+        targetVar = gt * m.alpha * (p * g * mean) + gt * gt * m.sigmaD2 + m.sigmaR2
+        return (p * g) ** 2 * brightVar / targetVar
+
+
+def _train(study, arms, replicate, trainMeans, log=None):
+    """Trains one network per arm, in lockstep, on every condition of the run (each crop draws its
+    condition): the network one would deploy for all of the camera's exposures, told the noise level by
+    its noise map. The crops, their conditions, the noise seeds and the initialisation depend on the
+    replicate only, so every arm sees the same scenes in the same order from the same starting weights;
+    the augmented arms even start from the same bright captures."""
+    config = study.config
+    nets, optimisers, schedules = {}, {}, {}
+    for arm in arms:
+        torch.manual_seed(_seed(config.seed, _ROLE_NETWORK, replicate) & 0x7FFFFFFFFFFFFFFF)
+        nets[arm] = Denoiser(config.width)
+        optimisers[arm] = torch.optim.Adam(nets[arm].parameters(), lr=config.learningRate)
+        schedules[arm] = torch.optim.lr_scheduler.CosineAnnealingLR(optimisers[arm], config.iterations)
+    limit = (config.trainSceneSize - config.patch) // 2 + 1
+    for it in range(config.iterations):
+        rng = np.random.default_rng(_seed(config.seed, _ROLE_BATCH, (replicate << 24) | it))
+        inputs, targets, weights = {arm: [] for arm in arms}, [], []
+        for b in range(config.batch):
+            condition = config.conditions[int(rng.integers(0, len(config.conditions)))]
+            scene = int(rng.integers(0, len(trainMeans)))
+            y0, x0 = 2 * int(rng.integers(0, limit)), 2 * int(rng.integers(0, limit))
+            mean = np.ascontiguousarray(trainMeans[scene][y0:y0 + config.patch, x0:x0 + config.patch])
+            sampleSeed = _seed(config.seed, _ROLE_SAMPLE, (replicate << 40) | (it << 8) | b)
+            for arm, planes in study.trainingInputs(mean, condition, arms, sampleSeed).items():
+                inputs[arm].append(planes)
+            targets.append(study.cleanPlanes(mean, condition))
+            weights.append(1.0 / study.targetVariance(condition))
+        y = torch.stack(targets)
+        w = torch.tensor(weights, dtype=torch.float32).view(-1, 1, 1, 1)
+        for arm in arms:
+            optimisers[arm].zero_grad()
+            loss = torch.mean(w * (nets[arm](torch.stack(inputs[arm])) - y) ** 2)
+            loss.backward()
+            optimisers[arm].step()
+            schedules[arm].step()
+        if log is not None and (it + 1) % max(1, config.iterations // 10) == 0:
+            log("  seed %d: iteration %d/%d" % (replicate, it + 1, config.iterations))
+    return {arm: net.eval() for arm, net in nets.items()}
+
+
+def _evaluate(net, testSet):
+    """Mean PSNR and SSIM over the test set (network output clipped to [0, 1]; net None: the input)."""
+    psnrs, ssims = [], []
+    with torch.no_grad():
+        for noisy, clean in testSet:
+            out = noisy[:4] if net is None else net(noisy[None])[0]
+            out = out.clamp(0.0, 1.0)
+            psnrs.append(psnr(out, clean))
+            ssims.append(ssim(out, clean))
+    return float(np.mean(psnrs)), float(np.mean(ssims))
+
+
+def runAblation(config, log=None):
+    """Runs the study and returns its results as a dict (see results.json): for every condition and
+    arm, the PSNR and SSIM of each replicate. `log` (a function of one string) receives progress."""
+    config.validate()
+    threads = int(config.threads) if config.threads else (os.cpu_count() or 1)
+    torch.set_num_threads(threads)
+    torch.use_deterministic_algorithms(True)
+    started = time.monotonic()
+    study = _Study(config)
+    trainMeans = study.scenes(_ROLE_TRAIN_SCENES, config.trainScenes, config.trainSceneSize)
+    testMeans = study.scenes(_ROLE_TEST_SCENES, config.testScenes, config.testSceneSize)
+    testSets = []
+    for ci, condition in enumerate(config.conditions):
+        testSet = []
+        for i, mean in enumerate(testMeans):
+            raw = study.targetCapture(mean, condition, _seed(config.seed, _ROLE_TEST_CAPTURE, (ci << 16) | i))
+            testSet.append((study.inputPlanes(raw, condition), study.cleanPlanes(mean, condition)))
+        testSets.append(testSet)
+    scores = {arm: [{"psnr": [], "ssim": []} for _ in config.conditions] for arm in config.arms}
+    trained = [a for a in config.arms if a in TRAINED_ARMS]
+    for replicate in range(config.seeds):
+        nets = _train(study, trained, replicate, trainMeans, log) if trained else {}
+        for arm in config.arms:
+            for ci, testSet in enumerate(testSets):
+                value = _evaluate(nets.get(arm), testSet)
+                scores[arm][ci]["psnr"].append(value[0])
+                scores[arm][ci]["ssim"].append(value[1])
+            if log is not None:
+                log("  seed %d %-13s PSNR %s dB" % (replicate, arm,
+                                                    " ".join("%.2f" % s["psnr"][-1] for s in scores[arm])))
+        if log is not None:
+            elapsed = time.monotonic() - started
+            log("[%d/%d seeds] %.0f s, about %.0f s left" % (replicate + 1, config.seeds, elapsed,
+                                                           elapsed / (replicate + 1) * (config.seeds - replicate - 1)))
+    conditions = [{"condition": dataclasses.asdict(c), "priorShare": study.priorShare(c),
+                   "arms": {arm: scores[arm][ci] for arm in config.arms}} for ci, c in enumerate(config.conditions)]
+    configDict = {k: v for k, v in dataclasses.asdict(config).items() if k not in ("model", "conditions")}
+    configDict["model"] = {"alpha": study.model.alpha, "sigmaD2": study.model.sigmaD2,
+                           "sigmaR2": study.model.sigmaR2}
+    configDict["arms"] = list(config.arms)
+    configDict["threads"] = threads
+    return {"config": configDict, "conditions": conditions, "seconds": time.monotonic() - started,
+            "torch": torch.__version__, "cpuPath": _rg.cpuPathName(_rg.activeCpuPath())}
+
+
+def _meanSd(values):
+    v = np.asarray(values, dtype=np.float64)
+    return float(v.mean()), float(v.std(ddof=1)) if v.size > 1 else 0.0
+
+
+def summarize(results):
+    """Per condition and arm: PSNR and SSIM mean and standard deviation over the replicates, and for
+    each arm against ACCOUNT_PRIOR the paired difference (ACCOUNT_PRIOR minus the arm) with a verdict:
+    'ACCOUNT_PRIOR better' or 'worse' when the mean difference exceeds the larger of the two arms'
+    seed-to-seed standard deviations, 'tie' otherwise (and 'n/a' with a single replicate)."""
+    rows = []
+    for entry in results["conditions"]:
+        arms = entry["arms"]
+        for arm, runs in arms.items():
+            p, ps = _meanSd(runs["psnr"])
+            s, ss = _meanSd(runs["ssim"])
+            row = {"condition": entry["condition"]["name"], "arm": arm, "psnr": p, "psnrSd": ps, "ssim": s,
+                   "ssimSd": ss, "priorShare": entry["priorShare"], "photonRatio": entry["condition"]["photonRatio"],
+                   "gainRatio": entry["condition"]["gainRatio"], "blurLength": entry["condition"]["blurLength"]}
+            if "ACCOUNT_PRIOR" in arms and arm != "ACCOUNT_PRIOR":
+                account = arms["ACCOUNT_PRIOR"]["psnr"]
+                diff = np.asarray(account) - np.asarray(runs["psnr"])
+                d, ds = _meanSd(diff)
+                spread = max(_meanSd(account)[1], ps)
+                if len(account) < 2:
+                    verdict = "n/a"
+                elif abs(d) <= spread:
+                    verdict = "tie"
+                else:
+                    verdict = "ACCOUNT_PRIOR better" if d > 0 else "ACCOUNT_PRIOR worse"
+                row.update({"accountMinus": d, "accountMinusSd": ds, "spread": spread, "verdict": verdict})
+            rows.append(row)
+    return rows
+
+
+def _plotScript(rows, arms):
+    """A gnuplot script (data inline) of PSNR against the photon ratio, one line per arm: one panel at
+    the bright gain, one with the gain change, and the blur conditions as points."""
+    styles = {"NONE": 1, "IGNORE_PRIOR": 2, "ACCOUNT_PRIOR": 3, "ORACLE": 4, "NOISY": 5}
+    panels = [("at the bright gain", lambda r: r["gainRatio"] == 1 and r["blurLength"] == 0),
+              ("gain raised by 1/ratio (at most +12 dB)", lambda r: r["gainRatio"] > 1 and r["blurLength"] == 0),
+              ("with motion blur", lambda r: r["blurLength"] > 0)]
+    panels = [(title, test) for title, test in panels if any(test(r) for r in rows)]
+    lines = ["set terminal pngcairo size %d,560 enhanced font 'DejaVu Sans,11'" % (520 * len(panels)),
+             "set multiplot layout 1,%d title 'Denoiser PSNR on captures simulated at the target "
+             "(mean and s.d. over seeds)'" % len(panels),
+             "set grid", "set key bottom left", "set ylabel 'PSNR (dB)'",
+             "set logscale x", "set xrange [*:*] reverse", "set xlabel 'photon ratio of the target (darker to the right)'",
+             "set offsets graph 0.05, graph 0.05, 0, 0"]
+    for k, arm in enumerate(arms):
+        lines.append("set style line %d lw 2 pt %d ps 1.2" % (styles[arm], k + 5))
+    for title, test in panels:
+        lines.append("set title '%s'" % title)
+        plots = []
+        for arm in arms:
+            data = sorted((r for r in rows if r["arm"] == arm and test(r)), key=lambda r: -r["photonRatio"])
+            if not data:
+                continue
+            block = "$%s_%d" % (arm.replace("_", ""), len(lines))
+            lines.append("%s << EOD" % block)
+            lines.extend("%.6g %.6f %.6f" % (r["photonRatio"], r["psnr"], r["psnrSd"]) for r in data)
+            lines.append("EOD")
+            plots.append("%s using 1:2:3 with yerrorlines ls %d title '%s'" % (block, styles[arm],
+                                                                               arm.replace("_", "\\\\_")))
+        lines.append("plot " + ", ".join(plots))
+    lines.append("unset multiplot")
+    return "\n".join(lines) + "\n"
+
+
+def _plotPng(rows, arms):
+    """The PNG bytes of the plot, or None and the reason when gnuplot is missing or fails."""
+    try:
+        result = subprocess.run(["gnuplot"], input=_plotScript(rows, arms).encode(), capture_output=True)
+    except FileNotFoundError:
+        return None, "gnuplot is not installed (apt-get install gnuplot-nox): psnr.png was not drawn"
+    if result.returncode != 0 or not result.stdout.startswith(b"\x89PNG"):
+        return None, "gnuplot failed: " + result.stderr.decode(errors="replace").strip()
+    return result.stdout, None
+
+
+def _fmt(mean, sd, digits):
+    return "%.*f ± %.*f" % (digits, mean, digits, sd)
+
+
+def _report(results, rows, plotNote):
+    config = results["config"]
+    arms = config["arms"]
+    m = config["model"]
+    conditions = [entry["condition"]["name"] for entry in results["conditions"]]
+    byKey = {(r["condition"], r["arm"]): r for r in rows}
+    out = ["# Noise-alignment ablation: a RAW denoiser trained on each kind of darkened capture", ""]
+    out.append("Sensor model: alpha = %.6g DN/e-, sigma_d^2 = %.6g DN^2, sigma_r^2 = %.6g DN^2 (quantisation "
+               "included), %d bits, black level %g, bright captures at gain %g. %d training replicate(s) "
+               "(seed %d), %d iterations of %d crops of %dx%d, tested on %d scenes of %dx%d simulated directly "
+               "at each target. %d torch thread(s), torch %s, CPU path %s; %.0f s." % (
+                   m["alpha"], m["sigmaD2"], m["sigmaR2"], config["bitDepth"], config["blackLevel"],
+                   config["baseGain"], config["seeds"], config["seed"], config["iterations"], config["batch"],
+                   config["patch"], config["patch"], config["testScenes"], config["testSceneSize"],
+                   config["testSceneSize"], config["threads"], results["torch"], results["cpuPath"],
+                   results["seconds"]))
+    out += ["", "![PSNR against darkening](psnr.png)" if plotNote is None else "Plot: " + plotNote, ""]
+    out += ["## PSNR (dB), mean ± s.d. over seeds", "",
+            "| condition | prior share | " + " | ".join(arms) + " |",
+            "|---|---|" + "---|" * len(arms)]
+    for name in conditions:
+        share = byKey[(name, arms[0])]["priorShare"]
+        out.append("| %s | %.3f | " % (name, share) +
+                   " | ".join(_fmt(byKey[(name, a)]["psnr"], byKey[(name, a)]["psnrSd"], 2) for a in arms) + " |")
+    out += ["", "## SSIM, mean ± s.d. over seeds", "", "| condition | " + " | ".join(arms) + " |",
+            "|---|" + "---|" * len(arms)]
+    for name in conditions:
+        out.append("| %s | " % name +
+                   " | ".join(_fmt(byKey[(name, a)]["ssim"], byKey[(name, a)]["ssimSd"], 4) for a in arms) + " |")
+    others = [a for a in arms if a != "ACCOUNT_PRIOR"]
+    if "ACCOUNT_PRIOR" in arms and others:
+        out += ["", "## ACCOUNT_PRIOR minus each arm (PSNR dB, paired by seed)", "",
+                "A difference counts only when its mean exceeds the larger seed-to-seed standard deviation of "
+                "the two arms; otherwise the arms tie.", "",
+                "| condition | " + " | ".join(others) + " |", "|---|" + "---|" * len(others)]
+        for name in conditions:
+            cells = []
+            for a in others:
+                r = byKey[(name, a)]
+                cells.append("%+.2f ± %.2f (%s)" % (r["accountMinus"], r["accountMinusSd"], r["verdict"]))
+            out.append("| %s | " % name + " | ".join(cells) + " |")
+    out += ["", "## Reading it", ""]
+    out += _findings(rows, conditions, arms)
+    out += ["", "Prior share: the part of the target's noise variance (mid-grey green) that the darkened bright "
+            "capture already carries. ACCOUNT_PRIOR adds only the rest; IGNORE_PRIOR adds the whole target "
+            "variance again, so its inputs carry (1 + share) times the target's; NONE adds nothing, so its inputs "
+            "carry only the share. Where the share is small, IGNORE_PRIOR and ACCOUNT_PRIOR should tie.", ""]
+    return "\n".join(out)
+
+
+def _findings(rows, conditions, arms):
+    """Plain statements drawn from the numbers (never from expectations)."""
+    byKey = {(r["condition"], r["arm"]): r for r in rows}
+    lines = []
+    if "ORACLE" in arms and "NOISY" in arms:
+        beaten = [c for c in conditions if byKey[(c, "ORACLE")]["psnr"] > byKey[(c, "NOISY")]["psnr"]]
+        lines.append("- The oracle beats the noisy input in %d of %d conditions%s." % (
+            len(beaten), len(conditions),
+            "" if len(beaten) == len(conditions) else
+            " (not in: %s)" % ", ".join(c for c in conditions if c not in beaten)))
+    if "ACCOUNT_PRIOR" not in arms:
+        return lines
+    for other in [a for a in ("NONE", "IGNORE_PRIOR", "ORACLE") if a in arms]:
+        verdicts = {}
+        for c in conditions:
+            verdicts.setdefault(byKey[(c, other)]["verdict"], []).append(c)
+        parts = ["%s in %s" % (v, ", ".join(cs)) for v, cs in sorted(verdicts.items())]
+        lines.append("- ACCOUNT_PRIOR against %s: %s." % (other, "; ".join(parts)))
+    return lines
+
+
+def _csv(rows):
+    keys = ["condition", "arm", "photonRatio", "gainRatio", "blurLength", "priorShare", "psnr", "psnrSd", "ssim",
+            "ssimSd", "accountMinus", "accountMinusSd", "verdict"]
+    out = [",".join(keys)]
+    for r in rows:
+        out.append(",".join(("%.6g" % r[k]) if isinstance(r.get(k), float) else str(r.get(k, "")) for k in keys))
+    return "\n".join(out) + "\n"
+
+
+def writeOutputs(results, outDir):
+    """Writes results.json, results.csv, psnr.png and report.md into outDir (created), each atomically.
+    Returns the paths written and the notes (a plot that could not be drawn)."""
+    os.makedirs(outDir, exist_ok=True)
+    rows = summarize(results)
+    png, note = _plotPng(rows, results["config"]["arms"])
+    written = []
+
+    def put(name, data):
+        path = os.path.join(outDir, name)
+        _rg.writeFileAtomically(path, data)
+        written.append(path)
+
+    put("results.json", (json.dumps(results, indent=1, sort_keys=True) + "\n").encode())
+    put("results.csv", _csv(rows).encode())
+    if png is not None:
+        put("psnr.png", png)
+    put("report.md", _report(results, rows, note).encode())
+    return written, [] if note is None else [note]
+
+
+def _parser():
+    parser = argparse.ArgumentParser(
+        prog="python3 -m rawgment.ablation",
+        description="Trains a small RAW denoiser on darkened captures made with each noise alignment (NONE, "
+                    "IGNORE_PRIOR, ACCOUNT_PRIOR), an oracle trained on captures simulated at the target, and "
+                    "the noisy input as the floor; tests all on captures simulated at the target; writes "
+                    "report.md, results.json, results.csv and psnr.png.",
+        epilog="The default budget (9 conditions x 4 trained arms x 3 seeds) takes about 15 minutes on 2 cores; "
+               "--quick about a minute. See docs/ablation.md.")
+    parser.add_argument("--model", help="a calibrated noise model (rawgment_calibrate's model.yml); default: "
+                                        "the simulator's default sensor")
+    parser.add_argument("--bit-depth", type=int, default=12, help="ADC bits of the sensor (default 12)")
+    parser.add_argument("--black-level", type=float, default=256.0, help="black level in DN (default 256)")
+    parser.add_argument("--base-gain-db", type=float, default=12.0,
+                        help="gain of the bright captures in dB (default 12)")
+    parser.add_argument("--out", default="ablation", help="output folder (default ./ablation)")
+    parser.add_argument("--quick", action="store_true",
+                        help="2 conditions, 2 seeds, 100 iterations of 8 crops, 4 test scenes: a check that it "
+                             "all runs")
+    parser.add_argument("--seeds", type=int, help="training replicates (default 3; --quick 2)")
+    parser.add_argument("--seed", type=int, default=0, help="base seed of everything (default 0)")
+    parser.add_argument("--iterations", type=int, help="training iterations per network (default 800)")
+    parser.add_argument("--arms", help="comma-separated subset of %s" % ",".join(ARMS))
+    parser.add_argument("--conditions",
+                        help="comma-separated subset of the conditions, by name (%s); one condition alone "
+                             "trains a network for that condition only" % ",".join(c.name for c in defaultConditions()))
+    parser.add_argument("--threads", type=int, default=0, help="torch threads (default: all cores)")
+    return parser
+
+
+def main(argv=None):
+    args = _parser().parse_args(argv)
+    config = AblationConfig()
+    if args.quick:
+        config.conditions = quickConditions()
+        config.seeds, config.iterations, config.batch, config.testScenes, config.trainScenes = 2, 100, 8, 4, 12
+    if args.model is not None:
+        if not os.path.isfile(args.model):
+            print("rawgment.ablation: --model '%s' is not a file" % args.model, file=sys.stderr)
+            return 2
+        config.model = _rg.NoiseModel.load(args.model)
+    config.bitDepth, config.blackLevel = args.bit_depth, args.black_level
+    config.baseGain = _rg.dbToLinearGain(args.base_gain_db)
+    config.seed, config.threads = args.seed, args.threads
+    if args.seeds is not None:
+        config.seeds = args.seeds
+    if args.iterations is not None:
+        config.iterations = args.iterations
+    if args.arms is not None:
+        config.arms = tuple(a.strip() for a in args.arms.split(",") if a.strip())
+    if args.conditions is not None:
+        known = {c.name: c for c in defaultConditions()}
+        names = [n.strip() for n in args.conditions.split(",") if n.strip()]
+        unknown = [n for n in names if n not in known]
+        if unknown:
+            print("rawgment.ablation: unknown condition(s) %s; the conditions are %s"
+                  % (", ".join(unknown), ", ".join(known)), file=sys.stderr)
+            return 2
+        config.conditions = [known[n] for n in names]
+    try:
+        config.validate()
+    except (ValueError, _rg.error) as e:
+        print("rawgment.ablation: %s" % e, file=sys.stderr)
+        return 2
+
+    def log(line):
+        print(line, file=sys.stderr, flush=True)
+
+    results = runAblation(config, log)
+    written, notes = writeOutputs(results, args.out)
+    for note in notes:
+        log("rawgment.ablation: " + note)
+    for path in written:
+        print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
