@@ -56,11 +56,21 @@ inline float sampledNoise(AddedVariance v, float q, float z, detail::CounterRng&
     return q * count + std::sqrt(total - shot) * z;
 }
 
-// Clipped to [0, white]; 16-bit output adds 0.5 and truncates: the same bits in every vector width.
+// Rounds a float or a vector of floats in [0, 2^23] to the nearest integer, ties to even: adding and
+// subtracting 2^23 (where the float spacing is 1) leaves the rounding to IEEE's default mode, the same
+// on every vector width. Adding 0.5 and truncating would round every tie up, a bias of +1/4 DN wherever
+// ties are common: integer mosaics halved with no noise added (NoiseAlignment::NONE, brightening pixels).
+template <typename V> inline __attribute__((always_inline)) V roundHalfToEven(V v)
+{
+    const float spacingOne = 8388608.0f;
+    return (v + spacingOne) - spacingOne;
+}
+
+// Clipped to [0, white]; 16-bit output is rounded half to even.
 template <typename T> inline __attribute__((always_inline)) T storeValue(float out, float white)
 {
     out = std::min(std::max(out, 0.0f), white);
-    return std::is_same<T, ushort>::value ? static_cast<T>(static_cast<int>(out + 0.5f))
+    return std::is_same<T, ushort>::value ? static_cast<T>(static_cast<int>(roundHalfToEven(out)))
                                           : static_cast<T>(out);
 }
 

@@ -53,9 +53,9 @@ RAWGMENT_KERNEL detail::AddedVarianceOf<V> jitterVariance(V xm, V pc, const Jitt
 // One row of Eq. 11/13 on explicit vectors of W lanes (cpu_dispatch.hpp). `prior` is the local-mean
 // row, or null to use the pixel's own value; per-column constants come in arrays (the CFA site
 // alternates along the row). The last partial block runs through the same vector code on padded
-// copies, so every pixel goes through the same operations on every path. Rounding to 16 bits adds 0.5
-// and truncates after clipping to [0, white]. Returns the number of brightening pixels (a negative
-// added variance, which adds no noise).
+// copies, so every pixel goes through the same operations on every path. 16-bit output is clipped to
+// [0, white] and rounded half to even (detail::roundHalfToEven). Returns the number of brightening pixels (a
+// negative added variance, which adds no noise).
 template <int W, typename T> struct PixelLanes;
 template <int W> struct PixelLanes<W, ushort>
 {
@@ -68,7 +68,7 @@ template <int W> struct PixelLanes<W, ushort>
     }
     RAWGMENT_KERNEL void store(ushort* p, F out, F white)
     {
-        out = detail::minLanes(detail::maxLanes(out, F{}), white) + 0.5f;
+        out = detail::roundHalfToEven(detail::minLanes(detail::maxLanes(out, F{}), white));
         const typename detail::Lanes<W>::U16 v = __builtin_convertvector(
             __builtin_convertvector(out, typename detail::Lanes<W>::I), typename detail::Lanes<W>::U16);
         std::memcpy(p, &v, sizeof(v));

@@ -158,8 +158,9 @@ template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int
     T* d = dst.ptr<T>(2 * planeRow + site / 2) + site % 2;
     const int width = dst.cols / 2;
     for (int j = 0; j < width; ++j)
-        d[2 * j] = std::is_same<T, ushort>::value ? static_cast<T>(static_cast<int>(v[j] + 0.5f))
-                                                  : static_cast<T>(v[j]);
+        d[2 * j] = std::is_same<T, ushort>::value
+                       ? static_cast<T>(static_cast<int>(detail::roundHalfToEven(v[j])))
+                       : static_cast<T>(v[j]);
 }
 
 // ShotNoiseSampling::POISSON for a resampled row: the shot part of Eq. 15 (or of the model, for

@@ -386,6 +386,55 @@ TEST(Augment, identityStepsAreSkippedAndReturnTheInputItself)
     EXPECT_EQ(out.data, src.data);
 }
 
+TEST(Augment, sixteenBitOutputRoundsTiesToEvenSoNoiselessStepsAreUnbiased)
+{
+    RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
+    fmt.blackLevel = Scalar::all(64);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    Mat out, outFloat;
+    RawFormat outFmt;
+    // The steps that average neighbours (blur, scale), with no noise added, against the unrounded float
+    // output of the same call: each pixel within half a DN and the mean not shifted. On random integers
+    // a 2-tap blur makes a tie at half the pixels and this 2x scale at 1.7% of them, so rounding ties up
+    // would add 0.12 and 0.008 DN. Unbiased rounding errors are uniform on [-1/2, 1/2] (s.d. 0.29): over
+    // 65536 pixels their mean has s.d. 0.0011, and 0.004 is 3.5 of those.
+    Mat src(256, 256, CV_16UC1), srcFloat;
+    RNG(7).fill(src, RNG::UNIFORM, 64, 4000);
+    src.convertTo(srcFloat, CV_32F);
+    const auto checkUnbiased = [&](const Mat& rounded, const Mat& exact, const char* step) {
+        Mat roundedFloat, difference;
+        rounded.convertTo(roundedFloat, CV_32F);
+        cv::subtract(roundedFloat, exact, difference);
+        double lo = 0, hi = 0;
+        cv::minMaxLoc(difference, &lo, &hi);
+        EXPECT_LE(std::max(-lo, hi), 0.5) << step;
+        EXPECT_NEAR(cv::mean(difference)[0], 0.0, 0.004) << step;
+    };
+    const Mat kernel = (Mat_<float>(1, 2) << 0.5f, 0.5f);
+    motionBlur(src, fmt, model, kernel, NoiseAlignment::NONE, 1, out);
+    motionBlur(srcFloat, fmt, model, kernel, NoiseAlignment::NONE, 1, outFloat);
+    checkUnbiased(out, outFloat, "motionBlur");
+    scaleMosaic(src, fmt, model, 2.0, NoiseAlignment::NONE, 1, out);
+    scaleMosaic(srcFloat, fmt, model, 2.0, NoiseAlignment::NONE, 1, outFloat);
+    checkUnbiased(out, outFloat, "scaleMosaic");
+
+    // Every integer from 0 to 2047 above black, halved: half the pixels are ties, and each goes to the
+    // even neighbour (1 -> 0, 3 -> 2, 5 -> 2, 7 -> 4, ...). Rounding them up would add exactly 1/4 DN.
+    Mat ramp(32, 64, CV_16UC1);
+    for (int i = 0; i < ramp.rows; ++i)
+        for (int j = 0; j < ramp.cols; ++j)
+            ramp.at<ushort>(i, j) = static_cast<ushort>(64 + i * ramp.cols + j);
+    colorJitter(ramp, fmt, model, ColorJitter::exposureChange(0.5, 1.0), NoiseAlignment::NONE, 1, out,
+                outFmt);
+    for (int i = 0; i < ramp.rows; ++i)
+        for (int j = 0; j < ramp.cols; ++j) {
+            const int above = i * ramp.cols + j;
+            const int half = above / 2;
+            const int expected = above % 2 == 0 || half % 2 == 0 ? half : half + 1;
+            ASSERT_EQ(out.at<ushort>(i, j), 64 + expected) << "at " << above << " DN above black";
+        }
+}
+
 TEST(Augment, badArgumentsGiveClearErrors)
 {
     const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
