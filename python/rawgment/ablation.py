@@ -684,8 +684,8 @@ def _parser():
                     "IGNORE_PRIOR, ACCOUNT_PRIOR), an oracle trained on captures simulated at the target, and "
                     "the noisy input as the floor; tests all on captures simulated at the target; writes "
                     "report.md, results.json, results.csv and psnr.png.",
-        epilog="The default budget (9 conditions x 4 trained arms x 3 seeds) takes about 15 minutes on 2 cores; "
-               "--quick about a minute. See docs/ablation.md.")
+        epilog="The default budget (9 conditions x 4 trained arms x 3 seeds) takes about 12 minutes on 2 cores; "
+               "--quick about 40 s. See docs/ablation.md.")
     parser.add_argument("--model", help="a calibrated noise model (rawgment_calibrate's model.yml); default: "
                                         "the simulator's default sensor")
     parser.add_argument("--bit-depth", type=int, default=12, help="ADC bits of the sensor (default 12)")
