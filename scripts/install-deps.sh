@@ -15,6 +15,7 @@ packages=(
   libgtest-dev      # GoogleTest
   libbenchmark-dev  # Google Benchmark
   gnuplot-nox       # PNG plots in apps and the demo
+  libimage-exiftool-perl  # exiftool: the tests' independent reader of the DNG tags we write
   doxygen           # the API reference (target doc), built without warnings by the tests
   texlive-binaries  # bibtex, which doxygen runs for @cite
   python3-dev       # the Python module (rawgment): headers of Debian's Python 3.11

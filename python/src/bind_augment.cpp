@@ -218,12 +218,16 @@ void bindAugment(py::module_& m)
         .def_readwrite("make", &RawImage::make, doc("RawImage::make"))
         .def_readwrite("model", &RawImage::model, doc("RawImage::model"))
         .def_readwrite("whiteBalance", &RawImage::whiteBalance, doc("RawImage::whiteBalance"))
-        .def_readwrite("cameraToSrgb", &RawImage::cameraToSrgb, doc("RawImage::cameraToSrgb"));
+        .def_readwrite("cameraToSrgb", &RawImage::cameraToSrgb, doc("RawImage::cameraToSrgb"))
+        .def_readwrite("noiseProfile", &RawImage::noiseProfile, doc("RawImage::noiseProfile"));
     defMatProperty(rawImage, "mosaic", &RawImage::mosaic, doc("RawImage::mosaic"), {CV_16U});
     m.def(
         "readRaw",
         [](const std::string& path) { return withoutGil("readRaw", [&] { return readRaw(path); }); },
         py::arg("path"), doc("readRaw"));
+    m.def("dngNoiseProfile", &dngNoiseProfile, py::arg("model"), py::arg("format"), doc("dngNoiseProfile"));
+    m.def("noiseLineFromDngProfile", &noiseLineFromDngProfile, py::arg("profile"), py::arg("format"),
+          py::arg("channel"), doc("noiseLineFromDngProfile"));
     m.def(
         "writeDng",
         [](const std::string& path, const RawImage& image) {

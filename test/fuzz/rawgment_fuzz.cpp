@@ -343,6 +343,12 @@ std::vector<Target> targets(const std::string& dataDir)
                          image.exposureTime = 0.01;
                          image.make = "Rawgment";
                          image.model = "Fuzz seed";
+                         // A NoiseProfile in both layouts, so mutations reach the tag reader.
+                         if (k == 0)
+                             image.noiseProfile = {cv::Vec2d(2e-5, 1e-8)};
+                         else
+                             image.noiseProfile = {cv::Vec2d(1e-4, 1e-7), cv::Vec2d(2e-4, 2e-7),
+                                                   cv::Vec2d(3e-4, 3e-7)};
                          const std::string path = work + cv::format("/seed_%d.dng", k);
                          fs::remove(path);
                          writeDng(path, image);
@@ -361,6 +367,12 @@ std::vector<Target> targets(const std::string& dataDir)
                      if (image.mosaic.empty() || image.mosaic.type() != CV_16UC1 || image.mosaic.rows % 2 ||
                          image.mosaic.cols % 2)
                          return std::string("accepted a file whose mosaic is empty, odd or not 16-bit");
+                     for (const cv::Vec2d& so : image.noiseProfile)
+                         if (!(so[0] > 0 && so[1] >= 0 && std::isfinite(so[0]) && std::isfinite(so[1])))
+                             return std::string("accepted a NoiseProfile DNG forbids");
+                     if (!image.noiseProfile.empty() && image.noiseProfile.size() != 1 &&
+                         image.noiseProfile.size() != 3)
+                         return std::string("accepted a NoiseProfile of neither 1 nor 3 pairs");
                      return checkFormat(image.format);
                  }});
     // A reader with a planted bug, so that a test proves the fuzzer reports what it must: it throws a

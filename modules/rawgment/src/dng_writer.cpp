@@ -19,7 +19,8 @@ enum TiffType : uint16_t
     TIFF_SHORT = 3,
     TIFF_LONG = 4,
     TIFF_RATIONAL = 5,
-    TIFF_SRATIONAL = 10
+    TIFF_SRATIONAL = 10,
+    TIFF_DOUBLE = 12
 };
 
 struct TiffEntry
@@ -77,6 +78,18 @@ public:
             put32(b, den);
         }
         add(tag, isSigned ? TIFF_SRATIONAL : TIFF_RATIONAL, uint32_t(v.size()), b);
+    }
+
+    void doubles(uint16_t tag, const std::vector<double>& v)
+    {
+        std::vector<uint8_t> b;
+        for (double x : v) {
+            uint64_t bits;
+            std::memcpy(&bits, &x, sizeof(bits));
+            put32(b, uint32_t(bits));
+            put32(b, uint32_t(bits >> 32));
+        }
+        add(tag, TIFF_DOUBLE, uint32_t(v.size()), b);
     }
 
     //! Moves the entries with these tags into the EXIF sub-IFD (where LibRaw looks for the ISO).
@@ -211,6 +224,8 @@ void writeDng(const String& path, const RawImage& image)
         CV_Error(Error::StsBadArg, format("writeDng: '%s': exposure time %g s does not fit its DNG tag "
                                           "(a rational of at most 4294967295 s)",
                                           path.c_str(), image.exposureTime));
+    if (!image.noiseProfile.empty())
+        detail::checkDngNoiseProfile(image.noiseProfile, ("writeDng: '" + path + "': noiseProfile").c_str());
     if (detail::fileExists(path))
         CV_Error(Error::StsError, "writeDng: '" + path + "' already exists; it is never overwritten");
 
@@ -268,6 +283,14 @@ void writeDng(const String& path, const RawImage& image)
         neutral[c] = image.whiteBalance[1] / image.whiteBalance[c];
     }
     t.rationals(50728, neutral, false);
+    if (!image.noiseProfile.empty()) {
+        std::vector<double> pairs;
+        for (const Vec2d& so : image.noiseProfile) {
+            pairs.push_back(so[0]);
+            pairs.push_back(so[1]);
+        }
+        t.doubles(51041, pairs);
+    }
     t.moveToExif({33434, 34855});
     const std::vector<uint8_t> bytes = t.build(m);
     writeFileAtomically(path, bytes.data(), bytes.size(), false);

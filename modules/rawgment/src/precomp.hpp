@@ -51,6 +51,11 @@ std::vector<double> readRealList(const FileNode& node, const char* field, int n)
  * (.yml/.yaml or .json); other extensions are rejected. */
 template <typename Writer> void writeFileStorageAtomically(const String& path, Writer&& writeBody);
 int fileStorageFormatOf(const String& path);
+//! The NoiseProfile (tag 51041) pairs of a DNG or other TIFF-based file, empty when it has none or is
+//! not TIFF-based; throws StsParseError naming the file when the tag or the IFDs are malformed.
+std::vector<Vec2d> readDngNoiseProfile(const String& path);
+//! Throws StsBadArg (prefixed by `what`) unless a NoiseProfile has 1 or 3 pairs, each S > 0, O >= 0.
+void checkDngNoiseProfile(const std::vector<Vec2d>& profile, const char* what);
 //! Whether anything exists at `path`.
 bool fileExists(const String& path);
 //! The whole content of a file; throws StsError naming it when it cannot be read.

@@ -175,6 +175,7 @@ RawImage readRaw(const String& path)
         }
     if (!haveMatrix)
         out.cameraToSrgb = Matx33d::eye();
+    out.noiseProfile = detail::readDngNoiseProfile(path);
     return out;
 }
 

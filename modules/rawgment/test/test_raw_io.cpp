@@ -5,6 +5,7 @@
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <dirent.h>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <sys/mount.h>
 #include <thread>
 #include <unistd.h>
@@ -239,6 +241,86 @@ TEST(RawIo, writeDngRejectsWhatDngCannotHold)
     img.format.blackLevel = Vec4d(10.5, 10, 10, 10);
     EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "not an integer");
     EXPECT_TRUE(filesIn(dir).empty()) << "a refused write leaves nothing behind";
+}
+
+TEST(RawIo, dngNoiseProfileRoundTripsAndGivesBackTheModelsLines)
+{
+    const std::string dir = makeTempDir("raw_io_noise_profile");
+    const NoiseModel model(0.3, 1.2, 2.5);
+    RawImage img;
+    img.mosaic = Mat(48, 64, CV_16UC1, Scalar(500)); // LibRaw refuses very small images
+    img.format.pattern = CFA_GBRG;
+    img.format.blackLevel = Vec4d(100, 101, 102, 103);
+    img.format.whiteLevel = 4000;
+    img.format.gain = 4;
+    img.noiseProfile = dngNoiseProfile(model, img.format);
+    ASSERT_EQ(img.noiseProfile.size(), 3u);
+    // GBRG: blue is site 1 (black 101), red site 2 (102), green sites 0 and 3 (mean 101.5).
+    EXPECT_DOUBLE_EQ(img.noiseProfile[0][0], 4 * 0.3 / (4000 - 102.0));
+    EXPECT_DOUBLE_EQ(img.noiseProfile[1][1], (16 * 1.2 + 2.5) / ((4000 - 101.5) * (4000 - 101.5)));
+    EXPECT_DOUBLE_EQ(img.noiseProfile[2][0], 4 * 0.3 / (4000 - 101.0));
+    writeDng(dir + "/profiled.dng", img);
+    const RawImage back = readRaw(dir + "/profiled.dng");
+    ASSERT_EQ(back.noiseProfile.size(), 3u);
+    for (int k = 0; k < 3; ++k)
+        EXPECT_EQ(back.noiseProfile[k], img.noiseProfile[k]) << "doubles are stored bit for bit";
+    // The line of each site at the mosaic's gain is the model's (4 alpha, 16 sigma_d^2 + sigma_r^2),
+    // up to the rounding of one division and one multiplication.
+    RawFormat atGain = back.format;
+    atGain.gain = 4;
+    const NoiseLine truth = model.lineAtGain(4);
+    for (CfaChannel channel : {CFA_R, CFA_G1, CFA_G2, CFA_B}) {
+        const NoiseLine line = noiseLineFromDngProfile(back.noiseProfile, atGain, channel);
+        EXPECT_NEAR(line.a, truth.a, 1e-14 * truth.a) << channel;
+        EXPECT_NEAR(line.b, truth.b, 1e-13 * truth.b) << channel;
+    }
+    const std::vector<Vec2d> single = {Vec2d(0.001, 2e-6)};
+    EXPECT_DOUBLE_EQ(noiseLineFromDngProfile(single, atGain, CFA_B).a, 0.001 * (4000 - 101));
+    img.noiseProfile.clear();
+    writeDng(dir + "/plain.dng", img);
+    EXPECT_TRUE(readRaw(dir + "/plain.dng").noiseProfile.empty());
+}
+
+TEST(RawIo, aNoiseProfileDngCannotHoldIsRefusedAndAMalformedTagNamesTheFile)
+{
+    const std::string dir = makeTempDir("raw_io_noise_profile_bad");
+    RawImage img;
+    img.mosaic = Mat(48, 64, CV_16UC1, Scalar(500));
+    img.format.whiteLevel = 4095;
+    img.noiseProfile = {Vec2d(1e-4, 1e-6), Vec2d(1e-4, 1e-6)};
+    EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/two.dng", img), "1 or 3");
+    img.noiseProfile = {Vec2d(0, 1e-6)};
+    EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/zero.dng", img), "S > 0 and O >= 0");
+    img.noiseProfile = {Vec2d(1e-4, std::numeric_limits<double>::quiet_NaN())};
+    EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/nan.dng", img), "S > 0 and O >= 0");
+    EXPECT_TRUE(filesIn(dir).empty());
+    EXPECT_CV_ERROR_CONTAINS(dngNoiseProfile(NoiseModel(0, 1, 1), img.format), "S > 0");
+
+    img.noiseProfile = {Vec2d(1e-4, 1e-6)};
+    writeDng(dir + "/good.dng", img);
+    const std::vector<char> good = readBytes(dir + "/good.dng");
+    // The tag's IFD entry: 51041 = 0xC761, little-endian, then type 12 (DOUBLE) and count 2.
+    const char entry[] = {'\x61', '\xC7', 12, 0, 2, 0, 0, 0};
+    const auto at = std::search(good.begin(), good.end(), entry, entry + sizeof(entry));
+    ASSERT_NE(at, good.end());
+    const size_t offset = static_cast<size_t>(at - good.begin());
+    std::vector<char> bad = good;
+    bad[offset + 4] = 5; // five values
+    writeBytes(dir + "/count.dng", bad);
+    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/count.dng"),
+                             "count.dng' has a NoiseProfile tag of type 12 with 5");
+    bad = good;
+    for (int k = 0; k < 4; ++k)
+        bad[offset + 8 + k] = '\x7F'; // the values' offset, far beyond the end
+    writeBytes(dir + "/beyond.dng", bad);
+    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/beyond.dng"), "beyond.dng' is truncated");
+    bad = good;
+    uint32_t valuesAt = 0;
+    std::memcpy(&valuesAt, &good[offset + 8], 4);
+    const double negative = -1e-4;
+    std::memcpy(&bad[valuesAt], &negative, 8);
+    writeBytes(dir + "/negative.dng", bad);
+    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/negative.dng"), "negative.dng' has an invalid NoiseProfile");
 }
 
 TEST(RawIo, missingUnreadableAndNonRawFilesNameTheFileAndTheReason)

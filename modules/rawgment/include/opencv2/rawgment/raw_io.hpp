@@ -6,6 +6,7 @@
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/bayer.hpp>
 #include <opencv2/rawgment/export.hpp>
+#include <opencv2/rawgment/noise_model.hpp>
 
 namespace cv {
 namespace rawgment {
@@ -28,30 +29,62 @@ struct CV_RAWGMENT_EXPORTS RawImage
     /** Camera RGB to linear sRGB, rows summing to 1 (from the file's colour matrix as LibRaw derives
      * it); the identity when the file has none. Pass it to IspParams::colorMatrix. */
     Matx33d cameraToSrgb = Matx33d::eye();
+    /** The DNG NoiseProfile (tag 51041): for the signal x of a colour plane normalised to [0, 1] by
+     * (white - black), the noise variance is S x + O, with one (S, O) pair per colour plane (red, green,
+     * blue) or one pair for all. Empty when the file has none. readRaw() reads it from a DNG's IFDs
+     * (LibRaw does not expose it), writeDng() writes it; dngNoiseProfile() makes it from a NoiseModel. */
+    std::vector<Vec2d> noiseProfile;
 };
+
+/** @brief The DNG NoiseProfile of a noise model at the format's gain (for RawImage::noiseProfile).
+ *
+ * For each colour plane (red, green, blue), with g = format.gain and r the white level minus the mean
+ * black level of the plane's CFA sites: \f$ S = g\alpha / r \f$, \f$ O = (g^2\sigma_d^2 + \sigma_r^2) / r^2
+ * \f$, so that \f$ S x + O \f$ is the model's variance of x = (value - black) / r. Like the model, the
+ * profile gives no shot noise below black (the DNG form is linear there).
+ * @throws cv::Exception when the format is invalid or the model gives S <= 0 (alpha = 0): a DNG reader
+ *         requires a positive S.
+ */
+CV_RAWGMENT_EXPORTS std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, const RawFormat& format);
+
+/** @brief The noise line of one CFA site at its capture's gain, from a DNG NoiseProfile: a = S r and
+ * b = O r^2 in DN, with r the white level minus the mean black level of the site's colour plane (the
+ * exact inverse of dngNoiseProfile()).
+ * @param profile one (S, O) pair for all colours, or three (red, green, blue)
+ * @param format the format of the mosaic the profile describes
+ * @param channel the CFA site
+ * @throws cv::Exception when the profile has another count or a pair with S <= 0, O < 0 or a
+ *         non-finite value.
+ */
+CV_RAWGMENT_EXPORTS NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& profile,
+                                                      const RawFormat& format, CfaChannel channel);
 
 /** @brief Reads the Bayer mosaic of a camera RAW file (any format LibRaw reads: DNG, NEF, CR2, CRW, ...).
  *
  * The mosaic is the visible area LibRaw reports (masked borders removed). The CFA pattern is the one
  * of the visible area's top-left pixel as LibRaw reports it, never assumed. The black level of each
  * site is LibRaw's `black + cblack[colour] + cblack[6 + pattern position]`; the white level is LibRaw's
- * `maximum`. Every LibRaw return code is checked.
+ * `maximum`. Every LibRaw return code is checked. The DNG NoiseProfile, which LibRaw does not expose,
+ * is read from the file's IFDs (IFD0, the IFDs chained after it and their SubIFDs).
  * @param path the file
  * @throws cv::Exception naming the file and the reason when the file is missing or unreadable, is not a
  *         RAW file, is truncated or corrupt (LibRaw's data-error callback fired), or is not a 2x2 Bayer
- *         mosaic (X-Trans, Foveon, four-colour, or a linear/demosaiced DNG).
+ *         mosaic (X-Trans, Foveon, four-colour, or a linear/demosaiced DNG), or has a malformed
+ *         NoiseProfile tag.
  */
 CV_RAWGMENT_EXPORTS RawImage readRaw(const String& path);
 
 /** @brief Writes a mosaic as an uncompressed DNG 1.4 file that LibRaw and RAW viewers open.
  *
  * The file holds the CFA pattern, the per-site black level (BlackLevelRepeatDim 2x2), the white level,
- * make and model, ISO, exposure time and the as-shot neutral from the white balance. It is written
+ * make and model, ISO, exposure time, the as-shot neutral from the white balance and, when
+ * RawImage::noiseProfile is not empty, the NoiseProfile tag (51041). It is written
  * atomically (a temporary file, then a hard link that fails if `path` exists).
  * @param path destination, which must not exist
  * @param image `mosaic` must be CV_16UC1 with even sides; the other fields are written as they are
  *        (`format.gain` is not a DNG field; writeMosaic() keeps it in the sidecar)
- * @throws cv::Exception when `path` exists, the mosaic is unsupported, or any write fails.
+ * @throws cv::Exception when `path` exists, the mosaic is unsupported, the noise profile is invalid
+ *         (see noiseLineFromDngProfile()), or any write fails.
  */
 CV_RAWGMENT_EXPORTS void writeDng(const String& path, const RawImage& image);
 
