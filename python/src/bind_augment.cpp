@@ -228,6 +228,21 @@ void bindAugment(py::module_& m)
     m.def("dngNoiseProfile", &dngNoiseProfile, py::arg("model"), py::arg("format"), doc("dngNoiseProfile"));
     m.def("noiseLineFromDngProfile", &noiseLineFromDngProfile, py::arg("profile"), py::arg("format"),
           py::arg("channel"), doc("noiseLineFromDngProfile"));
+    m.def("darktableNoiseProfiles", &darktableNoiseProfiles, py::arg("model"), py::arg("format"),
+          py::arg("baseIso"), py::arg("isos"), py::arg("maker"), py::arg("cameraModel"),
+          doc("darktableNoiseProfiles"));
+    m.def("noiseModelFromDarktable", &noiseModelFromDarktable, py::arg("path"), py::arg("format"),
+          py::arg("baseIso"), py::arg("maker"), py::arg("cameraModel"), doc("noiseModelFromDarktable"));
+    py::class_<AndroidNoiseProfile>(m, "AndroidNoiseProfile", doc("AndroidNoiseProfile"))
+        .def(keywordInit<AndroidNoiseProfile>())
+        .def_readwrite("A", &AndroidNoiseProfile::A, doc("AndroidNoiseProfile::A"))
+        .def_readwrite("B", &AndroidNoiseProfile::B, doc("AndroidNoiseProfile::B"))
+        .def_readwrite("C", &AndroidNoiseProfile::C, doc("AndroidNoiseProfile::C"))
+        .def_readwrite("D", &AndroidNoiseProfile::D, doc("AndroidNoiseProfile::D"));
+    m.def("androidNoiseProfile", &androidNoiseProfile, py::arg("model"), py::arg("format"),
+          py::arg("baseIso"), doc("androidNoiseProfile"));
+    m.def("noiseModelFromAndroid", &noiseModelFromAndroid, py::arg("profile"), py::arg("format"),
+          py::arg("baseIso"), doc("noiseModelFromAndroid"));
     m.def(
         "writeDng",
         [](const std::string& path, const RawImage& image) {

@@ -323,6 +323,158 @@ TEST(RawIo, aNoiseProfileDngCannotHoldIsRefusedAndAMalformedTagNamesTheFile)
     EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/negative.dng"), "negative.dng' has an invalid NoiseProfile");
 }
 
+// A format whose four sites have different black levels, so a per-colour or per-site range that used
+// the wrong site would show.
+RawFormat unevenBlackFormat()
+{
+    RawFormat format;
+    format.pattern = CFA_GRBG;
+    format.blackLevel = Vec4d(510, 512, 514, 516);
+    format.whiteLevel = 16383;
+    return format;
+}
+
+TEST(RawIo, darktableNoiseProfilesAreTheDngProfilesPerIsoAndGiveTheModelBack)
+{
+    const std::string dir = makeTempDir("darktable_profiles");
+    const NoiseModel model(0.42, 1.7, 3.1);
+    const RawFormat format = unevenBlackFormat();
+    const std::string json =
+        darktableNoiseProfiles(model, format, 100, {800, 100, 3200, 400}, "Rawgment", "Test \"Cam\"");
+    const std::string path = dir + "/noiseprofiles.json";
+    writeFileAtomically(path, json.data(), json.size());
+
+    FileStorage fs(path, FileStorage::READ);
+    const FileNode entry = fs["noiseprofiles"][0];
+    EXPECT_EQ(std::string(entry["maker"]), "Rawgment");
+    EXPECT_EQ(std::string(entry["models"][0]["model"]), "Test \"Cam\"");
+    const FileNode profiles = entry["models"][0]["profiles"];
+    ASSERT_EQ(profiles.size(), 4u);
+    const double isos[] = {100, 400, 800, 3200}; // written in ascending order, as darktable keeps them
+    for (int k = 0; k < 4; ++k) {
+        EXPECT_EQ(double(profiles[k]["iso"]), isos[k]);
+        RawFormat atIso = format;
+        atIso.gain = isos[k] / 100;
+        const std::vector<Vec2d> dng = dngNoiseProfile(model, atIso);
+        for (int c = 0; c < 3; ++c) {
+            // 17 significant digits give the double back exactly.
+            EXPECT_EQ(double(profiles[k]["a"][c]), dng[size_t(c)][0]);
+            EXPECT_EQ(double(profiles[k]["b"][c]), dng[size_t(c)][1]);
+        }
+    }
+
+    const NoiseModel back = noiseModelFromDarktable(path, format, 100, "Rawgment", "Test \"Cam\"");
+    // Exact up to the rounding of a 12-value least-squares line: a few ulps of the largest term.
+    EXPECT_NEAR(back.alpha, model.alpha, 1e-13 * model.alpha);
+    EXPECT_NEAR(back.sigmaD2, model.sigmaD2, 1e-11 * model.sigmaD2);
+    EXPECT_NEAR(back.sigmaR2, model.sigmaR2, 1e-9 * model.sigmaR2);
+    // Another base ISO scales the gain: the model at base ISO 200 has twice the per-gain terms.
+    const NoiseModel at200 = noiseModelFromDarktable(path, format, 200, "Rawgment", "Test \"Cam\"");
+    EXPECT_NEAR(at200.alpha, 2 * model.alpha, 1e-12);
+    EXPECT_NEAR(at200.sigmaD2, 4 * model.sigmaD2, 1e-9);
+
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(path, format, 100, "Rawgment", "Other"),
+                             "no profile of 'Rawgment / Other' (it has: Rawgment / Test \"Cam\")");
+    EXPECT_CV_ERROR_CONTAINS(darktableNoiseProfiles(model, format, 100, {100, 100}, "A", "B"), "given twice");
+    EXPECT_CV_ERROR_CONTAINS(darktableNoiseProfiles(model, format, 0, {100}, "A", "B"), "baseIso");
+    EXPECT_CV_ERROR_CONTAINS(darktableNoiseProfiles(model, format, 100, {}, "A", "B"), "no ISO");
+}
+
+TEST(RawIo, darktableFilesThatNoModelMatchesAreRefusedNamingWhy)
+{
+    const std::string dir = makeTempDir("darktable_refused");
+    const RawFormat format = unevenBlackFormat();
+    const auto write = [&](const std::string& name, const std::string& text) {
+        writeFileAtomically(dir + "/" + name, text.data(), text.size());
+        return dir + "/" + name;
+    };
+    // The layout of darktable's own file: a skipped profile, another maker, comments. The skipped profile
+    // is inconsistent with the others and must not be read.
+    const NoiseModel model(0.5, 2, 4);
+    RawFormat g1 = format, g2 = format;
+    g1.gain = 1;
+    g2.gain = 2;
+    const std::vector<Vec2d> p1 = dngNoiseProfile(model, g1), p2 = dngNoiseProfile(model, g2);
+    const auto list = [](const std::vector<Vec2d>& p, int k) {
+        return cv::format("[%.17g, %.17g, %.17g]", p[0][k], p[1][k], p[2][k]);
+    };
+    const std::string good = write(
+        "good.json",
+        "{\"version\": 0, \"noiseprofiles\": [\n"
+        " {\"maker\": \"Other\", \"models\": [{\"model\": \"X\", \"profiles\": []}]},\n"
+        " {\"maker\": \"Maker\", \"comment\": \"c\", \"models\": [{\"model\": \"M\", \"comment\": \"c\", "
+        "\"profiles\": [\n"
+        "  {\"name\": \"M iso 100\", \"iso\": 100, \"a\": " +
+            list(p1, 0) + ", \"b\": " + list(p1, 1) +
+            "},\n"
+            "  {\"name\": \"M iso 150\", \"iso\": 150, \"skip\": true, \"a\": [1, 1, 1], \"b\": [1, 1, "
+            "1]},\n"
+            "  {\"name\": \"M iso 200\", \"iso\": 200, \"a\": " +
+            list(p2, 0) + ", \"b\": " + list(p2, 1) + "}]}]}]}\n");
+    const NoiseModel back = noiseModelFromDarktable(good, format, 100, "Maker", "M");
+    EXPECT_NEAR(back.alpha, 0.5, 1e-13);
+    EXPECT_NEAR(back.sigmaD2, 2, 1e-11);
+    EXPECT_NEAR(back.sigmaR2, 4, 1e-10);
+
+    // A measured profile: the colours' a differ, as they do in darktable's database.
+    const std::string measured =
+        write("measured.json",
+              "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", \"models\": "
+              "[{\"model\": \"M\", \"profiles\": [\n"
+              "  {\"name\": \"a\", \"iso\": 100, \"a\": [7.6e-06, 1.5e-06, 2.3e-06], \"b\": [2e-09, "
+              "3e-09, 4.7e-09]},\n"
+              "  {\"name\": \"b\", \"iso\": 200, \"a\": [1.5e-05, 3e-06, 4.6e-06], \"b\": [8e-09, "
+              "1.2e-08, 1.9e-08]}]}]}]}\n");
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(measured, format, 100, "Maker", "M"),
+                             "measured.json': ISO 100 colour 1 gives alpha");
+    const std::string oneIso =
+        write("one_iso.json",
+              "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", \"models\": [{\"model\": "
+              "\"M\", \"profiles\": [{\"name\": \"a\", \"iso\": 100, \"a\": " +
+                  list(p1, 0) + ", \"b\": " + list(p1, 1) + "}]}]}]}\n");
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(oneIso, format, 100, "Maker", "M"), "one ISO only");
+    const std::string typo = write("typo.json", "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", "
+                                                "\"modles\": []}]}\n");
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(typo, format, 100, "Maker", "M"), "modles");
+    const std::string shortList =
+        write("short.json", "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", "
+                            "\"models\": [{\"model\": \"M\", \"profiles\": [{\"iso\": 100, "
+                            "\"a\": [1, 2], \"b\": [1, 2, 3]}]}]}]}\n");
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(shortList, format, 100, "Maker", "M"),
+                             "short.json': field 'a' must be a list of 3 numbers");
+}
+
+TEST(RawIo, androidNoiseProfileIsTheDngProfileOfEverySiteAtEverySensitivity)
+{
+    const NoiseModel model(0.42, 1.7, 3.1);
+    const RawFormat format = unevenBlackFormat();
+    const AndroidNoiseProfile p = androidNoiseProfile(model, format, 50);
+    for (double sensitivity : {50.0, 100.0, 800.0, 6400.0}) {
+        const NoiseLine line = model.lineAtGain(sensitivity / 50);
+        for (int site = 0; site < 4; ++site) {
+            const double r = format.whiteLevel - format.blackLevel[site];
+            EXPECT_NEAR(p.A[site] * sensitivity + p.B[site], line.a / r, 1e-15 * line.a / r);
+            EXPECT_NEAR(p.C[site] * sensitivity * sensitivity + p.D[site], line.b / (r * r),
+                        1e-14 * line.b / (r * r));
+        }
+    }
+    const NoiseModel back = noiseModelFromAndroid(p, format, 50);
+    EXPECT_NEAR(back.alpha, model.alpha, 1e-15);
+    EXPECT_NEAR(back.sigmaD2, model.sigmaD2, 1e-14);
+    EXPECT_NEAR(back.sigmaR2, model.sigmaR2, 1e-14);
+
+    AndroidNoiseProfile offset = p;
+    offset.B[2] = 1e-7;
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromAndroid(offset, format, 50), "site 2 has B = 1e-07");
+    AndroidNoiseProfile perColour = p;
+    perColour.C[3] *= 1.01;
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromAndroid(perColour, format, 50), "site 3 gives sigma_d^2");
+    AndroidNoiseProfile nan = p;
+    nan.D[1] = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromAndroid(nan, format, 50), "site 1 has a non-finite value");
+    EXPECT_CV_ERROR_CONTAINS(androidNoiseProfile(model, format, -1), "baseIso");
+}
+
 TEST(RawIo, missingUnreadableAndNonRawFilesNameTheFileAndTheReason)
 {
     const std::string dir = makeTempDir("raw_io_errors");

@@ -59,6 +59,82 @@ CV_RAWGMENT_EXPORTS std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, 
 CV_RAWGMENT_EXPORTS NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& profile,
                                                       const RawFormat& format, CfaChannel channel);
 
+/** @brief A noise model as darktable's noise profiles (the `noiseprofiles.json` that its "denoise
+ * (profiled)" module reads): one profile per ISO, each with per-colour `a` and `b` (red, green, blue)
+ * such that the variance of a signal x normalised to [0, 1] by (white - black) is a x + b.
+ *
+ * A profile at ISO s is the DNG NoiseProfile of the model at gain g = s / baseIso (dngNoiseProfile()):
+ * \f$ a = g\alpha / r \f$, \f$ b = (g^2\sigma_d^2 + \sigma_r^2) / r^2 \f$, r = white - mean black of the
+ * colour's sites. darktable measures its own profiles on raw data before white balance, which is
+ * what this assumes.
+ * @param model the calibrated model
+ * @param format black and white levels of the camera's raw files (its gain is not used)
+ * @param baseIso the ISO at which the model's gain is 1 (finite, > 0)
+ * @param isos the ISOs to write a profile for (each finite and > 0, no repeats; at least one)
+ * @param maker camera maker as darktable names it (e.g. "Canon"); not empty
+ * @param cameraModel camera model as darktable names it (e.g. "EOS 5D Mark II"); not empty
+ * @return the JSON text of a complete noise-profile file with one maker and one model entry; numbers are
+ *         written with 17 significant digits, so noiseModelFromDarktable() gives the model back.
+ * @throws cv::Exception on an invalid argument or a model without shot noise (alpha = 0).
+ */
+CV_RAWGMENT_EXPORTS String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format,
+                                                  double baseIso, const std::vector<double>& isos,
+                                                  const String& maker, const String& cameraModel);
+
+/** @brief The noise model whose darktable noise profiles a file holds, where the mapping is exact.
+ *
+ * Reads the profiles of one maker and model (profiles with `"skip": true` are ignored) and inverts
+ * darktableNoiseProfiles(): \f$ \alpha = a r / g \f$ from every colour and ISO, and \f$ \sigma_d^2 \f$,
+ * \f$ \sigma_r^2 \f$ from the line \f$ b r^2 = g^2\sigma_d^2 + \sigma_r^2 \f$ across ISOs (least squares).
+ * The model has one alpha for all colours and no other terms, so the file's values must agree with one
+ * model to 1e-9 relative; a profile measured by darktable's own tool generally does not, and is refused
+ * with the spread it has rather than averaged silently.
+ * @param path a darktable noise-profile JSON file (read with openFileStorageForReading(); every key is
+ *        checked)
+ * @param format black and white levels of the camera's raw files
+ * @param baseIso the ISO at which the returned model's gain is 1
+ * @param maker, cameraModel the entry to read, compared exactly
+ * @throws cv::Exception naming the file when it is unreadable or malformed, has no such entry, has
+ *         fewer than two distinct ISOs (sigma_d^2 and sigma_r^2 cannot be told apart), or is not of the
+ *         model's form.
+ */
+CV_RAWGMENT_EXPORTS NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format,
+                                                       double baseIso, const String& maker,
+                                                       const String& cameraModel);
+
+/** @brief The noise model in the form of Android's camera tests (the CTS/ITS `dng_noise_model` output
+ * behind `android.sensor.noiseProfile`): for sensitivity s (ISO), the DNG NoiseProfile of each CFA
+ * channel is \f$ S = A s + B \f$ and \f$ O = C s^2 + D \f$.
+ *
+ * The values are per CFA site in the order of the mosaic's 2x2 block read row by row (the order of
+ * Android's `android.sensor.blackLevelPattern`), each normalised by its own range r = white - black of
+ * the site. The form covers analog gain only: Android's tests scale D by the square of any digital
+ * gain above the maximum analog sensitivity, which the model does not describe.
+ */
+struct CV_RAWGMENT_EXPORTS AndroidNoiseProfile
+{
+    Vec4d A; //!< slope of S in sensitivity, per CFA site
+    Vec4d B; //!< S at sensitivity 0, per CFA site (0 for this model)
+    Vec4d C; //!< coefficient of sensitivity squared in O, per CFA site
+    Vec4d D; //!< O at sensitivity 0, per CFA site
+};
+
+/** @brief The Android form of a noise model:
+ * \f$ A = \alpha / (r s_0) \f$, B = 0, \f$ C = \sigma_d^2 / (r s_0)^2 \f$, \f$ D = \sigma_r^2 / r^2 \f$, with
+ * \f$ s_0 \f$ the base ISO (gain g = s / \f$ s_0 \f$) and r = white - black of each CFA site.
+ * @throws cv::Exception on an invalid model, format or base ISO.
+ */
+CV_RAWGMENT_EXPORTS AndroidNoiseProfile androidNoiseProfile(const NoiseModel& model, const RawFormat& format,
+                                                            double baseIso);
+
+/** @brief The noise model of an Android-form profile, where the mapping is exact: B must be 0 (the
+ * model's shot noise is proportional to the gain) and the four sites must give the same
+ * alpha, sigma_d^2 and sigma_r^2 to 1e-9 relative (the model has one set for all colours).
+ * @throws cv::Exception naming the site and the value when the profile is not of the model's form.
+ */
+CV_RAWGMENT_EXPORTS NoiseModel noiseModelFromAndroid(const AndroidNoiseProfile& profile,
+                                                     const RawFormat& format, double baseIso);
+
 /** @brief Reads the Bayer mosaic of a camera RAW file (any format LibRaw reads: DNG, NEF, CR2, CRW, ...).
  *
  * The mosaic is the visible area LibRaw reports (masked borders removed). The CFA pattern is the one

@@ -1,5 +1,8 @@
-"""The DNG NoiseProfile tag (51041) as an independent reader, exiftool, sees it: the values we write are
-the model's, in the layout the DNG specification gives, and they come back through readRaw."""
+"""The noise model in the forms other tools read. The DNG NoiseProfile tag (51041) as an independent
+reader, exiftool, sees it: the values we write are the model's, in the layout the DNG specification gives,
+and they come back through readRaw. darktable's JSON as Python's json module parses it, and the Android
+form, each back to the model."""
+import json
 import shutil
 import subprocess
 
@@ -58,3 +61,34 @@ def test_a_profile_dng_cannot_hold_is_refused(tmp_path):
     with pytest.raises(rg.error, match="1 or 3"):
         rg.writeDng(str(tmp_path / "two.dng"), image)
     assert not any(tmp_path.iterdir())
+
+
+def test_darktable_file_is_json_with_the_layout_darktable_reads(tmp_path):
+    model = rg.NoiseModel(alpha=0.4, sigmaD2=1.5, sigmaR2=3.0)
+    fmt = rg.RawFormat(pattern=rg.CFA_BGGR, blackLevel=(510, 512, 514, 516), whiteLevel=16383)
+    text = rg.darktableNoiseProfiles(model, fmt, 100, [100, 400, 1600], "Maker", "Model")
+    # Python's json module is an independent parser of what we write.
+    doc = json.loads(text)
+    assert doc["version"] == 0
+    entry = doc["noiseprofiles"][0]
+    assert entry["maker"] == "Maker" and entry["models"][0]["model"] == "Model"
+    profiles = entry["models"][0]["profiles"]
+    assert [p["iso"] for p in profiles] == [100, 400, 1600]
+    for p in profiles:
+        fmt.gain = p["iso"] / 100
+        assert list(zip(p["a"], p["b"])) == [tuple(so) for so in rg.dngNoiseProfile(model, fmt)]
+    path = tmp_path / "noiseprofiles.json"
+    path.write_text(text)
+    back = rg.noiseModelFromDarktable(str(path), fmt, 100, "Maker", "Model")
+    assert (back.alpha, back.sigmaD2, back.sigmaR2) == pytest.approx((0.4, 1.5, 3.0), rel=1e-9)
+
+
+def test_android_form_round_trips_and_refuses_what_the_model_cannot_hold():
+    model = rg.NoiseModel(alpha=0.4, sigmaD2=1.5, sigmaR2=3.0)
+    fmt = rg.RawFormat(blackLevel=(64, 64, 64, 64), whiteLevel=1023)
+    profile = rg.androidNoiseProfile(model, fmt, 100)
+    back = rg.noiseModelFromAndroid(profile, fmt, 100)
+    assert (back.alpha, back.sigmaD2, back.sigmaR2) == pytest.approx((0.4, 1.5, 3.0), rel=1e-12)
+    profile.B = (0, 1e-6, 0, 0)
+    with pytest.raises(rg.error, match="site 1 has B"):
+        rg.noiseModelFromAndroid(profile, fmt, 100)

@@ -1,0 +1,475 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The noise model in the forms other tools read (raw_io topic): the DNG NoiseProfile tag (51041), read
+// from a DNG's IFDs because LibRaw 0.20 parses but does not expose it; darktable's noise-profile JSON;
+// the Android camera tests' form.
+#include "precomp.hpp"
+
+#include <opencv2/rawgment/raw_io.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+
+namespace {
+
+//! DNG colour plane (CFAPlaneColor 0, 1, 2) of a CFA site.
+int colourPlaneOf(CfaChannel channel)
+{
+    return channel == CFA_R ? 0 : (channel == CFA_B ? 2 : 1);
+}
+
+//! Bounded reads of a TIFF file of either byte order: every offset is checked against the file's size,
+//! so a hostile file gives an error naming it, never a read outside it.
+class TiffFile
+{
+public:
+    explicit TiffFile(const String& path) : path_(path), in_(path, std::ios::binary)
+    {
+        if (!in_)
+            fail("cannot be opened");
+        in_.seekg(0, std::ios::end);
+        size_ = static_cast<uint64_t>(in_.tellg());
+        char order[2] = {0, 0};
+        bytes(0, order, 2);
+        if (order[0] == 'I' && order[1] == 'I')
+            bigEndian_ = false;
+        else if (order[0] == 'M' && order[1] == 'M')
+            bigEndian_ = true;
+        else
+            fail("is not a TIFF-based file");
+        if (u16(2) != 42)
+            fail("has a TIFF header without the number 42");
+    }
+    bool bigEndian() const { return bigEndian_; }
+    uint16_t u16(uint64_t at)
+    {
+        unsigned char b[2];
+        bytes(at, b, 2);
+        return bigEndian_ ? uint16_t(b[0] << 8 | b[1]) : uint16_t(b[1] << 8 | b[0]);
+    }
+    uint32_t u32(uint64_t at)
+    {
+        unsigned char b[4];
+        bytes(at, b, 4);
+        uint32_t v = 0;
+        for (int k = 0; k < 4; ++k)
+            v |= uint32_t(b[bigEndian_ ? k : 3 - k]) << (8 * (3 - k));
+        return v;
+    }
+    double f64(uint64_t at)
+    {
+        unsigned char b[8];
+        bytes(at, b, 8);
+        uint64_t v = 0;
+        for (int k = 0; k < 8; ++k)
+            v |= uint64_t(b[bigEndian_ ? k : 7 - k]) << (8 * (7 - k));
+        double d;
+        std::memcpy(&d, &v, sizeof(d));
+        return d;
+    }
+    [[noreturn]] void fail(const String& why) const
+    {
+        CV_Error(Error::StsParseError, "readRaw: '" + path_ + "' " + why);
+    }
+
+private:
+    void bytes(uint64_t at, void* out, uint64_t n)
+    {
+        if (at > size_ || n > size_ - at)
+            fail(format("is truncated: a TIFF field at byte %llu lies beyond its end (%llu bytes)",
+                        static_cast<unsigned long long>(at), static_cast<unsigned long long>(size_)));
+        in_.seekg(static_cast<std::streamoff>(at));
+        in_.read(static_cast<char*>(out), static_cast<std::streamsize>(n));
+        if (!in_)
+            fail("could not be read");
+    }
+    String path_;
+    std::ifstream in_;
+    uint64_t size_ = 0;
+    bool bigEndian_ = false;
+};
+
+const uint16_t kTagSubIfds = 330;
+const uint16_t kTagNoiseProfile = 51041;
+const uint16_t kTypeLong = 4, kTypeDouble = 12, kTypeIfd = 13;
+
+//! Searches one IFD for the NoiseProfile, queueing its SubIFDs; returns true when found.
+bool searchIfd(TiffFile& tiff, uint64_t ifd, std::vector<uint64_t>& queue, std::vector<Vec2d>& profile)
+{
+    const uint16_t entries = tiff.u16(ifd);
+    for (uint16_t i = 0; i < entries; ++i) {
+        const uint64_t entry = ifd + 2 + 12ull * i;
+        const uint16_t tag = tiff.u16(entry), type = tiff.u16(entry + 2);
+        const uint32_t count = tiff.u32(entry + 4);
+        if (tag == kTagSubIfds && (type == kTypeLong || type == kTypeIfd)) {
+            if (count == 1)
+                queue.push_back(tiff.u32(entry + 8));
+            else
+                for (uint32_t k = 0; k < count && k < 64; ++k)
+                    queue.push_back(tiff.u32(tiff.u32(entry + 8) + 4ull * k));
+        } else if (tag == kTagNoiseProfile) {
+            if (type != kTypeDouble || (count != 2 && count != 6))
+                tiff.fail(format("has a NoiseProfile tag of type %d with %u values; DNG requires 2 or 2 x 3 "
+                                 "DOUBLE values",
+                                 int(type), count));
+            const uint64_t values = tiff.u32(entry + 8);
+            for (uint32_t k = 0; k < count; k += 2)
+                profile.emplace_back(tiff.f64(values + 8ull * k), tiff.f64(values + 8ull * (k + 1)));
+            return true;
+        }
+    }
+    return false;
+}
+
+} // namespace
+
+namespace detail {
+
+double rangeOfColourPlane(const RawFormat& format, int plane)
+{
+    double black = 0;
+    int sites = 0;
+    for (int site = 0; site < 4; ++site)
+        if (colourPlaneOf(cfaChannelAt(format.pattern, site / 2, site % 2)) == plane) {
+            black += format.blackLevel[site];
+            ++sites;
+        }
+    return format.whiteLevel - black / sites;
+}
+
+//! The NoiseProfile pairs of a TIFF-based file (DNG), empty when it has none or is not TIFF-based.
+std::vector<Vec2d> readDngNoiseProfile(const String& path)
+{
+    {
+        std::ifstream probe(path, std::ios::binary);
+        char head[4] = {0, 0, 0, 0};
+        probe.read(head, 4);
+        const bool tiff = probe && ((head[0] == 'I' && head[1] == 'I' && head[2] == 42 && head[3] == 0) ||
+                                    (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && head[3] == 42));
+        if (!tiff)
+            return {};
+    }
+    TiffFile tiff(path);
+    // IFD0 and the IFDs chained after it, then the SubIFDs they name. A hostile file's loops end at the
+    // first revisit, and the search at 256 IFDs.
+    std::vector<uint64_t> queue;
+    std::set<uint64_t> chained;
+    for (uint64_t ifd = tiff.u32(4); ifd != 0 && chained.size() < 256 && chained.insert(ifd).second;
+         ifd = tiff.u32(ifd + 2 + 12ull * tiff.u16(ifd)))
+        queue.push_back(ifd);
+    std::vector<Vec2d> profile;
+    std::set<uint64_t> searched;
+    for (size_t k = 0; k < queue.size() && searched.size() < 256; ++k)
+        if (searched.insert(queue[k]).second && searchIfd(tiff, queue[k], queue, profile))
+            break;
+    if (!profile.empty()) {
+        try {
+            checkDngNoiseProfile(profile, "the NoiseProfile tag");
+        } catch (const Exception& e) {
+            tiff.fail("has an invalid NoiseProfile: " + e.err);
+        }
+    }
+    return profile;
+}
+
+void checkDngNoiseProfile(const std::vector<Vec2d>& profile, const char* what)
+{
+    if (profile.size() != 1 && profile.size() != 3)
+        CV_Error(Error::StsBadArg,
+                 format("%s: %d (S, O) pairs; a DNG NoiseProfile has 1 or 3 (red, green, blue)", what,
+                        int(profile.size())));
+    for (size_t k = 0; k < profile.size(); ++k)
+        if (!(std::isfinite(profile[k][0]) && std::isfinite(profile[k][1]) && profile[k][0] > 0 &&
+              profile[k][1] >= 0))
+            CV_Error(Error::StsBadArg, format("%s: pair %d is (%g, %g); DNG requires S > 0 and O >= 0", what,
+                                              int(k), profile[k][0], profile[k][1]));
+}
+
+} // namespace detail
+
+std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, const RawFormat& format)
+{
+    format.validate();
+    model.validate();
+    const double g = format.gain;
+    std::vector<Vec2d> profile(3);
+    for (int plane = 0; plane < 3; ++plane) {
+        const double r = detail::rangeOfColourPlane(format, plane);
+        profile[plane] = Vec2d(g * model.alpha / r, (g * g * model.sigmaD2 + model.sigmaR2) / (r * r));
+    }
+    detail::checkDngNoiseProfile(profile, "dngNoiseProfile");
+    return profile;
+}
+
+NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& profile, const RawFormat& format,
+                                  CfaChannel channel)
+{
+    detail::checkDngNoiseProfile(profile, "noiseLineFromDngProfile");
+    format.validate();
+    const int plane = colourPlaneOf(channel);
+    const Vec2d so = profile.size() == 1 ? profile[0] : profile[static_cast<size_t>(plane)];
+    const double r = detail::rangeOfColourPlane(format, plane);
+    NoiseLine line;
+    line.a = so[0] * r;
+    line.b = so[1] * r * r;
+    return line;
+}
+
+namespace {
+
+//! How far values that one exact model produced may disagree after a round trip through 17-digit text.
+const double kExactRelative = 1e-9;
+
+bool agrees(double a, double b)
+{
+    return std::abs(a - b) <= kExactRelative * std::max(std::abs(a), std::abs(b));
+}
+
+void checkBaseIso(double baseIso, const char* who)
+{
+    if (!(std::isfinite(baseIso) && baseIso > 0))
+        CV_Error(Error::StsBadArg, format("%s: baseIso %g must be finite and > 0", who, baseIso));
+}
+
+String jsonString(const String& text)
+{
+    String out = "\"";
+    for (char c : text) {
+        if (c == '"' || c == '\\')
+            out += '\\';
+        if (static_cast<unsigned char>(c) < 0x20)
+            out += format("\\u%04x", int(c));
+        else
+            out += c;
+    }
+    return out + "\"";
+}
+
+String jsonNumber(double v)
+{
+    return format("%.17g", v);
+}
+
+} // namespace
+
+String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format, double baseIso,
+                              const std::vector<double>& isos, const String& maker, const String& cameraModel)
+{
+    const char* who = "darktableNoiseProfiles";
+    checkBaseIso(baseIso, who);
+    if (isos.empty())
+        CV_Error(Error::StsBadArg, "darktableNoiseProfiles: no ISO given");
+    if (maker.empty() || cameraModel.empty())
+        CV_Error(Error::StsBadArg,
+                 "darktableNoiseProfiles: the maker and the camera model must not be empty");
+    std::vector<double> sorted = isos;
+    std::sort(sorted.begin(), sorted.end());
+    for (size_t k = 0; k < sorted.size(); ++k) {
+        if (!(std::isfinite(sorted[k]) && sorted[k] > 0))
+            CV_Error(Error::StsBadArg, cv::format("%s: ISO %g must be finite and > 0", who, sorted[k]));
+        if (k > 0 && sorted[k] == sorted[k - 1])
+            CV_Error(Error::StsBadArg, cv::format("%s: ISO %g is given twice", who, sorted[k]));
+    }
+    std::ostringstream out;
+    out << "{\n  \"version\": 0,\n  \"noiseprofiles\": [\n    {\n      \"maker\": " << jsonString(maker)
+        << ",\n      \"models\": [\n        {\n          \"model\": " << jsonString(cameraModel)
+        << ",\n          \"comment\": \"cv::rawgment: alpha " << jsonNumber(model.alpha) << ", sigma_d^2 "
+        << jsonNumber(model.sigmaD2) << ", sigma_r^2 " << jsonNumber(model.sigmaR2) << " at base ISO "
+        << jsonNumber(baseIso) << "\",\n          \"profiles\": [\n";
+    for (size_t k = 0; k < sorted.size(); ++k) {
+        RawFormat atIso = format;
+        atIso.gain = sorted[k] / baseIso;
+        const std::vector<Vec2d> so = dngNoiseProfile(model, atIso);
+        out << "            {\"name\": " << jsonString(cameraModel + cv::format(" iso %g", sorted[k]))
+            << ", \"iso\": " << jsonNumber(sorted[k]) << ",\n             \"a\": [" << jsonNumber(so[0][0])
+            << ", " << jsonNumber(so[1][0]) << ", " << jsonNumber(so[2][0]) << "],\n             \"b\": ["
+            << jsonNumber(so[0][1]) << ", " << jsonNumber(so[1][1]) << ", " << jsonNumber(so[2][1]) << "]}"
+            << (k + 1 < sorted.size() ? ",\n" : "\n");
+    }
+    out << "          ]\n        }\n      ]\n    }\n  ]\n}\n";
+    return out.str();
+}
+
+NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format, double baseIso,
+                                   const String& maker, const String& cameraModel)
+{
+    checkBaseIso(baseIso, "noiseModelFromDarktable");
+    format.validate();
+    const String where = "noiseModelFromDarktable: '" + path + "'";
+    FileStorage fs = openFileStorageForReading(path, "darktable noise profiles");
+    struct Profile
+    {
+        double iso;
+        std::vector<double> a, b;
+    };
+    std::vector<Profile> profiles;
+    std::vector<String> entries;
+    try {
+        const FileNode root = fs.root();
+        rejectUnknownKeys(root, {"version", "noiseprofiles"});
+        if (!root["noiseprofiles"].isSeq())
+            CV_Error(Error::StsParseError, "expected a list 'noiseprofiles'");
+        for (const FileNode& makerNode : root["noiseprofiles"]) {
+            rejectUnknownKeys(makerNode, {"maker", "models", "comment"});
+            if (!makerNode["maker"].isString() || !makerNode["models"].isSeq())
+                CV_Error(Error::StsParseError, "a maker entry needs a string 'maker' and a list 'models'");
+            for (const FileNode& modelNode : makerNode["models"]) {
+                rejectUnknownKeys(modelNode, {"model", "comment", "profiles"});
+                if (!modelNode["model"].isString() || !modelNode["profiles"].isSeq())
+                    CV_Error(Error::StsParseError,
+                             "a model entry needs a string 'model' and a list 'profiles'");
+                entries.push_back(String(makerNode["maker"]) + " / " + String(modelNode["model"]));
+                if (String(makerNode["maker"]) != maker || String(modelNode["model"]) != cameraModel)
+                    continue;
+                for (const FileNode& p : modelNode["profiles"]) {
+                    rejectUnknownKeys(p, {"name", "iso", "a", "b", "skip", "comment"});
+                    if (!p["skip"].empty() && p["skip"].isInt() && int(p["skip"]) != 0)
+                        continue;
+                    Profile profile{detail::readRealField(p, "iso"), detail::readRealList(p, "a", 3),
+                                    detail::readRealList(p, "b", 3)};
+                    if (!(std::isfinite(profile.iso) && profile.iso > 0))
+                        CV_Error(Error::StsParseError,
+                                 cv::format("ISO %g must be finite and > 0", profile.iso));
+                    profiles.push_back(profile);
+                }
+            }
+        }
+    } catch (const Exception& e) {
+        CV_Error(Error::StsParseError, where + ": " + e.err);
+    }
+    if (profiles.empty()) {
+        String known;
+        for (const String& e : entries)
+            known += (known.empty() ? "" : ", ") + e;
+        CV_Error(Error::StsParseError, where + " has no profile of '" + maker + " / " + cameraModel +
+                                           "' (it has: " + (known.empty() ? String("none") : known) + ")");
+    }
+
+    // alpha from every colour and ISO; sigma_d^2 and sigma_r^2 from b r^2 = g^2 sigma_d^2 + sigma_r^2.
+    double alpha = 0;
+    std::vector<double> x, y;
+    std::set<double> distinct;
+    for (const Profile& p : profiles) {
+        const double g = p.iso / baseIso;
+        distinct.insert(g);
+        for (int plane = 0; plane < 3; ++plane) {
+            const double r = detail::rangeOfColourPlane(format, plane);
+            const double a = p.a[size_t(plane)] * r / g;
+            if (alpha == 0)
+                alpha = a;
+            else if (!agrees(a, alpha))
+                CV_Error(
+                    Error::StsBadArg,
+                    cv::format("%s: ISO %g colour %d gives alpha %.9g where another gives %.9g; the model "
+                               "has one alpha for every colour and ISO, so this profile has no exact "
+                               "counterpart",
+                               where.c_str(), p.iso, plane, a, alpha));
+            x.push_back(g * g);
+            y.push_back(p.b[size_t(plane)] * r * r);
+        }
+    }
+    if (distinct.size() < 2)
+        CV_Error(Error::StsBadArg, where + ": profiles at one ISO only; sigma_d^2 and sigma_r^2 need two");
+    double mx = 0, my = 0;
+    for (size_t k = 0; k < x.size(); ++k) {
+        mx += x[k] / double(x.size());
+        my += y[k] / double(y.size());
+    }
+    double sxx = 0, sxy = 0;
+    for (size_t k = 0; k < x.size(); ++k) {
+        sxx += (x[k] - mx) * (x[k] - mx);
+        sxy += (x[k] - mx) * (y[k] - my);
+    }
+    NoiseModel model;
+    model.alpha = alpha;
+    model.sigmaD2 = sxy / sxx;
+    model.sigmaR2 = my - model.sigmaD2 * mx;
+    const double scale = *std::max_element(y.begin(), y.end());
+    for (size_t k = 0; k < x.size(); ++k)
+        if (std::abs(model.sigmaD2 * x[k] + model.sigmaR2 - y[k]) > kExactRelative * scale)
+            CV_Error(Error::StsBadArg,
+                     cv::format(
+                         "%s: the offsets b r^2 are not on one line in g^2 (%.9g at g^2 = %g where the line "
+                         "gives %.9g); the model has no exact counterpart",
+                         where.c_str(), y[k], x[k], model.sigmaD2 * x[k] + model.sigmaR2));
+    // Rounding can leave a term that is exactly zero a hair below it.
+    if (std::abs(model.sigmaD2) <= kExactRelative * scale)
+        model.sigmaD2 = std::max(model.sigmaD2, 0.0);
+    if (std::abs(model.sigmaR2) <= kExactRelative * scale)
+        model.sigmaR2 = std::max(model.sigmaR2, 0.0);
+    try {
+        model.validate();
+    } catch (const Exception& e) {
+        CV_Error(Error::StsBadArg, where + ": the profiles give an invalid model: " + e.err);
+    }
+    return model;
+}
+
+AndroidNoiseProfile androidNoiseProfile(const NoiseModel& model, const RawFormat& format, double baseIso)
+{
+    checkBaseIso(baseIso, "androidNoiseProfile");
+    model.validate();
+    format.validate();
+    AndroidNoiseProfile p;
+    for (int site = 0; site < 4; ++site) {
+        const double r = format.whiteLevel - format.blackLevel[site];
+        p.A[site] = model.alpha / (r * baseIso);
+        p.B[site] = 0;
+        p.C[site] = model.sigmaD2 / (r * baseIso * r * baseIso);
+        p.D[site] = model.sigmaR2 / (r * r);
+    }
+    return p;
+}
+
+NoiseModel noiseModelFromAndroid(const AndroidNoiseProfile& profile, const RawFormat& format, double baseIso)
+{
+    checkBaseIso(baseIso, "noiseModelFromAndroid");
+    format.validate();
+    NoiseModel model;
+    for (int site = 0; site < 4; ++site) {
+        const double r = format.whiteLevel - format.blackLevel[site];
+        const double values[4] = {profile.A[site], profile.B[site], profile.C[site], profile.D[site]};
+        for (double v : values)
+            if (!std::isfinite(v))
+                CV_Error(Error::StsBadArg,
+                         cv::format("noiseModelFromAndroid: site %d has a non-finite value", site));
+        if (profile.B[site] != 0)
+            CV_Error(Error::StsBadArg,
+                     cv::format(
+                         "noiseModelFromAndroid: site %d has B = %g; the model's shot noise is proportional "
+                         "to the gain (B = 0), so this profile has no exact counterpart",
+                         site, profile.B[site]));
+        const NoiseModel here(profile.A[site] * r * baseIso, profile.C[site] * (r * baseIso) * (r * baseIso),
+                              profile.D[site] * r * r);
+        if (site == 0) {
+            model = here;
+            continue;
+        }
+        const double got[3] = {here.alpha, here.sigmaD2, here.sigmaR2};
+        const double first[3] = {model.alpha, model.sigmaD2, model.sigmaR2};
+        const char* names[3] = {"alpha", "sigma_d^2", "sigma_r^2"};
+        for (int k = 0; k < 3; ++k)
+            if (!agrees(got[k], first[k]))
+                CV_Error(
+                    Error::StsBadArg,
+                    cv::format("noiseModelFromAndroid: site %d gives %s %.9g where site 0 gives %.9g; the "
+                               "model has one set of parameters for every colour, so this profile has no "
+                               "exact counterpart",
+                               site, names[k], got[k], first[k]));
+    }
+    try {
+        model.validate();
+    } catch (const Exception& e) {
+        CV_Error(Error::StsBadArg, "noiseModelFromAndroid: the profile gives an invalid model: " + e.err);
+    }
+    return model;
+}
+
+} // namespace rawgment
+} // namespace cv
