@@ -497,6 +497,59 @@ TEST(Apps, augmentKeepsInputsWithOneStemApartAndNeverTakesAnotherInputsOutput)
     EXPECT_EQ("not a preview", readText(dir + "/single/frame_000_v01_preview.png"));
 }
 
+TEST(Apps, augmentPreviewsAreBrightenedBackAndOutputsKeepTheCaptureTags)
+{
+    // A darkening scene's preview shows its noise at the input's brightness (as the demo's gallery does),
+    // not a dark frame; the output's sidecar and DNG state the capture it simulates.
+    const std::string dir = freshDir("augment_preview");
+    AppRun r = runApp("rawgment_simulate",
+                      "--out='" + dir + "/sim' --frames=3 --gains=6 --levels=0.5 --validation=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string input = dir + "/sim/g06dB_level0.50/frame_000.dng";
+    const std::string model = "--model='" + dir + "/sim/truth_noise_model.yml' ";
+    std::map<double, double> previewMean;
+    for (double photons : {1.0, 0.125}) {
+        const std::string tag = cv::format("x%g", photons);
+        {
+            cv::rawgment::Scene scene;
+            scene.jitter = cv::rawgment::ColorJitter::exposureChange(photons, 2.0);
+            cv::FileStorage fs(dir + "/" + tag + ".yml", cv::FileStorage::WRITE);
+            scene.write(fs, "scene");
+        }
+        r = runApp("rawgment_augment", model + "--scene='" + dir + "/" + tag + ".yml' --out='" + dir + "/" +
+                                           tag + "' --preview=true '" + input + "'");
+        ASSERT_EQ(0, r.status) << r.output;
+        const cv::Mat preview = cv::imread(dir + "/" + tag + "/frame_000_v00_preview.png");
+        ASSERT_FALSE(preview.empty());
+        previewMean[photons] = cv::mean(preview)[1];
+
+        cv::Mat out;
+        const cv::rawgment::MosaicMetadata meta =
+            cv::rawgment::readMosaic(dir + "/" + tag + "/frame_000_v00.dng", out);
+        ASSERT_TRUE(meta.hasCamera);
+        // The input's sidecar has the exact tags; its DNG the ISO rounded to an integer and the exposure
+        // time as a rational (LibRaw gives it back as a float: 1e-7 relative).
+        cv::Mat inMosaic;
+        const cv::rawgment::CameraTags in = cv::rawgment::readMosaic(input, inMosaic).camera;
+        const cv::rawgment::RawImage inDng = cv::rawgment::readRaw(input),
+                                     dng = cv::rawgment::readRaw(dir + "/" + tag + "/frame_000_v00.dng");
+        EXPECT_EQ(inDng.iso, 200) << "rawgment_simulate writes ISO 100 g (g = 6 dB, rounded)";
+        EXPECT_NEAR(in.iso, 100 * cv::rawgment::dbToLinearGain(6), 1e-9);
+        EXPECT_NEAR(meta.camera.iso, in.iso * 2, 1e-9);
+        EXPECT_EQ(dng.iso, std::round(in.iso * 2));
+        EXPECT_NEAR(meta.camera.exposureTime, in.exposureTime * photons, 1e-15);
+        EXPECT_NEAR(dng.exposureTime, in.exposureTime * photons, 1e-6 * in.exposureTime);
+        EXPECT_EQ(dng.make, "cv::rawgment");
+        EXPECT_EQ(dng.model, "simulated sensor");
+        EXPECT_EQ(dng.noiseProfile,
+                  cv::rawgment::dngNoiseProfile(
+                      cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml"), meta.format));
+    }
+    // Unbrightened, x0.125 would be about 0.125^(1/2.2) = 39% of the x1 preview's mean; brightened back it
+    // is the same scene with more noise, whose mean the tone curve's curvature moves by a few percent.
+    EXPECT_NEAR(previewMean[0.125], previewMean[1.0], 0.1 * previewMean[1.0]);
+}
+
 TEST(Apps, demoWritesAReportAndAGallery)
 {
     const std::string dir = freshDir("demo");

@@ -153,8 +153,19 @@ void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe)
     meta.scene = scene;
     meta.seed = job.seed;
     meta.source = job.input;
+    // The output is the camera's capture of the darker or brighter scene: the input's camera tags, with
+    // the ISO scaled by the gain ratio, the exposure time by the photon ratio (of green, which hue leaves
+    // alone) and the noise profile of the model at the output's gain.
+    const double signalRatio = scene.jitter.contrast[cfaSiteOfChannel(m.format.pattern, CFA_G1)];
+    meta.hasCamera = true;
+    meta.camera = m.camera;
+    meta.camera.iso = m.camera.iso * outFormat.gain / m.format.gain;
+    meta.camera.exposureTime = m.camera.exposureTime * signalRatio / scene.jitter.gainRatio;
+    meta.camera.noiseProfile =
+        recipe.model.alpha > 0 ? dngNoiseProfile(recipe.model, outFormat) : std::vector<cv::Vec2d>();
+    // A preview brightened back to the input's level shows the noise the scene added, not a dark frame.
     if (!job.preview.empty())
-        writeNewImage(job.preview, previewOf(out, outFormat));
+        writeNewImage(job.preview, previewOf(out, outFormat, 1.0 / signalRatio));
     writeMosaic(job.out, out, meta);
 }
 

@@ -88,10 +88,14 @@ LoadedMosaic loadMosaicFile(const std::string& path)
     if (pathExists(sidecarPathOf(path))) {
         const MosaicMetadata meta = readMosaic(path, out.mosaic);
         out.format = meta.format;
+        out.hasCamera = meta.hasCamera;
+        out.camera = meta.camera;
     } else {
         RawImage image = readRaw(path);
         out.mosaic = image.mosaic;
         out.format = image.format;
+        out.hasCamera = true;
+        out.camera = CameraTags::of(image);
     }
     return out;
 }

@@ -15,10 +15,15 @@ struct LoadedMosaic
 {
     cv::Mat mosaic;
     cv::rawgment::RawFormat format;
+    bool hasCamera = false; //!< a camera RAW file, or a mosaic whose sidecar has camera tags
+    cv::rawgment::CameraTags camera;
 };
 LoadedMosaic loadMosaicFile(const std::string& path);
 
 // ---------------------------------------------------------------------------------------------------
+//! The ISO that rawgment_simulate writes for unit gain (frames at gain g say ISO 100 g).
+constexpr double kSimulatedBaseIso = 100;
+
 struct SimulateOptions
 {
     std::string outDir;

@@ -153,6 +153,14 @@ SimulateResult simulateBursts(const SimulateOptions& o)
         meta.format = sensor.rawFormat(g);
         meta.source =
             cv::format("simulated colour checker, gain %.2f dB, exposure %.6g", b.gainDb, b.exposure);
+        // Tags as a camera writes them, so that calibration can take the gain from the files: ISO 100 at
+        // unit gain, 1/100 s per unit of exposure (the DNG rounds the ISO to an integer; the sidecar keeps
+        // the exact gain).
+        meta.hasCamera = true;
+        meta.camera.make = "cv::rawgment";
+        meta.camera.model = "simulated sensor";
+        meta.camera.iso = kSimulatedBaseIso * g;
+        meta.camera.exposureTime = 0.01 * b.exposure;
         for (int t = 0; t < b.frames; ++t) {
             const std::string name = b.dir + cv::format("/frame_%03d", t) + o.extension;
             files[i].push_back(name);

@@ -259,6 +259,17 @@ void bindAugment(py::module_& m)
         py::arg("path"), py::arg("data"), py::arg("replace") = false,
         doc("writeFileAtomically", "Python: `data` is a bytes object."));
     m.attr("MAX_TEXT_FILE_BYTES") = MAX_TEXT_FILE_BYTES;
+    py::class_<CameraTags>(m, "CameraTags", doc("CameraTags"))
+        .def(keywordInit<CameraTags>())
+        .def_readwrite("make", &CameraTags::make, doc("CameraTags::make"))
+        .def_readwrite("model", &CameraTags::model, doc("CameraTags::model"))
+        .def_readwrite("iso", &CameraTags::iso, doc("CameraTags::iso"))
+        .def_readwrite("exposureTime", &CameraTags::exposureTime, doc("CameraTags::exposureTime"))
+        .def_readwrite("whiteBalance", &CameraTags::whiteBalance, doc("CameraTags::whiteBalance"))
+        .def_readwrite("cameraToSrgb", &CameraTags::cameraToSrgb, doc("CameraTags::cameraToSrgb"))
+        .def_readwrite("noiseProfile", &CameraTags::noiseProfile, doc("CameraTags::noiseProfile"))
+        .def_static("of", &CameraTags::of, py::arg("image"), doc("CameraTags::of"))
+        .def("applyTo", &CameraTags::applyTo, py::arg("image"), doc("CameraTags::applyTo"));
     py::class_<MosaicMetadata>(m, "MosaicMetadata", doc("MosaicMetadata"))
         .def(keywordInit<MosaicMetadata>())
         .def_readonly_static("FORMAT_VERSION", &MosaicMetadata::FORMAT_VERSION,
@@ -268,6 +279,8 @@ void bindAugment(py::module_& m)
         .def_readwrite("scene", &MosaicMetadata::scene, doc("MosaicMetadata::scene"))
         .def_readwrite("seed", &MosaicMetadata::seed, doc("MosaicMetadata::seed"))
         .def_readwrite("source", &MosaicMetadata::source, doc("MosaicMetadata::source"))
+        .def_readwrite("hasCamera", &MosaicMetadata::hasCamera, doc("MosaicMetadata::hasCamera"))
+        .def_readwrite("camera", &MosaicMetadata::camera, doc("MosaicMetadata::camera"))
         .def_readwrite("size", &MosaicMetadata::size, doc("MosaicMetadata::size"))
         .def_readwrite("type", &MosaicMetadata::type, doc("MosaicMetadata::type"));
     m.def("sidecarPathOf", &sidecarPathOf, py::arg("path"), doc("sidecarPathOf"));

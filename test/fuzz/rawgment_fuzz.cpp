@@ -223,6 +223,11 @@ std::vector<Target> targets(const std::string& dataDir)
                      meta.hasScene = true;
                      meta.scene = seedScene();
                      meta.seed = 77;
+                     meta.hasCamera = true;
+                     meta.camera.make = "Fuzz";
+                     meta.camera.iso = 400;
+                     meta.camera.exposureTime = 0.01;
+                     meta.camera.noiseProfile = {cv::Vec2d(1e-4, 1e-7)};
                      meta.source = "frame_000.dng";
                      const cv::Mat mosaic = seedMosaic(cv::Size(16, 12), 4095, 2);
                      writeMosaic(seedDir + "/mosaic.png", mosaic, meta);

@@ -63,13 +63,14 @@ public:
     {
         std::vector<uint8_t> b;
         for (double x : v) {
-            // The largest power-of-ten denominator up to 10^6 whose numerator still fits 32 bits: six
-            // decimals for ordinary values, fewer for large ones, an error for what no rational holds.
+            // The largest power-of-ten denominator up to 10^9 whose numerator still fits 32 bits: nine
+            // decimals for values below 2 (an exposure time of 1/32000 s, scaled by an augmentation's
+            // photon ratio, keeps its digits), fewer for large ones, an error for what no rational holds.
             const double limit = isSigned ? 2147483647.0 : 4294967295.0;
             if (!std::isfinite(x) || std::abs(x) > limit || (!isSigned && x < 0))
                 CV_Error(Error::StsBadArg, format("writeDng: tag %d: %g does not fit a TIFF %s", int(tag), x,
                                                   isSigned ? "SRATIONAL" : "RATIONAL"));
-            uint32_t den = 1000000;
+            uint32_t den = 1000000000;
             while (den > 1 && std::abs(x) * den > limit)
                 den /= 10;
             const int64_t num = static_cast<int64_t>(std::llround(x * den));

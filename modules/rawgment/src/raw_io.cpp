@@ -182,6 +182,85 @@ RawImage readRaw(const String& path)
 // ---------------------------------------------------------------------------------------------------
 // Mosaics with sidecars.
 
+CameraTags CameraTags::of(const RawImage& image)
+{
+    CameraTags tags;
+    tags.make = image.make;
+    tags.model = image.model;
+    tags.iso = image.iso;
+    tags.exposureTime = image.exposureTime;
+    tags.whiteBalance = image.whiteBalance;
+    tags.cameraToSrgb = image.cameraToSrgb;
+    tags.noiseProfile = image.noiseProfile;
+    return tags;
+}
+
+void CameraTags::applyTo(RawImage& image) const
+{
+    image.make = make;
+    image.model = model;
+    image.iso = iso;
+    image.exposureTime = exposureTime;
+    image.whiteBalance = whiteBalance;
+    image.cameraToSrgb = cameraToSrgb;
+    image.noiseProfile = noiseProfile;
+}
+
+void CameraTags::write(FileStorage& fs, const String& name) const
+{
+    fs << name << "{";
+    fs << "make" << make << "model" << model << "iso" << iso << "exposure_time" << exposureTime;
+    fs << "white_balance" << std::vector<double>(whiteBalance.val, whiteBalance.val + 3);
+    fs << "camera_to_srgb" << std::vector<double>(cameraToSrgb.val, cameraToSrgb.val + 9);
+    std::vector<double> pairs;
+    for (const Vec2d& so : noiseProfile) {
+        pairs.push_back(so[0]);
+        pairs.push_back(so[1]);
+    }
+    fs << "noise_profile" << pairs;
+    fs << "}";
+}
+
+CameraTags CameraTags::read(const FileNode& node)
+{
+    if (node.empty() || !node.isMap())
+        CV_Error(Error::StsParseError, "camera tags: expected a map");
+    rejectUnknownKeys(
+        node, {"make", "model", "iso", "exposure_time", "white_balance", "camera_to_srgb", "noise_profile"});
+    CameraTags tags;
+    const auto text = [&](const char* field) {
+        const FileNode f = node[field];
+        if (!f.empty() && !f.isString())
+            CV_Error(Error::StsParseError, cv::format("camera tags: field '%s' must be a string", field));
+        return f.empty() ? String() : String(f);
+    };
+    tags.make = text("make");
+    tags.model = text("model");
+    tags.iso = detail::readOptionalRealField(node, "iso", 0);
+    tags.exposureTime = detail::readOptionalRealField(node, "exposure_time", 0);
+    if (!(tags.iso >= 0 && std::isfinite(tags.iso) && tags.exposureTime >= 0 &&
+          std::isfinite(tags.exposureTime)))
+        CV_Error(Error::StsParseError, "camera tags: iso and exposure_time must be finite and >= 0");
+    const std::vector<double> wb = detail::readRealList(node, "white_balance", 3);
+    const std::vector<double> m = detail::readRealList(node, "camera_to_srgb", 9);
+    for (int k = 0; k < 3; ++k)
+        tags.whiteBalance[k] = wb[size_t(k)];
+    for (int k = 0; k < 9; ++k)
+        tags.cameraToSrgb.val[k] = m[size_t(k)];
+    const FileNode profile = node["noise_profile"];
+    if (!profile.empty()) {
+        if (!profile.isSeq() || (profile.size() != 0 && profile.size() != 2 && profile.size() != 6))
+            CV_Error(Error::StsParseError,
+                     "camera tags: field 'noise_profile' must be a list of 0, 2 or 6 numbers");
+        const std::vector<double> v = detail::readRealList(node, "noise_profile", int(profile.size()));
+        for (size_t k = 0; k + 1 < v.size(); k += 2)
+            tags.noiseProfile.emplace_back(v[k], v[k + 1]);
+        if (!tags.noiseProfile.empty())
+            detail::checkDngNoiseProfile(tags.noiseProfile, "camera tags: noise_profile");
+    }
+    return tags;
+}
+
 void MosaicMetadata::write(FileStorage& fs, const String& name) const
 {
     format.validate();
@@ -197,6 +276,8 @@ void MosaicMetadata::write(FileStorage& fs, const String& name) const
         // FileStorage has no 64-bit integer: the seed travels as a decimal string.
         fs << "seed" << cv::format("%llu", static_cast<unsigned long long>(seed));
     }
+    if (hasCamera)
+        camera.write(fs, "camera");
     fs << "}";
 }
 
@@ -210,8 +291,8 @@ MosaicMetadata MosaicMetadata::read(const FileNode& node)
             Error::StsParseError,
             cv::format("mosaic metadata: format_version is missing or not one of 1..%d", FORMAT_VERSION));
     try {
-        rejectUnknownKeys(
-            node, {"format_version", "raw_format", "size", "type", "source", "has_scene", "scene", "seed"});
+        rejectUnknownKeys(node, {"format_version", "raw_format", "size", "type", "source", "has_scene",
+                                 "scene", "seed", "camera"});
     } catch (const Exception& e) {
         CV_Error(e.code, "mosaic metadata: " + e.err);
     }
@@ -241,6 +322,9 @@ MosaicMetadata MosaicMetadata::read(const FileNode& node)
                      "mosaic metadata: field 'seed' is missing or not a decimal integer");
         m.seed = static_cast<uint64>(v);
     }
+    m.hasCamera = !node["camera"].empty();
+    if (m.hasCamera)
+        m.camera = CameraTags::read(node["camera"]);
     return m;
 }
 
@@ -440,6 +524,8 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
             RawImage image;
             image.mosaic = mosaic;
             image.format = meta.format;
+            if (meta.hasCamera)
+                meta.camera.applyTo(image);
             writeDng(path, image);
             return;
         }

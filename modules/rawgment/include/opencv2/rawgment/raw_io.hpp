@@ -220,17 +220,44 @@ CV_RAWGMENT_EXPORTS FileStorage openFileStorageForReading(const String& path, co
  */
 CV_RAWGMENT_EXPORTS void rejectUnknownKeys(const FileNode& map, const std::vector<String>& valid);
 
+/** @brief What a RAW file says about its camera and capture beside the mosaic. Augmentation keeps it
+ * (MosaicMetadata::camera), so that an augmented DNG is still the camera's for a raw converter: the same
+ * maker, model, colour matrix and white balance, with the ISO, exposure time and noise profile of the
+ * capture it simulates. */
+struct CV_RAWGMENT_EXPORTS CameraTags
+{
+    String make;                           //!< camera maker, empty when unknown
+    String model;                          //!< camera model, empty when unknown
+    double iso = 0;                        //!< ISO speed, 0 when unknown
+    double exposureTime = 0;               //!< seconds, 0 when unknown
+    Vec3d whiteBalance = Vec3d(1, 1, 1);   //!< as RawImage::whiteBalance
+    Matx33d cameraToSrgb = Matx33d::eye(); //!< as RawImage::cameraToSrgb
+    std::vector<Vec2d> noiseProfile;       //!< as RawImage::noiseProfile; empty for none
+
+    //! The tags of a RAW image (every field but its mosaic and format).
+    static CameraTags of(const RawImage& image);
+    //! Sets these tags on a RAW image (for writeDng()).
+    void applyTo(RawImage& image) const;
+    //! Writes the tags as a map under `name`.
+    void write(FileStorage& fs, const String& name) const;
+    //! Reads tags written by write(). @throws cv::Exception naming an invalid or unknown field.
+    static CameraTags read(const FileNode& node);
+};
+
 /** @brief What a sidecar file says about a mosaic written by writeMosaic(). */
 struct CV_RAWGMENT_EXPORTS MosaicMetadata
 {
-    static constexpr int FORMAT_VERSION = 1; //!< version written to and accepted from files
-    RawFormat format;                        //!< the mosaic's format, with the gain after augmentation
-    bool hasScene = false;                   //!< whether `scene` and `seed` describe how the mosaic was made
-    Scene scene;                             //!< the scene applied to the source
-    uint64 seed = 0;                         //!< the noise seed of that scene
-    String source;                           //!< the file the mosaic was made from (informative)
-    Size size;           //!< the mosaic's size; set by writeMosaic(), checked by readMosaic()
-    int type = CV_16UC1; //!< the mosaic's type; set by writeMosaic(), checked by readMosaic()
+    /** Version written to files; versions 1 (no camera tags) and 2 are read. */
+    static constexpr int FORMAT_VERSION = 2;
+    RawFormat format;       //!< the mosaic's format, with the gain after augmentation
+    bool hasScene = false;  //!< whether `scene` and `seed` describe how the mosaic was made
+    Scene scene;            //!< the scene applied to the source
+    uint64 seed = 0;        //!< the noise seed of that scene
+    String source;          //!< the file the mosaic was made from (informative)
+    bool hasCamera = false; //!< whether `camera` describes the mosaic (a DNG then carries the tags)
+    CameraTags camera;      //!< the camera and capture, when hasCamera
+    Size size;              //!< the mosaic's size; set by writeMosaic(), checked by readMosaic()
+    int type = CV_16UC1;    //!< the mosaic's type; set by writeMosaic(), checked by readMosaic()
 
     //! Writes the metadata as a map under `name`.
     void write(FileStorage& fs, const String& name) const;
@@ -251,8 +278,10 @@ CV_RAWGMENT_EXPORTS String sidecarPathOf(const String& path);
  * cannot be written, the sidecar this call wrote is removed: no sidecar is left without its image.
  * @param path destination image, which must not exist
  * @param mosaic CV_16UC1 (any container) or CV_32FC1 (TIFF only)
- * @param metadata the format, and optionally the scene and seed that made the mosaic (validated)
- * @throws cv::Exception when `path` exists, the type does not fit the container, or a write fails.
+ * @param metadata the format, and optionally the scene and seed that made the mosaic and the camera tags
+ *        (validated); a DNG carries the camera tags when `hasCamera`
+ * @throws cv::Exception when `path` exists, the type does not fit the container, the camera tags do not
+ *         fit a DNG (see writeDng()), or a write fails.
  */
 CV_RAWGMENT_EXPORTS void writeMosaic(const String& path, InputArray mosaic, const MosaicMetadata& metadata);
 

@@ -1,0 +1,74 @@
+"""rawgment_augment on camera RAW files: the augmented DNGs stay the camera's. Make, model, colour matrix and
+white balance are kept; the ISO follows the gain ratio, the exposure time the photon ratio; the NoiseProfile is
+the model's at the output's gain. Checked with exiftool and with LibRaw (readRaw)."""
+import os
+import shutil
+import subprocess
+
+import pytest
+
+import rawgment as rg
+
+PHOTON_RATIO, GAIN_RATIO = 0.125, 4.0
+
+
+def exiftool_values(path, *tags):
+    exiftool = shutil.which("exiftool")
+    if exiftool is None:
+        pytest.fail("exiftool is missing: scripts/install-deps.sh installs it (libimage-exiftool-perl)")
+    run = subprocess.run([exiftool, "-n", "-s", *("-" + t for t in tags), path], capture_output=True,
+                         text=True, check=True)
+    values = {}
+    for line in run.stdout.splitlines():
+        key, _, value = line.partition(":")
+        values[key.strip()] = value.strip()
+    return values
+
+
+def camera_file(name):
+    path = os.path.join(os.environ.get("RAWGMENT_SHARED_DATA_DIR", ""), name)
+    if not os.path.isfile(path):
+        pytest.skip("%s is missing (see ../shared/data/SOURCES.md)" % name)
+    return path
+
+
+@pytest.mark.parametrize("name", ["RAW_NIKON_D1.NEF", "colorchart.dng"])
+def test_augmented_dng_keeps_the_camera_and_states_the_simulated_capture(tmp_path, name):
+    source = camera_file(name)
+    model = rg.NoiseModel(alpha=0.8, sigmaD2=2.0, sigmaR2=6.0)
+    model.save(str(tmp_path / "model.yml"))
+    contrast = PHOTON_RATIO * GAIN_RATIO
+    (tmp_path / "scene.yml").write_text("%%YAML:1.0\nscene: {contrast: [%g, %g, %g, %g], brightness: 0, "
+                                        "gain_ratio: %g}\n" % (contrast, contrast, contrast, contrast, GAIN_RATIO))
+    app = os.path.join(os.environ["RAWGMENT_APP_DIR"], "rawgment_augment")
+    subprocess.run([app, "--model=%s" % (tmp_path / "model.yml"), "--scene=%s" % (tmp_path / "scene.yml"),
+                    "--out=%s" % (tmp_path / "out"), "--preview", source], check=True, capture_output=True)
+    stem = os.path.splitext(name)[0]
+    out = str(tmp_path / "out" / (stem + "_v00.dng"))
+
+    before, after = rg.readRaw(source), rg.readRaw(out)
+    assert (after.make, after.model) == (before.make, before.model)
+    assert after.iso == pytest.approx(before.iso * GAIN_RATIO)
+    # The DNG stores the exposure time as a rational: exact to a part in 1e6 at these values.
+    assert after.exposureTime == pytest.approx(before.exposureTime * PHOTON_RATIO, rel=1e-6)
+    # White balance and colour matrix go through DNG rationals and LibRaw's own normalisation.
+    assert after.whiteBalance == pytest.approx(before.whiteBalance, rel=1e-5)
+    for row_after, row_before in zip(after.cameraToSrgb, before.cameraToSrgb):
+        assert row_after == pytest.approx(row_before, abs=1e-4)
+    after_format = rg.RawFormat(pattern=after.format.pattern, blackLevel=after.format.blackLevel,
+                                whiteLevel=after.format.whiteLevel, gain=GAIN_RATIO)
+    assert after.noiseProfile == [tuple(so) for so in rg.dngNoiseProfile(model, after_format)]
+
+    tags = exiftool_values(out, "Make", "Model", "ISO", "ExposureTime", "NoiseProfile", "UniqueCameraModel")
+    assert tags["Make"] == before.make
+    assert tags["Model"] == before.model
+    assert "cv::rawgment" not in tags["UniqueCameraModel"]
+    if before.iso > 0:
+        assert float(tags["ISO"]) == before.iso * GAIN_RATIO
+    else:
+        assert "ISO" not in tags  # unknown stays unknown
+    profile = [float(v) for v in tags["NoiseProfile"].split()]
+    assert profile == pytest.approx([v for so in after.noiseProfile for v in so], rel=1e-13)
+
+    # The preview's brightness is checked in test/test_apps.cpp (OpenCV reads PNG there).
+    assert os.path.getsize(str(tmp_path / "out" / (stem + "_v00_preview.png"))) > 0
