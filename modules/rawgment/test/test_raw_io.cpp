@@ -527,6 +527,63 @@ TEST(RawIo, linearDngIsNotABayerMosaic)
     EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/linear.dng"), "not a Bayer mosaic");
 }
 
+TEST(RawIo, cameraTagsTravelInTheSidecarAndTheDngAndFirstVersionSidecarsStillLoad)
+{
+    const std::string dir = makeTempDir("raw_io_camera_tags");
+    Mat m16(48, 64, CV_16UC1, Scalar(900));
+    MosaicMetadata meta;
+    meta.format.whiteLevel = 4095;
+    meta.format.blackLevel = Vec4d::all(64);
+    meta.hasCamera = true;
+    meta.camera.make = "Maker";
+    meta.camera.model = "Model";
+    meta.camera.iso = 1234.4;
+    meta.camera.exposureTime = 1.0 / 32000 * 0.3;
+    meta.camera.whiteBalance = Vec3d(2.1, 1, 1.6);
+    meta.camera.cameraToSrgb = Matx33d(1.6, -0.4, -0.2, -0.2, 1.5, -0.3, 0.1, -0.5, 1.4);
+    meta.camera.noiseProfile = {Vec2d(1e-4, 2e-7)};
+    writeMosaic(dir + "/tagged.dng", m16, meta);
+    Mat back;
+    const CameraTags side = readMosaic(dir + "/tagged.dng", back).camera;
+    EXPECT_EQ(side.make, "Maker");
+    EXPECT_EQ(side.iso, 1234.4) << "the sidecar keeps what the DNG rounds";
+    EXPECT_EQ(side.exposureTime, meta.camera.exposureTime);
+    EXPECT_EQ(side.whiteBalance, meta.camera.whiteBalance);
+    EXPECT_EQ(side.cameraToSrgb, meta.camera.cameraToSrgb);
+    EXPECT_EQ(side.noiseProfile, meta.camera.noiseProfile);
+    const RawImage dng = readRaw(dir + "/tagged.dng");
+    EXPECT_EQ(dng.make, "Maker");
+    EXPECT_EQ(dng.model, "Model");
+    EXPECT_EQ(dng.iso, 1234) << "ISOSpeedRatings is an integer";
+    // Nine decimals of the DNG rational, then LibRaw's float: 1e-7 relative.
+    EXPECT_NEAR(dng.exposureTime, meta.camera.exposureTime, 1e-6 * meta.camera.exposureTime);
+    EXPECT_NEAR(norm(Vec3d(dng.whiteBalance) - meta.camera.whiteBalance), 0, 1e-5);
+    EXPECT_EQ(dng.noiseProfile, meta.camera.noiseProfile);
+
+    // The same sidecar as format version 1 wrote it (no camera key) still loads.
+    meta.hasCamera = false;
+    writeMosaic(dir + "/plain.png", m16, meta);
+    std::string text;
+    {
+        const std::vector<char> bytes = readBytes(dir + "/plain.png.yml");
+        text.assign(bytes.begin(), bytes.end());
+    }
+    const size_t at = text.find("format_version: 2");
+    ASSERT_NE(at, std::string::npos) << text;
+    text.replace(at, 17, "format_version: 1");
+    std::remove((dir + "/plain.png.yml").c_str());
+    writeBytes(dir + "/plain.png.yml", std::vector<char>(text.begin(), text.end()));
+    EXPECT_FALSE(readMosaic(dir + "/plain.png", back).hasCamera);
+    // A misspelled camera key is named.
+    text.replace(at, 17, "format_version: 2");
+    text +=
+        "   camera: { make: x, iso: 1, white_balance: [1, 1, 1], camera_to_srgb: [1, 0, 0, 0, 1, 0, 0, 0, 1],"
+        " exposure: 1 }\n";
+    std::remove((dir + "/plain.png.yml").c_str());
+    writeBytes(dir + "/plain.png.yml", std::vector<char>(text.begin(), text.end()));
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/plain.png", back), "exposure");
+}
+
 TEST(RawIo, mosaicRoundTripsWithItsSidecarInEveryContainer)
 {
     const std::string dir = makeTempDir("raw_io_mosaic");
