@@ -65,6 +65,13 @@ void bindCalibration(py::module_& m)
         },
         py::arg("stats"), py::arg("squares"), py::arg("gain"), doc("sampleBurstPatches"));
     m.def(
+        "sampleStaticScene",
+        [](const BurstStatistics& stats, double gain, int maxSamples) {
+            return withoutGil("sampleStaticScene",
+                              [&] { return sampleStaticScene(stats, gain, maxSamples); });
+        },
+        py::arg("stats"), py::arg("gain"), py::arg("maxSamples") = 100000, doc("sampleStaticScene"));
+    m.def(
         "sampleSingleFramePatches",
         [](const py::object& raw, const RawFormat& format, const std::vector<cv::Rect>& squares,
            double gain) {

@@ -3,6 +3,8 @@
 #include "opencv2/rawgment/calibration.hpp"
 #include "precomp.hpp"
 
+#include <algorithm>
+
 namespace cv {
 namespace rawgment {
 
@@ -68,6 +70,65 @@ std::vector<NoiseSample> sampleBurstPatches(const BurstStatistics& stats, const 
                 s.dof = stats.frames() - 1;
                 s.channel = cfaChannelAt(stats.format().pattern, r, c);
                 out.push_back(s);
+            }
+    return out;
+}
+
+std::vector<NoiseSample> sampleStaticScene(const BurstStatistics& stats, double gain, int maxSamples)
+{
+    detail::checkFinitePositive(gain, "sampleStaticScene: gain");
+    if (maxSamples < 4)
+        CV_Error(Error::StsBadArg, format("sampleStaticScene: maxSamples %d must be >= 4", maxSamples));
+    if (stats.frames() < 2)
+        CV_Error(Error::StsBadArg, "sampleStaticScene: the burst needs at least 2 frames");
+    Mat mean, var, clipped;
+    stats.mean(mean);
+    stats.variance(var);
+    stats.clippedMask(clipped);
+    const int border = 4, rows = mean.rows, cols = mean.cols;
+    const int blockRows = (rows - 2 * border) / 2, blockCols = (cols - 2 * border) / 2;
+    if (blockRows < 1 || blockCols < 1)
+        return {};
+    // The smallest step whose grid of blocks (4 pixels each) fits maxSamples.
+    int step = 1;
+    while (double((blockRows + step - 1) / step) * double((blockCols + step - 1) / step) * 4 > maxSamples)
+        ++step;
+    const double frames = stats.frames();
+    std::vector<NoiseSample> out;
+    for (int by = 0; by < blockRows; by += step)
+        for (int bx = 0; bx < blockCols; bx += step)
+            for (int site = 0; site < 4; ++site) {
+                const int r = border + 2 * by + site / 2, c = border + 2 * bx + site % 2;
+                if (clipped.at<uchar>(r, c))
+                    continue;
+                const double mp = mean.at<double>(r, c);
+                // The noise of the means from the median variance of the nine pixels: shake inflates the
+                // variance of the very pixels whose means it smears (at most three of the nine along an
+                // edge), which must not widen their own tolerance; the median ignores them and, unlike the
+                // least variance, stays near the truth for bursts of a few frames.
+                double v[9];
+                int n = 0;
+                bool flat = true;
+                for (int dy = -2; dy <= 2; dy += 2)
+                    for (int dx = -2; dx <= 2; dx += 2) {
+                        flat = flat && !clipped.at<uchar>(r + dy, c + dx);
+                        v[n++] = var.at<double>(r + dy, c + dx);
+                    }
+                std::nth_element(v, v + 4, v + 9);
+                const double vmed = v[4];
+                const double tolerance = 4 * std::sqrt(2 * vmed / frames) + 0.002 * std::abs(mp);
+                for (int dy = -2; dy <= 2 && flat; dy += 2)
+                    for (int dx = -2; dx <= 2 && flat; dx += 2)
+                        flat = std::abs(mean.at<double>(r + dy, c + dx) - mp) <= tolerance;
+                if (!flat)
+                    continue;
+                NoiseSample sample;
+                sample.mean = mp;
+                sample.variance = var.at<double>(r, c);
+                sample.gain = gain;
+                sample.dof = stats.frames() - 1;
+                sample.channel = cfaChannelAt(stats.format().pattern, r, c);
+                out.push_back(sample);
             }
     return out;
 }

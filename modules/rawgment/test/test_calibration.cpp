@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "test_common.hpp"
 
+#include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
@@ -208,6 +209,79 @@ TEST(Calibration, singleFrameModeIsLessExactButRight)
     // 192 samples per gain with a relative spread of sqrt(2 / 141) = 12% each: the slope is known to
     // about 1.5%, so 7.5% is 5 standard errors.
     EXPECT_LT(std::abs(e.alpha), 0.075);
+}
+
+TEST(Calibration, staticSceneSamplingNeedsNoChartAndLeavesOutEdgesThatShakeMoves)
+{
+    ColorCheckerOptions chart;
+    chart.patchSize = 32;
+    chart.border = 8;
+    chart.illumination = 1000;
+    const ColorCheckerScene scene = makeColorCheckerScene(chart);
+    const SensorSimulator sensor(test::referenceSensorParams(), scene.meanAtUnitGain.size());
+    const NoiseModel truth = truthModel();
+    const int frames = 16;
+    // Every other frame of the shaken burst sees the scene two pixels (one CFA block) to the right.
+    Mat shifted;
+    warpAffine(scene.meanAtUnitGain, shifted, Matx23d(1, 0, 2, 0, 1, 0), scene.meanAtUnitGain.size(),
+               INTER_NEAREST, BORDER_REPLICATE);
+    std::vector<NoiseSample> calibration;
+    for (double db : {6.0, 12.0, 24.0})
+        for (double level : {0.2, 0.65}) {
+            const double g = dbToLinearGain(db);
+            BurstStatistics still(sensor.rawFormat(g)), shaken(sensor.rawFormat(g));
+            for (int t = 0; t < frames; ++t) {
+                Mat raw;
+                sensor.capture(scene.meanAtUnitGain, g, level * 3839 / (g * 1000), 91, t, raw);
+                still.add(raw);
+                sensor.capture(t % 2 ? shifted : scene.meanAtUnitGain, g, level * 3839 / (g * 1000), 92, t,
+                               raw);
+                shaken.add(raw);
+            }
+            const std::vector<NoiseSample> s = sampleStaticScene(still, g);
+            calibration.insert(calibration.end(), s.begin(), s.end());
+            // Under shake, the kept pixels have the model's variance (each ratio has relative spread
+            // sqrt(2 / 15) = 37%; over thousands of pixels the mean's is under 1%, so 3% is > 3 standard
+            // errors), while the patch edges the shake moved have several times more.
+            const std::vector<NoiseSample> kept = sampleStaticScene(shaken, g);
+            ASSERT_GT(kept.size(), 5000u);
+            double ratio = 0;
+            for (const NoiseSample& k : kept)
+                ratio += k.variance / truth.variance(k.mean, g) / double(kept.size());
+            EXPECT_NEAR(ratio, 1.0, 0.03) << db << " dB, level " << level;
+            Mat var;
+            shaken.variance(var);
+            Mat mean;
+            shaken.mean(mean);
+            double edgeRatio = 0;
+            int edges = 0;
+            for (const Rect& patch : scene.patches) {
+                const int r = patch.y + patch.height / 2, c = patch.x; // on the patch's left edge
+                edgeRatio += var.at<double>(r, c) / truth.variance(mean.at<double>(r, c), g);
+                ++edges;
+            }
+            EXPECT_GT(edgeRatio / edges, 2.0) << "the shake must be visible for the test to mean anything";
+        }
+    // Without a chart, from the pixels the rule keeps: at least as many per burst as the chart protocol's
+    // 24 squares, with 16 frames instead of 100, so its spread is about 2.5 times the chart protocol's
+    // (0.08%, 0.45%, 1.7%, see above): 1%, 6% and 15% are 5, 5 and 3.5 of those standard deviations.
+    const CalibrationReport r = calibrateNoiseModel(calibration);
+    const Errors e = relativeErrors(r.model, truth);
+    std::cout << "no chart, 16 frames: " << e << " from " << calibration.size() << " pixels\n";
+    EXPECT_LT(std::abs(e.alpha), 0.01);
+    EXPECT_LT(std::abs(e.sigmaD2), 0.06);
+    EXPECT_LT(std::abs(e.sigmaR2), 0.15);
+
+    BurstStatistics two(sensor.rawFormat(1));
+    Mat raw;
+    sensor.capture(scene.meanAtUnitGain, 1, 1, 5, 0, raw);
+    EXPECT_CV_ERROR_CONTAINS(sampleStaticScene(two, 1), "at least 2 frames");
+    two.add(raw);
+    sensor.capture(scene.meanAtUnitGain, 1, 1, 5, 1, raw);
+    two.add(raw);
+    EXPECT_LE(sampleStaticScene(two, 1, 400).size(), 400u);
+    EXPECT_GT(sampleStaticScene(two, 1, 400).size(), 200u) << "the grid fills most of its budget";
+    EXPECT_CV_ERROR_CONTAINS(sampleStaticScene(two, 1, 3), "maxSamples");
 }
 
 TEST(Calibration, burstStatisticsMarkClippedPixelsAndCheckFrames)

@@ -90,6 +90,26 @@ CV_RAWGMENT_EXPORTS std::vector<Rect> cfaAlignedSquares(const std::vector<Rect>&
 CV_RAWGMENT_EXPORTS std::vector<NoiseSample>
 sampleBurstPatches(const BurstStatistics& stats, const std::vector<Rect>& squares, double gain);
 
+/** @brief The temporal noise samples of a burst of any static scene, without a chart: unclipped pixels
+ * away from edges, on a regular grid of whole 2x2 blocks.
+ *
+ * Temporal statistics need no uniform patch: each pixel is its own patch. What they need is a scene that
+ * did not move, and a shaken tripod or a breathing lens moves edges, which turns into variance. So a
+ * pixel is kept only when the temporal means of its eight same-colour neighbours (two pixels away) all
+ * lie within \f$ 4\sqrt{2 v_{med} / T} + 0.002|\mu_p| \f$ of its own mean, with \f$ v_{med} \f$ the median
+ * temporal variance of the nine pixels and T the frames: a neighbourhood flat within the noise of a
+ * difference of means (the median sets it, because shake inflates the variance of the very pixels it
+ * smears, at most three of the nine along an edge) and a 0.2% allowance for smooth shading, whose own shake adds under 1% of the shot
+ * noise. Neither the pixels within 4 of the frame's border nor clipped pixels (or pixels next to them)
+ * are sampled; dark frames (a lens cap) pass as flat scenes.
+ * @param stats statistics of a burst with at least 2 frames
+ * @param gain linear gain of the burst (stored in the samples)
+ * @param maxSamples at most this many samples (>= 4): the grid's step in blocks grows until the frame's
+ *        blocks fit, so a 12-megapixel burst costs no more than a small one
+ */
+CV_RAWGMENT_EXPORTS std::vector<NoiseSample> sampleStaticScene(const BurstStatistics& stats, double gain,
+                                                               int maxSamples = 100000);
+
 /** @brief Single-frame mode: the spatial mean and variance of each CFA plane of each square.
  *
  * A plane a + b x + c y is fitted to each square's CFA plane and removed first, which takes out the
