@@ -12,7 +12,7 @@ int main(int argc, char** argv)
 {
     const char* keys =
         "{help h usage ? |       | print this message }"
-        "{@manifest      |       | calibration manifest (YAML) }"
+        "{@manifest      |       | calibration manifest (YAML/JSON), or a folder of burst folders }"
         "{out o          |       | output directory (required) }"
         "{method         | joint | joint (default, beyond the paper) or two-stage (the paper) }"
         "{side           | 24    | square side when the manifest says patches: detect }"
@@ -23,14 +23,22 @@ int main(int argc, char** argv)
         return 2;
     rawgment_apps::installInterruptCleanup();
     cv::CommandLineParser parser(argc, argv, keys);
-    parser.about("rawgment_calibrate: alpha, sigma_d^2, sigma_r^2 from bursts of a colour checker\n\n"
-                 "Manifest:\n"
-                 "  calibration_manifest:\n"
-                 "    patches: patches.yml        # squares (sample_colorchecker_patches), or: detect\n"
-                 "    bursts:\n"
-                 "      - { gain_db: 6, files: [ g6/frame_000.dng, g6/frame_001.dng, ... ] }\n"
-                 "Paths are relative to the manifest. Writes noise_model.yml, calibration_report.yml,\n"
-                 "samples.csv, lines.csv, shapiro.csv and PNG plots into --out; never overwrites them.");
+    parser.about(
+        "rawgment_calibrate: alpha, sigma_d^2, sigma_r^2 from bursts of a static scene\n\n"
+        "Manifest:\n"
+        "  calibration_manifest:\n"
+        "    patches: detect    # cv::mcc finds the chart; or none: any static scene; or patches.yml\n"
+        "    base_iso: 100      # optional: the ISO of gain 1 (default: the lowest ISO of the files)\n"
+        "    bursts:\n"
+        "      - { files: [ iso100/a.dng, iso100/b.dng, ... ] }           # gain from the files' ISO\n"
+        "      - { gain_db: 12, files: [ ... ] }                          # or as given\n"
+        "      - { dark: true, files: [ dark400/a.dng, ... ] }            # lens cap: pins read noise\n"
+        "Or a folder with one folder of frames per burst (names starting with 'dark': dark\n"
+        "frames), every gain from the ISO, no chart. The frames of a burst must share ISO,\n"
+        "exposure, size and levels. Paths are relative to the manifest. Writes noise_model.yml,\n"
+        "calibration_report.yml, samples.csv, lines.csv, shapiro.csv, PNG plots and, with gains\n"
+        "from ISO, darktable_noiseprofiles.json and android_noise_profile.yml into --out; never\n"
+        "overwrites them.");
     if (parser.has("help")) {
         parser.printMessage();
         return 0;

@@ -24,6 +24,7 @@ int main(int argc, char** argv)
         "{outliers       | 0        | sensor: fraction of hot + dead + noisy pixels }"
         "{seed           | 1        | noise seed }"
         "{format         | dng      | frame container: dng, png or tif }"
+        "{dark           | false    | also a burst of dark frames (no light, as under a lens cap) per gain }"
         "{validation     | true     | also write the bright and x0.5, x0.1 bursts for rawgment_validate }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_simulate"))
         return 2;
@@ -50,6 +51,7 @@ int main(int argc, char** argv)
         o.seed = parser.get<uint64_t>("seed");
         o.extension = "." + parser.get<std::string>("format");
         o.validation = parser.get<bool>("validation");
+        o.dark = parser.get<bool>("dark");
         if (!parser.check() || o.outDir.empty()) {
             parser.printErrors();
             std::cerr << "rawgment_simulate: --out is required (see --help)\n";

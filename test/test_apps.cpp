@@ -142,7 +142,8 @@ TEST(Apps, badManifestsAreErrorsNamingTheKeyOrTheFile)
                                   << "  bursts:\n    - { gain_db: 6, files: [a.dng] }\n";
     AppRun r = runApp("rawgment_calibrate", "'" + dir + "/m.yml' --out='" + dir + "/cal'");
     EXPECT_EQ(1, r.status) << r.output;
-    EXPECT_NE(std::string::npos, r.output.find("unknown key 'patchs' (valid keys: patches, bursts)"))
+    EXPECT_NE(std::string::npos,
+              r.output.find("unknown key 'patchs' (valid keys: patches, base_iso, bursts)"))
         << r.output;
     std::ofstream(dir + "/twice.yml") << "%YAML:1.0\ncalibration_manifest:\n  bursts:\n"
                                       << "    - { gain_db: 6, files: [a.dng, b.dng, a.dng] }\n";
@@ -154,6 +155,26 @@ TEST(Apps, badManifestsAreErrorsNamingTheKeyOrTheFile)
     r = runApp("rawgment_calibrate", "'" + dir + "/b.yml' --out='" + dir + "/cal2'");
     EXPECT_EQ(1, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("unknown key 'gain'")) << r.output;
+    std::ofstream(dir + "/dark.yml")
+        << "%YAML:1.0\ncalibration_manifest:\n  bursts:\n    - { dark: maybe, files: [a.dng] }\n";
+    r = runApp("rawgment_calibrate", "'" + dir + "/dark.yml' --out='" + dir + "/cal4'");
+    EXPECT_NE(std::string::npos, r.output.find("'dark' must be true or false")) << r.output;
+    std::ofstream(dir + "/iso.yml") << "%YAML:1.0\ncalibration_manifest:\n  base_iso: -100\n  bursts:\n"
+                                    << "    - { files: [a.dng] }\n";
+    r = runApp("rawgment_calibrate", "'" + dir + "/iso.yml' --out='" + dir + "/cal5'");
+    EXPECT_NE(std::string::npos, r.output.find("'base_iso' must be a finite number > 0")) << r.output;
+    // A mosaic that does not say its ISO needs a gain_db.
+    {
+        cv::rawgment::MosaicMetadata meta;
+        for (const char* name : {"/u0.png", "/u1.png"})
+            cv::rawgment::writeMosaic(dir + name, cv::Mat(16, 16, CV_16UC1, cv::Scalar(500)), meta);
+    }
+    std::ofstream(dir + "/noiso.yml") << "%YAML:1.0\ncalibration_manifest:\n  patches: none\n  bursts:\n"
+                                      << "    - { files: [u0.png, u1.png] }\n";
+    r = runApp("rawgment_calibrate", "'" + dir + "/noiso.yml' --out='" + dir + "/cal6'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("u0.png' does not say its ISO: give this burst a gain_db"))
+        << r.output;
     // A word where a number belongs was read as 0 (gain 0 dB, factor 0) before the manifest had a reader.
     cv::rawgment::NoiseModel(1, 1, 1).save(dir + "/model.yml");
     const auto validate = [&](const std::string& fields, const std::string& target, const char* expected) {
@@ -548,6 +569,95 @@ TEST(Apps, augmentPreviewsAreBrightenedBackAndOutputsKeepTheCaptureTags)
     // Unbrightened, x0.125 would be about 0.125^(1/2.2) = 39% of the x1 preview's mean; brightened back it
     // is the same scene with more noise, whose mean the tone curve's curvature moves by a few percent.
     EXPECT_NEAR(previewMean[0.125], previewMean[1.0], 0.1 * previewMean[1.0]);
+}
+
+TEST(Apps, calibrateTakesTheGainsFromTheFilesIsoWithOrWithoutAChart)
+{
+    // A user's own camera: DNG bursts that carry their ISO, no gain_db anywhere, no sidecars (so every
+    // number comes from the files as LibRaw reads them). Gains 2, 4 and 16 give integer ISOs 200, 400
+    // and 1600, which the DNG holds exactly.
+    const std::string dir = freshDir("calibrate_iso");
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir +
+                                               "/sim' --frames=16 --gains=6.0206,12.0412,24.0824 "
+                                               "--levels=0.2,0.65 --dark=true --validation=false --seed=9");
+    ASSERT_EQ(0, r.status) << r.output;
+    const cv::rawgment::NoiseModel truth = cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
+    std::ostringstream files;
+    std::vector<std::string> folders;
+    for (const char* gain : {"6.02", "12.04", "24.08"})
+        for (const char* level : {"0.20", "0.65"}) {
+            const std::string folder = cv::format("g%sdB_level%s", gain, level);
+            folders.push_back(folder);
+            files << "    - files: [";
+            for (int t = 0; t < 16; ++t) {
+                ASSERT_EQ(
+                    0,
+                    std::remove(
+                        cv::format("%s/sim/%s/frame_%03d.dng.yml", dir.c_str(), folder.c_str(), t).c_str()));
+                files << (t ? ", " : "") << cv::format("sim/%s/frame_%03d.dng", folder.c_str(), t);
+            }
+            files << "]\n";
+        }
+    for (const char* dark : {"dark_g6.02dB", "dark_g12.04dB", "dark_g24.08dB"})
+        for (int t = 0; t < 16; ++t)
+            ASSERT_EQ(0,
+                      std::remove(cv::format("%s/sim/%s/frame_%03d.dng.yml", dir.c_str(), dark, t).c_str()));
+    std::ofstream(dir + "/chart.yml") << "%YAML:1.0\ncalibration_manifest:\n  patches: sim/patches.yml\n"
+                                      << "  base_iso: 100\n  bursts:\n"
+                                      << files.str();
+    std::ofstream(dir + "/chartless.yml") << "%YAML:1.0\ncalibration_manifest:\n  patches: none\n"
+                                          << "  base_iso: 100\n  bursts:\n"
+                                          << files.str();
+    // Spreads measured over seeds 1-8 of this very simulation (16 frames; rawgment_simulate --seed=S, then
+    // rawgment_calibrate on its manifest, with and without patches: none): with the chart, alpha 0.16%,
+    // sigma_d^2 0.65%, sigma_r^2 11.7%; without a chart (twice the pixels, seeds 1-4) alpha 0.1%,
+    // sigma_d^2 0.2%, sigma_r^2 3.9%. sigma_r^2 is a small part of every offset here (0.9 of 6.9 DN^2 at
+    // the lowest gain), hence its spread. The bounds are about 4 of those spreads.
+    const auto expectTruth = [&](const cv::rawgment::NoiseModel& fitted, double scale, double sigmaR2Bound,
+                                 const std::string& what) {
+        EXPECT_NEAR(fitted.alpha, truth.alpha * scale, 0.01 * truth.alpha * scale) << what;
+        EXPECT_NEAR(fitted.sigmaD2, truth.sigmaD2 * scale * scale, 0.03 * truth.sigmaD2 * scale * scale)
+            << what;
+        EXPECT_NEAR(fitted.sigmaR2, truth.sigmaR2, sigmaR2Bound * truth.sigmaR2) << what;
+    };
+    for (const char* mode : {"chart", "chartless"}) {
+        r = runApp("rawgment_calibrate",
+                   "'" + dir + "/" + mode + ".yml' --out='" + dir + "/cal_" + mode + "' --plots=false");
+        ASSERT_EQ(0, r.status) << r.output;
+        EXPECT_NE(std::string::npos, r.output.find("from ISO 1600 relative to base ISO 100 (manifest)"))
+            << r.output;
+        const cv::rawgment::NoiseModel fitted =
+            cv::rawgment::NoiseModel::load(dir + "/cal_" + mode + "/noise_model.yml");
+        expectTruth(fitted, 1.0, std::string(mode) == "chart" ? 0.47 : 0.16, mode);
+        // The profile for darktable gives the same model back.
+        cv::rawgment::RawFormat format =
+            cv::rawgment::readRaw(dir + "/sim/g6.02dB_level0.20/frame_000.dng").format;
+        const cv::rawgment::NoiseModel viaDarktable =
+            cv::rawgment::noiseModelFromDarktable(dir + "/cal_" + mode + "/darktable_noiseprofiles.json",
+                                                  format, 100, "cv::rawgment", "simulated sensor");
+        EXPECT_NEAR(viaDarktable.alpha, fitted.alpha, 1e-9 * fitted.alpha);
+        EXPECT_TRUE(exists(dir + "/cal_" + mode + "/android_noise_profile.yml"));
+    }
+
+    // A folder of burst folders, with the dark frames (lens cap) in the dark_* folders: gains relative to
+    // the lowest ISO present (200), so the model's gain 1 is the simulator's gain 2 and its per-gain terms
+    // are alpha g and sigma_d^2 g^2 at g = 2. Dark frames pin the read noise: over seeds 1-6 of this
+    // simulation the spread of sigma_r^2 is 0.5% (11.7% with the chart alone), of sigma_d^2 0.07%, so 3%
+    // is 6 spreads.
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim' --out='" + dir + "/cal_folder' --plots=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("relative to base ISO 200 (the lowest in the files)"))
+        << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("dark_g24.08dB/frame_000.dng, dark): gain 18.06 dB"))
+        << r.output;
+    expectTruth(cv::rawgment::NoiseModel::load(dir + "/cal_folder/noise_model.yml"), 2.0, 0.03, "folder");
+
+    // A frame of another ISO in a burst is refused by name.
+    std::ifstream src(dir + "/sim/g12.04dB_level0.20/frame_000.dng", std::ios::binary);
+    std::ofstream(dir + "/sim/g6.02dB_level0.20/frame_999.dng", std::ios::binary) << src.rdbuf();
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim' --out='" + dir + "/cal_mixed' --plots=false");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("frame_999.dng' says ISO 400 where")) << r.output;
 }
 
 TEST(Apps, demoWritesAReportAndAGallery)

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -18,35 +19,123 @@ namespace rawgment_apps {
 
 using namespace cv::rawgment;
 
+namespace {
+
+//! A manifest made from a folder of burst folders.
+CalibrationManifest manifestOfFolder(const std::string& dir)
+{
+    CalibrationManifest manifest;
+    manifest.patches = "none";
+    std::vector<std::string> folders;
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+        if (entry.is_directory())
+            folders.push_back(entry.path().string());
+    std::sort(folders.begin(), folders.end());
+    for (const std::string& folder : folders) {
+        CalibrationManifest::Burst burst;
+        burst.dark = std::filesystem::path(folder).filename().string().rfind("dark", 0) == 0;
+        for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+            const std::string name = entry.path().filename().string();
+            // Sidecars (<image>.yml) belong to their images; hidden files to nobody.
+            const bool sidecar = name.size() > 4 && name.compare(name.size() - 4, 4, ".yml") == 0;
+            if (entry.is_regular_file() && !sidecar && name[0] != '.')
+                burst.files.push_back(entry.path().string());
+        }
+        std::sort(burst.files.begin(), burst.files.end());
+        if (!burst.files.empty())
+            manifest.bursts.push_back(burst);
+    }
+    if (manifest.bursts.empty())
+        throw std::runtime_error("'" + dir + "' has no folder of frames (one folder per burst)");
+    return manifest;
+}
+
+} // namespace
+
 CalibrationManifest readCalibrationManifest(const std::string& path)
 {
+    if (std::filesystem::is_directory(path))
+        return manifestOfFolder(path);
     cv::FileStorage fs = openFileStorageForReading(path, "calibration manifest");
     const cv::FileNode root = fs["calibration_manifest"];
     if (!root.isMap() || !root["bursts"].isSeq() || root["bursts"].size() == 0)
         throw std::runtime_error("'" + path +
                                  "': expected a map 'calibration_manifest' with a list 'bursts'");
-    requireKnownKeys(root, {"patches", "bursts"}, "'" + path + "'");
+    requireKnownKeys(root, {"patches", "base_iso", "bursts"}, "'" + path + "'");
     const std::string base = directoryOf(path);
     CalibrationManifest manifest;
     const cv::FileNode patches = root["patches"];
     if (!patches.empty() && !patches.isString())
         throw std::runtime_error("'" + path +
-                                 "': 'patches' must be \"detect\" or the path of a chart patches "
+                                 "': 'patches' must be \"detect\", \"none\" or the path of a chart patches "
                                  "file");
     const std::string value = patches.empty() ? std::string("detect") : std::string(patches);
-    manifest.patches = value == "detect" ? value : resolvePath(base, value);
+    manifest.patches = value == "detect" || value == "none" ? value : resolvePath(base, value);
+    const cv::FileNode baseIso = root["base_iso"];
+    if (!baseIso.empty()) {
+        if (!(baseIso.isReal() || baseIso.isInt()) || !(double(baseIso) > 0) ||
+            !std::isfinite(double(baseIso)))
+            throw std::runtime_error("'" + path + "': 'base_iso' must be a finite number > 0");
+        manifest.hasBaseIso = true;
+        manifest.baseIso = double(baseIso);
+    }
     for (const cv::FileNode& b : root["bursts"]) {
         const std::string where = cv::format("'%s' burst %zu", path.c_str(), manifest.bursts.size() + 1);
-        requireKnownKeys(b, {"gain_db", "level", "files"}, where);
-        if (b["gain_db"].empty() || !(b["gain_db"].isReal() || b["gain_db"].isInt()))
-            throw std::runtime_error(where + ": 'gain_db' is missing or not a number");
-        const double gainDb = double(b["gain_db"]);
-        if (!std::isfinite(gainDb))
-            throw std::runtime_error(where + ": 'gain_db' is not finite");
-        manifest.bursts.push_back({gainDb, readFileList(b["files"], base, where)});
+        requireKnownKeys(b, {"gain_db", "level", "dark", "files"}, where);
+        CalibrationManifest::Burst burst;
+        if (!b["gain_db"].empty()) {
+            if (!(b["gain_db"].isReal() || b["gain_db"].isInt()))
+                throw std::runtime_error(where + ": 'gain_db' is not a number");
+            burst.hasGainDb = true;
+            burst.gainDb = double(b["gain_db"]);
+            if (!std::isfinite(burst.gainDb))
+                throw std::runtime_error(where + ": 'gain_db' is not finite");
+        }
+        if (!b["dark"].empty()) {
+            if (!b["dark"].isInt() || (int(b["dark"]) != 0 && int(b["dark"]) != 1))
+                throw std::runtime_error(where + ": 'dark' must be true or false");
+            burst.dark = int(b["dark"]) != 0;
+        }
+        burst.files = readFileList(b["files"], base, where);
+        manifest.bursts.push_back(burst);
     }
     return manifest;
 }
+
+namespace {
+
+//! What must be the same in every frame of a burst; the first frame's, compared with each other frame's.
+void requireSameCapture(const LoadedMosaic& first, const std::string& firstPath, const LoadedMosaic& m,
+                        const std::string& path)
+{
+    std::string what;
+    if (m.mosaic.size() != first.mosaic.size())
+        what = cv::format("is %dx%d where '%s' is %dx%d", m.mosaic.cols, m.mosaic.rows, firstPath.c_str(),
+                          first.mosaic.cols, first.mosaic.rows);
+    else if (m.format.pattern != first.format.pattern || m.format.blackLevel != first.format.blackLevel ||
+             m.format.whiteLevel != first.format.whiteLevel)
+        what = "has other levels or another CFA pattern than '" + firstPath + "'";
+    else if (m.camera.iso != first.camera.iso)
+        what = cv::format("says ISO %g where '%s' says ISO %g", m.camera.iso, firstPath.c_str(),
+                          first.camera.iso);
+    else if (m.camera.exposureTime != first.camera.exposureTime)
+        what = cv::format("has exposure time %g s where '%s' has %g s", m.camera.exposureTime,
+                          firstPath.c_str(), first.camera.exposureTime);
+    if (!what.empty())
+        throw std::runtime_error("'" + path + "' " + what +
+                                 ": the frames of a burst must share ISO, exposure, size and levels");
+}
+
+//! Positions spread over the frame, away from its border, for the Shapiro-Wilk test without squares.
+std::vector<cv::Rect> frameGridSquares(cv::Size size)
+{
+    const int border = 8;
+    if (size.width <= 2 * border || size.height <= 2 * border)
+        return {cv::Rect(0, 0, size.width & ~1, size.height & ~1)};
+    return {cv::Rect(border, border, (size.width - 2 * border) & ~1, (size.height - 2 * border) & ~1)};
+}
+
+} // namespace
 
 CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
 {
@@ -73,13 +162,51 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     size_t totalFrames = 0;
     for (const CalibrationManifest::Burst& spec : specs)
         totalFrames += spec.files.size();
-    const std::vector<cv::Rect> squares =
-        manifestSquares(manifest.patches, specs.front().files.front(), o.side, result.notes);
 
-    // Shapiro-Wilk positions, the same in every burst: every k-th pixel of the squares, at most
-    // shapiroPixels of them.
+    // The gain of each burst: the manifest's gain_db, or the ISO of its first frame relative to the base
+    // ISO (the manifest's, or the lowest that a burst without gain_db has).
+    std::vector<double> isos(specs.size(), 0.0);
+    cv::Size frameSize;
+    for (size_t i = 0; i < specs.size(); ++i) {
+        const LoadedMosaic first = loadMosaicFile(specs[i].files.front());
+        if (i == 0) {
+            frameSize = first.mosaic.size();
+            result.camera = first.camera;
+        }
+        isos[i] = first.camera.iso;
+        if (!specs[i].hasGainDb && !(isos[i] > 0))
+            throw std::runtime_error("'" + specs[i].files.front() +
+                                     "' does not say its ISO: give this burst a gain_db in a manifest");
+    }
+    result.baseIso = manifest.hasBaseIso ? manifest.baseIso : 0.0;
+    for (size_t i = 0; i < specs.size(); ++i)
+        if (!manifest.hasBaseIso && !specs[i].hasGainDb && (result.baseIso == 0 || isos[i] < result.baseIso))
+            result.baseIso = isos[i];
+    std::vector<double> gainsDb(specs.size());
+    for (size_t i = 0; i < specs.size(); ++i) {
+        gainsDb[i] = specs[i].hasGainDb ? specs[i].gainDb : linearGainToDb(isos[i] / result.baseIso);
+        result.notes.push_back(
+            specs[i].hasGainDb
+                ? cv::format("burst %zu (%s%s): gain %.2f dB from the manifest", i + 1,
+                             specs[i].files.front().c_str(), specs[i].dark ? ", dark" : "", gainsDb[i])
+                : cv::format("burst %zu (%s%s): gain %.2f dB from ISO %g relative to base ISO %g%s", i + 1,
+                             specs[i].files.front().c_str(), specs[i].dark ? ", dark" : "", gainsDb[i],
+                             isos[i], result.baseIso,
+                             manifest.hasBaseIso ? " (manifest)" : " (the lowest in the files)"));
+    }
+
+    const bool chartless = manifest.patches == "none";
+    const std::vector<cv::Rect> squares =
+        chartless ? std::vector<cv::Rect>()
+                  : manifestSquares(manifest.patches, specs.front().files.front(), o.side, result.notes);
+    if (chartless)
+        result.notes.push_back(
+            "no chart: every unclipped pixel away from edges is a sample (sampleStaticScene)");
+
+    // Shapiro-Wilk positions, the same in every burst: every k-th pixel of the squares (of the frame
+    // without a chart), at most shapiroPixels of them.
     std::vector<cv::Point> positions;
-    for (const cv::Rect& s : squares)
+    for (const cv::Rect& s : chartless ? frameGridSquares(frameSize) : squares)
         for (int y = s.y; y < s.br().y; ++y)
             for (int x = s.x; x < s.br().x; ++x)
                 positions.emplace_back(x, y);
@@ -92,9 +219,12 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     CsvTable shapiro({"gain_db", "mean", "p_value", "W"});
     int gaussian = 0;
     ProgressBar progress("calibrate", totalFrames);
-    for (const CalibrationManifest::Burst& spec : specs) {
-        const double gain = dbToLinearGain(spec.gainDb);
+    RawFormat firstFormat;
+    for (size_t i = 0; i < specs.size(); ++i) {
+        const CalibrationManifest::Burst& spec = specs[i];
+        const double gain = dbToLinearGain(gainsDb[i]);
         std::unique_ptr<BurstStatistics> stats;
+        LoadedMosaic first;
         cv::Mat series(int(spec.files.size()), int(tested.size()), CV_64F);
         for (size_t t = 0; t < spec.files.size(); ++t) {
             const LoadedMosaic m = loadMosaicFile(spec.files[t]);
@@ -102,6 +232,11 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                 RawFormat f = m.format;
                 f.gain = gain;
                 stats.reset(new BurstStatistics(f));
+                if (i == 0)
+                    firstFormat = m.format;
+                first = m;
+            } else {
+                requireSameCapture(first, spec.files.front(), m, spec.files[t]);
             }
             stats->add(m.mosaic);
             if (t == 0)
@@ -117,7 +252,16 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                     integer ? m.mosaic.at<ushort>(tested[k]) : double(m.mosaic.at<float>(tested[k]));
             progress.advance();
         }
-        const std::vector<NoiseSample> burstSamples = sampleBurstPatches(*stats, squares, gain);
+        std::vector<NoiseSample> burstSamples = chartless || spec.dark
+                                                    ? sampleStaticScene(*stats, gain)
+                                                    : sampleBurstPatches(*stats, squares, gain);
+        // Dark frames hold no photo-electrons: their variance is the read noise alone. Their temporal means
+        // scatter around 0 by sigma / sqrt(T) (and by any dark shading), and the model's shot term
+        // g alpha max(mu, 0) at those means would bias the read-noise terms low (2% at 16 frames and
+        // 24 dB, measured); so they count at mean 0.
+        if (spec.dark)
+            for (NoiseSample& sample : burstSamples)
+                sample.mean = 0;
         samples.insert(samples.end(), burstSamples.begin(), burstSamples.end());
         std::vector<ShapiroWilkResult> sw;
         shapiroWilkBatch(series, sw, SW_SERIES_IN_COLUMNS);
@@ -128,7 +272,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             if (clipped.at<uchar>(tested[k]) || sw[k].constant)
                 continue;
             shapiro.addRow(
-                std::vector<double>{spec.gainDb, mean.at<double>(tested[k]), sw[k].pValue, sw[k].W});
+                std::vector<double>{gainsDb[i], mean.at<double>(tested[k]), sw[k].pValue, sw[k].W});
             ++result.shapiroTested;
             gaussian += sw[k].pValue > 0.05;
         }
@@ -143,10 +287,41 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     const CalibrationReport& report = result.report;
     writeNewText(reportPath,
                  yamlToString([&](cv::FileStorage& fs) { report.write(fs, "calibration_report"); }));
-    if (report.separable)
+    if (report.separable) {
         writeNewText(modelPath,
                      yamlToString([&](cv::FileStorage& fs) { report.model.write(fs, "noise_model"); }));
-    else
+        // With gains from ISO the model carries over to the tools that index noise by ISO.
+        if (result.baseIso > 0 && report.model.alpha > 0) {
+            std::vector<double> profileIsos;
+            for (size_t i = 0; i < specs.size(); ++i) {
+                const double iso = result.baseIso * dbToLinearGain(gainsDb[i]);
+                if (std::none_of(profileIsos.begin(), profileIsos.end(),
+                                 [&](double v) { return std::abs(v - iso) < 1e-9 * iso; }))
+                    profileIsos.push_back(iso);
+            }
+            const std::string maker = result.camera.make.empty() ? "unknown" : result.camera.make,
+                              model = result.camera.model.empty() ? "unknown" : result.camera.model;
+            writeNewText(
+                o.outDir + "/darktable_noiseprofiles.json",
+                darktableNoiseProfiles(report.model, firstFormat, result.baseIso, profileIsos, maker, model));
+            const AndroidNoiseProfile android =
+                androidNoiseProfile(report.model, firstFormat, result.baseIso);
+            writeNewText(o.outDir + "/android_noise_profile.yml", yamlToString([&](cv::FileStorage& fs) {
+                             fs << "android_noise_profile"
+                                << "{"
+                                << "comment"
+                                << "S = A s + B, O = C s^2 + D per CFA site (2x2 block row by row), s = ISO"
+                                << "base_iso" << result.baseIso;
+                             fs << "A" << std::vector<double>(android.A.val, android.A.val + 4);
+                             fs << "B" << std::vector<double>(android.B.val, android.B.val + 4);
+                             fs << "C" << std::vector<double>(android.C.val, android.C.val + 4);
+                             fs << "D" << std::vector<double>(android.D.val, android.D.val + 4) << "}";
+                         }));
+            result.notes.push_back(
+                "darktable_noiseprofiles.json and android_noise_profile.yml carry the model "
+                "to darktable and Android's camera tests");
+        }
+    } else
         result.notes.push_back(
             "sigma_d^2 and sigma_r^2 are not separable with these gains: no noise_model.yml "
             "written (see the report's notes)");
@@ -194,13 +369,13 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
 
     if (!o.plots)
         return result;
-    std::vector<double> gainsDb;
-    for (const CalibrationManifest::Burst& spec : specs)
-        if (std::none_of(gainsDb.begin(), gainsDb.end(),
-                         [&](double g) { return std::abs(g - spec.gainDb) < 1e-9; }))
-            gainsDb.push_back(spec.gainDb);
+    std::vector<double> distinctGainsDb;
+    for (double g : gainsDb)
+        if (std::none_of(distinctGainsDb.begin(), distinctGainsDb.end(),
+                         [&](double d) { return std::abs(g - d) < 1e-9; }))
+            distinctGainsDb.push_back(g);
     CalibrationPlotFiles files{samplesCsv, linesCsv, histCsv, shapiroCsv};
-    plotCalibration(o.outDir, report, files, counts.size(), gainsDb, result.pngs, result.notes);
+    plotCalibration(o.outDir, report, files, counts.size(), distinctGainsDb, result.pngs, result.notes);
     return result;
 }
 

@@ -35,6 +35,7 @@ struct SimulateOptions
     cv::rawgment::SensorParams sensor;
     uint64_t seed = 1;
     std::string extension = ".dng"; //!< container of the frames (.dng, .png or .tif)
+    bool dark = false;              //!< also a burst of dark frames (no light) per gain
     bool validation = true;         //!< also a bright and two dark bursts (x0.5, x0.1) at validationGainDb
     double validationGainDb = 12;
     int validationFrames = 100;
@@ -71,6 +72,8 @@ struct CalibrateResult
     std::vector<std::string> notes; //!< what the user should know (plots skipped, ...)
     double gaussianFraction = 0;    //!< fraction of tested pixels with Shapiro-Wilk p > 0.05
     int shapiroTested = 0;
+    double baseIso = 0;              //!< the ISO of gain 1 (0 when every gain came from the manifest)
+    cv::rawgment::CameraTags camera; //!< the first frame's camera tags
 };
 
 //! What a calibration manifest says, checked: every key known, gains finite, no file listed twice.
@@ -78,13 +81,21 @@ struct CalibrationManifest
 {
     struct Burst
     {
-        double gainDb;
+        bool hasGainDb = false; //!< false: the gain comes from the files' ISO relative to the base ISO
+        double gainDb = 0;
+        bool dark = false;              //!< dark frames (lens cap): every flat pixel, whatever `patches` says
         std::vector<std::string> files; //!< resolved against the manifest's folder
     };
     std::vector<Burst> bursts; //!< at least one, each with at least one file
-    std::string patches;       //!< "detect", or the resolved path of a chart patches file
+    //! "detect" (cv::mcc), "none" (any static scene: sampleStaticScene()), or the resolved path of a
+    //! chart patches file
+    std::string patches;
+    bool hasBaseIso = false; //!< false: the lowest ISO of the bursts that take their gain from it
+    double baseIso = 0;
 };
-//! Reads a calibration manifest; throws std::runtime_error or cv::Exception naming the file.
+/** Reads a calibration manifest (YAML or JSON), or makes one from a folder that holds one folder of
+ * frames per burst (sorted by name; a folder whose name starts with "dark" holds dark frames; patches
+ * "none"; every gain from the ISO). Throws std::runtime_error or cv::Exception naming the file. */
 CalibrationManifest readCalibrationManifest(const std::string& path);
 
 CalibrateResult calibrateFromManifest(const CalibrateOptions& options);

@@ -48,6 +48,7 @@ std::string jobDescription(const SimulateOptions& o)
         fs << "quantize" << int(o.sensor.quantize);
         fs << "seed" << cv::format("%llu", static_cast<unsigned long long>(o.seed)) << "extension"
            << o.extension;
+        fs << "dark" << int(o.dark);
         fs << "validation" << int(o.validation) << "validation_gain_db" << o.validationGainDb
            << "validation_frames" << o.validationFrames;
         fs << "}";
@@ -98,6 +99,7 @@ SimulateResult simulateBursts(const SimulateOptions& o)
         double gainDb, exposure, level;
         int frames;
         uint64_t seed;
+        bool dark = false;
     };
     std::vector<Burst> bursts;
     for (double gDb : o.gainsDb)
@@ -105,6 +107,13 @@ SimulateResult simulateBursts(const SimulateOptions& o)
             const double g = dbToLinearGain(gDb);
             bursts.push_back({burstFolder(gDb, level), gDb, level * range / (g * sceneMax), level, o.frames,
                               deriveSeed(o.seed, SEED_SIMULATED_BURST, bursts.size())});
+        }
+    // Dark frames (no light: the lens cap) after the lit bursts, so that their seeds leave those alone.
+    if (o.dark)
+        for (double gDb : o.gainsDb) {
+            const std::string folder = burstFolder(gDb, 0);
+            bursts.push_back({"dark_" + folder.substr(0, folder.find('_')), gDb, 0.0, 0.0, o.frames,
+                              deriveSeed(o.seed, SEED_SIMULATED_BURST, bursts.size()), true});
         }
     for (size_t i = 0; i < bursts.size(); ++i)
         for (size_t j = 0; j < i; ++j)
@@ -140,6 +149,7 @@ SimulateResult simulateBursts(const SimulateOptions& o)
     } else {
         writeTextAtomically(jobPath, job);
     }
+    const cv::Mat darkScene = cv::Mat::zeros(scene.meanAtUnitGain.size(), scene.meanAtUnitGain.type());
     size_t totalFrames = 0;
     for (const Burst& b : bursts)
         totalFrames += size_t(b.frames);
@@ -168,7 +178,11 @@ SimulateResult simulateBursts(const SimulateOptions& o)
             // Frames are deterministic: a frame left by an interrupted run is already right.
             if (!pathExists(path)) {
                 cv::Mat raw;
-                sensor.capture(scene.meanAtUnitGain, g, b.exposure, b.seed, t, raw);
+                // Dark frames see no light at all; the simulator's exposure must stay positive.
+                if (b.dark)
+                    sensor.capture(darkScene, g, 1.0, b.seed, t, raw);
+                else
+                    sensor.capture(scene.meanAtUnitGain, g, b.exposure, b.seed, t, raw);
                 writeMosaic(path, raw, meta);
             }
             ++result.files;
@@ -207,10 +221,13 @@ SimulateResult simulateBursts(const SimulateOptions& o)
                                << "patches.yml";
                             fs << "bursts"
                                << "[";
-                            for (size_t i = 0; i < calibrationBursts; ++i)
+                            for (size_t i = 0; i < calibrationBursts; ++i) {
                                 fs << "{"
-                                   << "gain_db" << bursts[i].gainDb << "level" << bursts[i].level << "files"
-                                   << files[i] << "}";
+                                   << "gain_db" << bursts[i].gainDb << "level" << bursts[i].level;
+                                if (bursts[i].dark)
+                                    fs << "dark" << 1;
+                                fs << "files" << files[i] << "}";
+                            }
                             fs << "]"
                                << "}";
                         }));
