@@ -92,9 +92,15 @@ CalibrationManifest readCalibrationManifest(const std::string& path)
                 throw std::runtime_error(where + ": 'gain_db' is not finite");
         }
         if (!b["dark"].empty()) {
-            if (!b["dark"].isInt() || (int(b["dark"]) != 0 && int(b["dark"]) != 1))
+            // OpenCV reads YAML's true and false as strings, and writes booleans as 1 and 0.
+            const cv::FileNode dark = b["dark"];
+            const std::string word = dark.isString() ? std::string(dark) : std::string();
+            if (dark.isInt() && (int(dark) == 0 || int(dark) == 1))
+                burst.dark = int(dark) == 1;
+            else if (word == "true" || word == "false")
+                burst.dark = word == "true";
+            else
                 throw std::runtime_error(where + ": 'dark' must be true or false");
-            burst.dark = int(b["dark"]) != 0;
         }
         burst.files = readFileList(b["files"], base, where);
         manifest.bursts.push_back(burst);

@@ -282,7 +282,11 @@ std::vector<Target> targets(const std::string& dataDir)
                          "{\n  \"calibration_manifest\": {\n    \"patches\": \"detect\",\n"
                          "    \"bursts\": [ { \"gain_db\": 24.0, \"files\": [ \"c/f0.png\", "
                          "\"c/f1.png\", \"c/f2.png\" ] } ]\n  }\n}\n";
-                     return std::vector<std::string>{yaml, json};
+                     const std::string fromIso = "%YAML:1.0\n---\ncalibration_manifest:\n"
+                                                 "   patches: none\n   base_iso: 100\n   bursts:\n"
+                                                 "      - { files: [ a/f0.dng, a/f1.dng ] }\n"
+                                                 "      - { dark: true, files: [ d/f0.dng, d/f1.dng ] }\n";
+                     return std::vector<std::string>{yaml, json, fromIso};
                  },
                  [](const std::string& in) {
                      const rawgment_apps::CalibrationManifest m = rawgment_apps::readCalibrationManifest(in);
@@ -291,7 +295,9 @@ std::vector<Target> targets(const std::string& dataDir)
                      for (const auto& b : m.bursts)
                          if (b.files.empty() || !std::isfinite(b.gainDb))
                              return std::string("accepted a burst without files or with a non-finite gain");
-                     if (m.patches != "detect") {
+                     if (m.hasBaseIso && !(m.baseIso > 0 && std::isfinite(m.baseIso)))
+                         return std::string("accepted a base ISO that is not finite and positive");
+                     if (m.patches != "detect" && m.patches != "none") {
                          std::vector<std::string> notes;
                          rawgment_apps::manifestSquares(m.patches, m.bursts.front().files.front(), 24, notes);
                      }
