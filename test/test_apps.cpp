@@ -660,6 +660,63 @@ TEST(Apps, calibrateTakesTheGainsFromTheFilesIsoWithOrWithoutAChart)
     EXPECT_NE(std::string::npos, r.output.find("frame_999.dng' says ISO 400 where")) << r.output;
 }
 
+TEST(Apps, calibrationVerdictFailsANonLinearFileAndGainsTooClose)
+{
+    const std::string dir = freshDir("calibrate_verdict");
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir +
+                                               "/sim' --frames=16 --gains=6,7 --levels=0.2,0.65 "
+                                               "--validation=false --format=png --seed=3");
+    ASSERT_EQ(0, r.status) << r.output;
+    // Gains 1 dB apart: the offsets cannot separate sigma_d^2 from sigma_r^2.
+    r = runApp("rawgment_calibrate",
+               "'" + dir + "/sim/manifest.yml' --out='" + dir + "/close' --plots=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("verdict: FAIL")) << r.output;
+    EXPECT_NE(std::string::npos,
+              r.output.find("FAIL separability of sigma_d^2 and sigma_r^2: gain ratio 1.12"))
+        << r.output;
+    const std::string report = readText(dir + "/close/report.md");
+    EXPECT_EQ(0u, report.find("# Calibration report\n\n**Verdict: FAIL**")) << report;
+
+    // The same bursts through a tone curve (x^(1/2.2) of the signal, as a processed file has): not linear.
+    std::ostringstream manifest;
+    manifest << "%YAML:1.0\ncalibration_manifest:\n  patches: sim/patches.yml\n  bursts:\n";
+    for (const char* burst : {"g06dB_level0.20", "g06dB_level0.65", "g07dB_level0.20", "g07dB_level0.65"}) {
+        const std::string folder = dir + "/curved/" + burst;
+        ASSERT_EQ(0, mkdir((dir + "/curved").c_str(), 0755) == 0 || errno == EEXIST ? 0 : -1);
+        ASSERT_EQ(0, mkdir(folder.c_str(), 0755));
+        manifest << "    - { gain_db: " << (std::string(burst).substr(1, 2) == "06" ? 6 : 7) << ", files: [";
+        for (int t = 0; t < 16; ++t) {
+            cv::Mat frame;
+            const cv::rawgment::MosaicMetadata meta = cv::rawgment::readMosaic(
+                cv::format("%s/sim/%s/frame_%03d.png", dir.c_str(), burst, t), frame);
+            const double black = meta.format.blackLevel[0], range = meta.format.whiteLevel - black;
+            cv::Mat signal, curved;
+            frame.convertTo(signal, CV_64F, 1.0 / range, -black / range);
+            signal = cv::max(signal, 0.0);
+            cv::pow(signal, 1 / 2.2, curved);
+            curved.convertTo(frame, CV_16U, range, black);
+            cv::rawgment::writeMosaic(cv::format("%s/frame_%03d.png", folder.c_str(), t), frame, meta);
+            manifest << (t ? ", " : "") << cv::format("curved/%s/frame_%03d.png", burst, t);
+        }
+        manifest << "] }\n";
+    }
+    std::ofstream(dir + "/curved.yml") << manifest.str();
+    r = runApp("rawgment_calibrate", "'" + dir + "/curved.yml' --out='" + dir + "/curved_cal' --plots=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("FAIL linearity (curvature of variance against mean)"))
+        << r.output;
+
+    // Too few frames is named with the burst.
+    std::ofstream(dir + "/few.yml")
+        << "%YAML:1.0\ncalibration_manifest:\n  patches: sim/patches.yml\n  bursts:\n"
+        << "    - { gain_db: 6, files: [sim/g06dB_level0.20/frame_000.png, "
+           "sim/g06dB_level0.20/frame_001.png, sim/g06dB_level0.20/frame_002.png] }\n";
+    r = runApp("rawgment_calibrate", "'" + dir + "/few.yml' --out='" + dir + "/few' --plots=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("FAIL frames per burst: fewest 3")) << r.output;
+}
+
 TEST(Apps, demoWritesAReportAndAGallery)
 {
     const std::string dir = freshDir("demo");

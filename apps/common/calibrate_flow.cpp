@@ -132,6 +132,50 @@ void requireSameCapture(const LoadedMosaic& first, const std::string& firstPath,
                                  ": the frames of a burst must share ISO, exposure, size and levels");
 }
 
+//! report.md: the verdict first, with its checks, then the model, the per-gain lines, the plots, the notes.
+std::string calibrationReportMarkdown(const CalibrateResult& r, const std::string& outDir)
+{
+    std::string md = "# Calibration report\n\n";
+    md += std::string("**Verdict: ") + (r.verdict.pass ? "PASS" : "FAIL") + "**\n\n";
+    md += "| check | result | measured figure and threshold |\n|---|---|---|\n";
+    for (const VerdictCheck& c : r.verdict.checks)
+        md += "| " + c.name + " | " + (c.pass ? "pass" : "**FAIL**") + " | " + c.figure + " |\n";
+    md +=
+        "\nThe thresholds and what to do on each failure: docs/calibrate_your_camera.md in cv::rawgment.\n\n";
+    const CalibrationReport& rep = r.report;
+    md += "## Model\n\n";
+    if (rep.separable)
+        md += cv::format("alpha %.6g, sigma_d^2 %.6g, sigma_r^2 %.6g (method %s, %d of %d samples used)\n\n",
+                         rep.model.alpha, rep.model.sigmaD2, rep.model.sigmaR2,
+                         rep.method == NOISE_FIT_JOINT ? "joint" : "two-stage", rep.samplesUsed, rep.samples);
+    else
+        md += cv::format("alpha %.6g; sigma_d^2 and sigma_r^2 not separable with these gains\n\n",
+                         rep.model.alpha);
+    if (r.baseIso > 0)
+        md += cv::format("Gain 1 is ISO %g.\n\n", r.baseIso);
+    md += "| gain (dB) | slope a | offset b | R^2 | inliers | samples |\n|---|---|---|---|---|---|\n";
+    for (const NoiseLineFit& l : rep.perGain)
+        md += cv::format("| %.2f | %.6g | %.6g | %.4f | %d | %d |\n", linearGainToDb(l.gain), l.line.a,
+                         l.line.b, l.rSquared, l.inliers, l.samples);
+    md += cv::format("\nShapiro-Wilk: %.1f%% of %d tested pixels have p > 0.05.\n", 100 * r.gaussianFraction,
+                     r.shapiroTested);
+    if (!r.pngs.empty()) {
+        md += "\n## Plots\n\n";
+        for (const std::string& png : r.pngs) {
+            const std::string name = png.rfind(outDir + "/", 0) == 0 ? png.substr(outDir.size() + 1) : png;
+            md += "![" + name + "](" + name + ")\n\n";
+        }
+    }
+    if (!rep.notes.empty() || !r.notes.empty()) {
+        md += "\n## Notes\n\n";
+        for (const std::string& n : rep.notes)
+            md += "- " + n + "\n";
+        for (const std::string& n : r.notes)
+            md += "- " + n + "\n";
+    }
+    return md;
+}
+
 //! Positions spread over the frame, away from its border, for the Shapiro-Wilk test without squares.
 std::vector<cv::Rect> frameGridSquares(cv::Size size)
 {
@@ -155,7 +199,8 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     // A finished calibration is never redone into its folder. A run that died before its end is
     // completed: the calibration is deterministic, outputs already there must be what this run writes
     // (writeNewText refuses anything else) and the missing ones are added.
-    std::vector<std::string> finished = {reportPath, samplesCsv, linesCsv, shapiroCsv, histCsv};
+    std::vector<std::string> finished = {reportPath, samplesCsv, linesCsv,
+                                         shapiroCsv, histCsv,    o.outDir + "/report.md"};
     if (o.plots)
         for (const char* png : {"calib_mean_variance.png", "calib_histograms.png", "calib_cross_gain.png",
                                 "shapiro_pvalue.png"})
@@ -226,6 +271,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     int gaussian = 0;
     ProgressBar progress("calibrate", totalFrames);
     RawFormat firstFormat;
+    std::vector<BurstFacts> facts;
     for (size_t i = 0; i < specs.size(); ++i) {
         const CalibrationManifest::Burst& spec = specs[i];
         const double gain = dbToLinearGain(gainsDb[i]);
@@ -274,6 +320,16 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         cv::Mat mean, clipped;
         stats->mean(mean);
         stats->clippedMask(clipped);
+        BurstFacts burstFacts{spec.files.front(), gainsDb[i], stats->frames(), 0.0, spec.dark};
+        {
+            double area = 0, clippedArea = 0;
+            for (const cv::Rect& r : chartless || spec.dark ? frameGridSquares(frameSize) : squares) {
+                area += r.area();
+                clippedArea += cv::countNonZero(clipped(r));
+            }
+            burstFacts.clippedFraction = area > 0 ? clippedArea / area : 0.0;
+        }
+        facts.push_back(burstFacts);
         for (size_t k = 0; k < tested.size(); ++k) {
             if (clipped.at<uchar>(tested[k]) || sw[k].constant)
                 continue;
@@ -291,6 +347,11 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     params.line.seed = o.seed;
     result.report = calibrateNoiseModel(samples, params);
     const CalibrationReport& report = result.report;
+    result.verdict =
+        judgeCalibration(samples, report, facts,
+                         firstFormat.whiteLevel - (firstFormat.blackLevel[0] + firstFormat.blackLevel[1] +
+                                                   firstFormat.blackLevel[2] + firstFormat.blackLevel[3]) /
+                                                      4);
     writeNewText(reportPath,
                  yamlToString([&](cv::FileStorage& fs) { report.write(fs, "calibration_report"); }));
     if (report.separable) {
@@ -373,15 +434,16 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     }
     hist.write(histCsv);
 
-    if (!o.plots)
-        return result;
-    std::vector<double> distinctGainsDb;
-    for (double g : gainsDb)
-        if (std::none_of(distinctGainsDb.begin(), distinctGainsDb.end(),
-                         [&](double d) { return std::abs(g - d) < 1e-9; }))
-            distinctGainsDb.push_back(g);
-    CalibrationPlotFiles files{samplesCsv, linesCsv, histCsv, shapiroCsv};
-    plotCalibration(o.outDir, report, files, counts.size(), distinctGainsDb, result.pngs, result.notes);
+    if (o.plots) {
+        std::vector<double> distinctGainsDb;
+        for (double g : gainsDb)
+            if (std::none_of(distinctGainsDb.begin(), distinctGainsDb.end(),
+                             [&](double d) { return std::abs(g - d) < 1e-9; }))
+                distinctGainsDb.push_back(g);
+        CalibrationPlotFiles files{samplesCsv, linesCsv, histCsv, shapiroCsv};
+        plotCalibration(o.outDir, report, files, counts.size(), distinctGainsDb, result.pngs, result.notes);
+    }
+    writeNewText(o.outDir + "/report.md", calibrationReportMarkdown(result, o.outDir));
     return result;
 }
 

@@ -65,6 +65,39 @@ struct CalibrateOptions
     uint64_t seed = 0; //!< seed of the RANSAC draws of the per-gain line fits
 };
 
+//! What the verdict of a calibration needs to know about one burst besides its samples.
+struct BurstFacts
+{
+    std::string name; //!< its first file
+    double gainDb = 0;
+    int frames = 0;
+    double clippedFraction = 0; //!< of the pixels it could sample (squares, or the frame without a chart)
+    bool dark = false;
+};
+
+//! One check of a calibration's verdict: a measured figure against a stated threshold.
+struct VerdictCheck
+{
+    std::string name;   //!< what is checked
+    bool pass = true;   //!< whether the figure meets the threshold
+    std::string figure; //!< the measured figure, the threshold and, on a failure, what to do
+};
+
+//! PASS when every check passes; the checks and their thresholds are in docs/calibrate_your_camera.md.
+struct CalibrationVerdict
+{
+    bool pass = true;
+    std::vector<VerdictCheck> checks;
+};
+
+/** Judges a calibration from its samples, its report and its bursts: residuals of the variance against
+ * the model per gain and mean bin, distinct means per gain, clipped fraction, frames per burst,
+ * curvature of variance against mean (a non-linear raw file), separability of sigma_d^2 and sigma_r^2.
+ * @param signalRange white level minus black level of the frames */
+CalibrationVerdict judgeCalibration(const std::vector<cv::rawgment::NoiseSample>& samples,
+                                    const cv::rawgment::CalibrationReport& report,
+                                    const std::vector<BurstFacts>& bursts, double signalRange);
+
 struct CalibrateResult
 {
     cv::rawgment::CalibrationReport report;
@@ -74,6 +107,7 @@ struct CalibrateResult
     int shapiroTested = 0;
     double baseIso = 0;              //!< the ISO of gain 1 (0 when every gain came from the manifest)
     cv::rawgment::CameraTags camera; //!< the first frame's camera tags
+    CalibrationVerdict verdict;
 };
 
 //! What a calibration manifest says, checked: every key known, gains finite, no file listed twice.

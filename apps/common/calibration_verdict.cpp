@@ -1,0 +1,205 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// rawgment_calibrate's verdict: each check a measured figure against a stated threshold. Where each
+// threshold comes from is in docs/calibrate_your_camera.md.
+#include "pipeline.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <map>
+
+namespace rawgment_apps {
+
+using namespace cv::rawgment;
+
+namespace {
+
+// Thresholds (docs/calibrate_your_camera.md says why each has its value).
+const int kMinFrames = 16;
+const double kMaxClippedFraction = 0.5;
+const int kMeanBins = 8;
+const int kMinBinSamples = 30;
+const int kMinDistinctMeans = 3;
+const double kMinMeanSpread = 0.1;
+const double kMaxBinDeviation = 0.05;
+const double kMaxCurvatureShare = 0.05;
+const double kMinGainRatio = 2.0;
+
+//! Median of chi-square(k) / k: the median of a sample variance over its expectation (Wilson-Hilferty).
+double medianVarianceRatio(double dof)
+{
+    const double t = 1 - 2 / (9 * dof);
+    return t * t * t;
+}
+
+double median(std::vector<double> v)
+{
+    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+    return v[v.size() / 2];
+}
+
+VerdictCheck check(const std::string& name, bool pass, const std::string& figure)
+{
+    return {name, pass, figure};
+}
+
+} // namespace
+
+CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, const CalibrationReport& report,
+                                    const std::vector<BurstFacts>& bursts, double signalRange)
+{
+    CalibrationVerdict verdict;
+    const auto add = [&](const VerdictCheck& c) {
+        verdict.checks.push_back(c);
+        verdict.pass = verdict.pass && c.pass;
+    };
+
+    int fewest = INT_MAX;
+    std::string fewestName;
+    double mostClipped = 0;
+    std::string mostClippedName;
+    for (const BurstFacts& b : bursts) {
+        if (b.frames < fewest) {
+            fewest = b.frames;
+            fewestName = b.name;
+        }
+        if (!b.dark && b.clippedFraction > mostClipped) {
+            mostClipped = b.clippedFraction;
+            mostClippedName = b.name;
+        }
+    }
+    add(check("frames per burst", fewest >= kMinFrames,
+              cv::format("fewest %d (%s); threshold %d%s", fewest, fewestName.c_str(), kMinFrames,
+                         fewest >= kMinFrames ? "" : ": shoot more frames per burst")));
+    add(check("clipped fraction", mostClipped <= kMaxClippedFraction,
+              cv::format("largest %.1f%% (%s); threshold %.0f%%%s", 100 * mostClipped,
+                         mostClippedName.empty() ? "none" : mostClippedName.c_str(),
+                         100 * kMaxClippedFraction,
+                         mostClipped <= kMaxClippedFraction ? "" : ": lower the exposure of that burst")));
+
+    // Separability: the spread of the gains.
+    double gMin = INFINITY, gMax = 0;
+    for (const NoiseLineFit& f : report.perGain) {
+        gMin = std::min(gMin, f.gain);
+        gMax = std::max(gMax, f.gain);
+    }
+    const double ratio = report.perGain.empty() ? 1.0 : gMax / gMin;
+    add(check("separability of sigma_d^2 and sigma_r^2", report.separable && ratio >= kMinGainRatio,
+              cv::format("gain ratio %.2f (%.1f dB) over %zu gains; threshold %.1f (%.1f dB)%s", ratio,
+                         linearGainToDb(ratio), report.perGain.size(), kMinGainRatio,
+                         linearGainToDb(kMinGainRatio),
+                         report.separable && ratio >= kMinGainRatio
+                             ? ""
+                             : ": add a burst at an ISO at least twice the lowest (dark frames help too)")));
+
+    // Per gain: distinct means, residuals per mean bin, curvature.
+    std::map<double, std::vector<const NoiseSample*>> byGain;
+    for (const NoiseSample& s : samples)
+        byGain[s.gain].push_back(&s);
+    std::string fewMeans, badBin, curved;
+    double worstBin = 0, worstCurvature = 0;
+    int worstDistinct = INT_MAX;
+    for (const auto& kv : byGain) {
+        const double g = kv.first;
+        const std::vector<const NoiseSample*>& gs = kv.second;
+        double lo = INFINITY, hi = -INFINITY;
+        for (const NoiseSample* s : gs) {
+            lo = std::min(lo, std::max(0.0, s->mean));
+            hi = std::max(hi, s->mean);
+        }
+        const double width = std::max(hi - lo, 1e-9) / kMeanBins;
+        std::vector<std::vector<double>> ratios(kMeanBins);
+        std::vector<double> dofs(kMeanBins, 0), binMeans(kMeanBins, 0);
+        for (const NoiseSample* s : gs) {
+            const int bin = std::min(kMeanBins - 1, std::max(0, int((std::max(0.0, s->mean) - lo) / width)));
+            const double predicted = report.model.variance(s->mean, g);
+            if (predicted > 0) {
+                ratios[size_t(bin)].push_back(s->variance / predicted);
+                dofs[size_t(bin)] += s->dof;
+                binMeans[size_t(bin)] += s->mean;
+            }
+        }
+        int distinct = 0;
+        double lowest = INFINITY, highest = -INFINITY;
+        for (int b = 0; b < kMeanBins; ++b) {
+            const std::vector<double>& r = ratios[size_t(b)];
+            if (int(r.size()) < kMinBinSamples)
+                continue;
+            ++distinct;
+            const double meanOfBin = binMeans[size_t(b)] / double(r.size());
+            lowest = std::min(lowest, meanOfBin);
+            highest = std::max(highest, meanOfBin);
+            // The median ratio over the median a correct model gives; its standard error is about
+            // 1.25 sqrt(2 / dof) / sqrt(n) (the median's efficiency against the mean is 2 / pi).
+            const double dof = dofs[size_t(b)] / double(r.size());
+            const double deviation = median(r) / medianVarianceRatio(dof) - 1;
+            const double standardError = 1.2533 * std::sqrt(2 / dof) / std::sqrt(double(r.size()));
+            const double excess = std::abs(deviation) - 4 * standardError;
+            if (excess > kMaxBinDeviation && std::abs(deviation) > std::abs(worstBin)) {
+                worstBin = deviation;
+                badBin = cv::format("%.2f dB, mean %.0f DN: %+.1f%%", linearGainToDb(g), meanOfBin,
+                                    100 * deviation);
+            }
+        }
+        const bool spread = distinct >= kMinDistinctMeans && highest - lowest >= kMinMeanSpread * signalRange;
+        if (!spread && distinct < worstDistinct) {
+            worstDistinct = distinct;
+            fewMeans = cv::format("%.2f dB: %d mean bins of %d samples, spanning %.1f%% of the range",
+                                  linearGainToDb(g), distinct, kMinBinSamples,
+                                  distinct ? 100 * (highest - lowest) / signalRange : 0.0);
+        }
+
+        // Curvature: weighted least squares of v = b + a mu + c mu^2 with weights dof / (2 model^2).
+        cv::Matx33d A = cv::Matx33d::zeros();
+        cv::Vec3d rhs(0, 0, 0);
+        for (const NoiseSample* s : gs) {
+            const double m = std::max(0.0, s->mean), predicted = report.model.variance(s->mean, g);
+            if (!(predicted > 0))
+                continue;
+            const double w = s->dof / (2 * predicted * predicted);
+            const cv::Vec3d x(1, m, m * m);
+            A += w * x * x.t();
+            rhs += w * s->variance * x;
+        }
+        cv::Matx33d cov;
+        if (cv::invert(A, cov, cv::DECOMP_SVD) == 0 || !(hi > 0))
+            continue;
+        const cv::Vec3d p = cov * rhs;
+        const double top = report.model.variance(hi, g);
+        const double share = p[2] * hi * hi / top, shareSe = std::sqrt(cov(2, 2)) * hi * hi / top;
+        if (std::abs(share) - 4 * shareSe > kMaxCurvatureShare &&
+            std::abs(share) > std::abs(worstCurvature)) {
+            worstCurvature = share;
+            curved = cv::format("%.2f dB: %+.1f%% of the variance at the highest mean (%.0f DN) is curvature",
+                                linearGainToDb(g), 100 * share, hi);
+        }
+    }
+    add(check("residuals per gain and mean bin", badBin.empty(),
+              badBin.empty()
+                  ? cv::format("every bin of >= %d samples within %.0f%% (+4 standard errors) of the "
+                               "model",
+                               kMinBinSamples, 100 * kMaxBinDeviation)
+                  : "worst " + badBin +
+                        cv::format("; threshold %.0f%% beyond 4 standard errors: the model does not "
+                                   "describe these data (see the mean-variance plot)",
+                                   100 * kMaxBinDeviation)));
+    add(check("distinct means per gain", fewMeans.empty(),
+              fewMeans.empty()
+                  ? cv::format("every gain has >= %d mean bins spanning >= %.0f%% of the range",
+                               kMinDistinctMeans, 100 * kMinMeanSpread)
+                  : fewMeans +
+                        cv::format("; threshold %d bins spanning %.0f%%: use a chart or scene with darker "
+                                   "and brighter parts, or a second exposure",
+                                   kMinDistinctMeans, 100 * kMinMeanSpread)));
+    add(check(
+        "linearity (curvature of variance against mean)", curved.empty(),
+        curved.empty()
+            ? cv::format("no gain has curvature beyond %.0f%% (+4 standard errors)", 100 * kMaxCurvatureShare)
+            : "worst " + curved +
+                  cv::format("; threshold %.0f%%: the raw values are not linear in light (a tone curve, "
+                             "compression or a processed file?)",
+                             100 * kMaxCurvatureShare)));
+    return verdict;
+}
+
+} // namespace rawgment_apps
