@@ -163,14 +163,15 @@ TEST(Apps, badManifestsAreErrorsNamingTheKeyOrTheFile)
                                     << "    - { files: [a.dng] }\n";
     r = runApp("rawgment_calibrate", "'" + dir + "/iso.yml' --out='" + dir + "/cal5'");
     EXPECT_NE(std::string::npos, r.output.find("'base_iso' must be a finite number > 0")) << r.output;
-    // A mosaic that does not say its ISO needs a gain_db.
+    // A mosaic that does not say its ISO needs a gain_db when other bursts have a gain.
     {
         cv::rawgment::MosaicMetadata meta;
-        for (const char* name : {"/u0.png", "/u1.png"})
+        for (const char* name : {"/u0.png", "/u1.png", "/u2.png", "/u3.png"})
             cv::rawgment::writeMosaic(dir + name, cv::Mat(16, 16, CV_16UC1, cv::Scalar(500)), meta);
     }
     std::ofstream(dir + "/noiso.yml") << "%YAML:1.0\ncalibration_manifest:\n  patches: none\n  bursts:\n"
-                                      << "    - { files: [u0.png, u1.png] }\n";
+                                      << "    - { files: [u0.png, u1.png] }\n"
+                                      << "    - { gain_db: 6, files: [u2.png, u3.png] }\n";
     r = runApp("rawgment_calibrate", "'" + dir + "/noiso.yml' --out='" + dir + "/cal6'");
     EXPECT_EQ(1, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("u0.png' does not say its ISO: give this burst a gain_db"))
@@ -715,6 +716,29 @@ TEST(Apps, calibrationVerdictFailsANonLinearFileAndGainsTooClose)
     r = runApp("rawgment_calibrate", "'" + dir + "/few.yml' --out='" + dir + "/few' --plots=false");
     ASSERT_EQ(0, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("FAIL frames per burst: fewest 3")) << r.output;
+}
+
+TEST(Apps, calibrateTheRealColourChartInSingleFrameModeSaysWhatItCannotDetermine)
+{
+    const std::string chart = std::string(RAWGMENT_SHARED_DATA_DIR) + "/colorchart.dng";
+    if (!exists(chart))
+        GTEST_SKIP() << chart << " is missing (see ../shared/data/SOURCES.md)";
+    const std::string dir = freshDir("calibrate_colorchart");
+    std::ofstream(dir + "/m.yml") << "%YAML:1.0\ncalibration_manifest:\n  patches: detect\n  bursts:\n"
+                                  << "    - { files: ['" << chart << "'] }\n";
+    const AppRun r = runApp("rawgment_calibrate", "'" + dir + "/m.yml' --out='" + dir + "/cal'");
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string report = readText(dir + "/cal/report.md");
+    // One frame at one unknown gain: the line of this capture, and a verdict that says why it is no more.
+    EXPECT_NE(std::string::npos, report.find("**Verdict: FAIL**")) << report;
+    EXPECT_NE(std::string::npos, report.find("| frames per burst | **FAIL** | fewest 1")) << report;
+    EXPECT_NE(std::string::npos, report.find("| separability of sigma_d^2 and sigma_r^2 | **FAIL**"))
+        << report;
+    EXPECT_NE(std::string::npos, report.find("the files do not say their ISO")) << report;
+    EXPECT_NE(std::string::npos, report.find("single-frame mode")) << report;
+    EXPECT_NE(std::string::npos, report.find("patches detected with cv::mcc")) << report;
+    EXPECT_FALSE(exists(dir + "/cal/noise_model.yml")) << "no model from one gain";
+    EXPECT_EQ(std::string::npos, r.output.find("arning")) << "no plot is attempted without its data";
 }
 
 TEST(Apps, demoWritesAReportAndAGallery)

@@ -157,8 +157,10 @@ std::string calibrationReportMarkdown(const CalibrateResult& r, const std::strin
     for (const NoiseLineFit& l : rep.perGain)
         md += cv::format("| %.2f | %.6g | %.6g | %.4f | %d | %d |\n", linearGainToDb(l.gain), l.line.a,
                          l.line.b, l.rSquared, l.inliers, l.samples);
-    md += cv::format("\nShapiro-Wilk: %.1f%% of %d tested pixels have p > 0.05.\n", 100 * r.gaussianFraction,
-                     r.shapiroTested);
+    md += r.shapiroTested > 0
+              ? cv::format("\nShapiro-Wilk: %.1f%% of %d tested pixels have p > 0.05.\n",
+                           100 * r.gaussianFraction, r.shapiroTested)
+              : std::string("\nShapiro-Wilk: no pixel tested (it needs bursts of 3 or more frames).\n");
     if (!r.pngs.empty()) {
         md += "\n## Plots\n\n";
         for (const std::string& png : r.pngs) {
@@ -225,16 +227,29 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             result.camera = first.camera;
         }
         isos[i] = first.camera.iso;
+    }
+    // Files that say no ISO and a manifest that gives no gain: one gain, whose value is unknown. The
+    // calibration then finds the noise line of that capture, and says what it cannot determine.
+    const bool noGainAnywhere =
+        std::none_of(specs.begin(), specs.end(),
+                     [](const CalibrationManifest::Burst& b) { return b.hasGainDb; }) &&
+        std::none_of(isos.begin(), isos.end(), [](double iso) { return iso > 0; });
+    for (size_t i = 0; i < specs.size() && !noGainAnywhere; ++i)
         if (!specs[i].hasGainDb && !(isos[i] > 0))
             throw std::runtime_error("'" + specs[i].files.front() +
                                      "' does not say its ISO: give this burst a gain_db in a manifest");
-    }
+    if (noGainAnywhere)
+        result.notes.push_back(
+            "the files do not say their ISO and the manifest gives no gain_db: every burst is "
+            "taken at gain 1 (0 dB), so alpha is the slope at this unknown gain, and neither "
+            "the gain nor the split of the read noise into sigma_d^2 and sigma_r^2 can be "
+            "determined");
     result.baseIso = manifest.hasBaseIso ? manifest.baseIso : 0.0;
     for (size_t i = 0; i < specs.size(); ++i)
         if (!manifest.hasBaseIso && !specs[i].hasGainDb && (result.baseIso == 0 || isos[i] < result.baseIso))
             result.baseIso = isos[i];
     std::vector<double> gainsDb(specs.size());
-    for (size_t i = 0; i < specs.size(); ++i) {
+    for (size_t i = 0; i < specs.size() && !noGainAnywhere; ++i) {
         gainsDb[i] = specs[i].hasGainDb ? specs[i].gainDb : linearGainToDb(isos[i] / result.baseIso);
         result.notes.push_back(
             specs[i].hasGainDb
@@ -304,9 +319,24 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                     integer ? m.mosaic.at<ushort>(tested[k]) : double(m.mosaic.at<float>(tested[k]));
             progress.advance();
         }
-        std::vector<NoiseSample> burstSamples = chartless || spec.dark
-                                                    ? sampleStaticScene(*stats, gain)
-                                                    : sampleBurstPatches(*stats, squares, gain);
+        // One frame: single-frame mode, the spatial statistics of each patch (less exact, see
+        // sampleSingleFramePatches()); it needs patches.
+        const bool singleFrame = spec.files.size() == 1;
+        if (singleFrame && (chartless || spec.dark))
+            throw std::runtime_error(
+                "'" + spec.files.front() +
+                "' is a burst of one frame: single-frame mode needs the patches of a chart "
+                "(patches: detect or a patches file), and dark frames need a burst");
+        if (singleFrame)
+            result.notes.push_back("'" + spec.files.front() +
+                                   "': single-frame mode, the spatial variance of each patch (it includes "
+                                   "fixed-pattern noise and any texture: less exact than a burst)");
+        RawFormat burstFormat = first.format;
+        burstFormat.gain = gain;
+        std::vector<NoiseSample> burstSamples =
+            singleFrame              ? sampleSingleFramePatches(first.mosaic, burstFormat, squares, gain)
+            : chartless || spec.dark ? sampleStaticScene(*stats, gain)
+                                     : sampleBurstPatches(*stats, squares, gain);
         // Dark frames hold no photo-electrons: their variance is the read noise alone. Their temporal means
         // scatter around 0 by sigma / sqrt(T) (and by any dark shading), and the model's shot term
         // g alpha max(mu, 0) at those means would bias the read-noise terms low (2% at 16 frames and
@@ -315,8 +345,10 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             for (NoiseSample& sample : burstSamples)
                 sample.mean = 0;
         samples.insert(samples.end(), burstSamples.begin(), burstSamples.end());
+        // Shapiro-Wilk needs 3 values per pixel.
         std::vector<ShapiroWilkResult> sw;
-        shapiroWilkBatch(series, sw, SW_SERIES_IN_COLUMNS);
+        if (series.rows >= 3)
+            shapiroWilkBatch(series, sw, SW_SERIES_IN_COLUMNS);
         cv::Mat mean, clipped;
         stats->mean(mean);
         stats->clippedMask(clipped);
@@ -330,7 +362,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             burstFacts.clippedFraction = area > 0 ? clippedArea / area : 0.0;
         }
         facts.push_back(burstFacts);
-        for (size_t k = 0; k < tested.size(); ++k) {
+        for (size_t k = 0; k < sw.size(); ++k) {
             if (clipped.at<uchar>(tested[k]) || sw[k].constant)
                 continue;
             shapiro.addRow(
@@ -441,7 +473,8 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                              [&](double d) { return std::abs(g - d) < 1e-9; }))
                 distinctGainsDb.push_back(g);
         CalibrationPlotFiles files{samplesCsv, linesCsv, histCsv, shapiroCsv};
-        plotCalibration(o.outDir, report, files, counts.size(), distinctGainsDb, result.pngs, result.notes);
+        plotCalibration(o.outDir, report, files, counts.size(), distinctGainsDb, result.shapiroTested > 0,
+                        result.pngs, result.notes);
     }
     writeNewText(o.outDir + "/report.md", calibrationReportMarkdown(result, o.outDir));
     return result;

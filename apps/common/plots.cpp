@@ -31,7 +31,7 @@ void plotOrNote(const std::string& png, const std::string& script, std::vector<s
 
 void plotCalibration(const std::string& outDir, const CalibrationReport& report,
                      const CalibrationPlotFiles& files, size_t histogramSeries,
-                     const std::vector<double>& gainsDb, std::vector<std::string>& pngs,
+                     const std::vector<double>& gainsDb, bool haveShapiro, std::vector<std::string>& pngs,
                      std::vector<std::string>& notes)
 {
     const NoiseModel& model = report.model;
@@ -63,22 +63,32 @@ void plotCalibration(const std::string& outDir, const CalibrationReport& report,
                         i ? ", " : "", files.histogramCsv.c_str(), i + 2, kSeriesColours[i % 7], i + 2);
     plotOrNote(outDir + "/calib_histograms.png", s, pngs, notes);
 
-    s = "set multiplot layout 1,2 title 'Cross-gain fit of the per-gain lines'\nset grid\nset key left top\n";
-    s += cv::format("set title 'slope a_g = g {/Symbol a}   (R^2 %.4f)'\nset xlabel 'linear gain g'\n"
-                    "set ylabel 'a_g (DN per DN)'\n",
-                    report.rSquaredSlope);
-    s += cv::format(
-        "plot '%s' every ::1 using 2:3 with points pt 7 ps 1.5 title 'per-gain fits', %.10g*x with lines "
-        "lw 2 title 'g {/Symbol a}'\n",
-        files.linesCsv.c_str(), model.alpha);
-    s += cv::format("set title 'offset b_g = g^2 {/Symbol s}_d^2 + {/Symbol s}_r^2   (R^2 %.4f)'\n"
-                    "set xlabel 'g^2'\nset ylabel 'b_g (DN^2)'\n",
-                    report.rSquaredOffset);
-    s += cv::format(
-        "plot '%s' every ::1 using ($2*$2):4 with points pt 7 ps 1.5 title 'per-gain fits', "
-        "%.10g*x + %.10g with lines lw 2 title 'g^2 {/Symbol s}_d^2 + {/Symbol s}_r^2'\nunset multiplot\n",
-        files.linesCsv.c_str(), model.sigmaD2, model.sigmaR2);
-    plotOrNote(outDir + "/calib_cross_gain.png", s, pngs, notes);
+    // A cross-gain fit needs two gains, a Shapiro-Wilk plot tested pixels (bursts of >= 3 frames).
+    if (report.perGain.size() < 2)
+        notes.push_back("one gain: no cross-gain plot");
+    if (!haveShapiro)
+        notes.push_back("no burst of 3 or more frames: no Shapiro-Wilk plot");
+    if (report.perGain.size() >= 2) {
+        s = "set multiplot layout 1,2 title 'Cross-gain fit of the per-gain lines'\nset grid\nset key left "
+            "top\n";
+        s += cv::format("set title 'slope a_g = g {/Symbol a}   (R^2 %.4f)'\nset xlabel 'linear gain g'\n"
+                        "set ylabel 'a_g (DN per DN)'\n",
+                        report.rSquaredSlope);
+        s += cv::format(
+            "plot '%s' every ::1 using 2:3 with points pt 7 ps 1.5 title 'per-gain fits', %.10g*x with lines "
+            "lw 2 title 'g {/Symbol a}'\n",
+            files.linesCsv.c_str(), model.alpha);
+        s += cv::format("set title 'offset b_g = g^2 {/Symbol s}_d^2 + {/Symbol s}_r^2   (R^2 %.4f)'\n"
+                        "set xlabel 'g^2'\nset ylabel 'b_g (DN^2)'\n",
+                        report.rSquaredOffset);
+        s += cv::format("plot '%s' every ::1 using ($2*$2):4 with points pt 7 ps 1.5 title 'per-gain fits', "
+                        "%.10g*x + %.10g with lines lw 2 title 'g^2 {/Symbol s}_d^2 + {/Symbol "
+                        "s}_r^2'\nunset multiplot\n",
+                        files.linesCsv.c_str(), model.sigmaD2, model.sigmaR2);
+        plotOrNote(outDir + "/calib_cross_gain.png", s, pngs, notes);
+    }
+    if (!haveShapiro)
+        return;
 
     s = "set title 'Shapiro-Wilk test of each pixel''s temporal series (Gaussian noise: p spread evenly on "
         "[0, 1])'\n";

@@ -17,11 +17,12 @@ struct CalibrationPlotFiles
 };
 
 /** calib_mean_variance.png, calib_histograms.png (histogramSeries columns after the first),
- * calib_cross_gain.png and shapiro_pvalue.png (one series per gain in gainsDb) in outDir. Each PNG
- * written goes to `pngs`; a plot that could not be made leaves its reason in `notes`. */
+ * calib_cross_gain.png (with two gains or more) and shapiro_pvalue.png (when `haveShapiro`; one series
+ * per gain in gainsDb) in outDir. Each PNG written goes to `pngs`; a plot that could not be made, or
+ * was not, leaves its reason in `notes`. */
 void plotCalibration(const std::string& outDir, const cv::rawgment::CalibrationReport& report,
                      const CalibrationPlotFiles& files, size_t histogramSeries,
-                     const std::vector<double>& gainsDb, std::vector<std::string>& pngs,
+                     const std::vector<double>& gainsDb, bool haveShapiro, std::vector<std::string>& pngs,
                      std::vector<std::string>& notes);
 
 //! One panel of the validation plot: an exposure factor and the largest mean of its bins.
