@@ -75,8 +75,11 @@ int main(int argc, char** argv)
             std::printf("model: alpha %.6f  sigma_d^2 %.5f  sigma_r^2 %.5f  (R^2 slope %.4f, offset %.4f)\n",
                         rep.model.alpha, rep.model.sigmaD2, rep.model.sigmaR2, rep.rSquaredSlope,
                         rep.rSquaredOffset);
-        std::printf("Shapiro-Wilk: %.1f%% of %d pixels have p > 0.05\n", 100 * r.gaussianFraction,
-                    r.shapiroTested);
+        if (r.shapiroTested > 0)
+            std::printf("Shapiro-Wilk: %.1f%% of %d pixels have p > 0.05\n", 100 * r.gaussianFraction,
+                        r.shapiroTested);
+        else
+            std::printf("Shapiro-Wilk: no pixel tested (it needs bursts of 3 or more frames)\n");
         for (const std::string& n : rep.notes)
             std::printf("note: %s\n", n.c_str());
         for (const std::string& n : r.notes)

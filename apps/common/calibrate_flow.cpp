@@ -393,7 +393,8 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         if (result.baseIso > 0 && report.model.alpha > 0) {
             std::vector<double> profileIsos;
             for (size_t i = 0; i < specs.size(); ++i) {
-                const double iso = result.baseIso * dbToLinearGain(gainsDb[i]);
+                // The file's ISO as it says it; a gain_db burst's from the gain (dB are not exact).
+                const double iso = specs[i].hasGainDb ? result.baseIso * dbToLinearGain(gainsDb[i]) : isos[i];
                 if (std::none_of(profileIsos.begin(), profileIsos.end(),
                                  [&](double v) { return std::abs(v - iso) < 1e-9 * iso; }))
                     profileIsos.push_back(iso);
@@ -445,7 +446,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     const double hiRatio = 3.0;
     std::map<double, std::vector<double>> counts;
     for (const NoiseSample& s : samples) {
-        const double predicted = report.model.variance(s.mean, s.gain);
+        const double predicted = fittedVariance(report, s.mean, s.gain);
         if (!(predicted > 0))
             continue;
         const int b = static_cast<int>(s.variance / predicted / hiRatio * bins);

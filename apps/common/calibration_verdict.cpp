@@ -45,6 +45,17 @@ VerdictCheck check(const std::string& name, bool pass, const std::string& figure
 
 } // namespace
 
+double fittedVariance(const CalibrationReport& report, double mean, double gain)
+{
+    if (report.separable || report.perGain.empty())
+        return report.model.variance(mean, gain);
+    const NoiseLineFit* nearest = &report.perGain.front();
+    for (const NoiseLineFit& f : report.perGain)
+        if (std::abs(std::log(f.gain / gain)) < std::abs(std::log(nearest->gain / gain)))
+            nearest = &f;
+    return nearest->line.a * std::max(0.0, mean) + nearest->line.b;
+}
+
 CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, const CalibrationReport& report,
                                     const std::vector<BurstFacts>& bursts, double signalRange)
 {
@@ -112,7 +123,7 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
         std::vector<double> dofs(kMeanBins, 0), binMeans(kMeanBins, 0);
         for (const NoiseSample* s : gs) {
             const int bin = std::min(kMeanBins - 1, std::max(0, int((std::max(0.0, s->mean) - lo) / width)));
-            const double predicted = report.model.variance(s->mean, g);
+            const double predicted = fittedVariance(report, s->mean, g);
             if (predicted > 0) {
                 ratios[size_t(bin)].push_back(s->variance / predicted);
                 dofs[size_t(bin)] += s->dof;
@@ -153,7 +164,7 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
         cv::Matx33d A = cv::Matx33d::zeros();
         cv::Vec3d rhs(0, 0, 0);
         for (const NoiseSample* s : gs) {
-            const double m = std::max(0.0, s->mean), predicted = report.model.variance(s->mean, g);
+            const double m = std::max(0.0, s->mean), predicted = fittedVariance(report, s->mean, g);
             if (!(predicted > 0))
                 continue;
             const double w = s->dof / (2 * predicted * predicted);
@@ -165,7 +176,7 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
         if (cv::invert(A, cov, cv::DECOMP_SVD) == 0 || !(hi > 0))
             continue;
         const cv::Vec3d p = cov * rhs;
-        const double top = report.model.variance(hi, g);
+        const double top = fittedVariance(report, hi, g);
         const double share = p[2] * hi * hi / top, shareSe = std::sqrt(cov(2, 2)) * hi * hi / top;
         if (std::abs(share) - 4 * shareSe > kMaxCurvatureShare &&
             std::abs(share) > std::abs(worstCurvature)) {

@@ -90,6 +90,11 @@ struct CalibrationVerdict
     std::vector<VerdictCheck> checks;
 };
 
+/** The variance the calibration predicts at `mean` and `gain`: the model when sigma_d^2 and sigma_r^2
+ * were separable; otherwise the line fitted at the nearest calibrated gain, since the model then
+ * holds alpha alone and would leave out the read noise. */
+double fittedVariance(const cv::rawgment::CalibrationReport& report, double mean, double gain);
+
 /** Judges a calibration from its samples, its report and its bursts: residuals of the variance against
  * the model per gain and mean bin, distinct means per gain, clipped fraction, frames per burst,
  * curvature of variance against mean (a non-linear raw file), separability of sigma_d^2 and sigma_r^2.

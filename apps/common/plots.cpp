@@ -36,8 +36,8 @@ void plotCalibration(const std::string& outDir, const CalibrationReport& report,
 {
     const NoiseModel& model = report.model;
     std::string s;
-    s += "set title 'Noise calibration: temporal variance against mean at each gain'\n";
-    s += "set xlabel 'mean signal above black (DN)'\nset ylabel 'temporal variance (DN^2)'\n";
+    s += "set title 'Noise calibration: variance against mean at each gain'\n";
+    s += "set xlabel 'mean signal above black (DN)'\nset ylabel 'variance (DN^2)'\n";
     s += "set key left top box opaque\nset grid\n";
     s += "plot ";
     for (size_t i = 0; i < report.perGain.size(); ++i) {
@@ -52,12 +52,16 @@ void plotCalibration(const std::string& outDir, const CalibrationReport& report,
             "(R^2 %.4f)', ",
             l.line.a, l.line.b, colour.c_str(), l.line.a, l.line.b, l.rSquared);
     }
-    s += cv::format("1/0 title 'model: {/Symbol a} %.4f, {/Symbol s}_d^2 %.4f, {/Symbol s}_r^2 %.4f'\n",
-                    model.alpha, model.sigmaD2, model.sigmaR2);
+    s += report.separable
+             ? cv::format("1/0 title 'model: {/Symbol a} %.4f, {/Symbol s}_d^2 %.4f, {/Symbol s}_r^2 %.4f'\n",
+                          model.alpha, model.sigmaD2, model.sigmaR2)
+             : cv::format("1/0 title 'model: {/Symbol a} %.4f ({/Symbol s}_d^2, {/Symbol s}_r^2 not "
+                          "separable)'\n",
+                          model.alpha);
     plotOrNote(outDir + "/calib_mean_variance.png", s, pngs, notes);
 
-    s = "set title 'Sample variance over model variance, per gain (ideal: centred on 1)'\n";
-    s += "set xlabel 'variance / model variance'\nset ylabel 'samples'\nset key right top\nset grid\nplot ";
+    s = "set title 'Sample variance over fitted variance, per gain (ideal: centred on 1)'\n";
+    s += "set xlabel 'variance / fitted variance'\nset ylabel 'samples'\nset key right top\nset grid\nplot ";
     for (size_t i = 0; i < histogramSeries; ++i)
         s += cv::format("%s'%s' every ::1 using 1:%zu with steps lw 2 lc rgb '%s' title columnhead(%zu)",
                         i ? ", " : "", files.histogramCsv.c_str(), i + 2, kSeriesColours[i % 7], i + 2);

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
 #include <memory>
@@ -19,6 +20,19 @@ namespace cv {
 namespace rawgment {
 
 namespace {
+
+/* LibRaw keeps ISO and exposure time as float: ISO 200 of a file can come back as 200.000002 once
+ * widened. The shortest decimal that gives the same float is the value the file held, and is what
+ * gain ratios and the exported profiles should see. */
+double shortestDecimal(float value)
+{
+    for (int digits = 1; digits < 9; ++digits) {
+        const double candidate = std::strtod(cv::format("%.*g", digits, double(value)).c_str(), nullptr);
+        if (float(candidate) == value)
+            return candidate;
+    }
+    return double(value);
+}
 
 [[noreturn]] void failOn(const String& path, const String& reason)
 {
@@ -161,8 +175,8 @@ RawImage readRaw(const String& path)
     } catch (const Exception& e) {
         failOn(path, "LibRaw's levels do not make a valid format: " + e.err);
     }
-    out.iso = d.other.iso_speed > 0 ? double(d.other.iso_speed) : 0.0;
-    out.exposureTime = d.other.shutter > 0 ? double(d.other.shutter) : 0.0;
+    out.iso = d.other.iso_speed > 0 ? shortestDecimal(d.other.iso_speed) : 0.0;
+    out.exposureTime = d.other.shutter > 0 ? shortestDecimal(d.other.shutter) : 0.0;
     out.make = d.idata.make;
     out.model = d.idata.model;
     if (c.cam_mul[0] > 0 && c.cam_mul[1] > 0 && c.cam_mul[2] > 0)
