@@ -35,10 +35,12 @@ int main(int argc, char** argv)
         "      - { dark: true, files: [ dark400/a.dng, ... ] }            # lens cap: pins read noise\n"
         "Or a folder with one folder of frames per burst (names starting with 'dark': dark\n"
         "frames), every gain from the ISO, no chart. The frames of a burst must share ISO,\n"
-        "exposure, size and levels. Paths are relative to the manifest. Writes noise_model.yml,\n"
-        "calibration_report.yml, samples.csv, lines.csv, shapiro.csv, PNG plots and, with gains\n"
-        "from ISO, darktable_noiseprofiles.json and android_noise_profile.yml into --out; never\n"
-        "overwrites them.");
+        "exposure, size and levels (16 frames or more for a PASS); a burst of one file is\n"
+        "single-frame mode (spatial variance of chart patches). Paths are relative to the\n"
+        "manifest. Writes report.md (a PASS/FAIL verdict, each check against its threshold),\n"
+        "noise_model.yml, calibration_report.yml, samples.csv, lines.csv, shapiro.csv, PNG plots\n"
+        "and, with gains from ISO, darktable_noiseprofiles.json and android_noise_profile.yml into\n"
+        "--out; never overwrites them. Step by step: docs/calibrate_your_camera.md.");
     if (parser.has("help")) {
         parser.printMessage();
         return 0;

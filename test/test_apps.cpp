@@ -572,6 +572,51 @@ TEST(Apps, augmentPreviewsAreBrightenedBackAndOutputsKeepTheCaptureTags)
     EXPECT_NEAR(previewMean[0.125], previewMean[1.0], 0.1 * previewMean[1.0]);
 }
 
+TEST(Apps, augmentTakesACameraFilesGainFromItsIsoAndTheModelsBaseIso)
+{
+    // A user's camera file (no sidecar) at ISO 200, and models of that camera whose gain 1 is ISO 100 (as
+    // rawgment_simulate's truth says, and rawgment_calibrate writes from ISO-tagged files) or unknown.
+    const std::string dir = freshDir("augment_iso");
+    AppRun r = runApp("rawgment_simulate",
+                      "--out='" + dir + "/sim' --frames=3 --gains=6 --levels=0.5 --validation=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    ASSERT_EQ(0, ::mkdir((dir + "/camera").c_str(), 0755));
+    {
+        std::ifstream in(dir + "/sim/g06dB_level0.50/frame_000.dng", std::ios::binary);
+        std::ofstream out(dir + "/camera/shot.dng", std::ios::binary);
+        out << in.rdbuf();
+        ASSERT_TRUE(out.good());
+    }
+    const cv::rawgment::NoiseModel withBase =
+        cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
+    EXPECT_EQ(100.0, withBase.baseIso);
+    cv::rawgment::NoiseModel withoutBase = withBase;
+    withoutBase.baseIso = 0;
+    withoutBase.save(dir + "/no_base.yml");
+    {
+        cv::rawgment::Scene scene;
+        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 2.0);
+        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
+        scene.write(fs, "scene");
+    }
+    // ISO 200 over base ISO 100: the input is at gain 2 and the output at 4. Without a base ISO the
+    // input is taken at gain 1, the output at 2; the ISO tag is the input's times the gain ratio either way.
+    for (const auto& c : {std::make_pair(std::string("/sim/truth_noise_model.yml"), 4.0),
+                          std::make_pair(std::string("/no_base.yml"), 2.0)}) {
+        const std::string out = dir + "/out" + std::to_string(int(c.second));
+        r = runApp("rawgment_augment", "--model='" + dir + c.first + "' --scene='" + dir +
+                                           "/scene.yml' --out='" + out + "' '" + dir + "/camera/shot.dng'");
+        ASSERT_EQ(0, r.status) << r.output;
+        cv::Mat mosaic;
+        const cv::rawgment::MosaicMetadata meta = cv::rawgment::readMosaic(out + "/shot_v00.dng", mosaic);
+        EXPECT_DOUBLE_EQ(c.second, meta.format.gain) << c.first;
+        EXPECT_DOUBLE_EQ(400.0, meta.camera.iso) << c.first;
+        EXPECT_EQ(cv::rawgment::readRaw(out + "/shot_v00.dng").noiseProfile,
+                  cv::rawgment::dngNoiseProfile(withBase, meta.format))
+            << c.first;
+    }
+}
+
 TEST(Apps, calibrateTakesTheGainsFromTheFilesIsoWithOrWithoutAChart)
 {
     // A user's own camera: DNG bursts that carry their ISO, no gain_db anywhere, no sidecars (so every
@@ -630,6 +675,7 @@ TEST(Apps, calibrateTakesTheGainsFromTheFilesIsoWithOrWithoutAChart)
         const cv::rawgment::NoiseModel fitted =
             cv::rawgment::NoiseModel::load(dir + "/cal_" + mode + "/noise_model.yml");
         expectTruth(fitted, 1.0, std::string(mode) == "chart" ? 0.47 : 0.16, mode);
+        EXPECT_EQ(100.0, fitted.baseIso) << "the model knows the ISO of its gain 1";
         // The profile for darktable gives the same model back.
         cv::rawgment::RawFormat format =
             cv::rawgment::readRaw(dir + "/sim/g6.02dB_level0.20/frame_000.dng").format;

@@ -141,7 +141,12 @@ AugmentPlan planAugmentJobs(const AugmentOptions& o)
 
 void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe)
 {
-    const LoadedMosaic m = loadMosaicFile(job.input);
+    LoadedMosaic m = loadMosaicFile(job.input);
+    // A camera file read without a sidecar is at the gain its ISO says, relative to the ISO of the
+    // model's gain 1 (a model calibrated from the camera's files knows it). A file that does not say its
+    // ISO, or a model without a base ISO, leaves gain 1: the capture is taken to be at the base ISO.
+    if (m.fromCameraFile && m.camera.iso > 0 && recipe.model.baseIso > 0)
+        m.format.gain = m.camera.iso / recipe.model.baseIso;
     const Scene scene = recipe.randomScenes ? recipe.policy.draw(m.mosaic, m.format, job.seed) : recipe.scene;
     cv::Mat out;
     RawFormat outFormat;

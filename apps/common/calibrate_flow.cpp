@@ -378,6 +378,8 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     params.method = o.method;
     params.line.seed = o.seed;
     result.report = calibrateNoiseModel(samples, params);
+    // The ISO of gain 1 travels with the model, so a camera file's ISO gives its gain when augmenting.
+    result.report.model.baseIso = result.baseIso;
     const CalibrationReport& report = result.report;
     result.verdict =
         judgeCalibration(samples, report, facts,
@@ -457,7 +459,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     }
     std::vector<std::string> histHeader = {"ratio"};
     for (const auto& kv : counts)
-        histHeader.push_back(cv::format("gain_%.1fdB", kv.first));
+        histHeader.push_back(cv::format("%.1f dB", kv.first));
     CsvTable hist(histHeader);
     for (int b = 0; b < bins; ++b) {
         std::vector<double> row = {(b + 0.5) * hiRatio / bins};

@@ -96,6 +96,7 @@ LoadedMosaic loadMosaicFile(const std::string& path)
         out.format = image.format;
         out.hasCamera = true;
         out.camera = CameraTags::of(image);
+        out.fromCameraFile = true;
     }
     return out;
 }

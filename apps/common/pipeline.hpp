@@ -15,7 +15,8 @@ struct LoadedMosaic
 {
     cv::Mat mosaic;
     cv::rawgment::RawFormat format;
-    bool hasCamera = false; //!< a camera RAW file, or a mosaic whose sidecar has camera tags
+    bool hasCamera = false;      //!< a camera RAW file, or a mosaic whose sidecar has camera tags
+    bool fromCameraFile = false; //!< read by LibRaw (no sidecar): format.gain is 1, whatever the ISO
     cv::rawgment::CameraTags camera;
 };
 LoadedMosaic loadMosaicFile(const std::string& path);

@@ -192,7 +192,10 @@ SimulateResult simulateBursts(const SimulateOptions& o)
     progress.finish();
 
     rawgment_helpers::writeChartPatches(patchesPath, patches);
-    sensor.effectiveModel().save(result.truthModel);
+    // The frames say ISO kSimulatedBaseIso g, so the truth's gain 1 is that ISO.
+    NoiseModel truth = sensor.effectiveModel();
+    truth.baseIso = kSimulatedBaseIso;
+    truth.save(result.truthModel);
     if (o.validation) {
         result.validationManifest = o.outDir + "/validation_manifest.yml";
         writeTextAtomically(result.validationManifest, yamlToString([&](cv::FileStorage& fs) {

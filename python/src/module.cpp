@@ -309,6 +309,7 @@ void bindCore(py::module_& m)
         .def_readwrite("alpha", &NoiseModel::alpha, doc("NoiseModel::alpha"))
         .def_readwrite("sigmaD2", &NoiseModel::sigmaD2, doc("NoiseModel::sigmaD2"))
         .def_readwrite("sigmaR2", &NoiseModel::sigmaR2, doc("NoiseModel::sigmaR2"))
+        .def_readwrite("baseIso", &NoiseModel::baseIso, doc("NoiseModel::baseIso"))
         .def("validate", &NoiseModel::validate, doc("NoiseModel::validate"))
         .def("lineAtGain", &NoiseModel::lineAtGain, py::arg("gain"), doc("NoiseModel::lineAtGain"))
         .def(

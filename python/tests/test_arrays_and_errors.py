@@ -117,6 +117,10 @@ def test_values_print_compare_and_pickle(tmp_path):
     model = rg.NoiseModel(0.5, 2, 1)
     model.save(str(tmp_path / "m.yml"))
     assert rg.NoiseModel.load(str(tmp_path / "m.yml")) == model
+    model.baseIso = 160.0
+    model.save(str(tmp_path / "iso.yml"))
+    assert rg.NoiseModel.load(str(tmp_path / "iso.yml")) == model
+    assert "baseIso=160" in repr(model)
     policy = rg.RandomScenePolicy(maxScale=0.01)
     policy.save(str(tmp_path / "p.json"))
     assert rg.RandomScenePolicy.load(str(tmp_path / "p.json")) == policy

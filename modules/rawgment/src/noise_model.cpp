@@ -53,6 +53,7 @@ void NoiseModel::validate() const
     detail::checkFiniteNonNegative(alpha, "NoiseModel.alpha");
     detail::checkFiniteNonNegative(sigmaD2, "NoiseModel.sigmaD2");
     detail::checkFiniteNonNegative(sigmaR2, "NoiseModel.sigmaR2");
+    detail::checkFiniteNonNegative(baseIso, "NoiseModel.baseIso");
 }
 
 namespace detail {
@@ -110,10 +111,12 @@ void NoiseModel::write(FileStorage& fs, const String& name) const
 {
     validate();
     fs << name << "{";
-    fs << "format_version" << FORMAT_VERSION;
+    fs << "format_version" << (baseIso > 0 ? 2 : 1);
     fs << "alpha" << alpha;
     fs << "sigma_d2" << sigmaD2;
     fs << "sigma_r2" << sigmaR2;
+    if (baseIso > 0)
+        fs << "base_iso" << baseIso;
     fs << "}";
 }
 
@@ -132,7 +135,10 @@ NoiseModel NoiseModel::read(const FileNode& node)
                         "(a newer cv::rawgment wrote the file)",
                         version, FORMAT_VERSION));
     try {
-        rejectUnknownKeys(node, {"format_version", "alpha", "sigma_d2", "sigma_r2"});
+        if (version == 1)
+            rejectUnknownKeys(node, {"format_version", "alpha", "sigma_d2", "sigma_r2"});
+        else
+            rejectUnknownKeys(node, {"format_version", "alpha", "sigma_d2", "sigma_r2", "base_iso"});
     } catch (const Exception& e) {
         CV_Error(e.code, "noise model: " + e.err);
     }
@@ -148,6 +154,16 @@ NoiseModel NoiseModel::read(const FileNode& node)
         if (!std::isfinite(*targets[i]) || *targets[i] < 0)
             CV_Error(Error::StsParseError, format("noise model: field '%s' must be finite and >= 0 (got %g)",
                                                   fields[i], *targets[i]));
+    }
+    if (!node["base_iso"].empty()) {
+        try {
+            m.baseIso = detail::readRealField(node, "base_iso");
+        } catch (const Exception& e) {
+            CV_Error(Error::StsParseError, "noise model: " + e.err);
+        }
+        if (!std::isfinite(m.baseIso) || !(m.baseIso > 0))
+            CV_Error(Error::StsParseError,
+                     format("noise model: field 'base_iso' must be finite and > 0 (got %g)", m.baseIso));
     }
     return m;
 }

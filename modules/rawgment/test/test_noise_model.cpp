@@ -101,7 +101,7 @@ TEST(NoiseModel, varianceImageMatchesScalarForm)
     EXPECT_CV_ERROR_CONTAINS(m.variance(withNan, 1.0, out), "NaN or Inf");
 }
 
-TEST(NoiseModel, fileRoundTripYamlAndJson)
+TEST(NoiseModel, fileRoundTripYamlAndJsonWithAndWithoutABaseIso)
 {
     const std::string dir = test::makeTempDir("noise_model_round_trip");
     // Values that need all 17 significant digits to survive a text round trip.
@@ -118,6 +118,20 @@ TEST(NoiseModel, fileRoundTripYamlAndJson)
     const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
     EXPECT_NE(text.find("\"format_version\""), std::string::npos) << text;
     EXPECT_CV_ERROR_CONTAINS(m.save(dir + "/model.txt"), "expected .yml, .yaml or .json");
+    // A base ISO takes version 2; a model without one is still written as version 1 for older readers.
+    EXPECT_NE(text.find("\"format_version\": 1"), std::string::npos) << text;
+    EXPECT_EQ(text.find("base_iso"), std::string::npos) << text;
+    NoiseModel withIso = m;
+    withIso.baseIso = 160;
+    withIso.save(dir + "/iso.yml");
+    const NoiseModel back = NoiseModel::load(dir + "/iso.yml");
+    EXPECT_EQ(160.0, back.baseIso);
+    EXPECT_EQ(m.alpha, back.alpha);
+    EXPECT_EQ(0.0, NoiseModel::load(dir + "/model.yml").baseIso);
+    FileStorage written(dir + "/iso.yml", FileStorage::READ);
+    EXPECT_EQ(2, int(written["noise_model"]["format_version"]));
+    withIso.baseIso = -1;
+    EXPECT_CV_ERROR_CONTAINS(withIso.save(dir + "/bad.yml"), "NoiseModel.baseIso");
     EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/missing.yml"), "cannot open");
 }
 
@@ -144,8 +158,15 @@ TEST(NoiseModel, readingRejectsBadFilesNamingTheField)
     EXPECT_CV_ERROR_CONTAINS(
         readFromYaml("  format_version: 1\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: abc\n"),
         "'sigma_r2' is not a number");
-    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 2\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
-                             "format_version 2 is not supported");
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 3\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
+                             "format_version 3 is not supported");
+    // base_iso came with version 2: a version 1 file that has it was not written by this project.
+    EXPECT_CV_ERROR_CONTAINS(
+        readFromYaml("  format_version: 1\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n  base_iso: 100\n"),
+        "unknown key 'base_iso'");
+    EXPECT_CV_ERROR_CONTAINS(
+        readFromYaml("  format_version: 2\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n  base_iso: 0\n"),
+        "'base_iso' must be finite and > 0");
     EXPECT_CV_ERROR_CONTAINS(readFromYaml("  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
                              "'format_version' is missing");
     FileStorage empty("%YAML:1.0\nother: 1\n", FileStorage::READ | FileStorage::MEMORY);

@@ -57,12 +57,16 @@ struct CV_RAWGMENT_EXPORTS NoiseLine
  */
 struct CV_RAWGMENT_EXPORTS NoiseModel
 {
-    //! Version of the file format written by write(); read() rejects newer versions.
-    static constexpr int FORMAT_VERSION = 1;
+    //! Newest version of the file format; read() rejects newer versions (see write()).
+    static constexpr int FORMAT_VERSION = 2;
 
     double alpha = 0;   //!< shot-noise slope at gain 1, DN per electron (>= 0)
     double sigmaD2 = 0; //!< read-noise variance before the analog gain, DN^2 at gain 1 (>= 0)
     double sigmaR2 = 0; //!< noise variance after the analog gain, DN^2 (>= 0)
+    /** ISO of gain 1, when the model was calibrated from files that say their ISO (0: unknown). It
+     * lets a camera file give its own gain, \f$ g = \mathrm{ISO} / \mathrm{baseIso} \f$; the noise
+     * terms do not depend on it. */
+    double baseIso = 0;
 
     NoiseModel() = default;
     /** @brief A validated model. @throws cv::Exception when a parameter is negative or not finite. */
@@ -90,7 +94,9 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      */
     void variance(InputArray mean, double gain, OutputArray dst) const;
 
-    /** @brief Writes the model as a map under `name`: format_version, alpha, sigma_d2, sigma_r2. */
+    /** @brief Writes the model as a map under `name`: format_version, alpha, sigma_d2, sigma_r2, and
+     * base_iso when it is known. The version is the lowest that holds what the model has (1 without a
+     * base ISO, 2 with one), so a model without one stays readable by older builds. */
     void write(FileStorage& fs, const String& name) const;
 
     /** @brief Reads a model written by write().
