@@ -408,6 +408,7 @@ NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format, 
     } catch (const Exception& e) {
         CV_Error(Error::StsBadArg, where + ": the profiles give an invalid model: " + e.err);
     }
+    model.baseIso = baseIso;
     return model;
 }
 
@@ -468,6 +469,7 @@ NoiseModel noiseModelFromAndroid(const AndroidNoiseProfile& profile, const RawFo
     } catch (const Exception& e) {
         CV_Error(Error::StsBadArg, "noiseModelFromAndroid: the profile gives an invalid model: " + e.err);
     }
+    model.baseIso = baseIso;
     return model;
 }
 

@@ -368,6 +368,7 @@ TEST(RawIo, darktableNoiseProfilesAreTheDngProfilesPerIsoAndGiveTheModelBack)
     EXPECT_NEAR(back.alpha, model.alpha, 1e-13 * model.alpha);
     EXPECT_NEAR(back.sigmaD2, model.sigmaD2, 1e-11 * model.sigmaD2);
     EXPECT_NEAR(back.sigmaR2, model.sigmaR2, 1e-9 * model.sigmaR2);
+    EXPECT_EQ(100.0, back.baseIso);
     // Another base ISO scales the gain: the model at base ISO 200 has twice the per-gain terms.
     const NoiseModel at200 = noiseModelFromDarktable(path, format, 200, "Rawgment", "Test \"Cam\"");
     EXPECT_NEAR(at200.alpha, 2 * model.alpha, 1e-12);
@@ -459,6 +460,7 @@ TEST(RawIo, androidNoiseProfileIsTheDngProfileOfEverySiteAtEverySensitivity)
         }
     }
     const NoiseModel back = noiseModelFromAndroid(p, format, 50);
+    EXPECT_EQ(50.0, back.baseIso);
     EXPECT_NEAR(back.alpha, model.alpha, 1e-15);
     EXPECT_NEAR(back.sigmaD2, model.sigmaD2, 1e-14);
     EXPECT_NEAR(back.sigmaR2, model.sigmaR2, 1e-14);

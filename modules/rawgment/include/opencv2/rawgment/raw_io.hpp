@@ -92,7 +92,7 @@ CV_RAWGMENT_EXPORTS String darktableNoiseProfiles(const NoiseModel& model, const
  * @param path a darktable noise-profile JSON file (read with openFileStorageForReading(); every key is
  *        checked)
  * @param format black and white levels of the camera's raw files
- * @param baseIso the ISO at which the returned model's gain is 1
+ * @param baseIso the ISO at which the returned model's gain is 1 (its NoiseModel::baseIso)
  * @param maker, cameraModel the entry to read, compared exactly
  * @throws cv::Exception naming the file when it is unreadable or malformed, has no such entry, has
  *         fewer than two distinct ISOs (sigma_d^2 and sigma_r^2 cannot be told apart), or is not of the
@@ -129,7 +129,8 @@ CV_RAWGMENT_EXPORTS AndroidNoiseProfile androidNoiseProfile(const NoiseModel& mo
 
 /** @brief The noise model of an Android-form profile, where the mapping is exact: B must be 0 (the
  * model's shot noise is proportional to the gain) and the four sites must give the same
- * alpha, sigma_d^2 and sigma_r^2 to 1e-9 relative (the model has one set for all colours).
+ * alpha, sigma_d^2 and sigma_r^2 to 1e-9 relative (the model has one set for all colours). The
+ * model's NoiseModel::baseIso is `baseIso`.
  * @throws cv::Exception naming the site and the value when the profile is not of the model's form.
  */
 CV_RAWGMENT_EXPORTS NoiseModel noiseModelFromAndroid(const AndroidNoiseProfile& profile,
