@@ -99,9 +99,9 @@ sampleBurstPatches(const BurstStatistics& stats, const std::vector<Rect>& square
  * lie within \f$ 4\sqrt{2 v_{med} / T} + 0.002|\mu_p| \f$ of its own mean, with \f$ v_{med} \f$ the median
  * temporal variance of the nine pixels and T the frames: a neighbourhood flat within the noise of a
  * difference of means (the median sets it, because shake inflates the variance of the very pixels it
- * smears, at most three of the nine along an edge) and a 0.2% allowance for smooth shading, whose own shake adds under 1% of the shot
- * noise. Neither the pixels within 4 of the frame's border nor clipped pixels (or pixels next to them)
- * are sampled; dark frames (a lens cap) pass as flat scenes.
+ * smears, at most three of the nine along an edge) and a 0.2% allowance for smooth shading, whose own shake
+ * adds under 1% of the shot noise. Neither the pixels within 4 of the frame's border nor clipped pixels (or
+ * pixels next to them) are sampled; dark frames (a lens cap) pass as flat scenes.
  * @param stats statistics of a burst with at least 2 frames
  * @param gain linear gain of the burst (stored in the samples)
  * @param maxSamples at most this many samples (>= 4): the grid's step in blocks grows until the frame's
