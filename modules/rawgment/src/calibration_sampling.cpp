@@ -46,6 +46,19 @@ void checkSquares(const std::vector<Rect>& squares, Size size, const char* who)
                             squares[i].y, size.width, size.height));
 }
 
+//! The temporal sample of pixel (r, c) of a burst.
+NoiseSample temporalSample(const BurstStatistics& stats, const Mat& mean, const Mat& var, int r, int c,
+                           double gain)
+{
+    NoiseSample s;
+    s.mean = mean.at<double>(r, c);
+    s.variance = var.at<double>(r, c);
+    s.gain = gain;
+    s.dof = stats.frames() - 1;
+    s.channel = cfaChannelAt(stats.format().pattern, r, c);
+    return s;
+}
+
 } // namespace
 
 std::vector<NoiseSample> sampleBurstPatches(const BurstStatistics& stats, const std::vector<Rect>& squares,
@@ -63,13 +76,7 @@ std::vector<NoiseSample> sampleBurstPatches(const BurstStatistics& stats, const 
             for (int c = sq.x; c < sq.x + sq.width; ++c) {
                 if (clipped.at<uchar>(r, c))
                     continue;
-                NoiseSample s;
-                s.mean = mean.at<double>(r, c);
-                s.variance = var.at<double>(r, c);
-                s.gain = gain;
-                s.dof = stats.frames() - 1;
-                s.channel = cfaChannelAt(stats.format().pattern, r, c);
-                out.push_back(s);
+                out.push_back(temporalSample(stats, mean, var, r, c, gain));
             }
     return out;
 }
@@ -122,13 +129,7 @@ std::vector<NoiseSample> sampleStaticScene(const BurstStatistics& stats, double 
                         flat = std::abs(mean.at<double>(r + dy, c + dx) - mp) <= tolerance;
                 if (!flat)
                     continue;
-                NoiseSample sample;
-                sample.mean = mp;
-                sample.variance = var.at<double>(r, c);
-                sample.gain = gain;
-                sample.dof = stats.frames() - 1;
-                sample.channel = cfaChannelAt(stats.format().pattern, r, c);
-                out.push_back(sample);
+                out.push_back(temporalSample(stats, mean, var, r, c, gain));
             }
     return out;
 }

@@ -47,28 +47,11 @@ public:
             fail("has a TIFF header without the number 42");
     }
     bool bigEndian() const { return bigEndian_; }
-    uint16_t u16(uint64_t at)
-    {
-        unsigned char b[2];
-        bytes(at, b, 2);
-        return bigEndian_ ? uint16_t(b[0] << 8 | b[1]) : uint16_t(b[1] << 8 | b[0]);
-    }
-    uint32_t u32(uint64_t at)
-    {
-        unsigned char b[4];
-        bytes(at, b, 4);
-        uint32_t v = 0;
-        for (int k = 0; k < 4; ++k)
-            v |= uint32_t(b[bigEndian_ ? k : 3 - k]) << (8 * (3 - k));
-        return v;
-    }
+    uint16_t u16(uint64_t at) { return static_cast<uint16_t>(unsignedAt<2>(at)); }
+    uint32_t u32(uint64_t at) { return static_cast<uint32_t>(unsignedAt<4>(at)); }
     double f64(uint64_t at)
     {
-        unsigned char b[8];
-        bytes(at, b, 8);
-        uint64_t v = 0;
-        for (int k = 0; k < 8; ++k)
-            v |= uint64_t(b[bigEndian_ ? k : 7 - k]) << (8 * (7 - k));
+        const uint64_t v = unsignedAt<8>(at);
         double d;
         std::memcpy(&d, &v, sizeof(d));
         return d;
@@ -88,6 +71,16 @@ private:
         in_.read(static_cast<char*>(out), static_cast<std::streamsize>(n));
         if (!in_)
             fail("could not be read");
+    }
+    //! The unsigned integer of `Bytes` bytes at `at`, in the file's byte order.
+    template <int Bytes> uint64_t unsignedAt(uint64_t at)
+    {
+        unsigned char b[Bytes];
+        bytes(at, b, Bytes);
+        uint64_t v = 0;
+        for (int k = 0; k < Bytes; ++k)
+            v |= uint64_t(b[bigEndian_ ? k : Bytes - 1 - k]) << (8 * (Bytes - 1 - k));
+        return v;
     }
     String path_;
     std::ifstream in_;
