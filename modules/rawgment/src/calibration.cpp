@@ -7,6 +7,7 @@
 #include <ceres/ceres.h>
 
 #include <algorithm>
+#include <deque>
 #include <map>
 #include <numeric>
 
@@ -235,23 +236,31 @@ struct OffsetResidual
     double g, b;
 };
 
-//! (v - (g alpha mu + g^2 sigma_d^2 + sigma_r^2)) / scale: one sample of the joint fit.
-struct JointResidual
+/* (v - (g alpha mu + g^2 sigma_d^2 + sigma_r^2)) / scale: one sample of the joint fit. The model is
+ * linear in its parameters, so the Jacobian is the constant (-g max(mu, 0), -g^2, -1) / scale; written
+ * out rather than differentiated automatically, and held in one array that the problem does not own,
+ * because a calibration without a chart has hundreds of thousands of samples and a heap object and a
+ * dual-number evaluation per sample were most of its time. */
+class JointResidual final : public ceres::SizedCostFunction<1, 3>
 {
+public:
     JointResidual(double mean, double variance, double gain, double invScale)
         : mu(mean), v(variance), g(gain), w(invScale)
     {
     }
-    template <typename T> bool operator()(const T* p, T* r) const
+    bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override
     {
-        r[0] = (T(v) - detail::noiseTermsAt(T(g), p[0], p[1], p[2]).variance(mu)) * T(w);
+        const double* p = parameters[0];
+        residuals[0] = (v - detail::noiseTermsAt(g, p[0], p[1], p[2]).variance(mu)) * w;
+        if (jacobians != nullptr && jacobians[0] != nullptr) {
+            jacobians[0][0] = -g * std::max(mu, 0.0) * w;
+            jacobians[0][1] = -g * g * w;
+            jacobians[0][2] = -w;
+        }
         return true;
     }
-    static ceres::CostFunction* Create(double mean, double variance, double gain, double invScale)
-    {
-        return new ceres::AutoDiffCostFunction<JointResidual, 1, 3>(
-            new JointResidual(mean, variance, gain, invScale));
-    }
+
+private:
     double mu, v, g, w;
 };
 
@@ -383,14 +392,19 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
             for (const NoiseSample& s : inlierSamples)
                 predicted.push_back(detail::noiseTermsAt(s.gain, p[0], p[1], p[2]).variance(s.mean));
             const double floor = detail::varianceFloor(*std::max_element(predicted.begin(), predicted.end()));
-            ceres::Problem problem;
+            // The residuals and the one loss outlive the problem, which only points at them (a deque:
+            // its elements never move, and a cost function cannot).
+            std::deque<JointResidual> residuals;
+            ceres::HuberLoss huber(params.lossScale);
+            ceres::Problem::Options problemOptions;
+            problemOptions.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+            problemOptions.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+            ceres::Problem problem(problemOptions);
             for (size_t i = 0; i < inlierSamples.size(); ++i) {
                 const NoiseSample& s = inlierSamples[i];
                 const double scale = detail::sampleVarianceStdError(predicted[i], s.dof, floor);
-                ceres::LossFunction* loss =
-                    params.line.robust ? new ceres::HuberLoss(params.lossScale) : nullptr;
-                problem.AddResidualBlock(JointResidual::Create(s.mean, s.variance, s.gain, 1.0 / scale), loss,
-                                         p);
+                residuals.emplace_back(s.mean, s.variance, s.gain, 1.0 / scale);
+                problem.AddResidualBlock(&residuals.back(), params.line.robust ? &huber : nullptr, p);
             }
             for (int k = 0; k < 3; ++k)
                 problem.SetParameterLowerBound(p, k, 0.0);
