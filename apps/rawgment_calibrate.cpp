@@ -71,12 +71,23 @@ int main(int argc, char** argv)
             std::printf("  %s %s: %s\n", c.pass ? "pass" : "FAIL", c.name.c_str(), c.figure.c_str());
         std::printf("method %s, %d of %d samples used\n", method.c_str(), rep.samplesUsed, rep.samples);
         for (const cv::rawgment::NoiseLineFit& l : rep.perGain)
-            std::printf("  gain %6.2f dB: variance = %.5f mean + %.4f  (R^2 %.4f, %d inliers)\n",
-                        cv::rawgment::linearGainToDb(l.gain), l.line.a, l.line.b, l.rSquared, l.inliers);
+            std::printf(
+                "  gain %6.2f dB: variance = (%.5f +- %.2g) mean + (%.4f +- %.2g)  (R^2 %.4f, %d inliers)\n",
+                cv::rawgment::linearGainToDb(l.gain), l.line.a, l.slopeStdError, l.line.b, l.offsetStdError,
+                l.rSquared, l.inliers);
+        // Standard errors, and 95% intervals for the read terms, whose relative errors are the larger.
+        const cv::Vec2d d = rep.interval(cv::rawgment::NOISE_PARAM_SIGMA_D2),
+                        r2 = rep.interval(cv::rawgment::NOISE_PARAM_SIGMA_R2);
         if (rep.separable)
-            std::printf("model: alpha %.6f  sigma_d^2 %.5f  sigma_r^2 %.5f  (R^2 slope %.4f, offset %.4f)\n",
-                        rep.model.alpha, rep.model.sigmaD2, rep.model.sigmaR2, rep.rSquaredSlope,
-                        rep.rSquaredOffset);
+            std::printf(
+                "model: alpha %.6f +- %.2g  sigma_d^2 %.5f +- %.2g [%.5g, %.5g]  sigma_r^2 %.5f +- %.2g "
+                "[%.5g, %.5g]  (+- one standard error, [95%% interval]; R^2 slope %.4f, offset %.4f)\n",
+                rep.model.alpha, rep.uncertainty.stdError[0], rep.model.sigmaD2, rep.uncertainty.stdError[1],
+                d[0], d[1], rep.model.sigmaR2, rep.uncertainty.stdError[2], r2[0], r2[1], rep.rSquaredSlope,
+                rep.rSquaredOffset);
+        else
+            std::printf("model: alpha %.6f +- %.2g (sigma_d^2 and sigma_r^2 not separable)\n",
+                        rep.model.alpha, rep.uncertainty.stdError[0]);
         if (r.shapiroTested > 0)
             std::printf("Shapiro-Wilk: %.1f%% of %d pixels have p > 0.05\n", 100 * r.gaussianFraction,
                         r.shapiroTested);

@@ -144,19 +144,56 @@ std::string calibrationReportMarkdown(const CalibrateResult& r, const std::strin
         "\nThe thresholds and what to do on each failure: docs/calibrate_your_camera.md in cv::rawgment.\n\n";
     const CalibrationReport& rep = r.report;
     md += "## Model\n\n";
+    md += cv::format("Method %s, %d of %d samples used. ",
+                     rep.method == NOISE_FIT_JOINT ? "joint" : "two-stage", rep.samplesUsed, rep.samples);
+    if (!rep.separable)
+        md += "sigma_d^2 and sigma_r^2 are not separable with these gains: alpha alone is known.";
+    md += "\n\n| parameter | value | standard error | 95% interval |\n|---|---|---|---|\n";
+    const char* names[3] = {"alpha", "sigma_d^2", "sigma_r^2"};
+    const double values[3] = {rep.model.alpha, rep.model.sigmaD2, rep.model.sigmaR2};
+    for (int k = 0; k < (rep.separable ? 3 : 1); ++k) {
+        const cv::Vec2d ci = rep.interval(static_cast<NoiseModelParameter>(k));
+        md += cv::format("| %s | %.6g | %.3g (%.2f%%) | [%.6g, %.6g] |\n", names[k], values[k],
+                         rep.uncertainty.stdError[k],
+                         values[k] > 0 ? 100 * rep.uncertainty.stdError[k] / values[k] : 0.0, ci[0], ci[1]);
+    }
+    md += cv::format(
+        "\nStandard errors from the %s (fit covariance: %.3g, %.3g, %.3g; bootstrap of %d "
+        "replicates: %.3g, %.3g, %.3g)",
+        rep.uncertainty.source == UNCERTAINTY_BOOTSTRAP ? "bootstrap" : "fit's sandwich covariance",
+        rep.uncertainty.fitStdError[0], rep.uncertainty.fitStdError[1], rep.uncertainty.fitStdError[2],
+        rep.uncertainty.bootstrapReplicates, rep.uncertainty.bootstrapStdError[0],
+        rep.uncertainty.bootstrapStdError[1], rep.uncertainty.bootstrapStdError[2]);
     if (rep.separable)
-        md += cv::format("alpha %.6g, sigma_d^2 %.6g, sigma_r^2 %.6g (method %s, %d of %d samples used)\n\n",
-                         rep.model.alpha, rep.model.sigmaD2, rep.model.sigmaR2,
-                         rep.method == NOISE_FIT_JOINT ? "joint" : "two-stage", rep.samplesUsed, rep.samples);
-    else
-        md += cv::format("alpha %.6g; sigma_d^2 and sigma_r^2 not separable with these gains\n\n",
-                         rep.model.alpha);
+        md +=
+            cv::format("; the errors of sigma_d^2 and sigma_r^2 correlate %+.2f, as both make up each gain's "
+                       "offset",
+                       rep.uncertainty.correlation(NOISE_PARAM_SIGMA_D2, NOISE_PARAM_SIGMA_R2));
+    md += ".\n\n";
     if (r.baseIso > 0)
         md += cv::format("Gain 1 is ISO %g.\n\n", r.baseIso);
     md += "| gain (dB) | slope a | offset b | R^2 | inliers | samples |\n|---|---|---|---|---|---|\n";
     for (const NoiseLineFit& l : rep.perGain)
-        md += cv::format("| %.2f | %.6g | %.6g | %.4f | %d | %d |\n", linearGainToDb(l.gain), l.line.a,
-                         l.line.b, l.rSquared, l.inliers, l.samples);
+        md += cv::format("| %.2f | %.6g +- %.2g | %.6g +- %.2g | %.4f | %d | %d |\n", linearGainToDb(l.gain),
+                         l.line.a, l.slopeStdError, l.line.b, l.offsetStdError, l.rSquared, l.inliers,
+                         l.samples);
+    if (!r.projections.empty()) {
+        md +=
+            "\n## What more data buys\n\n"
+            "Relative standard errors if the calibration were shot again with more data (projected from the "
+            "Fisher information of these samples under the fitted model, scaled to the errors measured "
+            "here). More of the same shrinks every error as 1/sqrt(pixels x (frames - 1)); dark frames and "
+            "wider gains change which parameter is pinned.\n\n"
+            "| plan | alpha | sigma_d^2 | sigma_r^2 |\n|---|---|---|---|\n";
+        for (const auto& plan : r.projections) {
+            md += "| " + plan.first;
+            for (int k = 0; k < 3; ++k)
+                md += values[k] > 0 && plan.second[k] > 0
+                          ? cv::format(" | %.3g%%", 100 * plan.second[k] / values[k])
+                          : std::string(" | -");
+            md += " |\n";
+        }
+    }
     md += r.shapiroTested > 0
               ? cv::format("\nShapiro-Wilk: %.1f%% of %d tested pixels have p > 0.05.\n",
                            100 * r.gaussianFraction, r.shapiroTested)
@@ -381,6 +418,24 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     // The ISO of gain 1 travels with the model, so a camera file's ISO gives its gain when augmenting.
     result.report.model.baseIso = result.baseIso;
     const CalibrationReport& report = result.report;
+    {
+        const double highest = report.perGain.back().gain;
+        const auto plan = [&](const std::string& name, double frames, double pixels, bool dark, double gain) {
+            CalibrationPlan p;
+            p.frameFactor = frames;
+            p.pixelFactor = pixels;
+            p.addDarkFrames = dark;
+            p.addGain = gain;
+            result.projections.emplace_back(name, projectedStdError(samples, report, p));
+        };
+        plan("as shot", 1, 1, false, 0);
+        plan("2x the frames per burst", 2, 1, false, 0);
+        plan("4x the frames per burst", 4, 1, false, 0);
+        plan("2x the pixels (patches)", 1, 2, false, 0);
+        if (std::none_of(facts.begin(), facts.end(), [](const BurstFacts& b) { return b.dark; }))
+            plan("dark frames at each gain", 1, 1, true, 0);
+        plan(cv::format("one more gain, %.1f dB", linearGainToDb(2 * highest)), 1, 1, false, 2 * highest);
+    }
     result.verdict =
         judgeCalibration(samples, report, facts,
                          firstFormat.whiteLevel - (firstFormat.blackLevel[0] + firstFormat.blackLevel[1] +

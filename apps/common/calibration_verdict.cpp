@@ -95,13 +95,25 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
         gMax = std::max(gMax, f.gain);
     }
     const double ratio = report.perGain.empty() ? 1.0 : gMax / gMin;
-    add(check("separability of sigma_d^2 and sigma_r^2", report.separable && ratio >= kMinGainRatio,
-              cv::format("gain ratio %.2f (%.1f dB) over %zu gains; threshold %.1f (%.1f dB)%s", ratio,
-                         linearGainToDb(ratio), report.perGain.size(), kMinGainRatio,
-                         linearGainToDb(kMinGainRatio),
-                         report.separable && ratio >= kMinGainRatio
-                             ? ""
-                             : ": add a burst at an ISO at least twice the lowest (dark frames help too)")));
+    // And the intervals: a read term whose 95% interval reaches 0 is not told apart from 0 by the data.
+    bool intervalsClear = report.separable && report.uncertainty.source != UNCERTAINTY_NONE;
+    std::string intervals;
+    if (intervalsClear) {
+        const cv::Vec2d d = report.interval(NOISE_PARAM_SIGMA_D2), r = report.interval(NOISE_PARAM_SIGMA_R2);
+        intervalsClear = d[0] > 0 && r[0] > 0;
+        intervals = cv::format("; 95%% intervals sigma_d^2 [%.4g, %.4g], sigma_r^2 [%.4g, %.4g]", d[0], d[1],
+                               r[0], r[1]);
+    }
+    const bool separated = report.separable && ratio >= kMinGainRatio && intervalsClear;
+    add(check(
+        "separability of sigma_d^2 and sigma_r^2", separated,
+        cv::format("gain ratio %.2f (%.1f dB) over %zu gains%s; threshold %.1f (%.1f dB) and both intervals "
+                   "above 0%s",
+                   ratio, linearGainToDb(ratio), report.perGain.size(), intervals.c_str(), kMinGainRatio,
+                   linearGainToDb(kMinGainRatio),
+                   separated ? ""
+                             : ": add a burst at an ISO at least twice the lowest, and dark frames at "
+                               "each ISO")));
 
     // Per gain: distinct means, residuals per mean bin, curvature.
     std::map<double, std::vector<const NoiseSample*>> byGain;

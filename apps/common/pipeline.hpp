@@ -114,6 +114,8 @@ struct CalibrateResult
     double baseIso = 0;              //!< the ISO of gain 1 (0 when every gain came from the manifest)
     cv::rawgment::CameraTags camera; //!< the first frame's camera tags
     CalibrationVerdict verdict;
+    //! What more data would buy: a plan's name and the standard errors it would give (projectedStdError()).
+    std::vector<std::pair<std::string, cv::Vec3d>> projections;
 };
 
 //! What a calibration manifest says, checked: every key known, gains finite, no file listed twice.

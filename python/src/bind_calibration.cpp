@@ -55,7 +55,8 @@ void bindCalibration(py::module_& m)
         .def_readwrite("variance", &NoiseSample::variance, doc("NoiseSample::variance"))
         .def_readwrite("gain", &NoiseSample::gain, doc("NoiseSample::gain"))
         .def_readwrite("dof", &NoiseSample::dof, doc("NoiseSample::dof"))
-        .def_readwrite("channel", &NoiseSample::channel, doc("NoiseSample::channel"));
+        .def_readwrite("channel", &NoiseSample::channel, doc("NoiseSample::channel"))
+        .def_readwrite("pixel", &NoiseSample::pixel, doc("NoiseSample::pixel"));
     m.def("cfaAlignedSquares", &cfaAlignedSquares, py::arg("patches"), py::arg("side") = 24,
           doc("cfaAlignedSquares"));
     m.def(
@@ -96,7 +97,11 @@ void bindCalibration(py::module_& m)
         .def_readwrite("line", &NoiseLineFit::line, doc("NoiseLineFit::line"))
         .def_readwrite("rSquared", &NoiseLineFit::rSquared, doc("NoiseLineFit::rSquared"))
         .def_readwrite("inliers", &NoiseLineFit::inliers, doc("NoiseLineFit::inliers"))
-        .def_readwrite("samples", &NoiseLineFit::samples, doc("NoiseLineFit::samples"));
+        .def_readwrite("samples", &NoiseLineFit::samples, doc("NoiseLineFit::samples"))
+        .def_readwrite("slopeStdError", &NoiseLineFit::slopeStdError, doc("NoiseLineFit::slopeStdError"))
+        .def_readwrite("offsetStdError", &NoiseLineFit::offsetStdError, doc("NoiseLineFit::offsetStdError"))
+        .def_readwrite("slopeOffsetCorrelation", &NoiseLineFit::slopeOffsetCorrelation,
+                       doc("NoiseLineFit::slopeOffsetCorrelation"));
     m.def(
         "fitNoiseLine",
         [](const std::vector<NoiseSample>& samples, const LineFitParams& params) {
@@ -116,7 +121,33 @@ void bindCalibration(py::module_& m)
                        doc("CalibrationParams::reweightIterations"))
         .def_readwrite("lossScale", &CalibrationParams::lossScale, doc("CalibrationParams::lossScale"))
         .def_readwrite("minGainRatio", &CalibrationParams::minGainRatio,
-                       doc("CalibrationParams::minGainRatio"));
+                       doc("CalibrationParams::minGainRatio"))
+        .def_readwrite("bootstrapReplicates", &CalibrationParams::bootstrapReplicates,
+                       doc("CalibrationParams::bootstrapReplicates"));
+    py::enum_<NoiseModelParameter>(m, "NoiseModelParameter", doc("NoiseModelParameter"))
+        .value("NOISE_PARAM_ALPHA", NOISE_PARAM_ALPHA, doc("NoiseModelParameter::NOISE_PARAM_ALPHA"))
+        .value("NOISE_PARAM_SIGMA_D2", NOISE_PARAM_SIGMA_D2, doc("NoiseModelParameter::NOISE_PARAM_SIGMA_D2"))
+        .value("NOISE_PARAM_SIGMA_R2", NOISE_PARAM_SIGMA_R2, doc("NoiseModelParameter::NOISE_PARAM_SIGMA_R2"))
+        .export_values();
+    py::enum_<UncertaintySource>(m, "UncertaintySource", doc("UncertaintySource"))
+        .value("UNCERTAINTY_NONE", UNCERTAINTY_NONE, doc("UncertaintySource::UNCERTAINTY_NONE"))
+        .value("UNCERTAINTY_COVARIANCE", UNCERTAINTY_COVARIANCE,
+               doc("UncertaintySource::UNCERTAINTY_COVARIANCE"))
+        .value("UNCERTAINTY_BOOTSTRAP", UNCERTAINTY_BOOTSTRAP,
+               doc("UncertaintySource::UNCERTAINTY_BOOTSTRAP"))
+        .export_values();
+    py::class_<ModelUncertainty>(m, "ModelUncertainty", doc("ModelUncertainty"))
+        .def(keywordInit<ModelUncertainty>())
+        .def_readwrite("source", &ModelUncertainty::source, doc("ModelUncertainty::source"))
+        .def_readwrite("stdError", &ModelUncertainty::stdError, doc("ModelUncertainty::stdError"))
+        .def_readwrite("covariance", &ModelUncertainty::covariance, doc("ModelUncertainty::covariance"))
+        .def_readwrite("fitStdError", &ModelUncertainty::fitStdError, doc("ModelUncertainty::fitStdError"))
+        .def_readwrite("bootstrapStdError", &ModelUncertainty::bootstrapStdError,
+                       doc("ModelUncertainty::bootstrapStdError"))
+        .def_readwrite("bootstrapReplicates", &ModelUncertainty::bootstrapReplicates,
+                       doc("ModelUncertainty::bootstrapReplicates"))
+        .def("correlation", &ModelUncertainty::correlation, py::arg("first"), py::arg("second"),
+             doc("ModelUncertainty::correlation"));
     py::class_<CalibrationReport>(m, "CalibrationReport", doc("CalibrationReport"))
         .def(keywordInit<CalibrationReport>())
         .def_readonly_static("FORMAT_VERSION", &CalibrationReport::FORMAT_VERSION,
@@ -132,8 +163,25 @@ void bindCalibration(py::module_& m)
         .def_readwrite("samples", &CalibrationReport::samples, doc("CalibrationReport::samples"))
         .def_readwrite("samplesUsed", &CalibrationReport::samplesUsed, doc("CalibrationReport::samplesUsed"))
         .def_readwrite("notes", &CalibrationReport::notes, doc("CalibrationReport::notes"))
+        .def_readwrite("uncertainty", &CalibrationReport::uncertainty, doc("CalibrationReport::uncertainty"))
+        .def("interval", &CalibrationReport::interval, py::arg("parameter"), py::arg("level") = 0.95,
+             doc("CalibrationReport::interval"))
         .def("save", &CalibrationReport::save, py::arg("path"), doc("CalibrationReport::save"))
         .def_static("load", &CalibrationReport::load, py::arg("path"), doc("CalibrationReport::load"));
+    py::class_<CalibrationPlan>(m, "CalibrationPlan", doc("CalibrationPlan"))
+        .def(keywordInit<CalibrationPlan>())
+        .def_readwrite("frameFactor", &CalibrationPlan::frameFactor, doc("CalibrationPlan::frameFactor"))
+        .def_readwrite("pixelFactor", &CalibrationPlan::pixelFactor, doc("CalibrationPlan::pixelFactor"))
+        .def_readwrite("addDarkFrames", &CalibrationPlan::addDarkFrames,
+                       doc("CalibrationPlan::addDarkFrames"))
+        .def_readwrite("addGain", &CalibrationPlan::addGain, doc("CalibrationPlan::addGain"));
+    m.def(
+        "projectedStdError",
+        [](const std::vector<NoiseSample>& samples, const CalibrationReport& report,
+           const CalibrationPlan& plan) {
+            return withoutGil("projectedStdError", [&] { return projectedStdError(samples, report, plan); });
+        },
+        py::arg("samples"), py::arg("report"), py::arg("plan"), doc("projectedStdError"));
     m.def(
         "calibrateNoiseModel",
         [](const std::vector<NoiseSample>& samples, const CalibrationParams& params) {

@@ -178,3 +178,35 @@ def test_fits_reports_and_tone_curves(sensor, capture, tmp_path):
     assert toned.dtype == np.float32 and abs(float(toned[2, 3]) - 1.0) < 1e-6 and abs(curve(0.5) - 0.7353569) < 1e-6
     rgb = rg.applyToneCurve(np.dstack([linear] * 3), curve, rg.CV_8U)
     assert rgb.shape == (3, 4, 3) and rgb.dtype == np.uint8
+
+
+def test_calibration_errors_intervals_and_projections(sensor, tmp_path):
+    """Each parameter's standard error, interval and covariance from Python, the same as C++ writes them,
+    and what more data would buy."""
+    _, mean = chart_mean()
+    samples = []
+    for gain in (1.0, 4.0):
+        stats = rg.BurstStatistics(sensor.rawFormat(gain))
+        for frame in sensor.captureBurst(mean, gain, 1.0 / gain, 16, 5):
+            stats.add(frame)
+        samples += rg.sampleStaticScene(stats, gain)
+    assert all(s.pixel >= 0 for s in samples)
+    report = rg.calibrateNoiseModel(samples, rg.CalibrationParams(bootstrapReplicates=50))
+    u = report.uncertainty
+    assert report.separable and u.source in (rg.UNCERTAINTY_COVARIANCE, rg.UNCERTAINTY_BOOTSTRAP)
+    assert u.bootstrapReplicates == 50 and u.covariance.shape == (3, 3)
+    assert all(e > 0 for e in u.stdError) and all(e > 0 for e in u.fitStdError)
+    low, high = report.interval(rg.NOISE_PARAM_ALPHA)
+    assert low < report.model.alpha < high
+    assert abs((high - low) / 2 - 1.959963984540054 * u.stdError[0]) < 1e-12
+    assert -1 <= u.correlation(rg.NOISE_PARAM_SIGMA_D2, rg.NOISE_PARAM_SIGMA_R2) <= 1
+    assert all(f.slopeStdError > 0 and f.offsetStdError > 0 for f in report.perGain)
+    report.save(str(tmp_path / "errors.yml"))
+    back = rg.CalibrationReport.load(str(tmp_path / "errors.yml"))
+    assert back.uncertainty.stdError == u.stdError and (back.uncertainty.covariance == u.covariance).all()
+    quarter = rg.projectedStdError(samples, report, rg.CalibrationPlan(pixelFactor=4))
+    assert all(abs(q - e / 2) <= 1e-9 * e for q, e in zip(quarter, u.stdError))
+    with pytest.raises(rg.error, match="level"):
+        report.interval(rg.NOISE_PARAM_ALPHA, 1.5)
+    with pytest.raises(rg.error, match="frameFactor"):
+        rg.projectedStdError(samples, report, rg.CalibrationPlan(frameFactor=-1))

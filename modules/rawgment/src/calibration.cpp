@@ -1,5 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "opencv2/rawgment/calibration.hpp"
+#include "calibration_uncertainty.hpp"
 #include "noise_terms.hpp"
 #include "precomp.hpp"
 #include "random.hpp"
@@ -7,9 +8,10 @@
 #include <ceres/ceres.h>
 
 #include <algorithm>
-#include <deque>
 #include <map>
+#include <mutex>
 #include <numeric>
+#include <set>
 
 namespace cv {
 namespace rawgment {
@@ -26,71 +28,56 @@ struct LineLS
     double a = 0, b = 0, r2 = 0;
 };
 
-/** Least squares of v on mu over the selected samples, weighted by `weights` (empty: unweighted);
- * R^2 is the ordinary one (unweighted sums). False when the means do not vary. */
-bool leastSquaresLine(const std::vector<NoiseSample>& s, const std::vector<int>& idx,
-                      const std::vector<double>& weights, LineLS& out)
+//! The ordinary R^2 of the line (a, b) over the selected samples.
+double ordinaryRSquared(const std::vector<NoiseSample>& s, const std::vector<int>& idx, double a, double b)
 {
-    if (idx.size() < 2)
-        return false;
-    double sw = 0, mx = 0, my = 0;
-    for (int i : idx) {
-        const double w = weights.empty() ? 1.0 : weights[i];
-        sw += w;
-        mx += w * s[i].mean;
-        my += w * s[i].variance;
-    }
-    mx /= sw;
-    my /= sw;
-    double sxx = 0, sxy = 0;
-    for (int i : idx) {
-        const double w = weights.empty() ? 1.0 : weights[i];
-        const double dx = s[i].mean - mx;
-        sxx += w * dx * dx;
-        sxy += w * dx * (s[i].variance - my);
-    }
-    if (!(sxx > 1e-12 * std::max(1.0, mx * mx) * sw))
-        return false;
-    out.a = sxy / sxx;
-    out.b = my - out.a * mx;
     double mean = 0;
     for (int i : idx)
         mean += s[i].variance;
     mean /= static_cast<double>(idx.size());
     double ssRes = 0, ssTot = 0;
     for (int i : idx) {
-        const double e = s[i].variance - (out.a * s[i].mean + out.b);
+        const double e = s[i].variance - (a * s[i].mean + b);
         ssRes += e * e;
         ssTot += (s[i].variance - mean) * (s[i].variance - mean);
     }
-    out.r2 = ssTot > 0 ? 1.0 - ssRes / ssTot : 1.0;
-    return true;
+    return ssTot > 0 ? 1.0 - ssRes / ssTot : 1.0;
 }
 
-/** Iterated weighted least squares: a sample variance of `dof` degrees of freedom has variance
- * 2 v^2 / dof around its expectation v, so each sample is weighted by dof / (2 v^2) with v from the
- * previous line (Fisher scoring for the Gamma likelihood of sample variances). Unlike ordinary least
- * squares, the many precise dark samples then pin the offset instead of the few noisy bright ones. */
+/** Ordinary least squares of v on mu over the selected samples, then iterated weighted least squares
+ * from it (refineNoiseLine(): a sample variance of `dof` degrees of freedom has variance 2 v^2 / dof
+ * around its expectation v, so each sample is weighted by dof / (2 v^2), Fisher scoring for the Gamma
+ * likelihood of sample variances). Unlike ordinary least squares, the many precise dark samples then pin
+ * the offset instead of the few noisy bright ones. False when the means do not vary. */
 bool weightedNoiseLine(const std::vector<NoiseSample>& s, const std::vector<int>& idx, LineLS& out)
 {
-    if (!leastSquaresLine(s, idx, {}, out))
+    if (idx.size() < 2)
         return false;
-    std::vector<double> w(s.size(), 0.0);
-    for (int round = 0; round < 4; ++round) {
-        double largest = 0;
-        for (int i : idx)
-            largest = std::max(largest, detail::lineVariance(out.a, out.b, s[i].mean));
-        const double floor = detail::varianceFloor(largest);
-        for (int i : idx) {
-            const double se = detail::sampleVarianceStdError(detail::lineVariance(out.a, out.b, s[i].mean),
-                                                             s[i].dof, floor);
-            w[i] = 1.0 / (se * se);
-        }
-        LineLS next;
-        if (!leastSquaresLine(s, idx, w, next))
-            break;
-        out = next;
+    double mx = 0, my = 0;
+    for (int i : idx) {
+        mx += s[i].mean;
+        my += s[i].variance;
     }
+    const double n = static_cast<double>(idx.size());
+    mx /= n;
+    my /= n;
+    double sxx = 0, sxy = 0;
+    for (int i : idx) {
+        const double dx = s[i].mean - mx;
+        sxx += dx * dx;
+        sxy += dx * (s[i].variance - my);
+    }
+    if (!(sxx > 1e-12 * std::max(1.0, mx * mx) * n))
+        return false;
+    std::vector<NoiseSample> chosen;
+    chosen.reserve(idx.size());
+    for (int i : idx)
+        chosen.push_back(s[i]);
+    const Vec2d ab = detail::refineNoiseLine(chosen.data(), nullptr, static_cast<int>(chosen.size()),
+                                             Vec2d(sxy / sxx, my - sxy / sxx * mx), 4);
+    out.a = ab[0];
+    out.b = ab[1];
+    out.r2 = ordinaryRSquared(s, idx, out.a, out.b);
     return true;
 }
 
@@ -117,19 +104,102 @@ double lineVarianceFloor(double a, double b, const MeanRange& range)
         std::max(detail::lineVariance(a, b, range.lo), detail::lineVariance(a, b, range.hi)));
 }
 
-//! Residual in standard errors of a sample variance around the line at the sample's mean.
-double standardizedResidual(const NoiseSample& s, double a, double b, double floor)
+/* The regularised lower incomplete gamma function P(a, x): its series below x = a + 1 and Lentz's
+ * continued fraction for the upper part above, each to double precision. */
+double lowerGammaRegularized(double a, double x)
 {
-    const double predicted = detail::lineVariance(a, b, s.mean);
-    return (s.variance - predicted) / detail::sampleVarianceStdError(predicted, s.dof, floor);
+    if (x <= 0)
+        return 0.0;
+    const double logPrefix = -x + a * std::log(x) - std::lgamma(a);
+    if (x < a + 1) {
+        double term = 1.0 / a, sum = term;
+        for (int n = 1; n < 1000 && term > sum * 1e-17; ++n) {
+            term *= x / (a + n);
+            sum += term;
+        }
+        return std::min(1.0, sum * std::exp(logPrefix));
+    }
+    const double tiny = 1e-300;
+    double b = x + 1 - a, c = 1 / tiny, d = 1 / b, h = d;
+    for (int i = 1; i < 1000; ++i) {
+        const double an = -i * (i - a);
+        b += 2;
+        d = an * d + b;
+        d = std::abs(d) < tiny ? tiny : d;
+        c = b + an / c;
+        c = std::abs(c) < tiny ? tiny : c;
+        d = 1 / d;
+        const double step = d * c;
+        h *= step;
+        if (std::abs(step - 1) < 1e-16)
+            break;
+    }
+    return std::max(0.0, 1.0 - std::exp(logPrefix) * h);
+}
+
+//! The chi-square quantile of `dof` degrees of freedom at probability p, by bisection on log q.
+double chiSquareQuantile(int dof, double p)
+{
+    double lo = std::log(1e-40), hi = std::log(100.0 * dof + 1000.0);
+    for (int i = 0; i < 200; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (lowerGammaRegularized(0.5 * dof, 0.5 * std::exp(mid)) < p ? lo : hi) = mid;
+    }
+    return std::exp(0.5 * (lo + hi));
+}
+
+/* Where a sample variance of `dof` degrees of freedom lies, relative to its expectation, with the
+ * probability that a normal variable has within +-k: [chi2(p), chi2(1 - p)] / dof with p = Phi(-k).
+ * A band of +-k standard errors would be lopsided, because a sample variance is skewed: at 15 degrees of
+ * freedom it never reaches -k = -4 (a variance of 0 is -2.7 standard errors) but exceeds +4 once in
+ * 750 samples, so it kept every dead or stuck pixel and cut only the high tail, which biased alpha
+ * low by 2-3 of its standard errors. Equal probability in both tails removes 2 Phi(-k) of the samples
+ * and shifts the mean of the rest by a few parts in 10^5. Cached by (dof, k): a burst has one dof. */
+struct ChiSquareBand
+{
+    double lo = 0, hi = 0;
+};
+
+ChiSquareBand chiSquareBand(int dof, double k)
+{
+    static std::mutex mutex;
+    static std::map<std::pair<int, double>, ChiSquareBand> cache;
+    std::lock_guard<std::mutex> lock(mutex);
+    const auto key = std::make_pair(std::max(dof, 1), k);
+    auto it = cache.find(key);
+    if (it != cache.end())
+        return it->second;
+    const double p = 0.5 * std::erfc(k / std::sqrt(2.0));
+    ChiSquareBand band;
+    band.lo = chiSquareQuantile(key.first, p) / key.first;
+    band.hi = chiSquareQuantile(key.first, 1 - p) / key.first;
+    cache.emplace(key, band);
+    return band;
+}
+
+//! The band of each sample (see chiSquareBand()).
+std::vector<ChiSquareBand> bandsOf(const std::vector<NoiseSample>& s, double k)
+{
+    std::vector<ChiSquareBand> bands(s.size());
+    for (size_t i = 0; i < s.size(); ++i)
+        bands[i] = i > 0 && s[i].dof == s[i - 1].dof ? bands[i - 1] : chiSquareBand(s[i].dof, k);
+    return bands;
+}
+
+//! Whether a sample's variance lies inside its band around the line at its mean.
+bool insideBand(const NoiseSample& s, const ChiSquareBand& band, double a, double b, double floor)
+{
+    const double predicted = std::max(detail::lineVariance(a, b, s.mean), floor);
+    return s.variance >= band.lo * predicted && s.variance <= band.hi * predicted;
 }
 
 std::vector<int> inliersOf(const std::vector<NoiseSample>& s, double a, double b, double threshold)
 {
     const double floor = lineVarianceFloor(a, b, meanRangeOf(s));
+    const std::vector<ChiSquareBand> bands = bandsOf(s, threshold);
     std::vector<int> idx;
     for (int i = 0; i < static_cast<int>(s.size()); ++i)
-        if (std::abs(standardizedResidual(s[i], a, b, floor)) <= threshold)
+        if (insideBand(s[i], bands[i], a, b, floor))
             idx.push_back(i);
     return idx;
 }
@@ -175,6 +245,7 @@ NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples, const LineFit
     if (params.robust) {
         const int n = static_cast<int>(samples.size());
         const MeanRange range = meanRangeOf(samples);
+        const std::vector<ChiSquareBand> bands = bandsOf(samples, params.inlierThreshold);
         size_t bestCount = 0;
         double bestA = ls.a, bestB = ls.b;
         for (int it = 0; it < params.ransacIterations; ++it) {
@@ -188,8 +259,8 @@ NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples, const LineFit
             const double b = samples[i].variance - a * samples[i].mean;
             const double floor = lineVarianceFloor(a, b, range);
             size_t count = 0;
-            for (const NoiseSample& s : samples)
-                count += std::abs(standardizedResidual(s, a, b, floor)) <= params.inlierThreshold ? 1 : 0;
+            for (int k = 0; k < n; ++k)
+                count += insideBand(samples[k], bands[k], a, b, floor) ? 1 : 0;
             if (count > bestCount) {
                 bestCount = count;
                 bestA = a;
@@ -212,6 +283,13 @@ NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples, const LineFit
     fit.line.b = ls.b;
     fit.rSquared = ls.r2;
     fit.inliers = static_cast<int>(chosen.size());
+    Matx22d cov;
+    if (detail::lineCovariance(samples, chosen, ls.a, ls.b, cov)) {
+        fit.slopeStdError = std::sqrt(cov(0, 0));
+        fit.offsetStdError = std::sqrt(cov(1, 1));
+        const double d = fit.slopeStdError * fit.offsetStdError;
+        fit.slopeOffsetCorrelation = d > 0 ? cov(0, 1) / d : 0.0;
+    }
     return fit;
 }
 
@@ -234,34 +312,6 @@ struct OffsetResidual
         return new ceres::AutoDiffCostFunction<OffsetResidual, 1, 1, 1>(new OffsetResidual(gain, offset));
     }
     double g, b;
-};
-
-/* (v - (g alpha mu + g^2 sigma_d^2 + sigma_r^2)) / scale: one sample of the joint fit. The model is
- * linear in its parameters, so the Jacobian is the constant (-g max(mu, 0), -g^2, -1) / scale; written
- * out rather than differentiated automatically, and held in one array that the problem does not own,
- * because a calibration without a chart has hundreds of thousands of samples and a heap object and a
- * dual-number evaluation per sample were most of its time. */
-class JointResidual final : public ceres::SizedCostFunction<1, 3>
-{
-public:
-    JointResidual(double mean, double variance, double gain, double invScale)
-        : mu(mean), v(variance), g(gain), w(invScale)
-    {
-    }
-    bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override
-    {
-        const double* p = parameters[0];
-        residuals[0] = (v - detail::noiseTermsAt(g, p[0], p[1], p[2]).variance(mu)) * w;
-        if (jacobians != nullptr && jacobians[0] != nullptr) {
-            jacobians[0][0] = -g * std::max(mu, 0.0) * w;
-            jacobians[0][1] = -g * g * w;
-            jacobians[0][2] = -w;
-        }
-        return true;
-    }
-
-private:
-    double mu, v, g, w;
 };
 
 ceres::Solver::Options solverOptions()
@@ -330,9 +380,10 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
     if (params.method != NOISE_FIT_JOINT && params.method != NOISE_FIT_TWO_STAGE)
         CV_Error(Error::StsBadArg,
                  format("calibrateNoiseModel: unknown method %d", static_cast<int>(params.method)));
-    if (!(params.lossScale > 0) || params.reweightIterations < 1 || !(params.minGainRatio >= 1))
-        CV_Error(Error::StsBadArg, "calibrateNoiseModel: lossScale must be > 0, reweightIterations >= 1, "
-                                   "minGainRatio >= 1");
+    if (!(params.lossScale >= 0) || params.reweightIterations < 1 || !(params.minGainRatio >= 1) ||
+        params.bootstrapReplicates < 0 || params.bootstrapReplicates == 1)
+        CV_Error(Error::StsBadArg, "calibrateNoiseModel: lossScale must be >= 0, reweightIterations >= 1, "
+                                   "minGainRatio >= 1, bootstrapReplicates 0 or >= 2");
     CalibrationReport report;
     report.method = params.method;
     report.samples = static_cast<int>(samples.size());
@@ -341,26 +392,84 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
     for (const NoiseSample& s : samples)
         byGain[s.gain].push_back(s);
     std::vector<NoiseSample> inlierSamples;
-    for (auto& entry : byGain) {
-        NoiseLineFit fit;
-        try {
-            fit = fitNoiseLine(entry.second, params.line);
-        } catch (const Exception& e) {
-            CV_Error(Error::StsBadArg, format("calibrateNoiseModel: gain %g: ", entry.first) + e.err);
+    std::vector<detail::GainGroup> groups;
+    std::set<int64> outlierPixels; // pixels outside the band of their gain's line in some burst
+    const auto fitEachGain = [&]() {
+        report.perGain.clear();
+        inlierSamples.clear();
+        groups.clear();
+        for (auto& entry : byGain) {
+            NoiseLineFit fit;
+            try {
+                fit = fitNoiseLine(entry.second, params.line);
+            } catch (const Exception& e) {
+                CV_Error(Error::StsBadArg, format("calibrateNoiseModel: gain %g: ", entry.first) + e.err);
+            }
+            report.perGain.push_back(fit);
+            detail::GainGroup group;
+            group.begin = static_cast<int>(inlierSamples.size());
+            if (params.line.robust) {
+                const std::vector<int> in =
+                    inliersOf(entry.second, fit.line.a, fit.line.b, params.line.inlierThreshold);
+                std::vector<bool> kept(entry.second.size(), false);
+                for (int i : in) {
+                    inlierSamples.push_back(entry.second[i]);
+                    kept[i] = true;
+                }
+                for (size_t i = 0; i < kept.size(); ++i)
+                    if (!kept[i] && entry.second[i].pixel >= 0)
+                        outlierPixels.insert(entry.second[i].pixel);
+            } else {
+                inlierSamples.insert(inlierSamples.end(), entry.second.begin(), entry.second.end());
+            }
+            group.end = static_cast<int>(inlierSamples.size());
+            groups.push_back(group);
         }
-        report.perGain.push_back(fit);
+    };
+    fitEachGain();
+    /* A noisy pixel (random telegraph noise) or a stuck one is the same pixel in every burst, but it stands
+     * out of the noise band only where the normal noise is small (dark patches, dark frames, low gains);
+     * in bright patches its extra variance hides inside the band, and kept there it biases the lines
+     * where it hides and not where it was cut (5% such pixels moved alpha by 2-3 standard errors). So a
+     * pixel outside the band in any burst is left out of every burst, as a defect map would, unless so
+     * many are that the lines themselves must be wrong. Normal pixels leave the band by chance in
+     * 2 Phi(-k) of bursts; that only costs samples, since their bursts are independent. */
+    if (!outlierPixels.empty()) {
+        std::set<int64> pixels;
+        for (const NoiseSample& s : samples)
+            if (s.pixel >= 0)
+                pixels.insert(s.pixel);
+        if (outlierPixels.size() <= pixels.size() / 5) {
+            for (auto& entry : byGain) {
+                std::vector<NoiseSample>& v = entry.second;
+                v.erase(
+                    std::remove_if(v.begin(), v.end(),
+                                   [&](const NoiseSample& x) { return outlierPixels.count(x.pixel) > 0; }),
+                    v.end());
+                if (v.size() < 2)
+                    CV_Error(Error::StsBadArg,
+                             format("calibrateNoiseModel: gain %g: fewer than 2 samples are left once the "
+                                    "pixels outside the noise band in any burst are left out",
+                                    entry.first));
+            }
+            fitEachGain();
+            report.notes.push_back(format("%d of %d pixels lay outside the noise band in at least one burst "
+                                          "(noisy, hot or stuck pixels) and were left out of every burst",
+                                          static_cast<int>(outlierPixels.size()),
+                                          static_cast<int>(pixels.size())));
+        } else {
+            report.notes.push_back(
+                format("%d of %d pixels lay outside the noise band in at least one burst: too "
+                       "many to be defects, so each was left out only where it was outside",
+                       static_cast<int>(outlierPixels.size()), static_cast<int>(pixels.size())));
+        }
+    }
+    for (const NoiseLineFit& fit : report.perGain)
         if (fit.line.a < 0 || fit.line.b < 0)
             report.notes.push_back(
                 format("gain %g: the line has a negative %s (a = %g, b = %g); the data do not "
                        "follow the model there",
                        fit.gain, fit.line.a < 0 ? "slope" : "offset", fit.line.a, fit.line.b));
-        if (params.line.robust) {
-            for (int i : inliersOf(entry.second, fit.line.a, fit.line.b, params.line.inlierThreshold))
-                inlierSamples.push_back(entry.second[i]);
-        } else {
-            inlierSamples.insert(inlierSamples.end(), entry.second.begin(), entry.second.end());
-        }
-    }
 
     // alpha from a_g = g alpha (least squares through the origin, non-negative).
     double sga = 0, sgg = 0;
@@ -379,41 +488,16 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
                                           : "the gains differ by less than minGainRatio"));
         report.model = NoiseModel(alpha, 0.0, 0.0);
         report.samplesUsed = static_cast<int>(inlierSamples.size());
+        report.uncertainty = detail::modelUncertainty(inlierSamples, groups, report, params, report.notes);
         return report;
     }
     double sigmaD2 = 0, sigmaR2 = 0;
     fitOffsets(report.perGain, sigmaD2, sigmaR2);
 
     if (params.method == NOISE_FIT_JOINT) {
-        double p[3] = {alpha, sigmaD2, sigmaR2};
-        for (int round = 0; round < params.reweightIterations; ++round) {
-            // Weights from the previous fit: the standard error of each sample variance.
-            std::vector<double> predicted;
-            for (const NoiseSample& s : inlierSamples)
-                predicted.push_back(detail::noiseTermsAt(s.gain, p[0], p[1], p[2]).variance(s.mean));
-            const double floor = detail::varianceFloor(*std::max_element(predicted.begin(), predicted.end()));
-            // The residuals and the one loss outlive the problem, which only points at them (a deque:
-            // its elements never move, and a cost function cannot).
-            std::deque<JointResidual> residuals;
-            ceres::HuberLoss huber(params.lossScale);
-            ceres::Problem::Options problemOptions;
-            problemOptions.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-            problemOptions.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-            ceres::Problem problem(problemOptions);
-            for (size_t i = 0; i < inlierSamples.size(); ++i) {
-                const NoiseSample& s = inlierSamples[i];
-                const double scale = detail::sampleVarianceStdError(predicted[i], s.dof, floor);
-                residuals.emplace_back(s.mean, s.variance, s.gain, 1.0 / scale);
-                problem.AddResidualBlock(&residuals.back(), params.line.robust ? &huber : nullptr, p);
-            }
-            for (int k = 0; k < 3; ++k)
-                problem.SetParameterLowerBound(p, k, 0.0);
-            ceres::Solver::Summary summary;
-            ceres::Solve(solverOptions(), &problem, &summary);
-            if (!summary.IsSolutionUsable())
-                CV_Error(Error::StsError,
-                         "calibrateNoiseModel: the joint fit failed: " + summary.BriefReport());
-        }
+        const Vec3d p = detail::refineJointFit(
+            inlierSamples.data(), nullptr, static_cast<int>(inlierSamples.size()),
+            Vec3d(alpha, sigmaD2, sigmaR2), params.lossScale, params.line.robust, params.reweightIterations);
         alpha = p[0];
         sigmaD2 = p[1];
         sigmaR2 = p[2];
@@ -437,11 +521,71 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
     }
     report.rSquaredSlope = rSquared(a, aFit);
     report.rSquaredOffset = rSquared(b, bFit);
+    report.uncertainty = detail::modelUncertainty(inlierSamples, groups, report, params, report.notes);
     return report;
 }
 
 // ---------------------------------------------------------------------------------------------------
 // Report I/O
+
+namespace {
+
+const char* uncertaintySourceName(UncertaintySource source)
+{
+    return source == UNCERTAINTY_BOOTSTRAP ? "bootstrap" : "covariance";
+}
+
+void writeReals(FileStorage& fs, const char* name, const double* values, int count)
+{
+    fs << name << "[:";
+    for (int i = 0; i < count; ++i)
+        fs << values[i];
+    fs << "]";
+}
+
+//! A list of exactly `count` numbers, or an error naming the field.
+void readReals(const FileNode& node, const char* field, double* values, int count)
+{
+    const FileNode list = node[field];
+    if (!list.isSeq() || static_cast<int>(list.size()) != count)
+        CV_Error(Error::StsParseError,
+                 format("calibration report: field '%s' must be a list of %d numbers", field, count));
+    for (int i = 0; i < count; ++i) {
+        if (!list[i].isReal() && !list[i].isInt())
+            CV_Error(Error::StsParseError,
+                     format("calibration report: field '%s' holds something other than a number", field));
+        values[i] = static_cast<double>(list[i]);
+    }
+}
+
+ModelUncertainty readUncertainty(const FileNode& node)
+{
+    if (!node.isMap())
+        CV_Error(Error::StsParseError, "calibration report: field 'uncertainty' is missing or not a map");
+    try {
+        rejectUnknownKeys(node, {"source", "std_error", "covariance", "fit_std_error", "bootstrap_std_error",
+                                 "bootstrap_replicates"});
+    } catch (const Exception& e) {
+        CV_Error(e.code, "calibration report: uncertainty: " + e.err);
+    }
+    ModelUncertainty u;
+    const FileNode source = node["source"];
+    if (!source.isString() || (source.string() != "covariance" && source.string() != "bootstrap"))
+        CV_Error(Error::StsParseError,
+                 "calibration report: uncertainty: field 'source' must be 'covariance' or 'bootstrap'");
+    u.source = source.string() == "bootstrap" ? UNCERTAINTY_BOOTSTRAP : UNCERTAINTY_COVARIANCE;
+    readReals(node, "std_error", u.stdError.val, 3);
+    readReals(node, "covariance", u.covariance.val, 9);
+    readReals(node, "fit_std_error", u.fitStdError.val, 3);
+    readReals(node, "bootstrap_std_error", u.bootstrapStdError.val, 3);
+    u.bootstrapReplicates = static_cast<int>(detail::readRealField(node, "bootstrap_replicates"));
+    for (int k = 0; k < 3; ++k)
+        if (!(u.stdError[k] >= 0) || !(u.fitStdError[k] >= 0) || !(u.bootstrapStdError[k] >= 0))
+            CV_Error(Error::StsParseError, "calibration report: uncertainty: standard errors must be >= 0");
+    return u;
+}
+
+} // namespace
 
 void CalibrationReport::write(FileStorage& fs, const String& name) const
 {
@@ -449,8 +593,11 @@ void CalibrationReport::write(FileStorage& fs, const String& name) const
     if (method != NOISE_FIT_JOINT && method != NOISE_FIT_TWO_STAGE)
         CV_Error(Error::StsBadArg,
                  format("CalibrationReport::write: method %d is not a NoiseFitMethod", int(method)));
+    // The lowest version that holds what the report has: one without errors stays readable by builds
+    // that know only version 1.
+    const bool withErrors = uncertainty.source != UNCERTAINTY_NONE;
     fs << name << "{";
-    fs << "format_version" << FORMAT_VERSION;
+    fs << "format_version" << (withErrors ? FORMAT_VERSION : 1);
     fs << "method" << (method == NOISE_FIT_JOINT ? "joint" : "two_stage");
     fs << "separable" << static_cast<int>(separable);
     model.write(fs, "noise_model");
@@ -458,12 +605,26 @@ void CalibrationReport::write(FileStorage& fs, const String& name) const
     fs << "r_squared_offset" << rSquaredOffset;
     fs << "samples" << samples;
     fs << "samples_used" << samplesUsed;
+    if (withErrors) {
+        fs << "uncertainty"
+           << "{";
+        fs << "source" << uncertaintySourceName(uncertainty.source);
+        writeReals(fs, "std_error", uncertainty.stdError.val, 3);
+        writeReals(fs, "covariance", uncertainty.covariance.val, 9);
+        writeReals(fs, "fit_std_error", uncertainty.fitStdError.val, 3);
+        writeReals(fs, "bootstrap_std_error", uncertainty.bootstrapStdError.val, 3);
+        fs << "bootstrap_replicates" << uncertainty.bootstrapReplicates;
+        fs << "}";
+    }
     fs << "per_gain"
        << "[";
     for (const NoiseLineFit& f : perGain) {
         fs << "{";
         fs << "gain" << f.gain << "gain_db" << linearGainToDb(f.gain) << "a" << f.line.a << "b" << f.line.b;
         fs << "r_squared" << f.rSquared << "inliers" << f.inliers << "samples" << f.samples;
+        if (withErrors)
+            fs << "a_std_error" << f.slopeStdError << "b_std_error" << f.offsetStdError << "ab_correlation"
+               << f.slopeOffsetCorrelation;
         fs << "}";
     }
     fs << "]";
@@ -479,16 +640,25 @@ CalibrationReport CalibrationReport::read(const FileNode& node)
 {
     if (node.empty() || !node.isMap())
         CV_Error(Error::StsParseError, "calibration report: expected a map");
-    const FileNode version = node["format_version"];
-    if (!version.isInt() || static_cast<int>(version) < 1 || static_cast<int>(version) > FORMAT_VERSION)
+    const FileNode versionNode = node["format_version"];
+    if (!versionNode.isInt() || static_cast<int>(versionNode) < 1 ||
+        static_cast<int>(versionNode) > FORMAT_VERSION)
         CV_Error(Error::StsParseError,
                  format("calibration report: format_version is missing or newer than %d", FORMAT_VERSION));
+    const int version = static_cast<int>(versionNode);
     CalibrationReport r;
     try {
-        rejectUnknownKeys(node, {"format_version", "method", "separable", "noise_model", "r_squared_slope",
-                                 "r_squared_offset", "samples", "samples_used", "per_gain", "notes"});
+        std::vector<String> keys = {
+            "format_version",   "method",  "separable",    "noise_model", "r_squared_slope",
+            "r_squared_offset", "samples", "samples_used", "per_gain",    "notes"};
+        std::vector<String> gainKeys = {"gain", "gain_db", "a", "b", "r_squared", "inliers", "samples"};
+        if (version >= 2) {
+            keys.push_back("uncertainty");
+            gainKeys.insert(gainKeys.end(), {"a_std_error", "b_std_error", "ab_correlation"});
+        }
+        rejectUnknownKeys(node, keys);
         for (const FileNode& g : node["per_gain"])
-            rejectUnknownKeys(g, {"gain", "gain_db", "a", "b", "r_squared", "inliers", "samples"});
+            rejectUnknownKeys(g, gainKeys);
     } catch (const Exception& e) {
         CV_Error(e.code, "calibration report: " + e.err);
     }
@@ -502,6 +672,8 @@ CalibrationReport CalibrationReport::read(const FileNode& node)
     r.rSquaredOffset = detail::readRealField(node, "r_squared_offset");
     r.samples = static_cast<int>(detail::readRealField(node, "samples"));
     r.samplesUsed = static_cast<int>(detail::readRealField(node, "samples_used"));
+    if (version >= 2)
+        r.uncertainty = readUncertainty(node["uncertainty"]);
     const FileNode perGain = node["per_gain"];
     if (!perGain.isSeq())
         CV_Error(Error::StsParseError, "calibration report: field 'per_gain' is missing or not a list");
@@ -513,6 +685,11 @@ CalibrationReport CalibrationReport::read(const FileNode& node)
         f.rSquared = detail::readRealField(g, "r_squared");
         f.inliers = static_cast<int>(detail::readRealField(g, "inliers"));
         f.samples = static_cast<int>(detail::readRealField(g, "samples"));
+        if (version >= 2) {
+            f.slopeStdError = detail::readRealField(g, "a_std_error");
+            f.offsetStdError = detail::readRealField(g, "b_std_error");
+            f.slopeOffsetCorrelation = detail::readRealField(g, "ab_correlation");
+        }
         r.perGain.push_back(f);
     }
     for (const FileNode& n : node["notes"])

@@ -56,6 +56,7 @@ NoiseSample temporalSample(const BurstStatistics& stats, const Mat& mean, const 
     s.gain = gain;
     s.dof = stats.frames() - 1;
     s.channel = cfaChannelAt(stats.format().pattern, r, c);
+    s.pixel = static_cast<int64>(r) * mean.cols + c;
     return s;
 }
 
@@ -71,13 +72,19 @@ std::vector<NoiseSample> sampleBurstPatches(const BurstStatistics& stats, const 
     stats.clippedMask(clipped);
     checkSquares(squares, stats.size(), "sampleBurstPatches");
     std::vector<NoiseSample> out;
-    for (const Rect& sq : squares)
+    for (const Rect& sq : squares) {
+        /* A patch near white keeps only the pixels that never clipped, whose variance is cut short: one
+         * clipped pixel drops its whole CFA plane in this square, which leaves out every plane within
+         * about 3.5 standard deviations of white (16 frames of a 24x24 square draw 2304 values). */
+        bool planeClipped[2][2] = {{false, false}, {false, false}};
         for (int r = sq.y; r < sq.y + sq.height; ++r)
-            for (int c = sq.x; c < sq.x + sq.width; ++c) {
-                if (clipped.at<uchar>(r, c))
-                    continue;
-                out.push_back(temporalSample(stats, mean, var, r, c, gain));
-            }
+            for (int c = sq.x; c < sq.x + sq.width; ++c)
+                planeClipped[r & 1][c & 1] = planeClipped[r & 1][c & 1] || clipped.at<uchar>(r, c) != 0;
+        for (int r = sq.y; r < sq.y + sq.height; ++r)
+            for (int c = sq.x; c < sq.x + sq.width; ++c)
+                if (!planeClipped[r & 1][c & 1])
+                    out.push_back(temporalSample(stats, mean, var, r, c, gain));
+    }
     return out;
 }
 

@@ -11,25 +11,7 @@
 namespace cv {
 namespace rawgment {
 
-namespace {
-
-const int kMinSamples = 3;
-const int kMaxSamples = 5000;
-
-//! c[0] + c[1] x + ... + c[count-1] x^(count-1), Horner's scheme.
-double polynomial(const double* c, int count, double x)
-{
-    double r = c[count - 1];
-    for (int i = count - 2; i >= 0; --i)
-        r = r * x + c[i];
-    return r;
-}
-
-//! Standard normal upper tail P(Z > z), accurate in relative terms far into both tails.
-double normalUpperTail(double z)
-{
-    return 0.5 * std::erfc(z / std::sqrt(2.0));
-}
+namespace detail {
 
 /** Standard normal quantile for p in (0, 0.5]: Abramowitz & Stegun 26.2.23 as a start (error below
  * 4.5e-4), then Halley steps on the erfc-based CDF. Each step triples the number of correct digits, so
@@ -47,6 +29,30 @@ double lowerNormalQuantile(double p)
         x -= step / (1.0 + 0.5 * x * step); // Halley's correction
     }
     return x;
+}
+
+} // namespace detail
+
+namespace {
+
+using detail::lowerNormalQuantile;
+
+const int kMinSamples = 3;
+const int kMaxSamples = 5000;
+
+//! c[0] + c[1] x + ... + c[count-1] x^(count-1), Horner's scheme.
+double polynomial(const double* c, int count, double x)
+{
+    double r = c[count - 1];
+    for (int i = count - 2; i >= 0; --i)
+        r = r * x + c[i];
+    return r;
+}
+
+//! Standard normal upper tail P(Z > z), accurate in relative terms far into both tails.
+double normalUpperTail(double z)
+{
+    return 0.5 * std::erfc(z / std::sqrt(2.0));
 }
 
 /** The AS R94 coefficients for one sample size, centred, and the test of a sorted sample. */

@@ -35,6 +35,9 @@ Mat normalisedKernel(InputArray kernel, const char* who);
  * capture and a blurred augmentation agree up to the frame's edge. */
 constexpr int kBlurBorder = BORDER_REPLICATE;
 
+/** Standard normal quantile for p in (0, 0.5] (negative), to the precision of erfc (normality.cpp). */
+double lowerNormalQuantile(double p);
+
 /* The one reader of numeric fields in YAML/JSON files: a field is a number or an error naming it. */
 //! A required real field of a FileStorage map, named in the error when it is missing or not a number.
 double readRealField(const FileNode& node, const char* field);

@@ -224,6 +224,7 @@ RAWGMENT_KERNEL void philox8BlocksFor(uint32_t firstBlock, uint64_t stream,
  * - simulator fixed pattern (PRNU, DSNU, defects): key SensorParams::fixedPatternSeed; stream
  *   fixedPatternStream(row).
  * - RANSAC of fitNoiseLine(): key LineFitParams::seed; stream ransacStream(iteration).
+ * - bootstrap of calibrateNoiseModel(): key LineFitParams::seed; stream bootstrapStream(replicate).
  * - apps and programs on the library: the public SeedPurpose (ids 16 and up, never a RandomStream id):
  *   deriveSeed(user seed, purpose, index) = stepKey(stepKey(seed, purpose), index), given to the
  *   library call it drives; augmented outputs: augmentedOutputSeed(user seed, input stem, variant).
@@ -276,6 +277,12 @@ inline uint64_t fixedPatternStream(int row)
 inline uint64_t ransacStream(int iteration)
 {
     return static_cast<uint64_t>(iteration);
+}
+
+//! Stream of one bootstrap replicate of a calibration: bit 62 set, never a RANSAC iteration's stream.
+inline uint64_t bootstrapStream(int replicate)
+{
+    return (uint64_t(1) << 62) | static_cast<uint64_t>(replicate);
 }
 
 //! Stream of one row of one CFA plane in the resampling steps.

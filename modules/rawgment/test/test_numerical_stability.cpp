@@ -291,7 +291,7 @@ TEST(NumericalStability, shapiroWilkLargestSampleSize)
 // ---------------------------------------------------------------------------------------------------
 // Line and cross-gain fits
 
-std::vector<NoiseSample> linePoints(const std::vector<Point2d>& pts, double gain = 1.0)
+std::vector<NoiseSample> linePoints(const std::vector<Point2d>& pts, double gain = 1.0, int dof = 99)
 {
     std::vector<NoiseSample> s;
     for (const Point2d& p : pts) {
@@ -299,7 +299,7 @@ std::vector<NoiseSample> linePoints(const std::vector<Point2d>& pts, double gain
         n.mean = p.x;
         n.variance = p.y;
         n.gain = gain;
-        n.dof = 99;
+        n.dof = dof;
         s.push_back(n);
     }
     return s;
@@ -307,9 +307,13 @@ std::vector<NoiseSample> linePoints(const std::vector<Point2d>& pts, double gain
 
 TEST(NumericalStability, lineFitHardCases)
 {
-    // Collinear: exact, R^2 = 1, every point an inlier.
-    const NoiseLineFit exact = fitNoiseLine(linePoints({{0, 2}, {10, 7}, {100, 52}, {1000, 502}}));
-    EXPECT_NEAR(exact.line.a, 0.5, 1e-12);
+    // Collinear: exact, R^2 = 1, every point an inlier. The fit corrects for the error of each sample's
+    // mean, which it takes to have the variance v / (dof + 1); noise-free points have none, and the
+    // correction moves their line by about 1/(dof + 1) relative (5e-4 at 99), so they are given 1e9
+    // degrees of freedom, where it is below 1e-9.
+    const NoiseLineFit exact =
+        fitNoiseLine(linePoints({{0, 2}, {10, 7}, {100, 52}, {1000, 502}}, 1.0, 1000000000));
+    EXPECT_NEAR(exact.line.a, 0.5, 1e-9);
     EXPECT_NEAR(exact.line.b, 2, 1e-9);
     EXPECT_NEAR(exact.rSquared, 1, 1e-12);
     EXPECT_EQ(exact.inliers, 4);

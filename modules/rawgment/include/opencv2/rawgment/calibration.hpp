@@ -76,6 +76,10 @@ struct CV_RAWGMENT_EXPORTS NoiseSample
     double gain = 1;     //!< linear gain of the capture
     int dof = 1;         //!< degrees of freedom of the variance (frames - 1 for a burst)
     int channel = -1;    //!< CfaChannel of the pixel (or patch plane)
+    /** The pixel's position on the sensor, row * width + column, or -1 when the sample is not one pixel
+     * (single-frame patches). calibrateNoiseModel() leaves a pixel that is an outlier in one burst out
+     * of every burst (a noisy or stuck pixel), so samples of one sensor must number pixels alike. */
+    int64 pixel = -1;
 };
 
 /** @brief Squares of side `side` (even) centred in each patch, with even corners so that each holds
@@ -131,8 +135,11 @@ struct CV_RAWGMENT_EXPORTS LineFitParams
 {
     bool robust = true;         //!< RANSAC, then least squares on the inliers; false: least squares on all
     int ransacIterations = 500; //!< line hypotheses drawn from random pairs of samples
-    /** Inlier band, in standard errors of a sample variance: |v - line(mu)| <= k sqrt(2 / dof) line(mu),
-     * the spread of a sample variance of `dof` degrees of freedom around its expectation. */
+    /** Inlier band: a sample is kept when its variance lies where a sample variance of `dof` degrees of
+     * freedom lies with the probability that a normal variable lies within +-k,
+     * \f$ \chi^2_{dof}(\Phi(-k))/dof \le v / line(\mu) \le \chi^2_{dof}(\Phi(k))/dof \f$ (about
+     * +-k standard errors for large dof; equal in probability on both sides, because a sample variance is
+     * skewed and a band of equal width keeps every zero variance and cuts only the high tail). */
     double inlierThreshold = 4.0;
     uint64 seed = 0; //!< seed of the RANSAC draws (deterministic)
 };
@@ -149,6 +156,15 @@ struct CV_RAWGMENT_EXPORTS NoiseLineFit
     double rSquared = 0; //!< coefficient of determination on the inliers
     int inliers = 0;     //!< samples used by the final least squares
     int samples = 0;     //!< samples offered
+    /** Standard errors of a and b and their correlation: the sandwich (Huber-White) covariance of the
+     * final weighted least squares, \f$ A^{-1} B A^{-1} \f$ with \f$ A = \sum w_i x_i x_i^T \f$ and
+     * \f$ B = \sum w_i^2 e_i^2 x_i x_i^T \f$, \f$ x_i = (\mu_i, 1) \f$: it takes the scatter the data
+     * show rather than the \f$ 2v^2/dof \f$ of Gaussian noise, so excess kurtosis (Poisson at low
+     * counts, quantisation, noisy pixels inside the inlier band) widens it as it should. Conditional on
+     * the inliers chosen. 0 when there are fewer than 3 inliers. */
+    double slopeStdError = 0;
+    double offsetStdError = 0;         //!< standard error of b (see slopeStdError)
+    double slopeOffsetCorrelation = 0; //!< correlation of the errors of a and b (see slopeStdError)
 };
 
 /** @brief Fits \f$ \sigma^2 = a\mu + b \f$ to samples of one gain (paper Eq. 6), robustly by default.
@@ -162,10 +178,11 @@ CV_RAWGMENT_EXPORTS NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& sa
 enum NoiseFitMethod : int
 {
     /** One fit of \f$ \sigma^2 = g\alpha\mu + g^2\sigma_d^2 + \sigma_r^2 \f$ over all samples of all gains,
-     * each weighted by the inverse standard deviation of a sample variance, \f$ \sqrt{2/dof}\,\sigma^2 \f$
-     * (iterated: the weights use the previous fit), with a Huber loss, on the per-gain RANSAC inliers.
-     * The default: it uses the dark samples that pin \f$ \sigma_r^2 \f$ directly instead of extrapolating
-     * each offset. */
+     * each weighted by the inverse squared standard error of a sample variance, \f$ dof / (2\sigma^4) \f$
+     * (iterated: the weights use the previous fit), corrected for the error of each sample's own mean
+     * (see docs/mathematics.md), on the per-gain RANSAC inliers, with every parameter >= 0 (an exact
+     * bounded solve). The default: it uses the dark samples that pin \f$ \sigma_r^2 \f$ directly
+     * instead of extrapolating each offset. */
     NOISE_FIT_JOINT = 0,
     /** The paper's method (Eq. 7, 8): per-gain lines, then \f$ a_g = g\alpha \f$ and
      * \f$ b_g = g^2\sigma_d^2 + \sigma_r^2 \f$ by least squares with non-negative bounds. */
@@ -177,20 +194,73 @@ struct CV_RAWGMENT_EXPORTS CalibrationParams
 {
     NoiseFitMethod method = NOISE_FIT_JOINT; //!< cross-gain method
     LineFitParams line;                      //!< per-gain line fits (also select the joint fit's inliers)
-    int reweightIterations = 4;              //!< joint fit: re-weighting rounds
-    /** Joint fit: Huber loss scale, in standard errors. A sample variance is skewed (chi-squared), so a
-     * loss that bites inside the bulk of its distribution (Cauchy at 3) biases the fit low by ~0.4%;
-     * at the RANSAC band it only tames what RANSAC let through. */
-    double lossScale = 4.0;
+    int reweightIterations = 8;              //!< joint fit: re-weighting rounds from the two-stage fit
+    /** Joint fit: Huber loss scale in standard errors, 0 for none (the default). The per-gain band
+     * (LineFitParams::inlierThreshold) has already removed what cannot be noise, and a loss on a skewed
+     * residual (a sample variance is chi-squared) cuts its long tail only and biases the fit low: Cauchy
+     * at 3 by ~0.4%, and even Huber at 4 measurably. */
+    double lossScale = 0.0;
     /** Gains closer than this ratio count as one when deciding whether sigma_d^2 and sigma_r^2 are
      * separable (1.12 is 1 dB). */
     double minGainRatio = 1.12;
+    /** Bootstrap replicates of the final fit (0: none), the check of the covariance and its stand-in
+     * where the covariance does not hold (see ModelUncertainty). Each replicate draws the samples of
+     * each gain anew with replacement and repeats the final weighted fit; 200 give each standard
+     * error to about 5% (\f$ 1/\sqrt{2R} \f$). Keyed by `line.seed`: the same seed gives the same
+     * errors on any number of threads. */
+    int bootstrapReplicates = 200;
+};
+
+/** @brief The parameters of a NoiseModel, as indices into the vectors and matrices of
+ * ModelUncertainty. */
+enum NoiseModelParameter : int
+{
+    NOISE_PARAM_ALPHA = 0,    //!< \f$ \alpha \f$
+    NOISE_PARAM_SIGMA_D2 = 1, //!< \f$ \sigma_d^2 \f$
+    NOISE_PARAM_SIGMA_R2 = 2  //!< \f$ \sigma_r^2 \f$
+};
+
+/** @brief Where the standard errors of a calibration come from. */
+enum UncertaintySource : int
+{
+    UNCERTAINTY_NONE = 0, //!< none were computed (a report of format 1)
+    /** The sandwich covariance of the final fit (see NoiseLineFit::slopeStdError), confirmed by the
+     * bootstrap where one ran. */
+    UNCERTAINTY_COVARIANCE = 1,
+    /** The bootstrap: a parameter sits at its bound 0, where a covariance from derivatives does not
+     * hold, or the bootstrap found an error over 25% larger than the covariance's (its own spread at
+     * 200 replicates is 5%, so this is no chance). */
+    UNCERTAINTY_BOOTSTRAP = 2
+};
+
+/** @brief How exact a calibrated model is: the standard errors of alpha, sigma_d^2 and sigma_r^2 and
+ * their covariance.
+ *
+ * The errors are those of the final fit given its inliers (the RANSAC choice is not redone); they
+ * describe scatter, not bias, and the coverage study (study_calibration_coverage) measures how often
+ * the 95% interval holds the simulator's truth. When sigma_d^2 and sigma_r^2 are not separable only
+ * alpha has an error. */
+struct CV_RAWGMENT_EXPORTS ModelUncertainty
+{
+    UncertaintySource source = UNCERTAINTY_NONE; //!< which of the two estimates below is used
+    Vec3d stdError;                              //!< standard errors used, indexed by NoiseModelParameter
+    Matx33d covariance;                          //!< their covariance (DN units squared of each pair)
+    Vec3d fitStdError;           //!< from the sandwich covariance of the fit (0 for a parameter at its bound)
+    Vec3d bootstrapStdError;     //!< from the bootstrap (0 when none ran)
+    int bootstrapReplicates = 0; //!< replicates of the bootstrap that ran
+
+    /** @brief The correlation of the errors of two parameters (0 when either has no error). The one
+     * of sigma_d^2 and sigma_r^2 is usually strongly negative: both make up each gain's offset. */
+    double correlation(NoiseModelParameter first, NoiseModelParameter second) const;
 };
 
 /** @brief Everything a calibration found, readable and writable as YAML or JSON. */
 struct CV_RAWGMENT_EXPORTS CalibrationReport
 {
-    static constexpr int FORMAT_VERSION = 1; //!< version of the file format
+    /** Newest version of the file format. Version 2 adds the uncertainty and the per-gain standard
+     * errors; a report without an uncertainty (source UNCERTAINTY_NONE) is written as version 1, and
+     * files of version 1 still load. */
+    static constexpr int FORMAT_VERSION = 2;
 
     NoiseFitMethod method = NOISE_FIT_JOINT; //!< the method that ran
     /** The fitted model. Valid only when `separable`; with a single gain (or gains closer than
@@ -203,6 +273,13 @@ struct CV_RAWGMENT_EXPORTS CalibrationReport
     int samples = 0;                   //!< samples offered
     int samplesUsed = 0;               //!< samples in the final fit
     std::vector<std::string> notes;    //!< what the user should know (bounds hit, not separable, ...)
+    ModelUncertainty uncertainty;      //!< standard errors of the model's parameters
+
+    /** @brief The two-sided confidence interval of a parameter, value \f$ \pm z_{(1+level)/2} \f$
+     * standard errors (normal: each estimate is a weighted sum over thousands of samples). Not cut at
+     * 0, so that an interval that spans 0 shows the data cannot tell the parameter from 0.
+     * @throws cv::Exception when level is not in (0, 1) or the report has no uncertainty. */
+    Vec2d interval(NoiseModelParameter parameter, double level = 0.95) const;
 
     /** @brief Writes the report as a map under `name`. */
     void write(FileStorage& fs, const String& name) const;
@@ -213,6 +290,37 @@ struct CV_RAWGMENT_EXPORTS CalibrationReport
     /** @brief Loads a report saved by save(). */
     static CalibrationReport load(const String& path);
 };
+
+/** @brief A change to the data of a calibration, for projectedStdError(): what a user could shoot more of. */
+struct CV_RAWGMENT_EXPORTS CalibrationPlan
+{
+    double frameFactor = 1; //!< frames per burst times this (> 0): each sample's dof + 1 scales
+    double pixelFactor = 1; //!< pixels per burst times this (> 0): more or larger patches
+    bool addDarkFrames =
+        false; //!< one burst of dark frames (mean 0) per gain, as many pixels as its light samples
+    /** > 0: one more gain (linear), shot like the highest gain: the same means, pixels and frames. */
+    double addGain = 0;
+};
+
+/** @brief The standard errors a calibration would have if its data changed by `plan`.
+ *
+ * From the Fisher information of the samples under the fitted model, \f$ I = \sum_i x_i x_i^T\, dof_i /
+ * (2 m_i^2) \f$ with \f$ x_i = (g\mu_i, g^2, 1) \f$ and \f$ m_i \f$ the model's variance, the errors of the
+ * changed data are the report's errors times \f$ \sqrt{[I'^{-1}]_{kk} / [I^{-1}]_{kk}} \f$: the ratio
+ * carries over whatever the report measured beyond Gaussian scatter (shot noise's kurtosis, quantisation).
+ * More of the same data has the formula \f$ \sigma' = \sigma / \sqrt{p} \f$ for p times the pixels and about
+ * \f$ \sigma\sqrt{(T - 1)/(fT - 1)} \f$ for f times T frames; new gains and dark frames change the design,
+ * and only the information says what they buy. Where the report has no error for a parameter (not
+ * separable), the information's own error is returned.
+ * @param samples the samples the report was calibrated from
+ * @param report its report (with an uncertainty)
+ * @param plan the change
+ * @return standard errors of alpha, sigma_d^2 and sigma_r^2 (0 where the changed data still cannot
+ *         determine a parameter)
+ * @throws cv::Exception on an invalid plan, no samples, or a report without an uncertainty
+ */
+CV_RAWGMENT_EXPORTS Vec3d projectedStdError(const std::vector<NoiseSample>& samples,
+                                            const CalibrationReport& report, const CalibrationPlan& plan);
 
 /** @brief Calibrates the noise model from samples of one or more gains (paper Sec. 3.2).
  * @param samples noise samples of all gains (their `gain` field groups them)
