@@ -114,9 +114,10 @@ int main(int argc, char** argv)
             if (rawgment_apps::pathExists(p))
                 throw std::runtime_error("'" + p + "' already exists; outputs are never overwritten");
 
-        rawgment_apps::ProgressBar progress("tradeoffs", 5 + 6 * static_cast<size_t>(set.seeds));
+        rawgment_apps::ProgressBar progress("tradeoffs", 5 + 9 * static_cast<size_t>(set.seeds));
         std::vector<rawgment_apps::TradeoffRow> rows;
-        rawgment_apps::measureTradeoffs(set, progress, rows);
+        std::vector<rawgment_apps::PrecisionRow> precision;
+        rawgment_apps::measureTradeoffs(set, progress, rows, precision);
         progress.finish();
 
         std::vector<std::string> header = {"knob", "setting", "measure", "error", "ms_per_mp"};
@@ -151,6 +152,28 @@ int main(int argc, char** argv)
              << markdownTable(rows) << "\n## What each setting means\n\n";
         for (const rawgment_apps::TradeoffRow& r : rows)
             text << "- " << r.knob << ", " << r.setting << ": " << r.meaning << ".\n";
+        text << "\n## Calibration precision: what more data buys\n\n"
+                "Relative standard errors the calibration states (mean over "
+             << set.seeds
+             << " campaigns), the relative errors it makes (RMS over the same campaigns, against the "
+                "simulator's truth: with few campaigns a noisy figure of the same size), and for more of the "
+                "same data the formula se0 sqrt((T0 - 1) N0 / ((T - 1) N)) from the reference row (T frames, "
+                "N "
+                "pixels). Fewer gains and dark frames change the design; their rows are measured only "
+                "(`projectedStdError` and the calibrate app's report project them for a user's own data).\n\n"
+                "| set-up | alpha stated | made | formula | sigma_d^2 stated | made | formula | sigma_r^2 "
+                "stated | "
+                "made | formula |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        const auto percent = [](double v) {
+            return v > 0 ? cv::format("%.3g%%", 100 * v) : std::string("-");
+        };
+        for (const rawgment_apps::PrecisionRow& p : precision) {
+            text << "| " << p.setting;
+            for (int k = 0; k < 3; ++k)
+                text << " | " << percent(p.stated[k]) << " | " << percent(p.made[k]) << " | "
+                     << percent(p.formula[k]);
+            text << " |\n";
+        }
         rawgment_apps::writeTextAtomically(md, text.str());
         table.write(csv);
         // One gnuplot data block per knob, inside the script: no extra files to write or clean.

@@ -855,6 +855,13 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
                              "Calibration burst length", "Calibration patch size",
                              "Calibration RANSAC iterations", "Shapiro-Wilk"})
         EXPECT_NE(std::string::npos, md.find(knob)) << knob;
+    // What more data buys: a row per burst length, per square side, for two gains and for dark frames,
+    // each with the stated and the made error of every parameter.
+    const size_t precision = md.find("## Calibration precision: what more data buys");
+    ASSERT_NE(std::string::npos, precision);
+    for (const char* setup :
+         {"24x24, 3 gains |", "8x8, 3 gains |", "2 gains (6 and 24 dB) |", "+ dark frames |"})
+        EXPECT_NE(std::string::npos, md.find(setup, precision)) << setup;
     expectPngDecodes(dir + "/t/tradeoffs.png");
     // error and time of each (knob, setting) from the CSV: finite, and the orderings the knobs promise.
     std::map<std::string, double> error;

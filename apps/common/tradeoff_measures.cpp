@@ -10,6 +10,7 @@
 #include <opencv2/rawgment/simulate.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <functional>
 #include <limits>
@@ -354,7 +355,7 @@ void measureStatisticsPrecision(const TradeoffSettings& set, const Mat& timingRa
 
 // Calibration: burst length, patch size and RANSAC iterations on the paper's protocol.
 void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRow>& rows,
-                             rawgment_apps::ProgressBar& progress)
+                             std::vector<PrecisionRow>& precision, rawgment_apps::ProgressBar& progress)
 {
     ColorCheckerOptions chart;
     chart.patchSize = 32;
@@ -382,10 +383,31 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
     for (int it : {20, 100, 2000})
         settings.push_back({"Calibration RANSAC iterations", std::to_string(it), maxFrames, 24, it});
     std::vector<double> squaredError(settings.size(), 0), ms(settings.size(), 0);
+    // Precision set-ups: every burst length and side as above, then gains and dark frames at the longest
+    // bursts and 24x24 squares (the reference, whose errors the formula scales).
+    struct Setup
+    {
+        std::string name;
+        int frames, side;
+        bool twoGains, dark;
+    };
+    std::vector<Setup> setups;
+    for (int f : set.burstLengths)
+        setups.push_back({std::to_string(f) + " frames, 24x24, 3 gains", f, 24, false, false});
+    for (int side : {8, 16})
+        setups.push_back({std::to_string(maxFrames) + " frames, " + std::to_string(side) + "x" +
+                              std::to_string(side) + ", 3 gains",
+                          maxFrames, side, false, false});
+    setups.push_back(
+        {std::to_string(maxFrames) + " frames, 24x24, 2 gains (6 and 24 dB)", maxFrames, 24, true, false});
+    setups.push_back(
+        {std::to_string(maxFrames) + " frames, 24x24, 3 gains + dark frames", maxFrames, 24, false, true});
+    std::vector<std::array<double, 3>> stated(setups.size(), {0, 0, 0}), made(setups.size(), {0, 0, 0});
     double statsMsPerFrame = 0;
     for (int campaign = 0; campaign < set.seeds; ++campaign) {
         // Statistics of each burst after f frames, for every burst length; sampled for every side.
         std::map<std::pair<int, int>, std::vector<NoiseSample>> samples; // (frames, side)
+        std::map<int, std::vector<NoiseSample>> darkSamples;             // (frames), 24x24
         std::map<std::pair<int, int>, double> samplingMs;
         uint64 burstIndex = 0;
         for (double db : {6.0, 12.0, 24.0}) {
@@ -415,6 +437,41 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
                 ++burstIndex;
                 progress.advance();
             }
+            // A burst of dark frames (counted at mean 0, as rawgment_calibrate counts them).
+            BurstStatistics dark(fmt);
+            const Mat black = Mat::zeros(scene.meanAtUnitGain.size(), CV_32FC1);
+            for (int t = 0; t < maxFrames; ++t) {
+                Mat raw;
+                sensor.capture(
+                    black, g, 1.0,
+                    studySeed(set, DRAW_CAMPAIGN_BURST, 100 * static_cast<uint64>(campaign) + burstIndex), t,
+                    raw);
+                dark.add(raw);
+                if (std::find(set.burstLengths.begin(), set.burstLengths.end(), t + 1) !=
+                    set.burstLengths.end())
+                    for (NoiseSample x : sampleBurstPatches(dark, cfaAlignedSquares(scene.patches, 24), g)) {
+                        x.mean = 0;
+                        darkSamples[t + 1].push_back(x);
+                    }
+            }
+            ++burstIndex;
+            progress.advance();
+        }
+        for (size_t i = 0; i < setups.size(); ++i) {
+            const Setup& u = setups[i];
+            std::vector<NoiseSample> use;
+            for (const NoiseSample& x : samples[{u.frames, u.side}])
+                if (!u.twoGains || std::abs(linearGainToDb(x.gain) - 12) > 1)
+                    use.push_back(x);
+            if (u.dark)
+                use.insert(use.end(), darkSamples[u.frames].begin(), darkSamples[u.frames].end());
+            const CalibrationReport r = calibrateNoiseModel(use);
+            const double est[3] = {r.model.alpha, r.model.sigmaD2, r.model.sigmaR2};
+            const double tru[3] = {truth.alpha, truth.sigmaD2, truth.sigmaR2};
+            for (int k = 0; k < 3; ++k) {
+                stated[i][size_t(k)] += r.uncertainty.stdError[k] / tru[k] / set.seeds;
+                made[i][size_t(k)] += (est[k] / tru[k] - 1) * (est[k] / tru[k] - 1) / set.seeds;
+            }
         }
         for (size_t i = 0; i < settings.size(); ++i) {
             const Setting& s = settings[i];
@@ -430,6 +487,25 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
                                        std::abs(r.model.sigmaR2 / truth.sigmaR2 - 1)});
             squaredError[i] += e * e;
         }
+    }
+    // The reference: the longest bursts, 24x24, 3 gains, no dark frames (the row of the paper's protocol).
+    size_t reference = 0;
+    for (size_t i = 0; i < setups.size(); ++i)
+        if (setups[i].frames == maxFrames && setups[i].side == 24 && !setups[i].twoGains && !setups[i].dark)
+            reference = i;
+    for (size_t i = 0; i < setups.size(); ++i) {
+        PrecisionRow row;
+        row.setting = setups[i].name;
+        const Setup& u = setups[i];
+        const bool moreOfTheSame = !u.twoGains && !u.dark;
+        // Pixels per square scale with side^2; frames enter as T - 1 degrees of freedom.
+        const double scale = std::sqrt((maxFrames - 1.0) * 24 * 24 / ((u.frames - 1.0) * u.side * u.side));
+        for (int k = 0; k < 3; ++k) {
+            row.stated[k] = stated[i][size_t(k)];
+            row.made[k] = std::sqrt(made[i][size_t(k)]);
+            row.formula[k] = moreOfTheSame ? stated[reference][size_t(k)] * scale : 0.0;
+        }
+        precision.push_back(row);
     }
     statsMsPerFrame /= set.seeds * 6.0 * maxFrames;
     for (size_t i = 0; i < settings.size(); ++i) {
@@ -486,7 +562,8 @@ void measureShapiroWilk(const TradeoffSettings& set, std::vector<TradeoffRow>& r
 
 } // namespace
 
-void measureTradeoffs(const TradeoffSettings& set, ProgressBar& progress, std::vector<TradeoffRow>& rows)
+void measureTradeoffs(const TradeoffSettings& set, ProgressBar& progress, std::vector<TradeoffRow>& rows,
+                      std::vector<PrecisionRow>& precision)
 {
     const SensorSimulator timingSensor(SensorParams(), set.timingSize);
     const RawFormat timingFmt = timingSensor.rawFormat(2);
@@ -501,7 +578,7 @@ void measureTradeoffs(const TradeoffSettings& set, ProgressBar& progress, std::v
     progress.advance();
     measureStatisticsPrecision(set, timingRaw, timingFmt, rows);
     progress.advance();
-    measureCalibrationKnobs(set, rows, progress);
+    measureCalibrationKnobs(set, rows, precision, progress);
     measureShapiroWilk(set, rows);
     progress.advance();
 }

@@ -36,10 +36,23 @@ struct TradeoffRow
     std::vector<double> msPerMpByPath;
 };
 
+/** How exact one calibration set-up is: the relative standard errors the calibration states (mean over
+ * campaigns), the relative errors it makes (RMS over campaigns, against the simulator's truth), and
+ * the errors the formula se0 sqrt((T0 - 1) N0 / ((T - 1) N)) gives from the reference set-up for more of
+ * the same (frames T, pixels N; 0 where no formula applies). Parameters: alpha, sigma_d^2, sigma_r^2. */
+struct PrecisionRow
+{
+    std::string setting;
+    double stated[3] = {0, 0, 0};
+    double made[3] = {0, 0, 0};
+    double formula[3] = {0, 0, 0};
+};
+
 /** Measures every knob in one run (colour jitter, blur, burst statistics, calibration, Shapiro-Wilk)
- * and appends one row per setting; `progress` advances by 5 + 6 * settings.seeds. */
-void measureTradeoffs(const TradeoffSettings& settings, ProgressBar& progress,
-                      std::vector<TradeoffRow>& rows);
+ * and appends one row per setting, and the calibration's precision per set-up; `progress` advances by
+ * 5 + 9 * settings.seeds. */
+void measureTradeoffs(const TradeoffSettings& settings, ProgressBar& progress, std::vector<TradeoffRow>& rows,
+                      std::vector<PrecisionRow>& precision);
 
 } // namespace rawgment_apps
 
