@@ -88,6 +88,15 @@ int main(int argc, char** argv)
         else
             std::printf("model: alpha %.6f +- %.2g (sigma_d^2 and sigma_r^2 not separable)\n",
                         rep.model.alpha, rep.uncertainty.stdError[0]);
+        const std::string correlation =
+            rep.separable ? cv::format("; sigma_d^2 and sigma_r^2 correlate %+.2f",
+                                       rep.uncertainty.correlation(cv::rawgment::NOISE_PARAM_SIGMA_D2,
+                                                                   cv::rawgment::NOISE_PARAM_SIGMA_R2))
+                          : std::string();
+        std::printf("errors: from the %s%s\n",
+                    rep.uncertainty.source == cv::rawgment::UNCERTAINTY_BOOTSTRAP ? "bootstrap"
+                                                                                  : "fit's covariance",
+                    correlation.c_str());
         if (r.shapiroTested > 0)
             std::printf("Shapiro-Wilk: %.1f%% of %d pixels have p > 0.05\n", 100 * r.gaussianFraction,
                         r.shapiroTested);

@@ -118,9 +118,12 @@ int main(int argc, char** argv)
         }
         std::fprintf(stderr, "\n");
     }
-    std::printf("%d campaigns of %d frames per burst; the 95%% interval holds the truth in [90%%, 99%%] of "
-                "campaigns when its standard errors are right (binomial spread at 40: +-3.4%%).\n\n",
-                campaigns, frames);
+    std::printf(
+        "%d campaigns of %d frames per burst. When the standard errors are right, the 95%% interval "
+        "holds the truth in 95%% of campaigns (binomial spread at %d campaigns: +-%.1f%%), mean z is 0 "
+        "(+-%.2f) and RMS z 1 (+-%.2f).\n\n",
+        campaigns, frames, campaigns, 100 * std::sqrt(0.95 * 0.05 / campaigns), 1 / std::sqrt(campaigns),
+        std::sqrt(0.5 / campaigns));
     std::printf("| outliers | method | parameter | coverage | mean z | RMS z | relative standard error | "
                 "bootstrap used |\n|---|---|---|---:|---:|---:|---:|---:|\n");
     const char* names[3] = {"alpha", "sigma_d^2", "sigma_r^2"};

@@ -81,6 +81,8 @@ bool weightedNoiseLine(const std::vector<NoiseSample>& s, const std::vector<int>
     return true;
 }
 
+const int kRansacScoringSamples = 4096;
+
 //! The lowest and highest mean of a set of samples: where a line's largest prediction lies.
 struct MeanRange
 {
@@ -246,6 +248,14 @@ NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples, const LineFit
         const int n = static_cast<int>(samples.size());
         const MeanRange range = meanRangeOf(samples);
         const std::vector<ChiSquareBand> bands = bandsOf(samples, params.inlierThreshold);
+        /* Each hypothesis is scored on at most kRansacScoringSamples samples spread evenly over the list
+         * (which follows the patches and the frame): its inlier share is then known to 0.8% at worst,
+         * enough to pick a line whose inliers the refinement below then takes from every sample, and a
+         * chartless burst of 10^5 samples per gain no longer costs 500 x 10^5 band tests. */
+        const int scored = std::min(n, kRansacScoringSamples);
+        std::vector<int> scoring(static_cast<size_t>(scored));
+        for (int m = 0; m < scored; ++m)
+            scoring[static_cast<size_t>(m)] = static_cast<int>(static_cast<int64>(m) * n / scored);
         size_t bestCount = 0;
         double bestA = ls.a, bestB = ls.b;
         for (int it = 0; it < params.ransacIterations; ++it) {
@@ -259,7 +269,7 @@ NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples, const LineFit
             const double b = samples[i].variance - a * samples[i].mean;
             const double floor = lineVarianceFloor(a, b, range);
             size_t count = 0;
-            for (int k = 0; k < n; ++k)
+            for (int k : scoring)
                 count += insideBand(samples[k], bands[k], a, b, floor) ? 1 : 0;
             if (count > bestCount) {
                 bestCount = count;
