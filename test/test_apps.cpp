@@ -775,6 +775,20 @@ TEST(Apps, calibrationVerdictFailsANonLinearFileAndGainsTooClose)
     const std::string report = readText(dir + "/close/report.md");
     EXPECT_EQ(0u, report.find("# Calibration report\n\n**Verdict: FAIL**")) << report;
 
+    // Gains 4x apart, but a sensor without read noise before the gain: sigma_d^2's 95% interval reaches 0,
+    // so the data cannot tell it from 0 and the split fails on the intervals, not on the gains.
+    r = runApp("rawgment_simulate", "--out='" + dir +
+                                        "/nopre' --frames=16 --gains=6,18 --levels=0.2,0.65 --sigma_d2=0 "
+                                        "--validation=false --format=png --seed=3");
+    ASSERT_EQ(0, r.status) << r.output;
+    r = runApp("rawgment_calibrate",
+               "'" + dir + "/nopre/manifest.yml' --out='" + dir + "/nopre_cal' --plots=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos,
+              r.output.find("FAIL separability of sigma_d^2 and sigma_r^2: gain ratio 3.98 (12.0 "
+                            "dB) over 2 gains; 95% intervals sigma_d^2 [-"))
+        << r.output;
+
     // The same bursts through a tone curve (x^(1/2.2) of the signal, as a processed file has): not linear.
     std::ostringstream manifest;
     manifest << "%YAML:1.0\ncalibration_manifest:\n  patches: sim/patches.yml\n  bursts:\n";
