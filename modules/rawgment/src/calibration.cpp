@@ -449,6 +449,8 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
         for (const NoiseSample& s : samples)
             if (s.pixel >= 0)
                 pixels.insert(s.pixel);
+        // The count before the refit: the refit's own outliers are not left out again.
+        const int leftOut = static_cast<int>(outlierPixels.size());
         if (outlierPixels.size() <= pixels.size() / 5) {
             for (auto& entry : byGain) {
                 std::vector<NoiseSample>& v = entry.second;
@@ -465,13 +467,12 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
             fitEachGain();
             report.notes.push_back(format("%d of %d pixels lay outside the noise band in at least one burst "
                                           "(noisy, hot or stuck pixels) and were left out of every burst",
-                                          static_cast<int>(outlierPixels.size()),
-                                          static_cast<int>(pixels.size())));
+                                          leftOut, static_cast<int>(pixels.size())));
         } else {
             report.notes.push_back(
                 format("%d of %d pixels lay outside the noise band in at least one burst: too "
                        "many to be defects, so each was left out only where it was outside",
-                       static_cast<int>(outlierPixels.size()), static_cast<int>(pixels.size())));
+                       leftOut, static_cast<int>(pixels.size())));
         }
     }
     for (const NoiseLineFit& fit : report.perGain)

@@ -240,6 +240,19 @@ Vec3d stdErrorsOf(const Matx33d& cov)
                  std::sqrt(std::max(0.0, cov(2, 2))));
 }
 
+/* The mean-error correction of one sample (docs/mathematics.md): a fit's estimating equation gains
+ * (c b w / T)(x' - 2 c x / m), with c the slope of the variance in the mean, b = m - c mu the read part,
+ * T = dof + 1 frames, x' the regressors' slope in the mean. Returned: the factor c b w / T, and the
+ * caller adds it times (x' - 2 c x / m). Only above black, where the model has a slope: dark frames are
+ * given their exact mean 0 (rawgment_calibrate does), which has no error to correct. */
+double meanErrorFactor(const NoiseSample& s, double slope, double m, double w)
+{
+    if (!(s.mean > 0))
+        return 0.0;
+    const double c = std::max(slope, 0.0);
+    return c * std::max(m - c * s.mean, 0.0) * w / (s.dof + 1.0);
+}
+
 } // namespace
 
 Vec2d refineNoiseLine(const NoiseSample* s, const uint32_t* counts, int n, Vec2d ab, int rounds)
@@ -261,15 +274,8 @@ Vec2d refineNoiseLine(const NoiseSample* s, const uint32_t* counts, int n, Vec2d
             const Vec2d x(s[i].mean, 1.0);
             A += (x * x.t()) * w;
             r += x * (w * s[i].variance);
-            /* Mean-error correction (docs/mathematics.md): E[psi] = (w x' + w' x)(k3 - m' m) / T with the
-             * line's slope m' = a, x' = (1, 0), the shot noise's third cumulant k3 = a^2 mu and the
-             * weight's slope w' = -2 w a / m. Only above black, where the model has a slope: dark frames
-             * are given their exact mean 0 (rawgment_calibrate does), which has no error to correct. */
-            if (s[i].mean > 0) {
-                const double a = std::max(ab[0], 0.0);
-                const double k = a * std::max(m - a * s[i].mean, 0.0) * w / (s[i].dof + 1.0);
-                r += (Vec2d(1, 0) - x * (2 * a / m)) * k;
-            }
+            const double a = std::max(ab[0], 0.0);
+            r += (Vec2d(1, 0) - x * (2 * a / m)) * meanErrorFactor(s[i], a, m, w);
         }
         const double det = A(0, 0) * A(1, 1) - A(0, 1) * A(1, 0);
         if (!(det > 0))
@@ -302,11 +308,8 @@ Vec3d refineJointFit(const NoiseSample* s, const uint32_t* counts, int n, Vec3d 
                 w *= lossScale / z; // Huber's loss as a reweighting
             A += (x * x.t()) * w;
             r += x * (w * s[i].variance);
-            if (s[i].mean > 0) { // the mean-error correction, as in refineNoiseLine()
-                const double c = s[i].gain * p[0];
-                const double k = c * std::max(m - c * s[i].mean, 0.0) * w / (s[i].dof + 1.0);
-                r += (Vec3d(s[i].gain, 0, 0) - x * (2 * c / m)) * k;
-            }
+            const double c = std::max(s[i].gain * p[0], 0.0);
+            r += (Vec3d(s[i].gain, 0, 0) - x * (2 * c / m)) * meanErrorFactor(s[i], c, m, w);
         }
         p = nonNegativeLeastSquares<3>(A, r);
     }
@@ -451,14 +454,13 @@ Vec3d projectedStdError(const std::vector<NoiseSample>& samples, const Calibrati
     for (const NoiseSample& s : samples) {
         highest = std::max(highest, s.gain);
         pixelsOfGain[s.gain] += 1;
+    }
+    for (const NoiseSample& s : samples) {
         const Vec3d x = detail::jointRegressors(s);
         const double m = variance(s.gain, s.mean);
         const int dof = std::max(1, static_cast<int>(std::lround((s.dof + 1) * plan.frameFactor)) - 1);
         addInformation(now, x, m, s.dof, 1.0);
         addInformation(changed, x, m, dof, plan.pixelFactor);
-    }
-    for (const NoiseSample& s : samples) {
-        const int dof = std::max(1, static_cast<int>(std::lround((s.dof + 1) * plan.frameFactor)) - 1);
         if (plan.addGain > 0 && s.gain == highest) {
             NoiseSample t = s;
             t.gain = plan.addGain;
