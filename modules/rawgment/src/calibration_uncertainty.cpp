@@ -189,8 +189,7 @@ Vec3d twoStageOfLines(const std::vector<NoiseLineFit>& lines, const std::vector<
  * (a multinomial count per sample: the rounds then read the samples in order), and repeats the final
  * fit from the fitted values: two reweighting rounds move a converged fit by far less than its error. */
 std::vector<Vec3d> bootstrapEstimates(const std::vector<NoiseSample>& s, const std::vector<GainGroup>& groups,
-                                      const CalibrationReport& report, const CalibrationParams& params,
-                                      double floor)
+                                      const CalibrationReport& report, const CalibrationParams& params)
 {
     const int replicates = params.bootstrapReplicates;
     const Vec3d p(report.model.alpha, report.model.sigmaD2, report.model.sigmaR2);
@@ -363,7 +362,7 @@ ModelUncertainty modelUncertainty(const std::vector<NoiseSample>& inliers,
     const int parameters = report.separable ? 3 : 1;
     const bool boundActive = !free[0] || (report.separable && (!free[1] || !free[2]));
     if (params.bootstrapReplicates >= 2) {
-        const Matx33d bootCov = covarianceOf(bootstrapEstimates(inliers, groups, report, params, floor));
+        const Matx33d bootCov = covarianceOf(bootstrapEstimates(inliers, groups, report, params));
         u.bootstrapStdError = stdErrorsOf(bootCov);
         u.bootstrapReplicates = params.bootstrapReplicates;
         int widest = -1;

