@@ -21,11 +21,34 @@ using detail::storeValue;
 struct JitterConstants
 {
     float pc[4], black[4];
+    float slope[4], offset[4]; // lineBySite: the added variance per site (perSiteLine())
     float pb, pg, white;
     detail::NoiseTerms<float> in; // the model's terms at the input gain
     NoiseAlignment alignment;
     ShotNoiseSampling sampling;
+    // ACCOUNT_PRIOR without brightness: the prior's share p_u = p_c / p_g is one number per CFA site, so
+    // Eq. 13 is a line in the mean per site, its slope and offset computed once (perSiteLine()).
+    bool lineBySite;
 };
+
+// The column arrays of one row (the CFA site alternates along it): contrast, black level and, for
+// lineBySite, the slope and offset of the added variance.
+struct JitterColumns
+{
+    const float *pc, *black, *slope, *offset;
+};
+
+/* Eq. 13 with p_u = p_c / p_g (no brightness) as a line in the black-subtracted mean:
+ * slope p_u (1 - p_u) p_g^2 g alpha, offset (1 - p_u^2) p_g^2 g^2 sigma_d^2 + (1 - p_c^2) sigma_r^2,
+ * in double and rounded once. The per-pixel form divides by the clamped mean for every pixel and gives
+ * the same values to float rounding; this one costs a multiply-add. */
+void perSiteLine(double pc, double pg, const detail::NoiseTerms<double>& in, float& slope, float& offset)
+{
+    const double pu = pc / pg;
+    slope = static_cast<float>(pu * (1 - pu) * pg * pg * in.shot);
+    offset =
+        static_cast<float>((1 - pu * pu) * pg * pg * in.readBeforeGain + (1 - pc * pc) * in.readAfterGain);
+}
 
 // The variance to add to a pixel, split into its shot part and the rest (read noise, and for
 // ACCOUNT_PRIOR the correction of the scaled prior), before any clipping. xm is the prior-mean estimate
@@ -90,40 +113,46 @@ template <int W> struct PixelLanes<W, float>
     }
 };
 
-template <int W, typename T, NoiseAlignment A, bool kLocalMean>
-RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* prior, const float* pc,
-                                 const float* black, const JitterConstants& k,
+template <int W, typename T, NoiseAlignment A, bool kLocalMean, bool kLineBySite>
+RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* prior,
+                                 const JitterColumns& col, int c, const JitterConstants& k,
                                  typename detail::Lanes<W>::I& bright)
 {
     typedef typename detail::Lanes<W>::F F;
     typedef PixelLanes<W, T> P;
     F pcv, blackv;
-    std::memcpy(&pcv, pc, sizeof(pcv));
-    std::memcpy(&blackv, black, sizeof(blackv));
-    const F x = P::load(s) - blackv;
+    std::memcpy(&pcv, col.pc + c, sizeof(pcv));
+    std::memcpy(&blackv, col.black + c, sizeof(blackv));
+    const F x = P::load(s + c) - blackv;
     F out = pcv * x + k.pb;
     if (A != NoiseAlignment::NONE) {
-        F xm = x, zv;
+        F xm = x, zv, total;
         if (kLocalMean)
-            std::memcpy(&xm, prior, sizeof(xm));
-        std::memcpy(&zv, z, sizeof(zv));
-        const detail::AddedVarianceOf<F> v = jitterVariance<A>(xm, pcv, k);
-        const F total = v.shot + v.rest;
+            std::memcpy(&xm, prior + c, sizeof(xm));
+        std::memcpy(&zv, z + c, sizeof(zv));
+        if (kLineBySite) {
+            F slope, offset;
+            std::memcpy(&slope, col.slope + c, sizeof(slope));
+            std::memcpy(&offset, col.offset + c, sizeof(offset));
+            total = slope * detail::maxLanes(xm, F{}) + offset;
+        } else {
+            const detail::AddedVarianceOf<F> v = jitterVariance<A>(xm, pcv, k);
+            total = v.shot + v.rest;
+        }
         bright -= total < 0; // -1 per brightening lane
         out += detail::sqrtLanes(detail::maxLanes(total, F{})) * zv;
     }
-    P::store(d, out + blackv, F{} + k.white);
+    P::store(d + c, out + blackv, F{} + k.white);
 }
 
-template <int W, typename T, NoiseAlignment A, bool kLocalMean>
-RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
-                                  const float* black, const JitterConstants& k, int cols)
+template <int W, typename T, NoiseAlignment A, bool kLocalMean, bool kLineBySite>
+RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float* prior,
+                                  const JitterColumns& col, const JitterConstants& k, int cols)
 {
     typename detail::Lanes<W>::I bright = {};
     int c = 0;
     for (; c + W <= cols; c += W)
-        jitterBlock<W, T, A, kLocalMean>(s + c, d + c, z + c, kLocalMean ? prior + c : nullptr, pc + c,
-                                         black + c, k, bright);
+        jitterBlock<W, T, A, kLocalMean, kLineBySite>(s, d, z, prior, col, c, k, bright);
     int total = 0;
     for (int i = 0; i < W; ++i)
         total += bright[i];
@@ -131,16 +160,20 @@ RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float*
     if (rest > 0) {
         // Padded copies: the extra lanes compute on zeros and are neither stored nor counted.
         T sPad[W] = {}, dPad[W];
-        float zPad[W] = {}, priorPad[W] = {}, pcPad[W] = {}, blackPad[W] = {};
+        float zPad[W] = {}, priorPad[W] = {}, pcPad[W] = {}, blackPad[W] = {}, slopePad[W] = {},
+              offsetPad[W] = {};
         for (int i = 0; i < rest; ++i) {
             sPad[i] = s[c + i];
             zPad[i] = z ? z[c + i] : 0.0f;
             priorPad[i] = kLocalMean ? prior[c + i] : 0.0f;
-            pcPad[i] = pc[c + i];
-            blackPad[i] = black[c + i];
+            pcPad[i] = col.pc[c + i];
+            blackPad[i] = col.black[c + i];
+            slopePad[i] = kLineBySite ? col.slope[c + i] : 0.0f;
+            offsetPad[i] = kLineBySite ? col.offset[c + i] : 0.0f;
         }
+        const JitterColumns padded = {pcPad, blackPad, slopePad, offsetPad};
         typename detail::Lanes<W>::I tail = {};
-        jitterBlock<W, T, A, kLocalMean>(sPad, dPad, zPad, priorPad, pcPad, blackPad, k, tail);
+        jitterBlock<W, T, A, kLocalMean, kLineBySite>(sPad, dPad, zPad, priorPad, padded, 0, k, tail);
         for (int i = 0; i < rest; ++i) {
             d[c + i] = dPad[i];
             total += tail[i];
@@ -151,46 +184,48 @@ RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float*
 
 template <int W, typename T, bool kLocalMean>
 RAWGMENT_KERNEL int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* prior,
-                                          const float* pc, const float* black, const JitterConstants& k,
-                                          int cols)
+                                          const JitterColumns& col, const JitterConstants& k, int cols)
 {
     switch (k.alignment) {
     case NoiseAlignment::ACCOUNT_PRIOR:
-        return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean>(s, d, z, prior, pc, black, k,
-                                                                              cols);
+        if (k.lineBySite)
+            return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, true>(s, d, z, prior, col,
+                                                                                        k, cols);
+        return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, false>(s, d, z, prior, col, k,
+                                                                                     cols);
     case NoiseAlignment::IGNORE_PRIOR:
-        return jitterRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, kLocalMean>(s, d, z, prior, pc, black, k,
-                                                                             cols);
+        return jitterRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, kLocalMean, false>(s, d, z, prior, col, k,
+                                                                                    cols);
     default:
-        return jitterRowBody<W, T, NoiseAlignment::NONE, kLocalMean>(s, d, z, prior, pc, black, k, cols);
+        return jitterRowBody<W, T, NoiseAlignment::NONE, kLocalMean, false>(s, d, z, prior, col, k, cols);
     }
 }
 
 template <int W>
 RAWGMENT_KERNEL int jitterRowKernel(const ushort* s, ushort* d, const float* z, const float* prior,
-                                    const float* pc, const float* black, const JitterConstants& k, int cols)
+                                    const JitterColumns& col, const JitterConstants& k, int cols)
 {
-    return prior ? jitterRowAnyAlignment<W, ushort, true>(s, d, z, prior, pc, black, k, cols)
-                 : jitterRowAnyAlignment<W, ushort, false>(s, d, z, prior, pc, black, k, cols);
+    return prior ? jitterRowAnyAlignment<W, ushort, true>(s, d, z, prior, col, k, cols)
+                 : jitterRowAnyAlignment<W, ushort, false>(s, d, z, prior, col, k, cols);
 }
 
 template <int W>
 RAWGMENT_KERNEL int jitterRowKernel(const float* s, float* d, const float* z, const float* prior,
-                                    const float* pc, const float* black, const JitterConstants& k, int cols)
+                                    const JitterColumns& col, const JitterConstants& k, int cols)
 {
-    return prior ? jitterRowAnyAlignment<W, float, true>(s, d, z, prior, pc, black, k, cols)
-                 : jitterRowAnyAlignment<W, float, false>(s, d, z, prior, pc, black, k, cols);
+    return prior ? jitterRowAnyAlignment<W, float, true>(s, d, z, prior, col, k, cols)
+                 : jitterRowAnyAlignment<W, float, false>(s, d, z, prior, col, k, cols);
 }
 
 // One dispatched entry point per pixel type (cpu_dispatch.hpp).
 RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
-                             (const ushort* s, ushort* d, const float* z, const float* prior, const float* pc,
-                              const float* black, const JitterConstants& k, int cols),
-                             (s, d, z, prior, pc, black, k, cols))
+                             (const ushort* s, ushort* d, const float* z, const float* prior,
+                              const JitterColumns& col, const JitterConstants& k, int cols),
+                             (s, d, z, prior, col, k, cols))
 RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
-                             (const float* s, float* d, const float* z, const float* prior, const float* pc,
-                              const float* black, const JitterConstants& k, int cols),
-                             (s, d, z, prior, pc, black, k, cols))
+                             (const float* s, float* d, const float* z, const float* prior,
+                              const JitterColumns& col, const JitterConstants& k, int cols),
+                             (s, d, z, prior, col, k, cols))
 
 template <typename T, NoiseAlignment A>
 int jitterRowPoissonBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
@@ -224,27 +259,32 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstant
     const int cols = src.cols;
     std::vector<float> z(static_cast<size_t>(cols));
     // Per-column constants for even rows (sites 0, 1) and odd rows (sites 2, 3).
-    std::vector<float> pcByParity(2 * static_cast<size_t>(cols)),
-        blackByParity(2 * static_cast<size_t>(cols));
+    const size_t n = 2 * static_cast<size_t>(cols);
+    std::vector<float> pcByParity(n), blackByParity(n), slopeByParity(n), offsetByParity(n);
     for (int parity = 0; parity < 2; ++parity)
         for (int c = 0; c < cols; ++c) {
-            pcByParity[static_cast<size_t>(parity * cols + c)] = k.pc[2 * parity + (c & 1)];
-            blackByParity[static_cast<size_t>(parity * cols + c)] = k.black[2 * parity + (c & 1)];
+            const size_t i = static_cast<size_t>(parity * cols + c);
+            const int site = 2 * parity + (c & 1);
+            pcByParity[i] = k.pc[site];
+            blackByParity[i] = k.black[site];
+            slopeByParity[i] = k.slope[site];
+            offsetByParity[i] = k.offset[site];
         }
     const bool poisson = k.sampling == ShotNoiseSampling::POISSON && k.alignment != NoiseAlignment::NONE;
     int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
         if (k.alignment != NoiseAlignment::NONE)
             detail::fillGaussian(seed, static_cast<uint64_t>(r), z.data(), cols);
-        const float* pc = pcByParity.data() + (r & 1) * cols;
-        const float* black = blackByParity.data() + (r & 1) * cols;
+        const size_t rowStart = static_cast<size_t>((r & 1) * cols);
+        const JitterColumns col = {pcByParity.data() + rowStart, blackByParity.data() + rowStart,
+                                   slopeByParity.data() + rowStart, offsetByParity.data() + rowStart};
         const float* priorRow = prior.empty() ? nullptr : prior.ptr<float>(r);
         if (poisson) {
             detail::CounterRng rng(poissonSeed, static_cast<uint64_t>(r));
-            localBright +=
-                jitterRowPoisson(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, pc, black, k, rng, cols);
+            localBright += jitterRowPoisson(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, col.pc,
+                                            col.black, k, rng, cols);
         } else {
-            localBright += jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, pc, black, k, cols);
+            localBright += jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, col, k, cols);
         }
     }
     brightening += localBright;
@@ -333,6 +373,12 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
             static_cast<float>(terms.readAfterGain)};
     k.alignment = noise.alignment;
     k.sampling = noise.shotSampling;
+    k.lineBySite = noise.alignment == NoiseAlignment::ACCOUNT_PRIOR && jitter.brightness == 0;
+    for (int s = 0; s < 4; ++s) {
+        k.slope[s] = k.offset[s] = 0;
+        if (k.lineBySite)
+            perSiteLine(jitter.contrast[s], jitter.gainRatio, terms, k.slope[s], k.offset[s]);
+    }
 
     const Mat prior =
         noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && noise.alignment != NoiseAlignment::NONE

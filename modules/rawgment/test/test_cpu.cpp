@@ -66,12 +66,16 @@ std::vector<Mat> everyDispatchedLoop()
                 noise.alignment = a;
                 Mat out;
                 RawFormat f;
-                // Brightening and darkening sites, a gain change.
+                // Brightening and darkening sites, a gain change; without brightness (ACCOUNT_PRIOR's
+                // variance is then a line per site) and with it (a share per pixel).
                 ColorJitter jitter;
                 jitter.contrast = Vec4d(0.3, 1.4, 0.25, 0.5);
                 jitter.gainRatio = 2;
-                colorJitter(input, format, model, jitter, noise, 5, out, f);
-                outs.push_back(out);
+                for (double brightness : {0.0, -15.0}) {
+                    jitter.brightness = brightness;
+                    colorJitter(input, format, model, jitter, noise, 5, out, f);
+                    outs.push_back(out);
+                }
                 motionBlur(input, format, model, linearMotionKernel(13, 30), noise, 6, out);
                 outs.push_back(out);
                 scaleMosaic(input, format, model, 1.07, noise, 7, out);
