@@ -5,7 +5,9 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
+#include <cstring>
 #include <limits>
+#include <mutex>
 
 namespace cv {
 namespace rawgment {
@@ -95,6 +97,40 @@ Scene Scene::read(const FileNode& node)
     return s;
 }
 
+namespace {
+
+/* Each CFA plane moved by half the (even) shift, vacated pixels replicating the plane's edge, in one
+ * pass: output pixel (r, c) is source pixel (2 clamp(r/2 - shift.y/2) + r%2, 2 clamp(c/2 - shift.x/2) +
+ * c%2), the clamps to the plane's rows and columns. The same values as splitting the planes, moving each
+ * with warpAffine (INTER_NEAREST, BORDER_REPLICATE) and merging them (Augment.shiftMatchesThePlaneWise
+ * Composition), at the cost of a copy: the inner columns of a row are one memcpy. */
+void shiftMosaic(const Mat& src, Point shift, Mat& dst)
+{
+    CV_Assert(shift.x % 2 == 0 && shift.y % 2 == 0 && src.rows % 2 == 0 && src.cols % 2 == 0);
+    dst.create(src.size(), src.type());
+    const int planeRows = src.rows / 2, planeCols = src.cols / 2, hy = shift.y / 2;
+    const size_t esz = src.elemSize();
+    // Output columns [first, last) read source column c - shift.x; those left of them read the first
+    // pair of source columns, those right of them the last pair.
+    const int first = std::min(std::max(shift.x, 0), src.cols),
+              last = std::max(std::min(src.cols + shift.x, src.cols), 0);
+    parallel_for_(Range(0, src.rows), [&](const Range& rows) {
+        for (int r = rows.start; r < rows.end; ++r) {
+            const int planeRow = std::min(std::max(r / 2 - hy, 0), planeRows - 1);
+            const uchar* s = src.ptr(2 * planeRow + (r & 1));
+            uchar* d = dst.ptr(r);
+            for (int c = 0; c < first; ++c)
+                std::memcpy(d + c * esz, s + (c & 1) * esz, esz);
+            if (last > first)
+                std::memcpy(d + first * esz, s + (first - shift.x) * esz, (last - first) * esz);
+            for (int c = std::max(last, first); c < src.cols; ++c)
+                std::memcpy(d + c * esz, s + (2 * (planeCols - 1) + (c & 1)) * esz, esz);
+        }
+    });
+}
+
+} // namespace
+
 void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& model, const Scene& scene,
                 uint64 seed, OutputArray _dst, RawFormat& dstFormat, AugmentReport* report,
                 std::vector<Rect>* boxes)
@@ -112,18 +148,9 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
                                               scene.shift.x, scene.shift.y, current.cols, current.rows));
     const Point shift(2 * cvRound(scene.shift.x / 2.0), 2 * cvRound(scene.shift.y / 2.0));
     if (shift != Point(0, 0)) {
-        // Shift each CFA plane by half the (even) offset: the phase of the mosaic is kept.
-        std::vector<Mat> planes;
-        splitCfaPlanes(current, planes);
-        const Matx23d m(1, 0, shift.x / 2, 0, 1, shift.y / 2);
-        for (Mat& p : planes) {
-            Mat moved;
-            warpAffine(p, moved, m, p.size(), INTER_NEAREST, BORDER_REPLICATE);
-            p = moved;
-        }
         // Into a new Mat: `current` still shares the caller's data, which must never be written.
         Mat shifted;
-        mergeCfaPlanes(planes, shifted);
+        shiftMosaic(current, shift, shifted);
         current = shifted;
         if (boxes)
             for (Rect& b : *boxes)
@@ -146,19 +173,50 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
 
 namespace {
 
+// The smallest value of each CFA site (index cfaSite(row, col) of a 2x2 block), rows split among
+// threads. A row is read in blocks of 16 values whose lane i always holds column parity i % 2, so the
+// lane-wise minima vectorise on every path; the row's tail, fewer than 16 values, goes one by one.
+template <typename T> void siteMinima(const Mat& src, const Range& rows, T lowest[4])
+{
+    typedef T Block __attribute__((vector_size(16 * sizeof(T))));
+    for (int r = rows.start; r < rows.end; ++r) {
+        const T* p = src.ptr<T>(r);
+        T* lo = lowest + 2 * (r & 1);
+        Block acc;
+        for (int i = 0; i < 16; ++i)
+            acc[i] = std::numeric_limits<T>::max();
+        int c = 0;
+        for (; c + 16 <= src.cols; c += 16) {
+            Block v;
+            std::memcpy(&v, p + c, sizeof(v));
+            acc = detail::minLanes(acc, v);
+        }
+        for (int i = 0; i < 16; ++i)
+            lo[i & 1] = std::min(lo[i & 1], acc[i]);
+        for (; c < src.cols; ++c)
+            lo[c & 1] = std::min(lo[c & 1], p[c]);
+    }
+}
+
 // min over pixels of (value - black of its site), without a black-subtracted copy of the frame.
 template <typename T> double minimumAboveBlackOf(const Mat& src, const RawFormat& format)
 {
-    double lowest = std::numeric_limits<double>::infinity();
-    for (int r = 0; r < src.rows; ++r) {
-        const T* p = src.ptr<T>(r);
-        T lo[2] = {std::numeric_limits<T>::max(), std::numeric_limits<T>::max()};
-        for (int c = 0; c < src.cols; ++c)
-            lo[c & 1] = std::min(lo[c & 1], p[c]);
-        for (int phase = 0; phase < std::min(2, src.cols); ++phase)
-            lowest = std::min(lowest, static_cast<double>(lo[phase]) - format.blackAt(r, phase));
-    }
-    return lowest;
+    std::mutex mutex;
+    T lowest[4];
+    std::fill(lowest, lowest + 4, std::numeric_limits<T>::max());
+    parallel_for_(Range(0, src.rows), [&](const Range& rows) {
+        T local[4];
+        std::fill(local, local + 4, std::numeric_limits<T>::max());
+        siteMinima(src, rows, local);
+        const std::lock_guard<std::mutex> lock(mutex);
+        for (int i = 0; i < 4; ++i)
+            lowest[i] = std::min(lowest[i], local[i]);
+    });
+    double result = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 4; ++i)
+        if (i / 2 < src.rows && i % 2 < src.cols) // a site the frame has
+            result = std::min(result, static_cast<double>(lowest[i]) - format.blackAt(i / 2, i % 2));
+    return result;
 }
 
 double minimumAboveBlack(const Mat& src, const RawFormat& format)

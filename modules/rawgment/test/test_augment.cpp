@@ -2,6 +2,7 @@
 #include "test_common.hpp"
 
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
@@ -507,6 +508,40 @@ TEST(Augment, shiftKeepsTheCfaPhaseAndMovesBoxes)
     EXPECT_EQ(boxes[1].area(), 0); // moved out of the frame
 }
 
+TEST(Augment, shiftMatchesThePlaneWiseComposition)
+{
+    // The one-pass shift against what it replaced: each CFA plane moved by half the shift with
+    // warpAffine (nearest, edge replicated), for shifts inside, at and beyond the middle, up to the
+    // whole frame, on both depths and on a view that is not continuous.
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    Mat big(22, 40, CV_16UC1);
+    randu(big, 0, 4096);
+    for (const Mat& src : {big(Rect(4, 2, 30, 18)), Mat(big(Rect(4, 2, 30, 18)).clone())})
+        for (int depth : {CV_16U, CV_32F})
+            for (const Point shift : {Point(2, 0), Point(0, -4), Point(6, 8), Point(-12, 10), Point(-30, -18),
+                                      Point(30, 18), Point(28, -16)}) {
+                Mat typed;
+                src.convertTo(typed, depth);
+                std::vector<Mat> planes;
+                splitCfaPlanes(typed, planes);
+                for (Mat& plane : planes) {
+                    Mat moved;
+                    warpAffine(plane, moved, Matx23d(1, 0, shift.x / 2, 0, 1, shift.y / 2), plane.size(),
+                               INTER_NEAREST, BORDER_REPLICATE);
+                    plane = moved;
+                }
+                Mat expected, out;
+                mergeCfaPlanes(planes, expected);
+                Scene scene;
+                scene.shift = shift;
+                RawFormat f;
+                applyScene(typed, fmt, model, scene, 0, out, f);
+                ASSERT_EQ(out.type(), typed.type());
+                EXPECT_EQ(0, norm(out, expected, NORM_INF)) << "shift " << shift << ", depth " << depth;
+            }
+}
+
 TEST(Augment, randomPolicyDrawsInItsRangesAndRoundTrips)
 {
     const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
@@ -566,6 +601,27 @@ TEST(Augment, randomPolicyDrawsInItsRangesAndRoundTrips)
     FileStorage fs("%YAML:1.0\nscene_policy: {hue_probability: 2}\n",
                    FileStorage::READ | FileStorage::MEMORY);
     EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy::read(fs["scene_policy"]), "hueProbability");
+}
+
+TEST(Augment, policyBrightnessIsAFractionOfTheSmallestValueAboveBlack)
+{
+    // brightness = uniform(min, max) * min over pixels of (value - black of its site): with min = max = 1
+    // it is that minimum itself. Each site has its own black level; the minimum sits at each site in
+    // turn, inside the 16-value blocks or in a row's tail (37 columns: 32 + 5), on both depths.
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d(60, 64, 70, 50);
+    fmt.whiteLevel = 4095;
+    RandomScenePolicy policy;
+    policy.brightnessMin = policy.brightnessMax = 1;
+    for (int depth : {CV_16U, CV_32F})
+        for (const Point where : {Point(3, 0), Point(34, 0), Point(0, 7), Point(35, 9), Point(10, 12)}) {
+            Mat src(14, 37, CV_16UC1, Scalar(2000));
+            src.at<ushort>(where) = 300;
+            const double expected = 300 - fmt.blackAt(where.y, where.x);
+            Mat typed;
+            src.convertTo(typed, depth);
+            EXPECT_EQ(policy.draw(typed, fmt, 1).jitter.brightness, expected) << where << ", depth " << depth;
+        }
 }
 
 TEST(Augment, sceneRoundTripsThroughFileStorage)
