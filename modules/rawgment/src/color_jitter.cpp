@@ -252,32 +252,49 @@ int jitterRowPoisson(const T* s, T* d, const float* z, const float* prior, const
     return jitterRowPoissonBody<T, NoiseAlignment::IGNORE_PRIOR>(s, d, z, prior, pc, black, k, rng, cols);
 }
 
+// The column arrays of even rows (sites 0, 1) and odd rows (sites 2, 3), made once per call: a
+// parallel_for_ stripe can be a single row, which would otherwise rebuild them for four times its work.
+class JitterColumnTables
+{
+public:
+    JitterColumnTables(const JitterConstants& k, int cols) : cols_(cols)
+    {
+        for (std::vector<float>* t : {&pc_, &black_, &slope_, &offset_})
+            t->resize(2 * static_cast<size_t>(cols));
+        for (int parity = 0; parity < 2; ++parity)
+            for (int c = 0; c < cols; ++c) {
+                const size_t i = static_cast<size_t>(parity * cols + c);
+                const int site = 2 * parity + (c & 1);
+                pc_[i] = k.pc[site];
+                black_[i] = k.black[site];
+                slope_[i] = k.slope[site];
+                offset_[i] = k.offset[site];
+            }
+    }
+    JitterColumns forRow(int r) const
+    {
+        const size_t start = static_cast<size_t>((r & 1) * cols_);
+        return {pc_.data() + start, black_.data() + start, slope_.data() + start, offset_.data() + start};
+    }
+
+private:
+    int cols_;
+    std::vector<float> pc_, black_, slope_, offset_;
+};
+
 template <typename T>
-void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstants& k, uint64_t seed,
-                uint64_t poissonSeed, const Range& rows, std::atomic<int64>& brightening)
+void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstants& k,
+                const JitterColumnTables& tables, uint64_t seed, uint64_t poissonSeed, const Range& rows,
+                std::atomic<int64>& brightening)
 {
     const int cols = src.cols;
     std::vector<float> z(static_cast<size_t>(cols));
-    // Per-column constants for even rows (sites 0, 1) and odd rows (sites 2, 3).
-    const size_t n = 2 * static_cast<size_t>(cols);
-    std::vector<float> pcByParity(n), blackByParity(n), slopeByParity(n), offsetByParity(n);
-    for (int parity = 0; parity < 2; ++parity)
-        for (int c = 0; c < cols; ++c) {
-            const size_t i = static_cast<size_t>(parity * cols + c);
-            const int site = 2 * parity + (c & 1);
-            pcByParity[i] = k.pc[site];
-            blackByParity[i] = k.black[site];
-            slopeByParity[i] = k.slope[site];
-            offsetByParity[i] = k.offset[site];
-        }
     const bool poisson = k.sampling == ShotNoiseSampling::POISSON && k.alignment != NoiseAlignment::NONE;
     int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
         if (k.alignment != NoiseAlignment::NONE)
             detail::fillGaussian(seed, static_cast<uint64_t>(r), z.data(), cols);
-        const size_t rowStart = static_cast<size_t>((r & 1) * cols);
-        const JitterColumns col = {pcByParity.data() + rowStart, blackByParity.data() + rowStart,
-                                   slopeByParity.data() + rowStart, offsetByParity.data() + rowStart};
+        const JitterColumns col = tables.forRow(r);
         const float* priorRow = prior.empty() ? nullptr : prior.ptr<float>(r);
         if (poisson) {
             detail::CounterRng rng(poissonSeed, static_cast<uint64_t>(r));
@@ -388,11 +405,12 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     std::atomic<int64> brightening{0};
     const uint64_t key = detail::stepKey(seed, detail::RandomStream::JITTER_GAUSSIAN),
                    poissonKey = detail::stepKey(seed, detail::RandomStream::JITTER_POISSON);
+    const JitterColumnTables tables(k, src.cols);
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
-            jitterRows<ushort>(src, prior, dst, k, key, poissonKey, rows, brightening);
+            jitterRows<ushort>(src, prior, dst, k, tables, key, poissonKey, rows, brightening);
         else
-            jitterRows<float>(src, prior, dst, k, key, poissonKey, rows, brightening);
+            jitterRows<float>(src, prior, dst, k, tables, key, poissonKey, rows, brightening);
     });
     detail::reportSaturation(src, format, report, saturatedMask);
     _dst.assign(dst);
