@@ -41,6 +41,17 @@ void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* re
         mask.assign(saturated);
 }
 
+Mat stepOutput(const Mat& src, OutputArray dst)
+{
+    if (dst.kind() == _InputArray::MAT) {
+        Mat m = dst.getMat();
+        const bool overlaps = m.datastart < src.dataend && src.datastart < m.dataend;
+        if (!m.empty() && m.size() == src.size() && m.type() == src.type() && !overlaps)
+            return m;
+    }
+    return Mat(src.size(), src.type());
+}
+
 bool isIdentityKernel(const Mat& kernel)
 {
     return kernel.empty() || kernel.total() == 1;

@@ -27,6 +27,12 @@ void checkResampleInput(const Mat& src, const RawFormat& format, const NoiseMode
 //! Counts or masks saturated input pixels, only when the caller asks: the hot loops do not pay for it.
 void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* report, OutputArray mask);
 
+/** The Mat a noise step writes its result into: the caller's dst when it is a Mat of src's size and type
+ * that shares no memory with src, else a new one. A buffer reused call after call costs no page faults:
+ * on a virtual machine, first touching a new 48 MB float frame costs more than the step itself. A dst
+ * that overlaps src gets a new Mat, so the input is never written. */
+Mat stepOutput(const Mat& src, OutputArray dst);
+
 //! Whether a motion kernel leaves the mosaic as it is (empty or a single tap).
 bool isIdentityKernel(const Mat& kernel);
 

@@ -401,7 +401,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
         noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && noise.alignment != NoiseAlignment::NONE
             ? localPriorMean(src, format)
             : Mat();
-    Mat dst(src.size(), src.type());
+    Mat dst = detail::stepOutput(src, _dst);
     std::atomic<int64> brightening{0};
     const uint64_t key = detail::stepKey(seed, detail::RandomStream::JITTER_GAUSSIAN),
                    poissonKey = detail::stepKey(seed, detail::RandomStream::JITTER_POISSON);

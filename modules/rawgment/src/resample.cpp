@@ -446,7 +446,7 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
     const ResampleConstants k =
         resampleConstants(format, model, noise, seed, detail::RandomStream::SCALE_GAUSSIAN,
                           detail::RandomStream::SCALE_POISSON);
-    Mat dst(src.size(), src.type());
+    Mat dst = detail::stepOutput(src, _dst);
     parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
         if (src.depth() == CV_16U)
             scalePlaneRows<ushort>(src, dst, cols, rows, k, range);
@@ -493,7 +493,7 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
         format, model, noise, seed, detail::RandomStream::BLUR_GAUSSIAN, detail::RandomStream::BLUR_POISSON);
     const float readFactor = static_cast<float>(1 - w.dot(w));
     const bool shotFromMean = noise.blurNoiseSum == BlurNoiseSum::FROM_BLURRED_MEAN;
-    Mat dst(src.size(), src.type());
+    Mat dst = detail::stepOutput(src, _dst);
     parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
         if (src.depth() == CV_16U)
             blurPlaneRows<ushort>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);

@@ -1,6 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "test_common.hpp"
 
+#include <functional>
+
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/augment.hpp>
@@ -385,6 +387,51 @@ TEST(Augment, identityStepsAreSkippedAndReturnTheInputItself)
     EXPECT_TRUE(linearMotionKernel(0, 0).total() == 1);
     motionBlur(src, fmt, model, linearMotionKernel(2, 0), NoiseAlignment::ACCOUNT_PRIOR, 1, out);
     EXPECT_EQ(out.data, src.data);
+}
+
+TEST(Augment, stepsWriteIntoTheCallersBufferButNeverIntoTheirInput)
+{
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    const Mat kernel = linearMotionKernel(5, 30);
+    typedef std::function<void(const Mat&, Mat&)> Step;
+    const std::vector<std::pair<const char*, Step>> steps = {
+        {"colorJitter",
+         [&](const Mat& in, Mat& out) {
+             RawFormat f;
+             colorJitter(in, fmt, model, ColorJitter::exposureChange(0.5, 2), NoiseOptions(), 3, out, f);
+         }},
+        {"motionBlur",
+         [&](const Mat& in, Mat& out) { motionBlur(in, fmt, model, kernel, NoiseOptions(), 3, out); }},
+        {"scaleMosaic",
+         [&](const Mat& in, Mat& out) { scaleMosaic(in, fmt, model, 1.1, NoiseOptions(), 3, out); }}};
+    for (const auto& step : steps) {
+        Mat big(40, 48, CV_16UC1);
+        randu(big, 300, 3000);
+        const Mat original = big.clone();
+        const Mat src = big(Rect(8, 4, 32, 24));
+        Mat expected;
+        step.second(src, expected);
+        // A buffer of the right size and type is written in place, with the same result.
+        Mat reused(src.size(), src.type(), Scalar(7));
+        const uchar* buffer = reused.data;
+        step.second(src, reused);
+        EXPECT_EQ(reused.data, buffer) << step.first;
+        EXPECT_EQ(0, norm(reused, expected, NORM_INF)) << step.first;
+        // The input as output, or a view that overlaps it: a new Mat, the input untouched.
+        Mat same = src;
+        step.second(src, same);
+        EXPECT_NE(same.data, src.data) << step.first;
+        EXPECT_EQ(0, norm(same, expected, NORM_INF)) << step.first;
+        Mat overlapping = big(Rect(10, 6, 32, 24));
+        step.second(src, overlapping);
+        EXPECT_EQ(0, norm(overlapping, expected, NORM_INF)) << step.first;
+        EXPECT_EQ(0, norm(big, original, NORM_INF)) << step.first << " wrote into its input";
+        // A buffer of another size or type is replaced.
+        Mat wrongType(src.size(), CV_32FC1);
+        step.second(src, wrongType);
+        EXPECT_EQ(wrongType.type(), CV_16UC1) << step.first;
+    }
 }
 
 TEST(Augment, sixteenBitOutputRoundsTiesToEvenSoNoiselessStepsAreUnbiased)

@@ -134,7 +134,8 @@ struct CV_RAWGMENT_EXPORTS ColorJitter
  * @param jitter the change (a step at identity is skipped: dst shares src's data, no noise is drawn)
  * @param noise how the prior noise is treated (alignment) and how the noise is drawn
  * @param seed the noise seed: the same seed gives the same output on any number of threads
- * @param dst output mosaic
+ * @param dst output mosaic; a Mat of src's size and type that shares no memory with src is written in
+ * place (no new allocation), anything else is replaced by a new Mat
  * @param dstFormat output format (the new gain)
  * @param report optional: counts of brightening and saturated pixels, steps run
  * @param saturatedMask optional CV_8UC1 output, 255 where the input was at or above white
@@ -170,7 +171,7 @@ CV_RAWGMENT_EXPORTS Mat linearMotionKernel(double length, double angleDegrees);
  *        is the identity and the step is skipped
  * @param noise how the prior noise is treated (alignment), how the noise is drawn
  * @param seed noise seed
- * @param dst output, same type
+ * @param dst output, same type; reused as colorJitter()'s dst is
  * @param report optional
  */
 CV_RAWGMENT_EXPORTS void motionBlur(InputArray src, const RawFormat& format, const NoiseModel& model,
@@ -195,7 +196,7 @@ CV_RAWGMENT_EXPORTS void motionBlur(InputArray src, const RawFormat& format, con
  *        skipped (dst shares src's data)
  * @param noise how the prior noise is treated (alignment), how the noise is drawn
  * @param seed noise seed
- * @param dst output, same type and size
+ * @param dst output, same type and size; reused as colorJitter()'s dst is
  * @param report optional
  */
 CV_RAWGMENT_EXPORTS void scaleMosaic(InputArray src, const RawFormat& format, const NoiseModel& model,
