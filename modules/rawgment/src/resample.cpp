@@ -77,38 +77,44 @@ void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, 
     }
 }
 
-// One kernel tap over a row: mean += w x, and for ACCOUNT_PRIOR shot += w (1 - w) max(x, 0) (the prior
-// mean is never negative), in one pass over the source row.
-template <int W>
-RAWGMENT_KERNEL void addTapBlock(float* mean, float* shot, const float* x, float w, float shotWeight,
-                                 bool withShot)
+// Every kernel tap of an output row: mean = sum over taps of w x, and for ACCOUNT_PRIOR shot = sum of
+// w (1 - w) max(x, 0) (the prior mean is never negative). Taps innermost, so the sums of a block of
+// columns stay in registers and each tap costs one load; each pixel adds its taps in their order,
+// as a pass per tap would. x[t] is tap t's source row, already offset by the tap's column.
+template <int W, bool kShot>
+RAWGMENT_KERNEL void addTapsBlocks(float* mean, float* shot, const float* const* x, const float* w,
+                                   const float* shotWeight, int taps, int n)
 {
     typedef typename detail::Lanes<W>::F F;
-    F m, xv;
-    std::memcpy(&m, mean, sizeof(m));
-    std::memcpy(&xv, x, sizeof(xv));
-    m += w * xv;
-    std::memcpy(mean, &m, sizeof(m));
-    if (withShot) {
-        F sh;
-        std::memcpy(&sh, shot, sizeof(sh));
-        sh += shotWeight * detail::maxLanes(xv, F{});
-        std::memcpy(shot, &sh, sizeof(sh));
+    for (int j = 0; j < n; j += W) {
+        F m = F{}, sh = F{};
+        for (int t = 0; t < taps; ++t) {
+            F xv;
+            std::memcpy(&xv, x[t] + j, sizeof(xv));
+            m += w[t] * xv;
+            if (kShot)
+                sh += shotWeight[t] * detail::maxLanes(xv, F{});
+        }
+        std::memcpy(mean + j, &m, sizeof(m));
+        if (kShot)
+            std::memcpy(shot + j, &sh, sizeof(sh));
     }
 }
 
 // The buffers hold whole blocks (detail::wholeBlocks()): the last block runs over the row's end.
 template <int W>
-RAWGMENT_KERNEL void addTapRowKernel(float* mean, float* shot, const float* x, float w, float shotWeight,
-                                     bool withShot, int n)
+RAWGMENT_KERNEL void addTapsRowKernel(float* mean, float* shot, const float* const* x, const float* w,
+                                      const float* shotWeight, int taps, bool withShot, int n)
 {
-    for (int j = 0; j < n; j += W)
-        addTapBlock<W>(mean + j, withShot ? shot + j : nullptr, x + j, w, shotWeight, withShot);
+    if (withShot)
+        addTapsBlocks<W, true>(mean, shot, x, w, shotWeight, taps, n);
+    else
+        addTapsBlocks<W, false>(mean, shot, x, w, shotWeight, taps, n);
 }
-RAWGMENT_DISPATCHED_BY_WIDTH(void, addTapRow,
-                             (float* mean, float* shot, const float* x, float w, float shotWeight,
-                              bool withShot, int n),
-                             (mean, shot, x, w, shotWeight, withShot, n))
+RAWGMENT_DISPATCHED_BY_WIDTH(void, addTapsRow,
+                             (float* mean, float* shot, const float* const* x, const float* w,
+                              const float* shotWeight, int taps, bool withShot, int n),
+                             (mean, shot, x, w, shotWeight, taps, withShot, n))
 
 template <int W>
 RAWGMENT_KERNEL void finishResampledBlock(float* mean, const float* shotSum, const float* readFactor,
@@ -285,6 +291,8 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             edgeColumns.push_back(std::move(e));
         }
     std::vector<KernelTap> rowTaps, pixelTaps;
+    std::vector<const float*> tapRows;
+    std::vector<float> tapWeights, tapShotWeights;
     int ringSite = -1;
     for (int idx = range.start; idx < range.end; ++idx) {
         const int site = idx / ph, i = idx % ph;
@@ -295,9 +303,11 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
         const bool edgeRow = i < ry || i >= ph - ry;
         const float rowReadFactor =
             edgeRow ? mergeClampedTaps(taps, i, 0, plane, radius, true, false, rowTaps) : readFactor;
-        std::fill(mean.begin(), mean.end(), 0.0f);
-        std::fill(shotSum.begin(), shotSum.end(), 0.0f);
         std::fill(readFactors.begin(), readFactors.end(), rowReadFactor);
+        // The rows of one output row are distinct ring slots, so every tap's row stays loaded.
+        tapRows.clear();
+        tapWeights.clear();
+        tapShotWeights.clear();
         for (const KernelTap& t : edgeRow ? rowTaps : taps) {
             const int si = std::min(std::max(i + t.dy - ry, 0), ph - 1);
             const size_t slot = static_cast<size_t>(si % ksize.height);
@@ -306,8 +316,12 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
                 loadPlaneRow<T>(src, site, si, rx, k.black[site], row);
                 ringRow[slot] = si;
             }
-            addTapRow(mean.data(), shotSum.data(), row + t.dx, t.w, t.shotWeight, exactShot, pw);
+            tapRows.push_back(row + t.dx);
+            tapWeights.push_back(t.w);
+            tapShotWeights.push_back(t.shotWeight);
         }
+        addTapsRow(mean.data(), shotSum.data(), tapRows.data(), tapWeights.data(), tapShotWeights.data(),
+                   static_cast<int>(tapRows.size()), exactShot, pw);
         if (!account) {
             finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i);
             continue;
