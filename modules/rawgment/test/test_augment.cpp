@@ -3,6 +3,7 @@
 
 #include <functional>
 
+#include "../src/random.hpp"
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/augment.hpp>
@@ -432,6 +433,40 @@ TEST(Augment, stepsWriteIntoTheCallersBufferButNeverIntoTheirInput)
         step.second(src, wrongType);
         EXPECT_EQ(wrongType.type(), CV_16UC1) << step.first;
     }
+}
+
+TEST(Augment, jitterAddsRowROfItsOwnStreamValueForValue)
+{
+    // The noise the jitter adds must be row r of its stream, value for value: a row that reused another
+    // row's numbers, or restarted its stream part-way, would pass statistical tests. IGNORE_PRIOR on
+    // float input with no clipping lets the test read the normal back: z = (out - black - c x) /
+    // sqrt(v), v the model's variance at the new mean.
+    const int rows = 5, cols = 1000; // rows of both CFA parities; 1000 is not a whole number of blocks
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d::all(100);
+    fmt.whiteLevel = 1e6;
+    fmt.gain = 1;
+    const NoiseModel model(0.5, 1.5, 3.0);
+    Mat src(rows, cols, CV_32FC1);
+    randu(src, 1000, 3000);
+    ColorJitter jitter;
+    jitter.contrast = Vec4d::all(0.5);
+    const uint64 seed = 99;
+    Mat out;
+    RawFormat outFmt;
+    colorJitter(src, fmt, model, jitter, NoiseAlignment::IGNORE_PRIOR, seed, out, outFmt);
+    Mat z;
+    fillStandardNormal(z, Size(cols, rows), detail::stepKey(seed, detail::RandomStream::JITTER_GAUSSIAN));
+    const NoiseLine line = model.lineAtGain(1.0);
+    double worst = 0;
+    for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c) {
+            const double mean = 0.5 * (src.at<float>(r, c) - 100);
+            const double added = out.at<float>(r, c) - 100 - mean;
+            worst = std::max(worst, std::abs(added / std::sqrt(line.a * mean + line.b) - z.at<float>(r, c)));
+        }
+    // Float arithmetic of values near 1000 (ulp 6e-5) divided by a standard deviation near 25.
+    EXPECT_LT(worst, 1e-4);
 }
 
 TEST(Augment, sixteenBitOutputRoundsTiesToEvenSoNoiselessStepsAreUnbiased)
