@@ -52,6 +52,40 @@ Mat stepOutput(const Mat& src, OutputArray dst)
     return Mat(src.size(), src.type());
 }
 
+void darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, int r, int cols, float* extra)
+{
+    const int even = 2 * (r & 1);
+    float amp[2] = {0, 0};
+    if (d.row) {
+        detail::CounterRng rng(rowKey, static_cast<uint64_t>(r));
+        const float z = static_cast<float>(rng.gaussian());
+        amp[0] = d.rowSigma[even] * z;
+        amp[1] = d.rowSigma[even + 1] * z;
+    }
+    if (!d.shading) {
+        for (int c = 0; c < cols; ++c)
+            extra[c] = amp[c & 1];
+        return;
+    }
+    const float* bd = model.darkShadingPerGain.ptr<float>(r);
+    const float* br = model.darkShadingOffset.ptr<float>(r);
+    for (int c = 0; c < cols; ++c) {
+        const int site = even + (c & 1);
+        extra[c] = amp[c & 1] + d.shadingPerGain[site] * bd[c] + d.shadingOffset[site] * br[c];
+    }
+}
+
+void checkDarkShadingSize(const NoiseModel& model, Size size, const char* who)
+{
+    if (model.hasDarkShading() && model.darkShadingPerGain.size() != size)
+        CV_Error(
+            Error::StsBadArg,
+            format("%s: the model's dark shading is %dx%d but the mosaic %dx%d; the maps are per pixel of "
+                   "the sensor, so the mosaic must be a whole frame of it",
+                   who, model.darkShadingPerGain.cols, model.darkShadingPerGain.rows, size.width,
+                   size.height));
+}
+
 bool isIdentityKernel(const Mat& kernel)
 {
     return kernel.empty() || kernel.total() == 1;

@@ -62,6 +62,42 @@ inline float sampledNoise(AddedVariance v, float q, float z, detail::CounterRng&
     return q * count + std::sqrt(total - shot) * z;
 }
 
+/* sampledNoise() with the read part from the unit-variance heavy-tailed draw t (NoiseModel::tukeyRead)
+ * and the shot part from z, or as an electron count when `poisson`. The variance added is
+ * max(shot + rest, 0) as on every path; the read part is the rest, never more than that total. */
+inline float sampledNoiseWithTails(AddedVariance v, float q, bool poisson, float z, float t,
+                                   detail::CounterRng& rng)
+{
+    const float total = std::max(v.shot + v.rest, 0.0f);
+    const float read = std::min(std::max(v.rest, 0.0f), total), shot = total - read;
+    float shotNoise = std::sqrt(shot) * z;
+    if (poisson && q > 0 && shot > 0) {
+        const double m = static_cast<double>(shot) / (static_cast<double>(q) * q);
+        if (m <= detail::kMaxPoissonMean)
+            shotNoise = q * static_cast<float>(static_cast<double>(rng.poisson(m)) - m);
+    }
+    return shotNoise + std::sqrt(read) * t;
+}
+
+/** The dark-frame components a noise step adds (NoiseModel's row noise, dark shading and Tukey read),
+ * per CFA site: a row offset of amplitude rowSigma drawn once per mosaic row, the deterministic
+ * shadingPerGain B_d + shadingOffset B_r, and the lambda of the read part's heavy tails. */
+struct DarkTerms
+{
+    bool row = false, shading = false, tails = false;
+    float rowSigma[4] = {0, 0, 0, 0};
+    float shadingPerGain[4] = {0, 0, 0, 0}, shadingOffset[4] = {0, 0, 0, 0};
+    double lambda[4] = {0, 0, 0, 0};
+    bool any() const { return row || shading; }
+};
+
+/** Row r's additive part of `d` into extra[0..cols): d.rowSigma[site] times the row's one draw from
+ * stream (rowKey, r), plus the dark shading. Sites of one row share the draw, as a real row offset does. */
+void darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, int r, int cols,
+                  float* extra);
+//! Throws StsBadArg naming `who` when the model has dark shading of another size than the mosaic.
+void checkDarkShadingSize(const NoiseModel& model, Size size, const char* who);
+
 // Rounds a float or a vector of floats in [0, 2^23] to the nearest integer, ties to even: adding and
 // subtracting 2^23 (where the float spacing is 1) leaves the rounding to IEEE's default mode, the same
 // on every vector width. Adding 0.5 and truncating would round every tie up, a bias of +1/4 DN wherever

@@ -29,6 +29,7 @@ struct JitterConstants
     // ACCOUNT_PRIOR without brightness: the prior's share p_u = p_c / p_g is one number per CFA site, so
     // Eq. 13 is a line in the mean per site, its slope and offset computed once (perSiteLine()).
     bool lineBySite;
+    detail::DarkTerms dark; // the model's dark-frame components this jitter adds
 };
 
 // The column arrays of one row (the CFA site alternates along it): contrast, black level and, for
@@ -114,7 +115,7 @@ template <int W> struct PixelLanes<W, float>
 };
 
 template <int W, typename T, NoiseAlignment A, bool kLocalMean, bool kLineBySite>
-RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* prior,
+RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* prior, const float* extra,
                                  const JitterColumns& col, int c, const JitterConstants& k,
                                  typename detail::Lanes<W>::I& bright)
 {
@@ -142,17 +143,22 @@ RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* 
         bright -= total < 0; // -1 per brightening lane
         out += detail::sqrtLanes(detail::maxLanes(total, F{})) * zv;
     }
+    if (extra) { // the dark-frame components (row offset, dark shading), when the model has them
+        F e;
+        std::memcpy(&e, extra + c, sizeof(e));
+        out += e;
+    }
     P::store(d + c, out + blackv, F{} + k.white);
 }
 
 template <int W, typename T, NoiseAlignment A, bool kLocalMean, bool kLineBySite>
-RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float* prior,
+RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float* prior, const float* extra,
                                   const JitterColumns& col, const JitterConstants& k, int cols)
 {
     typename detail::Lanes<W>::I bright = {};
     int c = 0;
     for (; c + W <= cols; c += W)
-        jitterBlock<W, T, A, kLocalMean, kLineBySite>(s, d, z, prior, col, c, k, bright);
+        jitterBlock<W, T, A, kLocalMean, kLineBySite>(s, d, z, prior, extra, col, c, k, bright);
     int total = 0;
     for (int i = 0; i < W; ++i)
         total += bright[i];
@@ -160,12 +166,13 @@ RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float*
     if (rest > 0) {
         // Padded copies: the extra lanes compute on zeros and are neither stored nor counted.
         T sPad[W] = {}, dPad[W];
-        float zPad[W] = {}, priorPad[W] = {}, pcPad[W] = {}, blackPad[W] = {}, slopePad[W] = {},
-              offsetPad[W] = {};
+        float zPad[W] = {}, priorPad[W] = {}, extraPad[W] = {}, pcPad[W] = {}, blackPad[W] = {},
+              slopePad[W] = {}, offsetPad[W] = {};
         for (int i = 0; i < rest; ++i) {
             sPad[i] = s[c + i];
             zPad[i] = z ? z[c + i] : 0.0f;
             priorPad[i] = kLocalMean ? prior[c + i] : 0.0f;
+            extraPad[i] = extra ? extra[c + i] : 0.0f;
             pcPad[i] = col.pc[c + i];
             blackPad[i] = col.black[c + i];
             slopePad[i] = kLineBySite ? col.slope[c + i] : 0.0f;
@@ -173,7 +180,8 @@ RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float*
         }
         const JitterColumns padded = {pcPad, blackPad, slopePad, offsetPad};
         typename detail::Lanes<W>::I tail = {};
-        jitterBlock<W, T, A, kLocalMean, kLineBySite>(sPad, dPad, zPad, priorPad, padded, 0, k, tail);
+        jitterBlock<W, T, A, kLocalMean, kLineBySite>(sPad, dPad, zPad, priorPad, extra ? extraPad : nullptr,
+                                                      padded, 0, k, tail);
         for (int i = 0; i < rest; ++i) {
             d[c + i] = dPad[i];
             total += tail[i];
@@ -184,72 +192,90 @@ RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float*
 
 template <int W, typename T, bool kLocalMean>
 RAWGMENT_KERNEL int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* prior,
-                                          const JitterColumns& col, const JitterConstants& k, int cols)
+                                          const float* extra, const JitterColumns& col,
+                                          const JitterConstants& k, int cols)
 {
     switch (k.alignment) {
     case NoiseAlignment::ACCOUNT_PRIOR:
         if (k.lineBySite)
-            return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, true>(s, d, z, prior, col,
-                                                                                        k, cols);
-        return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, false>(s, d, z, prior, col, k,
-                                                                                     cols);
+            return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, true>(s, d, z, prior, extra,
+                                                                                        col, k, cols);
+        return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, false>(s, d, z, prior, extra,
+                                                                                     col, k, cols);
     case NoiseAlignment::IGNORE_PRIOR:
-        return jitterRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, kLocalMean, false>(s, d, z, prior, col, k,
-                                                                                    cols);
+        return jitterRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, kLocalMean, false>(s, d, z, prior, extra,
+                                                                                    col, k, cols);
     default:
-        return jitterRowBody<W, T, NoiseAlignment::NONE, kLocalMean, false>(s, d, z, prior, col, k, cols);
+        return jitterRowBody<W, T, NoiseAlignment::NONE, kLocalMean, false>(s, d, z, prior, extra, col, k,
+                                                                            cols);
     }
 }
 
 template <int W>
 RAWGMENT_KERNEL int jitterRowKernel(const ushort* s, ushort* d, const float* z, const float* prior,
-                                    const JitterColumns& col, const JitterConstants& k, int cols)
+                                    const float* extra, const JitterColumns& col, const JitterConstants& k,
+                                    int cols)
 {
-    return prior ? jitterRowAnyAlignment<W, ushort, true>(s, d, z, prior, col, k, cols)
-                 : jitterRowAnyAlignment<W, ushort, false>(s, d, z, prior, col, k, cols);
+    return prior ? jitterRowAnyAlignment<W, ushort, true>(s, d, z, prior, extra, col, k, cols)
+                 : jitterRowAnyAlignment<W, ushort, false>(s, d, z, prior, extra, col, k, cols);
 }
 
 template <int W>
 RAWGMENT_KERNEL int jitterRowKernel(const float* s, float* d, const float* z, const float* prior,
-                                    const JitterColumns& col, const JitterConstants& k, int cols)
+                                    const float* extra, const JitterColumns& col, const JitterConstants& k,
+                                    int cols)
 {
-    return prior ? jitterRowAnyAlignment<W, float, true>(s, d, z, prior, col, k, cols)
-                 : jitterRowAnyAlignment<W, float, false>(s, d, z, prior, col, k, cols);
+    return prior ? jitterRowAnyAlignment<W, float, true>(s, d, z, prior, extra, col, k, cols)
+                 : jitterRowAnyAlignment<W, float, false>(s, d, z, prior, extra, col, k, cols);
 }
 
 // One dispatched entry point per pixel type (cpu_dispatch.hpp).
 RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
                              (const ushort* s, ushort* d, const float* z, const float* prior,
-                              const JitterColumns& col, const JitterConstants& k, int cols),
-                             (s, d, z, prior, col, k, cols))
+                              const float* extra, const JitterColumns& col, const JitterConstants& k,
+                              int cols),
+                             (s, d, z, prior, extra, col, k, cols))
 RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
                              (const float* s, float* d, const float* z, const float* prior,
-                              const JitterColumns& col, const JitterConstants& k, int cols),
-                             (s, d, z, prior, col, k, cols))
+                              const float* extra, const JitterColumns& col, const JitterConstants& k,
+                              int cols),
+                             (s, d, z, prior, extra, col, k, cols))
 
+// The scalar rows: ShotNoiseSampling::POISSON (a rejection loop per pixel) or Tukey-lambda read noise
+// (NoiseModel::tukeyRead: t holds the row's unit-variance heavy-tailed draws), with the dark terms'
+// `extra` when present. The same code on every CpuPath.
 template <typename T, NoiseAlignment A>
-int jitterRowPoissonBody(const T* s, T* d, const float* z, const float* prior, const float* pc,
-                         const float* black, const JitterConstants& k, detail::CounterRng& rng, int cols)
+int jitterRowScalarBody(const T* s, T* d, const float* z, const float* t, const float* prior,
+                        const float* extra, const float* pc, const float* black, const JitterConstants& k,
+                        detail::CounterRng& rng, int cols)
 {
     const float q = k.pg * k.in.shot; // DN per electron at the output gain: g alpha p_g
+    const bool poisson = k.sampling == ShotNoiseSampling::POISSON;
     int bright = 0;
     for (int c = 0; c < cols; ++c) {
         const float x = static_cast<float>(s[c]) - black[c];
         const AddedVariance v = jitterVariance<A>(prior ? prior[c] : x, pc[c], k);
         bright += v.shot + v.rest < 0 ? 1 : 0;
-        d[c] = storeValue<T>(pc[c] * x + k.pb + sampledNoise(v, q, z[c], rng) + black[c], k.white);
+        const float noise =
+            t ? detail::sampledNoiseWithTails(v, q, poisson, z[c], t[c], rng) : sampledNoise(v, q, z[c], rng);
+        float out = pc[c] * x + k.pb + noise;
+        if (extra)
+            out += extra[c];
+        d[c] = storeValue<T>(out + black[c], k.white);
     }
     return bright;
 }
 
 template <typename T>
-int jitterRowPoisson(const T* s, T* d, const float* z, const float* prior, const float* pc,
-                     const float* black, const JitterConstants& k, detail::CounterRng& rng, int cols)
+int jitterRowScalar(const T* s, T* d, const float* z, const float* t, const float* prior, const float* extra,
+                    const float* pc, const float* black, const JitterConstants& k, detail::CounterRng& rng,
+                    int cols)
 {
     if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR)
-        return jitterRowPoissonBody<T, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, prior, pc, black, k, rng,
-                                                                      cols);
-    return jitterRowPoissonBody<T, NoiseAlignment::IGNORE_PRIOR>(s, d, z, prior, pc, black, k, rng, cols);
+        return jitterRowScalarBody<T, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, t, prior, extra, pc, black, k,
+                                                                     rng, cols);
+    return jitterRowScalarBody<T, NoiseAlignment::IGNORE_PRIOR>(s, d, z, t, prior, extra, pc, black, k, rng,
+                                                                cols);
 }
 
 // The column arrays of even rows (sites 0, 1) and odd rows (sites 2, 3), made once per call: a
@@ -282,29 +308,89 @@ private:
     std::vector<float> pc_, black_, slope_, offset_;
 };
 
+// The keys of a jitter's random streams (random.hpp): Gaussian, Poisson, row offset, Tukey uniforms.
+struct JitterKeys
+{
+    uint64_t gaussian, poisson, row, tukey;
+};
+
 template <typename T>
-void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstants& k,
-                const JitterColumnTables& tables, uint64_t seed, uint64_t poissonSeed, const Range& rows,
+void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& model, const JitterConstants& k,
+                const JitterColumnTables& tables, const JitterKeys& keys, const Range& rows,
                 std::atomic<int64>& brightening)
 {
     const int cols = src.cols;
-    std::vector<float> z(static_cast<size_t>(cols));
-    const bool poisson = k.sampling == ShotNoiseSampling::POISSON && k.alignment != NoiseAlignment::NONE;
+    const bool noise = k.alignment != NoiseAlignment::NONE;
+    const bool tails = noise && k.dark.tails, dark = noise && k.dark.any();
+    std::vector<float> z(static_cast<size_t>(cols)), t(tails ? cols : 0), extra(dark ? cols : 0);
+    const bool scalar = noise && (k.sampling == ShotNoiseSampling::POISSON || tails);
+    const detail::TukeyUnitSampler samplers[4] = {
+        detail::TukeyUnitSampler(k.dark.lambda[0]), detail::TukeyUnitSampler(k.dark.lambda[1]),
+        detail::TukeyUnitSampler(k.dark.lambda[2]), detail::TukeyUnitSampler(k.dark.lambda[3])};
     int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
-        if (k.alignment != NoiseAlignment::NONE)
-            detail::fillGaussian(seed, static_cast<uint64_t>(r), z.data(), cols);
+        if (noise)
+            detail::fillGaussian(keys.gaussian, static_cast<uint64_t>(r), z.data(), cols);
+        if (tails) {
+            detail::CounterRng uniforms(keys.tukey, static_cast<uint64_t>(r));
+            const detail::TukeyUnitSampler* rowSamplers = samplers + 2 * (r & 1);
+            for (int c = 0; c < cols; ++c)
+                t[static_cast<size_t>(c)] = static_cast<float>(rowSamplers[c & 1](uniforms.uniform()));
+        }
+        if (dark)
+            detail::darkRowExtra(k.dark, model, keys.row, r, cols, extra.data());
         const JitterColumns col = tables.forRow(r);
         const float* priorRow = prior.empty() ? nullptr : prior.ptr<float>(r);
-        if (poisson) {
-            detail::CounterRng rng(poissonSeed, static_cast<uint64_t>(r));
-            localBright += jitterRowPoisson(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, col.pc,
-                                            col.black, k, rng, cols);
+        const float* extraRow = dark ? extra.data() : nullptr;
+        if (scalar) {
+            detail::CounterRng rng(keys.poisson, static_cast<uint64_t>(r));
+            localBright += jitterRowScalar(src.ptr<T>(r), dst.ptr<T>(r), z.data(), tails ? t.data() : nullptr,
+                                           priorRow, extraRow, col.pc, col.black, k, rng, cols);
         } else {
-            localBright += jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, col, k, cols);
+            localBright +=
+                jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, extraRow, col, k, cols);
         }
     }
     brightening += localBright;
+}
+
+/* The dark-frame components a jitter adds (docs/mathematics.md, "Dark-frame noise"), per CFA site of
+ * contrast p_c at gain ratio p_g (p_u = p_c / p_g) from gain g:
+ * - row: ACCOUNT_PRIOR adds (1 - p_u^2) p_g^2 g^2 sigma_row_d^2 + (1 - p_c^2) sigma_row_r^2 (Eq. 13's
+ *   split applied to the row offset); IGNORE_PRIOR the target's whole row variance;
+ * - shading: ACCOUNT_PRIOR adds the target's g p_g B_d + B_r minus the scaled input's p_c (g B_d + B_r);
+ *   IGNORE_PRIOR the target's whole shading;
+ * - tails: the added read part's lambda (addedReadLambda(): the prior's read p_c^2 b is kept); IGNORE_PRIOR
+ *   the model's lambda. */
+detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, const ColorJitter& jitter,
+                                  NoiseAlignment alignment)
+{
+    detail::DarkTerms d;
+    if (alignment == NoiseAlignment::NONE)
+        return d;
+    d.row = model.hasRowNoise();
+    d.shading = model.hasDarkShading();
+    d.tails = model.tukeyRead;
+    const double pg = jitter.gainRatio, g = gain;
+    const double readIn = g * g * model.sigmaD2 + model.sigmaR2;
+    const double readOut = pg * pg * g * g * model.sigmaD2 + model.sigmaR2;
+    const bool account = alignment == NoiseAlignment::ACCOUNT_PRIOR;
+    for (int s = 0; s < 4; ++s) {
+        const double pc = jitter.contrast[s], pu = pc / pg;
+        const double rowAdded =
+            account ? (1 - pu * pu) * pg * pg * g * g * model.rowSigmaD2 + (1 - pc * pc) * model.rowSigmaR2
+                    : model.rowVariance(g * pg);
+        d.rowSigma[s] = static_cast<float>(std::sqrt(std::max(rowAdded, 0.0)));
+        d.shadingPerGain[s] = static_cast<float>(account ? g * pg - pc * g : g * pg);
+        d.shadingOffset[s] = static_cast<float>(account ? 1 - pc : 1.0);
+        if (!d.tails)
+            continue;
+        d.lambda[s] =
+            account ? detail::addedReadLambda(model.tukeyLambda, readOut, std::pow(pc, 4) * readIn * readIn,
+                                              readOut - pc * pc * readIn)
+                    : model.tukeyLambda;
+    }
+    return d;
 }
 
 // PriorMeanEstimate::LOCAL_MEAN: the black-subtracted mean of each pixel's 3x3 neighbourhood on its own
@@ -345,6 +431,8 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     format.validate();
     model.validate();
     noise.validate();
+    if (noise.alignment != NoiseAlignment::NONE)
+        detail::checkDarkShadingSize(model, src.size(), "colorJitter");
     for (int s = 0; s < 4; ++s)
         detail::checkFinitePositive(jitter.contrast[s], "colorJitter: contrast");
     if (!std::isfinite(jitter.brightness))
@@ -401,16 +489,19 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
         noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && noise.alignment != NoiseAlignment::NONE
             ? localPriorMean(src, format)
             : Mat();
+    k.dark = jitterDarkTerms(model, format.gain, jitter, noise.alignment);
     Mat dst = detail::stepOutput(src, _dst);
     std::atomic<int64> brightening{0};
-    const uint64_t key = detail::stepKey(seed, detail::RandomStream::JITTER_GAUSSIAN),
-                   poissonKey = detail::stepKey(seed, detail::RandomStream::JITTER_POISSON);
+    const JitterKeys keys = {detail::stepKey(seed, detail::RandomStream::JITTER_GAUSSIAN),
+                             detail::stepKey(seed, detail::RandomStream::JITTER_POISSON),
+                             detail::stepKey(seed, detail::RandomStream::JITTER_ROW),
+                             detail::stepKey(seed, detail::RandomStream::JITTER_TUKEY)};
     const JitterColumnTables tables(k, src.cols);
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
-            jitterRows<ushort>(src, prior, dst, k, tables, key, poissonKey, rows, brightening);
+            jitterRows<ushort>(src, prior, dst, model, k, tables, keys, rows, brightening);
         else
-            jitterRows<float>(src, prior, dst, k, tables, key, poissonKey, rows, brightening);
+            jitterRows<float>(src, prior, dst, model, k, tables, keys, rows, brightening);
     });
     detail::reportSaturation(src, format, report, saturatedMask);
     _dst.assign(dst);

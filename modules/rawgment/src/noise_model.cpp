@@ -3,6 +3,10 @@
 #include "noise_terms.hpp"
 #include "precomp.hpp"
 
+#include <opencv2/imgcodecs.hpp>
+
+#include <cinttypes>
+
 namespace cv {
 namespace rawgment {
 
@@ -21,6 +25,51 @@ template <typename T> void varianceOfMeans(const Mat& mean, Mat& dst, const Nois
                 d[c] = detail::lineVariance(a, b, m[c]);
         }
     });
+}
+
+// FNV-1a over the rows of a continuous or not CV_32FC1 map: the check that a model file and its
+// dark-shading images belong together.
+std::string mapChecksum(const Mat& map)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (int r = 0; r < map.rows; ++r) {
+        const uchar* p = map.ptr<uchar>(r);
+        for (size_t i = 0; i < map.cols * map.elemSize(); ++i) {
+            h ^= p[i];
+            h *= 0x100000001b3ull;
+        }
+    }
+    return format("%016" PRIx64, h);
+}
+
+String folderOf(const String& path)
+{
+    const size_t slash = path.find_last_of('/');
+    return slash == String::npos ? String() : path.substr(0, slash + 1);
+}
+
+String baseNameOf(const String& path)
+{
+    const size_t slash = path.find_last_of('/');
+    return slash == String::npos ? path : path.substr(slash + 1);
+}
+
+String withoutExtension(const String& path)
+{
+    const size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
+    return dot == String::npos || (slash != String::npos && dot < slash) ? path : path.substr(0, dot);
+}
+
+const char* const kShadingKeys[2] = {"per_gain", "offset"};
+
+void checkShadingMap(const Mat& map, const char* what, Size size)
+{
+    if (map.type() != CV_32FC1 || map.size() != size)
+        CV_Error(Error::StsBadArg,
+                 format("NoiseModel.%s must be CV_32FC1 of %dx%d like darkShadingPerGain (got %s, %dx%d)",
+                        what, size.width, size.height, typeToString(map.type()).c_str(), map.cols, map.rows));
+    if (!checkRange(map, true))
+        CV_Error(Error::StsBadArg, format("NoiseModel.%s contains NaN or Inf", what));
 }
 
 } // namespace
@@ -54,6 +103,35 @@ void NoiseModel::validate() const
     detail::checkFiniteNonNegative(sigmaD2, "NoiseModel.sigmaD2");
     detail::checkFiniteNonNegative(sigmaR2, "NoiseModel.sigmaR2");
     detail::checkFiniteNonNegative(baseIso, "NoiseModel.baseIso");
+    detail::checkFiniteNonNegative(rowSigmaD2, "NoiseModel.rowSigmaD2");
+    detail::checkFiniteNonNegative(rowSigmaR2, "NoiseModel.rowSigmaR2");
+    if (tukeyRead && !(tukeyLambda >= detail::kTukeyLambdaMin && tukeyLambda <= 1))
+        CV_Error(Error::StsBadArg, format("NoiseModel.tukeyLambda must lie in [%g, 1] (got %g): below, the "
+                                          "kurtosis of the read noise is beyond any sensor's",
+                                          detail::kTukeyLambdaMin, tukeyLambda));
+    if (darkShadingPerGain.empty() != darkShadingOffset.empty())
+        CV_Error(Error::StsBadArg, "NoiseModel: darkShadingPerGain and darkShadingOffset must be both set or "
+                                   "both empty");
+    if (hasDarkShading()) {
+        checkShadingMap(darkShadingPerGain, "darkShadingPerGain", darkShadingPerGain.size());
+        checkShadingMap(darkShadingOffset, "darkShadingOffset", darkShadingPerGain.size());
+    }
+}
+
+double NoiseModel::rowVariance(double gain) const
+{
+    detail::checkFinitePositive(gain, "gain");
+    return gain * gain * rowSigmaD2 + rowSigmaR2;
+}
+
+Mat NoiseModel::darkShadingAt(double gain) const
+{
+    detail::checkFinitePositive(gain, "gain");
+    if (!hasDarkShading())
+        return Mat();
+    Mat s;
+    addWeighted(darkShadingPerGain, gain, darkShadingOffset, 1.0, 0.0, s, CV_32F);
+    return s;
 }
 
 namespace detail {
@@ -107,20 +185,88 @@ void NoiseModel::variance(InputArray _mean, double gain, OutputArray _dst) const
     _dst.assign(dst);
 }
 
-void NoiseModel::write(FileStorage& fs, const String& name) const
+void NoiseModel::write(FileStorage& fs, const String& name, const std::vector<String>& shadingImages) const
 {
     validate();
+    if (hasDarkShading() && shadingImages.size() != 2)
+        CV_Error(Error::StsBadArg, "NoiseModel::write: a model with dark shading needs the names of its two "
+                                   "images (save() writes them)");
+    const int version = hasDarkComponents() ? 3 : baseIso > 0 ? 2 : 1;
     fs << name << "{";
-    fs << "format_version" << (baseIso > 0 ? 2 : 1);
+    fs << "format_version" << version;
     fs << "alpha" << alpha;
     fs << "sigma_d2" << sigmaD2;
     fs << "sigma_r2" << sigmaR2;
     if (baseIso > 0)
         fs << "base_iso" << baseIso;
+    if (hasRowNoise())
+        fs << "row_sigma_d2" << rowSigmaD2 << "row_sigma_r2" << rowSigmaR2;
+    if (tukeyRead)
+        fs << "tukey_lambda" << tukeyLambda;
+    if (hasDarkShading()) {
+        const Mat* maps[2] = {&darkShadingPerGain, &darkShadingOffset};
+        fs << "dark_shading"
+           << "{";
+        fs << "width" << darkShadingPerGain.cols << "height" << darkShadingPerGain.rows;
+        for (int i = 0; i < 2; ++i)
+            fs << kShadingKeys[i] << "{"
+               << "image" << shadingImages[static_cast<size_t>(i)] << "fnv1a64" << mapChecksum(*maps[i])
+               << "}";
+        fs << "}";
+    }
     fs << "}";
 }
 
-NoiseModel NoiseModel::read(const FileNode& node)
+namespace {
+
+double readNonNegative(const FileNode& node, const char* field)
+{
+    double v = 0;
+    try {
+        v = detail::readRealField(node, field);
+    } catch (const Exception& e) {
+        CV_Error(Error::StsParseError, "noise model: " + e.err);
+    }
+    if (!std::isfinite(v) || v < 0)
+        CV_Error(Error::StsParseError,
+                 format("noise model: field '%s' must be finite and >= 0 (got %g)", field, v));
+    return v;
+}
+
+Mat readShadingImage(const FileNode& entry, const char* key, const String& folder, Size size)
+{
+    const FileNode n = entry[key];
+    if (n.empty() || !n.isMap())
+        CV_Error(Error::StsParseError, format("noise model: dark_shading.%s must be a map with image and "
+                                              "fnv1a64",
+                                              key));
+    rejectUnknownKeys(n, {"image", "fnv1a64"});
+    if (!n["image"].isString() || !n["fnv1a64"].isString())
+        CV_Error(Error::StsParseError,
+                 format("noise model: dark_shading.%s.image and .fnv1a64 must be strings", key));
+    const String name = n["image"].string(), checksum = n["fnv1a64"].string();
+    const String path = name.empty() || name[0] == '/' ? name : folder + name;
+    if (!detail::fileExists(path))
+        CV_Error(Error::StsError, format("noise model: dark-shading image '%s' is missing", path.c_str()));
+    const Mat map = imread(path, IMREAD_UNCHANGED);
+    if (map.type() != CV_32FC1 || map.size() != size)
+        CV_Error(
+            Error::StsParseError,
+            format("noise model: dark-shading image '%s' must be a CV_32FC1 TIFF of %dx%d (got %s, %dx%d)",
+                   path.c_str(), size.width, size.height, typeToString(map.type()).c_str(), map.cols,
+                   map.rows));
+    if (mapChecksum(map) != checksum)
+        CV_Error(
+            Error::StsParseError,
+            format("noise model: dark-shading image '%s' does not match the model file (checksum %s, the "
+                   "file says %s): the image and the model come from different saves",
+                   path.c_str(), mapChecksum(map).c_str(), checksum.c_str()));
+    return map;
+}
+
+} // namespace
+
+NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
 {
     if (node.empty() || !node.isMap())
         CV_Error(Error::StsParseError,
@@ -135,26 +281,19 @@ NoiseModel NoiseModel::read(const FileNode& node)
                         "(a newer cv::rawgment wrote the file)",
                         version, FORMAT_VERSION));
     try {
-        if (version == 1)
-            rejectUnknownKeys(node, {"format_version", "alpha", "sigma_d2", "sigma_r2"});
-        else
-            rejectUnknownKeys(node, {"format_version", "alpha", "sigma_d2", "sigma_r2", "base_iso"});
+        std::vector<String> keys = {"format_version", "alpha", "sigma_d2", "sigma_r2"};
+        if (version >= 2)
+            keys.push_back("base_iso");
+        if (version >= 3)
+            keys.insert(keys.end(), {"row_sigma_d2", "row_sigma_r2", "tukey_lambda", "dark_shading"});
+        rejectUnknownKeys(node, keys);
     } catch (const Exception& e) {
         CV_Error(e.code, "noise model: " + e.err);
     }
     NoiseModel m;
-    double* const targets[] = {&m.alpha, &m.sigmaD2, &m.sigmaR2};
-    const char* const fields[] = {"alpha", "sigma_d2", "sigma_r2"};
-    for (int i = 0; i < 3; ++i) {
-        try {
-            *targets[i] = detail::readRealField(node, fields[i]);
-        } catch (const Exception& e) {
-            CV_Error(Error::StsParseError, "noise model: " + e.err);
-        }
-        if (!std::isfinite(*targets[i]) || *targets[i] < 0)
-            CV_Error(Error::StsParseError, format("noise model: field '%s' must be finite and >= 0 (got %g)",
-                                                  fields[i], *targets[i]));
-    }
+    m.alpha = readNonNegative(node, "alpha");
+    m.sigmaD2 = readNonNegative(node, "sigma_d2");
+    m.sigmaR2 = readNonNegative(node, "sigma_r2");
     if (!node["base_iso"].empty()) {
         try {
             m.baseIso = detail::readRealField(node, "base_iso");
@@ -165,20 +304,164 @@ NoiseModel NoiseModel::read(const FileNode& node)
             CV_Error(Error::StsParseError,
                      format("noise model: field 'base_iso' must be finite and > 0 (got %g)", m.baseIso));
     }
+    if (node["row_sigma_d2"].empty() != node["row_sigma_r2"].empty())
+        CV_Error(Error::StsParseError, "noise model: row_sigma_d2 and row_sigma_r2 come together");
+    if (!node["row_sigma_d2"].empty()) {
+        m.rowSigmaD2 = readNonNegative(node, "row_sigma_d2");
+        m.rowSigmaR2 = readNonNegative(node, "row_sigma_r2");
+    }
+    if (!node["tukey_lambda"].empty()) {
+        try {
+            m.tukeyLambda = detail::readRealField(node, "tukey_lambda");
+        } catch (const Exception& e) {
+            CV_Error(Error::StsParseError, "noise model: " + e.err);
+        }
+        m.tukeyRead = true;
+        if (!(m.tukeyLambda >= detail::kTukeyLambdaMin && m.tukeyLambda <= 1))
+            CV_Error(Error::StsParseError,
+                     format("noise model: field 'tukey_lambda' must lie in [%g, 1] (got %g)",
+                            detail::kTukeyLambdaMin, m.tukeyLambda));
+    }
+    const FileNode shading = node["dark_shading"];
+    if (!shading.empty()) {
+        if (!shading.isMap())
+            CV_Error(Error::StsParseError, "noise model: dark_shading must be a map");
+        try {
+            rejectUnknownKeys(shading, {"width", "height", kShadingKeys[0], kShadingKeys[1]});
+        } catch (const Exception& e) {
+            CV_Error(e.code, "noise model: dark_shading: " + e.err);
+        }
+        const int width = detail::readOptionalIntField(shading, "width", 0),
+                  height = detail::readOptionalIntField(shading, "height", 0);
+        if (width <= 0 || height <= 0)
+            CV_Error(Error::StsParseError, "noise model: dark_shading.width and .height must be > 0");
+        m.darkShadingPerGain = readShadingImage(shading, kShadingKeys[0], folder, Size(width, height));
+        m.darkShadingOffset = readShadingImage(shading, kShadingKeys[1], folder, Size(width, height));
+    }
+    try {
+        m.validate();
+    } catch (const Exception& e) {
+        CV_Error(Error::StsParseError, "noise model: " + e.err);
+    }
     return m;
 }
 
 void NoiseModel::save(const String& path) const
 {
     validate();
-    detail::writeFileStorageAtomically(path, [&](FileStorage& fs) { write(fs, kTopLevelName); });
+    std::vector<String> images;
+    if (hasDarkShading()) {
+        const Mat* maps[2] = {&darkShadingPerGain, &darkShadingOffset};
+        for (int i = 0; i < 2; ++i) {
+            const String image = withoutExtension(path) + ".dark_shading_" + kShadingKeys[i] + ".tiff";
+            std::vector<uchar> bytes;
+            if (!imencode(".tiff", *maps[i], bytes, {IMWRITE_TIFF_COMPRESSION, 1}) || bytes.empty())
+                CV_Error(Error::StsError, "NoiseModel::save: cannot encode the dark-shading image " + image);
+            writeFileAtomically(image, bytes.data(), bytes.size(), true);
+            images.push_back(baseNameOf(image));
+        }
+    }
+    detail::writeFileStorageAtomically(path, [&](FileStorage& fs) { write(fs, kTopLevelName, images); });
 }
 
 NoiseModel NoiseModel::load(const String& path)
 {
     return detail::loadFileStorage(path, kTopLevelName, "noise model file",
-                                   [](const FileNode& n) { return read(n); });
+                                   [&](const FileNode& n) { return read(n, folderOf(path)); });
 }
+
+namespace detail {
+
+namespace {
+
+// log B(a, b) for a, b > 0.
+double logBeta(double a, double b)
+{
+    return std::lgamma(a) + std::lgamma(b) - std::lgamma(a + b);
+}
+
+// Below this |lambda| the Beta-function moments lose digits to cancellation (E[X^4] is 1/lambda^4 times a
+// difference of order lambda^4: 6e-10 relative at 0.02); there the moments are integrated instead.
+constexpr double kClosedFormLambda = 0.02;
+
+// E[X^2] and E[X^4] of the unit-scale Tukey-lambda variable.
+void tukeyMoments(double l, double& m2, double& m4)
+{
+    if (std::abs(l) >= kClosedFormLambda) {
+        m2 = (2 / (2 * l + 1) - 2 * std::exp(logBeta(l + 1, l + 1))) / (l * l);
+        m4 = (2 / (4 * l + 1) - 8 * std::exp(logBeta(3 * l + 1, l + 1)) +
+              6 * std::exp(logBeta(2 * l + 1, 2 * l + 1))) /
+             (l * l * l * l);
+        return;
+    }
+    // u = 1 / (1 + e^s) over the real line: du = u (1 - u) ds, the integrand is analytic and decays at
+    // least as e^{-0.92 |s|}, so the trapezoid rule converges geometrically (step 0.05 over |s| <= 60:
+    // below 1e-13 relative, checked against the closed form at |lambda| = 0.02).
+    const double h = 0.05;
+    m2 = m4 = 0;
+    for (int i = -1200; i <= 1200; ++i) {
+        const double sv = i * h;
+        const double logU = -(sv > 0 ? sv + std::log1p(std::exp(-sv)) : std::log1p(std::exp(sv)));
+        const double log1mU = logU + sv; // log(1 - u) = log(u) + s
+        const double q = l == 0 ? logU - log1mU : (std::expm1(l * logU) - std::expm1(l * log1mU)) / l;
+        const double w = std::exp(logU + log1mU);
+        m2 += q * q * w;
+        m4 += q * q * q * q * w;
+    }
+    m2 *= h;
+    m4 *= h;
+}
+
+} // namespace
+
+double tukeyLambdaVariance(double lambda)
+{
+    CV_Assert(lambda > -0.5);
+    double m2, m4;
+    tukeyMoments(lambda, m2, m4);
+    return m2;
+}
+
+double tukeyLambdaExcessKurtosis(double lambda)
+{
+    CV_Assert(lambda > -0.25);
+    double m2, m4;
+    tukeyMoments(lambda, m2, m4);
+    return m4 / (m2 * m2) - 3;
+}
+
+double tukeyLambdaOfExcessKurtosis(double kurtosis)
+{
+    double lo = kTukeyLambdaMin, hi = 1; // kurtosis(lo) > kurtosis(hi)
+    if (!(kurtosis < tukeyLambdaExcessKurtosis(lo)))
+        return lo;
+    if (!(kurtosis > tukeyLambdaExcessKurtosis(hi)))
+        return hi;
+    for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (tukeyLambdaExcessKurtosis(mid) > kurtosis ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+double tukeyLambdaQuantile(double u, double lambda)
+{
+    const double a = std::log(u), b = std::log1p(-u);
+    if (lambda == 0)
+        return a - b;
+    return (std::expm1(lambda * a) - std::expm1(lambda * b)) / lambda;
+}
+
+double addedReadLambda(double lambda, double targetRead, double priorFourthMoment, double added)
+{
+    if (!(added > 0))
+        return lambda;
+    const double kappa = tukeyLambdaExcessKurtosis(lambda);
+    return tukeyLambdaOfExcessKurtosis(kappa * (targetRead * targetRead - priorFourthMoment) /
+                                       (added * added));
+}
+
+} // namespace detail
 
 } // namespace rawgment
 } // namespace cv

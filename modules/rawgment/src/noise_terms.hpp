@@ -46,6 +46,45 @@ template <typename T> inline NoiseTerms<T> noiseTermsAt(T gain, T alpha, T sigma
  * built from it. */
 NoiseTerms<double> checkedNoiseTerms(const NoiseModel& model, double gain);
 
+/** @name The Tukey-lambda shape of the read noise (NoiseModel::tukeyRead)
+ * X = (U^lambda - (1 - U)^lambda) / lambda for U uniform in (0, 1); lambda = 0 is the logistic
+ * log(U / (1 - U)). Moments from the Beta function (docs/mathematics.md, "Dark-frame noise").
+ * Exported for the tests, which check them against SciPy; not installed. */
+//! @{
+//! The variance of X (finite for lambda > -1/2).
+CV_RAWGMENT_EXPORTS double tukeyLambdaVariance(double lambda);
+//! The excess kurtosis of X (finite for lambda > -1/4): 0 near lambda = 0.1349, 1.2 at 0, -1.2 at 1.
+CV_RAWGMENT_EXPORTS double tukeyLambdaExcessKurtosis(double lambda);
+/** The lambda in [kTukeyLambdaMin, 1] whose excess kurtosis is `kurtosis`, clamped to the kurtosis range
+ * of that interval (bisection: the kurtosis falls monotonically as lambda grows there). */
+CV_RAWGMENT_EXPORTS double tukeyLambdaOfExcessKurtosis(double kurtosis);
+//! The quantile X(u) (expm1 keeps it exact for lambda near 0).
+CV_RAWGMENT_EXPORTS double tukeyLambdaQuantile(double u, double lambda);
+//! The smallest lambda the library draws or accounts for: excess kurtosis 95, far past any sensor's.
+constexpr double kTukeyLambdaMin = -0.2;
+
+/** Unit-variance Tukey-lambda draws: quantile(u) / sd(lambda). */
+struct TukeyUnitSampler
+{
+    double lambda = 0, invSd = 1;
+    explicit TukeyUnitSampler(double lambda_ = 0)
+        : lambda(lambda_), invSd(1 / std::sqrt(tukeyLambdaVariance(lambda_)))
+    {
+    }
+    double operator()(double u) const { return invSd * tukeyLambdaQuantile(u, lambda); }
+};
+
+/** The shape of the read noise an augmentation adds so that, added to the prior's (Tukey, lambda),
+ * the result has the target's excess kurtosis: fourth cumulants add for independent parts, so the
+ * added part needs kappa (b_t^2 - K_prior) / added^2, where b_t is the target's read variance, K_prior
+ * the prior's sum over its weighted copies of w^4 b^2 (a scaled prior: p^4 b_in^2; a blur: sum w^4 b^2)
+ * and `added` = b_t - (the prior's read variance). Two shapes summed are not a Tukey-lambda shape:
+ * this matches variance and kurtosis only (docs/mathematics.md measures the error). Returns `lambda`
+ * itself when nothing is added. */
+CV_RAWGMENT_EXPORTS double addedReadLambda(double lambda, double targetRead, double priorFourthMoment,
+                                           double added);
+//! @}
+
 /** The smallest variance a sample's expectation is taken to have when it is weighted or standardised:
  * zero to double precision next to the largest variance the line or model predicts over the samples
  * (1e-15 of it, and > 0). It only keeps a prediction of 0 from dividing by 0. A larger floor would be

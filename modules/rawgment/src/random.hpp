@@ -250,6 +250,14 @@ enum class RandomStream : uint64_t
     JITTER_POISSON = 5,
     BLUR_POISSON = 6,
     SCALE_POISSON = 8,
+    // The dark-frame components (NoiseModel): a row offset per mosaic row (stream: the row) and the
+    // uniforms of Tukey-lambda read noise (stream: as the step's Gaussian stream).
+    JITTER_ROW = 9,
+    JITTER_TUKEY = 10,
+    BLUR_ROW = 11,
+    BLUR_TUKEY = 12,
+    SCALE_ROW = 13,
+    SCALE_TUKEY = 14,
 };
 
 /** The key of one family under a user's seed: the SplitMix64 finaliser of seed + golden * (id + 1),

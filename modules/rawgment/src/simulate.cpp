@@ -140,6 +140,17 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
     const double alpha = unit.shot, sigmaD = std::sqrt(unit.readBeforeGain),
                  sigmaR = std::sqrt(unit.readAfterGain);
     const double noisySigma = std::sqrt(p.noisyPixelVariance);
+    // The dark-frame components (NoiseModel), each drawn only when the model has it: one row offset per
+    // (frame, row), the read noise as one Tukey-lambda draw of the same variance, the dark shading.
+    const double rowSigma = std::sqrt(p.noise.rowVariance(gain));
+    const bool tukey = p.noise.tukeyRead;
+    const detail::TukeyUnitSampler tukeyDraw(tukey ? p.noise.tukeyLambda : 0.0);
+    const double readSigma = std::sqrt(gain * gain * unit.readBeforeGain + unit.readAfterGain);
+    const Mat shading = p.noise.darkShadingAt(gain);
+    if (!shading.empty() && shading.size() != size_)
+        CV_Error(Error::StsBadArg,
+                 format("SensorSimulator::capture: the model's dark shading is %dx%d, the sensor %dx%d",
+                        shading.cols, shading.rows, size_.width, size_.height));
     const double hotLevel = std::round(0.9 * white);
     Mat raw(size_, p.quantize ? CV_16UC1 : CV_32FC1);
     parallel_for_(Range(0, size_.height), [&](const Range& rows) {
@@ -149,6 +160,8 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
             const float* prnu = prnu_.ptr<float>(r);
             const float* dsnu = dsnu_.ptr<float>(r);
             const uchar* defect = defects_.ptr<uchar>(r);
+            const double rowOffset = p.noise.hasRowNoise() ? rowSigma * rng.gaussian() : 0.0;
+            const float* shade = shading.empty() ? nullptr : shading.ptr<float>(r);
             for (int c = 0; c < size_.width; ++c) {
                 const double black = p.blackLevel[cfaSite(r, c)];
                 double x;
@@ -161,8 +174,13 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
                     // alpha = 0 is a sensor without shot noise: the signal is then deterministic.
                     const double photoSignal =
                         alpha > 0 ? alpha * static_cast<double>(rng.poisson(signal / alpha)) : signal;
-                    x = gain * (photoSignal + sigmaD * rng.gaussian()) + sigmaR * rng.gaussian() + dsnu[c] +
-                        black;
+                    x = tukey ? gain * photoSignal + readSigma * tukeyDraw(rng.uniform())
+                              : gain * (photoSignal + sigmaD * rng.gaussian()) + sigmaR * rng.gaussian();
+                    x = x + dsnu[c] + black;
+                    if (p.noise.hasRowNoise())
+                        x += rowOffset;
+                    if (shade)
+                        x += shade[c];
                     if (defect[c] == DEFECT_NOISY)
                         x += noisySigma * rng.gaussian();
                 }

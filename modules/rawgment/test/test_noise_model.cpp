@@ -1,6 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "test_common.hpp"
 
+#include "../src/noise_terms.hpp"
+
 #include <opencv2/rawgment/noise_model.hpp>
 
 #include <filesystem>
@@ -158,8 +160,8 @@ TEST(NoiseModel, readingRejectsBadFilesNamingTheField)
     EXPECT_CV_ERROR_CONTAINS(
         readFromYaml("  format_version: 1\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: abc\n"),
         "'sigma_r2' is not a number");
-    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 3\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
-                             "format_version 3 is not supported");
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 4\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
+                             "format_version 4 is not supported");
     // base_iso came with version 2: a version 1 file that has it was not written by this project.
     EXPECT_CV_ERROR_CONTAINS(
         readFromYaml("  format_version: 1\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n  base_iso: 100\n"),
@@ -226,6 +228,142 @@ TEST(NoiseModel, integersBeyond32BitsAreRefusedNotWrapped)
     writeText(dir + "/real.yml", "%YAML:1.0\nnoise_model:\n  format_version: 1\n  alpha: 4294967297.0\n"
                                  "  sigma_d2: 1\n  sigma_r2: 1\n");
     EXPECT_EQ(NoiseModel::load(dir + "/real.yml").alpha, 4294967297.0);
+}
+
+// A model with every dark-frame component, maps of a small sensor.
+NoiseModel darkComponentModel(Size size)
+{
+    NoiseModel m(0.25, 1.5, 0.8);
+    m.rowSigmaD2 = 0.04;
+    m.rowSigmaR2 = 0.3;
+    m.tukeyRead = true;
+    m.tukeyLambda = -0.05;
+    m.darkShadingPerGain.create(size, CV_32FC1);
+    m.darkShadingOffset.create(size, CV_32FC1);
+    randu(m.darkShadingPerGain, -0.5, 1.5);
+    randu(m.darkShadingOffset, -3.0, 3.0);
+    return m;
+}
+
+TEST(NoiseModel, darkComponentsRoundTripWithTheirImagesAsVersion3)
+{
+    const std::string dir = test::makeTempDir("noise_model_dark_components");
+    const NoiseModel m = darkComponentModel(Size(12, 8));
+    for (const char* name : {"/dark.yml", "/dark.json"}) {
+        m.save(dir + name);
+        const NoiseModel r = NoiseModel::load(dir + name);
+        EXPECT_EQ(m.rowSigmaD2, r.rowSigmaD2) << name;
+        EXPECT_EQ(m.rowSigmaR2, r.rowSigmaR2) << name;
+        EXPECT_TRUE(r.tukeyRead) << name;
+        EXPECT_EQ(m.tukeyLambda, r.tukeyLambda) << name;
+        EXPECT_EQ(0, norm(m.darkShadingPerGain, r.darkShadingPerGain, NORM_INF)) << name;
+        EXPECT_EQ(0, norm(m.darkShadingOffset, r.darkShadingOffset, NORM_INF)) << name;
+    }
+    FileStorage written(dir + "/dark.yml", FileStorage::READ);
+    EXPECT_EQ(3, int(written["noise_model"]["format_version"]));
+    EXPECT_EQ("dark.dark_shading_per_gain.tiff",
+              std::string(written["noise_model"]["dark_shading"]["per_gain"]["image"]));
+    written.release();
+    // Lambda 0 (logistic) is present, not absent: the flag says so.
+    NoiseModel logistic(0.25, 1.5, 0.8);
+    logistic.tukeyRead = true;
+    logistic.save(dir + "/logistic.yml");
+    const NoiseModel back = NoiseModel::load(dir + "/logistic.yml");
+    EXPECT_TRUE(back.tukeyRead);
+    EXPECT_EQ(0.0, back.tukeyLambda);
+    EXPECT_FALSE(back.hasRowNoise());
+    EXPECT_FALSE(back.hasDarkShading());
+    // Without components a model stays version 1, readable by builds that predate them.
+    NoiseModel plain(0.25, 1.5, 0.8);
+    plain.save(dir + "/plain.yml");
+    FileStorage plainFile(dir + "/plain.yml", FileStorage::READ);
+    EXPECT_EQ(1, int(plainFile["noise_model"]["format_version"]));
+}
+
+TEST(NoiseModel, darkShadingImagesOfAnotherSaveOrMissingAreErrors)
+{
+    const std::string dir = test::makeTempDir("noise_model_dark_mismatch");
+    const NoiseModel a = darkComponentModel(Size(12, 8));
+    a.save(dir + "/a.yml");
+    NoiseModel b = darkComponentModel(Size(12, 8));
+    b.darkShadingOffset += 1;
+    b.save(dir + "/b.yml");
+    // a.yml with the images of b.yml: the checksums tell them apart.
+    std::rename((dir + "/b.dark_shading_offset.tiff").c_str(), (dir + "/a.dark_shading_offset.tiff").c_str());
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/a.yml"), "different saves");
+    std::remove((dir + "/a.dark_shading_per_gain.tiff").c_str());
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/a.yml"), "is missing");
+    // write() without image names cannot describe the maps.
+    FileStorage fs(".yml", FileStorage::WRITE | FileStorage::MEMORY);
+    EXPECT_CV_ERROR_CONTAINS(a.write(fs, "noise_model"), "needs the names of its two images");
+}
+
+TEST(NoiseModel, darkComponentsAreValidated)
+{
+    NoiseModel m(0.25, 1.5, 0.8);
+    m.rowSigmaD2 = -1;
+    EXPECT_CV_ERROR_CONTAINS(m.validate(), "NoiseModel.rowSigmaD2");
+    m.rowSigmaD2 = 0;
+    m.tukeyRead = true;
+    m.tukeyLambda = -0.3;
+    EXPECT_CV_ERROR_CONTAINS(m.validate(), "NoiseModel.tukeyLambda");
+    m.tukeyLambda = 0;
+    m.darkShadingPerGain = Mat::zeros(4, 4, CV_32FC1);
+    EXPECT_CV_ERROR_CONTAINS(m.validate(), "both set or both empty");
+    m.darkShadingOffset = Mat::zeros(4, 6, CV_32FC1);
+    EXPECT_CV_ERROR_CONTAINS(m.validate(), "CV_32FC1 of 4x4");
+    m.darkShadingOffset = Mat::zeros(4, 4, CV_32FC1);
+    m.darkShadingOffset.at<float>(1, 1) = std::numeric_limits<float>::infinity();
+    EXPECT_CV_ERROR_CONTAINS(m.validate(), "NaN or Inf");
+    // A version-1 file may not carry the newer keys.
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 1\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"
+                                          "  row_sigma_d2: 1\n"),
+                             "row_sigma_d2");
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 3\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"
+                                          "  row_sigma_d2: 1\n"),
+                             "come together");
+}
+
+// Reference values from SciPy (scipy.stats.tukeylambda, 1.10), produced by
+//   /usr/bin/python3 -c "from scipy.stats import tukeylambda as t; [print(l, *map(float, t.stats(l,
+//   moments='vk')), t.ppf(0.9, l), t.ppf(0.001, l)) for l in (-0.2, -0.05, 0.0, 0.1349, 0.3, 1.0)]"
+TEST(NoiseModel, tukeyLambdaMomentsAndQuantilesMatchScipy)
+{
+    struct Reference
+    {
+        double lambda, variance, kurtosis, q90, q001;
+    };
+    const Reference refs[] = {
+        {-0.2, 7.485121693687224, 19.212645820411677, 2.817987524304892, -14.90435792723451},
+        {-0.05, 3.936722678907758, 2.131297930577237, 2.334730561453274, -8.249750367096063},
+        {0.0, 3.289868133696453, 1.2, 2.1972245773362196, -6.906754778648553},
+        {0.1349, 2.142062315583447, 6.731396968762127e-05, 1.8746783137461684, -4.4925353408366595},
+        {0.3, 1.3688395477826087, -0.5924829106006726, 1.558996425233304, -2.912691179203477},
+        {1.0, 0.3333333333333333, -1.1999999999999997, 0.8, -0.998}};
+    // The two ways of computing the moments meet at |lambda| = 0.02.
+    for (double l : {0.019999999, -0.019999999})
+        EXPECT_NEAR(detail::tukeyLambdaExcessKurtosis(l), detail::tukeyLambdaExcessKurtosis(l * 1.00000005),
+                    1e-7)
+            << l;
+    for (const Reference& r : refs) {
+        // Closed forms and quadrature in double: 1e-9 relative leaves room only for lgamma's rounding and
+        // the cancellation bounded in tukeyMoments() (6e-10 at |lambda| = 0.02).
+        EXPECT_NEAR(r.variance, detail::tukeyLambdaVariance(r.lambda), 1e-9 * r.variance) << r.lambda;
+        EXPECT_NEAR(r.kurtosis, detail::tukeyLambdaExcessKurtosis(r.lambda),
+                    1e-8 * (1 + std::abs(r.kurtosis)))
+            << r.lambda;
+        EXPECT_NEAR(r.q90, detail::tukeyLambdaQuantile(0.9, r.lambda), 1e-12 * (1 + std::abs(r.q90)))
+            << r.lambda;
+        EXPECT_NEAR(r.q001, detail::tukeyLambdaQuantile(0.001, r.lambda), 1e-12 * (1 + std::abs(r.q001)))
+            << r.lambda;
+        if (r.lambda >= detail::kTukeyLambdaMin)
+            EXPECT_NEAR(r.lambda, detail::tukeyLambdaOfExcessKurtosis(r.kurtosis), 1e-9) << r.lambda;
+    }
+    // The added part needs more kurtosis than the whole when the prior keeps part of the tails, and the
+    // model's own lambda when nothing of the prior is kept.
+    EXPECT_NEAR(-0.05, detail::addedReadLambda(-0.05, 10, 0, 10), 1e-9);
+    EXPECT_LT(detail::addedReadLambda(-0.05, 10, 0.25 * 0.25 * 100, 10 - 0.25 * 10), -0.05);
+    EXPECT_EQ(-0.05, detail::addedReadLambda(-0.05, 10, 0, 0));
 }
 
 } // namespace

@@ -5,6 +5,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/rawgment/export.hpp>
 
+#include <vector>
+
 namespace cv {
 namespace rawgment {
 
@@ -58,7 +60,7 @@ struct CV_RAWGMENT_EXPORTS NoiseLine
 struct CV_RAWGMENT_EXPORTS NoiseModel
 {
     //! Newest version of the file format; read() rejects newer versions (see write()).
-    static constexpr int FORMAT_VERSION = 2;
+    static constexpr int FORMAT_VERSION = 3;
 
     double alpha = 0;   //!< shot-noise slope at gain 1, DN per electron (>= 0)
     double sigmaD2 = 0; //!< read-noise variance before the analog gain, DN^2 at gain 1 (>= 0)
@@ -68,11 +70,45 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      * terms do not depend on it. */
     double baseIso = 0;
 
+    /** @name Dark-frame components beyond the paper (each absent by default)
+     * An absent component changes no output and costs nothing; see docs/mathematics.md, "Dark-frame
+     * noise". Calibrated from dark frames by calibrateDarkNoise(). */
+    //! @{
+    /** Row noise (banding) before the analog gain, DN^2 at gain 1: every pixel of a row shares one
+     * offset of variance \f$ g^2\sigma_{row,d}^2 + \sigma_{row,r}^2 \f$ per frame. */
+    double rowSigmaD2 = 0;
+    double rowSigmaR2 = 0; //!< row noise after the analog gain, DN^2 (see rowSigmaD2)
+    /** Dark shading per unit gain, \f$ B_d \f$: CV_32FC1 of the sensor's size, DN. A dark frame at gain
+     * g has the fixed per-pixel offset \f$ g B_d + B_r \f$ above the black level. Empty: no dark
+     * shading (then darkShadingOffset must be empty too). */
+    Mat darkShadingPerGain;
+    Mat darkShadingOffset; //!< dark shading independent of the gain, \f$ B_r \f$ (see darkShadingPerGain)
+    /** Whether the read noise (\f$ g^2\sigma_d^2 + \sigma_r^2 \f$ together, variance unchanged) has the
+     * heavy-tailed Tukey-lambda shape of tukeyLambda instead of a Gaussian one. An explicit flag:
+     * lambda = 0 is the logistic shape, not "absent". */
+    bool tukeyRead = false;
+    /** Shape of the read noise when tukeyRead: -0.25 < lambda <= 1; about 0.14 is Gaussian, smaller
+     * values have heavier tails (0: logistic, excess kurtosis 1.2). */
+    double tukeyLambda = 0;
+
+    bool hasRowNoise() const { return rowSigmaD2 > 0 || rowSigmaR2 > 0; } //!< whether row noise is present
+    bool hasDarkShading() const { return !darkShadingPerGain.empty(); }   //!< whether dark shading is present
+    //! Whether any dark-frame component is present.
+    bool hasDarkComponents() const { return hasRowNoise() || hasDarkShading() || tukeyRead; }
+    /** @brief Variance of the row offset at linear gain g: \f$ g^2\sigma_{row,d}^2 + \sigma_{row,r}^2 \f$. */
+    double rowVariance(double gain) const;
+    /** @brief The dark shading at linear gain g, \f$ g B_d + B_r \f$ (CV_32FC1), or an empty Mat without
+     * dark shading. */
+    Mat darkShadingAt(double gain) const;
+    //! @}
+
     NoiseModel() = default;
     /** @brief A validated model. @throws cv::Exception when a parameter is negative or not finite. */
     NoiseModel(double alpha, double sigmaD2, double sigmaR2);
 
-    /** @brief Throws cv::Exception (StsBadArg) naming the parameter that is negative or not finite. */
+    /** @brief Throws cv::Exception (StsBadArg) naming the parameter that is negative or not finite, a
+     * tukeyLambda outside (-0.25, 1], or dark-shading maps that are not two finite CV_32FC1 Mats of one
+     * size. */
     void validate() const;
 
     /** @brief The per-gain line: \f$ a = g\alpha,\; b = g^2\sigma_d^2 + \sigma_r^2 \f$.
@@ -94,23 +130,39 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      */
     void variance(InputArray mean, double gain, OutputArray dst) const;
 
-    /** @brief Writes the model as a map under `name`: format_version, alpha, sigma_d2, sigma_r2, and
-     * base_iso when it is known. The version is the lowest that holds what the model has (1 without a
-     * base ISO, 2 with one), so a model without one stays readable by older builds. */
-    void write(FileStorage& fs, const String& name) const;
+    /** @brief Writes the model as a map under `name`: format_version, alpha, sigma_d2, sigma_r2,
+     * base_iso when it is known, and the dark-frame components that are present (row_sigma_d2,
+     * row_sigma_r2, tukey_lambda, and dark_shading: the names, size and FNV-1a checksums of two
+     * CV_32FC1 TIFF images). The version is the lowest that holds what the model has (1 without a base
+     * ISO, 2 with one, 3 with a dark-frame component), so a model without them stays readable by older
+     * builds.
+     * @param fs the storage
+     * @param name the map's name
+     * @param shadingImages the file names of the dark-shading images (per gain, offset) as the file
+     *        refers to them (relative to the model file's folder); required when the model has dark
+     *        shading, which save() writes as those files. write() itself writes no image.
+     */
+    void write(FileStorage& fs, const String& name, const std::vector<String>& shadingImages = {}) const;
 
     /** @brief Reads a model written by write().
+     * @param node the map
+     * @param folder where the dark-shading images named in the file are (the model file's folder)
      * @throws cv::Exception naming the field when a field is missing, not a number, negative or not
-     *         finite, or when format_version is newer than FORMAT_VERSION.
+     *         finite, or unknown; when format_version is newer than FORMAT_VERSION; when a dark-shading
+     *         image is missing, unreadable, of another size or type, or does not match its checksum.
      */
-    static NoiseModel read(const FileNode& node);
+    static NoiseModel read(const FileNode& node, const String& folder = String());
 
     /** @brief Saves the model to a YAML (.yml, .yaml) or JSON (.json) file, atomically: the file is
      * written under a temporary name next to `path` and renamed, so a reader never sees half a file.
+     * Dark shading goes first into `<path without extension>.dark_shading_per_gain.tiff` and
+     * `.dark_shading_offset.tiff` (each atomically); the model file names them with their checksums,
+     * so a model file and images of different saves are never taken for a pair.
      */
     void save(const String& path) const;
 
-    /** @brief Loads a model saved by save() (the top-level map is `noise_model`). */
+    /** @brief Loads a model saved by save() (the top-level map is `noise_model`), with its dark-shading
+     * images. */
     static NoiseModel load(const String& path);
 };
 

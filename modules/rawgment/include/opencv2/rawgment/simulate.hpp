@@ -48,6 +48,11 @@ struct CV_RAWGMENT_EXPORTS SensorParams
  * with the exact Poisson distribution (not its Gaussian approximation), exposure factor e, and the
  * fixed pattern (PRNU, DSNU, hot, dead and noisy pixels) drawn once from `fixedPatternSeed`.
  *
+ * The dark-frame components of the model (NoiseModel::hasDarkComponents()) are drawn when present: a
+ * Gaussian offset of variance NoiseModel::rowVariance() shared by each row of each frame, the dark
+ * shading NoiseModel::darkShadingAt() added to every frame, and with NoiseModel::tukeyRead the read
+ * noise \f$ g n_d + n_r \f$ as one Tukey-lambda draw of variance \f$ g^2\sigma_d^2 + \sigma_r^2 \f$.
+ *
  * Random numbers come from a counter-based generator keyed by (seed, frame, row): the same seed gives
  * bit-identical frames whatever the number of threads.
  */
