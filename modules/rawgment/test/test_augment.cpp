@@ -1025,6 +1025,189 @@ TEST(Augment, misspelledKeysInSceneAndPolicyFilesAreErrorsNamingThem)
     EXPECT_CV_ERROR_CONTAINS(Scene::read(scene["scene"]), "scene: unknown key 'sclae'");
 }
 
+// The statistics of a dark-frame component (docs/mathematics.md, "Dark-frame noise") of a float burst of
+// a flat scene, black-subtracted: the residual e = x - (the pixel's temporal mean), its row means R and
+// the rest f = e - R. Over T frames of H x W: E[sum R^2] = (T - 1) H (rowVar + pixVar / W) and
+// E[sum f^2] = (T - 1) H (W - 1) pixVar.
+struct DarkStats
+{
+    Mat pixelMean;     // temporal mean per pixel (the fixed pattern plus the scene)
+    double rowMeanVar; // sum R^2 / ((T - 1) H): row variance plus pixVar / W
+    double pixelVar;   // per-pixel temporal variance without the rows
+    double kurtosis;   // excess kurtosis of f
+    double kurtosisSE; // its standard error, from the spread over the frames
+    int dof;           // degrees of freedom of rowMeanVar
+};
+
+DarkStats darkStats(const std::vector<Mat>& burst, double black)
+{
+    const int T = static_cast<int>(burst.size()), H = burst[0].rows, W = burst[0].cols;
+    DarkStats d;
+    Mat sum(burst[0].size(), CV_64F, Scalar(0));
+    for (const Mat& f : burst) {
+        Mat x;
+        f.convertTo(x, CV_64F, 1, -black);
+        sum += x;
+    }
+    d.pixelMean = sum / T;
+    double sumR2 = 0, sumF2 = 0, sumF4 = 0;
+    std::vector<double> frameKurtosis;
+    for (const Mat& f : burst) {
+        Mat e;
+        f.convertTo(e, CV_64F, 1, -black);
+        e -= d.pixelMean;
+        double m2 = 0, m4 = 0;
+        for (int r = 0; r < H; ++r) {
+            const double* p = e.ptr<double>(r);
+            double rowSum = 0;
+            for (int c = 0; c < W; ++c)
+                rowSum += p[c];
+            const double R = rowSum / W;
+            sumR2 += R * R;
+            for (int c = 0; c < W; ++c) {
+                const double v = (p[c] - R) * (p[c] - R);
+                m2 += v;
+                m4 += v * v;
+            }
+        }
+        sumF2 += m2;
+        sumF4 += m4;
+        const double n = static_cast<double>(H) * W;
+        frameKurtosis.push_back((m4 / n) / ((m2 / n) * (m2 / n)) - 3);
+    }
+    const double n = static_cast<double>(T) * H * W;
+    d.rowMeanVar = sumR2 / ((T - 1.0) * H);
+    d.pixelVar = sumF2 / ((T - 1.0) * H * (W - 1));
+    d.kurtosis = (sumF4 / n) / ((sumF2 / n) * (sumF2 / n)) - 3;
+    double mk = 0, vk = 0;
+    for (double k : frameKurtosis)
+        mk += k / T;
+    for (double k : frameKurtosis)
+        vk += (k - mk) * (k - mk) / (T - 1);
+    d.kurtosisSE = std::sqrt(vk / T);
+    d.dof = (T - 1) * H;
+    return d;
+}
+
+// The mean square difference of two bursts' fixed patterns over what their noise alone gives: 0 when
+// the patterns agree. A temporal mean of T frames carries (pixVar + rowVar) / T of noise per pixel.
+double fixedPatternExcess(const DarkStats& a, const DarkStats& b, int T, int W)
+{
+    Mat d = a.pixelMean - b.pixelMean;
+    d -= cv::mean(d)[0]; // the scene's level is not the pattern
+    const double noise = (a.pixelVar + b.pixelVar + (a.rowMeanVar + b.rowMeanVar) * (1 - 1.0 / W)) / T;
+    return d.dot(d) / d.total() / noise - 1;
+}
+
+// A sensor with every dark-frame component: row noise mostly before the gain (it grows with it, the
+// banding of high-gain captures), heavy-tailed read noise, and dark shading with a column ramp plus a
+// per-pixel pattern. Unquantised, so that the float augmentation and the capture compare bit for bit
+// in their statistics (quantisation would add 1/12 DN^2 to one side only).
+SensorParams darkComponentSensor(Size size)
+{
+    SensorParams p = test::referenceSensorParams();
+    p.quantize = false;
+    p.noise.rowSigmaD2 = 0.3;
+    p.noise.rowSigmaR2 = 0.5;
+    p.noise.tukeyRead = true;
+    p.noise.tukeyLambda = -0.1;
+    Mat bd(size, CV_32FC1), br(size, CV_32FC1);
+    RNG rng(19);
+    rng.fill(bd, RNG::NORMAL, 0, 0.8);
+    rng.fill(br, RNG::NORMAL, 0, 2.0);
+    for (int c = 0; c < size.width; ++c)
+        bd.col(c) += 2.0 * c / size.width;
+    p.noise.darkShadingPerGain = bd;
+    p.noise.darkShadingOffset = br;
+    return p;
+}
+
+TEST(Augment, darkeningAddsTheDarkFrameComponentsATargetCaptureHas)
+{
+    const Size size(256, 256);
+    const int T = 32;
+    const SensorParams params = darkComponentSensor(size);
+    const SensorSimulator sensor(params, size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(1.0);
+    const double black = fmt.blackLevel[0];
+    const Mat scene(size, CV_32FC1, Scalar(400));
+    std::vector<Mat> bright;
+    sensor.captureBurst(scene, 1.0, 1.0, T, 7, bright);
+    NoiseModel gaussianRead = model;
+    gaussianRead.tukeyRead = false;
+    struct Case
+    {
+        double photonRatio, gainRatio;
+        bool priorMatters; // whether the scaled prior is a sizeable part of the target (IGNORE_PRIOR shows)
+    };
+    for (const Case& c : {Case{1.0 / 200, 8, false}, Case{0.5, 2, true}}) {
+        SCOPED_TRACE(testing::Message() << "photons x" << c.photonRatio << ", gain x" << c.gainRatio);
+        std::vector<Mat> target;
+        sensor.captureBurst(scene, c.gainRatio, c.photonRatio, T, 8, target);
+        const DarkStats truth = darkStats(target, black);
+        const ColorJitter jitter = ColorJitter::exposureChange(c.photonRatio, c.gainRatio);
+        auto augmented = [&](const NoiseModel& m, const NoiseOptions& options) {
+            std::vector<Mat> out(T);
+            RawFormat outFmt;
+            for (int t = 0; t < T; ++t)
+                colorJitter(bright[t], fmt, m, jitter, options, 100 + t, out[t], outFmt);
+            return darkStats(out, black);
+        };
+        // Row-mean variances of (T - 1) H Gaussian row means: relative standard error sqrt(2 / dof) each;
+        // pixel variances: sqrt((2 + kurtosis) / n) each with n = (T - 1) H (W - 1) (a sample variance of
+        // heavy-tailed data). Five standard errors of the difference of two such estimates.
+        const double rowTol = 5 * std::sqrt(2.0) * std::sqrt(2.0 / truth.dof);
+        const double pixTol =
+            5 * std::sqrt(2.0) *
+            std::sqrt((2 + std::max(truth.kurtosis, 0.0)) / (truth.dof * (size.width - 1.0)));
+        // The fixed-pattern excess is a mean of H W squared normal differences: standard error
+        // sqrt(2 / (H W)) (0.55%); 5 of them.
+        const double patternTol = 5 * std::sqrt(2.0 / size.area());
+        const DarkStats account = augmented(model, NoiseAlignment::ACCOUNT_PRIOR);
+        EXPECT_NEAR(account.rowMeanVar / truth.rowMeanVar, 1, rowTol) << "row-mean variance";
+        EXPECT_NEAR(account.pixelVar / truth.pixelVar, 1, pixTol) << "per-pixel variance";
+        EXPECT_NEAR(fixedPatternExcess(account, truth, T, size.width), 0, patternTol) << "fixed pattern";
+        // The capture's shot noise is a Poisson count (excess kurtosis 1 / electrons: 0.2 at 5 electrons,
+        // 0.07 of the total's kurtosis here), which Gaussian shot draws lack: the kurtosis is compared
+        // with Poisson shot draws, so that only the read part's tails are under test.
+        NoiseOptions poisson;
+        poisson.shotSampling = ShotNoiseSampling::POISSON;
+        const DarkStats accountPoisson = augmented(model, poisson);
+        const double kurtosisTol = 5 * std::hypot(accountPoisson.kurtosisSE, truth.kurtosisSE);
+        EXPECT_NEAR(accountPoisson.kurtosis, truth.kurtosis, kurtosisTol) << "excess kurtosis";
+        EXPECT_NEAR(accountPoisson.pixelVar / truth.pixelVar, 1, pixTol) << "per-pixel variance (Poisson)";
+        const DarkStats none = augmented(model, NoiseAlignment::NONE);
+        EXPECT_LT(none.rowMeanVar / truth.rowMeanVar, 1 - rowTol) << "NONE keeps only the scaled rows";
+        EXPECT_LT(none.pixelVar / truth.pixelVar, 1 - pixTol) << "NONE keeps only the scaled prior";
+        EXPECT_GT(fixedPatternExcess(none, truth, T, size.width), patternTol)
+            << "NONE keeps the scaled pattern";
+        const DarkStats ignore = augmented(model, NoiseAlignment::IGNORE_PRIOR);
+        if (c.priorMatters) {
+            EXPECT_GT(ignore.rowMeanVar / truth.rowMeanVar, 1 + rowTol) << "IGNORE_PRIOR doubles the rows";
+            EXPECT_GT(ignore.pixelVar / truth.pixelVar, 1 + pixTol) << "IGNORE_PRIOR doubles the noise";
+            EXPECT_GT(fixedPatternExcess(ignore, truth, T, size.width), patternTol)
+                << "IGNORE_PRIOR adds the pattern on top of the scaled one";
+        } else {
+            // Where the target's read noise dominates, the tails must come from the added part: Gaussian
+            // draws of the same variance leave the result less heavy-tailed than the capture.
+            const DarkStats gaussian = augmented(gaussianRead, poisson);
+            EXPECT_LT(gaussian.kurtosis,
+                      truth.kurtosis - 5 * std::hypot(gaussian.kurtosisSE, truth.kurtosisSE))
+                << "Gaussian read noise";
+            EXPECT_NEAR(gaussian.pixelVar / truth.pixelVar, 1, pixTol) << "its variance is still right";
+        }
+        std::cout << "photons x" << c.photonRatio << " gain x" << c.gainRatio << ": row-mean var (capture "
+                  << truth.rowMeanVar << ") NONE " << none.rowMeanVar << ", IGNORE " << ignore.rowMeanVar
+                  << ", ACCOUNT " << account.rowMeanVar << "; kurtosis (capture " << truth.kurtosis << " +- "
+                  << truth.kurtosisSE << ") NONE " << none.kurtosis << ", IGNORE " << ignore.kurtosis
+                  << ", ACCOUNT " << account.kurtosis << " (Poisson shot " << accountPoisson.kurtosis
+                  << "); pattern excess NONE " << fixedPatternExcess(none, truth, T, size.width)
+                  << ", IGNORE " << fixedPatternExcess(ignore, truth, T, size.width) << ", ACCOUNT "
+                  << fixedPatternExcess(account, truth, T, size.width) << "\n";
+    }
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv
