@@ -6,6 +6,7 @@
 #include <opencv2/rawgment/bayer.hpp>
 #include <opencv2/rawgment/export.hpp>
 #include <opencv2/rawgment/noise_model.hpp>
+#include <opencv2/rawgment/normality.hpp>
 
 #include <memory>
 #include <string>
@@ -330,6 +331,84 @@ CV_RAWGMENT_EXPORTS Vec3d projectedStdError(const std::vector<NoiseSample>& samp
  */
 CV_RAWGMENT_EXPORTS CalibrationReport calibrateNoiseModel(
     const std::vector<NoiseSample>& samples, const CalibrationParams& params = CalibrationParams());
+
+/** @brief Options of calibrateDarkNoise(): which dark-frame components to fit. */
+struct CV_RAWGMENT_EXPORTS DarkCalibrationParams
+{
+    bool rowNoise = true;    //!< fit NoiseModel::rowSigmaD2 and rowSigmaR2 (two or more distinct gains)
+    bool darkShading = true; //!< fit the dark-shading maps (two or more distinct gains)
+    bool tukeyShape = true;  //!< fit NoiseModel::tukeyLambda (and set tukeyRead)
+    double lambdaMin = -0.2; //!< the search range of lambda (>= -0.2)
+    double lambdaMax = 0.5;  //!< (<= 1; 0.14 is Gaussian, so the range covers light tails too)
+    /** Residuals per gain that enter the probability plot (a fixed spread-out subsample; all when fewer).
+     * 100,000 put the PPCC's own noise near 1e-5, below the differences between lambdas 0.01 apart. */
+    int ppccSamples = 100000;
+
+    void validate() const; //!< throws cv::Exception naming the invalid field
+};
+
+/** @brief What one gain's dark burst shows (calibrateDarkNoise()). */
+struct CV_RAWGMENT_EXPORTS DarkGainStatistics
+{
+    double gain = 0;        //!< linear gain
+    int frames = 0;         //!< frames of the burst
+    double rowMeanVar = 0;  //!< variance of a row's mean after the fixed pattern is removed
+    double rowVariance = 0; //!< the row noise: rowMeanVar less the pixel noise's share, pixelVariance / width
+    double rowVarianceSE = 0;  //!< its standard error (Gaussian row means)
+    double pixelVariance = 0;  //!< per-pixel temporal variance without the rows
+    double excessKurtosis = 0; //!< of the pixel residuals after the rows are removed
+    ShapiroWilkResult before;  //!< Shapiro-Wilk of 5000 residuals with the row offsets still in
+    ShapiroWilkResult after;   //!< ... and of the same residuals without them
+};
+
+/** @brief Everything calibrateDarkNoise() found. */
+struct CV_RAWGMENT_EXPORTS DarkCalibrationReport
+{
+    NoiseModel model;                      //!< the base model with the fitted components
+    std::vector<DarkGainStatistics> gains; //!< by increasing gain
+    std::vector<Vec2d> ppcc;               //!< (lambda, probability-plot correlation) over the search grid
+    /** The lambda whose probability plot fits the residuals best, before the correction for what the
+     * temporal mean and rounding mix into them (model.tukeyLambda is after it). */
+    double lambdaOfResiduals = 0;
+    double ppccBest = 0;            //!< the correlation at lambdaOfResiduals
+    double ppccGaussian = 0;        //!< the correlation of a normal probability plot, for comparison
+    std::vector<std::string> notes; //!< what the user should know (a component at a bound, few frames, ...)
+
+    /** @brief Writes the report (without the maps, which the model's save() writes) under `name`. */
+    void write(FileStorage& fs, const String& name) const;
+};
+
+/** @brief Calibrates the dark-frame components of a noise model from bursts of dark frames (lens cap)
+ * at several gains (docs/mathematics.md, "Dark-frame noise").
+ *
+ * Per gain g with T frames of H x W: the residual of a frame is its pixels less their temporal mean,
+ * which removes the fixed pattern. Its row means R have variance \f$ (1 - 1/T)(\sigma_{row}^2 +
+ * \sigma_{pix}^2 / W) \f$, and the rest of the residual \f$ (1 - 1/T)(1 - 1/W)\sigma_{pix}^2 \f$, which
+ * gives each gain's row variance corrected for the pixel noise's part of a row mean.
+ * - row noise: \f$ \sigma_{row}^2(g) = g^2\sigma_{row,d}^2 + \sigma_{row,r}^2 \f$ by weighted least squares
+ *   over the gains (each weighted by its standard error), both parts >= 0;
+ * - dark shading: each pixel's temporal means over the gains fitted by the line \f$ g B_d + B_r \f$
+ *   (weights: frames over variance per gain);
+ * - Tukey lambda: the lambda that maximises the probability-plot correlation (Filliben's medians) of the
+ *   pooled, standardised residuals without the rows, over the gains whose pixel noise is at least 2 DN
+ *   (quantisation flattens the tails below; the highest gain when none is). Removing the temporal mean
+ *   mixes 1/T of the other frames into each residual, and rounding a uniform part, both of which pull
+ *   the shape towards the Gaussian; their effect on the excess kurtosis is known (c(T) and the share
+ *   1/12 over the variance), so the lambda of the residuals is carried back to the read noise's through
+ *   its kurtosis. The accuracy reached per number of frames is in docs/calibrate_your_camera.md.
+ *
+ * @param bursts bursts[k] are the dark frames at gains[k]: CV_16UC1 or CV_32FC1 mosaics of one size,
+ *        at least 3 frames each
+ * @param gains the linear gains, finite and > 0
+ * @param format the CFA format (its black level is subtracted; its gain is not used)
+ * @param base the model to extend (alpha, sigma_d^2, sigma_r^2 and base ISO are kept)
+ * @param params what to fit
+ * @throws cv::Exception naming the problem: no bursts, sizes or types that differ, fewer than 3 frames,
+ *         fewer than 2 distinct gains for row noise or dark shading, non-finite values.
+ */
+CV_RAWGMENT_EXPORTS DarkCalibrationReport calibrateDarkNoise(
+    const std::vector<std::vector<Mat>>& bursts, const std::vector<double>& gains, const RawFormat& format,
+    const NoiseModel& base, const DarkCalibrationParams& params = DarkCalibrationParams());
 
 //! @}
 

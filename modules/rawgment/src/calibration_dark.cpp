@@ -1,0 +1,441 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Calibration of the dark-frame components (row noise, dark shading, Tukey-lambda read noise) from
+// bursts of dark frames; the equations are in docs/mathematics.md, "Dark-frame noise".
+#include "noise_terms.hpp"
+#include "opencv2/rawgment/calibration.hpp"
+#include "precomp.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+namespace cv {
+namespace rawgment {
+
+namespace {
+
+// What one gain's burst gives: its statistics, its temporal mean and its residual samples.
+struct GainData
+{
+    DarkGainStatistics stats;
+    Mat mean;                       // CV_64FC1 temporal mean, black-subtracted
+    std::vector<double> ppccSample; // residuals without the rows, a spread-out subsample
+};
+
+// Per-row sums of one frame's residual: of R^2 (R the row's mean), f^2 and f^4 (f = e - R).
+struct RowSums
+{
+    double r2 = 0, f2 = 0, f4 = 0;
+};
+
+Mat blackSubtracted64(const Mat& raw, const RawFormat& format)
+{
+    Mat x, x64;
+    subtractBlackLevel(raw, format, x, false);
+    x.convertTo(x64, CV_64F);
+    return x64;
+}
+
+GainData analyseGain(const std::vector<Mat>& frames, double gain, const RawFormat& format, int ppccSamples,
+                     Size size, int type)
+{
+    const int T = static_cast<int>(frames.size()), H = size.height, W = size.width;
+    if (T < 3)
+        CV_Error(Error::StsBadArg,
+                 cv::format("calibrateDarkNoise: the burst at gain %g has %d frames; at least 3 are "
+                            "needed (the temporal mean and two residuals)",
+                            gain, T));
+    std::vector<Mat> x(static_cast<size_t>(T));
+    GainData d;
+    d.mean = Mat::zeros(size, CV_64FC1);
+    for (int t = 0; t < T; ++t) {
+        const Mat& f = frames[static_cast<size_t>(t)];
+        if (f.size() != size || f.type() != type)
+            CV_Error(Error::StsBadArg,
+                     cv::format(
+                         "calibrateDarkNoise: frame %d at gain %g is %s %dx%d; every frame must be %s %dx%d",
+                         t, gain, typeToString(f.type()).c_str(), f.cols, f.rows, typeToString(type).c_str(),
+                         size.width, size.height));
+        if (type == CV_32FC1 && !checkRange(f, true))
+            CV_Error(Error::StsBadArg,
+                     cv::format("calibrateDarkNoise: frame %d at gain %g has NaN or Inf", t, gain));
+        x[static_cast<size_t>(t)] = blackSubtracted64(f, format);
+        d.mean += x[static_cast<size_t>(t)];
+    }
+    d.mean /= T;
+    // Per row and frame, so that the sums do not depend on how the rows are split among threads.
+    std::vector<RowSums> sums(static_cast<size_t>(T) * H);
+    parallel_for_(Range(0, T * H), [&](const Range& range) {
+        for (int i = range.start; i < range.end; ++i) {
+            const int t = i / H, r = i % H;
+            const double* p = x[static_cast<size_t>(t)].ptr<double>(r);
+            const double* m = d.mean.ptr<double>(r);
+            double rowSum = 0;
+            for (int c = 0; c < W; ++c)
+                rowSum += p[c] - m[c];
+            const double R = rowSum / W;
+            RowSums s;
+            s.r2 = R * R;
+            for (int c = 0; c < W; ++c) {
+                const double f = p[c] - m[c] - R, f2 = f * f;
+                s.f2 += f2;
+                s.f4 += f2 * f2;
+            }
+            sums[static_cast<size_t>(i)] = s;
+        }
+    });
+    RowSums total;
+    for (const RowSums& s : sums) {
+        total.r2 += s.r2;
+        total.f2 += s.f2;
+        total.f4 += s.f4;
+    }
+    DarkGainStatistics& st = d.stats;
+    st.gain = gain;
+    st.frames = T;
+    const double dofRows = (T - 1.0) * H, n = static_cast<double>(T) * H * W;
+    st.rowMeanVar = total.r2 / dofRows;
+    st.pixelVariance = total.f2 / (dofRows * (W - 1));
+    st.rowVariance = st.rowMeanVar - st.pixelVariance / W;
+    st.rowVarianceSE = std::sqrt(2 / dofRows) * st.rowMeanVar;
+    st.excessKurtosis = total.f2 > 0 ? (total.f4 / n) / ((total.f2 / n) * (total.f2 / n)) - 3 : 0;
+
+    // Samples at odd strides through (frame, row, column), so that both sites of a row take part.
+    auto residualAt = [&](size_t index, bool withRow) {
+        const int t = static_cast<int>(index / (static_cast<size_t>(H) * W));
+        const int r = static_cast<int>((index / W) % H), c = static_cast<int>(index % W);
+        const double* p = x[static_cast<size_t>(t)].ptr<double>(r);
+        const double* m = d.mean.ptr<double>(r);
+        double rowSum = 0;
+        if (!withRow)
+            for (int j = 0; j < W; ++j)
+                rowSum += p[j] - m[j];
+        return p[c] - m[c] - rowSum / W;
+    };
+    const size_t count = static_cast<size_t>(n);
+    const size_t swStride = std::max<size_t>(1, count / 5000) | 1;
+    std::vector<double> before, after;
+    for (size_t i = 0; i < count && before.size() < 5000; i += swStride) {
+        before.push_back(residualAt(i, true));
+        after.push_back(residualAt(i, false));
+    }
+    if (before.size() >= 3) {
+        st.before = shapiroWilk(before);
+        st.after = shapiroWilk(after);
+    }
+    const size_t ppccStride = std::max<size_t>(1, count / static_cast<size_t>(ppccSamples)) | 1;
+    // Row means of every (frame, row), so that the subsample costs one subtraction per value.
+    std::vector<double> rowMean(static_cast<size_t>(T) * H);
+    for (int i = 0; i < T * H; ++i) {
+        const int t = i / H, r = i % H;
+        const double* p = x[static_cast<size_t>(t)].ptr<double>(r);
+        const double* m = d.mean.ptr<double>(r);
+        double rowSum = 0;
+        for (int c = 0; c < W; ++c)
+            rowSum += p[c] - m[c];
+        rowMean[static_cast<size_t>(i)] = rowSum / W;
+    }
+    for (size_t i = 0; i < count; i += ppccStride) {
+        const size_t row = i / W;
+        const int t = static_cast<int>(row / H), r = static_cast<int>(row % H), c = static_cast<int>(i % W);
+        d.ppccSample.push_back(x[static_cast<size_t>(t)].ptr<double>(r)[c] - d.mean.ptr<double>(r)[c] -
+                               rowMean[row]);
+    }
+    return d;
+}
+
+// Weighted least squares of y = g^2 u + v over the gains with both parts >= 0 (the bound taken when the
+// free fit crosses it).
+Vec2d fitRowNoise(const std::vector<GainData>& data, std::vector<std::string>& notes)
+{
+    double s00 = 0, s01 = 0, s11 = 0, t0 = 0, t1 = 0;
+    for (const GainData& d : data) {
+        const double w = 1 / std::max(d.stats.rowVarianceSE * d.stats.rowVarianceSE, 1e-300);
+        const double g2 = d.stats.gain * d.stats.gain, y = d.stats.rowVariance;
+        s00 += w * g2 * g2;
+        s01 += w * g2;
+        s11 += w;
+        t0 += w * g2 * y;
+        t1 += w * y;
+    }
+    const double det = s00 * s11 - s01 * s01;
+    Vec2d uv((s11 * t0 - s01 * t1) / det, (s00 * t1 - s01 * t0) / det);
+    if (uv[0] < 0) {
+        uv = Vec2d(0, std::max(t1 / s11, 0.0));
+        notes.push_back("row noise before the gain came out negative and is set to 0 (bound)");
+    } else if (uv[1] < 0) {
+        uv = Vec2d(std::max(t0 / s00, 0.0), 0);
+        notes.push_back("row noise after the gain came out negative and is set to 0 (bound)");
+    }
+    return uv;
+}
+
+// Per pixel, the weighted line g B_d + B_r through the temporal means of the gains.
+void fitDarkShading(const std::vector<GainData>& data, Mat& perGain, Mat& offset)
+{
+    double sw = 0, sg = 0, sgg = 0;
+    std::vector<double> w;
+    for (const GainData& d : data) {
+        // A temporal mean carries (pixel + row variance) / T of noise.
+        w.push_back(d.stats.frames /
+                    std::max(d.stats.pixelVariance + std::max(d.stats.rowVariance, 0.0), 1e-12));
+        sw += w.back();
+        sg += w.back() * d.stats.gain;
+        sgg += w.back() * d.stats.gain * d.stats.gain;
+    }
+    const double det = sw * sgg - sg * sg;
+    const Size size = data[0].mean.size();
+    // New buffers: the base model's maps may be shared with the caller's (Mat copies share data).
+    perGain = Mat(size, CV_32FC1);
+    offset = Mat(size, CV_32FC1);
+    parallel_for_(Range(0, size.height), [&](const Range& rows) {
+        for (int r = rows.start; r < rows.end; ++r) {
+            float* bd = perGain.ptr<float>(r);
+            float* br = offset.ptr<float>(r);
+            for (int c = 0; c < size.width; ++c) {
+                double sm = 0, sgm = 0;
+                for (size_t k = 0; k < data.size(); ++k) {
+                    const double m = data[k].mean.ptr<double>(r)[c];
+                    sm += w[k] * m;
+                    sgm += w[k] * data[k].stats.gain * m;
+                }
+                const double slope = (sw * sgm - sg * sm) / det;
+                bd[c] = static_cast<float>(slope);
+                br[c] = static_cast<float>((sm - slope * sg) / sw);
+            }
+        }
+    });
+}
+
+// The probability-plot correlation of a sorted sample against Tukey-lambda quantiles at Filliben's
+// medians, whose logs are precomputed (logM = log m_i, log1mM = log(1 - m_i)).
+double ppccAt(const std::vector<double>& sorted, const std::vector<double>& logM,
+              const std::vector<double>& log1mM, double lambda)
+{
+    const size_t n = sorted.size();
+    double sq = 0, sqq = 0, sy = 0, syy = 0, syq = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const double q = lambda == 0
+                             ? logM[i] - log1mM[i]
+                             : (std::expm1(lambda * logM[i]) - std::expm1(lambda * log1mM[i])) / lambda;
+        const double y = sorted[i];
+        sq += q;
+        sqq += q * q;
+        sy += y;
+        syy += y * y;
+        syq += y * q;
+    }
+    const double cov = syq - sy * sq / n, vq = sqq - sq * sq / n, vy = syy - sy * sy / n;
+    return vq > 0 && vy > 0 ? cov / std::sqrt(vq * vy) : 0;
+}
+
+} // namespace
+
+void DarkCalibrationParams::validate() const
+{
+    if (!(lambdaMin >= detail::kTukeyLambdaMin && lambdaMin < lambdaMax && lambdaMax <= 1))
+        CV_Error(Error::StsBadArg, cv::format("DarkCalibrationParams: lambdaMin %g and lambdaMax %g must "
+                                              "satisfy %g <= lambdaMin < lambdaMax "
+                                              "<= 1",
+                                              lambdaMin, lambdaMax, detail::kTukeyLambdaMin));
+    if (ppccSamples < 100)
+        CV_Error(Error::StsBadArg,
+                 cv::format("DarkCalibrationParams.ppccSamples must be >= 100 (got %d)", ppccSamples));
+}
+
+void DarkCalibrationReport::write(FileStorage& fs, const String& name) const
+{
+    fs << name << "{";
+    fs << "row_sigma_d2" << model.rowSigmaD2 << "row_sigma_r2" << model.rowSigmaR2;
+    fs << "tukey_read" << static_cast<int>(model.tukeyRead) << "tukey_lambda" << model.tukeyLambda;
+    fs << "dark_shading" << static_cast<int>(model.hasDarkShading());
+    fs << "lambda_of_residuals" << lambdaOfResiduals << "ppcc_best" << ppccBest << "ppcc_gaussian"
+       << ppccGaussian;
+    fs << "gains"
+       << "[";
+    for (const DarkGainStatistics& g : gains) {
+        fs << "{";
+        fs << "gain" << g.gain << "frames" << g.frames << "row_mean_var" << g.rowMeanVar << "row_variance"
+           << g.rowVariance << "row_variance_se" << g.rowVarianceSE << "pixel_variance" << g.pixelVariance
+           << "excess_kurtosis" << g.excessKurtosis;
+        fs << "shapiro_wilk_with_rows"
+           << "{"
+           << "W" << g.before.W << "p" << g.before.pValue << "n" << g.before.n << "}";
+        fs << "shapiro_wilk_without_rows"
+           << "{"
+           << "W" << g.after.W << "p" << g.after.pValue << "n" << g.after.n << "}";
+        fs << "}";
+    }
+    fs << "]";
+    fs << "ppcc"
+       << "[";
+    for (const Vec2d& p : ppcc)
+        fs << "[:" << p[0] << p[1] << "]";
+    fs << "]";
+    fs << "notes"
+       << "[";
+    for (const std::string& note : notes)
+        fs << note;
+    fs << "]";
+    fs << "}";
+}
+
+DarkCalibrationReport calibrateDarkNoise(const std::vector<std::vector<Mat>>& bursts,
+                                         const std::vector<double>& gains, const RawFormat& format,
+                                         const NoiseModel& base, const DarkCalibrationParams& params)
+{
+    params.validate();
+    format.validate();
+    base.validate();
+    if (bursts.empty())
+        CV_Error(Error::StsBadArg, "calibrateDarkNoise: no bursts");
+    if (bursts.size() != gains.size())
+        CV_Error(Error::StsBadArg,
+                 cv::format("calibrateDarkNoise: %zu bursts but %zu gains", bursts.size(), gains.size()));
+    for (double g : gains)
+        detail::checkFinitePositive(g, "calibrateDarkNoise: gain");
+    if (bursts[0].empty())
+        CV_Error(Error::StsBadArg, "calibrateDarkNoise: the first burst has no frames");
+    const Size size = bursts[0][0].size();
+    const int type = bursts[0][0].type();
+    if (type != CV_16UC1 && type != CV_32FC1)
+        CV_Error(Error::StsBadArg,
+                 cv::format("calibrateDarkNoise: frames must be CV_16UC1 or CV_32FC1 (got %s)",
+                            typeToString(type).c_str()));
+    if (size.width < 2 || size.height < 2 || size.width % 2 || size.height % 2)
+        CV_Error(Error::StsBadArg,
+                 cv::format("calibrateDarkNoise: frames must have even sides >= 2 (got %dx%d)", size.width,
+                            size.height));
+    std::vector<size_t> order(gains.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return gains[a] < gains[b]; });
+    std::vector<GainData> data;
+    for (size_t k : order)
+        data.push_back(analyseGain(bursts[k], gains[k], format, params.ppccSamples, size, type));
+    int distinct = 1;
+    for (size_t k = 1; k < data.size(); ++k)
+        distinct += data[k].stats.gain > data[k - 1].stats.gain * (1 + 1e-9) ? 1 : 0;
+
+    DarkCalibrationReport report;
+    report.model = base;
+    for (const GainData& d : data) {
+        report.gains.push_back(d.stats);
+        if (d.stats.frames < 16)
+            report.notes.push_back(
+                cv::format("the burst at gain %g has %d frames: with fewer than 16 the fixed pattern "
+                           "and lambda are noticeably less accurate (docs/calibrate_your_camera.md)",
+                           d.stats.gain, d.stats.frames));
+    }
+    if ((params.rowNoise || params.darkShading) && distinct < 2)
+        CV_Error(Error::StsBadArg,
+                 "calibrateDarkNoise: row noise and dark shading are split by how they change "
+                 "with the gain: give bursts at 2 or more distinct gains (or turn both off)");
+    if (params.rowNoise) {
+        const Vec2d uv = fitRowNoise(data, report.notes);
+        report.model.rowSigmaD2 = uv[0];
+        report.model.rowSigmaR2 = uv[1];
+    }
+    if (params.darkShading)
+        fitDarkShading(data, report.model.darkShadingPerGain, report.model.darkShadingOffset);
+    if (params.tukeyShape) {
+        std::vector<double> pooled;
+        // The kurtosis the pooled residuals show, as A kappa + B of the read noise's own (see below).
+        double shrinkA = 0, shrinkB = 0;
+        bool any = false;
+        for (const GainData& d : data)
+            if (d.stats.pixelVariance >= 4)
+                any = true;
+        for (size_t k = 0; k < data.size(); ++k) {
+            const GainData& d = data[k];
+            if (any ? d.stats.pixelVariance < 4 : k + 1 != data.size())
+                continue;
+            const double sd = std::sqrt(std::max(d.stats.pixelVariance, 1e-300));
+            for (double v : d.ppccSample)
+                pooled.push_back(v / sd);
+            // A residual is (1 - 1/T) of its frame's noise less 1/T of each of the T - 1 others: its excess
+            // kurtosis is c(T) = ((1 - 1/T)^4 + (T - 1) / T^4) / (1 - 1/T)^2 of the noise's. Rounding (for
+            // 16-bit frames) adds a uniform part, share q = (1/12) / variance, of excess kurtosis -1.2.
+            const double T = d.stats.frames, keep = 1 - 1 / T;
+            const double c = (std::pow(keep, 4) + (T - 1) / std::pow(T, 4)) / (keep * keep);
+            const double q =
+                type == CV_16UC1 ? std::min(1.0 / 12 / std::max(d.stats.pixelVariance, 1e-300), 1.0) : 0;
+            const double share = static_cast<double>(d.ppccSample.size());
+            shrinkA += share * c * (1 - q) * (1 - q);
+            shrinkB += share * c * -1.2 * q * q;
+        }
+        shrinkA /= static_cast<double>(pooled.size());
+        shrinkB /= static_cast<double>(pooled.size());
+        if (!any)
+            report.notes.push_back(
+                "no gain has a pixel noise of 2 DN or more: lambda comes from the highest gain, "
+                "where quantisation may still flatten the tails");
+        std::sort(pooled.begin(), pooled.end());
+        const size_t n = pooled.size();
+        std::vector<double> logM(n), log1mM(n);
+        double sz = 0, szz = 0, sy = 0, syy = 0, syz = 0;
+        for (size_t i = 0; i < n; ++i) {
+            // Filliben's medians of the uniform order statistics.
+            const double last = std::pow(0.5, 1.0 / n);
+            const double m = i == 0 ? 1 - last : i + 1 == n ? last : (i + 1 - 0.3175) / (n + 0.365);
+            logM[i] = std::log(m);
+            log1mM[i] = std::log1p(-m);
+            const double z = m <= 0.5 ? detail::lowerNormalQuantile(m) : -detail::lowerNormalQuantile(1 - m);
+            sz += z;
+            szz += z * z;
+            sy += pooled[i];
+            syy += pooled[i] * pooled[i];
+            syz += pooled[i] * z;
+        }
+        report.ppccGaussian =
+            (syz - sy * sz / n) / std::sqrt(std::max((szz - sz * sz / n) * (syy - sy * sy / n), 1e-300));
+        double best = params.lambdaMin, bestR = -2;
+        const int steps = static_cast<int>(std::round((params.lambdaMax - params.lambdaMin) / 0.01));
+        for (int i = 0; i <= steps; ++i) {
+            const double l = params.lambdaMin + (params.lambdaMax - params.lambdaMin) * i / steps;
+            const double r = ppccAt(pooled, logM, log1mM, l);
+            report.ppcc.push_back(Vec2d(l, r));
+            if (r > bestR) {
+                bestR = r;
+                best = l;
+            }
+        }
+        // Golden-section search within a grid step of the best grid point.
+        double lo = std::max(params.lambdaMin, best - 0.01), hi = std::min(params.lambdaMax, best + 0.01);
+        const double phi = (std::sqrt(5.0) - 1) / 2;
+        double a = hi - phi * (hi - lo), b = lo + phi * (hi - lo);
+        double ra = ppccAt(pooled, logM, log1mM, a), rb = ppccAt(pooled, logM, log1mM, b);
+        for (int it = 0; it < 40; ++it) {
+            if (ra > rb) {
+                hi = b;
+                b = a;
+                rb = ra;
+                a = hi - phi * (hi - lo);
+                ra = ppccAt(pooled, logM, log1mM, a);
+            } else {
+                lo = a;
+                a = b;
+                ra = rb;
+                b = lo + phi * (hi - lo);
+                rb = ppccAt(pooled, logM, log1mM, b);
+            }
+        }
+        const double shown = 0.5 * (lo + hi);
+        report.ppccBest = ppccAt(pooled, logM, log1mM, shown);
+        report.lambdaOfResiduals = shown;
+        // The shape the residuals show, carried back to the read noise's own through its kurtosis.
+        const double lambda =
+            std::min(std::max(detail::tukeyLambdaOfExcessKurtosis(
+                                  (detail::tukeyLambdaExcessKurtosis(shown) - shrinkB) / shrinkA),
+                              params.lambdaMin),
+                     params.lambdaMax);
+        report.model.tukeyRead = true;
+        report.model.tukeyLambda = lambda;
+        if (lambda <= params.lambdaMin + 0.005 || lambda >= params.lambdaMax - 0.005)
+            report.notes.push_back(cv::format("lambda %.3f is at the edge of the search range [%g, %g]",
+                                              lambda, params.lambdaMin, params.lambdaMax));
+    }
+    report.model.validate();
+    return report;
+}
+
+} // namespace rawgment
+} // namespace cv
