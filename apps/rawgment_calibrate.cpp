@@ -18,7 +18,9 @@ int main(int argc, char** argv)
         "{side           | 24    | square side when the manifest says patches: detect }"
         "{shapiro        | 2000  | pixels per burst tested with Shapiro-Wilk }"
         "{seed           | 0     | seed of the robust line fits (RANSAC) }"
-        "{plots          | true  | write PNG plots with gnuplot }";
+        "{plots          | true  | write PNG plots with gnuplot }"
+        "{dark_components| false | also row noise, dark shading and the read noise's shape from the dark "
+        "bursts }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_calibrate"))
         return 2;
     rawgment_apps::installInterruptCleanup();
@@ -39,6 +41,8 @@ int main(int argc, char** argv)
         "single-frame mode (spatial variance of chart patches). Paths are relative to the\n"
         "manifest. Writes report.md (a PASS/FAIL verdict, each check against its threshold),\n"
         "noise_model.yml, calibration_report.yml, samples.csv, lines.csv, shapiro.csv, PNG plots\n"
+        "(with --dark_components also dark_calibration.yml, dark_rows.csv, dark_ppcc.csv, their\n"
+        "plots, dark_shading.png and the dark-shading TIFFs beside noise_model.yml)\n"
         "and, with gains from ISO, darktable_noiseprofiles.json and android_noise_profile.yml into\n"
         "--out; never overwrites them. Step by step: docs/calibrate_your_camera.md.");
     if (parser.has("help")) {
@@ -53,6 +57,7 @@ int main(int argc, char** argv)
     o.shapiroPixels = parser.get<int>("shapiro");
     o.plots = parser.get<bool>("plots");
     o.seed = parser.get<uint64_t>("seed");
+    o.darkComponents = parser.get<bool>("dark_components");
     if (!parser.check() || o.manifest.empty() || o.outDir.empty() ||
         (method != "joint" && method != "two-stage") || o.shapiroPixels < 1 || o.shapiroPixels > 1000000 ||
         o.side < 2 || o.side % 2) {
@@ -102,6 +107,22 @@ int main(int argc, char** argv)
                         r.shapiroTested);
         else
             std::printf("Shapiro-Wilk: no pixel tested (it needs bursts of 3 or more frames)\n");
+        if (r.haveDark) {
+            const cv::rawgment::NoiseModel& m = rep.model;
+            std::printf(
+                "dark frames: row noise %.4g g^2 + %.4g DN^2, read-noise lambda %.3f (PPCC %.5f, Gaussian "
+                "%.5f)%s\n",
+                m.rowSigmaD2, m.rowSigmaR2, m.tukeyLambda, r.dark.ppccBest, r.dark.ppccGaussian,
+                m.hasDarkShading() ? ", dark shading maps beside noise_model.yml" : "");
+            for (const cv::rawgment::DarkGainStatistics& g : r.dark.gains)
+                std::printf(
+                    "  gain %6.2f dB: row variance %.4g +- %.2g, pixel variance %.4g, excess kurtosis "
+                    "%.3f, Shapiro-Wilk p %.3g with the rows, %.3g without\n",
+                    cv::rawgment::linearGainToDb(g.gain), g.rowVariance, g.rowVarianceSE, g.pixelVariance,
+                    g.excessKurtosis, g.before.pValue, g.after.pValue);
+            for (const std::string& n : r.dark.notes)
+                std::printf("note: %s\n", n.c_str());
+        }
         for (const std::string& n : rep.notes)
             std::printf("note: %s\n", n.c_str());
         for (const std::string& n : r.notes)

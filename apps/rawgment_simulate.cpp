@@ -6,7 +6,9 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include <cmath>
 #include <iostream>
+#include <stdexcept>
 
 int main(int argc, char** argv)
 {
@@ -25,6 +27,9 @@ int main(int argc, char** argv)
         "{seed           | 1        | noise seed }"
         "{format         | dng      | frame container: dng, png or tif }"
         "{dark           | false    | also a burst of dark frames (no light, as under a lens cap) per gain }"
+        "{row_noise      | 0,0      | sensor: row-noise variance before, after the gain (DN^2) }"
+        "{tukey_lambda   | none     | sensor: Tukey-lambda shape of the read noise (none: Gaussian) }"
+        "{dark_shading   | 0        | sensor: amplitude of a dark-shading pattern (DN; 0: none) }"
         "{validation     | true     | also write the bright and x0.5, x0.1 bursts for rawgment_validate }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_simulate"))
         return 2;
@@ -52,6 +57,27 @@ int main(int argc, char** argv)
         o.extension = "." + parser.get<std::string>("format");
         o.validation = parser.get<bool>("validation");
         o.dark = parser.get<bool>("dark");
+        const std::vector<double> rowNoise =
+            rawgment_apps::parseNumberList(parser.get<std::string>("row_noise"));
+        if (rowNoise.size() != 2)
+            throw std::runtime_error("--row_noise takes two variances: before,after the gain");
+        o.sensor.noise.rowSigmaD2 = rowNoise[0];
+        o.sensor.noise.rowSigmaR2 = rowNoise[1];
+        const std::string lambda = parser.get<std::string>("tukey_lambda");
+        if (lambda != "none") {
+            o.sensor.noise.tukeyRead = true;
+            try {
+                size_t used = 0;
+                o.sensor.noise.tukeyLambda = std::stod(lambda, &used);
+                if (used != lambda.size())
+                    throw std::invalid_argument(lambda);
+            } catch (const std::logic_error&) {
+                throw std::runtime_error("--tukey_lambda must be a number or none (got '" + lambda + "')");
+            }
+        }
+        o.darkShading = parser.get<double>("dark_shading");
+        if (!(o.darkShading >= 0 && std::isfinite(o.darkShading)))
+            throw std::runtime_error("--dark_shading must be a finite amplitude >= 0");
         if (!parser.check() || o.outDir.empty()) {
             parser.printErrors();
             std::cerr << "rawgment_simulate: --out is required (see --help)\n";

@@ -851,6 +851,42 @@ TEST(Apps, calibrateTheRealColourChartInSingleFrameModeSaysWhatItCannotDetermine
     EXPECT_EQ(std::string::npos, r.output.find("arning")) << "no plot is attempted without its data";
 }
 
+TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
+{
+    const std::string dir = freshDir("dark_components");
+    AppRun r =
+        runApp("rawgment_simulate", "--frames=8 --levels=0.5 --format=png --validation=false --gains=6,18 "
+                                    "--dark=true --row_noise=0.05,0.5 --tukey_lambda=-0.05 --dark_shading=4 "
+                                    "--out='" +
+                                        dir + "/sim'");
+    ASSERT_EQ(0, r.status) << r.output;
+    r = runApp("rawgment_calibrate",
+               "'" + dir + "/sim/manifest.yml' --dark_components=true --out='" + dir + "/cal'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("dark frames: row noise")) << r.output;
+    for (const char* f : {"dark_calibration.yml", "dark_rows.csv", "dark_ppcc.csv", "dark_rows.png",
+                          "dark_ppcc.png", "dark_shading.png", "noise_model.dark_shading_per_gain.tiff"})
+        EXPECT_TRUE(exists(dir + "/cal/" + f)) << f;
+    expectPngDecodes(dir + "/cal/dark_shading.png");
+    EXPECT_NE(std::string::npos, readText(dir + "/cal/report.md").find("## Dark-frame components"));
+    // The model file and its maps load as a pair, and the truth's components come back (8 frames of
+    // 296 x 200 at two gains: the row variances to about 10%, lambda to 0.02).
+    const cv::rawgment::NoiseModel fitted = cv::rawgment::NoiseModel::load(dir + "/cal/noise_model.yml"),
+                                   truth = cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
+    ASSERT_TRUE(fitted.hasDarkShading());
+    EXPECT_EQ(truth.darkShadingPerGain.size(), fitted.darkShadingPerGain.size());
+    EXPECT_NEAR(fitted.rowVariance(8), truth.rowVariance(8), 0.15 * truth.rowVariance(8));
+    EXPECT_NEAR(fitted.tukeyLambda, truth.tukeyLambda, 0.03);
+    // Without dark bursts the option is an error that says what it needs.
+    r = runApp("rawgment_simulate",
+               "--frames=3 --levels=0.5 --format=png --validation=false --gains=6 --out='" + dir + "/plain'");
+    ASSERT_EQ(0, r.status) << r.output;
+    r = runApp("rawgment_calibrate",
+               "'" + dir + "/plain/manifest.yml' --dark_components=true --out='" + dir + "/c2'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("needs dark bursts")) << r.output;
+}
+
 TEST(Apps, demoWritesAReportAndAGallery)
 {
     const std::string dir = freshDir("demo");

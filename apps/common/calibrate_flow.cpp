@@ -143,6 +143,27 @@ std::string calibrationReportMarkdown(const CalibrateResult& r, const std::strin
     md +=
         "\nThe thresholds and what to do on each failure: docs/calibrate_your_camera.md in cv::rawgment.\n\n";
     const CalibrationReport& rep = r.report;
+    if (r.haveDark) {
+        const NoiseModel& m = rep.model;
+        md += "## Dark-frame components\n\n";
+        md += cv::format(
+            "Row noise %.4g g^2 + %.4g DN^2; read noise Tukey lambda %.3f (the residuals' %.3f, PPCC "
+            "%.5f against %.5f for a normal plot); dark shading %s.\n\n",
+            m.rowSigmaD2, m.rowSigmaR2, m.tukeyLambda, r.dark.lambdaOfResiduals, r.dark.ppccBest,
+            r.dark.ppccGaussian,
+            m.hasDarkShading() ? "in noise_model.dark_shading_*.tiff (dark_shading.png)" : "not fitted");
+        md +=
+            "| gain (dB) | frames | row variance | model | pixel variance | excess kurtosis | Shapiro-Wilk p "
+            "with rows | without |\n|---|---|---|---|---|---|---|---|\n";
+        for (const DarkGainStatistics& g : r.dark.gains)
+            md += cv::format("| %.2f | %d | %.4g +- %.2g | %.4g | %.4g | %.3f | %.3g | %.3g |\n",
+                             linearGainToDb(g.gain), g.frames, g.rowVariance, g.rowVarianceSE,
+                             m.rowVariance(g.gain), g.pixelVariance, g.excessKurtosis, g.before.pValue,
+                             g.after.pValue);
+        for (const std::string& n : r.dark.notes)
+            md += "\nNote: " + n + "\n";
+        md += "\n";
+    }
     md += "## Model\n\n";
     md += cv::format("Method %s, %d of %d samples used. ",
                      rep.method == NOISE_FIT_JOINT ? "joint" : "two-stage", rep.samplesUsed, rep.samples);
@@ -324,6 +345,9 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     ProgressBar progress("calibrate", totalFrames);
     RawFormat firstFormat;
     std::vector<BurstFacts> facts;
+    // The dark bursts' frames, kept for the dark-frame components (their statistics need every frame).
+    std::vector<std::vector<cv::Mat>> darkFrames;
+    std::vector<double> darkGains;
     for (size_t i = 0; i < specs.size(); ++i) {
         const CalibrationManifest::Burst& spec = specs[i];
         const double gain = dbToLinearGain(gainsDb[i]);
@@ -343,6 +367,13 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                 requireSameCapture(first, spec.files.front(), m, spec.files[t]);
             }
             stats->add(m.mosaic);
+            if (spec.dark && o.darkComponents) {
+                if (t == 0) {
+                    darkFrames.emplace_back();
+                    darkGains.push_back(gain);
+                }
+                darkFrames.back().push_back(m.mosaic);
+            }
             if (t == 0)
                 for (const cv::Rect& s : squares)
                     if ((s & cv::Rect(cv::Point(), stats->size())) != s)
@@ -417,6 +448,28 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     result.report = calibrateNoiseModel(samples, params);
     // The ISO of gain 1 travels with the model, so a camera file's ISO gives its gain when augmenting.
     result.report.model.baseIso = result.baseIso;
+    if (o.darkComponents) {
+        if (darkFrames.empty())
+            throw std::runtime_error(
+                "--dark_components needs dark bursts (dark: true in the manifest, or folders "
+                "named dark*) of 3 or more frames");
+        DarkCalibrationParams darkParams;
+        int distinct = 0;
+        for (size_t k = 0; k < darkGains.size(); ++k)
+            distinct += std::none_of(darkGains.begin(), darkGains.begin() + long(k),
+                                     [&](double g) { return std::abs(g - darkGains[k]) < 1e-9 * g; });
+        if (distinct < 2) {
+            darkParams.rowNoise = darkParams.darkShading = false;
+            result.notes.push_back(
+                "dark bursts at one gain only: row noise and dark shading change with the gain "
+                "and need dark bursts at 2 or more gains; only the read noise's shape is "
+                "calibrated");
+        }
+        result.dark = calibrateDarkNoise(darkFrames, darkGains, firstFormat, result.report.model, darkParams);
+        result.report.model = result.dark.model;
+        result.haveDark = true;
+        darkFrames.clear();
+    }
     const CalibrationReport& report = result.report;
     {
         const double highest = report.perGain.back().gain;
@@ -444,8 +497,19 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     writeNewText(reportPath,
                  yamlToString([&](cv::FileStorage& fs) { report.write(fs, "calibration_report"); }));
     if (report.separable) {
-        writeNewText(modelPath,
-                     yamlToString([&](cv::FileStorage& fs) { report.model.write(fs, "noise_model"); }));
+        // Dark shading goes into two float TIFFs next to the model, which names them with their checksums.
+        std::vector<std::string> shadingImages;
+        if (report.model.hasDarkShading()) {
+            shadingImages = {"noise_model.dark_shading_per_gain.tiff",
+                             "noise_model.dark_shading_offset.tiff"};
+            writeNewImage(o.outDir + "/" + shadingImages[0], report.model.darkShadingPerGain);
+            writeNewImage(o.outDir + "/" + shadingImages[1], report.model.darkShadingOffset);
+        }
+        writeNewText(modelPath, yamlToString([&](cv::FileStorage& fs) {
+                         report.model.write(
+                             fs, "noise_model",
+                             std::vector<cv::String>(shadingImages.begin(), shadingImages.end()));
+                     }));
         // With gains from ISO the model carries over to the tools that index noise by ISO.
         if (result.baseIso > 0 && report.model.alpha > 0) {
             std::vector<double> profileIsos;
@@ -524,6 +588,24 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     }
     hist.write(histCsv);
 
+    if (result.haveDark) {
+        writeNewText(o.outDir + "/dark_calibration.yml",
+                     yamlToString([&](cv::FileStorage& fs) { result.dark.write(fs, "dark_calibration"); }));
+        CsvTable rows({"gain_db", "gain", "row_variance", "row_variance_se", "model_row_variance",
+                       "pixel_variance", "excess_kurtosis", "sw_p_with_rows", "sw_p_without_rows"});
+        for (const DarkGainStatistics& g : result.dark.gains)
+            rows.addRow(std::vector<double>{linearGainToDb(g.gain), g.gain, g.rowVariance, g.rowVarianceSE,
+                                            report.model.rowVariance(g.gain), g.pixelVariance,
+                                            g.excessKurtosis, g.before.pValue, g.after.pValue});
+        rows.write(o.outDir + "/dark_rows.csv");
+        CsvTable ppcc({"lambda", "ppcc"});
+        for (const cv::Vec2d& p : result.dark.ppcc)
+            ppcc.addRow(std::vector<double>{p[0], p[1]});
+        ppcc.write(o.outDir + "/dark_ppcc.csv");
+        if (o.plots)
+            plotDarkComponents(o.outDir, result.dark, o.outDir + "/dark_rows.csv",
+                               o.outDir + "/dark_ppcc.csv", result.pngs, result.notes);
+    }
     if (o.plots) {
         std::vector<double> distinctGainsDb;
         for (double g : gainsDb)

@@ -111,4 +111,18 @@ cv::Mat previewOf(const cv::Mat& mosaic, const RawFormat& format, double exposur
     return bgr;
 }
 
+void addDarkShadingPattern(cv::Size size, double amplitude, uint64_t seed, cv::rawgment::NoiseModel& model)
+{
+    cv::Mat perGain(size, CV_32FC1), offset(size, CV_32FC1);
+    cv::RNG rng(seed ^ 0x5ad1ull);
+    rng.fill(perGain, cv::RNG::NORMAL, 0, amplitude / 4);
+    rng.fill(offset, cv::RNG::NORMAL, 0, amplitude);
+    for (int c = 0; c < size.width; ++c)
+        perGain.col(c) += amplitude / 2 * c / size.width;
+    for (int r = 0; r < size.height; ++r)
+        offset.row(r) += 2 * amplitude * r / size.height;
+    model.darkShadingPerGain = perGain;
+    model.darkShadingOffset = offset;
+}
+
 } // namespace rawgment_apps

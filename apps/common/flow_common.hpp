@@ -5,6 +5,7 @@
 #define RAWGMENT_APPS_FLOW_COMMON_HPP
 
 #include <opencv2/core.hpp>
+#include <opencv2/rawgment/noise_model.hpp>
 
 #include <functional>
 #include <string>
@@ -26,6 +27,11 @@ void refuseExisting(const std::vector<std::string>& outputs);
  * "detect" (cv::mcc on the first frame, noted in `notes`). */
 std::vector<cv::Rect> manifestSquares(const std::string& patches, const std::string& firstFrame, int side,
                                       std::vector<std::string>& notes);
+
+/** Gives `model` a dark-shading pattern of `size` (NoiseModel::darkShadingPerGain and Offset), as a
+ * sensor's might look: B_r a vertical gradient plus per-pixel scatter of `amplitude` DN, B_d a
+ * horizontal ramp with scatter of a quarter of it (so that at gain 4 both are alike). Drawn from `seed`. */
+void addDarkShadingPattern(cv::Size size, double amplitude, uint64_t seed, cv::rawgment::NoiseModel& model);
 
 } // namespace rawgment_apps
 

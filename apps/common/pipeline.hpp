@@ -37,7 +37,10 @@ struct SimulateOptions
     uint64_t seed = 1;
     std::string extension = ".dng"; //!< container of the frames (.dng, .png or .tif)
     bool dark = false;              //!< also a burst of dark frames (no light) per gain
-    bool validation = true;         //!< also a bright and two dark bursts (x0.5, x0.1) at validationGainDb
+    //! Amplitude (DN) of a dark-shading pattern drawn for the chart's size (addDarkShadingPattern(); 0:
+    //! none).
+    double darkShading = 0;
+    bool validation = true; //!< also a bright and two dark bursts (x0.5, x0.1) at validationGainDb
     double validationGainDb = 12;
     int validationFrames = 100;
 };
@@ -64,6 +67,8 @@ struct CalibrateOptions
     int shapiroPixels = 2000; //!< pixels per burst tested by Shapiro-Wilk (spread over the squares)
     bool plots = true;
     uint64_t seed = 0; //!< seed of the RANSAC draws of the per-gain line fits
+    //! Also the dark-frame components (row noise, dark shading, Tukey read noise) from the dark bursts.
+    bool darkComponents = false;
 };
 
 //! What the verdict of a calibration needs to know about one burst besides its samples.
@@ -116,6 +121,8 @@ struct CalibrateResult
     CalibrationVerdict verdict;
     //! What more data would buy: a plan's name and the standard errors it would give (projectedStdError()).
     std::vector<std::pair<std::string, cv::Vec3d>> projections;
+    bool haveDark = false;                    //!< whether the dark-frame components were calibrated
+    cv::rawgment::DarkCalibrationReport dark; //!< their calibration (its model is report.model)
 };
 
 //! What a calibration manifest says, checked: every key known, gains finite, no file listed twice.

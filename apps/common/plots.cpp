@@ -3,6 +3,10 @@
 
 #include "app_tools.hpp"
 
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+
 namespace rawgment_apps {
 
 using namespace cv::rawgment;
@@ -107,6 +111,64 @@ void plotCalibration(const std::string& outDir, const CalibrationReport& report,
             gainsDb[i]);
     s += "0.05 with lines lw 2 lc rgb 'black' dt 2 title 'p = 0.05'\n";
     plotOrNote(outDir + "/shapiro_pvalue.png", s, pngs, notes);
+}
+
+void plotDarkComponents(const std::string& outDir, const DarkCalibrationReport& dark,
+                        const std::string& rowsCsv, const std::string& ppccCsv,
+                        std::vector<std::string>& pngs, std::vector<std::string>& notes)
+{
+    const NoiseModel& m = dark.model;
+    std::string rows = "set title 'Row noise: variance of a row offset against gain'\n";
+    rows += "set xlabel 'linear gain'\nset ylabel 'row variance (DN^2)'\nset logscale xy\nset grid\n";
+    rows += "set key left top box opaque\nset datafile separator ','\n";
+    rows += cv::format(
+        "plot '%s' every ::1 using 2:3:4 with yerrorbars pt 7 lc rgb '%s' title 'measured (+- 1 "
+        "standard error)', x*x*%.10g + %.10g with lines lw 2 lc rgb '%s' title 'fit: g^2 %.4g + %.4g'\n",
+        rowsCsv.c_str(), kSeriesColours[0], m.rowSigmaD2, m.rowSigmaR2, kSeriesColours[1], m.rowSigmaD2,
+        m.rowSigmaR2);
+    plotOrNote(outDir + "/dark_rows.png", rows, pngs, notes);
+    std::string ppcc = "set title 'Read-noise shape: probability-plot correlation against Tukey lambda'\n";
+    ppcc += "set xlabel 'lambda (0.14: Gaussian, smaller: heavier tails)'\nset ylabel 'PPCC'\nset grid\n";
+    ppcc += "set datafile separator ','\nset key left bottom box opaque\n";
+    ppcc += cv::format("set arrow from %.6g, graph 0 to %.6g, graph 1 nohead dt 2 lc rgb '%s'\n",
+                       dark.lambdaOfResiduals, dark.lambdaOfResiduals, kSeriesColours[1]);
+    ppcc += cv::format(
+        "plot '%s' every ::1 using 1:2 with linespoints pt 7 ps 0.5 lc rgb '%s' title "
+        "'residuals (best %.3f; Gaussian plot %.5f); model lambda %.3f after the correction'\n",
+        ppccCsv.c_str(), kSeriesColours[0], dark.lambdaOfResiduals, dark.ppccGaussian, m.tukeyLambda);
+    plotOrNote(outDir + "/dark_ppcc.png", ppcc, pngs, notes);
+    if (!m.hasDarkShading())
+        return;
+    const std::string shading = outDir + "/dark_shading.png";
+    if (pathExists(shading)) {
+        pngs.push_back(shading);
+        return;
+    }
+    // Each map in false colour over its 1st to 99th percentile, side by side, with its range as text.
+    std::vector<cv::Mat> panels;
+    for (int i = 0; i < 2; ++i) {
+        const cv::Mat& map = i == 0 ? m.darkShadingPerGain : m.darkShadingOffset;
+        std::vector<float> v(map.begin<float>(), map.end<float>());
+        std::sort(v.begin(), v.end());
+        const float lo = v[v.size() / 100], hi = v[v.size() - 1 - v.size() / 100];
+        cv::Mat scaled, colour;
+        map.convertTo(scaled, CV_8U, 255.0 / std::max(hi - lo, 1e-6f),
+                      -lo * 255.0 / std::max(hi - lo, 1e-6f));
+        // About 600 pixels wide, whatever the sensor: small maps are enlarged pixel for pixel.
+        const double fit = 600.0 / map.cols;
+        cv::resize(scaled, scaled, cv::Size(), fit, fit, fit < 1 ? cv::INTER_AREA : cv::INTER_NEAREST);
+        cv::applyColorMap(scaled, colour, cv::COLORMAP_VIRIDIS);
+        cv::Mat panel(colour.rows + 40, colour.cols + 20, CV_8UC3, cv::Scalar::all(255));
+        colour.copyTo(panel(cv::Rect(10, 40, colour.cols, colour.rows)));
+        cv::putText(
+            panel, cv::format("%s: %.3g to %.3g DN", i == 0 ? "B_d (per unit gain)" : "B_r (offset)", lo, hi),
+            cv::Point(10, 28), cv::FONT_HERSHEY_SIMPLEX, 0.6, cv::Scalar::all(0), 1, cv::LINE_AA);
+        panels.push_back(panel);
+    }
+    cv::Mat both;
+    cv::hconcat(panels, both);
+    writeNewImage(shading, both);
+    pngs.push_back(shading);
 }
 
 void plotValidation(const std::string& outDir, const std::string& csvPath,

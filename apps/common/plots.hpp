@@ -25,6 +25,13 @@ void plotCalibration(const std::string& outDir, const cv::rawgment::CalibrationR
                      const std::vector<double>& gainsDb, bool haveShapiro, std::vector<std::string>& pngs,
                      std::vector<std::string>& notes);
 
+/** The dark-frame components' plots in outDir: dark_rows.png (row variance against gain with the fitted
+ * g^2 sigma_row_d^2 + sigma_row_r^2), dark_ppcc.png (probability-plot correlation against lambda) and
+ * dark_shading.png (the two maps in false colour, without gnuplot). */
+void plotDarkComponents(const std::string& outDir, const cv::rawgment::DarkCalibrationReport& dark,
+                        const std::string& rowsCsv, const std::string& ppccCsv,
+                        std::vector<std::string>& pngs, std::vector<std::string>& notes);
+
 //! One panel of the validation plot: an exposure factor and the largest mean of its bins.
 struct ValidationPanel
 {

@@ -48,7 +48,7 @@ std::string jobDescription(const SimulateOptions& o)
         fs << "quantize" << int(o.sensor.quantize);
         fs << "seed" << cv::format("%llu", static_cast<unsigned long long>(o.seed)) << "extension"
            << o.extension;
-        fs << "dark" << int(o.dark);
+        fs << "dark" << int(o.dark) << "dark_shading" << o.darkShading;
         fs << "validation" << int(o.validation) << "validation_gain_db" << o.validationGainDb
            << "validation_frames" << o.validationFrames;
         fs << "}";
@@ -78,7 +78,10 @@ SimulateResult simulateBursts(const SimulateOptions& o)
     co.pattern = o.sensor.pattern;
     co.patchSize = o.patchSize;
     const ColorCheckerScene scene = makeColorCheckerScene(co);
-    const SensorSimulator sensor(o.sensor, scene.meanAtUnitGain.size());
+    SensorParams params = o.sensor;
+    if (o.darkShading > 0)
+        addDarkShadingPattern(scene.meanAtUnitGain.size(), o.darkShading, o.seed, params.noise);
+    const SensorSimulator sensor(params, scene.meanAtUnitGain.size());
     double sceneMax = 0;
     cv::minMaxLoc(scene.meanAtUnitGain, nullptr, &sceneMax);
     const RawFormat unit = sensor.rawFormat(1.0);

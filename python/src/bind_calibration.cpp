@@ -196,6 +196,64 @@ void bindCalibration(py::module_& m)
         .def_readwrite("pValue", &ShapiroWilkResult::pValue, doc("ShapiroWilkResult::pValue"))
         .def_readwrite("n", &ShapiroWilkResult::n, doc("ShapiroWilkResult::n"))
         .def_readwrite("constant", &ShapiroWilkResult::constant, doc("ShapiroWilkResult::constant"));
+    // The dark-frame calibration after ShapiroWilkResult, which its statistics hold (the stub names the
+    // Python type only of classes already bound).
+    py::class_<DarkCalibrationParams>(m, "DarkCalibrationParams", doc("DarkCalibrationParams"))
+        .def(keywordInit<DarkCalibrationParams>())
+        .def_readwrite("rowNoise", &DarkCalibrationParams::rowNoise, doc("DarkCalibrationParams::rowNoise"))
+        .def_readwrite("darkShading", &DarkCalibrationParams::darkShading,
+                       doc("DarkCalibrationParams::darkShading"))
+        .def_readwrite("tukeyShape", &DarkCalibrationParams::tukeyShape,
+                       doc("DarkCalibrationParams::tukeyShape"))
+        .def_readwrite("lambdaMin", &DarkCalibrationParams::lambdaMin,
+                       doc("DarkCalibrationParams::lambdaMin"))
+        .def_readwrite("lambdaMax", &DarkCalibrationParams::lambdaMax,
+                       doc("DarkCalibrationParams::lambdaMax"))
+        .def_readwrite("ppccSamples", &DarkCalibrationParams::ppccSamples,
+                       doc("DarkCalibrationParams::ppccSamples"))
+        .def("validate", &DarkCalibrationParams::validate, doc("DarkCalibrationParams::validate"));
+    py::class_<DarkGainStatistics>(m, "DarkGainStatistics", doc("DarkGainStatistics"))
+        .def(keywordInit<DarkGainStatistics>())
+        .def_readwrite("gain", &DarkGainStatistics::gain, doc("DarkGainStatistics::gain"))
+        .def_readwrite("frames", &DarkGainStatistics::frames, doc("DarkGainStatistics::frames"))
+        .def_readwrite("rowMeanVar", &DarkGainStatistics::rowMeanVar, doc("DarkGainStatistics::rowMeanVar"))
+        .def_readwrite("rowVariance", &DarkGainStatistics::rowVariance,
+                       doc("DarkGainStatistics::rowVariance"))
+        .def_readwrite("rowVarianceSE", &DarkGainStatistics::rowVarianceSE,
+                       doc("DarkGainStatistics::rowVarianceSE"))
+        .def_readwrite("pixelVariance", &DarkGainStatistics::pixelVariance,
+                       doc("DarkGainStatistics::pixelVariance"))
+        .def_readwrite("excessKurtosis", &DarkGainStatistics::excessKurtosis,
+                       doc("DarkGainStatistics::excessKurtosis"))
+        .def_readwrite("before", &DarkGainStatistics::before, doc("DarkGainStatistics::before"))
+        .def_readwrite("after", &DarkGainStatistics::after, doc("DarkGainStatistics::after"));
+    py::class_<DarkCalibrationReport>(m, "DarkCalibrationReport", doc("DarkCalibrationReport"))
+        .def(keywordInit<DarkCalibrationReport>())
+        .def_readwrite("model", &DarkCalibrationReport::model, doc("DarkCalibrationReport::model"))
+        .def_readwrite("gains", &DarkCalibrationReport::gains, doc("DarkCalibrationReport::gains"))
+        .def_readwrite("ppcc", &DarkCalibrationReport::ppcc, doc("DarkCalibrationReport::ppcc"))
+        .def_readwrite("lambdaOfResiduals", &DarkCalibrationReport::lambdaOfResiduals,
+                       doc("DarkCalibrationReport::lambdaOfResiduals"))
+        .def_readwrite("ppccBest", &DarkCalibrationReport::ppccBest, doc("DarkCalibrationReport::ppccBest"))
+        .def_readwrite("ppccGaussian", &DarkCalibrationReport::ppccGaussian,
+                       doc("DarkCalibrationReport::ppccGaussian"))
+        .def_readwrite("notes", &DarkCalibrationReport::notes, doc("DarkCalibrationReport::notes"));
+    m.def(
+        "calibrateDarkNoise",
+        [](const py::list& bursts, const std::vector<double>& gains, const RawFormat& format,
+           const NoiseModel& base, const DarkCalibrationParams& params) {
+            std::vector<std::vector<cv::Mat>> frames;
+            for (const py::handle& burst : bursts)
+                frames.push_back(matsFromList(burst, "bursts", {CV_16U, CV_32F}));
+            return withoutGil("calibrateDarkNoise",
+                              [&] { return calibrateDarkNoise(frames, gains, format, base, params); });
+        },
+        py::arg("bursts"), py::arg("gains"), py::arg("format"), py::arg("base"),
+        py::arg("params") = DarkCalibrationParams(),
+        doc("calibrateDarkNoise",
+            "Python: `bursts` is a list (one per gain) of lists of uint16 or float32 HxW "
+            "arrays."));
+
     m.def(
         "shapiroWilk",
         [](const py::object& samples) {

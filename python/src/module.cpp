@@ -310,6 +310,45 @@ void bindCore(py::module_& m)
         .def_readwrite("sigmaD2", &NoiseModel::sigmaD2, doc("NoiseModel::sigmaD2"))
         .def_readwrite("sigmaR2", &NoiseModel::sigmaR2, doc("NoiseModel::sigmaR2"))
         .def_readwrite("baseIso", &NoiseModel::baseIso, doc("NoiseModel::baseIso"))
+        .def_readwrite("rowSigmaD2", &NoiseModel::rowSigmaD2, doc("NoiseModel::rowSigmaD2"))
+        .def_readwrite("rowSigmaR2", &NoiseModel::rowSigmaR2, doc("NoiseModel::rowSigmaR2"))
+        .def_readwrite("tukeyRead", &NoiseModel::tukeyRead, doc("NoiseModel::tukeyRead"))
+        .def_readwrite("tukeyLambda", &NoiseModel::tukeyLambda, doc("NoiseModel::tukeyLambda"))
+        .def_property(
+            "darkShadingPerGain",
+            [](const NoiseModel& self) -> py::object {
+                return self.darkShadingPerGain.empty()
+                           ? py::object(py::none())
+                           : py::object(arrayFromMat(self.darkShadingPerGain.clone()));
+            },
+            [](NoiseModel& self, const py::object& map) {
+                self.darkShadingPerGain =
+                    map.is_none() ? cv::Mat() : matFromArray(map, "darkShadingPerGain", {CV_32F}).clone();
+            },
+            doc("NoiseModel::darkShadingPerGain", "Python: a float32 HxW array (a copy), or None."))
+        .def_property(
+            "darkShadingOffset",
+            [](const NoiseModel& self) -> py::object {
+                return self.darkShadingOffset.empty()
+                           ? py::object(py::none())
+                           : py::object(arrayFromMat(self.darkShadingOffset.clone()));
+            },
+            [](NoiseModel& self, const py::object& map) {
+                self.darkShadingOffset =
+                    map.is_none() ? cv::Mat() : matFromArray(map, "darkShadingOffset", {CV_32F}).clone();
+            },
+            doc("NoiseModel::darkShadingOffset", "Python: a float32 HxW array (a copy), or None."))
+        .def("hasRowNoise", &NoiseModel::hasRowNoise, doc("NoiseModel::hasRowNoise"))
+        .def("hasDarkShading", &NoiseModel::hasDarkShading, doc("NoiseModel::hasDarkShading"))
+        .def("hasDarkComponents", &NoiseModel::hasDarkComponents, doc("NoiseModel::hasDarkComponents"))
+        .def("rowVariance", &NoiseModel::rowVariance, py::arg("gain"), doc("NoiseModel::rowVariance"))
+        .def(
+            "darkShadingAt",
+            [](const NoiseModel& self, double gain) -> py::object {
+                const cv::Mat s = self.darkShadingAt(gain);
+                return s.empty() ? py::object(py::none()) : py::object(arrayFromMat(s));
+            },
+            py::arg("gain"), doc("NoiseModel::darkShadingAt", "Python: a float32 array, or None."))
         .def("validate", &NoiseModel::validate, doc("NoiseModel::validate"))
         .def("lineAtGain", &NoiseModel::lineAtGain, py::arg("gain"), doc("NoiseModel::lineAtGain"))
         .def(

@@ -611,7 +611,13 @@ void CalibrationReport::write(FileStorage& fs, const String& name) const
     fs << "format_version" << (withErrors ? FORMAT_VERSION : 1);
     fs << "method" << (method == NOISE_FIT_JOINT ? "joint" : "two_stage");
     fs << "separable" << static_cast<int>(separable);
-    model.write(fs, "noise_model");
+    {
+        // The dark-shading maps live beside the model file (NoiseModel::save()), not in the report.
+        NoiseModel withoutMaps = model;
+        withoutMaps.darkShadingPerGain = Mat();
+        withoutMaps.darkShadingOffset = Mat();
+        withoutMaps.write(fs, "noise_model");
+    }
     fs << "r_squared_slope" << rSquaredSlope;
     fs << "r_squared_offset" << rSquaredOffset;
     fs << "samples" << samples;

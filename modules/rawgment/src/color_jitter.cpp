@@ -314,15 +314,20 @@ struct JitterKeys
     uint64_t gaussian, poisson, row, tukey;
 };
 
+// inputShading (ACCOUNT_PRIOR with dark shading): the input's shading at its gain, which each row takes
+// out of its values with the black level, so that Eq. 13's prior mean is signal only (the shot noise of
+// a dark input would otherwise count its dark offset as photons); the extra terms then add the target's
+// shading less the input's.
 template <typename T>
 void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& model, const JitterConstants& k,
-                const JitterColumnTables& tables, const JitterKeys& keys, const Range& rows,
-                std::atomic<int64>& brightening)
+                const JitterColumnTables& tables, const JitterKeys& keys, const Mat& inputShading,
+                const Range& rows, std::atomic<int64>& brightening)
 {
     const int cols = src.cols;
     const bool noise = k.alignment != NoiseAlignment::NONE;
     const bool tails = noise && k.dark.tails, dark = noise && k.dark.any();
-    std::vector<float> z(static_cast<size_t>(cols)), t(tails ? cols : 0), extra(dark ? cols : 0);
+    std::vector<float> z(static_cast<size_t>(cols)), t(tails ? cols : 0), extra(dark ? cols : 0),
+        blackAndShading(inputShading.empty() ? 0 : cols);
     const bool scalar = noise && (k.sampling == ShotNoiseSampling::POISSON || tails);
     const detail::TukeyUnitSampler samplers[4] = {
         detail::TukeyUnitSampler(k.dark.lambda[0]), detail::TukeyUnitSampler(k.dark.lambda[1]),
@@ -339,7 +344,13 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
         }
         if (dark)
             detail::darkRowExtra(k.dark, model, keys.row, r, cols, extra.data());
-        const JitterColumns col = tables.forRow(r);
+        JitterColumns col = tables.forRow(r);
+        if (!inputShading.empty()) {
+            const float* s = inputShading.ptr<float>(r);
+            for (int c = 0; c < cols; ++c)
+                blackAndShading[static_cast<size_t>(c)] = col.black[c] + s[c];
+            col.black = blackAndShading.data();
+        }
         const float* priorRow = prior.empty() ? nullptr : prior.ptr<float>(r);
         const float* extraRow = dark ? extra.data() : nullptr;
         if (scalar) {
@@ -358,8 +369,9 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
  * contrast p_c at gain ratio p_g (p_u = p_c / p_g) from gain g:
  * - row: ACCOUNT_PRIOR adds (1 - p_u^2) p_g^2 g^2 sigma_row_d^2 + (1 - p_c^2) sigma_row_r^2 (Eq. 13's
  *   split applied to the row offset); IGNORE_PRIOR the target's whole row variance;
- * - shading: ACCOUNT_PRIOR adds the target's g p_g B_d + B_r minus the scaled input's p_c (g B_d + B_r);
- *   IGNORE_PRIOR the target's whole shading;
+ * - shading: ACCOUNT_PRIOR takes the input's g B_d + B_r out with the black level (jitterRows()) and
+ *   puts the target's g p_g B_d + B_r in its place, so it adds g (p_g - 1) B_d on top of that; IGNORE_PRIOR
+ *   adds the target's whole shading to the values as they are;
  * - tails: the added read part's lambda (addedReadLambda(): the prior's read p_c^2 b is kept); IGNORE_PRIOR
  *   the model's lambda. */
 detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, const ColorJitter& jitter,
@@ -381,8 +393,8 @@ detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, const Co
             account ? (1 - pu * pu) * pg * pg * g * g * model.rowSigmaD2 + (1 - pc * pc) * model.rowSigmaR2
                     : model.rowVariance(g * pg);
         d.rowSigma[s] = static_cast<float>(std::sqrt(std::max(rowAdded, 0.0)));
-        d.shadingPerGain[s] = static_cast<float>(account ? g * pg - pc * g : g * pg);
-        d.shadingOffset[s] = static_cast<float>(account ? 1 - pc : 1.0);
+        d.shadingPerGain[s] = static_cast<float>(account ? g * (pg - 1) : g * pg);
+        d.shadingOffset[s] = static_cast<float>(account ? 0.0 : 1.0);
         if (!d.tails)
             continue;
         d.lambda[s] =
@@ -485,10 +497,14 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
             perSiteLine(jitter.contrast[s], jitter.gainRatio, terms, k.slope[s], k.offset[s]);
     }
 
-    const Mat prior =
-        noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && noise.alignment != NoiseAlignment::NONE
-            ? localPriorMean(src, format)
-            : Mat();
+    const Mat inputShading = noise.alignment == NoiseAlignment::ACCOUNT_PRIOR && model.hasDarkShading()
+                                 ? model.darkShadingAt(format.gain)
+                                 : Mat();
+    Mat prior = noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && noise.alignment != NoiseAlignment::NONE
+                    ? localPriorMean(src, format)
+                    : Mat();
+    if (!prior.empty() && !inputShading.empty())
+        prior -= inputShading;
     k.dark = jitterDarkTerms(model, format.gain, jitter, noise.alignment);
     Mat dst = detail::stepOutput(src, _dst);
     std::atomic<int64> brightening{0};
@@ -499,9 +515,9 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     const JitterColumnTables tables(k, src.cols);
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
-            jitterRows<ushort>(src, prior, dst, model, k, tables, keys, rows, brightening);
+            jitterRows<ushort>(src, prior, dst, model, k, tables, keys, inputShading, rows, brightening);
         else
-            jitterRows<float>(src, prior, dst, model, k, tables, keys, rows, brightening);
+            jitterRows<float>(src, prior, dst, model, k, tables, keys, inputShading, rows, brightening);
     });
     detail::reportSaturation(src, format, report, saturatedMask);
     _dst.assign(dst);

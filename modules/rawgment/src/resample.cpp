@@ -60,17 +60,31 @@ struct ResampleConstants
     NoiseAlignment alignment;
     ShotNoiseSampling sampling;
     uint64_t key, poissonKey; // the step's Gaussian and Poisson streams
+    // The dark-frame components (resampleDarkTerms()): the rows' variance to restore, the shading to
+    // restore, the tails; their streams; the model that holds the maps.
+    detail::DarkTerms dark;
+    double rowVariance = 0; // the input's row variance at its gain
+    Mat inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out of the values before the step
+    Mat shading;      // the target's dark shading, added after it
+    uint64_t rowKey = 0, tukeyKey = 0;
 };
 
-// Plane row `planeRow` of site `site`, black-subtracted, into out[0..pad + width + pad) with the plane's
-// edge replicated `pad` columns on each side.
+// Plane row `planeRow` of site `site`, black-subtracted (and without the input's dark shading when
+// `shading` is not empty), into out[0..pad + width + pad) with the plane's edge replicated `pad` columns
+// on each side.
 template <typename T>
-void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, float* out)
+void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, float* out,
+                  const Mat& shading = Mat())
 {
     const T* s = src.ptr<T>(2 * planeRow + site / 2) + site % 2;
     const int width = src.cols / 2;
     for (int j = 0; j < width; ++j)
         out[pad + j] = static_cast<float>(s[2 * j]) - black;
+    if (!shading.empty()) {
+        const float* b = shading.ptr<float>(2 * planeRow + site / 2) + site % 2;
+        for (int j = 0; j < width; ++j)
+            out[pad + j] -= b[2 * j];
+    }
     for (int j = 0; j < pad; ++j) {
         out[j] = out[pad];
         out[pad + width + j] = out[pad + width - 1];
@@ -118,7 +132,8 @@ RAWGMENT_DISPATCHED_BY_WIDTH(void, addTapsRow,
 
 template <int W>
 RAWGMENT_KERNEL void finishResampledBlock(float* mean, const float* shotSum, const float* readFactor,
-                                          const float* z, const ResampleConstants& k, float black)
+                                          const float* z, const float* extra, const ResampleConstants& k,
+                                          float black)
 {
     typedef typename detail::Lanes<W>::F F;
     const F zero = F{}, white = zero + k.white;
@@ -137,7 +152,13 @@ RAWGMENT_KERNEL void finishResampledBlock(float* mean, const float* shotSum, con
         } else {
             v = k.shot * detail::maxLanes(m, zero) + k.floorVar;
         }
-        m = detail::minLanes(detail::maxLanes(m + detail::sqrtLanes(v) * zv + black, zero), white);
+        m += detail::sqrtLanes(v) * zv;
+        if (extra) { // the dark-frame components, when the model has them
+            F e;
+            std::memcpy(&e, extra, sizeof(e));
+            m += e;
+        }
+        m = detail::minLanes(detail::maxLanes(m + black, zero), white);
     }
     std::memcpy(mean, &m, sizeof(m));
 }
@@ -147,17 +168,18 @@ RAWGMENT_KERNEL void finishResampledBlock(float* mean, const float* shotSum, con
 // (detail::wholeBlocks()).
 template <int W>
 RAWGMENT_KERNEL void finishResampledRowKernel(float* mean, const float* shotSum, const float* readFactor,
-                                              const float* z, const ResampleConstants& k, float black, int n)
+                                              const float* z, const float* extra, const ResampleConstants& k,
+                                              float black, int n)
 {
     const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
     for (int j = 0; j < n; j += W)
         finishResampledBlock<W>(mean + j, account ? shotSum + j : nullptr, account ? readFactor + j : nullptr,
-                                z ? z + j : nullptr, k, black);
+                                z ? z + j : nullptr, extra ? extra + j : nullptr, k, black);
 }
 RAWGMENT_DISPATCHED_BY_WIDTH(void, finishResampledRow,
                              (float* mean, const float* shotSum, const float* readFactor, const float* z,
-                              const ResampleConstants& k, float black, int n),
-                             (mean, shotSum, readFactor, z, k, black, n))
+                              const float* extra, const ResampleConstants& k, float black, int n),
+                             (mean, shotSum, readFactor, z, extra, k, black, n))
 
 template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int planeRow)
 {
@@ -169,33 +191,76 @@ template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int
                        : static_cast<T>(v[j]);
 }
 
-// ShotNoiseSampling::POISSON for a resampled row: the shot part of Eq. 15 (or of the model, for
-// IGNORE_PRIOR) as an electron count at the input gain (see sampledNoise), the rest Gaussian.
-void finishResampledRowPoisson(float* mean, const float* shotSum, const float* readFactor, const float* z,
-                               const ResampleConstants& k, float black, detail::CounterRng& rng, int n)
+// The scalar rows: ShotNoiseSampling::POISSON for a resampled row (the shot part of Eq. 15, or of the
+// model for IGNORE_PRIOR, as an electron count at the input gain, see sampledNoise) and Tukey-lambda
+// read noise (t: the row's unit-variance draws, the read part's shape), with the dark terms' `extra`.
+void finishResampledRowScalar(float* mean, const float* shotSum, const float* readFactor, const float* z,
+                              const float* t, const float* extra, const ResampleConstants& k, float black,
+                              detail::CounterRng& rng, int n)
 {
+    const bool poisson = k.sampling == ShotNoiseSampling::POISSON;
     for (int j = 0; j < n; ++j) {
         const AddedVariance v = k.alignment == NoiseAlignment::ACCOUNT_PRIOR
                                     ? AddedVariance{k.shot * shotSum[j], readFactor[j] * k.floorVar}
                                     : AddedVariance{k.shot * std::max(mean[j], 0.0f), k.floorVar};
-        mean[j] = std::min(std::max(mean[j] + sampledNoise(v, k.shot, z[j], rng) + black, 0.0f), k.white);
+        const float noise = t ? detail::sampledNoiseWithTails(v, k.shot, poisson, z[j], t[j], rng)
+                              : sampledNoise(v, k.shot, z[j], rng);
+        float out = mean[j] + noise;
+        if (extra)
+            out += extra[j];
+        mean[j] = std::min(std::max(out + black, 0.0f), k.white);
     }
 }
 
-// The end of every resampled row: its noise streams (site, row), the noise, the black level, the store.
+// The dark-frame terms of one output plane row into extra[0..n): the row offset that the step's
+// vertical weights removed (rowKeep = their sum of squares: the share of the input's row variance
+// kept), drawn once per mosaic row so both sites of a row share it, plus the dark shading to restore.
+void resampledDarkRow(const ResampleConstants& k, int site, int planeRow, float rowKeep, float* extra, int n)
+{
+    const int r = 2 * planeRow + site / 2;
+    float amp = 0;
+    if (k.dark.row) {
+        const double added =
+            k.alignment == NoiseAlignment::ACCOUNT_PRIOR ? k.rowVariance * (1.0 - rowKeep) : k.rowVariance;
+        detail::CounterRng rng(k.rowKey, static_cast<uint64_t>(r));
+        amp = static_cast<float>(std::sqrt(std::max(added, 0.0)) * rng.gaussian());
+    }
+    const float* delta = k.dark.shading ? k.shading.ptr<float>(r) + site % 2 : nullptr;
+    for (int j = 0; j < n; ++j)
+        extra[j] = amp + (delta ? delta[2 * j] : 0.0f);
+}
+
+// The end of every resampled row: its noise streams (site, row), the noise, the dark terms, the black
+// level, the store.
 template <typename T>
 void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float* readFactor,
-                    std::vector<float>& z, const ResampleConstants& k, Mat& dst, int site, int planeRow)
+                    std::vector<float>& z, const ResampleConstants& k, Mat& dst, int site, int planeRow,
+                    float rowKeep = 1)
 {
     const int n = dst.cols / 2;
     const uint64_t stream = detail::planeRowStream(site, planeRow);
-    if (k.alignment != NoiseAlignment::NONE)
+    const bool noise = k.alignment != NoiseAlignment::NONE;
+    if (noise)
         detail::fillGaussian(k.key, stream, z.data(), n);
-    if (k.alignment != NoiseAlignment::NONE && k.sampling == ShotNoiseSampling::POISSON) {
+    std::vector<float> extra, t;
+    if (noise && k.dark.any()) {
+        extra.resize(detail::wholeBlocks(n));
+        resampledDarkRow(k, site, planeRow, rowKeep, extra.data(), n);
+    }
+    if (noise && k.dark.tails) {
+        t.resize(static_cast<size_t>(n));
+        detail::CounterRng uniforms(k.tukeyKey, stream);
+        const detail::TukeyUnitSampler tukey(k.dark.lambda[site]);
+        for (int j = 0; j < n; ++j)
+            t[static_cast<size_t>(j)] = static_cast<float>(tukey(uniforms.uniform()));
+    }
+    const float* extraRow = extra.empty() ? nullptr : extra.data();
+    if (noise && (k.sampling == ShotNoiseSampling::POISSON || k.dark.tails)) {
         detail::CounterRng rng(k.poissonKey, stream);
-        finishResampledRowPoisson(mean.data(), shotSum, readFactor, z.data(), k, k.black[site], rng, n);
+        finishResampledRowScalar(mean.data(), shotSum, readFactor, z.data(), t.empty() ? nullptr : t.data(),
+                                 extraRow, k, k.black[site], rng, n);
     } else {
-        finishResampledRow(mean.data(), shotSum, readFactor, z.data(), k, k.black[site], n);
+        finishResampledRow(mean.data(), shotSum, readFactor, z.data(), extraRow, k, k.black[site], n);
     }
     storePlaneRow<T>(mean.data(), dst, site, planeRow);
 }
@@ -216,6 +281,45 @@ ResampleConstants resampleConstants(const RawFormat& format, const NoiseModel& m
     k.key = detail::stepKey(seed, gaussian);
     k.poissonKey = detail::stepKey(seed, poisson);
     return k;
+}
+
+/* The dark-frame components a resampling step adds (docs/mathematics.md, "Dark-frame noise"). The step
+ * keeps the gain, so the target has the input's components in full. A weighted sum keeps sum W^2 of the
+ * input's row variance (W the weights per source row: resampledDarkRow()). ACCOUNT_PRIOR takes the
+ * input's dark shading S out of the values before the step (so that it is neither resampled nor taken
+ * for signal by the shot-noise estimate of Eq. 15) and adds S after it; IGNORE_PRIOR adds S on top.
+ * The read part keeps sum w^2 of its variance and sum w^4 of its fourth cumulant: the added part's
+ * lambda is addedReadLambda() with the step's typical weights (sumW2, sumW4; per pixel they vary near
+ * edges and, for scaling, along the row: the variance stays exact per pixel, the kurtosis is matched
+ * on average). */
+void resampleDarkTerms(ResampleConstants& k, const NoiseModel& model, const RawFormat& format, Size size,
+                       double sumW2, double sumW4, uint64 seed, detail::RandomStream rowStream,
+                       detail::RandomStream tukeyStream)
+{
+    if (k.alignment == NoiseAlignment::NONE)
+        return;
+    detail::checkDarkShadingSize(model, size, "the resampling step");
+    detail::DarkTerms& d = k.dark;
+    d.row = model.hasRowNoise();
+    d.shading = model.hasDarkShading();
+    d.tails = model.tukeyRead;
+    k.rowVariance = model.rowVariance(format.gain);
+    k.rowKey = detail::stepKey(seed, rowStream);
+    k.tukeyKey = detail::stepKey(seed, tukeyStream);
+    const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
+    if (d.tails) {
+        const double b = k.floorVar;
+        const double lambda =
+            account ? detail::addedReadLambda(model.tukeyLambda, b, sumW4 * b * b, (1 - sumW2) * b)
+                    : model.tukeyLambda;
+        for (int s = 0; s < 4; ++s)
+            d.lambda[s] = lambda;
+    }
+    if (d.shading) {
+        k.shading = model.darkShadingAt(format.gain);
+        if (account)
+            k.inputShading = k.shading;
+    }
 }
 
 struct KernelTap
@@ -291,6 +395,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             edgeColumns.push_back(std::move(e));
         }
     std::vector<KernelTap> rowTaps, pixelTaps;
+    std::vector<float> rowWeights; // the kernel's weight per source row (after clamping)
     std::vector<const float*> tapRows;
     std::vector<float> tapWeights, tapShotWeights;
     int ringSite = -1;
@@ -301,6 +406,15 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             ringSite = site;
         }
         const bool edgeRow = i < ry || i >= ph - ry;
+        float rowKeep = 1;
+        if (k.dark.row) {
+            rowWeights.assign(static_cast<size_t>(ksize.height), 0.0f);
+            for (const KernelTap& t : taps)
+                rowWeights[static_cast<size_t>(std::min(std::max(i + t.dy - ry, 0), ph - 1) - i + ry)] += t.w;
+            rowKeep = 0;
+            for (float w : rowWeights)
+                rowKeep += w * w;
+        }
         const float rowReadFactor =
             edgeRow ? mergeClampedTaps(taps, i, 0, plane, radius, true, false, rowTaps) : readFactor;
         std::fill(readFactors.begin(), readFactors.end(), rowReadFactor);
@@ -313,7 +427,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             const size_t slot = static_cast<size_t>(si % ksize.height);
             float* row = ring.data() + slot * stride;
             if (ringRow[slot] != si) {
-                loadPlaneRow<T>(src, site, si, rx, k.black[site], row);
+                loadPlaneRow<T>(src, site, si, rx, k.black[site], row, k.inputShading);
                 ringRow[slot] = si;
             }
             tapRows.push_back(row + t.dx);
@@ -323,7 +437,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
         addTapsRow(mean.data(), shotSum.data(), tapRows.data(), tapWeights.data(), tapShotWeights.data(),
                    static_cast<int>(tapRows.size()), exactShot, pw);
         if (!account) {
-            finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i);
+            finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i, rowKeep);
             continue;
         }
         for (const EdgeColumn& e : edgeColumns) {
@@ -346,7 +460,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
             for (int j = 0; j < pw; ++j)
                 shotSum[static_cast<size_t>(j)] =
                     readFactors[static_cast<size_t>(j)] * std::max(mean[static_cast<size_t>(j)], 0.0f);
-        finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i);
+        finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i, rowKeep);
     }
 }
 
@@ -434,11 +548,15 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
         const int site = idx / ph, i = idx % ph;
         const BilinearAxis& ax = cols[site % 2];
         const BilinearAxis& ay = rows[site / 2];
-        loadPlaneRow<T>(src, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site], row0.data());
-        loadPlaneRow<T>(src, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data());
+        loadPlaneRow<T>(src, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site], row0.data(),
+                        k.inputShading);
+        loadPlaneRow<T>(src, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data(),
+                        k.inputShading);
         bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
                     ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
-        finishPlaneRow<T>(mean, shot.data(), readFactor.data(), z, k, dst, site, i);
+        const float fy = ay.f[static_cast<size_t>(i)];
+        finishPlaneRow<T>(mean, shot.data(), readFactor.data(), z, k, dst, site, i,
+                          (1 - fy) * (1 - fy) + fy * fy);
     }
 }
 
@@ -457,9 +575,25 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
     }
     const BilinearAxis cols[2] = {bilinearAxis(src.cols / 2, 0, scale), bilinearAxis(src.cols / 2, 1, scale)};
     const BilinearAxis rows[2] = {bilinearAxis(src.rows / 2, 0, scale), bilinearAxis(src.rows / 2, 1, scale)};
-    const ResampleConstants k =
-        resampleConstants(format, model, noise, seed, detail::RandomStream::SCALE_GAUSSIAN,
-                          detail::RandomStream::SCALE_POISSON);
+    ResampleConstants k = resampleConstants(format, model, noise, seed, detail::RandomStream::SCALE_GAUSSIAN,
+                                            detail::RandomStream::SCALE_POISSON);
+    if (model.hasDarkComponents()) {
+        // The typical weights: sum w^2 and sum w^4 of the bilinear taps averaged over the output pixels
+        // (a product of the two axes' averages).
+        double axis2[2] = {0, 0}, axis4[2] = {0, 0};
+        for (int a = 0; a < 2; ++a) {
+            const BilinearAxis* axis = a == 0 ? cols : rows;
+            const int n = a == 0 ? src.cols / 2 : src.rows / 2;
+            for (int p = 0; p < 2; ++p)
+                for (int j = 0; j < n; ++j) {
+                    const double f = axis[p].f[static_cast<size_t>(j)];
+                    axis2[a] += (f * f + (1 - f) * (1 - f)) / (2.0 * n);
+                    axis4[a] += (std::pow(f, 4) + std::pow(1 - f, 4)) / (2.0 * n);
+                }
+        }
+        resampleDarkTerms(k, model, format, src.size(), axis2[0] * axis2[1], axis4[0] * axis4[1], seed,
+                          detail::RandomStream::SCALE_ROW, detail::RandomStream::SCALE_TUKEY);
+    }
     Mat dst = detail::stepOutput(src, _dst);
     parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
         if (src.depth() == CV_16U)
@@ -503,9 +637,14 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
             if (wk > 0)
                 taps.push_back({y, x, static_cast<float>(wk), static_cast<float>(wk * (1 - wk))});
         }
-    const ResampleConstants k = resampleConstants(
-        format, model, noise, seed, detail::RandomStream::BLUR_GAUSSIAN, detail::RandomStream::BLUR_POISSON);
+    ResampleConstants k = resampleConstants(format, model, noise, seed, detail::RandomStream::BLUR_GAUSSIAN,
+                                            detail::RandomStream::BLUR_POISSON);
     const float readFactor = static_cast<float>(1 - w.dot(w));
+    if (model.hasDarkComponents()) {
+        Mat w2 = w.mul(w);
+        resampleDarkTerms(k, model, format, src.size(), sum(w2)[0], w2.dot(w2), seed,
+                          detail::RandomStream::BLUR_ROW, detail::RandomStream::BLUR_TUKEY);
+    }
     const bool shotFromMean = noise.blurNoiseSum == BlurNoiseSum::FROM_BLURRED_MEAN;
     Mat dst = detail::stepOutput(src, _dst);
     parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {

@@ -1208,6 +1208,72 @@ TEST(Augment, darkeningAddsTheDarkFrameComponentsATargetCaptureHas)
     }
 }
 
+TEST(Augment, blurAndScaleRestoreTheDarkFrameComponentsTheyAverageAway)
+{
+    // A dark flat scene at a high gain, where the components are a large part of the noise: the target
+    // of a blur or a scale of a flat scene is a plain capture (captureBlurred of a flat scene is one).
+    const Size size(256, 256);
+    const int T = 32;
+    const double gain = 8;
+    const SensorSimulator sensor(darkComponentSensor(size), size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(gain);
+    const double black = fmt.blackLevel[0];
+    const Mat scene(size, CV_32FC1, Scalar(2)); // 16 DN at gain 8: 5 electrons
+    std::vector<Mat> input, target;
+    sensor.captureBurst(scene, gain, 1.0, T, 9, input);
+    sensor.captureBurst(scene, gain, 1.0, T, 10, target);
+    const DarkStats truth = darkStats(target, black);
+    const Mat kernel = linearMotionKernel(9, 30);
+    typedef std::function<void(const Mat&, const NoiseOptions&, uint64, Mat&)> Step;
+    const std::pair<const char*, Step> steps[] = {
+        {"motionBlur", [&](const Mat& in, const NoiseOptions& o, uint64 seed,
+                           Mat& out) { motionBlur(in, fmt, model, kernel, o, seed, out); }},
+        {"scale 1.3", [&](const Mat& in, const NoiseOptions& o, uint64 seed, Mat& out) {
+             scaleMosaic(in, fmt, model, 1.3, o, seed, out);
+         }}};
+    // Tolerances as in darkeningAddsTheDarkFrameComponentsATargetCaptureHas.
+    const double rowTol = 5 * std::sqrt(2.0) * std::sqrt(2.0 / truth.dof);
+    const double pixTol = 5 * std::sqrt(2.0) *
+                          std::sqrt((2 + std::max(truth.kurtosis, 0.0)) / (truth.dof * (size.width - 1.0)));
+    const double patternTol = 5 * std::sqrt(2.0 / size.area());
+    for (const auto& step : steps) {
+        SCOPED_TRACE(step.first);
+        auto stats = [&](const NoiseOptions& o) {
+            std::vector<Mat> out(T);
+            for (int t = 0; t < T; ++t)
+                step.second(input[t], o, 300 + t, out[t]);
+            return darkStats(out, black);
+        };
+        NoiseOptions poisson;
+        poisson.shotSampling = ShotNoiseSampling::POISSON;
+        const DarkStats account = stats(poisson), none = stats(NoiseAlignment::NONE),
+                        ignore = stats(NoiseAlignment::IGNORE_PRIOR);
+        EXPECT_NEAR(account.rowMeanVar / truth.rowMeanVar, 1, rowTol) << "row-mean variance";
+        EXPECT_NEAR(account.pixelVar / truth.pixelVar, 1, pixTol) << "per-pixel variance";
+        EXPECT_NEAR(fixedPatternExcess(account, truth, T, size.width), 0, patternTol) << "fixed pattern";
+        // The added read part's shape matches the kurtosis of the step's typical weights: exact inside a
+        // blur, on average along a scaled row; the tolerance is statistical only, which the measured
+        // error (printed) stays within.
+        EXPECT_NEAR(account.kurtosis, truth.kurtosis, 5 * std::hypot(account.kurtosisSE, truth.kurtosisSE))
+            << "excess kurtosis";
+        EXPECT_LT(none.rowMeanVar / truth.rowMeanVar, 1 - rowTol) << "NONE averages the rows away";
+        EXPECT_LT(none.pixelVar / truth.pixelVar, 1 - pixTol) << "NONE averages the noise away";
+        EXPECT_GT(fixedPatternExcess(none, truth, T, size.width), patternTol) << "NONE blurs the pattern";
+        EXPECT_GT(ignore.rowMeanVar / truth.rowMeanVar, 1 + rowTol) << "IGNORE_PRIOR adds rows on top";
+        EXPECT_GT(ignore.pixelVar / truth.pixelVar, 1 + pixTol) << "IGNORE_PRIOR adds noise on top";
+        EXPECT_GT(fixedPatternExcess(ignore, truth, T, size.width), patternTol) << "IGNORE_PRIOR doubles it";
+        std::cout << step.first << ": row-mean var (capture " << truth.rowMeanVar << ") NONE "
+                  << none.rowMeanVar << ", IGNORE " << ignore.rowMeanVar << ", ACCOUNT " << account.rowMeanVar
+                  << "; pixel var (" << truth.pixelVar << ") " << none.pixelVar << ", " << ignore.pixelVar
+                  << ", " << account.pixelVar << "; kurtosis (" << truth.kurtosis << " +- "
+                  << truth.kurtosisSE << ") ACCOUNT " << account.kurtosis << "; pattern excess "
+                  << fixedPatternExcess(none, truth, T, size.width) << ", "
+                  << fixedPatternExcess(ignore, truth, T, size.width) << ", "
+                  << fixedPatternExcess(account, truth, T, size.width) << "\n";
+    }
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv

@@ -50,7 +50,20 @@ std::vector<Mat> everyDispatchedLoop()
     Mat src;
     sensor.capture(scene, 4.0, 1.0, 11, 0, src); // the simulator's Gaussian draws
     outs.push_back(src);
-    const NoiseModel model(0.4, 0.5, 2.0);
+    const NoiseModel plain(0.4, 0.5, 2.0);
+    // The dark-frame components add a row term and shading to the vector rows and take the scalar rows
+    // for the Tukey draws (NoiseModel).
+    NoiseModel dark = plain;
+    dark.rowSigmaD2 = 0.2;
+    dark.rowSigmaR2 = 0.4;
+    dark.tukeyRead = true;
+    dark.tukeyLambda = -0.05;
+    dark.darkShadingPerGain.create(sensor.size(), CV_32FC1);
+    dark.darkShadingOffset.create(sensor.size(), CV_32FC1);
+    RNG(4).fill(dark.darkShadingPerGain, RNG::NORMAL, 0, 1);
+    RNG(5).fill(dark.darkShadingOffset, RNG::NORMAL, 0, 2);
+    NoiseModel rowsAndShading = dark;
+    rowsAndShading.tukeyRead = false;
     Mat srcFloat;
     src.convertTo(srcFloat, CV_32F);
     NoiseOptions poisson;
@@ -58,29 +71,30 @@ std::vector<Mat> everyDispatchedLoop()
     NoiseOptions localMean;
     localMean.priorMean = PriorMeanEstimate::LOCAL_MEAN;
     localMean.blurNoiseSum = BlurNoiseSum::FROM_BLURRED_MEAN;
-    for (const Mat& input : {src, srcFloat})
-        for (NoiseAlignment a :
-             {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR})
-            for (const NoiseOptions& base : {NoiseOptions(), poisson, localMean}) {
-                NoiseOptions noise = base;
-                noise.alignment = a;
-                Mat out;
-                RawFormat f;
-                // Brightening and darkening sites, a gain change; without brightness (ACCOUNT_PRIOR's
-                // variance is then a line per site) and with it (a share per pixel).
-                ColorJitter jitter;
-                jitter.contrast = Vec4d(0.3, 1.4, 0.25, 0.5);
-                jitter.gainRatio = 2;
-                for (double brightness : {0.0, -15.0}) {
-                    jitter.brightness = brightness;
-                    colorJitter(input, format, model, jitter, noise, 5, out, f);
+    for (const NoiseModel& model : {plain, rowsAndShading, dark})
+        for (const Mat& input : {src, srcFloat})
+            for (NoiseAlignment a :
+                 {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR})
+                for (const NoiseOptions& base : {NoiseOptions(), poisson, localMean}) {
+                    NoiseOptions noise = base;
+                    noise.alignment = a;
+                    Mat out;
+                    RawFormat f;
+                    // Brightening and darkening sites, a gain change; without brightness (ACCOUNT_PRIOR's
+                    // variance is then a line per site) and with it (a share per pixel).
+                    ColorJitter jitter;
+                    jitter.contrast = Vec4d(0.3, 1.4, 0.25, 0.5);
+                    jitter.gainRatio = 2;
+                    for (double brightness : {0.0, -15.0}) {
+                        jitter.brightness = brightness;
+                        colorJitter(input, format, model, jitter, noise, 5, out, f);
+                        outs.push_back(out);
+                    }
+                    motionBlur(input, format, model, linearMotionKernel(13, 30), noise, 6, out);
+                    outs.push_back(out);
+                    scaleMosaic(input, format, model, 1.07, noise, 7, out);
                     outs.push_back(out);
                 }
-                motionBlur(input, format, model, linearMotionKernel(13, 30), noise, 6, out);
-                outs.push_back(out);
-                scaleMosaic(input, format, model, 1.07, noise, 7, out);
-                outs.push_back(out);
-            }
     for (int depth : {CV_64F, CV_32F}) {
         BurstStatistics stats(format, 4, depth);
         for (int t = 0; t < 6; ++t) {

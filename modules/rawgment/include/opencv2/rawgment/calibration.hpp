@@ -282,7 +282,8 @@ struct CV_RAWGMENT_EXPORTS CalibrationReport
      * @throws cv::Exception when level is not in (0, 1) or the report has no uncertainty. */
     Vec2d interval(NoiseModelParameter parameter, double level = 0.95) const;
 
-    /** @brief Writes the report as a map under `name`. */
+    /** @brief Writes the report as a map under `name`; its model without the dark-shading maps, which
+     * NoiseModel::save() writes beside the model file. */
     void write(FileStorage& fs, const String& name) const;
     /** @brief Reads a report written by write(). @throws cv::Exception naming a missing field. */
     static CalibrationReport read(const FileNode& node);
