@@ -114,7 +114,7 @@ int main(int argc, char** argv)
             if (rawgment_apps::pathExists(p))
                 throw std::runtime_error("'" + p + "' already exists; outputs are never overwritten");
 
-        rawgment_apps::ProgressBar progress("tradeoffs", 5 + 9 * static_cast<size_t>(set.seeds));
+        rawgment_apps::ProgressBar progress("tradeoffs", 6 + 9 * static_cast<size_t>(set.seeds));
         std::vector<rawgment_apps::TradeoffRow> rows;
         std::vector<rawgment_apps::PrecisionRow> precision;
         rawgment_apps::measureTradeoffs(set, progress, rows, precision);

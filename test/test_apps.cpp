@@ -911,9 +911,11 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
     AppRun r = runApp("rawgment_tradeoffs", "--quick --out='" + dir + "/t'");
     ASSERT_EQ(0, r.status) << r.output;
     const std::string md = readText(dir + "/t/tradeoffs.md");
-    for (const char* knob : {"Shot-noise sampling", "Prior mean", "Motion-blur noise sum", "Arithmetic",
-                             "Calibration burst length", "Calibration patch size",
-                             "Calibration RANSAC iterations", "Shapiro-Wilk"})
+    for (const char* knob :
+         {"Shot-noise sampling", "Prior mean", "Motion-blur noise sum", "Arithmetic",
+          "Calibration burst length", "Calibration patch size", "Calibration RANSAC iterations",
+          "Shapiro-Wilk", "Row noise (dark-frame component)", "Dark shading (dark-frame component)",
+          "Read-noise tails (dark-frame component)"})
         EXPECT_NE(std::string::npos, md.find(knob)) << knob;
     // What more data buys: a row per burst length, per square side, for two gains and for dark frames,
     // each with the stated and the made error of every parameter.

@@ -1,6 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "tradeoff_measures.hpp"
 
+#include "flow_common.hpp"
+
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/augment.hpp>
@@ -39,7 +41,10 @@ enum StudyDraw : uint64
     DRAW_BLUR_STEP,
     DRAW_STATE_BURST,
     DRAW_SHAPIRO_DATA,
-    DRAW_CAMPAIGN_BURST
+    DRAW_CAMPAIGN_BURST,
+    DRAW_DARK_INPUT,
+    DRAW_DARK_TARGET,
+    DRAW_DARK_STEP
 };
 
 uint64 studySeed(const TradeoffSettings& set, StudyDraw draw, uint64 sub = 0)
@@ -558,6 +563,159 @@ void measureShapiroWilk(const TradeoffSettings& set, std::vector<TradeoffRow>& r
                     {}});
 }
 
+/* The dark-frame statistics of a float burst of a flat scene, black-subtracted: with e the residual from
+ * each pixel's temporal mean, R its row means and f = e - R over T frames of H x W, the row-mean
+ * variance sum R^2 / ((T - 1) H), the excess kurtosis of f, and the temporal mean (the fixed pattern). */
+struct DarkBurstStats
+{
+    Mat pixelMean;
+    double rowMeanVar = 0, kurtosis = 0;
+};
+
+DarkBurstStats darkBurstStats(const std::vector<Mat>& burst, double black)
+{
+    const int T = static_cast<int>(burst.size()), H = burst[0].rows, W = burst[0].cols;
+    DarkBurstStats d;
+    d.pixelMean = Mat::zeros(burst[0].size(), CV_64F);
+    std::vector<Mat> x(burst.size());
+    for (size_t t = 0; t < burst.size(); ++t) {
+        burst[t].convertTo(x[t], CV_64F, 1, -black);
+        d.pixelMean += x[t] / T;
+    }
+    double r2 = 0, f2 = 0, f4 = 0;
+    for (const Mat& frame : x) {
+        const Mat e = frame - d.pixelMean;
+        for (int r = 0; r < H; ++r) {
+            const double* p = e.ptr<double>(r);
+            double rowSum = 0;
+            for (int c = 0; c < W; ++c)
+                rowSum += p[c];
+            const double R = rowSum / W;
+            r2 += R * R;
+            for (int c = 0; c < W; ++c) {
+                const double v = (p[c] - R) * (p[c] - R);
+                f2 += v;
+                f4 += v * v;
+            }
+        }
+    }
+    const double n = static_cast<double>(T) * H * W;
+    d.rowMeanVar = r2 / ((T - 1.0) * H);
+    d.kurtosis = (f4 / n) / ((f2 / n) * (f2 / n)) - 3;
+    return d;
+}
+
+/* The dark-frame components (NoiseModel): for each, the accuracy of a very dark augmentation (a bright
+ * burst darkened x1/200 at x8 gain, 5 electrons per pixel, against a burst simulated at that target by
+ * a sensor that has every component) when the model lacks it and when it has it, and the time of a
+ * colour jitter on the timing frame without and with it. */
+void measureDarkComponents(const TradeoffSettings& set, const Mat& timingRaw, const RawFormat& timingFmt,
+                           const NoiseModel& timingModel, std::vector<TradeoffRow>& rows)
+{
+    const Size size(256, 256);
+    const int T = 8;
+    SensorParams params;
+    params.quantize = false;
+    params.noise.rowSigmaD2 = 0.3;
+    params.noise.rowSigmaR2 = 0.5;
+    params.noise.tukeyRead = true;
+    params.noise.tukeyLambda = -0.1;
+    addDarkShadingPattern(size, 4, set.seed, params.noise);
+    const SensorSimulator sensor(params, size);
+    const NoiseModel full = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(1);
+    const double black = fmt.blackLevel[0];
+    const Mat scene(size, CV_32FC1, Scalar(400));
+    std::vector<Mat> bright, target;
+    sensor.captureBurst(scene, 1, 1, T, studySeed(set, DRAW_DARK_INPUT), bright);
+    sensor.captureBurst(scene, 8, 1.0 / 200, T, studySeed(set, DRAW_DARK_TARGET), target);
+    const DarkBurstStats truth = darkBurstStats(target, black);
+    NoiseOptions options;
+    options.shotSampling = ShotNoiseSampling::POISSON; // the capture's shot noise is a count
+    const auto augmented = [&](const NoiseModel& m) {
+        std::vector<Mat> out(T);
+        RawFormat f;
+        for (int t = 0; t < T; ++t)
+            colorJitter(bright[t], fmt, m, ColorJitter::exposureChange(1.0 / 200, 8), options,
+                        studySeed(set, DRAW_DARK_STEP, uint64(t)), out[t], f);
+        return darkBurstStats(out, black);
+    };
+    // The time model: the timing frame's, with the component; the dark shading a map of its size.
+    NoiseModel timingShading = timingModel;
+    addDarkShadingPattern(timingRaw.size(), 4, set.seed, timingShading);
+    enum Component
+    {
+        ROWS,
+        SHADING,
+        TAILS
+    };
+    for (Component c : {ROWS, SHADING, TAILS}) {
+        for (bool present : {false, true}) {
+            NoiseModel m = full, timed = c == SHADING ? timingShading : timingModel;
+            if (!present) {
+                if (c == ROWS)
+                    m.rowSigmaD2 = m.rowSigmaR2 = 0;
+                if (c == SHADING)
+                    m.darkShadingPerGain = m.darkShadingOffset = Mat();
+                if (c == TAILS)
+                    m.tukeyRead = false;
+                timed = timingModel;
+            } else {
+                if (c == ROWS) {
+                    timed.rowSigmaD2 = full.rowSigmaD2;
+                    timed.rowSigmaR2 = full.rowSigmaR2;
+                }
+                if (c == TAILS) {
+                    timed.tukeyRead = true;
+                    timed.tukeyLambda = full.tukeyLambda;
+                }
+            }
+            const DarkBurstStats a = augmented(m);
+            double error = 0;
+            if (c == ROWS)
+                error = std::abs(a.rowMeanVar / truth.rowMeanVar - 1);
+            if (c == SHADING) {
+                // RMS difference of the fixed patterns (the scene's level taken out), in DN: with equal
+                // patterns, what remains is the noise of the two 8-frame means (about 5-6 DN here).
+                Mat d = a.pixelMean - truth.pixelMean;
+                d -= cv::mean(d)[0];
+                error = std::sqrt(d.dot(d) / static_cast<double>(d.total()));
+            }
+            if (c == TAILS)
+                error = std::abs(a.kurtosis - truth.kurtosis);
+            double active = 0;
+            Mat out;
+            RawFormat f;
+            const std::vector<double> byPath = perMegapixel(
+                fastestMsOnEveryPath(
+                    set.repeats,
+                    [&] {
+                        colorJitter(timingRaw, timingFmt, timed, ColorJitter::exposureChange(0.1, 4),
+                                    NoiseAlignment::ACCOUNT_PRIOR, studySeed(set, DRAW_TIMED_STEP), out, f);
+                    },
+                    active),
+                timingRaw.size());
+            const char* knob = c == ROWS      ? "Row noise (dark-frame component)"
+                               : c == SHADING ? "Dark shading (dark-frame component)"
+                                              : "Read-noise tails (dark-frame component)";
+            const char* measure = c == ROWS ? "|row-mean variance / capture's - 1| at 5 e-, x8 gain"
+                                  : c == SHADING
+                                      ? "RMS fixed-pattern difference (DN) of 8-frame means at 5 e-, x8 gain"
+                                      : "|excess kurtosis - capture's| at 5 e-, x8 gain";
+            const char* meaning =
+                c == ROWS ? (present ? "banding of a dark high-gain capture"
+                                     : "no banding: the rows of the capture are missing")
+                : c == SHADING
+                    ? (present ? "the target gain's dark offset pattern; costs a map read per pixel"
+                               : "the input's pattern, scaled down by the darkening")
+                    : (present ? "heavy-tailed added read noise; scalar Tukey draws per pixel"
+                               : "Gaussian added read noise: too few outliers in the dark");
+            rows.push_back({knob, present ? "in the model" : "absent from the model", measure, error,
+                            active / megapixels(timingRaw.size()), meaning, byPath});
+        }
+    }
+}
+
 //! A pipe inside a table cell would end the cell.
 
 } // namespace
@@ -580,6 +738,8 @@ void measureTradeoffs(const TradeoffSettings& set, ProgressBar& progress, std::v
     progress.advance();
     measureCalibrationKnobs(set, rows, precision, progress);
     measureShapiroWilk(set, rows);
+    progress.advance();
+    measureDarkComponents(set, timingRaw, timingFmt, timingModel, rows);
     progress.advance();
 }
 

@@ -50,7 +50,7 @@ struct PrecisionRow
 
 /** Measures every knob in one run (colour jitter, blur, burst statistics, calibration, Shapiro-Wilk)
  * and appends one row per setting, and the calibration's precision per set-up; `progress` advances by
- * 5 + 9 * settings.seeds. */
+ * 6 + 9 * settings.seeds. */
 void measureTradeoffs(const TradeoffSettings& settings, ProgressBar& progress, std::vector<TradeoffRow>& rows,
                       std::vector<PrecisionRow>& precision);
 
