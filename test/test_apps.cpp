@@ -896,6 +896,10 @@ TEST(Apps, demoWritesAReportAndAGallery)
     EXPECT_NE(std::string::npos, report.find("| alpha |")) << report;
     EXPECT_NE(std::string::npos, report.find("gallery.png"));
     expectPngDecodes(dir + "/demo/gallery.png");
+    // The dark-frame components, calibrated and side by side with and without them.
+    EXPECT_NE(std::string::npos, report.find("## Dark-frame noise beyond the paper")) << report;
+    EXPECT_NE(std::string::npos, report.find("| read-noise Tukey lambda | -0.080 |")) << report;
+    expectPngDecodes(dir + "/demo/dark_components.png");
     r = runApp("rawgment_demo", "--out='" + dir + "/demo' --frames=8");
     EXPECT_EQ(1, r.status) << "an existing report is never overwritten";
 }
@@ -926,7 +930,7 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
         EXPECT_NE(std::string::npos, md.find(setup, precision)) << setup;
     expectPngDecodes(dir + "/t/tradeoffs.png");
     // error and time of each (knob, setting) from the CSV: finite, and the orderings the knobs promise.
-    std::map<std::string, double> error;
+    std::map<std::string, double> error, errorOfKnob;
     std::istringstream csv(readText(dir + "/t/tradeoffs.csv"));
     const auto split = [](const std::string& line) {
         std::vector<std::string> cells;
@@ -958,9 +962,17 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
             else
                 EXPECT_TRUE(cells[k].empty()) << line;
         error[cells[1]] = e;
+        errorOfKnob[cells[0] + " | " + cells[1]] = e;
         ++rows;
     }
-    EXPECT_EQ(rows, 20); // 2 settings of 2 knobs, 4 blur rows, 2 burst lengths (--quick), 3 + 3, 2
+    // 2 settings of 2 knobs, 4 blur rows, 2 burst lengths (--quick), 3 + 3, 2, and 2 for each of the
+    // 3 dark-frame components.
+    EXPECT_EQ(rows, 26);
+    for (const char* component : {"Row noise", "Dark shading", "Read-noise tails"}) {
+        const std::string knob = std::string(component) + " (dark-frame component) | ";
+        EXPECT_LT(errorOfKnob[knob + "in the model"], errorOfKnob[knob + "absent from the model"] / 1.5)
+            << knob;
+    }
     // Text cells hold semicolons where the report has commas.
     EXPECT_LT(error["POISSON"], error["GAUSSIAN (paper)"] / 10) << "the lattice of a dark capture";
     EXPECT_LT(error["EXACT (Eq. 15); peaked 1x5 (1 4 6 4 1)"],
