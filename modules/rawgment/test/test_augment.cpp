@@ -328,46 +328,125 @@ Mat smallMosaic(int type = CV_16UC1)
     return out;
 }
 
+// A sensor with every dark-frame component: row noise mostly before the gain (it grows with it, the
+// banding of high-gain captures), heavy-tailed read noise, and dark shading with a column ramp plus a
+// per-pixel pattern. Unquantised, so that the float augmentation and the capture compare bit for bit
+// in their statistics (quantisation would add 1/12 DN^2 to one side only).
+SensorParams darkComponentSensor(Size size)
+{
+    SensorParams p = test::referenceSensorParams();
+    p.quantize = false;
+    p.noise.rowSigmaD2 = 0.3;
+    p.noise.rowSigmaR2 = 0.5;
+    p.noise.tukeyRead = true;
+    p.noise.tukeyLambda = -0.1;
+    Mat bd(size, CV_32FC1), br(size, CV_32FC1);
+    RNG rng(19);
+    rng.fill(bd, RNG::NORMAL, 0, 0.8);
+    rng.fill(br, RNG::NORMAL, 0, 2.0);
+    for (int c = 0; c < size.width; ++c)
+        bd.col(c) += 2.0 * c / size.width;
+    p.noise.darkShadingPerGain = bd;
+    p.noise.darkShadingOffset = br;
+    return p;
+}
+
 TEST(Augment, sameSeedSameBitsOnAnyThreadCount)
 {
     const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
-    const NoiseModel model(0.4, 0.5, 2.0);
-    Mat src(200, 300, CV_16UC1);
-    RNG(1).fill(src, RNG::UNIFORM, 256, 3000);
-    Scene scene;
-    scene.jitter.contrast = Vec4d(0.3, 0.25, 0.25, 0.35);
-    scene.jitter.gainRatio = 2;
-    scene.motionKernel = linearMotionKernel(11, 45);
-    scene.shift = Point(6, -4);
-    scene.scale = 1.02;
-    const Mat original = src.clone();
-    const int saved = getNumThreads();
-    // The paper's knobs and the other settings: Poisson draws and local means are per row too.
-    NoiseOptions knobs;
-    knobs.shotSampling = ShotNoiseSampling::POISSON;
-    knobs.priorMean = PriorMeanEstimate::LOCAL_MEAN;
-    knobs.blurNoiseSum = BlurNoiseSum::FROM_BLURRED_MEAN;
-    for (const NoiseOptions& noise : {NoiseOptions(), knobs}) {
-        scene.noise = noise;
-        std::vector<Mat> outs;
-        for (int threads : {1, 2, 8}) {
-            setNumThreads(threads);
-            Mat out;
-            RawFormat f;
-            applyScene(src, fmt, model, scene, 99, out, f);
-            outs.push_back(out);
+    const NoiseModel plain(0.4, 0.5, 2.0);
+    // With every dark-frame component too: the row draws and the Tukey uniforms are per row as well.
+    NoiseModel dark = darkComponentSensor(Size(300, 200)).noise;
+    dark.alpha = plain.alpha;
+    for (const NoiseModel& model : {plain, dark}) {
+        Mat src(200, 300, CV_16UC1);
+        RNG(1).fill(src, RNG::UNIFORM, 256, 3000);
+        Scene scene;
+        scene.jitter.contrast = Vec4d(0.3, 0.25, 0.25, 0.35);
+        scene.jitter.gainRatio = 2;
+        scene.motionKernel = linearMotionKernel(11, 45);
+        scene.shift = Point(6, -4);
+        scene.scale = 1.02;
+        const Mat original = src.clone();
+        const int saved = getNumThreads();
+        // The paper's knobs and the other settings: Poisson draws and local means are per row too.
+        NoiseOptions knobs;
+        knobs.shotSampling = ShotNoiseSampling::POISSON;
+        knobs.priorMean = PriorMeanEstimate::LOCAL_MEAN;
+        knobs.blurNoiseSum = BlurNoiseSum::FROM_BLURRED_MEAN;
+        for (const NoiseOptions& noise : {NoiseOptions(), knobs}) {
+            scene.noise = noise;
+            std::vector<Mat> outs;
+            for (int threads : {1, 2, 8}) {
+                setNumThreads(threads);
+                Mat out;
+                RawFormat f;
+                applyScene(src, fmt, model, scene, 99, out, f);
+                outs.push_back(out);
+            }
+            setNumThreads(saved);
+            EXPECT_EQ(norm(src, original, NORM_INF), 0) << "the input was written to";
+            EXPECT_EQ(norm(outs[0], outs[1], NORM_INF), 0);
+            EXPECT_EQ(norm(outs[0], outs[2], NORM_INF), 0);
         }
-        setNumThreads(saved);
-        EXPECT_EQ(norm(src, original, NORM_INF), 0) << "the input was written to";
-        EXPECT_EQ(norm(outs[0], outs[1], NORM_INF), 0);
-        EXPECT_EQ(norm(outs[0], outs[2], NORM_INF), 0);
+        scene.noise = NoiseOptions();
+        Mat first, second;
+        RawFormat f;
+        applyScene(src, fmt, model, scene, 99, first, f);
+        applyScene(src, fmt, model, scene, 100, second, f);
+        EXPECT_GT(norm(first, second, NORM_L1), 0) << "another seed, other noise";
     }
-    scene.noise = NoiseOptions();
-    Mat first, second;
+}
+
+TEST(Augment, anAbsentComponentChangesNoBitAndBrighteningWithComponentsIsClippedAndCounted)
+{
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel plain(0.4, 0.5, 2.0);
+    Mat src(64, 96, CV_16UC1);
+    RNG(2).fill(src, RNG::UNIFORM, 256, 3000);
+    // Components present but zero (no rows: both variances 0) are absent: the same bits as the plain model.
+    NoiseModel zeroRows = plain;
+    zeroRows.rowSigmaD2 = zeroRows.rowSigmaR2 = 0;
+    ASSERT_FALSE(zeroRows.hasDarkComponents());
+    const ColorJitter jitter = ColorJitter::exposureChange(0.2, 2);
+    Mat a, b;
     RawFormat f;
-    applyScene(src, fmt, model, scene, 99, first, f);
-    applyScene(src, fmt, model, scene, 100, second, f);
-    EXPECT_GT(norm(first, second, NORM_L1), 0) << "another seed, other noise";
+    colorJitter(src, fmt, plain, jitter, NoiseOptions(), 5, a, f);
+    colorJitter(src, fmt, zeroRows, jitter, NoiseOptions(), 5, b, f);
+    EXPECT_EQ(0, norm(a, b, NORM_INF));
+    // Brightening x4 with every component: no NaN, values in range, the brightening pixels counted.
+    NoiseModel dark = darkComponentSensor(src.size()).noise;
+    Mat srcFloat, out;
+    src.convertTo(srcFloat, CV_32F);
+    for (const Mat& input : {src, srcFloat}) {
+        AugmentReport report;
+        colorJitter(input, fmt, dark, ColorJitter::exposureChange(4, 1), NoiseOptions(), 6, out, f, &report);
+        EXPECT_GT(report.brighteningPixels, 0);
+        Mat asFloat;
+        out.convertTo(asFloat, CV_32F);
+        EXPECT_EQ(0, test::countNonFinite(asFloat));
+        double lo, hi;
+        minMaxLoc(asFloat, &lo, &hi);
+        EXPECT_GE(lo, 0);
+        EXPECT_LE(hi, fmt.whiteLevel);
+        for (const char* step : {"blur", "scale"}) {
+            Mat resampled;
+            if (std::string(step) == "blur")
+                motionBlur(input, fmt, dark, linearMotionKernel(9, 10), NoiseOptions(), 7, resampled);
+            else
+                scaleMosaic(input, fmt, dark, 1.1, NoiseOptions(), 7, resampled);
+            resampled.convertTo(asFloat, CV_32F);
+            EXPECT_EQ(0, test::countNonFinite(asFloat)) << step;
+        }
+    }
+    // A model whose maps are of another sensor size is an error naming both sizes.
+    Mat small = src(Rect(0, 0, 32, 32));
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(small, fmt, dark, jitter, NoiseOptions(), 5, out, f),
+                             "the model's dark shading is 96x64 but the mosaic 32x32");
+    EXPECT_CV_ERROR_CONTAINS(motionBlur(small, fmt, dark, linearMotionKernel(9, 10), NoiseOptions(), 7, out),
+                             "the model's dark shading is 96x64");
+    // Without noise (NONE) the maps are not used, so any size goes.
+    EXPECT_NO_THROW(colorJitter(small, fmt, dark, jitter, NoiseAlignment::NONE, 5, out, f));
 }
 
 TEST(Augment, identityStepsAreSkippedAndReturnTheInputItself)
@@ -1097,29 +1176,6 @@ double fixedPatternExcess(const DarkStats& a, const DarkStats& b, int T, int W)
     d -= cv::mean(d)[0]; // the scene's level is not the pattern
     const double noise = (a.pixelVar + b.pixelVar + (a.rowMeanVar + b.rowMeanVar) * (1 - 1.0 / W)) / T;
     return d.dot(d) / d.total() / noise - 1;
-}
-
-// A sensor with every dark-frame component: row noise mostly before the gain (it grows with it, the
-// banding of high-gain captures), heavy-tailed read noise, and dark shading with a column ramp plus a
-// per-pixel pattern. Unquantised, so that the float augmentation and the capture compare bit for bit
-// in their statistics (quantisation would add 1/12 DN^2 to one side only).
-SensorParams darkComponentSensor(Size size)
-{
-    SensorParams p = test::referenceSensorParams();
-    p.quantize = false;
-    p.noise.rowSigmaD2 = 0.3;
-    p.noise.rowSigmaR2 = 0.5;
-    p.noise.tukeyRead = true;
-    p.noise.tukeyLambda = -0.1;
-    Mat bd(size, CV_32FC1), br(size, CV_32FC1);
-    RNG rng(19);
-    rng.fill(bd, RNG::NORMAL, 0, 0.8);
-    rng.fill(br, RNG::NORMAL, 0, 2.0);
-    for (int c = 0; c < size.width; ++c)
-        bd.col(c) += 2.0 * c / size.width;
-    p.noise.darkShadingPerGain = bd;
-    p.noise.darkShadingOffset = br;
-    return p;
 }
 
 TEST(Augment, darkeningAddsTheDarkFrameComponentsATargetCaptureHas)
