@@ -152,6 +152,46 @@ int main(int argc, char** argv)
         numbers << "calibration_alpha " << calibration.model.alpha << "\ncalibration_sigmaD2 "
                 << calibration.model.sigmaD2 << "\ncalibration_sigmaR2 " << calibration.model.sigmaR2 << "\n";
 
+        // The dark-frame components: maps of exact binary values (so Python builds the same floats).
+        NoiseModel dark = model;
+        dark.rowSigmaD2 = 0.2;
+        dark.rowSigmaR2 = 0.4;
+        dark.tukeyRead = true;
+        dark.tukeyLambda = -0.05;
+        dark.darkShadingPerGain.create(96, 128, CV_32F);
+        dark.darkShadingOffset.create(96, 128, CV_32F);
+        for (int r = 0; r < 96; ++r)
+            for (int c = 0; c < 128; ++c) {
+                dark.darkShadingPerGain.at<float>(r, c) = static_cast<float>((c % 7) * 0.25 - 0.5);
+                dark.darkShadingOffset.at<float>(r, c) = static_cast<float>((r % 5) - 2 + (c % 3) * 0.5);
+            }
+        Mat darkJittered, darkBlurred;
+        RawFormat darkFormat;
+        colorJitter(capture, format, dark, ColorJitter::exposureChange(0.1, 4.0),
+                    NoiseAlignment::ACCOUNT_PRIOR, 8, darkJittered, darkFormat);
+        saveNpy("dark_jitter", darkJittered);
+        motionBlur(capture, format, dark, linearMotionKernel(9, 30), NoiseAlignment::ACCOUNT_PRIOR, 9,
+                   darkBlurred);
+        saveNpy("dark_blur", darkBlurred);
+        SensorParams darkParams = params;
+        darkParams.noise.rowSigmaD2 = dark.rowSigmaD2;
+        darkParams.noise.rowSigmaR2 = dark.rowSigmaR2;
+        darkParams.noise.tukeyRead = true;
+        darkParams.noise.tukeyLambda = dark.tukeyLambda;
+        darkParams.noise.darkShadingPerGain = dark.darkShadingPerGain;
+        darkParams.noise.darkShadingOffset = dark.darkShadingOffset;
+        const SensorSimulator darkSim(darkParams, Size(128, 96));
+        std::vector<std::vector<Mat>> darkBursts(2);
+        for (int g = 0; g < 2; ++g)
+            darkSim.captureBurst(Mat::zeros(96, 128, CV_32F), 1.0 + 7 * g, 1.0, 4, 200 + g, darkBursts[g]);
+        saveNpy("dark_capture", darkBursts[1][0]);
+        const DarkCalibrationReport darkCalibration =
+            calibrateDarkNoise(darkBursts, {1.0, 8.0}, darkSim.rawFormat(1.0), darkSim.effectiveModel());
+        numbers << "dark_row_d2 " << darkCalibration.model.rowSigmaD2 << "\ndark_row_r2 "
+                << darkCalibration.model.rowSigmaR2 << "\ndark_lambda " << darkCalibration.model.tukeyLambda
+                << "\n";
+        saveNpy("dark_shading_per_gain", darkCalibration.model.darkShadingPerGain);
+
         Mat bgr;
         renderSimpleIsp(capture, format, bgr);
         saveNpy("isp", bgr);

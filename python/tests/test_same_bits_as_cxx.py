@@ -96,3 +96,54 @@ def test_every_cpu_path_gives_the_same_bits(sensor, capture):
     finally:
         rg.setCpuPath(rg.CpuPath.AUTO)
     assert all(np.array_equal(results[0], r) for r in results[1:])
+
+
+def dark_model(model):
+    """The dark-frame components of tests/cxx_reference.cpp: maps of exact binary values."""
+    dark = rg.NoiseModel(model.alpha, model.sigmaD2, model.sigmaR2)
+    dark.rowSigmaD2, dark.rowSigmaR2 = 0.2, 0.4
+    dark.tukeyRead, dark.tukeyLambda = True, -0.05
+    r, c = np.mgrid[0:96, 0:128]
+    dark.darkShadingPerGain = ((c % 7) * 0.25 - 0.5).astype(np.float32)
+    dark.darkShadingOffset = ((r % 5) - 2 + (c % 3) * 0.5).astype(np.float32)
+    return dark
+
+
+def test_dark_frame_components(cxx_reference, sensor, capture):
+    ref = numbers(cxx_reference)
+    fmt = sensor.rawFormat(2.0)
+    dark = dark_model(sensor.effectiveModel())
+    out = rg.colorJitter(capture, fmt, dark, rg.ColorJitter.exposureChange(0.1, 4.0), rg.NoiseAlignment.ACCOUNT_PRIOR,
+                         seed=8)[0]
+    same(cxx_reference, "dark_jitter", out)
+    blurred, _ = rg.motionBlur(capture, fmt, dark, rg.linearMotionKernel(9, 30), rg.NoiseAlignment.ACCOUNT_PRIOR,
+                               seed=9)
+    same(cxx_reference, "dark_blur", blurred)
+    params = rg.SensorParams()
+    params.blackLevel = (64, 66, 65, 63)
+    params.bitDepth = 12
+    noise = params.noise
+    noise.rowSigmaD2, noise.rowSigmaR2 = dark.rowSigmaD2, dark.rowSigmaR2
+    noise.tukeyRead, noise.tukeyLambda = True, dark.tukeyLambda
+    noise.darkShadingPerGain, noise.darkShadingOffset = dark.darkShadingPerGain, dark.darkShadingOffset
+    params.noise = noise
+    sim = rg.SensorSimulator(params, (128, 96))
+    zeros = np.zeros((96, 128), np.float32)
+    bursts = [sim.captureBurst(zeros, 1.0 + 7 * g, 1.0, 4, 200 + g) for g in range(2)]
+    same(cxx_reference, "dark_capture", bursts[1][0])
+    calibrated = rg.calibrateDarkNoise(bursts, [1.0, 8.0], sim.rawFormat(1.0), sim.effectiveModel())
+    assert repr(calibrated.model.rowSigmaD2) == repr(float(ref["dark_row_d2"][0]))
+    assert repr(calibrated.model.rowSigmaR2) == repr(float(ref["dark_row_r2"][0]))
+    assert repr(calibrated.model.tukeyLambda) == repr(float(ref["dark_lambda"][0]))
+    same(cxx_reference, "dark_shading_per_gain", calibrated.model.darkShadingPerGain)
+
+
+def test_dark_components_survive_save_and_load(tmp_path, sensor):
+    dark = dark_model(sensor.effectiveModel())
+    dark.save(str(tmp_path / "dark.yml"))
+    back = rg.NoiseModel.load(str(tmp_path / "dark.yml"))
+    assert (back.rowSigmaD2, back.rowSigmaR2, back.tukeyRead, back.tukeyLambda) == (0.2, 0.4, True, -0.05)
+    assert np.array_equal(back.darkShadingOffset, dark.darkShadingOffset)
+    assert np.array_equal(back.darkShadingAt(2.0), 2 * dark.darkShadingPerGain + dark.darkShadingOffset)
+    plain = rg.NoiseModel(1, 1, 1)
+    assert plain.darkShadingPerGain is None and not plain.hasDarkComponents()
