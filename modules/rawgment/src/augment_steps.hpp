@@ -5,6 +5,7 @@
 #ifndef OPENCV_RAWGMENT_SRC_AUGMENT_STEPS_HPP
 #define OPENCV_RAWGMENT_SRC_AUGMENT_STEPS_HPP
 
+#include "noise_terms.hpp"
 #include "opencv2/rawgment/augment.hpp"
 #include "precomp.hpp"
 #include "random.hpp"
@@ -88,7 +89,38 @@ struct DarkTerms
     float rowSigma[4] = {0, 0, 0, 0};
     float shadingPerGain[4] = {0, 0, 0, 0}, shadingOffset[4] = {0, 0, 0, 0};
     double lambda[4] = {0, 0, 0, 0};
+    double tailInvSd[4] = {1, 1, 1, 1}; // 1 / sd of the Tukey variable of lambda[site] (setTails())
     bool any() const { return row || shading; }
+    //! Sets the tails' lambda of a site and its scale, once per call: the moments cost microseconds.
+    void setTails(int site, double l)
+    {
+        lambda[site] = l;
+        tailInvSd[site] = TukeyUnitSampler(l).invSd;
+    }
+    //! A unit-variance heavy-tailed draw for `site` from a uniform u in (0, 1).
+    float tail(int site, double u) const
+    {
+        return static_cast<float>(tailInvSd[site] * tukeyLambdaQuantile(u, lambda[site]));
+    }
+};
+
+/** The dark shading g B_d + B_r of a model at one gain, read row by row from its maps: a whole-frame
+ * map per call (48 MB at 12 MP) would cost more in first-touch page faults than the step itself. */
+struct ShadingRows
+{
+    const Mat* perGain = nullptr; // null: no shading
+    const Mat* offset = nullptr;
+    float gain = 0;
+    ShadingRows() = default;
+    ShadingRows(const NoiseModel& model, double g)
+        : perGain(&model.darkShadingPerGain), offset(&model.darkShadingOffset), gain(static_cast<float>(g))
+    {
+    }
+    bool empty() const { return perGain == nullptr; }
+    //! g B_d + B_r of mosaic row r, column c (float: the same on every CPU path).
+    float at(const float* bd, const float* br, int c) const { return gain * bd[c] + br[c]; }
+    const float* perGainRow(int r) const { return perGain->ptr<float>(r); }
+    const float* offsetRow(int r) const { return offset->ptr<float>(r); }
 };
 
 /** Row r's additive part of `d` into extra[0..cols): d.rowSigma[site] times the row's one draw from

@@ -320,35 +320,32 @@ struct JitterKeys
 // shading less the input's.
 template <typename T>
 void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& model, const JitterConstants& k,
-                const JitterColumnTables& tables, const JitterKeys& keys, const Mat& inputShading,
-                const Range& rows, std::atomic<int64>& brightening)
+                const JitterColumnTables& tables, const JitterKeys& keys,
+                const detail::ShadingRows& inputShading, const Range& rows, std::atomic<int64>& brightening)
 {
     const int cols = src.cols;
     const bool noise = k.alignment != NoiseAlignment::NONE;
     const bool tails = noise && k.dark.tails, dark = noise && k.dark.any();
     std::vector<float> z(static_cast<size_t>(cols)), t(tails ? cols : 0), extra(dark ? cols : 0),
-        blackAndShading(inputShading.empty() ? 0 : cols);
+        blackAndShading(inputShading.empty() ? 0 : static_cast<size_t>(cols));
     const bool scalar = noise && (k.sampling == ShotNoiseSampling::POISSON || tails);
-    const detail::TukeyUnitSampler samplers[4] = {
-        detail::TukeyUnitSampler(k.dark.lambda[0]), detail::TukeyUnitSampler(k.dark.lambda[1]),
-        detail::TukeyUnitSampler(k.dark.lambda[2]), detail::TukeyUnitSampler(k.dark.lambda[3])};
     int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
         if (noise)
             detail::fillGaussian(keys.gaussian, static_cast<uint64_t>(r), z.data(), cols);
         if (tails) {
             detail::CounterRng uniforms(keys.tukey, static_cast<uint64_t>(r));
-            const detail::TukeyUnitSampler* rowSamplers = samplers + 2 * (r & 1);
+            const int even = 2 * (r & 1);
             for (int c = 0; c < cols; ++c)
-                t[static_cast<size_t>(c)] = static_cast<float>(rowSamplers[c & 1](uniforms.uniform()));
+                t[static_cast<size_t>(c)] = k.dark.tail(even + (c & 1), uniforms.uniform());
         }
         if (dark)
             detail::darkRowExtra(k.dark, model, keys.row, r, cols, extra.data());
         JitterColumns col = tables.forRow(r);
         if (!inputShading.empty()) {
-            const float* s = inputShading.ptr<float>(r);
+            const float *bd = inputShading.perGainRow(r), *br = inputShading.offsetRow(r);
             for (int c = 0; c < cols; ++c)
-                blackAndShading[static_cast<size_t>(c)] = col.black[c] + s[c];
+                blackAndShading[static_cast<size_t>(c)] = col.black[c] + inputShading.at(bd, br, c);
             col.black = blackAndShading.data();
         }
         const float* priorRow = prior.empty() ? nullptr : prior.ptr<float>(r);
@@ -397,10 +394,10 @@ detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, const Co
         d.shadingOffset[s] = static_cast<float>(account ? 0.0 : 1.0);
         if (!d.tails)
             continue;
-        d.lambda[s] =
-            account ? detail::addedReadLambda(model.tukeyLambda, readOut, std::pow(pc, 4) * readIn * readIn,
-                                              readOut - pc * pc * readIn)
-                    : model.tukeyLambda;
+        d.setTails(s, account ? detail::addedReadLambda(model.tukeyLambda, readOut,
+                                                        std::pow(pc, 4) * readIn * readIn,
+                                                        readOut - pc * pc * readIn)
+                              : model.tukeyLambda);
     }
     return d;
 }
@@ -497,14 +494,15 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
             perSiteLine(jitter.contrast[s], jitter.gainRatio, terms, k.slope[s], k.offset[s]);
     }
 
-    const Mat inputShading = noise.alignment == NoiseAlignment::ACCOUNT_PRIOR && model.hasDarkShading()
-                                 ? model.darkShadingAt(format.gain)
-                                 : Mat();
+    const detail::ShadingRows inputShading =
+        noise.alignment == NoiseAlignment::ACCOUNT_PRIOR && model.hasDarkShading()
+            ? detail::ShadingRows(model, format.gain)
+            : detail::ShadingRows();
     Mat prior = noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && noise.alignment != NoiseAlignment::NONE
                     ? localPriorMean(src, format)
                     : Mat();
     if (!prior.empty() && !inputShading.empty())
-        prior -= inputShading;
+        prior -= model.darkShadingAt(format.gain);
     k.dark = jitterDarkTerms(model, format.gain, jitter, noise.alignment);
     Mat dst = detail::stepOutput(src, _dst);
     std::atomic<int64> brightening{0};

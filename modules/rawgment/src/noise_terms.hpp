@@ -67,7 +67,8 @@ constexpr double kTukeyLambdaMin = -0.2;
 struct TukeyUnitSampler
 {
     double lambda = 0, invSd = 1;
-    explicit TukeyUnitSampler(double lambda_ = 0)
+    TukeyUnitSampler() = default; //!< unused: no moments computed
+    explicit TukeyUnitSampler(double lambda_)
         : lambda(lambda_), invSd(1 / std::sqrt(tukeyLambdaVariance(lambda_)))
     {
     }

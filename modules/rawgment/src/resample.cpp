@@ -63,9 +63,9 @@ struct ResampleConstants
     // The dark-frame components (resampleDarkTerms()): the rows' variance to restore, the shading to
     // restore, the tails; their streams; the model that holds the maps.
     detail::DarkTerms dark;
-    double rowVariance = 0; // the input's row variance at its gain
-    Mat inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out of the values before the step
-    Mat shading;      // the target's dark shading, added after it
+    double rowVariance = 0;           // the input's row variance at its gain
+    detail::ShadingRows inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out before the step
+    detail::ShadingRows shading;      // the target's dark shading, added after it
     uint64_t rowKey = 0, tukeyKey = 0;
 };
 
@@ -74,16 +74,17 @@ struct ResampleConstants
 // on each side.
 template <typename T>
 void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, float* out,
-                  const Mat& shading = Mat())
+                  const detail::ShadingRows& shading = detail::ShadingRows())
 {
     const T* s = src.ptr<T>(2 * planeRow + site / 2) + site % 2;
     const int width = src.cols / 2;
     for (int j = 0; j < width; ++j)
         out[pad + j] = static_cast<float>(s[2 * j]) - black;
     if (!shading.empty()) {
-        const float* b = shading.ptr<float>(2 * planeRow + site / 2) + site % 2;
+        const int r = 2 * planeRow + site / 2;
+        const float *bd = shading.perGainRow(r) + site % 2, *br = shading.offsetRow(r) + site % 2;
         for (int j = 0; j < width; ++j)
-            out[pad + j] -= b[2 * j];
+            out[pad + j] -= shading.at(bd, br, 2 * j);
     }
     for (int j = 0; j < pad; ++j) {
         out[j] = out[pad];
@@ -225,9 +226,13 @@ void resampledDarkRow(const ResampleConstants& k, int site, int planeRow, float 
         detail::CounterRng rng(k.rowKey, static_cast<uint64_t>(r));
         amp = static_cast<float>(std::sqrt(std::max(added, 0.0)) * rng.gaussian());
     }
-    const float* delta = k.dark.shading ? k.shading.ptr<float>(r) + site % 2 : nullptr;
+    if (!k.dark.shading) {
+        std::fill(extra, extra + n, amp);
+        return;
+    }
+    const float *bd = k.shading.perGainRow(r) + site % 2, *br = k.shading.offsetRow(r) + site % 2;
     for (int j = 0; j < n; ++j)
-        extra[j] = amp + (delta ? delta[2 * j] : 0.0f);
+        extra[j] = amp + k.shading.at(bd, br, 2 * j);
 }
 
 // The end of every resampled row: its noise streams (site, row), the noise, the dark terms, the black
@@ -250,9 +255,8 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
     if (noise && k.dark.tails) {
         t.resize(static_cast<size_t>(n));
         detail::CounterRng uniforms(k.tukeyKey, stream);
-        const detail::TukeyUnitSampler tukey(k.dark.lambda[site]);
         for (int j = 0; j < n; ++j)
-            t[static_cast<size_t>(j)] = static_cast<float>(tukey(uniforms.uniform()));
+            t[static_cast<size_t>(j)] = k.dark.tail(site, uniforms.uniform());
     }
     const float* extraRow = extra.empty() ? nullptr : extra.data();
     if (noise && (k.sampling == ShotNoiseSampling::POISSON || k.dark.tails)) {
@@ -313,10 +317,10 @@ void resampleDarkTerms(ResampleConstants& k, const NoiseModel& model, const RawF
             account ? detail::addedReadLambda(model.tukeyLambda, b, sumW4 * b * b, (1 - sumW2) * b)
                     : model.tukeyLambda;
         for (int s = 0; s < 4; ++s)
-            d.lambda[s] = lambda;
+            d.setTails(s, lambda);
     }
     if (d.shading) {
-        k.shading = model.darkShadingAt(format.gain);
+        k.shading = detail::ShadingRows(model, format.gain);
         if (account)
             k.inputShading = k.shading;
     }

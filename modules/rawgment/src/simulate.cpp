@@ -144,7 +144,8 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
     // (frame, row), the read noise as one Tukey-lambda draw of the same variance, the dark shading.
     const double rowSigma = std::sqrt(p.noise.rowVariance(gain));
     const bool tukey = p.noise.tukeyRead;
-    const detail::TukeyUnitSampler tukeyDraw(tukey ? p.noise.tukeyLambda : 0.0);
+    const detail::TukeyUnitSampler tukeyDraw =
+        tukey ? detail::TukeyUnitSampler(p.noise.tukeyLambda) : detail::TukeyUnitSampler();
     const double readSigma = std::sqrt(gain * gain * unit.readBeforeGain + unit.readAfterGain);
     const Mat shading = p.noise.darkShadingAt(gain);
     if (!shading.empty() && shading.size() != size_)
