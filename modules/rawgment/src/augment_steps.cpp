@@ -52,7 +52,12 @@ Mat stepOutput(const Mat& src, OutputArray dst)
     return Mat(src.size(), src.type());
 }
 
-void darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, int r, int cols, float* extra)
+void throwNonFiniteShading(const char* who)
+{
+    CV_Error(Error::StsBadArg, format("%s: the model's dark shading contains NaN or Inf", who));
+}
+
+bool darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, int r, int cols, float* extra)
 {
     const int even = 2 * (r & 1);
     float amp[2] = {0, 0};
@@ -65,14 +70,25 @@ void darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, 
     if (!d.shading) {
         for (int c = 0; c < cols; ++c)
             extra[c] = amp[c & 1];
-        return;
+        return true;
     }
     const float* bd = model.darkShadingPerGain.ptr<float>(r);
     const float* br = model.darkShadingOffset.ptr<float>(r);
-    for (int c = 0; c < cols; ++c) {
-        const int site = even + (c & 1);
-        extra[c] = amp[c & 1] + d.shadingPerGain[site] * bd[c] + d.shadingOffset[site] * br[c];
+    // A pair of columns (both sites of the row) per iteration, each with its site's coefficients.
+    const float g0 = d.shadingPerGain[even], g1 = d.shadingPerGain[even + 1];
+    const float o0 = d.shadingOffset[even], o1 = d.shadingOffset[even + 1];
+    for (int c = 0; c + 1 < cols; c += 2) {
+        extra[c] = amp[0] + g0 * bd[c] + o0 * br[c];
+        extra[c + 1] = amp[1] + g1 * bd[c + 1] + o1 * br[c + 1];
     }
+    if (cols & 1)
+        extra[cols - 1] = amp[0] + g0 * bd[cols - 1] + o0 * br[cols - 1];
+    // x - x is 0 for every finite x and NaN for NaN and Inf; the maps are checked, not the products, so
+    // a coefficient of 0 cannot hide a bad value.
+    float check = 0;
+    for (int c = 0; c < cols; ++c)
+        check += (bd[c] - bd[c]) + (br[c] - br[c]);
+    return check == 0;
 }
 
 void checkDarkShadingSize(const NoiseModel& model, Size size, const char* who)

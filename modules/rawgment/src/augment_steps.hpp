@@ -124,9 +124,12 @@ struct ShadingRows
 };
 
 /** Row r's additive part of `d` into extra[0..cols): d.rowSigma[site] times the row's one draw from
- * stream (rowKey, r), plus the dark shading. Sites of one row share the draw, as a real row offset does. */
-void darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, int r, int cols,
+ * stream (rowKey, r), plus the dark shading. Sites of one row share the draw, as a real row offset does.
+ * Returns false when the row's shading holds NaN or Inf (the check costs one subtraction per value). */
+bool darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, int r, int cols,
                   float* extra);
+//! The error of a step whose dark-shading rows held NaN or Inf (darkRowExtra() returned false).
+void throwNonFiniteShading(const char* who);
 //! Throws StsBadArg naming `who` when the model has dark shading of another size than the mosaic.
 void checkDarkShadingSize(const NoiseModel& model, Size size, const char* who);
 

@@ -321,7 +321,8 @@ struct JitterKeys
 template <typename T>
 void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& model, const JitterConstants& k,
                 const JitterColumnTables& tables, const JitterKeys& keys,
-                const detail::ShadingRows& inputShading, const Range& rows, std::atomic<int64>& brightening)
+                const detail::ShadingRows& inputShading, const Range& rows, std::atomic<int64>& brightening,
+                std::atomic<bool>& nonFinite)
 {
     const int cols = src.cols;
     const bool noise = k.alignment != NoiseAlignment::NONE;
@@ -339,8 +340,8 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
             for (int c = 0; c < cols; ++c)
                 t[static_cast<size_t>(c)] = k.dark.tail(even + (c & 1), uniforms.uniform());
         }
-        if (dark)
-            detail::darkRowExtra(k.dark, model, keys.row, r, cols, extra.data());
+        if (dark && !detail::darkRowExtra(k.dark, model, keys.row, r, cols, extra.data()))
+            nonFinite = true;
         JitterColumns col = tables.forRow(r);
         if (!inputShading.empty()) {
             const float *bd = inputShading.perGainRow(r), *br = inputShading.offsetRow(r);
@@ -506,6 +507,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     k.dark = jitterDarkTerms(model, format.gain, jitter, noise.alignment);
     Mat dst = detail::stepOutput(src, _dst);
     std::atomic<int64> brightening{0};
+    std::atomic<bool> nonFinite{false};
     const JitterKeys keys = {detail::stepKey(seed, detail::RandomStream::JITTER_GAUSSIAN),
                              detail::stepKey(seed, detail::RandomStream::JITTER_POISSON),
                              detail::stepKey(seed, detail::RandomStream::JITTER_ROW),
@@ -513,10 +515,14 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     const JitterColumnTables tables(k, src.cols);
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
-            jitterRows<ushort>(src, prior, dst, model, k, tables, keys, inputShading, rows, brightening);
+            jitterRows<ushort>(src, prior, dst, model, k, tables, keys, inputShading, rows, brightening,
+                               nonFinite);
         else
-            jitterRows<float>(src, prior, dst, model, k, tables, keys, inputShading, rows, brightening);
+            jitterRows<float>(src, prior, dst, model, k, tables, keys, inputShading, rows, brightening,
+                              nonFinite);
     });
+    if (nonFinite)
+        detail::throwNonFiniteShading("colorJitter");
     detail::reportSaturation(src, format, report, saturatedMask);
     _dst.assign(dst);
     dstFormat = format;

@@ -68,8 +68,6 @@ void checkShadingMap(const Mat& map, const char* what, Size size)
         CV_Error(Error::StsBadArg,
                  format("NoiseModel.%s must be CV_32FC1 of %dx%d like darkShadingPerGain (got %s, %dx%d)",
                         what, size.width, size.height, typeToString(map.type()).c_str(), map.cols, map.rows));
-    if (!checkRange(map, true))
-        CV_Error(Error::StsBadArg, format("NoiseModel.%s contains NaN or Inf", what));
 }
 
 } // namespace
@@ -185,9 +183,24 @@ void NoiseModel::variance(InputArray _mean, double gain, OutputArray _dst) const
     _dst.assign(dst);
 }
 
+namespace detail {
+
+void checkDarkShadingFinite(const NoiseModel& model)
+{
+    if (!model.hasDarkShading())
+        return;
+    if (!checkRange(model.darkShadingPerGain, true))
+        CV_Error(Error::StsBadArg, "NoiseModel.darkShadingPerGain contains NaN or Inf");
+    if (!checkRange(model.darkShadingOffset, true))
+        CV_Error(Error::StsBadArg, "NoiseModel.darkShadingOffset contains NaN or Inf");
+}
+
+} // namespace detail
+
 void NoiseModel::write(FileStorage& fs, const String& name, const std::vector<String>& shadingImages) const
 {
     validate();
+    detail::checkDarkShadingFinite(*this);
     if (hasDarkShading() && shadingImages.size() != 2)
         CV_Error(Error::StsBadArg, "NoiseModel::write: a model with dark shading needs the names of its two "
                                    "images (save() writes them)");
@@ -340,6 +353,7 @@ NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
     }
     try {
         m.validate();
+        detail::checkDarkShadingFinite(m);
     } catch (const Exception& e) {
         CV_Error(Error::StsParseError, "noise model: " + e.err);
     }

@@ -86,6 +86,11 @@ CV_RAWGMENT_EXPORTS double addedReadLambda(double lambda, double targetRead, dou
                                            double added);
 //! @}
 
+/** Throws StsBadArg naming the map when a dark-shading map holds NaN or Inf: a pass over both maps, so
+ * it runs where a model enters (read(), write(), the simulator), not in validate(), which every step
+ * calls; the steps detect a non-finite map in the rows they read (darkRowExtra()). */
+void checkDarkShadingFinite(const NoiseModel& model);
+
 /** The smallest variance a sample's expectation is taken to have when it is weighted or standardised:
  * zero to double precision next to the largest variance the line or model predicts over the samples
  * (1e-15 of it, and > 0). It only keeps a prediction of 0 from dividing by 0. A larger floor would be

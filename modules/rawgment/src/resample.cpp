@@ -5,6 +5,7 @@
 #include "noise_terms.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 
 namespace cv {
@@ -67,6 +68,7 @@ struct ResampleConstants
     detail::ShadingRows inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out before the step
     detail::ShadingRows shading;      // the target's dark shading, added after it
     uint64_t rowKey = 0, tukeyKey = 0;
+    std::atomic<bool>* nonFiniteShading = nullptr; // set when a shading row held NaN or Inf
 };
 
 // Plane row `planeRow` of site `site`, black-subtracted (and without the input's dark shading when
@@ -216,7 +218,7 @@ void finishResampledRowScalar(float* mean, const float* shotSum, const float* re
 // The dark-frame terms of one output plane row into extra[0..n): the row offset that the step's
 // vertical weights removed (rowKeep = their sum of squares: the share of the input's row variance
 // kept), drawn once per mosaic row so both sites of a row share it, plus the dark shading to restore.
-void resampledDarkRow(const ResampleConstants& k, int site, int planeRow, float rowKeep, float* extra, int n)
+bool resampledDarkRow(const ResampleConstants& k, int site, int planeRow, float rowKeep, float* extra, int n)
 {
     const int r = 2 * planeRow + site / 2;
     float amp = 0;
@@ -228,11 +230,15 @@ void resampledDarkRow(const ResampleConstants& k, int site, int planeRow, float 
     }
     if (!k.dark.shading) {
         std::fill(extra, extra + n, amp);
-        return;
+        return true;
     }
     const float *bd = k.shading.perGainRow(r) + site % 2, *br = k.shading.offsetRow(r) + site % 2;
-    for (int j = 0; j < n; ++j)
+    float check = 0; // as in detail::darkRowExtra(): NaN when a map value is not finite
+    for (int j = 0; j < n; ++j) {
         extra[j] = amp + k.shading.at(bd, br, 2 * j);
+        check += (bd[2 * j] - bd[2 * j]) + (br[2 * j] - br[2 * j]);
+    }
+    return check == 0;
 }
 
 // The end of every resampled row: its noise streams (site, row), the noise, the dark terms, the black
@@ -250,7 +256,8 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
     std::vector<float> extra, t;
     if (noise && k.dark.any()) {
         extra.resize(detail::wholeBlocks(n));
-        resampledDarkRow(k, site, planeRow, rowKeep, extra.data(), n);
+        if (!resampledDarkRow(k, site, planeRow, rowKeep, extra.data(), n))
+            *k.nonFiniteShading = true;
     }
     if (noise && k.dark.tails) {
         t.resize(static_cast<size_t>(n));
@@ -579,8 +586,10 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
     }
     const BilinearAxis cols[2] = {bilinearAxis(src.cols / 2, 0, scale), bilinearAxis(src.cols / 2, 1, scale)};
     const BilinearAxis rows[2] = {bilinearAxis(src.rows / 2, 0, scale), bilinearAxis(src.rows / 2, 1, scale)};
+    std::atomic<bool> nonFinite{false};
     ResampleConstants k = resampleConstants(format, model, noise, seed, detail::RandomStream::SCALE_GAUSSIAN,
                                             detail::RandomStream::SCALE_POISSON);
+    k.nonFiniteShading = &nonFinite;
     if (model.hasDarkComponents()) {
         // The typical weights: sum w^2 and sum w^4 of the bilinear taps averaged over the output pixels
         // (a product of the two axes' averages).
@@ -605,6 +614,8 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
         else
             scalePlaneRows<float>(src, dst, cols, rows, k, range);
     });
+    if (nonFinite)
+        detail::throwNonFiniteShading("scaleMosaic");
     _dst.assign(dst);
     if (report)
         report->steps.push_back("scale");
@@ -641,9 +652,11 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
             if (wk > 0)
                 taps.push_back({y, x, static_cast<float>(wk), static_cast<float>(wk * (1 - wk))});
         }
+    std::atomic<bool> nonFinite{false};
     ResampleConstants k = resampleConstants(format, model, noise, seed, detail::RandomStream::BLUR_GAUSSIAN,
                                             detail::RandomStream::BLUR_POISSON);
     const float readFactor = static_cast<float>(1 - w.dot(w));
+    k.nonFiniteShading = &nonFinite;
     if (model.hasDarkComponents()) {
         Mat w2 = w.mul(w);
         resampleDarkTerms(k, model, format, src.size(), sum(w2)[0], w2.dot(w2), seed,
@@ -657,6 +670,8 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
         else
             blurPlaneRows<float>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
     });
+    if (nonFinite)
+        detail::throwNonFiniteShading("motionBlur");
     _dst.assign(dst);
     if (report)
         report->steps.push_back("motionBlur");

@@ -59,6 +59,7 @@ void SensorParams::validate() const
 SensorSimulator::SensorSimulator(const SensorParams& params, Size size) : params_(params), size_(size)
 {
     params_.validate();
+    detail::checkDarkShadingFinite(params_.noise);
     if (size.width <= 0 || size.height <= 0 || size.width % 2 || size.height % 2)
         CV_Error(Error::StsBadArg,
                  format("SensorSimulator: size %dx%d must be positive and even", size.width, size.height));

@@ -445,6 +445,16 @@ TEST(Augment, anAbsentComponentChangesNoBitAndBrighteningWithComponentsIsClipped
                              "the model's dark shading is 96x64 but the mosaic 32x32");
     EXPECT_CV_ERROR_CONTAINS(motionBlur(small, fmt, dark, linearMotionKernel(9, 10), NoiseOptions(), 7, out),
                              "the model's dark shading is 96x64");
+    // A map value that is not finite is an error, never a NaN output.
+    NoiseModel bad = dark;
+    bad.darkShadingPerGain = dark.darkShadingPerGain.clone();
+    bad.darkShadingPerGain.at<float>(40, 17) = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(src, fmt, bad, jitter, NoiseOptions(), 5, out, f),
+                             "colorJitter: the model's dark shading contains NaN or Inf");
+    EXPECT_CV_ERROR_CONTAINS(motionBlur(src, fmt, bad, linearMotionKernel(9, 10), NoiseOptions(), 7, out),
+                             "motionBlur: the model's dark shading contains NaN or Inf");
+    EXPECT_CV_ERROR_CONTAINS(scaleMosaic(src, fmt, bad, 1.1, NoiseAlignment::IGNORE_PRIOR, 7, out),
+                             "scaleMosaic: the model's dark shading contains NaN or Inf");
     // Without noise (NONE) the maps are not used, so any size goes.
     EXPECT_NO_THROW(colorJitter(small, fmt, dark, jitter, NoiseAlignment::NONE, 5, out, f));
 }

@@ -107,8 +107,9 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
     NoiseModel(double alpha, double sigmaD2, double sigmaR2);
 
     /** @brief Throws cv::Exception (StsBadArg) naming the parameter that is negative or not finite, a
-     * tukeyLambda outside (-0.25, 1], or dark-shading maps that are not two finite CV_32FC1 Mats of one
-     * size. */
+     * tukeyLambda outside [-0.2, 1], or dark-shading maps that are not two CV_32FC1 Mats of one size.
+     * Cheap, so every step calls it; a map that holds NaN or Inf is refused where a model is read,
+     * written or simulated, and by the steps in the rows they read. */
     void validate() const;
 
     /** @brief The per-gain line: \f$ a = g\alpha,\; b = g^2\sigma_d^2 + \sigma_r^2 \f$.
