@@ -1,5 +1,7 @@
 """Python gives the C++ API's bits: every result of tests/cxx_reference.cpp, recomputed through the
 module with the same parameters and seeds, is identical (arrays bit for bit, numbers to the last digit)."""
+import pickle
+
 import numpy as np
 
 import rawgment as rg
@@ -147,3 +149,5 @@ def test_dark_components_survive_save_and_load(tmp_path, sensor):
     assert np.array_equal(back.darkShadingAt(2.0), 2 * dark.darkShadingPerGain + dark.darkShadingOffset)
     plain = rg.NoiseModel(1, 1, 1)
     assert plain.darkShadingPerGain is None and not plain.hasDarkComponents()
+    # Pickled with its maps, as Dask sends a model to its workers.
+    assert pickle.loads(pickle.dumps(dark)) == dark and pickle.loads(pickle.dumps(plain)) == plain

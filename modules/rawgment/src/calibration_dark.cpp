@@ -21,19 +21,46 @@ struct GainData
     std::vector<double> ppccSample; // residuals without the rows, a spread-out subsample
 };
 
-// Per-row sums of one frame's residual: of R^2 (R the row's mean), f^2 and f^4 (f = e - R).
+// Per-row sums of one frame's residual: its row mean R, and the sums of R^2, f^2 and f^4 (f = e - R).
 struct RowSums
 {
-    double r2 = 0, f2 = 0, f4 = 0;
+    double R = 0, r2 = 0, f2 = 0, f4 = 0;
 };
 
-Mat blackSubtracted64(const Mat& raw, const RawFormat& format)
+// The black-subtracted values of a burst, read row by row from the caller's frames: a burst of 24 MP
+// frames held as doubles would take 6 GB at 32 frames.
+class BlackSubtracted
 {
-    Mat x, x64;
-    subtractBlackLevel(raw, format, x, false);
-    x.convertTo(x64, CV_64F);
-    return x64;
-}
+public:
+    BlackSubtracted(const std::vector<Mat>& frames, const RawFormat& format)
+        : frames_(frames), format_(format)
+    {
+    }
+    double at(int t, int r, int c) const
+    {
+        const Mat& f = frames_[static_cast<size_t>(t)];
+        const double v = f.depth() == CV_16U ? f.ptr<ushort>(r)[c] : static_cast<double>(f.ptr<float>(r)[c]);
+        return v - format_.blackAt(r, c);
+    }
+    void row(int t, int r, double* out, int width) const
+    {
+        const Mat& f = frames_[static_cast<size_t>(t)];
+        const double b[2] = {format_.blackAt(r, 0), format_.blackAt(r, 1)};
+        if (f.depth() == CV_16U) {
+            const ushort* p = f.ptr<ushort>(r);
+            for (int c = 0; c < width; ++c)
+                out[c] = p[c] - b[c & 1];
+        } else {
+            const float* p = f.ptr<float>(r);
+            for (int c = 0; c < width; ++c)
+                out[c] = static_cast<double>(p[c]) - b[c & 1];
+        }
+    }
+
+private:
+    const std::vector<Mat>& frames_;
+    const RawFormat& format_;
+};
 
 GainData analyseGain(const std::vector<Mat>& frames, double gain, const RawFormat& format, int ppccSamples,
                      Size size, int type)
@@ -44,9 +71,6 @@ GainData analyseGain(const std::vector<Mat>& frames, double gain, const RawForma
                  cv::format("calibrateDarkNoise: the burst at gain %g has %d frames; at least 3 are "
                             "needed (the temporal mean and two residuals)",
                             gain, T));
-    std::vector<Mat> x(static_cast<size_t>(T));
-    GainData d;
-    d.mean = Mat::zeros(size, CV_64FC1);
     for (int t = 0; t < T; ++t) {
         const Mat& f = frames[static_cast<size_t>(t)];
         if (f.size() != size || f.type() != type)
@@ -58,25 +82,41 @@ GainData analyseGain(const std::vector<Mat>& frames, double gain, const RawForma
         if (type == CV_32FC1 && !checkRange(f, true))
             CV_Error(Error::StsBadArg,
                      cv::format("calibrateDarkNoise: frame %d at gain %g has NaN or Inf", t, gain));
-        x[static_cast<size_t>(t)] = blackSubtracted64(f, format);
-        d.mean += x[static_cast<size_t>(t)];
     }
-    d.mean /= T;
-    // Per row and frame, so that the sums do not depend on how the rows are split among threads.
+    const BlackSubtracted x(frames, format);
+    GainData d;
+    d.mean = Mat::zeros(size, CV_64FC1);
+    // Per row, then per (frame, row): every sum is made in one order whatever the threads.
+    parallel_for_(Range(0, H), [&](const Range& range) {
+        std::vector<double> values(static_cast<size_t>(W));
+        for (int r = range.start; r < range.end; ++r) {
+            double* m = d.mean.ptr<double>(r);
+            for (int t = 0; t < T; ++t) {
+                x.row(t, r, values.data(), W);
+                for (int c = 0; c < W; ++c)
+                    m[c] += values[static_cast<size_t>(c)];
+            }
+            for (int c = 0; c < W; ++c)
+                m[c] /= T;
+        }
+    });
     std::vector<RowSums> sums(static_cast<size_t>(T) * H);
     parallel_for_(Range(0, T * H), [&](const Range& range) {
+        std::vector<double> e(static_cast<size_t>(W));
         for (int i = range.start; i < range.end; ++i) {
             const int t = i / H, r = i % H;
-            const double* p = x[static_cast<size_t>(t)].ptr<double>(r);
+            x.row(t, r, e.data(), W);
             const double* m = d.mean.ptr<double>(r);
             double rowSum = 0;
-            for (int c = 0; c < W; ++c)
-                rowSum += p[c] - m[c];
-            const double R = rowSum / W;
-            RowSums s;
-            s.r2 = R * R;
             for (int c = 0; c < W; ++c) {
-                const double f = p[c] - m[c] - R, f2 = f * f;
+                e[static_cast<size_t>(c)] -= m[c];
+                rowSum += e[static_cast<size_t>(c)];
+            }
+            RowSums s;
+            s.R = rowSum / W;
+            s.r2 = s.R * s.R;
+            for (int c = 0; c < W; ++c) {
+                const double f = e[static_cast<size_t>(c)] - s.R, f2 = f * f;
                 s.f2 += f2;
                 s.f4 += f2 * f2;
             }
@@ -99,17 +139,13 @@ GainData analyseGain(const std::vector<Mat>& frames, double gain, const RawForma
     st.rowVarianceSE = std::sqrt(2 / dofRows) * st.rowMeanVar;
     st.excessKurtosis = total.f2 > 0 ? (total.f4 / n) / ((total.f2 / n) * (total.f2 / n)) - 3 : 0;
 
-    // Samples at odd strides through (frame, row, column), so that both sites of a row take part.
+    // Samples at odd strides through (frame, row, column), so that both sites of a row take part: the
+    // residual e with the row's offset still in, or without it.
     auto residualAt = [&](size_t index, bool withRow) {
         const int t = static_cast<int>(index / (static_cast<size_t>(H) * W));
         const int r = static_cast<int>((index / W) % H), c = static_cast<int>(index % W);
-        const double* p = x[static_cast<size_t>(t)].ptr<double>(r);
-        const double* m = d.mean.ptr<double>(r);
-        double rowSum = 0;
-        if (!withRow)
-            for (int j = 0; j < W; ++j)
-                rowSum += p[j] - m[j];
-        return p[c] - m[c] - rowSum / W;
+        const double e = x.at(t, r, c) - d.mean.ptr<double>(r)[c];
+        return withRow ? e : e - sums[static_cast<size_t>(t) * H + r].R;
     };
     const size_t count = static_cast<size_t>(n);
     const size_t swStride = std::max<size_t>(1, count / 5000) | 1;
@@ -123,23 +159,8 @@ GainData analyseGain(const std::vector<Mat>& frames, double gain, const RawForma
         st.after = shapiroWilk(after);
     }
     const size_t ppccStride = std::max<size_t>(1, count / static_cast<size_t>(ppccSamples)) | 1;
-    // Row means of every (frame, row), so that the subsample costs one subtraction per value.
-    std::vector<double> rowMean(static_cast<size_t>(T) * H);
-    for (int i = 0; i < T * H; ++i) {
-        const int t = i / H, r = i % H;
-        const double* p = x[static_cast<size_t>(t)].ptr<double>(r);
-        const double* m = d.mean.ptr<double>(r);
-        double rowSum = 0;
-        for (int c = 0; c < W; ++c)
-            rowSum += p[c] - m[c];
-        rowMean[static_cast<size_t>(i)] = rowSum / W;
-    }
-    for (size_t i = 0; i < count; i += ppccStride) {
-        const size_t row = i / W;
-        const int t = static_cast<int>(row / H), r = static_cast<int>(row % H), c = static_cast<int>(i % W);
-        d.ppccSample.push_back(x[static_cast<size_t>(t)].ptr<double>(r)[c] - d.mean.ptr<double>(r)[c] -
-                               rowMean[row]);
-    }
+    for (size_t i = 0; i < count; i += ppccStride)
+        d.ppccSample.push_back(residualAt(i, false));
     return d;
 }
 
