@@ -328,26 +328,13 @@ Mat smallMosaic(int type = CV_16UC1)
     return out;
 }
 
-// A sensor with every dark-frame component: row noise mostly before the gain (it grows with it, the
-// banding of high-gain captures), heavy-tailed read noise, and dark shading with a column ramp plus a
-// per-pixel pattern. Unquantised, so that the float augmentation and the capture compare bit for bit
-// in their statistics (quantisation would add 1/12 DN^2 to one side only).
+// The sensor with every dark-frame component (test_common.hpp), lambda -0.1, unquantised: the float
+// augmentation and the capture then compare in their statistics without 1/12 DN^2 of rounding on one
+// side only.
 SensorParams darkComponentSensor(Size size)
 {
-    SensorParams p = test::referenceSensorParams();
+    SensorParams p = test::darkComponentSensorParams(size, -0.1, 19);
     p.quantize = false;
-    p.noise.rowSigmaD2 = 0.3;
-    p.noise.rowSigmaR2 = 0.5;
-    p.noise.tukeyRead = true;
-    p.noise.tukeyLambda = -0.1;
-    Mat bd(size, CV_32FC1), br(size, CV_32FC1);
-    RNG rng(19);
-    rng.fill(bd, RNG::NORMAL, 0, 0.8);
-    rng.fill(br, RNG::NORMAL, 0, 2.0);
-    for (int c = 0; c < size.width; ++c)
-        bd.col(c) += 2.0 * c / size.width;
-    p.noise.darkShadingPerGain = bd;
-    p.noise.darkShadingOffset = br;
     return p;
 }
 

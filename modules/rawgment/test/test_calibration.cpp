@@ -596,20 +596,7 @@ TEST(Calibration, reportErrorsRoundTripAndFirstVersionReportsStillLoad)
 // A sensor with every dark-frame component (the same kind as the augmentation tests'), quantised.
 SensorParams darkSensor(Size size, double lambda)
 {
-    SensorParams p = test::referenceSensorParams();
-    p.noise.rowSigmaD2 = 0.3;
-    p.noise.rowSigmaR2 = 0.5;
-    p.noise.tukeyRead = true;
-    p.noise.tukeyLambda = lambda;
-    Mat bd(size, CV_32FC1), br(size, CV_32FC1);
-    RNG rng(23);
-    rng.fill(bd, RNG::NORMAL, 0, 0.8);
-    rng.fill(br, RNG::NORMAL, 0, 2.0);
-    for (int c = 0; c < size.width; ++c)
-        bd.col(c) += 2.0 * c / size.width;
-    p.noise.darkShadingPerGain = bd;
-    p.noise.darkShadingOffset = br;
-    return p;
+    return test::darkComponentSensorParams(size, lambda, 23);
 }
 
 struct DarkRun

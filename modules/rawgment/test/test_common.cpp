@@ -48,6 +48,24 @@ SensorParams referenceSensorParams()
     return p;
 }
 
+SensorParams darkComponentSensorParams(Size size, double lambda, uint64 seed)
+{
+    SensorParams p = referenceSensorParams();
+    p.noise.rowSigmaD2 = 0.3;
+    p.noise.rowSigmaR2 = 0.5;
+    p.noise.tukeyRead = true;
+    p.noise.tukeyLambda = lambda;
+    Mat bd(size, CV_32FC1), br(size, CV_32FC1);
+    RNG rng(seed);
+    rng.fill(bd, RNG::NORMAL, 0, 0.8);
+    rng.fill(br, RNG::NORMAL, 0, 2.0);
+    for (int c = 0; c < size.width; ++c)
+        bd.col(c) += 2.0 * c / size.width;
+    p.noise.darkShadingPerGain = bd;
+    p.noise.darkShadingOffset = br;
+    return p;
+}
+
 } // namespace test
 } // namespace rawgment
 } // namespace cv

@@ -29,6 +29,11 @@ int countNonFinite(const Mat& m);
  * struggles. */
 SensorParams referenceSensorParams();
 
+/** referenceSensorParams() with every dark-frame component: row noise 0.3 g^2 + 0.5 DN^2 (mostly before
+ * the gain: the banding of high-gain captures), Tukey-lambda read noise of `lambda`, and dark shading of
+ * `size` (B_d: scatter 0.8 plus a ramp of 2 across the columns; B_r: scatter 2 DN) drawn from `seed`. */
+SensorParams darkComponentSensorParams(Size size, double lambda, uint64 seed);
+
 } // namespace test
 } // namespace rawgment
 } // namespace cv
