@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <cinttypes>
+#include <sys/stat.h>
 
 namespace cv {
 namespace rawgment {
@@ -258,9 +259,20 @@ Mat readShadingImage(const FileNode& entry, const char* key, const String& folde
         CV_Error(Error::StsParseError,
                  format("noise model: dark_shading.%s.image and .fnv1a64 must be strings", key));
     const String name = n["image"].string(), checksum = n["fnv1a64"].string();
-    const String path = name.empty() || name[0] == '/' ? name : folder + name;
-    if (!detail::fileExists(path))
+    // A file name in the model's folder, nothing else: a hostile model file could otherwise name a device
+    // or a pipe that blocks the reader, or a file anywhere on the machine.
+    if (name.empty() || name == "." || name == ".." || name.find('/') != String::npos)
+        CV_Error(Error::StsParseError,
+                 format("noise model: dark_shading.%s.image '%s' must be a file name in the model's folder "
+                        "(no '/')",
+                        key, name.c_str()));
+    const String path = folder + name;
+    struct stat info;
+    if (::stat(path.c_str(), &info) != 0)
         CV_Error(Error::StsError, format("noise model: dark-shading image '%s' is missing", path.c_str()));
+    if (!S_ISREG(info.st_mode))
+        CV_Error(Error::StsParseError,
+                 format("noise model: dark-shading image '%s' is not a regular file", path.c_str()));
     const Mat map = imread(path, IMREAD_UNCHANGED);
     if (map.type() != CV_32FC1 || map.size() != size)
         CV_Error(

@@ -294,6 +294,18 @@ TEST(NoiseModel, darkShadingImagesOfAnotherSaveOrMissingAreErrors)
     EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/a.yml"), "different saves");
     std::remove((dir + "/a.dark_shading_per_gain.tiff").c_str());
     EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/a.yml"), "is missing");
+    // Image names are file names in the model's folder: no paths, no devices.
+    std::ifstream original(dir + "/b.yml");
+    const std::string text((std::istreambuf_iterator<char>(original)), std::istreambuf_iterator<char>());
+    for (const std::string& hostile : {"/dev/stdin", "../b.dark_shading_per_gain.tiff", ".."}) {
+        SCOPED_TRACE(hostile);
+        std::string edited = text;
+        const std::string from = "b.dark_shading_per_gain.tiff";
+        edited.replace(edited.find(from), from.size(), hostile);
+        std::ofstream(dir + "/hostile.yml") << edited;
+        EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/hostile.yml"),
+                                 "must be a file name in the model's folder");
+    }
     // write() without image names cannot describe the maps.
     FileStorage fs(".yml", FileStorage::WRITE | FileStorage::MEMORY);
     EXPECT_CV_ERROR_CONTAINS(a.write(fs, "noise_model"), "needs the names of its two images");

@@ -150,7 +150,8 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      * @param folder where the dark-shading images named in the file are (the model file's folder)
      * @throws cv::Exception naming the field when a field is missing, not a number, negative or not
      *         finite, or unknown; when format_version is newer than FORMAT_VERSION; when a dark-shading
-     *         image is missing, unreadable, of another size or type, or does not match its checksum.
+     *         image is not a plain file name in `folder`, is missing, not a regular file, unreadable, of
+     *         another size or type, or does not match its checksum.
      */
     static NoiseModel read(const FileNode& node, const String& folder = String());
 
