@@ -89,6 +89,15 @@ std::string checkModel(const NoiseModel& m)
           std::isfinite(m.sigmaR2) && m.sigmaR2 >= 0))
         return cv::format("accepted a model with alpha %g, sigma_d^2 %g, sigma_r^2 %g", m.alpha, m.sigmaD2,
                           m.sigmaR2);
+    if (!(std::isfinite(m.rowSigmaD2) && m.rowSigmaD2 >= 0 && std::isfinite(m.rowSigmaR2) &&
+          m.rowSigmaR2 >= 0))
+        return cv::format("accepted row noise %g, %g", m.rowSigmaD2, m.rowSigmaR2);
+    if (m.tukeyRead && !(m.tukeyLambda >= -0.2 && m.tukeyLambda <= 1))
+        return cv::format("accepted a Tukey lambda of %g", m.tukeyLambda);
+    if (m.hasDarkShading() && (m.darkShadingPerGain.type() != CV_32FC1 ||
+                               m.darkShadingOffset.size() != m.darkShadingPerGain.size() ||
+                               !cv::checkRange(m.darkShadingPerGain) || !cv::checkRange(m.darkShadingOffset)))
+        return "accepted dark-shading maps that are not finite CV_32FC1 maps of one size";
     return std::string();
 }
 
@@ -140,6 +149,20 @@ NoiseModel seedModel()
     return NoiseModel(1.7, 2.5, 0.8);
 }
 
+//! seedModel() with every dark-frame component; its maps are saved beside the seeds (and so beside the
+//! mutated input, which names them).
+NoiseModel seedDarkModel()
+{
+    NoiseModel m = seedModel();
+    m.rowSigmaD2 = 0.2;
+    m.rowSigmaR2 = 0.4;
+    m.tukeyRead = true;
+    m.tukeyLambda = -0.05;
+    m.darkShadingPerGain = cv::Mat(6, 8, CV_32FC1, cv::Scalar(0.5));
+    m.darkShadingOffset = cv::Mat(6, 8, CV_32FC1, cv::Scalar(-1.25));
+    return m;
+}
+
 std::vector<NoiseSample> seedSamples()
 {
     // Three gains, means spread over the range, variances on the model's lines with a deterministic
@@ -178,6 +201,12 @@ std::vector<Target> targets(const std::string& dataDir)
     t.push_back({"model", "input.yml", false, Errors::LIBRARY,
                  [](const std::string& work) {
                      return textSeeds(work, "model", [](const std::string& p) { seedModel().save(p); });
+                 },
+                 [](const std::string& in) { return checkModel(NoiseModel::load(in)); }});
+    t.push_back({"dark_model", "input.yml", false, Errors::LIBRARY,
+                 [](const std::string& work) {
+                     return textSeeds(work, "dark_model",
+                                      [](const std::string& p) { seedDarkModel().save(p); });
                  },
                  [](const std::string& in) { return checkModel(NoiseModel::load(in)); }});
     t.push_back({"report", "input.yml", false, Errors::LIBRARY,
