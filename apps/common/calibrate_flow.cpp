@@ -348,6 +348,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     // The dark bursts' frames, kept for the dark-frame components (their statistics need every frame).
     std::vector<std::vector<cv::Mat>> darkFrames;
     std::vector<double> darkGains;
+    std::vector<bool> lightSample; // per sample: from a burst with light (its mean holds the dark shading)
     for (size_t i = 0; i < specs.size(); ++i) {
         const CalibrationManifest::Burst& spec = specs[i];
         const double gain = dbToLinearGain(gainsDb[i]);
@@ -413,6 +414,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             for (NoiseSample& sample : burstSamples)
                 sample.mean = 0;
         samples.insert(samples.end(), burstSamples.begin(), burstSamples.end());
+        lightSample.insert(lightSample.end(), burstSamples.size(), !spec.dark);
         // Shapiro-Wilk needs 3 values per pixel.
         std::vector<ShapiroWilkResult> sw;
         if (series.rows >= 3)
@@ -466,9 +468,40 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                 "calibrated");
         }
         result.dark = calibrateDarkNoise(darkFrames, darkGains, firstFormat, result.report.model, darkParams);
-        result.report.model = result.dark.model;
-        result.haveDark = true;
         darkFrames.clear();
+        if (result.dark.model.hasDarkShading()) {
+            // A light sample's mean holds the dark shading, which is no signal: its shot noise is that of the
+            // mean less g B_d + B_r. Uncorrected, a shading of mean s moves every light sample by s and takes
+            // g alpha s from the line's offset, so g^2 alpha from sigma_d^2 (0.25 of 1.5 in a simulated
+            // run with 4 DN of shading). Each light sample is corrected by the frame's mean shading at its
+            // gain (the samples do not keep their pixels), and the model is fitted again.
+            const double meanPerGain = cv::mean(result.dark.model.darkShadingPerGain)[0],
+                         meanOffset = cv::mean(result.dark.model.darkShadingOffset)[0];
+            for (size_t i = 0; i < samples.size(); ++i)
+                if (lightSample[i])
+                    samples[i].mean -= samples[i].gain * meanPerGain + meanOffset;
+            result.report = calibrateNoiseModel(samples, params);
+            result.report.model.baseIso = result.baseIso;
+            result.notes.push_back(
+                cv::format("the light samples' means were corrected by the dark shading's mean "
+                           "(%.3g g + %.3g DN) and the model fitted again",
+                           meanPerGain, meanOffset));
+        }
+        // The components with the (refitted) light model; the rows move out of its read terms, as
+        // calibrateDarkNoise() does (a pixel's temporal variance holds its row's offset).
+        NoiseModel withComponents = result.dark.model;
+        const NoiseModel& light = result.report.model;
+        withComponents.alpha = light.alpha;
+        withComponents.sigmaD2 = std::max(light.sigmaD2 - withComponents.rowSigmaD2, 0.0);
+        withComponents.sigmaR2 = std::max(light.sigmaR2 - withComponents.rowSigmaR2, 0.0);
+        if (withComponents.hasRowNoise())
+            result.notes.push_back(cv::format(
+                "sigma_d^2 and sigma_r^2 of noise_model.yml are the pixel's own read "
+                "noise: the calibrated %.4g and %.4g less the row noise %.4g and %.4g",
+                light.sigmaD2, light.sigmaR2, withComponents.rowSigmaD2, withComponents.rowSigmaR2));
+        result.dark.model = withComponents;
+        result.report.model = withComponents;
+        result.haveDark = true;
     }
     const CalibrationReport& report = result.report;
     {

@@ -354,6 +354,17 @@ DarkCalibrationReport calibrateDarkNoise(const std::vector<std::vector<Mat>>& bu
         const Vec2d uv = fitRowNoise(data, report.notes);
         report.model.rowSigmaD2 = uv[0];
         report.model.rowSigmaR2 = uv[1];
+        // A pixel's temporal variance holds its row's offset too, so the base model's read terms (from
+        // calibrateNoiseModel()) include the rows: they move out of them, or the augmentation would add
+        // them twice.
+        report.model.sigmaD2 = std::max(base.sigmaD2 - uv[0], 0.0);
+        report.model.sigmaR2 = std::max(base.sigmaR2 - uv[1], 0.0);
+        if (base.sigmaD2 < uv[0] || base.sigmaR2 < uv[1])
+            report.notes.push_back(
+                cv::format("the base model's read noise (%g, %g) is below the row noise (%g, %g): "
+                           "its read terms are set to what is left, at least 0; was it "
+                           "calibrated from the same camera?",
+                           base.sigmaD2, base.sigmaR2, uv[0], uv[1]));
     }
     if (params.darkShading)
         fitDarkShading(data, report.model.darkShadingPerGain, report.model.darkShadingOffset);

@@ -617,7 +617,11 @@ DarkRun calibrateSimulatedDark(int frames, double lambda, uint64 seed)
     const Mat dark = Mat::zeros(size, CV_32FC1);
     for (size_t k = 0; k < run.gains.size(); ++k)
         sensor.captureBurst(dark, run.gains[k], 1.0, frames, seed + k, bursts[k]);
-    run.report = calibrateDarkNoise(bursts, run.gains, sensor.rawFormat(1.0), sensor.effectiveModel());
+    // The base a calibration from light bursts gives: per-pixel temporal variances hold the rows too.
+    NoiseModel base = sensor.effectiveModel();
+    base.sigmaD2 += run.truth.noise.rowSigmaD2;
+    base.sigmaR2 += run.truth.noise.rowSigmaR2;
+    run.report = calibrateDarkNoise(bursts, run.gains, sensor.rawFormat(1.0), base);
     return run;
 }
 
@@ -641,6 +645,10 @@ TEST(Calibration, darkFramesRecoverRowNoiseDarkShadingAndTheReadNoiseShape)
     const double det = s00 * s11 - s01 * s01;
     EXPECT_NEAR(r.model.rowSigmaD2, truth.rowSigmaD2, 5 * std::sqrt(s11 / det));
     EXPECT_NEAR(r.model.rowSigmaR2, truth.rowSigmaR2, 5 * std::sqrt(s00 / det));
+    // The rows move out of the base's read terms, which are then the pixel's own, to the rows' error.
+    const NoiseModel pixelOnly = SensorSimulator(run.truth, Size(2, 2)).effectiveModel();
+    EXPECT_NEAR(r.model.sigmaD2, pixelOnly.sigmaD2, 5 * std::sqrt(s11 / det));
+    EXPECT_NEAR(r.model.sigmaR2, pixelOnly.sigmaR2, 5 * std::sqrt(s00 / det));
     // Dark shading: each pixel's weighted line through its T-frame means M_k, slope = sum h_k M_k and
     // offset = sum o_k M_k. A mean carries pixel noise (independent per pixel) and the row offsets'
     // mean (shared by a row), so the mean square error over the map is P + R, with the standard error

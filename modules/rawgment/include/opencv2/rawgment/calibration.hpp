@@ -402,7 +402,9 @@ struct CV_RAWGMENT_EXPORTS DarkCalibrationReport
  *        at least 3 frames each
  * @param gains the linear gains, finite and > 0
  * @param format the CFA format (its black level is subtracted; its gain is not used)
- * @param base the model to extend (alpha, sigma_d^2, sigma_r^2 and base ISO are kept)
+ * @param base the model to extend, as calibrateNoiseModel() gives it: alpha and the base ISO are kept;
+ *        its sigma_d^2 and sigma_r^2, measured from per-pixel temporal variances, hold the row noise too,
+ *        so the fitted row parts are moved out of them (at least 0, with a note when they do not fit)
  * @param params what to fit
  * @throws cv::Exception naming the problem: no bursts, sizes or types that differ, fewer than 3 frames,
  *         fewer than 2 distinct gains for row noise or dark shading, non-finite values.
