@@ -473,19 +473,29 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             // A light sample's mean holds the dark shading, which is no signal: its shot noise is that of the
             // mean less g B_d + B_r. Uncorrected, a shading of mean s moves every light sample by s and takes
             // g alpha s from the line's offset, so g^2 alpha from sigma_d^2 (0.25 of 1.5 in a simulated
-            // run with 4 DN of shading). Each light sample is corrected by the frame's mean shading at its
-            // gain (the samples do not keep their pixels), and the model is fitted again.
-            const double meanPerGain = cv::mean(result.dark.model.darkShadingPerGain)[0],
-                         meanOffset = cv::mean(result.dark.model.darkShadingOffset)[0];
-            for (size_t i = 0; i < samples.size(); ++i)
-                if (lightSample[i])
-                    samples[i].mean -= samples[i].gain * meanPerGain + meanOffset;
+            // run with 4 DN of shading). Each light sample loses its pixel's shading at its gain (a sample
+            // that is no single pixel, the frame's mean shading), and the model is fitted again.
+            const cv::Mat& bd = result.dark.model.darkShadingPerGain;
+            const cv::Mat& br = result.dark.model.darkShadingOffset;
+            const double meanPerGain = cv::mean(bd)[0], meanOffset = cv::mean(br)[0];
+            const int64 pixels = static_cast<int64>(bd.total());
+            for (size_t i = 0; i < samples.size(); ++i) {
+                if (!lightSample[i])
+                    continue;
+                NoiseSample& sample = samples[i];
+                if (sample.pixel >= 0 && sample.pixel < pixels) {
+                    const int r = static_cast<int>(sample.pixel / bd.cols),
+                              c = static_cast<int>(sample.pixel % bd.cols);
+                    sample.mean -= sample.gain * bd.at<float>(r, c) + br.at<float>(r, c);
+                } else {
+                    sample.mean -= sample.gain * meanPerGain + meanOffset;
+                }
+            }
             result.report = calibrateNoiseModel(samples, params);
             result.report.model.baseIso = result.baseIso;
             result.notes.push_back(
-                cv::format("the light samples' means were corrected by the dark shading's mean "
-                           "(%.3g g + %.3g DN) and the model fitted again",
-                           meanPerGain, meanOffset));
+                "the light samples' means were corrected by their pixels' dark shading and the "
+                "model fitted again");
         }
         // The components with the (refitted) light model; the rows move out of its read terms, as
         // calibrateDarkNoise() does (a pixel's temporal variance holds its row's offset).
