@@ -402,10 +402,15 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                                    "fixed-pattern noise and any texture: less exact than a burst)");
         RawFormat burstFormat = first.format;
         burstFormat.gain = gain;
+        // Dark frames: every unclipped pixel away from the border. A dark frame has no scene, so the static
+        // sampler's flatness test would only reject the pixels of a dark-shading pattern (with 4 DN of
+        // shading it kept a third of them, and the offsets were then extrapolated from the light samples:
+        // +2.3%).
         std::vector<NoiseSample> burstSamples =
-            singleFrame              ? sampleSingleFramePatches(first.mosaic, burstFormat, squares, gain)
-            : chartless || spec.dark ? sampleStaticScene(*stats, gain)
-                                     : sampleBurstPatches(*stats, squares, gain);
+            singleFrame ? sampleSingleFramePatches(first.mosaic, burstFormat, squares, gain)
+            : spec.dark ? sampleBurstPatches(*stats, frameGridSquares(stats->size()), gain)
+            : chartless ? sampleStaticScene(*stats, gain)
+                        : sampleBurstPatches(*stats, squares, gain);
         // Dark frames hold no photo-electrons: their variance is the read noise alone. Their temporal means
         // scatter around 0 by sigma / sqrt(T) (and by any dark shading), and the model's shot term
         // g alpha max(mu, 0) at those means would bias the read-noise terms low (2% at 16 frames and
