@@ -477,9 +477,9 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         if (result.dark.model.hasDarkShading()) {
             // A light sample's mean holds the dark shading, which is no signal: its shot noise is that of the
             // mean less g B_d + B_r. Uncorrected, a shading of mean s moves every light sample by s and takes
-            // g alpha s from the line's offset, so g^2 alpha from sigma_d^2 (0.25 of 1.5 in a simulated
-            // run with 4 DN of shading). Each light sample loses its pixel's shading at its gain (a sample
-            // that is no single pixel, the frame's mean shading), and the model is fitted again.
+            // g alpha s from the line's offset (docs/mathematics.md: with 4 DN, sigma_r^2 came out 59% low).
+            // Each light sample loses its pixel's shading at its gain (a sample that is no single pixel, the
+            // frame's mean shading), and the model is fitted again.
             const cv::Mat& bd = result.dark.model.darkShadingPerGain;
             const cv::Mat& br = result.dark.model.darkShadingOffset;
             const double meanPerGain = cv::mean(bd)[0], meanOffset = cv::mean(br)[0];
