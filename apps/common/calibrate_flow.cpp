@@ -483,12 +483,14 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             const cv::Mat& bd = result.dark.model.darkShadingPerGain;
             const cv::Mat& br = result.dark.model.darkShadingOffset;
             const double meanPerGain = cv::mean(bd)[0], meanOffset = cv::mean(br)[0];
-            const int64 pixels = static_cast<int64>(bd.total());
+            // A sample numbers its pixel row * width + column of its frame: the maps' pixels only when the
+            // light frames are of the dark frames' size.
+            const bool samePixels = bd.size() == frameSize;
             for (size_t i = 0; i < samples.size(); ++i) {
                 if (!lightSample[i])
                     continue;
                 NoiseSample& sample = samples[i];
-                if (sample.pixel >= 0 && sample.pixel < pixels) {
+                if (samePixels && sample.pixel >= 0 && sample.pixel < static_cast<int64>(bd.total())) {
                     const int r = static_cast<int>(sample.pixel / bd.cols),
                               c = static_cast<int>(sample.pixel % bd.cols);
                     sample.mean -= sample.gain * bd.at<float>(r, c) + br.at<float>(r, c);
