@@ -87,8 +87,8 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      * heavy-tailed Tukey-lambda shape of tukeyLambda instead of a Gaussian one. An explicit flag:
      * lambda = 0 is the logistic shape, not "absent". */
     bool tukeyRead = false;
-    /** Shape of the read noise when tukeyRead: -0.25 < lambda <= 1; about 0.14 is Gaussian, smaller
-     * values have heavier tails (0: logistic, excess kurtosis 1.2). */
+    /** Shape of the read noise when tukeyRead: -0.2 <= lambda <= 1 (validate()); about 0.14 is Gaussian,
+     * smaller values have heavier tails (0: logistic, excess kurtosis 1.2). */
     double tukeyLambda = 0;
 
     bool hasRowNoise() const { return rowSigmaD2 > 0 || rowSigmaR2 > 0; } //!< whether row noise is present
