@@ -88,20 +88,8 @@ struct DarkTerms
     bool row = false, shading = false, tails = false;
     float rowSigma[4] = {0, 0, 0, 0};
     float shadingPerGain[4] = {0, 0, 0, 0}, shadingOffset[4] = {0, 0, 0, 0};
-    double lambda[4] = {0, 0, 0, 0};
-    double tailInvSd[4] = {1, 1, 1, 1}; // 1 / sd of the Tukey variable of lambda[site] (setTails())
+    TukeyUnitSampler tailSampler[4]; // the added read part's heavy-tailed shape per site, when `tails`
     bool any() const { return row || shading; }
-    //! Sets the tails' lambda of a site and its scale, once per call: the moments cost microseconds.
-    void setTails(int site, double l)
-    {
-        lambda[site] = l;
-        tailInvSd[site] = TukeyUnitSampler(l).invSd;
-    }
-    //! A unit-variance heavy-tailed draw for `site` from a uniform u in (0, 1).
-    float tail(int site, double u) const
-    {
-        return static_cast<float>(tailInvSd[site] * tukeyLambdaQuantile(u, lambda[site]));
-    }
 };
 
 /** The dark shading g B_d + B_r of a model at one gain, read row by row from its maps: a whole-frame

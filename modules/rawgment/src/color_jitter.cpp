@@ -338,7 +338,8 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
             detail::CounterRng uniforms(keys.tukey, static_cast<uint64_t>(r));
             const int even = 2 * (r & 1);
             for (int c = 0; c < cols; ++c)
-                t[static_cast<size_t>(c)] = k.dark.tail(even + (c & 1), uniforms.uniform());
+                t[static_cast<size_t>(c)] =
+                    static_cast<float>(k.dark.tailSampler[even + (c & 1)](uniforms.uniform()));
         }
         if (dark && !detail::darkRowExtra(k.dark, model, keys.row, r, cols, extra.data()))
             nonFinite = true;
@@ -395,10 +396,10 @@ detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, const Co
         d.shadingOffset[s] = static_cast<float>(account ? 0.0 : 1.0);
         if (!d.tails)
             continue;
-        d.setTails(s, account ? detail::addedReadLambda(model.tukeyLambda, readOut,
-                                                        std::pow(pc, 4) * readIn * readIn,
-                                                        readOut - pc * pc * readIn)
-                              : model.tukeyLambda);
+        d.tailSampler[s] = detail::TukeyUnitSampler(
+            account ? detail::addedReadLambda(model.tukeyLambda, readOut, std::pow(pc, 4) * readIn * readIn,
+                                              readOut - pc * pc * readIn)
+                    : model.tukeyLambda);
     }
     return d;
 }

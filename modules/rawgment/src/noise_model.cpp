@@ -128,8 +128,15 @@ Mat NoiseModel::darkShadingAt(double gain) const
     detail::checkFinitePositive(gain, "gain");
     if (!hasDarkShading())
         return Mat();
-    Mat s;
-    addWeighted(darkShadingPerGain, gain, darkShadingOffset, 1.0, 0.0, s, CV_32F);
+    // In float, as the noise steps read it row by row (detail::ShadingRows): one formula, the same bits.
+    const float g = static_cast<float>(gain);
+    Mat s(darkShadingPerGain.size(), CV_32FC1);
+    for (int r = 0; r < s.rows; ++r) {
+        const float *bd = darkShadingPerGain.ptr<float>(r), *br = darkShadingOffset.ptr<float>(r);
+        float* out = s.ptr<float>(r);
+        for (int c = 0; c < s.cols; ++c)
+            out[c] = g * bd[c] + br[c];
+    }
     return s;
 }
 

@@ -263,7 +263,7 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
         t.resize(static_cast<size_t>(n));
         detail::CounterRng uniforms(k.tukeyKey, stream);
         for (int j = 0; j < n; ++j)
-            t[static_cast<size_t>(j)] = k.dark.tail(site, uniforms.uniform());
+            t[static_cast<size_t>(j)] = static_cast<float>(k.dark.tailSampler[site](uniforms.uniform()));
     }
     const float* extraRow = extra.empty() ? nullptr : extra.data();
     if (noise && (k.sampling == ShotNoiseSampling::POISSON || k.dark.tails)) {
@@ -324,7 +324,7 @@ void resampleDarkTerms(ResampleConstants& k, const NoiseModel& model, const RawF
             account ? detail::addedReadLambda(model.tukeyLambda, b, sumW4 * b * b, (1 - sumW2) * b)
                     : model.tukeyLambda;
         for (int s = 0; s < 4; ++s)
-            d.setTails(s, lambda);
+            d.tailSampler[s] = detail::TukeyUnitSampler(lambda);
     }
     if (d.shading) {
         k.shading = detail::ShadingRows(model, format.gain);
