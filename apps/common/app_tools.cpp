@@ -52,10 +52,16 @@ std::vector<uchar> encodeByExtension(const std::string& path, const cv::Mat& ima
 void writeNewBytes(const std::string& path, const std::vector<uchar>& bytes)
 {
     if (pathExists(path)) {
-        std::ifstream f(path, std::ios::binary);
-        const std::vector<uchar> existing((std::istreambuf_iterator<char>(f)),
-                                          std::istreambuf_iterator<char>());
-        if (existing == bytes)
+        // Read no more than the new bytes: a larger file, a FIFO or a device differs anyway.
+        bool same = false;
+        try {
+            const std::string existing =
+                cv::rawgment::readFileBounded(path, static_cast<long long>(bytes.size()), "existing output");
+            same = existing.size() == bytes.size() && std::equal(bytes.begin(), bytes.end(), existing.begin(),
+                                                                 [](uchar a, char b) { return a == uchar(b); });
+        } catch (const cv::Exception&) {
+        }
+        if (same)
             return;
         throw std::runtime_error("'" + path + "' already exists; it is never overwritten");
     }

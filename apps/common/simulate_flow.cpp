@@ -143,8 +143,8 @@ SimulateResult simulateBursts(const SimulateOptions& o)
     // The job before any frame: a folder holds the frames of one job, and a rerun continues only that job.
     const std::string jobPath = o.outDir + "/simulation_job.yml", job = jobDescription(o);
     if (pathExists(jobPath)) {
-        std::ifstream f(jobPath, std::ios::binary);
-        const std::string existing((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+        const std::string existing =
+            cv::rawgment::readFileBounded(jobPath, cv::rawgment::MAX_TEXT_FILE_BYTES, "simulation job file");
         if (existing != job)
             throw std::runtime_error("'" + jobPath +
                                      "' describes another simulation (other gains, levels, frames, "

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <climits>
 #include <cstring>
+#include <fcntl.h>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -247,16 +248,84 @@ void rejectUnsupportedStructure(const String& path, const std::string& text)
 
 std::string readTextFile(const String& path)
 {
-    std::ifstream f(path, std::ios::binary);
-    if (!f)
-        CV_Error(Error::StsError, "cannot open '" + path + "': " + std::strerror(errno));
-    std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    if (f.bad())
-        CV_Error(Error::StsError, "cannot read '" + path + "'");
-    return text;
+    return readFileBounded(path, MAX_TEXT_FILE_BYTES, "file");
+}
+
+void checkRegularFile(const String& path, const String& what)
+{
+    struct stat status;
+    if (::stat(path.c_str(), &status) != 0)
+        CV_Error(Error::StsError, "cannot open " + what + " '" + path +
+                                      "': " + (errno == ENOENT ? "no such file" : std::strerror(errno)));
+    if (!S_ISREG(status.st_mode))
+        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': " + notRegularReason(status.st_mode));
+}
+
+const char* notRegularReason(unsigned mode)
+{
+    if (S_ISDIR(mode))
+        return "it is a directory";
+    if (S_ISFIFO(mode))
+        return "it is a FIFO (named pipe), not a regular file; only regular files are read";
+    if (S_ISCHR(mode) || S_ISBLK(mode))
+        return "it is a device, not a regular file; only regular files are read";
+    if (S_ISSOCK(mode))
+        return "it is a socket, not a regular file; only regular files are read";
+    return "it is not a regular file; only regular files are read";
 }
 
 } // namespace detail
+
+std::string readFileBounded(const String& path, long long maxBytes, const String& what)
+{
+    if (path.empty())
+        CV_Error(Error::StsBadArg, "cannot open " + what + ": the path is empty");
+    if (maxBytes < 0)
+        CV_Error(Error::StsBadArg, format("readFileBounded: maxBytes must be >= 0 (got %lld)", maxBytes));
+    // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer that may never come; the
+    // type is decided on the opened file itself, so nothing can swap it in between.
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0)
+        CV_Error(Error::StsError, "cannot open " + what + " '" + path +
+                                      "': " + (errno == ENOENT ? "no such file" : std::strerror(errno)));
+    struct Closer
+    {
+        int fd;
+        ~Closer() { ::close(fd); }
+    } closer{fd};
+    struct stat status;
+    if (::fstat(fd, &status) != 0)
+        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': " + std::strerror(errno));
+    if (!S_ISREG(status.st_mode))
+        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': " + detail::notRegularReason(status.st_mode));
+    const auto tooLarge = [&](long long bytes) {
+        CV_Error(Error::StsError,
+                 format("cannot open %s '%s': %lld bytes, more than the %lld bytes such a file may have",
+                        what.c_str(), path.c_str(), bytes, maxBytes));
+    };
+    if (status.st_size > maxBytes)
+        tooLarge(static_cast<long long>(status.st_size));
+    // One byte beyond the limit is asked for, so that a file that grew while being read is noticed.
+    std::string data(static_cast<size_t>(std::min<long long>(status.st_size, maxBytes)) + 1, '\0');
+    size_t got = 0;
+    for (;;) {
+        if (got == data.size()) {
+            if (static_cast<long long>(got) > maxBytes)
+                tooLarge(static_cast<long long>(got));
+            data.resize(std::min<size_t>(data.size() * 2, static_cast<size_t>(maxBytes) + 1));
+        }
+        const ssize_t n = ::read(fd, &data[got], data.size() - got);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0)
+            CV_Error(Error::StsError, "cannot read " + what + " '" + path + "': " + std::strerror(errno));
+        if (n == 0)
+            break;
+        got += static_cast<size_t>(n);
+    }
+    data.resize(got);
+    return data;
+}
 
 void rejectUnknownKeys(const FileNode& map, const std::vector<String>& valid)
 {
@@ -284,25 +353,11 @@ FileStorage openFileStorageForReading(const String& path, const String& what)
 {
     if (path.empty())
         CV_Error(Error::StsBadArg, "cannot open " + what + ": the path is empty");
-    // Checked first so that OpenCV does not log its own error for a missing file.
-    struct stat status;
-    if (::stat(path.c_str(), &status) != 0)
-        CV_Error(Error::StsError, "cannot open " + what + " '" + path +
-                                      "': " + (errno == ENOENT ? "no such file" : std::strerror(errno)));
-    if (S_ISDIR(status.st_mode))
-        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': it is a directory");
-    if (status.st_size > MAX_TEXT_FILE_BYTES)
-        CV_Error(Error::StsError, format("cannot open %s '%s': %lld bytes, more than the %lld a YAML or "
-                                         "JSON file of this module may have",
-                                         what.c_str(), path.c_str(), static_cast<long long>(status.st_size),
-                                         static_cast<long long>(MAX_TEXT_FILE_BYTES)));
     // Read once and parsed from memory: the integer check and OpenCV's parser see the same bytes.
-    std::string text = detail::readTextFile(path);
+    std::string text = readFileBounded(path, MAX_TEXT_FILE_BYTES, what);
     // A UTF-8 byte-order mark (some Windows editors write one) is not part of the YAML or JSON.
     if (text.compare(0, 3, "\xEF\xBB\xBF") == 0)
         text.erase(0, 3);
-    if (text.size() > size_t(MAX_TEXT_FILE_BYTES))
-        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': it grew while being read");
     detail::rejectUnsupportedStructure(path, text);
     detail::rejectWrappingIntegers(path, text);
     FileStorage fs;

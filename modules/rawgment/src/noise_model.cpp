@@ -5,7 +5,10 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <cinttypes>
+#include <filesystem>
 #include <sys/stat.h>
 
 namespace cv {
@@ -53,12 +56,6 @@ String baseNameOf(const String& path)
 {
     const size_t slash = path.find_last_of('/');
     return slash == String::npos ? path : path.substr(slash + 1);
-}
-
-String withoutExtension(const String& path)
-{
-    const size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
-    return dot == String::npos || (slash != String::npos && dot < slash) ? path : path.substr(0, dot);
 }
 
 const char* const kShadingKeys[2] = {"per_gain", "offset"};
@@ -379,22 +376,71 @@ NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
     return m;
 }
 
+namespace {
+
+// `<model file name>.dark_shading_<key>.<checksum>.tiff`: the model file's whole name keeps cam.yml and
+// cam.json apart, the checksum gives every new map a new name, so a save never touches the maps the
+// current model file names until that file has been switched.
+String shadingImageName(const String& modelPath, int key, const Mat& map)
+{
+    return baseNameOf(modelPath) + ".dark_shading_" + kShadingKeys[key] + "." + mapChecksum(map) + ".tiff";
+}
+
+bool isShadingImageOf(const String& modelPath, const std::string& name)
+{
+    for (int key = 0; key < 2; ++key) {
+        const std::string prefix = baseNameOf(modelPath) + ".dark_shading_" + kShadingKeys[key] + ".";
+        if (name.size() != prefix.size() + 16 + 5 || name.compare(0, prefix.size(), prefix) != 0 ||
+            name.compare(name.size() - 5, 5, ".tiff") != 0)
+            continue;
+        if (std::all_of(name.begin() + long(prefix.size()), name.end() - 5,
+                        [](char c) { return std::isxdigit(static_cast<unsigned char>(c)) != 0; }))
+            return true;
+    }
+    return false;
+}
+
+} // namespace
+
 void NoiseModel::save(const String& path) const
 {
+    // Everything that can refuse the model runs before the first byte is written.
     validate();
+    detail::checkDarkShadingFinite(*this);
     std::vector<String> images;
-    if (hasDarkShading()) {
-        const Mat* maps[2] = {&darkShadingPerGain, &darkShadingOffset};
-        for (int i = 0; i < 2; ++i) {
-            const String image = withoutExtension(path) + ".dark_shading_" + kShadingKeys[i] + ".tiff";
+    const Mat* maps[2] = {&darkShadingPerGain, &darkShadingOffset};
+    if (hasDarkShading())
+        for (int i = 0; i < 2; ++i)
+            images.push_back(shadingImageName(path, i, *maps[i]));
+    const std::string text =
+        detail::fileStorageText(path, [&](FileStorage& fs) { write(fs, kTopLevelName, images); });
+    const String folder = folderOf(path);
+    std::vector<String> created;
+    try {
+        for (size_t i = 0; i < images.size(); ++i) {
+            const String image = folder + images[i];
+            // Same name, same checksum: a map an earlier save left is this one already.
+            if (detail::fileExists(image))
+                continue;
             std::vector<uchar> bytes;
             if (!imencode(".tiff", *maps[i], bytes, {IMWRITE_TIFF_COMPRESSION, 1}) || bytes.empty())
                 CV_Error(Error::StsError, "NoiseModel::save: cannot encode the dark-shading image " + image);
-            writeFileAtomically(image, bytes.data(), bytes.size(), true);
-            images.push_back(baseNameOf(image));
+            writeFileAtomically(image, bytes.data(), bytes.size(), false);
+            created.push_back(image);
         }
+        writeFileAtomically(path, text.data(), text.size(), true);
+    } catch (...) {
+        for (const String& image : created)
+            std::remove(image.c_str());
+        throw;
     }
-    detail::writeFileStorageAtomically(path, [&](FileStorage& fs) { write(fs, kTopLevelName, images); });
+    // The model file now names only the new maps: its earlier ones go.
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator(folder.empty() ? "." : folder, error)) {
+        const std::string name = entry.path().filename().string();
+        if (isShadingImageOf(path, name) && std::find(images.begin(), images.end(), name) == images.end())
+            std::filesystem::remove(entry.path(), error);
+    }
 }
 
 NoiseModel NoiseModel::load(const String& path)

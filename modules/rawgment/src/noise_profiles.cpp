@@ -139,6 +139,7 @@ double rangeOfColourPlane(const RawFormat& format, int plane)
 //! The NoiseProfile pairs of a TIFF-based file (DNG), empty when it has none or is not TIFF-based.
 std::vector<Vec2d> readDngNoiseProfile(const String& path)
 {
+    checkRegularFile(path, "RAW file");
     {
         std::ifstream probe(path, std::ios::binary);
         char head[4] = {0, 0, 0, 0};

@@ -63,8 +63,13 @@ double rangeOfColourPlane(const RawFormat& format, int plane);
 void checkDngNoiseProfile(const std::vector<Vec2d>& profile, const char* what);
 //! Whether anything exists at `path`.
 bool fileExists(const String& path);
-//! The whole content of a file; throws StsError naming it when it cannot be read.
+//! The whole content of a regular file of at most MAX_TEXT_FILE_BYTES; throws StsError naming it.
 std::string readTextFile(const String& path);
+//! Throws StsError naming `path` (as `what`) unless it exists and is a regular file: a reader handed a
+//! FIFO or a device would block or read forever.
+void checkRegularFile(const String& path, const String& what);
+//! Why a file of this st_mode is not read ("it is a FIFO ...").
+const char* notRegularReason(unsigned mode);
 /** Throws StsParseError naming the file (`path`) and line of an integer literal of `text` beyond 32 bits:
  * OpenCV's YAML and JSON readers keep integers in an int and silently wrap them (4294967297 reads as 1). */
 void rejectWrappingIntegers(const String& path, const std::string& text);

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <memory>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <vector>
 
@@ -112,6 +113,10 @@ RawImage readRaw(const String& path)
         CV_Error(Error::StsBadArg, "readRaw: the path is empty");
     if (!detail::fileExists(path))
         failOn(path, "no such file");
+    struct stat status;
+    // LibRaw would block on a FIFO's open and read a device until its own allocation limit.
+    if (::stat(path.c_str(), &status) == 0 && !S_ISREG(status.st_mode))
+        failOn(path, detail::notRegularReason(status.st_mode));
     // LibRaw's state is a few hundred kilobytes: keep it off the stack.
     std::unique_ptr<LibRaw> raw(new LibRaw(0));
     DataErrors errors;
@@ -569,6 +574,7 @@ MosaicMetadata readMosaic(const String& path, OutputArray _mosaic)
     const String sidecar = sidecarPathOf(path);
     if (!detail::fileExists(path))
         CV_Error(Error::StsError, "readMosaic: '" + path + "': no such file");
+    detail::checkRegularFile(path, "mosaic");
     const MosaicMetadata meta =
         detail::loadFileStorage(sidecar, "mosaic_metadata", "mosaic sidecar",
                                 [](const FileNode& n) { return MosaicMetadata::read(n); });

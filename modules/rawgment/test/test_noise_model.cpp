@@ -6,8 +6,10 @@
 #include <opencv2/rawgment/noise_model.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 
 namespace cv {
 namespace rawgment {
@@ -231,6 +233,22 @@ TEST(NoiseModel, integersBeyond32BitsAreRefusedNotWrapped)
     EXPECT_EQ(NoiseModel::load(dir + "/real.yml").alpha, 4294967297.0);
 }
 
+// The image that a saved model file names for its dark-shading map `key` (per_gain or offset).
+std::string shadingImageOf(const std::string& modelPath, const char* key)
+{
+    FileStorage fs(modelPath, FileStorage::READ);
+    return fs["noise_model"]["dark_shading"][key]["image"].string();
+}
+
+std::vector<std::string> filesOf(const std::string& dir)
+{
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+        names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
 // A model with every dark-frame component, maps of a small sensor.
 NoiseModel darkComponentModel(Size size)
 {
@@ -262,9 +280,10 @@ TEST(NoiseModel, darkComponentsRoundTripWithTheirImagesAsVersion3)
     }
     FileStorage written(dir + "/dark.yml", FileStorage::READ);
     EXPECT_EQ(3, int(written["noise_model"]["format_version"]));
-    EXPECT_EQ("dark.dark_shading_per_gain.tiff",
-              std::string(written["noise_model"]["dark_shading"]["per_gain"]["image"]));
     written.release();
+    EXPECT_EQ("dark.yml.dark_shading_per_gain." + std::string(16, 'h') + ".tiff",
+              std::regex_replace(shadingImageOf(dir + "/dark.yml", "per_gain"), std::regex("[0-9a-f]{16}"),
+                                 std::string(16, 'h')));
     // Lambda 0 (logistic) is present, not absent: the flag says so.
     NoiseModel logistic(0.25, 1.5, 0.8);
     logistic.tukeyRead = true;
@@ -281,6 +300,41 @@ TEST(NoiseModel, darkComponentsRoundTripWithTheirImagesAsVersion3)
     EXPECT_EQ(1, int(plainFile["noise_model"]["format_version"]));
 }
 
+TEST(NoiseModel, aSaveWithMapsIsAllOrNothingAndModelsInOneFolderKeepTheirOwnMaps)
+{
+    const std::string dir = test::makeTempDir("noise_model_maps_all_or_nothing");
+    const NoiseModel a = darkComponentModel(Size(12, 8));
+    NoiseModel b = darkComponentModel(Size(12, 8));
+    b.darkShadingOffset += 1;
+    // One folder, one stem, two formats: each file keeps its own maps.
+    a.save(dir + "/cam.yml");
+    b.save(dir + "/cam.json");
+    EXPECT_EQ(0, norm(a.darkShadingOffset, NoiseModel::load(dir + "/cam.yml").darkShadingOffset, NORM_INF));
+    EXPECT_EQ(0, norm(b.darkShadingOffset, NoiseModel::load(dir + "/cam.json").darkShadingOffset, NORM_INF));
+    const std::vector<std::string> before = filesOf(dir);
+    EXPECT_EQ(6u, before.size());
+
+    // A refused save writes nothing: the old model and its maps load as they were.
+    NoiseModel refused = b;
+    refused.darkShadingPerGain = b.darkShadingPerGain.clone();
+    refused.darkShadingPerGain.at<float>(2, 3) = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_CV_ERROR_CONTAINS(refused.save(dir + "/cam.yml"), "darkShadingPerGain contains NaN or Inf");
+    EXPECT_EQ(before, filesOf(dir));
+    EXPECT_EQ(0, norm(a.darkShadingPerGain, NoiseModel::load(dir + "/cam.yml").darkShadingPerGain, NORM_INF));
+
+    // Replacing the model: the new maps, and the old ones of that file gone, the other file untouched.
+    b.save(dir + "/cam.yml");
+    EXPECT_EQ(0, norm(b.darkShadingOffset, NoiseModel::load(dir + "/cam.yml").darkShadingOffset, NORM_INF));
+    EXPECT_EQ(before.size(), filesOf(dir).size());
+    EXPECT_EQ(0, norm(b.darkShadingOffset, NoiseModel::load(dir + "/cam.json").darkShadingOffset, NORM_INF));
+    // Saving the same maps again keeps them; a model without shading leaves none of that file behind.
+    b.save(dir + "/cam.yml");
+    EXPECT_EQ(before.size(), filesOf(dir).size());
+    NoiseModel(0.25, 1.5, 0.8).save(dir + "/cam.yml");
+    EXPECT_EQ(4u, filesOf(dir).size());
+    EXPECT_NO_THROW(NoiseModel::load(dir + "/cam.json"));
+}
+
 TEST(NoiseModel, darkShadingImagesOfAnotherSaveOrMissingAreErrors)
 {
     const std::string dir = test::makeTempDir("noise_model_dark_mismatch");
@@ -290,17 +344,20 @@ TEST(NoiseModel, darkShadingImagesOfAnotherSaveOrMissingAreErrors)
     b.darkShadingOffset += 1;
     b.save(dir + "/b.yml");
     // a.yml with the images of b.yml: the checksums tell them apart.
-    std::rename((dir + "/b.dark_shading_offset.tiff").c_str(), (dir + "/a.dark_shading_offset.tiff").c_str());
+    const std::string aOffset = dir + "/" + shadingImageOf(dir + "/a.yml", "offset"),
+                      aPerGain = dir + "/" + shadingImageOf(dir + "/a.yml", "per_gain"),
+                      bPerGain = shadingImageOf(dir + "/b.yml", "per_gain");
+    std::rename((dir + "/" + shadingImageOf(dir + "/b.yml", "offset")).c_str(), aOffset.c_str());
     EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/a.yml"), "different saves");
-    std::remove((dir + "/a.dark_shading_per_gain.tiff").c_str());
+    std::remove(aPerGain.c_str());
     EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/a.yml"), "is missing");
     // Image names are file names in the model's folder: no paths, no devices.
     std::ifstream original(dir + "/b.yml");
     const std::string text((std::istreambuf_iterator<char>(original)), std::istreambuf_iterator<char>());
-    for (const std::string& hostile : {"/dev/stdin", "../b.dark_shading_per_gain.tiff", ".."}) {
+    for (const std::string& hostile : {std::string("/dev/stdin"), "../" + bPerGain, std::string("..")}) {
         SCOPED_TRACE(hostile);
         std::string edited = text;
-        const std::string from = "b.dark_shading_per_gain.tiff";
+        const std::string& from = bPerGain;
         edited.replace(edited.find(from), from.size(), hostile);
         std::ofstream(dir + "/hostile.yml") << edited;
         EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/hostile.yml"),

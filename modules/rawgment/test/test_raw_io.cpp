@@ -15,6 +15,7 @@
 #include <iterator>
 #include <limits>
 #include <sys/mount.h>
+#include <sys/stat.h>
 #include <thread>
 #include <unistd.h>
 #include <vector>
@@ -126,6 +127,29 @@ TEST(RawIo, aFullDiskIsAnErrorAndNeverReplacesAGoodFile)
                              "No space left on device");
     // Nothing new is left behind: no empty report, no half sidecar, no temporary.
     EXPECT_EQ(filesIn(disk.path()), (std::vector<std::string>{"filler", "filler2", "noise_model.yml"}));
+}
+
+TEST(RawIo, aFullDiskNeverBreaksAModelWithDarkShadingMaps)
+{
+    const SmallDisk disk(512 * 1024);
+    if (disk.path().empty())
+        GTEST_SKIP() << disk.why();
+    const std::string model = disk.path() + "/cam.yml";
+    const NoiseModel good = test::darkComponentSensorParams(Size(64, 48), -0.05, 1).noise;
+    good.save(model);
+    const std::vector<std::string> files = filesIn(disk.path());
+    disk.fill();
+    NoiseModel other = test::darkComponentSensorParams(Size(64, 48), -0.05, 2).noise;
+    EXPECT_CV_ERROR_CONTAINS(other.save(model), "No space left on device");
+    // The old model file and its maps, as they were: nothing new, nothing removed.
+    std::vector<std::string> after = filesIn(disk.path());
+    after.erase(std::remove_if(after.begin(), after.end(),
+                               [](const std::string& n) { return n.compare(0, 6, "filler") == 0; }),
+                after.end());
+    EXPECT_EQ(files, after);
+    NoiseModel back;
+    ASSERT_NO_THROW(back = NoiseModel::load(model));
+    EXPECT_EQ(0, norm(good.darkShadingOffset, back.darkShadingOffset, NORM_INF));
 }
 
 TEST(RawIo, colorchartDngHasTheLevelsLibRawReports)
@@ -758,6 +782,31 @@ TEST(RawIo, openFileStorageForReadingRefusesStreamsOpenCvNeverFinishes)
     EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(dir, "x"), "it is a directory");
     EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(dir + "/none.yml", "scene"),
                              "cannot open scene '" + dir + "/none.yml': no such file");
+}
+
+TEST(RawIo, everyReaderRefusesDevicesAndFifosWithoutBlocking)
+{
+    // /dev/zero has st_size 0 and never ends; a FIFO's open waits for a writer that never comes. Each
+    // reader must refuse both at once, naming the file and what it is.
+    const std::string dir = makeTempDir("raw_io_not_regular");
+    const std::string fifo = dir + "/pipe.dng", fifoYaml = dir + "/pipe.yml";
+    ASSERT_EQ(0, ::mkfifo(fifo.c_str(), 0600));
+    ASSERT_EQ(0, ::mkfifo(fifoYaml.c_str(), 0600));
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel::load("/dev/zero"), "'/dev/zero': it is a device");
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(fifoYaml), "pipe.yml': it is a FIFO");
+    EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(fifoYaml, "manifest"), "cannot open manifest");
+    EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy::load(fifoYaml), "it is a FIFO");
+    EXPECT_CV_ERROR_CONTAINS(CalibrationReport::load("/dev/zero"), "it is a device");
+    EXPECT_CV_ERROR_CONTAINS(readRaw(fifo), "pipe.dng': it is a FIFO");
+    EXPECT_CV_ERROR_CONTAINS(readRaw("/dev/zero"), "it is a device");
+    Mat mosaic;
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(fifo, mosaic), "it is a FIFO");
+    EXPECT_CV_ERROR_CONTAINS(readFileBounded("/dev/urandom", 10, "noise"), "cannot open noise '/dev/urandom'");
+    EXPECT_CV_ERROR_CONTAINS(readFileBounded(dir, 10, "x"), "it is a directory");
+    // A regular file: its bytes up to the bound, an error beyond it.
+    const std::string text = textFile(dir, "ten.txt", "0123456789");
+    EXPECT_EQ("0123456789", readFileBounded(text, 10, "x"));
+    EXPECT_CV_ERROR_CONTAINS(readFileBounded(text, 9, "x"), "10 bytes, more than the 9 bytes");
 }
 
 TEST(RawIo, openFileStorageForReadingBoundsTheFileAndScansLongLines)

@@ -157,9 +157,13 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
 
     /** @brief Saves the model to a YAML (.yml, .yaml) or JSON (.json) file, atomically: the file is
      * written under a temporary name next to `path` and renamed, so a reader never sees half a file.
-     * Dark shading goes first into `<path without extension>.dark_shading_per_gain.tiff` and
-     * `.dark_shading_offset.tiff` (each atomically); the model file names them with their checksums,
-     * so a model file and images of different saves are never taken for a pair.
+     * The save is all or nothing: a model that validate() refuses or a map with NaN or Inf writes
+     * nothing. Dark shading goes first into new files `<file name of path>.dark_shading_per_gain.<fnv>.tiff`
+     * and `.dark_shading_offset.<fnv>.tiff` (fnv: the map's FNV-1a 64 checksum, so `cam.yml` and
+     * `cam.json` never share a map and a new map never replaces one the current model file names); the
+     * model file, which names them with their checksums, is switched last; only then are the maps of the
+     * model file's earlier saves removed. When any write fails (a full disk), the maps this call made
+     * are removed and the model file and its maps are as they were.
      */
     void save(const String& path) const;
 

@@ -195,6 +195,21 @@ CV_RAWGMENT_EXPORTS void removeTemporaryFilesInProgress();
 //! The largest YAML or JSON file openFileStorageForReading() (and so every reader of this module) opens.
 static constexpr long long MAX_TEXT_FILE_BYTES = 64LL << 20;
 
+/** @brief Reads a whole regular file of at most `maxBytes` bytes, the way every reader of this module
+ * reads its text files.
+ *
+ * A FIFO, a device (`/dev/zero`), a socket or a directory is refused before anything is read, without
+ * waiting for a FIFO's writer; a file larger than `maxBytes`, or one that grows beyond it while being
+ * read, is refused without reading more than `maxBytes + 1` bytes.
+ * @param path the file
+ * @param maxBytes the largest size accepted
+ * @param what what the file is, for the messages ("noise model file", "calibration manifest")
+ * @return the file's bytes
+ * @throws cv::Exception StsError naming `what` and `path`: missing, unreadable, not a regular file (and
+ * which kind it is), or larger than `maxBytes`; StsBadArg for an empty path or a negative limit.
+ */
+CV_RAWGMENT_EXPORTS std::string readFileBounded(const String& path, long long maxBytes, const String& what);
+
 /** @brief Opens a YAML or JSON file for reading the way every reader of this module does.
  *
  * What it adds to cv::FileStorage, which readers of your own files (manifests, job files) can use too:
@@ -205,7 +220,8 @@ static constexpr long long MAX_TEXT_FILE_BYTES = 64LL << 20;
  * @param path the file (.yml, .yaml or .json; the content decides how it is parsed)
  * @param what what the file is, for the messages ("scene", "calibration manifest")
  * @return an opened storage
- * @throws cv::Exception StsError for a missing, unreadable, oversized file or a directory;
+ * @throws cv::Exception StsError for a missing, unreadable or oversized file, or anything but a regular
+ * file (a directory, a FIFO, a device: see readFileBounded());
  * StsParseError for an empty file, XML, text that is not YAML or JSON, or a YAML stream that is not one
  * document whose root collection starts a line at column 0 (OpenCV 4.6's parser never returns on some
  * multi-document streams).
