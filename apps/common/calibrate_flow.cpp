@@ -327,17 +327,21 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         result.notes.push_back(
             "no chart: every unclipped pixel away from edges is a sample (sampleStaticScene)");
 
-    // Shapiro-Wilk positions, the same in every burst: every k-th pixel of the squares (of the frame
-    // without a chart), at most shapiroPixels of them.
-    std::vector<cv::Point> positions;
-    for (const cv::Rect& s : chartless ? frameGridSquares(frameSize) : squares)
-        for (int y = s.y; y < s.br().y; ++y)
-            for (int x = s.x; x < s.br().x; ++x)
-                positions.emplace_back(x, y);
-    const size_t step = std::max<size_t>(1, positions.size() / size_t(std::max(1, o.shapiroPixels)));
-    std::vector<cv::Point> tested;
-    for (size_t k = 0; k < positions.size(); k += step)
-        tested.push_back(positions[k]);
+    // Shapiro-Wilk positions: every k-th pixel of the squares (of each burst's own frame without a
+    // chart), at most shapiroPixels of them. Bursts may differ in size (dark frames of a crop, say): each
+    // is read only inside its own frame.
+    const auto testedPositions = [&](const std::vector<cv::Rect>& rects) {
+        std::vector<cv::Point> positions;
+        for (const cv::Rect& s : rects)
+            for (int y = s.y; y < s.br().y; ++y)
+                for (int x = s.x; x < s.br().x; ++x)
+                    positions.emplace_back(x, y);
+        const size_t step = std::max<size_t>(1, positions.size() / size_t(std::max(1, o.shapiroPixels)));
+        std::vector<cv::Point> tested;
+        for (size_t k = 0; k < positions.size(); k += step)
+            tested.push_back(positions[k]);
+        return tested;
+    };
 
     std::vector<NoiseSample> samples;
     CsvTable shapiro({"gain_db", "mean", "p_value", "W"});
@@ -349,12 +353,14 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     std::vector<std::vector<cv::Mat>> darkFrames;
     std::vector<double> darkGains;
     std::vector<bool> lightSample; // per sample: from a burst with light (its mean holds the dark shading)
+    std::vector<cv::Size> sampleFrame; // per sample: the size of the frame whose pixel it numbers
     for (size_t i = 0; i < specs.size(); ++i) {
         const CalibrationManifest::Burst& spec = specs[i];
         const double gain = dbToLinearGain(gainsDb[i]);
         std::unique_ptr<BurstStatistics> stats;
         LoadedMosaic first;
-        cv::Mat series(int(spec.files.size()), int(tested.size()), CV_64F);
+        std::vector<cv::Point> tested;
+        cv::Mat series;
         for (size_t t = 0; t < spec.files.size(); ++t) {
             const LoadedMosaic m = loadMosaicFile(spec.files[t]);
             if (!stats) {
@@ -375,12 +381,18 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                 }
                 darkFrames.back().push_back(m.mosaic);
             }
-            if (t == 0)
+            if (t == 0) {
                 for (const cv::Rect& s : squares)
                     if ((s & cv::Rect(cv::Point(), stats->size())) != s)
-                        throw std::runtime_error(
-                            cv::format("square at (%d, %d) lies outside the %dx%d frames", s.x, s.y,
-                                       stats->size().width, stats->size().height));
+                        throw std::runtime_error(cv::format(
+                            "square at (%d, %d) of %dx%d lies outside the %dx%d frames of '%s' (the squares "
+                            "are found on '%s', %dx%d)",
+                            s.x, s.y, s.width, s.height, stats->size().width, stats->size().height,
+                            spec.files.front().c_str(), specs.front().files.front().c_str(), frameSize.width,
+                            frameSize.height));
+                tested = testedPositions(chartless ? frameGridSquares(stats->size()) : squares);
+                series.create(int(spec.files.size()), int(tested.size()), CV_64F);
+            }
             // stats->add() has checked the size and the type (CV_16UC1 or CV_32FC1).
             const bool integer = m.mosaic.depth() == CV_16U;
             for (size_t k = 0; k < tested.size(); ++k)
@@ -420,6 +432,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                 sample.mean = 0;
         samples.insert(samples.end(), burstSamples.begin(), burstSamples.end());
         lightSample.insert(lightSample.end(), burstSamples.size(), !spec.dark);
+        sampleFrame.insert(sampleFrame.end(), burstSamples.size(), stats->size());
         // Shapiro-Wilk needs 3 values per pixel.
         std::vector<ShapiroWilkResult> sw;
         if (series.rows >= 3)
@@ -430,7 +443,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         BurstFacts burstFacts{spec.files.front(), gainsDb[i], stats->frames(), 0.0, spec.dark};
         {
             double area = 0, clippedArea = 0;
-            for (const cv::Rect& r : chartless || spec.dark ? frameGridSquares(frameSize) : squares) {
+            for (const cv::Rect& r : chartless || spec.dark ? frameGridSquares(stats->size()) : squares) {
                 area += r.area();
                 clippedArea += cv::countNonZero(clipped(r));
             }
@@ -483,14 +496,14 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             const cv::Mat& bd = result.dark.model.darkShadingPerGain;
             const cv::Mat& br = result.dark.model.darkShadingOffset;
             const double meanPerGain = cv::mean(bd)[0], meanOffset = cv::mean(br)[0];
-            // A sample numbers its pixel row * width + column of its frame: the maps' pixels only when the
-            // light frames are of the dark frames' size.
-            const bool samePixels = bd.size() == frameSize;
             for (size_t i = 0; i < samples.size(); ++i) {
                 if (!lightSample[i])
                     continue;
                 NoiseSample& sample = samples[i];
-                if (samePixels && sample.pixel >= 0 && sample.pixel < static_cast<int64>(bd.total())) {
+                // A sample numbers its pixel row * width + column of its own frame: the maps' pixels only
+                // when that frame is of the dark frames' size.
+                if (sampleFrame[i] == bd.size() && sample.pixel >= 0 &&
+                    sample.pixel < static_cast<int64>(bd.total())) {
                     const int r = static_cast<int>(sample.pixel / bd.cols),
                               c = static_cast<int>(sample.pixel % bd.cols);
                     sample.mean -= sample.gain * bd.at<float>(r, c) + br.at<float>(r, c);

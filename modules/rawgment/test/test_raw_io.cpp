@@ -1,6 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "test_common.hpp"
 
+#include "../src/precomp.hpp"
+
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
@@ -807,6 +809,20 @@ TEST(RawIo, everyReaderRefusesDevicesAndFifosWithoutBlocking)
     const std::string text = textFile(dir, "ten.txt", "0123456789");
     EXPECT_EQ("0123456789", readFileBounded(text, 10, "x"));
     EXPECT_CV_ERROR_CONTAINS(readFileBounded(text, 9, "x"), "10 bytes, more than the 9 bytes");
+}
+
+TEST(RawIo, aYamlTextOnWhichOpenCvNeverFinishesIsAnErrorNotAHang)
+{
+    // The sidecar fuzz target's find (seed 2): a root that ends early, then a '-'. OpenCV 4.6 loops
+    // forever on it. The text check refuses the shape at once...
+    const std::string dir = makeTempDir("raw_io_yaml_hang");
+    const std::string hang = "---\n!: -.\n{  -\n ";
+    EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(textFile(dir, "hang.yml", hang), "sidecar"),
+                             "line 2: a line at column 0 that is neither a key nor an item");
+    // ...and the bounded parse stops any shape the text check lets through.
+    EXPECT_CV_ERROR_CONTAINS(detail::requireParseFinishes("hang.yml", "%YAML:1.0\n" + hang),
+                             "OpenCV's YAML reader did not finish within 2 s");
+    EXPECT_NO_THROW(detail::requireParseFinishes("ok.yml", "%YAML:1.0\n---\nm:\n   a: 1\n"));
 }
 
 TEST(RawIo, openFileStorageForReadingBoundsTheFileAndScansLongLines)
