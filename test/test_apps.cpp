@@ -163,7 +163,13 @@ TEST(Apps, badManifestsAreErrorsNamingTheKeyOrTheFile)
     std::ofstream(dir + "/iso.yml") << "%YAML:1.0\ncalibration_manifest:\n  base_iso: -100\n  bursts:\n"
                                     << "    - { files: [a.dng] }\n";
     r = runApp("rawgment_calibrate", "'" + dir + "/iso.yml' --out='" + dir + "/cal5'");
-    EXPECT_NE(std::string::npos, r.output.find("'base_iso' must be a finite number > 0")) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("'base_iso' must be a number in [1, 1e+07]")) << r.output;
+    for (const char* iso : {"1e300", "1e-300"}) {
+        std::ofstream(dir + "/iso.yml") << "%YAML:1.0\ncalibration_manifest:\n  base_iso: " << iso
+                                        << "\n  bursts:\n    - { files: [a.dng] }\n";
+        r = runApp("rawgment_calibrate", "'" + dir + "/iso.yml' --out='" + dir + "/cal5'");
+        EXPECT_NE(std::string::npos, r.output.find("'base_iso' must be a number in [1, 1e+07]")) << r.output;
+    }
     // A mosaic that does not say its ISO needs a gain_db when other bursts have a gain.
     {
         cv::rawgment::MosaicMetadata meta;

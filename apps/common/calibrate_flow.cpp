@@ -73,9 +73,10 @@ CalibrationManifest readCalibrationManifest(const std::string& path)
     manifest.patches = value == "detect" || value == "none" ? value : resolvePath(base, value);
     const cv::FileNode baseIso = root["base_iso"];
     if (!baseIso.empty()) {
-        if (!(baseIso.isReal() || baseIso.isInt()) || !(double(baseIso) > 0) ||
-            !std::isfinite(double(baseIso)))
-            throw std::runtime_error("'" + path + "': 'base_iso' must be a finite number > 0");
+        if (!(baseIso.isReal() || baseIso.isInt()) || !(double(baseIso) >= NoiseModel::MIN_BASE_ISO) ||
+            !(double(baseIso) <= NoiseModel::MAX_BASE_ISO))
+            throw std::runtime_error(cv::format("'%s': 'base_iso' must be a number in [%g, %g]", path.c_str(),
+                                                NoiseModel::MIN_BASE_ISO, NoiseModel::MAX_BASE_ISO));
         manifest.hasBaseIso = true;
         manifest.baseIso = double(baseIso);
     }

@@ -2,6 +2,9 @@
 // Python bindings of augmentation (noise steps, scenes, policies), RAW and mosaic files, and the ISP.
 #include "binding_tools.hpp"
 
+#include <climits>
+#include <cmath>
+
 namespace rawgment_python {
 
 using namespace cv::rawgment;
@@ -17,15 +20,30 @@ std::vector<cv::Rect> boxesFrom(const py::object& boxes)
     if (boxes.is_none())
         return out;
     if (py::isinstance<py::array>(boxes)) {
-        const auto a = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(boxes);
+        // Read as doubles, which hold every int32 exactly, and checked one by one: a cast would wrap
+        // 2^32 + 5 to 5 and turn NaN into 0 without a word, where the list form raises.
+        const char kind = py::array(boxes).dtype().kind();
+        if (kind != 'i' && kind != 'u' && kind != 'f' && kind != 'b')
+            throw py::type_error("argument 'boxes' must be an N x 4 array of integers (x, y, w, h)");
+        const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(boxes);
         if (!a)
             throw py::value_error("argument 'boxes' must be an N x 4 array of (x, y, w, h)");
         if (a.size() == 0)
             return out;
         if (a.ndim() != 2 || a.shape(1) != 4)
             throw py::value_error("argument 'boxes' must be an N x 4 array of (x, y, w, h)");
-        for (py::ssize_t i = 0; i < a.shape(0); ++i)
-            out.emplace_back(int(a.at(i, 0)), int(a.at(i, 1)), int(a.at(i, 2)), int(a.at(i, 3)));
+        for (py::ssize_t i = 0; i < a.shape(0); ++i) {
+            int v[4];
+            for (py::ssize_t j = 0; j < 4; ++j) {
+                const double x = a.at(i, j);
+                if (!(x == std::floor(x)) || x < INT_MIN || x > INT_MAX)
+                    throw py::value_error(cv::format("argument 'boxes' row %zd column %zd is %.17g: each value "
+                                                     "must be an integer in the 32-bit range",
+                                                     i, j, x));
+                v[j] = static_cast<int>(x);
+            }
+            out.emplace_back(v[0], v[1], v[2], v[3]);
+        }
         return out;
     }
     try {

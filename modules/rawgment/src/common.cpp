@@ -29,6 +29,16 @@ void checkFinitePositive(double value, const char* what)
         CV_Error(Error::StsBadArg, format("%s must be finite and > 0 (got %g)", what, value));
 }
 
+void checkBaseIso(double baseIso, const char* what, bool zeroIsUnknown)
+{
+    if (zeroIsUnknown && baseIso == 0)
+        return;
+    if (!(baseIso >= NoiseModel::MIN_BASE_ISO && baseIso <= NoiseModel::MAX_BASE_ISO))
+        CV_Error(Error::StsBadArg, format("%s must lie in [%g, %g]%s (got %g)", what, NoiseModel::MIN_BASE_ISO,
+                                          NoiseModel::MAX_BASE_ISO, zeroIsUnknown ? ", or be 0 for unknown" : "",
+                                          baseIso));
+}
+
 void checkFiniteNonNegative(double value, const char* what)
 {
     if (!std::isfinite(value) || value < 0)

@@ -98,7 +98,7 @@ void NoiseModel::validate() const
     detail::checkFiniteNonNegative(alpha, "NoiseModel.alpha");
     detail::checkFiniteNonNegative(sigmaD2, "NoiseModel.sigmaD2");
     detail::checkFiniteNonNegative(sigmaR2, "NoiseModel.sigmaR2");
-    detail::checkFiniteNonNegative(baseIso, "NoiseModel.baseIso");
+    detail::checkBaseIso(baseIso, "NoiseModel.baseIso", true);
     detail::checkFiniteNonNegative(rowSigmaD2, "NoiseModel.rowSigmaD2");
     detail::checkFiniteNonNegative(rowSigmaR2, "NoiseModel.rowSigmaR2");
     if (tukeyRead && !(tukeyLambda >= detail::kTukeyLambdaMin && tukeyLambda <= 1))
@@ -304,7 +304,12 @@ NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
     if (versionNode.empty() || !versionNode.isInt())
         CV_Error(Error::StsParseError, "noise model: field 'format_version' is missing or not an integer");
     const int version = static_cast<int>(versionNode);
-    if (version > FORMAT_VERSION || version < 1)
+    if (version < 1)
+        CV_Error(Error::StsParseError,
+                 format("noise model: format_version %d is not a version of this format (versions start at 1; "
+                        "this build reads 1 to %d)",
+                        version, FORMAT_VERSION));
+    if (version > FORMAT_VERSION)
         CV_Error(Error::StsParseError,
                  format("noise model: format_version %d is not supported; this build reads versions 1 to %d "
                         "(a newer cv::rawgment wrote the file)",
@@ -329,9 +334,11 @@ NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
         } catch (const Exception& e) {
             CV_Error(Error::StsParseError, "noise model: " + e.err);
         }
-        if (!std::isfinite(m.baseIso) || !(m.baseIso > 0))
-            CV_Error(Error::StsParseError,
-                     format("noise model: field 'base_iso' must be finite and > 0 (got %g)", m.baseIso));
+        try {
+            detail::checkBaseIso(m.baseIso, "field 'base_iso'", false);
+        } catch (const Exception& e) {
+            CV_Error(Error::StsParseError, "noise model: " + e.err);
+        }
     }
     if (node["row_sigma_d2"].empty() != node["row_sigma_r2"].empty())
         CV_Error(Error::StsParseError, "noise model: row_sigma_d2 and row_sigma_r2 come together");

@@ -212,6 +212,12 @@ NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& profile, const RawFo
     NoiseLine line;
     line.a = so[0] * r;
     line.b = so[1] * r * r;
+    // S and O are finite, but S r or O r^2 need not be (S = 1e308 at a white level of 4095).
+    if (!std::isfinite(line.a) || !std::isfinite(line.b))
+        CV_Error(Error::StsBadArg,
+                 cv::format("noiseLineFromDngProfile: the pair (%g, %g) gives the line a = %g, b = %g at a range "
+                        "of %g DN; a noise profile must give a finite line",
+                        so[0], so[1], line.a, line.b, r));
     return line;
 }
 
@@ -227,8 +233,7 @@ bool agrees(double a, double b)
 
 void checkBaseIso(double baseIso, const char* who)
 {
-    if (!(std::isfinite(baseIso) && baseIso > 0))
-        CV_Error(Error::StsBadArg, format("%s: baseIso %g must be finite and > 0", who, baseIso));
+    detail::checkBaseIso(baseIso, (String(who) + ": baseIso").c_str(), false);
 }
 
 String jsonString(const String& text)
@@ -347,6 +352,7 @@ NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format, 
 
     // alpha from every colour and ISO; sigma_d^2 and sigma_r^2 from b r^2 = g^2 sigma_d^2 + sigma_r^2.
     double alpha = 0;
+    bool haveAlpha = false;
     std::vector<double> x, y;
     std::set<double> distinct;
     for (const Profile& p : profiles) {
@@ -354,10 +360,17 @@ NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format, 
         distinct.insert(g);
         for (int plane = 0; plane < 3; ++plane) {
             const double r = detail::rangeOfColourPlane(format, plane);
+            if (!(std::isfinite(p.a[size_t(plane)]) && p.a[size_t(plane)] >= 0 &&
+                  std::isfinite(p.b[size_t(plane)])))
+                CV_Error(Error::StsBadArg, cv::format("%s: ISO %g colour %d has a = %g, b = %g; a must be "
+                                                      "finite and >= 0, b finite",
+                                                      where.c_str(), p.iso, plane, p.a[size_t(plane)],
+                                                      p.b[size_t(plane)]));
             const double a = p.a[size_t(plane)] * r / g;
-            if (alpha == 0)
+            if (!haveAlpha) {
                 alpha = a;
-            else if (!agrees(a, alpha))
+                haveAlpha = true;
+            } else if (!agrees(a, alpha))
                 CV_Error(
                     Error::StsBadArg,
                     cv::format("%s: ISO %g colour %d gives alpha %.9g where another gives %.9g; the model "

@@ -61,6 +61,9 @@ std::vector<Vec2d> readDngNoiseProfile(const String& path);
 double rangeOfColourPlane(const RawFormat& format, int plane);
 //! Throws StsBadArg (prefixed by `what`) unless a NoiseProfile has 1 or 3 pairs, each S > 0, O >= 0.
 void checkDngNoiseProfile(const std::vector<Vec2d>& profile, const char* what);
+//! Throws StsBadArg naming `what` unless baseIso lies in [NoiseModel::MIN_BASE_ISO, MAX_BASE_ISO] (or is 0,
+//! for unknown, when zeroIsUnknown).
+CV_RAWGMENT_EXPORTS void checkBaseIso(double baseIso, const char* what, bool zeroIsUnknown);
 //! Whether anything exists at `path`.
 bool fileExists(const String& path);
 //! The whole content of a regular file of at most MAX_TEXT_FILE_BYTES; throws StsError naming it.

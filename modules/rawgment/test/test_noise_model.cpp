@@ -169,9 +169,20 @@ TEST(NoiseModel, readingRejectsBadFilesNamingTheField)
     EXPECT_CV_ERROR_CONTAINS(
         readFromYaml("  format_version: 1\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n  base_iso: 100\n"),
         "unknown key 'base_iso'");
-    EXPECT_CV_ERROR_CONTAINS(
-        readFromYaml("  format_version: 2\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n  base_iso: 0\n"),
-        "'base_iso' must be finite and > 0");
+    // A base ISO far outside any camera's under- or overflows the gains: 1e300 wrote a model of zeros.
+    for (const char* iso : {"0", "1e300", "1e-300", "-5", ".nan"}) {
+        SCOPED_TRACE(iso);
+        EXPECT_CV_ERROR_CONTAINS(readFromYaml(std::string("  format_version: 2\n  alpha: 1\n  sigma_d2: 1\n  "
+                                                          "sigma_r2: 1\n  base_iso: ") +
+                                              iso + "\n"),
+                                 "field 'base_iso' must lie in [1, 1e+07]");
+    }
+    NoiseModel far(1, 1, 1);
+    far.baseIso = 1e300;
+    EXPECT_CV_ERROR_CONTAINS(far.validate(), "NoiseModel.baseIso must lie in [1, 1e+07], or be 0 for unknown");
+    // Version 0 was never written: it is no newer file.
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 0\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
+                             "format_version 0 is not a version of this format");
     EXPECT_CV_ERROR_CONTAINS(readFromYaml("  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
                              "'format_version' is missing");
     FileStorage empty("%YAML:1.0\nother: 1\n", FileStorage::READ | FileStorage::MEMORY);

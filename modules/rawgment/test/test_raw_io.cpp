@@ -302,6 +302,10 @@ TEST(RawIo, dngNoiseProfileRoundTripsAndGivesBackTheModelsLines)
     }
     const std::vector<Vec2d> single = {Vec2d(0.001, 2e-6)};
     EXPECT_DOUBLE_EQ(noiseLineFromDngProfile(single, atGain, CFA_B).a, 0.001 * (4000 - 101));
+    // Finite S and O that DNG allows can still give an infinite line.
+    EXPECT_CV_ERROR_CONTAINS(noiseLineFromDngProfile({Vec2d(1e308, 0)}, atGain, CFA_B),
+                             "a noise profile must give a finite line");
+    EXPECT_CV_ERROR_CONTAINS(noiseLineFromDngProfile({Vec2d(1e-3, 1e305)}, atGain, CFA_R), "b = inf");
     img.noiseProfile.clear();
     writeDng(dir + "/plain.dng", img);
     EXPECT_TRUE(readRaw(dir + "/plain.dng").noiseProfile.empty());
@@ -469,6 +473,25 @@ TEST(RawIo, darktableFilesThatNoModelMatchesAreRefusedNamingWhy)
                             "\"a\": [1, 2], \"b\": [1, 2, 3]}]}]}]}\n");
     EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(shortList, format, 100, "Maker", "M"),
                              "short.json': field 'a' must be a list of 3 numbers");
+    // a = 0 at one ISO: 0 once meant "alpha not yet seen", so the profile was taken. A zero slope where
+    // another ISO has one is no exact model.
+    const std::string zeroSlope =
+        write("zero_slope.json",
+              "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", \"models\": [{\"model\": "
+              "\"M\", \"profiles\": [{\"name\": \"a\", \"iso\": 100, \"a\": [0, 0, 0], \"b\": " +
+                  list(p1, 1) + "},\n  {\"name\": \"b\", \"iso\": 200, \"a\": " + list(p2, 0) +
+                  ", \"b\": " + list(p2, 1) + "}]}]}]}\n");
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(zeroSlope, format, 100, "Maker", "M"),
+                             "zero_slope.json': ISO 200 colour 0 gives alpha");
+    const std::string negative =
+        write("negative.json",
+              "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", \"models\": [{\"model\": "
+              "\"M\", \"profiles\": [{\"name\": \"a\", \"iso\": 100, \"a\": [-1e-6, 1e-6, 1e-6], \"b\": " +
+                  list(p1, 1) + "}]}]}]}\n");
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(negative, format, 100, "Maker", "M"),
+                             "ISO 100 colour 0 has a = -1e-06");
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(good, format, 1e300, "Maker", "M"),
+                             "baseIso must lie in [1, 1e+07]");
 }
 
 TEST(RawIo, androidNoiseProfileIsTheDngProfileOfEverySiteAtEverySensitivity)

@@ -61,11 +61,17 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
 {
     //! Newest version of the file format; read() rejects newer versions (see write()).
     static constexpr int FORMAT_VERSION = 3;
+    /** The range of a known baseIso, with room on both sides of every camera's (ISO 25 to 3,280,000):
+     * beyond it a gain ISO / baseIso under- or overflows the noise terms (a base ISO of 1e300 wrote a
+     * model of zeros, 1e-300 stopped the solver). */
+    static constexpr double MIN_BASE_ISO = 1;
+    static constexpr double MAX_BASE_ISO = 1e7; //!< see MIN_BASE_ISO
 
     double alpha = 0;   //!< shot-noise slope at gain 1, DN per electron (>= 0)
     double sigmaD2 = 0; //!< read-noise variance before the analog gain, DN^2 at gain 1 (>= 0)
     double sigmaR2 = 0; //!< noise variance after the analog gain, DN^2 (>= 0)
-    /** ISO of gain 1, when the model was calibrated from files that say their ISO (0: unknown). It
+    /** ISO of gain 1, when the model was calibrated from files that say their ISO (0: unknown; else in
+     * [MIN_BASE_ISO, MAX_BASE_ISO]). It
      * lets a camera file give its own gain, \f$ g = \mathrm{ISO} / \mathrm{baseIso} \f$; the noise
      * terms do not depend on it. */
     double baseIso = 0;
