@@ -38,7 +38,7 @@ int main(int argc, char** argv)
     o.policy = parser.get<std::string>("policy");
     o.outDir = parser.get<std::string>("out");
     o.variants = parser.get<int>("variants");
-    o.seed = parser.get<uint64_t>("seed");
+    o.seed = rawgment_apps::seedOption(parser, "rawgment_augment");
     const std::string format = parser.get<std::string>("format");
     o.previews = parser.get<bool>("preview");
     // CommandLineParser keeps one positional value; the rest of the command line are inputs too.

@@ -56,7 +56,7 @@ int main(int argc, char** argv)
     o.side = parser.get<int>("side");
     o.shapiroPixels = parser.get<int>("shapiro");
     o.plots = parser.get<bool>("plots");
-    o.seed = parser.get<uint64_t>("seed");
+    o.seed = rawgment_apps::seedOption(parser, "rawgment_calibrate");
     o.darkComponents = parser.get<bool>("dark_components");
     if (!parser.check() || o.manifest.empty() || o.outDir.empty() ||
         (method != "joint" && method != "two-stage") || o.shapiroPixels < 1 || o.shapiroPixels > 1000000 ||

@@ -73,7 +73,7 @@ int main(int argc, char** argv)
     const int frames = parser.get<int>("frames");
     const double alpha = parser.get<double>("alpha"), sigmaD2 = parser.get<double>("sigma_d2"),
                  sigmaR2 = parser.get<double>("sigma_r2");
-    const uint64_t seed = parser.get<uint64_t>("seed");
+    const uint64_t seed = rawgment_apps::seedOption(parser, "rawgment_demo");
     if (!parser.check() || out.empty() || frames < 3) {
         parser.printErrors();
         std::cerr << "rawgment_demo: --out must be set and --frames >= 3 (see --help)\n";

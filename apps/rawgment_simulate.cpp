@@ -53,7 +53,7 @@ int main(int argc, char** argv)
         o.sensor.bitDepth = parser.get<int>("bits");
         const double outliers = parser.get<double>("outliers");
         o.sensor.hotPixelFraction = o.sensor.deadPixelFraction = o.sensor.noisyPixelFraction = outliers / 3;
-        o.seed = parser.get<uint64_t>("seed");
+        o.seed = rawgment_apps::seedOption(parser, "rawgment_simulate");
         o.extension = "." + parser.get<std::string>("format");
         o.validation = parser.get<bool>("validation");
         o.dark = parser.get<bool>("dark");

@@ -91,7 +91,7 @@ int main(int argc, char** argv)
     rawgment_apps::TradeoffSettings set;
     set.seeds = parser.get<int>("seeds");
     set.repeats = parser.get<int>("repeats");
-    set.seed = parser.get<uint64>("seed");
+    set.seed = rawgment_apps::seedOption(parser, "rawgment_tradeoffs");
     const bool plots = parser.get<bool>("plots");
     if (parser.get<bool>("quick")) {
         set.timingSize = Size(800, 600);

@@ -40,7 +40,7 @@ int main(int argc, char** argv)
     o.model = parser.get<std::string>("model");
     o.outDir = parser.get<std::string>("out");
     o.bins = parser.get<int>("bins");
-    o.seed = parser.get<uint64_t>("seed");
+    o.seed = rawgment_apps::seedOption(parser, "rawgment_validate");
     o.plots = parser.get<bool>("plots");
     if (!parser.check() || o.manifest.empty() || o.model.empty() || o.outDir.empty() || o.bins < 1) {
         parser.printErrors();

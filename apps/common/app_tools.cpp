@@ -159,6 +159,35 @@ bool isRegularFile(const std::string& path)
     return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
+std::string canonicalPath(const std::string& path)
+{
+    std::error_code error;
+    const std::filesystem::path resolved = std::filesystem::weakly_canonical(path, error);
+    return error ? path : resolved.string();
+}
+
+uint64_t parseSeed(const std::string& text)
+{
+    const std::string why = "--seed must be an integer from 0 to 18446744073709551615 (got '" + text + "')";
+    if (text.empty() || text.size() > 20 || text.find_first_not_of("0123456789") != std::string::npos)
+        throw std::runtime_error(why);
+    errno = 0;
+    const unsigned long long value = std::strtoull(text.c_str(), nullptr, 10);
+    if (errno == ERANGE)
+        throw std::runtime_error(why);
+    return static_cast<uint64_t>(value);
+}
+
+uint64_t seedOption(const cv::CommandLineParser& parser, const char* app)
+{
+    try {
+        return parseSeed(parser.get<std::string>("seed"));
+    } catch (const std::runtime_error& e) {
+        std::cerr << app << ": " << e.what() << "\n";
+        std::exit(2);
+    }
+}
+
 OutputDirectory::OutputDirectory(std::string path) : path_(std::move(path)), existed_(pathExists(path_)) {}
 
 OutputDirectory::~OutputDirectory()

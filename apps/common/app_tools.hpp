@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <mutex>
 #include <string>
@@ -18,6 +19,14 @@ namespace rawgment_apps {
 bool pathExists(const std::string& path);
 //! Whether `path` is a regular file (or a link to one).
 bool isRegularFile(const std::string& path);
+//! `path` with '.', '..' and links resolved (as far as it exists): two names of one file compare equal.
+std::string canonicalPath(const std::string& path);
+/** The seed of a --seed option: decimal digits of a value in [0, 2^64 - 1], the one rule of every app
+ * and of rawgment.batch (a negative seed used to wrap to 2^64 - 1 here and raise in Python). Throws
+ * std::runtime_error naming the value. */
+uint64_t parseSeed(const std::string& text);
+//! parseSeed() of a command line's --seed; prints "<app>: <why>" and exits with status 2 when it is bad.
+uint64_t seedOption(const cv::CommandLineParser& parser, const char* app);
 
 /** The output directory of one run: removed at the end of a run that created it and failed before
  * writing anything into it (an empty folder is no result). Call keep() when the run succeeded. */

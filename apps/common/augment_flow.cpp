@@ -26,10 +26,13 @@ namespace {
 std::vector<std::string> outputNames(const std::vector<std::string>& inputs)
 {
     std::map<std::string, int> stems;
-    std::set<std::string> seen;
+    std::map<std::string, std::string> seen; // canonical path -> the name it was given as first
     for (const std::string& in : inputs) {
-        if (!seen.insert(in).second)
-            throw std::runtime_error("input '" + in + "' is given twice");
+        const auto given = seen.emplace(canonicalPath(in), in);
+        if (!given.second)
+            throw std::runtime_error("input '" + in + "' is given twice" +
+                                     (given.first->second == in ? std::string()
+                                                                : " (also as '" + given.first->second + "')"));
         ++stems[stemOf(in)];
     }
     std::vector<std::string> names;
@@ -91,12 +94,21 @@ AugmentRecipe loadAugmentRecipe(const AugmentOptions& o)
     return recipe;
 }
 
+//! The most variants of one input, and outputs of one run (each job is a few hundred bytes in the plan).
+const int kMaxVariants = 100000;
+const size_t kMaxJobs = 1000000;
+
 AugmentPlan planAugmentJobs(const AugmentOptions& o)
 {
     if (o.inputs.empty())
         throw std::runtime_error("no input files");
-    if (o.variants < 1)
-        throw std::runtime_error("variants must be >= 1");
+    if (o.variants < 1 || o.variants > kMaxVariants)
+        throw std::runtime_error(cv::format("variants must lie in [1, %d] (got %d)", kMaxVariants, o.variants));
+    // Every job is planned before the first runs: a bound keeps the plan in memory.
+    if (o.inputs.size() * static_cast<size_t>(o.variants) > kMaxJobs)
+        throw std::runtime_error(cv::format("%zu inputs x %d variants is more than the %zu outputs one run makes; "
+                                            "split the inputs over several runs",
+                                            o.inputs.size(), o.variants, kMaxJobs));
     for (const std::string& in : o.inputs) {
         if (!pathExists(in))
             throw std::runtime_error("input '" + in + "': no such file");

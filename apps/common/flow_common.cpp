@@ -31,9 +31,13 @@ std::vector<std::string> readFileList(const cv::FileNode& node, const std::strin
     std::vector<std::string> files;
     for (const cv::FileNode& f : node) {
         files.push_back(resolvePath(base, std::string(f)));
-        // A frame listed twice would count as two identical captures: zero variance, a wrong model.
-        if (std::find(files.begin(), files.end() - 1, files.back()) != files.end() - 1)
-            throw std::runtime_error(where + ": '" + files.back() + "' is listed twice");
+        // A frame listed twice (under one name or two: ./a.dng and a.dng) would count as two identical
+        // captures: zero variance, a wrong model.
+        const std::string canonical = canonicalPath(files.back());
+        for (auto it = files.begin(); it + 1 != files.end(); ++it)
+            if (canonicalPath(*it) == canonical)
+                throw std::runtime_error(where + ": '" + files.back() + "' is listed twice" +
+                                         (*it == files.back() ? std::string() : " (also as '" + *it + "')"));
     }
     return files;
 }

@@ -59,6 +59,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
         raise ValueError("give exactly one of policy and scene")
     if format not in (None, "dng", "png", "tif"):
         raise ValueError("format must be 'dng', 'png' or 'tif', not %r" % (format,))
+    seed = _checkedSeed(seed)
     inputs = [os.fspath(p) for p in inputs]
     # Workers may run elsewhere: the files every job reads are named absolutely (they are not recorded
     # in the outputs, so this changes no byte).
@@ -99,6 +100,13 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     return {"written": written, "skipped": plan["skipped"], "outputs": list(plan["outputs"])}
 
 
+def _checkedSeed(seed):
+    """The rule of the apps' --seed: an integer from 0 to 2**64 - 1."""
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 64:
+        raise ValueError("seed must be an integer from 0 to 18446744073709551615 (got %r)" % (seed,))
+    return seed
+
+
 def _terminalProgress(total):
     if not sys.stderr.isatty() or total == 0:
         return lambda done, total: None
@@ -127,18 +135,28 @@ def main(argv=None):
     group.add_argument("--scene", help="a scene file (map 'scene') applied to every input")
     parser.add_argument("--out", required=True, help="output folder")
     parser.add_argument("--variants", type=int, default=1, help="variants per input (default 1)")
-    parser.add_argument("--seed", type=int, default=1, help="seed: same seed, same files (default 1)")
+    parser.add_argument("--seed", type=int, default=1,
+                        help="seed from 0 to 2**64 - 1: same seed, same files (default 1)")
     parser.add_argument("--format", choices=("dng", "png", "tif"), help="output container")
     parser.add_argument("--preview", action="store_true", help="also write an sRGB preview PNG per output")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     where.add_argument("--workers", type=int, help="start a local Dask cluster with this many worker processes")
+    parser.add_argument("--dashboard", metavar="HOST:PORT",
+                        help="where the local cluster's dashboard listens (default: a free port of 127.0.0.1 "
+                             "only; this tool opens no port to other machines unless asked)")
     parser.add_argument("inputs", nargs="+", help="input files")
     args = parser.parse_args(argv)
     if args.variants < 1:
         parser.error("--variants must be >= 1")
     if args.workers is not None and args.workers < 1:
         parser.error("--workers must be >= 1")
+    try:
+        _checkedSeed(args.seed)
+    except ValueError as e:
+        parser.error("--" + str(e))
+    if args.dashboard is not None and not args.workers:
+        parser.error("--dashboard is for the local cluster of --workers")
 
     client = cluster = None
     try:
@@ -148,8 +166,10 @@ def main(argv=None):
             if args.scheduler:
                 client = Client(args.scheduler)
             else:
+                # Scheduler, workers and dashboard on the loopback: Dask's defaults listen on every
+                # interface (its dashboard on 0.0.0.0:8787) and would serve the files' names to the network.
                 cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=None)
+                                       host="127.0.0.1", dashboard_address=args.dashboard or "127.0.0.1:0")
                 client = Client(cluster)
         result = augmentFiles(args.inputs, args.model, args.out, policy=args.policy, scene=args.scene,
                               variants=args.variants, seed=args.seed, format=args.format, previews=args.preview,

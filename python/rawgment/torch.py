@@ -3,10 +3,10 @@
 Seeds derive from (base seed, epoch, sample index) only, so a ``DataLoader`` gives the same samples
 for any ``num_workers`` and any order in which workers take samples::
 
-    dataset = rawgment.torch.RawFolderDataset("raws/", model="camera.yml", base_seed=7)
-    loader = torch.utils.data.DataLoader(dataset, batch_size=4, num_workers=2)
+    dataset = rawgment.torch.RawFolderDataset("raws/", model="camera.yml", baseSeed=7)
+    loader = torch.utils.data.DataLoader(dataset, batch_size=4, num_workers=2, persistent_workers=True)
     for epoch in range(10):
-        dataset.set_epoch(epoch)   # before the loader's workers start (they copy the dataset)
+        dataset.set_epoch(epoch)   # before iterating: the epoch is shared with the loader's workers
         for batch in loader:
             ...
 
@@ -170,13 +170,22 @@ class RawFolderDataset(torch.utils.data.Dataset):
         self.pack = bool(pack)
         self.normalize = bool(normalize)
         self.augment = bool(augment)
-        self.epoch = 0
+        # In shared memory: a DataLoader's workers hold copies of the dataset, and persistent workers keep
+        # theirs across epochs; a plain attribute set after they started never reached them, and they
+        # repeated epoch 0's augmentations.
+        self._epoch = torch.zeros(1, dtype=torch.int64).share_memory_()
+
+    @property
+    def epoch(self):
+        """The epoch whose seeds samples use (set_epoch() sets it, in every worker too)."""
+        return int(self._epoch[0])
 
     def set_epoch(self, epoch):
-        """Sets the epoch whose seeds the next iteration uses (call it before creating the iterator)."""
+        """Sets the epoch whose seeds the next iteration uses, in this process and in a DataLoader's
+        workers, persistent or not (call it before iterating over the loader for that epoch)."""
         if int(epoch) < 0:
             raise ValueError("epoch must be >= 0, got %r" % epoch)
-        self.epoch = int(epoch)
+        self._epoch[0] = int(epoch)
 
     def __len__(self):
         return len(self.files)

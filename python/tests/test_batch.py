@@ -102,6 +102,50 @@ def test_bad_options_are_errors_before_any_output(job, tmp_path):
         batch.augmentFiles(job["inputs"], job["policy"], tmp_path / "z", policy=job["policy"])
 
 
+def test_unsafe_or_unbounded_requests_are_refused(app_dir, job, tmp_path):
+    # One seed rule for the app and Python: -1 wrapped to 2**64 - 1 in the app and was a traceback here.
+    with pytest.raises(ValueError, match="seed must be an integer from 0 to 18446744073709551615"):
+        batch.augmentFiles(job["inputs"], job["model"], tmp_path / "s", policy=job["policy"], seed=-1)
+    run = [sys.executable, "-m", "rawgment.batch", "--model", job["model"], "--policy", job["policy"]]
+    bad = subprocess.run(run + ["--out", str(tmp_path / "s2"), "--seed", "-1", job["inputs"][0]],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "seed must be an integer from 0 to 18446744073709551615" in bad.stderr
+    app = subprocess.run([os.path.join(app_dir, "rawgment_augment"), "--model=" + job["model"],
+                          "--policy=" + job["policy"], "--out=" + str(tmp_path / "s3"), "--seed=-1",
+                          job["inputs"][0]], capture_output=True, text=True)
+    assert app.returncode == 2 and "seed must be an integer from 0 to 18446744073709551615" in app.stderr
+    # A plan is held in memory before the first job: 10^8 variants grew it to bad_alloc.
+    with pytest.raises(RuntimeError, match=r"variants must lie in \[1, 100000\]"):
+        batch.augmentFiles(job["inputs"], job["model"], tmp_path / "v", policy=job["policy"], variants=100000000)
+    # Two names of one file are one input, not two augmentations of it.
+    here = os.getcwd()
+    try:
+        os.chdir(job["root"])
+        with pytest.raises(RuntimeError, match="is given twice"):
+            batch.augmentFiles(["./a/frame.dng", "a/frame.dng"], job["model"], tmp_path / "t", policy=job["policy"])
+    finally:
+        os.chdir(here)
+
+
+def test_a_local_cluster_listens_on_the_loopback_only(job, tmp_path, monkeypatch):
+    import distributed
+
+    seen = {}
+
+    class Recorder:
+        def __init__(self, **kwargs):
+            seen.update(kwargs)
+            raise RuntimeError("recorded")
+
+    monkeypatch.setattr(distributed, "LocalCluster", Recorder)
+    args = ["--model", job["model"], "--policy", job["policy"], "--out", str(tmp_path / "d"), "--workers", "1",
+            job["inputs"][0]]
+    assert batch.main(args) == 1
+    assert seen["host"] == "127.0.0.1" and seen["dashboard_address"] == "127.0.0.1:0"
+    assert batch.main(args + ["--dashboard", "127.0.0.1:8799"]) == 1
+    assert seen["dashboard_address"] == "127.0.0.1:8799"
+
+
 def test_command_line(job, tmp_path):
     run = [sys.executable, "-m", "rawgment.batch"]
     bad = subprocess.run(run + ["--model", job["model"], "--policy", job["policy"], "--out", str(tmp_path),

@@ -80,6 +80,20 @@ def test_dataloader_gives_the_same_samples_with_0_and_2_workers(folder, sensor):
     assert all(torch.equal(a[1], b[1]) for a, b in zip(results[0], again))
 
 
+def test_persistent_workers_see_every_epoch(folder, sensor):
+    # Persistent workers keep their copy of the dataset: set_epoch() must still reach them (they used to
+    # repeat epoch 0's augmentations).
+    dataset = rgt.RawFolderDataset(folder, sensor.effectiveModel(), baseSeed=5)
+    persistent = torch.utils.data.DataLoader(dataset, batch_size=2, num_workers=2, persistent_workers=True)
+    seen = []
+    for epoch in range(3):
+        dataset.set_epoch(epoch)
+        seen.append(batches(persistent))
+        fresh = batches(torch.utils.data.DataLoader(dataset, batch_size=2, num_workers=0))
+        assert all(torch.equal(a[1], b[1]) for a, b in zip(seen[-1], fresh)), epoch
+    assert not all(torch.equal(a[1], b[1]) for a, b in zip(seen[0], seen[1]))
+
+
 def test_dataset_options_and_errors(folder, tmp_path, sensor):
     plain = rgt.RawFolderDataset(folder, sensor.effectiveModel(), augment=False, normalize=False)
     raw = plain[0]["raw"]

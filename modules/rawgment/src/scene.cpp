@@ -265,7 +265,12 @@ void RandomScenePolicy::validate() const
         CV_Error(Error::StsBadArg,
                  format("RandomScenePolicy: blurLengthMax must be <= %g mosaic pixels (got %g)",
                         MAX_MOTION_LENGTH, blurLengthMax));
-    range(0, maxShift, "shift");
+    // A fraction of each side: from 1 on, a draw can shift the content off the frame, and applyScene
+    // refuses it only after some outputs are written.
+    if (!(maxShift >= 0 && maxShift < 1))
+        CV_Error(Error::StsBadArg,
+                 format("RandomScenePolicy: maxShift must lie in [0, 1), a fraction of each side (got %g)",
+                        maxShift));
     if (!(maxScale >= 0 && maxScale < 1))
         CV_Error(Error::StsBadArg,
                  format("RandomScenePolicy: maxScale must lie in [0, 1) (got %g)", maxScale));

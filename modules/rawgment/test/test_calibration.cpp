@@ -745,6 +745,13 @@ TEST(Calibration, darkFrameCalibrationRejectsWhatItCannotFit)
     DarkCalibrationParams badRange;
     badRange.lambdaMin = -0.5;
     EXPECT_CV_ERROR_CONTAINS(calibrateDarkNoise(bursts, {2.0}, fmt, base, badRange), "lambdaMin");
+    // Constant or all-clipped frames: an error that says so, not "sigmaD2 ... (got -nan)".
+    for (double level : {fmt.blackLevel[0], fmt.whiteLevel}) {
+        SCOPED_TRACE(level);
+        std::vector<std::vector<Mat>> flat(2, std::vector<Mat>(4, Mat(size, CV_16UC1, Scalar(level))));
+        EXPECT_CV_ERROR_CONTAINS(calibrateDarkNoise(flat, {2.0, 8.0}, fmt, base),
+                                 "the 4 frames at gain 2 do not vary");
+    }
 }
 
 } // namespace

@@ -272,7 +272,7 @@ struct CV_RAWGMENT_EXPORTS RandomScenePolicy
     double blurProbability = 0.5;     //!< probability of a motion blur
     double blurLengthMax = 13;        //!< longest motion, in mosaic pixels
     double geometryProbability = 0.8; //!< probability of a shift and a scale
-    double maxShift = 0.1;            //!< largest shift, as a fraction of each side
+    double maxShift = 0.1;            //!< largest shift, as a fraction of each side, in [0, 1)
     double maxScale = 0.03;           //!< largest relative scale change, in [0, 1)
     NoiseOptions noise;               //!< copied into every scene
 
