@@ -10,6 +10,9 @@ threads run them in parallel. Same seed, same bits as the C++ API, on any thread
 Optional parts: ``rawgment.torch`` (PyTorch transform and dataset; needs torch) and ``rawgment.batch``
 (folder augmentation on one machine or a Dask cluster; needs dask.distributed for a cluster).
 """
+import functools as _functools
+import numbers as _numbers
+
 import numpy as _np
 
 from . import _rawgment
@@ -70,3 +73,112 @@ for _name in __all__:
             not issubclass(_cls, BaseException) and _fields(_cls):
         _add_value_behaviour(_cls)
 del _name, _cls
+
+
+# pybind11 answers a call whose arguments do not convert with "incompatible function arguments" and the
+# whole signature, naming no argument. Module functions are wrapped so that the error names the first
+# argument that does not fit and what it must be; any other exception passes through unchanged.
+_SEED_LIMIT = 2 ** 64
+
+
+def _parameters(doc, name):
+    """(name, type) of each parameter of the first signature in a pybind11 docstring; '*' is skipped."""
+    for line in (doc or "").splitlines():
+        line = line.strip()
+        if line[:1].isdigit() and ". " in line:
+            line = line.split(". ", 1)[1]
+        if not line.startswith(name + "("):
+            continue
+        text, depth, parts, current = line[len(name) + 1:], 0, [], ""
+        for ch in text:
+            if ch in "([{":
+                depth += 1
+            elif ch in ")]}":
+                if depth == 0:
+                    break
+                depth -= 1
+            if ch == "," and depth == 0:
+                parts.append(current)
+                current = ""
+            else:
+                current += ch
+        parts.append(current)
+        params = []
+        for part in parts:
+            part = part.split("=", 1)[0].strip()
+            if not part or part in ("*", "/"):
+                continue
+            pname, _, ptype = part.partition(":")
+            params.append((pname.strip(), ptype.strip()))
+        return params
+    return None
+
+
+def _misfit(pname, ptype, value):
+    """Why `value` cannot be parameter `pname` of C++ type `ptype` (as pybind11 spells it), or None."""
+    if ptype.startswith("rawgment._rawgment."):
+        cls = getattr(_rawgment, ptype.rsplit(".", 1)[1], None)
+        if isinstance(cls, type) and not isinstance(value, cls):
+            return "must be a rawgment.%s, not %s" % (cls.__name__, type(value).__name__)
+    elif ptype == "int":
+        if not isinstance(value, _numbers.Integral):
+            return "must be an int, not %s" % type(value).__name__
+        if "seed" in pname.lower() and not 0 <= int(value) < _SEED_LIMIT:
+            return "must be a seed, an integer from 0 to %d (got %d)" % (_SEED_LIMIT - 1, value)
+    elif ptype == "float":
+        if not isinstance(value, _numbers.Real):
+            return "must be a number, not %s" % type(value).__name__
+    elif ptype == "str":
+        if not isinstance(value, str):
+            return "must be a str, not %s" % type(value).__name__
+    elif ptype == "bool":
+        if not isinstance(value, (bool, _np.bool_)):
+            return "must be a bool, not %s" % type(value).__name__
+    elif value is None and ptype != "object":
+        return "must be %s, not None" % ptype
+    return None
+
+
+def _explain(fn, name, args, kwargs):
+    params = _parameters(fn.__doc__, name)
+    if params is None:
+        return None
+    names = [p for p, _ in params]
+    if len(args) > len(params):
+        return "%s(): %d positional arguments given, it takes at most %d" % (name, len(args), len(params))
+    bound = dict(zip(names, args))
+    for key, value in kwargs.items():
+        if key not in names:
+            return "%s(): unknown keyword argument '%s' (its arguments: %s)" % (name, key, ", ".join(names))
+        bound[key] = value
+    for pname, ptype in params:
+        if pname in bound:
+            why = _misfit(pname, ptype, bound[pname])
+            if why:
+                return "%s(): argument '%s' %s" % (name, pname, why)
+    return None
+
+
+def _explained(fn):
+    name = fn.__name__
+
+    @_functools.wraps(fn)
+    def call(*args, **kwargs):
+        try:
+            return fn(*args, **kwargs)
+        except TypeError as e:
+            if "incompatible function arguments" not in str(e):
+                raise
+            why = _explain(fn, name, args, kwargs)
+            if why is None:
+                raise
+            raise TypeError(why) from None
+
+    return call
+
+
+for _name in __all__:
+    _fn = getattr(_rawgment, _name)
+    if type(_fn).__name__ == "builtin_function_or_method":
+        globals()[_name] = _explained(_fn)
+del _name, _fn

@@ -120,6 +120,10 @@ cv::Mat matFromArray(const py::handle& obj, const char* argument, const std::vec
     const auto rows = a.shape(0), cols = a.shape(1);
     if (rows > INT_MAX || cols > INT_MAX)
         throw py::value_error(std::string("argument '") + argument + "' is too large for OpenCV");
+    // An array without elements has no layout to speak of (numpy gives 0x4 strides of 0): the callee
+    // says the input is empty, which a copy would not change.
+    if (rows == 0 || cols == 0)
+        return cv::Mat();
     const auto item = a.itemsize();
     const py::ssize_t pixelStride = withChannels ? item * channels : item;
     const bool elementsContiguous =
@@ -131,8 +135,6 @@ cv::Mat matFromArray(const py::handle& obj, const char* argument, const std::vec
             ", strides in bytes " +
             std::string(py::str(py::cast(std::vector<py::ssize_t>(a.strides(), a.strides() + a.ndim())))) +
             "); pass numpy.ascontiguousarray(" + argument + ")");
-    if (rows == 0 || cols == 0)
-        return cv::Mat();
     return cv::Mat(static_cast<int>(rows), static_cast<int>(cols), CV_MAKETYPE(depth, channels),
                    const_cast<void*>(a.data()), static_cast<size_t>(rowStride));
 }

@@ -69,6 +69,43 @@ def test_bad_arrays_of_other_arguments():
                       boxes=np.zeros((2, 3)))
 
 
+def test_arguments_that_do_not_convert_are_named(sensor):
+    # pybind11's own message named no argument and printed the whole call.
+    capture = np.zeros((8, 8), np.uint16)
+    fmt, model = sensor.rawFormat(1.0), sensor.effectiveModel()
+    with pytest.raises(TypeError, match=r"colorJitter\(\): argument 'model' must be a rawgment.NoiseModel, not NoneType"):
+        rg.colorJitter(capture, fmt, None, rg.ColorJitter(), seed=1)
+    with pytest.raises(TypeError, match=r"argument 'seed' must be a seed, an integer from 0 to 18446744073709551615 \(got -1\)"):
+        rg.colorJitter(capture, fmt, model, rg.ColorJitter(), seed=-1)
+    with pytest.raises(TypeError, match="unknown keyword argument 'sed'"):
+        rg.applyScene(capture, fmt, model, rg.Scene(), sed=1)
+    # An array without elements is empty, whatever numpy's strides: no advice to copy it.
+    with pytest.raises(rg.error, match="src is empty"):
+        rg.colorJitter(np.zeros((0, 4), np.uint16), fmt, model, rg.ColorJitter(), seed=1)
+
+
+@pytest.mark.parametrize("boxes, words", [
+    (np.array([[0, 0, 2 ** 32 + 5, 4]]), "row 0 column 2 is 4294967301"),
+    (np.array([[0.0, np.nan, 4.0, 4.0]]), "row 0 column 1 is nan"),
+    (np.array([[0.5, 0.0, 4.0, 4.0]]), "row 0 column 0 is 0.5"),
+])
+def test_array_boxes_are_never_wrapped_or_zeroed(boxes, words):
+    with pytest.raises(ValueError, match="'boxes' " + words):
+        rg.applyScene(np.zeros((8, 8), np.uint16), rg.RawFormat(), rg.NoiseModel(1, 1, 1), rg.Scene(), seed=1,
+                      boxes=boxes)
+
+
+def test_devices_and_fifos_are_refused_not_read(tmp_path):
+    import os
+
+    with pytest.raises(rg.error, match="'/dev/zero': it is a device"):
+        rg.NoiseModel.load("/dev/zero")
+    fifo = str(tmp_path / "model.yml")
+    os.mkfifo(fifo)
+    with pytest.raises(rg.error, match="it is a FIFO"):
+        rg.NoiseModel.load(fifo)
+
+
 def test_cxx_errors_are_rawgment_error_with_the_cxx_message(sensor, tmp_path):
     with pytest.raises(rg.error) as info:
         rg.NoiseModel(-1, 0, 0)
