@@ -9,6 +9,9 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <fcntl.h>
+#include <filesystem>
+#include <chrono>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -259,6 +262,59 @@ TEST(Apps, aRunRemovesTheTemporariesThatKilledRunsLeft)
     ASSERT_EQ(0, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("removed 1 temporary file(s)")) << r.output;
     EXPECT_FALSE(exists(dir + "/manifest.yml.tmp-" + std::to_string(gone) + "-0"));
+}
+
+TEST(Apps, aRunStoppedWhileAPlotIsDrawnLeavesNoScriptBehind)
+{
+    // SIGINT while gnuplot ran left "<plot>.gp.<pid>.run" in the output folder. The run is stopped the
+    // moment it has a gnuplot running on a plot script (a child process whose command line names one),
+    // and nothing but finished files may stay.
+    const std::string dir = freshDir("interrupted_plot");
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=4 --gains=6,18 --levels=0.5 "
+                                           "--format=png --validation=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string out = dir + "/cal", manifest = dir + "/sim/manifest.yml";
+    const std::string app = std::string(RAWGMENT_APP_DIR) + "/rawgment_calibrate";
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        ::freopen("/dev/null", "w", stdout);
+        ::freopen("/dev/null", "w", stderr);
+        ::execl(app.c_str(), app.c_str(), manifest.c_str(), ("--out=" + out).c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    const auto plotting = [&] {
+        std::ifstream children("/proc/" + std::to_string(child) + "/task/" + std::to_string(child) + "/children");
+        for (std::string pid; children >> pid;) {
+            // A process that just ended has no command line to read: read() fails, the text stays empty.
+            std::string command(4096, '\0');
+            const int fd = ::open(("/proc/" + pid + "/cmdline").c_str(), O_RDONLY);
+            const ssize_t got = fd < 0 ? 0 : ::read(fd, &command[0], command.size());
+            if (fd >= 0)
+                ::close(fd);
+            command.resize(got > 0 ? size_t(got) : 0);
+            if (command.find("gnuplot") != std::string::npos && command.find("--version") == std::string::npos)
+                return true;
+        }
+        return false;
+    };
+    const auto start = std::chrono::steady_clock::now();
+    bool sawScript = false;
+    while (!sawScript && std::chrono::steady_clock::now() - start < std::chrono::seconds(60)) {
+        sawScript = plotting();
+        int status = 0;
+        if (!sawScript && ::waitpid(child, &status, WNOHANG) == child)
+            FAIL() << "the run ended before its first plot";
+    }
+    ::kill(child, SIGINT);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    ASSERT_TRUE(sawScript);
+    for (const auto& entry : std::filesystem::directory_iterator(out)) {
+        const std::string name = entry.path().filename().string();
+        EXPECT_EQ(std::string::npos, name.find(".run")) << name;
+        EXPECT_EQ(std::string::npos, name.find(".tmp-")) << name;
+    }
 }
 
 TEST(Apps, anOutputFolderThatCannotBeWrittenIsRefusedBeforeAnyWork)

@@ -17,6 +17,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <utility>
@@ -444,8 +445,18 @@ bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, 
             "gnuplot is not installed (apt-get install gnuplot-nox); plot with: gnuplot '" + scriptPath + "'";
         return false;
     }
-    const std::string runScript = scriptPath + "." + std::to_string(::getpid()) + ".run";
-    writeTextAtomically(runScript, preamble + scriptBody + "\n");
+    // The script gnuplot runs lives in memory (a memfd, which gnuplot opens as /dev/fd/N): a run stopped
+    // by a signal or killed leaves nothing of it behind. Without memfd (kernels before 3.17), a file
+    // "<plot>.gp.<pid>.run" that the next run in the folder removes once this process is gone.
+    const std::string runBody = preamble + scriptBody + "\n";
+    std::string runScript;
+    const int memfd = static_cast<int>(::syscall(SYS_memfd_create, "rawgment-plot", 0));
+    if (memfd >= 0 && ::write(memfd, runBody.data(), runBody.size()) == static_cast<ssize_t>(runBody.size())) {
+        runScript = "/dev/fd/" + std::to_string(memfd);
+    } else {
+        runScript = scriptPath + "." + std::to_string(::getpid()) + ".run";
+        writeTextAtomically(runScript, runBody);
+    }
     const std::string command = "gnuplot '" + runScript + "'";
     FILE* pipe = ::popen(command.c_str(), "r");
     std::vector<char> png;
@@ -456,7 +467,10 @@ bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, 
             png.insert(png.end(), buf, buf + n);
     }
     const int status = pipe ? ::pclose(pipe) : -1;
-    std::remove(runScript.c_str());
+    if (memfd >= 0)
+        ::close(memfd);
+    if (runScript.compare(0, 8, "/dev/fd/") != 0)
+        std::remove(runScript.c_str());
     if (status != 0 || png.empty()) {
         message = "gnuplot failed on '" + scriptPath + "' (its messages are above)";
         return false;
