@@ -228,6 +228,13 @@ void bindAugment(py::module_& m)
         .def_static("load", &RandomScenePolicy::load, py::arg("path"), doc("RandomScenePolicy::load"));
 
     // ---- raw_io ------------------------------------------------------------------------------------
+    py::class_<DngTag>(m, "DngTag", doc("DngTag"))
+        .def(keywordInit<DngTag>())
+        .def_readwrite("tag", &DngTag::tag, doc("DngTag::tag"))
+        .def_readwrite("type", &DngTag::type, doc("DngTag::type"))
+        .def_readwrite("count", &DngTag::count, doc("DngTag::count"))
+        .def_readwrite("values", &DngTag::values, doc("DngTag::values"))
+        .def("validate", &DngTag::validate, py::arg("what"), doc("DngTag::validate"));
     py::class_<RawImage> rawImage(m, "RawImage", doc("RawImage"));
     rawImage.def(keywordInit<RawImage>())
         .def_readwrite("format", &RawImage::format, doc("RawImage::format"))
@@ -237,7 +244,8 @@ void bindAugment(py::module_& m)
         .def_readwrite("model", &RawImage::model, doc("RawImage::model"))
         .def_readwrite("whiteBalance", &RawImage::whiteBalance, doc("RawImage::whiteBalance"))
         .def_readwrite("cameraToSrgb", &RawImage::cameraToSrgb, doc("RawImage::cameraToSrgb"))
-        .def_readwrite("noiseProfile", &RawImage::noiseProfile, doc("RawImage::noiseProfile"));
+        .def_readwrite("noiseProfile", &RawImage::noiseProfile, doc("RawImage::noiseProfile"))
+        .def_readwrite("colorTags", &RawImage::colorTags, doc("RawImage::colorTags"));
     defMatProperty(rawImage, "mosaic", &RawImage::mosaic, doc("RawImage::mosaic"), {CV_16U});
     m.def(
         "readRaw",
@@ -286,6 +294,7 @@ void bindAugment(py::module_& m)
         .def_readwrite("whiteBalance", &CameraTags::whiteBalance, doc("CameraTags::whiteBalance"))
         .def_readwrite("cameraToSrgb", &CameraTags::cameraToSrgb, doc("CameraTags::cameraToSrgb"))
         .def_readwrite("noiseProfile", &CameraTags::noiseProfile, doc("CameraTags::noiseProfile"))
+        .def_readwrite("colorTags", &CameraTags::colorTags, doc("CameraTags::colorTags"))
         .def_static("of", &CameraTags::of, py::arg("image"), doc("CameraTags::of"))
         .def("applyTo", &CameraTags::applyTo, py::arg("image"), doc("CameraTags::applyTo"));
     py::class_<MosaicMetadata>(m, "MosaicMetadata", doc("MosaicMetadata"))

@@ -25,6 +25,20 @@ def exiftool_values(path, *tags):
     return values
 
 
+def white_xy(tags):
+    """The as-shot white point a DNG reader derives from one ColorMatrix (DNG 1.6 chapter 6, one
+    calibration illuminant): XYZ = inverse(AnalogBalance x CameraCalibration1 x ColorMatrix1) x AsShotNeutral."""
+    import numpy as np
+
+    cm = np.array([float(v) for v in tags["ColorMatrix1"].split()]).reshape(3, 3)
+    ab = np.diag([float(v) for v in tags.get("AnalogBalance", "1 1 1").split()])
+    cc = np.array([float(v) for v in tags["CameraCalibration1"].split()]).reshape(3, 3) \
+        if "CameraCalibration1" in tags else np.eye(3)
+    neutral = np.array([float(v) for v in tags["AsShotNeutral"].split()])
+    xyz = np.linalg.solve(ab @ cc @ cm, neutral)
+    return tuple(xyz[:2] / xyz.sum())
+
+
 def camera_file(name):
     path = os.path.join(os.environ.get("RAWGMENT_SHARED_DATA_DIR", ""), name)
     if not os.path.isfile(path):
@@ -69,6 +83,26 @@ def test_augmented_dng_keeps_the_camera_and_states_the_simulated_capture(tmp_pat
         assert "ISO" not in tags  # unknown stays unknown
     profile = [float(v) for v in tags["NoiseProfile"].split()]
     assert profile == pytest.approx([v for so in after.noiseProfile for v in so], rel=1e-13)
+
+    # The colour tags as the source states them: a DNG's verbatim (colorchart.dng has no
+    # CalibrationIlluminant1, and none may appear), another RAW's from LibRaw's XYZ matrix unscaled.
+    colour = ["ColorMatrix1", "ColorMatrix2", "CalibrationIlluminant1", "CalibrationIlluminant2",
+              "AsShotNeutral", "AsShotWhiteXY", "AnalogBalance", "CameraCalibration1", "ForwardMatrix1"]
+    tags_out = exiftool_values(out, *colour)
+    if name.endswith(".dng"):
+        tags_in = exiftool_values(source, *colour)
+        assert tags_out == tags_in
+        assert "CalibrationIlluminant1" not in tags_out
+    else:
+        cm = [v for t in before.colorTags if t.tag == 50721 for v in t.values]
+        assert [float(v) for v in tags_out["ColorMatrix1"].split()] == pytest.approx(
+            [cm[k] / cm[k + 1] for k in range(0, 18, 2)], abs=1e-12)
+        assert tags_out["CalibrationIlluminant1"] == "21"
+    xy_in, xy_out = white_xy(exiftool_values(source if name.endswith(".dng") else out, *colour)), white_xy(tags_out)
+    assert xy_out == pytest.approx(xy_in, abs=1e-9)
+    if name == "colorchart.dng":
+        # The white point a DNG reader derives, as an independent computation gave it for the input.
+        assert xy_out == pytest.approx((0.338, 0.369), abs=1e-3)
 
     # The preview's brightness is checked in test/test_apps.cpp (OpenCV reads PNG there).
     assert os.path.getsize(str(tmp_path / "out" / (stem + "_v00_preview.png"))) > 0

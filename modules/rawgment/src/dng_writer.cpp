@@ -23,6 +23,18 @@ enum TiffType : uint16_t
     TIFF_DOUBLE = 12
 };
 
+void put16le(std::vector<uint8_t>& b, uint16_t v)
+{
+    b.push_back(uint8_t(v));
+    b.push_back(uint8_t(v >> 8));
+}
+
+void put32le(std::vector<uint8_t>& b, uint32_t v)
+{
+    for (int k = 0; k < 4; ++k)
+        b.push_back(uint8_t(v >> (8 * k)));
+}
+
 struct TiffEntry
 {
     uint16_t tag;
@@ -269,21 +281,57 @@ void writeDng(const String& path, const RawImage& image)
         t.add(50714, TIFF_LONG, 4, b);
     }
     t.longs(50717, {static_cast<uint32_t>(std::llround(image.format.whiteLevel))});
-    // ColorMatrix1 maps XYZ to camera RGB: camera = inverse(cameraToSrgb) * (XYZ to linear sRGB, D65).
-    const Matx33d xyzToSrgb(3.2404542, -1.5371385, -0.4985314, -0.9692660, 1.8760108, 0.0415560, 0.0556434,
-                            -0.2040259, 1.0572252);
-    Matx33d inv;
-    if (cv::invert(image.cameraToSrgb, inv, DECOMP_SVD) == 0)
-        CV_Error(Error::StsBadArg, "writeDng: cameraToSrgb is singular");
-    const Matx33d colorMatrix = inv * xyzToSrgb;
-    t.rationals(50721, std::vector<double>(colorMatrix.val, colorMatrix.val + 9), true);
-    t.shorts(50778, {21}); // CalibrationIlluminant1: D65
-    std::vector<double> neutral(3);
-    for (int c = 0; c < 3; ++c) {
-        detail::checkFinitePositive(image.whiteBalance[c], "writeDng: whiteBalance");
-        neutral[c] = image.whiteBalance[1] / image.whiteBalance[c];
+    // The colour tags as the source stated them (RawImage::colorTags): rebuilt from LibRaw's normalised
+    // matrix, ColorMatrix1's rows came out rescaled and a reader derived another white point.
+    const auto has = [&](int tag) {
+        return std::any_of(image.colorTags.begin(), image.colorTags.end(),
+                           [&](const DngTag& d) { return d.tag == tag; });
+    };
+    for (const DngTag& tag : image.colorTags) {
+        tag.validate("writeDng: colour tag");
+        if (std::count_if(image.colorTags.begin(), image.colorTags.end(),
+                          [&](const DngTag& d) { return d.tag == tag.tag; }) > 1)
+            CV_Error(Error::StsBadArg, format("writeDng: colour tag %d is given twice", tag.tag));
+        std::vector<uint8_t> b;
+        for (double v : tag.values) {
+            if (tag.type == 3)
+                put16le(b, static_cast<uint16_t>(v));
+            else if (tag.type == 11) {
+                const float f = static_cast<float>(v);
+                uint32_t bits;
+                std::memcpy(&bits, &f, sizeof(bits));
+                put32le(b, bits);
+            } else if (tag.type == 12) {
+                uint64_t bits;
+                std::memcpy(&bits, &v, sizeof(bits));
+                put32le(b, uint32_t(bits));
+                put32le(b, uint32_t(bits >> 32));
+            } else
+                put32le(b, static_cast<uint32_t>(static_cast<int64_t>(v)));
+        }
+        t.add(uint16_t(tag.tag), uint16_t(tag.type), uint32_t(tag.count), b);
     }
-    t.rationals(50728, neutral, false);
+    if (!has(50721)) {
+        // No stated colour: ColorMatrix1 maps XYZ to camera RGB, camera = inverse(cameraToSrgb) * (XYZ to
+        // linear sRGB, D65), for D65.
+        const Matx33d xyzToSrgb(3.2404542, -1.5371385, -0.4985314, -0.9692660, 1.8760108, 0.0415560,
+                                0.0556434, -0.2040259, 1.0572252);
+        Matx33d inv;
+        if (cv::invert(image.cameraToSrgb, inv, DECOMP_SVD) == 0)
+            CV_Error(Error::StsBadArg, "writeDng: cameraToSrgb is singular");
+        const Matx33d colorMatrix = inv * xyzToSrgb;
+        t.rationals(50721, std::vector<double>(colorMatrix.val, colorMatrix.val + 9), true);
+        if (!has(50778))
+            t.shorts(50778, {21}); // CalibrationIlluminant1: D65
+    }
+    if (!has(50728) && !has(50729)) {
+        std::vector<double> neutral(3);
+        for (int c = 0; c < 3; ++c) {
+            detail::checkFinitePositive(image.whiteBalance[c], "writeDng: whiteBalance");
+            neutral[c] = image.whiteBalance[1] / image.whiteBalance[c];
+        }
+        t.rationals(50728, neutral, false);
+    }
     if (!image.noiseProfile.empty()) {
         std::vector<double> pairs;
         for (const Vec2d& so : image.noiseProfile) {

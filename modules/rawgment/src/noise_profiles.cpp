@@ -60,6 +60,41 @@ public:
     {
         CV_Error(Error::StsParseError, "readRaw: '" + path_ + "' " + why);
     }
+    //! The values of the IFD entry at `entry` as numbers (rationals as numerator, denominator pairs).
+    std::vector<double> values(uint64_t entry)
+    {
+        const uint16_t tag = u16(entry), type = u16(entry + 2);
+        const uint32_t count = u32(entry + 4);
+        static const int sizes[13] = {0, 1, 1, 2, 4, 8, 1, 1, 2, 4, 8, 4, 8};
+        if (type < 1 || type > 12 || count > 64)
+            fail(format("has tag %d of type %d with %u values; a colour tag has at most 64 values of a "
+                        "TIFF type 1 to 12",
+                        int(tag), int(type), count));
+        const uint64_t size = uint64_t(sizes[type]) * count;
+        const uint64_t at = size <= 4 ? entry + 8 : u32(entry + 8);
+        std::vector<double> v;
+        for (uint32_t k = 0; k < count; ++k) {
+            const uint64_t p = at + uint64_t(sizes[type]) * k;
+            switch (type) {
+            case 3: v.push_back(u16(p)); break;
+            case 8: v.push_back(static_cast<int16_t>(u16(p))); break;
+            case 4: v.push_back(u32(p)); break;
+            case 9: v.push_back(static_cast<int32_t>(u32(p))); break;
+            case 5: v.push_back(u32(p)); v.push_back(u32(p + 4)); break;
+            case 10: v.push_back(static_cast<int32_t>(u32(p))); v.push_back(static_cast<int32_t>(u32(p + 4))); break;
+            case 11: {
+                const uint32_t bits = u32(p);
+                float f;
+                std::memcpy(&f, &bits, sizeof(f));
+                v.push_back(f);
+                break;
+            }
+            case 12: v.push_back(f64(p)); break;
+            default: v.push_back(static_cast<double>(unsignedAt<1>(p))); break;
+            }
+        }
+        return v;
+    }
 
 private:
     void bytes(uint64_t at, void* out, uint64_t n)
@@ -136,6 +171,54 @@ double rangeOfColourPlane(const RawFormat& format, int plane)
     return format.whiteLevel - black / sites;
 }
 
+bool isColorTag(int tag)
+{
+    static const int tags[] = {50721, 50722, 50723, 50724, 50725, 50726, 50727,
+                               50728, 50729, 50778, 50779, 50964, 50965};
+    return std::find(std::begin(tags), std::end(tags), tag) != std::end(tags);
+}
+
+std::vector<DngTag> readDngColorTags(const String& path)
+{
+    checkRegularFile(path, "RAW file");
+    {
+        std::ifstream probe(path, std::ios::binary);
+        char head[4] = {0, 0, 0, 0};
+        probe.read(head, 4);
+        if (!probe || !((head[0] == 'I' && head[1] == 'I' && head[2] == 42 && head[3] == 0) ||
+                        (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && head[3] == 42)))
+            return {};
+    }
+    TiffFile tiff(path);
+    // DNG keeps its colour tags in IFD0.
+    const uint64_t ifd = tiff.u32(4);
+    const uint16_t entries = tiff.u16(ifd);
+    std::vector<DngTag> tags;
+    for (uint16_t i = 0; i < entries; ++i) {
+        const uint64_t entry = ifd + 2 + 12ull * i;
+        const int tag = tiff.u16(entry);
+        if (!isColorTag(tag))
+            continue;
+        DngTag t;
+        t.tag = tag;
+        t.type = tiff.u16(entry + 2);
+        t.count = static_cast<int>(tiff.u32(entry + 4));
+        t.values = tiff.values(entry);
+        try {
+            t.validate("colour tag");
+        } catch (const Exception& e) {
+            tiff.fail("has an invalid " + e.err);
+        }
+        if (std::none_of(tags.begin(), tags.end(), [&](const DngTag& d) { return d.tag == tag; }))
+            tags.push_back(t);
+    }
+    // ColorMatrix1 is what makes the others mean anything: without it the file states no colour.
+    if (std::none_of(tags.begin(), tags.end(), [](const DngTag& d) { return d.tag == 50721; }))
+        return {};
+    std::sort(tags.begin(), tags.end(), [](const DngTag& a, const DngTag& b) { return a.tag < b.tag; });
+    return tags;
+}
+
 //! The NoiseProfile pairs of a TIFF-based file (DNG), empty when it has none or is not TIFF-based.
 std::vector<Vec2d> readDngNoiseProfile(const String& path)
 {
@@ -186,6 +269,32 @@ void checkDngNoiseProfile(const std::vector<Vec2d>& profile, const char* what)
 }
 
 } // namespace detail
+
+void DngTag::validate(const char* what) const
+{
+    if (!detail::isColorTag(tag))
+        CV_Error(Error::StsBadArg, format("%s: tag %d is not one of the DNG colour tags", what, tag));
+    const bool rational = type == 5 || type == 10;
+    if (type != 3 && type != 4 && !rational && type != 11 && type != 12)
+        CV_Error(Error::StsBadArg, format("%s %d: TIFF type %d is not SHORT, LONG, RATIONAL, SRATIONAL, FLOAT or "
+                                          "DOUBLE",
+                                          what, tag, type));
+    if (count < 1 || count > 64 || values.size() != size_t(count) * (rational ? 2 : 1))
+        CV_Error(Error::StsBadArg, format("%s %d: %zu values for a count of %d%s", what, tag, values.size(), count,
+                                          rational ? " (rationals take two each)" : ""));
+    const double lo = type == 10 ? -2147483648.0 : 0, hi = type == 3 ? 65535.0 : type == 10 ? 2147483647.0 : 4294967295.0;
+    for (size_t k = 0; k < values.size(); ++k) {
+        const double v = values[k];
+        if (type == 11 || type == 12) {
+            if (!std::isfinite(v))
+                CV_Error(Error::StsBadArg, format("%s %d: value %zu is not finite", what, tag, k));
+            continue;
+        }
+        if (!(v == std::floor(v) && v >= lo && v <= hi) || (rational && k % 2 == 1 && v == 0))
+            CV_Error(Error::StsBadArg, format("%s %d: value %zu (%g) does not fit TIFF type %d%s", what, tag, k, v,
+                                              type, rational && k % 2 == 1 ? " (a denominator must not be 0)" : ""));
+    }
+}
 
 std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, const RawFormat& format)
 {

@@ -61,6 +61,11 @@ std::vector<Vec2d> readDngNoiseProfile(const String& path);
 double rangeOfColourPlane(const RawFormat& format, int plane);
 //! Throws StsBadArg (prefixed by `what`) unless a NoiseProfile has 1 or 3 pairs, each S > 0, O >= 0.
 void checkDngNoiseProfile(const std::vector<Vec2d>& profile, const char* what);
+//! Whether `tag` is one of the DNG colour tags that DngTag holds.
+bool isColorTag(int tag);
+//! The colour tags of a DNG's IFD0 (sorted by tag), empty when the file has no ColorMatrix1 or is not
+//! TIFF-based; throws StsParseError naming the file when a tag or the IFD is malformed.
+std::vector<DngTag> readDngColorTags(const String& path);
 //! Throws StsBadArg naming `what` unless baseIso lies in [NoiseModel::MIN_BASE_ISO, MAX_BASE_ISO] (or is 0,
 //! for unknown, when zeroIsUnknown).
 CV_RAWGMENT_EXPORTS void checkBaseIso(double baseIso, const char* what, bool zeroIsUnknown);

@@ -195,6 +195,29 @@ RawImage readRaw(const String& path)
     if (!haveMatrix)
         out.cameraToSrgb = Matx33d::eye();
     out.noiseProfile = detail::readDngNoiseProfile(path);
+    out.colorTags = detail::readDngColorTags(path);
+    // Another RAW format: LibRaw's XYZ-to-camera matrix is Adobe's coefficients for the camera (integers
+    // over 10000, given for D65), which is the DNG's ColorMatrix with CalibrationIlluminant D65 (21).
+    bool haveXyz = false;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            haveXyz = haveXyz || c.cam_xyz[i][j] != 0;
+    if (out.colorTags.empty() && haveXyz) {
+        DngTag colorMatrix;
+        colorMatrix.tag = 50721;
+        colorMatrix.type = 10;
+        colorMatrix.count = 9;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                colorMatrix.values.insert(colorMatrix.values.end(),
+                                          {static_cast<double>(std::llround(c.cam_xyz[i][j] * 10000.0)), 10000.0});
+        DngTag illuminant;
+        illuminant.tag = 50778;
+        illuminant.type = 3;
+        illuminant.count = 1;
+        illuminant.values = {21};
+        out.colorTags = {colorMatrix, illuminant};
+    }
     return out;
 }
 
@@ -211,6 +234,7 @@ CameraTags CameraTags::of(const RawImage& image)
     tags.whiteBalance = image.whiteBalance;
     tags.cameraToSrgb = image.cameraToSrgb;
     tags.noiseProfile = image.noiseProfile;
+    tags.colorTags = image.colorTags;
     return tags;
 }
 
@@ -223,6 +247,7 @@ void CameraTags::applyTo(RawImage& image) const
     image.whiteBalance = whiteBalance;
     image.cameraToSrgb = cameraToSrgb;
     image.noiseProfile = noiseProfile;
+    image.colorTags = colorTags;
 }
 
 void CameraTags::write(FileStorage& fs, const String& name) const
@@ -237,6 +262,14 @@ void CameraTags::write(FileStorage& fs, const String& name) const
         pairs.push_back(so[1]);
     }
     fs << "noise_profile" << pairs;
+    if (!colorTags.empty()) {
+        fs << "color_tags"
+           << "[";
+        for (const DngTag& t : colorTags)
+            fs << "{"
+               << "tag" << t.tag << "type" << t.type << "count" << t.count << "values" << t.values << "}";
+        fs << "]";
+    }
     fs << "}";
 }
 
@@ -244,8 +277,8 @@ CameraTags CameraTags::read(const FileNode& node)
 {
     if (node.empty() || !node.isMap())
         CV_Error(Error::StsParseError, "camera tags: expected a map");
-    rejectUnknownKeys(
-        node, {"make", "model", "iso", "exposure_time", "white_balance", "camera_to_srgb", "noise_profile"});
+    rejectUnknownKeys(node, {"make", "model", "iso", "exposure_time", "white_balance", "camera_to_srgb",
+                             "noise_profile", "color_tags"});
     CameraTags tags;
     const auto text = [&](const char* field) {
         const FileNode f = node[field];
@@ -276,6 +309,33 @@ CameraTags CameraTags::read(const FileNode& node)
             tags.noiseProfile.emplace_back(v[k], v[k + 1]);
         if (!tags.noiseProfile.empty())
             detail::checkDngNoiseProfile(tags.noiseProfile, "camera tags: noise_profile");
+    }
+    const FileNode colour = node["color_tags"];
+    if (!colour.empty()) {
+        if (!colour.isSeq() || colour.size() > 16)
+            CV_Error(Error::StsParseError, "camera tags: field 'color_tags' must be a list of at most 16 tags");
+        for (const FileNode& entry : colour) {
+            rejectUnknownKeys(entry, {"tag", "type", "count", "values"});
+            DngTag t;
+            t.tag = detail::readOptionalIntField(entry, "tag", 0);
+            t.type = detail::readOptionalIntField(entry, "type", 0);
+            t.count = detail::readOptionalIntField(entry, "count", 0);
+            const bool rational = t.type == 5 || t.type == 10;
+            if (t.count < 1 || t.count > 64)
+                CV_Error(Error::StsParseError, format("camera tags: colour tag %d: count %d is not in [1, 64]",
+                                                      t.tag, t.count));
+            t.values = detail::readRealList(entry, "values", t.count * (rational ? 2 : 1));
+            try {
+                t.validate("camera tags: colour tag");
+            } catch (const Exception& e) {
+                CV_Error(Error::StsParseError, e.err);
+            }
+            if (std::any_of(tags.colorTags.begin(), tags.colorTags.end(),
+                            [&](const DngTag& d) { return d.tag >= t.tag; }))
+                CV_Error(Error::StsParseError,
+                         format("camera tags: colour tag %d is repeated or out of order", t.tag));
+            tags.colorTags.push_back(t);
+        }
     }
     return tags;
 }

@@ -611,6 +611,43 @@ TEST(RawIo, cameraTagsTravelInTheSidecarAndTheDngAndFirstVersionSidecarsStillLoa
     EXPECT_NEAR(norm(Vec3d(dng.whiteBalance) - meta.camera.whiteBalance), 0, 1e-5);
     EXPECT_EQ(dng.noiseProfile, meta.camera.noiseProfile);
 
+    // Colour tags travel verbatim through the sidecar and the DNG: a big-endian source's numerators,
+    // an unsigned rational beyond int32, a CalibrationIlluminant2 that writeDng would never make.
+    DngTag colorMatrix, neutral, illuminant2;
+    colorMatrix.tag = 50721;
+    colorMatrix.type = 10;
+    colorMatrix.count = 9;
+    colorMatrix.values = {6461, 10000, -1164, 10000, -857, 10000, -3825, 10000, 11597,
+                          10000, 2534, 10000, -416, 10000, 1540, 10000, 6039, 10000};
+    neutral.tag = 50728;
+    neutral.type = 5;
+    neutral.count = 3;
+    neutral.values = {3000000000.0, 3000000000.0, 2477, 1000, 1462, 1000};
+    illuminant2.tag = 50779;
+    illuminant2.type = 3;
+    illuminant2.count = 1;
+    illuminant2.values = {17};
+    meta.camera.colorTags = {colorMatrix, neutral, illuminant2};
+    writeMosaic(dir + "/colour.dng", m16, meta);
+    const CameraTags colourSide = readMosaic(dir + "/colour.dng", back).camera;
+    const RawImage colourDng = readRaw(dir + "/colour.dng");
+    for (const std::vector<DngTag>* tags : {&colourSide.colorTags, &colourDng.colorTags}) {
+        ASSERT_EQ(3u, tags->size());
+        for (size_t k = 0; k < 3; ++k) {
+            EXPECT_EQ((*tags)[k].tag, meta.camera.colorTags[k].tag);
+            EXPECT_EQ((*tags)[k].type, meta.camera.colorTags[k].type);
+            EXPECT_EQ((*tags)[k].values, meta.camera.colorTags[k].values);
+        }
+    }
+    // What no TIFF value holds is refused, naming the tag.
+    DngTag bad = neutral;
+    bad.values[1] = 0;
+    EXPECT_CV_ERROR_CONTAINS(bad.validate("x"), "x 50728: value 1 (0) does not fit TIFF type 5 (a denominator");
+    bad = colorMatrix;
+    bad.tag = 271;
+    EXPECT_CV_ERROR_CONTAINS(bad.validate("x"), "tag 271 is not one of the DNG colour tags");
+    meta.camera.colorTags.clear();
+
     // The same sidecar as format version 1 wrote it (no camera key) still loads.
     meta.hasCamera = false;
     writeMosaic(dir + "/plain.png", m16, meta);

@@ -14,6 +14,26 @@ namespace rawgment {
 //! @addtogroup rawgment_raw_io
 //! @{
 
+/** @brief A colour tag of a DNG as a file stores it, kept verbatim when a DNG is written again.
+ *
+ * The colour tags (ColorMatrix1/2 50721/50722, CameraCalibration1/2 50723/50724, ReductionMatrix1/2
+ * 50725/50726, AnalogBalance 50727, AsShotNeutral 50728, AsShotWhiteXY 50729, CalibrationIlluminant1/2
+ * 50778/50779, ForwardMatrix1/2 50964/50965) together define the camera's colour and white point for a
+ * reader that follows the DNG specification; rebuilding any of them from a normalised matrix moves the
+ * white point. Values hold the TIFF values as numbers: a RATIONAL or SRATIONAL as its numerator and
+ * denominator, so `values` has 2 x count entries and nothing is rounded.
+ */
+struct CV_RAWGMENT_EXPORTS DngTag
+{
+    int tag = 0;                //!< TIFF tag number (one of the colour tags above)
+    int type = 0;               //!< TIFF type: 3 SHORT, 4 LONG, 5 RATIONAL, 10 SRATIONAL, 11 FLOAT or 12 DOUBLE
+    int count = 0;              //!< number of values as TIFF counts them (1 to 64)
+    std::vector<double> values; //!< the values (numerator, denominator pairs for rationals)
+    //! Throws cv::Exception (prefixed by `what`) unless the tag is one of the colour tags, of a type
+    //! above, and its values fit the type (integers in range, non-zero denominators).
+    void validate(const char* what) const;
+};
+
 /** @brief A Bayer mosaic read from a camera RAW file, with what the file says about its capture. */
 struct CV_RAWGMENT_EXPORTS RawImage
 {
@@ -34,6 +54,12 @@ struct CV_RAWGMENT_EXPORTS RawImage
      * blue) or one pair for all. Empty when the file has none. readRaw() reads it from a DNG's IFDs
      * (LibRaw does not expose it), writeDng() writes it; dngNoiseProfile() makes it from a NoiseModel. */
     std::vector<Vec2d> noiseProfile;
+    /** The DNG colour tags, sorted by tag. From a DNG: its IFD0's tags, verbatim. From another RAW file:
+     * ColorMatrix1, the XYZ (D65) to camera matrix LibRaw knows for the camera (the Adobe coefficients,
+     * given for D65 as the DNG specification defines it), with CalibrationIlluminant1 = D65; empty when
+     * LibRaw knows none. writeDng() writes them as they are, adding only what a DNG needs and they lack
+     * (ColorMatrix1, from cameraToSrgb, and AsShotNeutral, from whiteBalance). */
+    std::vector<DngTag> colorTags;
 };
 
 /** @brief The DNG NoiseProfile of a noise model at the format's gain (for RawImage::noiseProfile).
@@ -250,6 +276,7 @@ struct CV_RAWGMENT_EXPORTS CameraTags
     Vec3d whiteBalance = Vec3d(1, 1, 1);   //!< as RawImage::whiteBalance
     Matx33d cameraToSrgb = Matx33d::eye(); //!< as RawImage::cameraToSrgb
     std::vector<Vec2d> noiseProfile;       //!< as RawImage::noiseProfile; empty for none
+    std::vector<DngTag> colorTags;         //!< as RawImage::colorTags; empty for none
 
     //! The tags of a RAW image (every field but its mosaic and format).
     static CameraTags of(const RawImage& image);
