@@ -6,12 +6,12 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
-#include <chrono>
 #include <fstream>
 #include <iterator>
 #include <map>
@@ -270,8 +270,9 @@ TEST(Apps, aRunStoppedWhileAPlotIsDrawnLeavesNoScriptBehind)
     // moment it has a gnuplot running on a plot script (a child process whose command line names one),
     // and nothing but finished files may stay.
     const std::string dir = freshDir("interrupted_plot");
-    AppRun r = runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=4 --gains=6,18 --levels=0.5 "
-                                           "--format=png --validation=false");
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir +
+                                               "/sim' --frames=4 --gains=6,18 --levels=0.5 "
+                                               "--format=png --validation=false");
     ASSERT_EQ(0, r.status) << r.output;
     const std::string out = dir + "/cal", manifest = dir + "/sim/manifest.yml";
     const std::string app = std::string(RAWGMENT_APP_DIR) + "/rawgment_calibrate";
@@ -280,11 +281,13 @@ TEST(Apps, aRunStoppedWhileAPlotIsDrawnLeavesNoScriptBehind)
     if (child == 0) {
         ::freopen("/dev/null", "w", stdout);
         ::freopen("/dev/null", "w", stderr);
-        ::execl(app.c_str(), app.c_str(), manifest.c_str(), ("--out=" + out).c_str(), static_cast<char*>(nullptr));
+        ::execl(app.c_str(), app.c_str(), manifest.c_str(), ("--out=" + out).c_str(),
+                static_cast<char*>(nullptr));
         ::_exit(127);
     }
     const auto plotting = [&] {
-        std::ifstream children("/proc/" + std::to_string(child) + "/task/" + std::to_string(child) + "/children");
+        std::ifstream children("/proc/" + std::to_string(child) + "/task/" + std::to_string(child) +
+                               "/children");
         for (std::string pid; children >> pid;) {
             // A process that just ended has no command line to read: read() fails, the text stays empty.
             std::string command(4096, '\0');
@@ -293,7 +296,8 @@ TEST(Apps, aRunStoppedWhileAPlotIsDrawnLeavesNoScriptBehind)
             if (fd >= 0)
                 ::close(fd);
             command.resize(got > 0 ? size_t(got) : 0);
-            if (command.find("gnuplot") != std::string::npos && command.find("--version") == std::string::npos)
+            if (command.find("gnuplot") != std::string::npos &&
+                command.find("--version") == std::string::npos)
                 return true;
         }
         return false;
@@ -987,20 +991,22 @@ TEST(Apps, calibrateReadsBurstsOfDifferentFrameSizesEachInsideItsOwnFrame)
                   {"dark_g06dB", 6, true, dark},
                   {"dark_g18dB", 18, true, dark}};
     for (const auto& b : bursts) {
-        manifest << "    - { gain_db: " << b.gainDb << ", dark: " << (b.dark ? "true" : "false") << ", files: [";
+        manifest << "    - { gain_db: " << b.gainDb << ", dark: " << (b.dark ? "true" : "false")
+                 << ", files: [";
         for (int t = 0; t < 4; ++t)
             manifest << (t ? ", " : "") << "'" << cropped(b.burst, t, b.size) << "'";
         manifest << "] }\n";
     }
     std::ofstream(dir + "/m.yml") << manifest.str();
     for (const char* darkComponents : {"false", "true"}) {
-        r = runApp("rawgment_calibrate", "'" + dir + "/m.yml' --plots=false --dark_components=" +
-                                             darkComponents + " --out='" + dir + "/cal_" + darkComponents +
-                                             "'");
+        r = runApp("rawgment_calibrate", "'" + dir +
+                                             "/m.yml' --plots=false --dark_components=" + darkComponents +
+                                             " --out='" + dir + "/cal_" + darkComponents + "'");
         ASSERT_EQ(0, r.status) << r.output;
         const cv::rawgment::NoiseModel fitted =
             cv::rawgment::NoiseModel::load(dir + "/cal_" + darkComponents + "/noise_model.yml");
-        const cv::rawgment::NoiseModel truth = cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
+        const cv::rawgment::NoiseModel truth =
+            cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
         // 4 frames: alpha within 10% (the trade-off report's worst parameter error at 8 frames is 8.8%;
         // alpha, fitted from every light pixel, is the best determined of them).
         EXPECT_NEAR(fitted.alpha, truth.alpha, 0.1 * truth.alpha) << darkComponents;

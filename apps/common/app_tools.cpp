@@ -58,8 +58,9 @@ void writeNewBytes(const std::string& path, const std::vector<uchar>& bytes)
         try {
             const std::string existing =
                 cv::rawgment::readFileBounded(path, static_cast<long long>(bytes.size()), "existing output");
-            same = existing.size() == bytes.size() && std::equal(bytes.begin(), bytes.end(), existing.begin(),
-                                                                 [](uchar a, char b) { return a == uchar(b); });
+            same =
+                existing.size() == bytes.size() && std::equal(bytes.begin(), bytes.end(), existing.begin(),
+                                                              [](uchar a, char b) { return a == uchar(b); });
         } catch (const cv::Exception&) {
         }
         if (same)
@@ -451,7 +452,8 @@ bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, 
     const std::string runBody = preamble + scriptBody + "\n";
     std::string runScript;
     const int memfd = static_cast<int>(::syscall(SYS_memfd_create, "rawgment-plot", 0));
-    if (memfd >= 0 && ::write(memfd, runBody.data(), runBody.size()) == static_cast<ssize_t>(runBody.size())) {
+    if (memfd >= 0 &&
+        ::write(memfd, runBody.data(), runBody.size()) == static_cast<ssize_t>(runBody.size())) {
         runScript = "/dev/fd/" + std::to_string(memfd);
     } else {
         runScript = scriptPath + "." + std::to_string(::getpid()) + ".run";

@@ -30,9 +30,9 @@ std::vector<std::string> outputNames(const std::vector<std::string>& inputs)
     for (const std::string& in : inputs) {
         const auto given = seen.emplace(canonicalPath(in), in);
         if (!given.second)
-            throw std::runtime_error("input '" + in + "' is given twice" +
-                                     (given.first->second == in ? std::string()
-                                                                : " (also as '" + given.first->second + "')"));
+            throw std::runtime_error(
+                "input '" + in + "' is given twice" +
+                (given.first->second == in ? std::string() : " (also as '" + given.first->second + "')"));
         ++stems[stemOf(in)];
     }
     std::vector<std::string> names;
@@ -103,12 +103,14 @@ AugmentPlan planAugmentJobs(const AugmentOptions& o)
     if (o.inputs.empty())
         throw std::runtime_error("no input files");
     if (o.variants < 1 || o.variants > kMaxVariants)
-        throw std::runtime_error(cv::format("variants must lie in [1, %d] (got %d)", kMaxVariants, o.variants));
+        throw std::runtime_error(
+            cv::format("variants must lie in [1, %d] (got %d)", kMaxVariants, o.variants));
     // Every job is planned before the first runs: a bound keeps the plan in memory.
     if (o.inputs.size() * static_cast<size_t>(o.variants) > kMaxJobs)
-        throw std::runtime_error(cv::format("%zu inputs x %d variants is more than the %zu outputs one run makes; "
-                                            "split the inputs over several runs",
-                                            o.inputs.size(), o.variants, kMaxJobs));
+        throw std::runtime_error(
+            cv::format("%zu inputs x %d variants is more than the %zu outputs one run makes; "
+                       "split the inputs over several runs",
+                       o.inputs.size(), o.variants, kMaxJobs));
     for (const std::string& in : o.inputs) {
         if (!pathExists(in))
             throw std::runtime_error("input '" + in + "': no such file");

@@ -37,9 +37,10 @@ std::vector<cv::Rect> boxesFrom(const py::object& boxes)
             for (py::ssize_t j = 0; j < 4; ++j) {
                 const double x = a.at(i, j);
                 if (!(x == std::floor(x)) || x < INT_MIN || x > INT_MAX)
-                    throw py::value_error(cv::format("argument 'boxes' row %zd column %zd is %.17g: each value "
-                                                     "must be an integer in the 32-bit range",
-                                                     i, j, x));
+                    throw py::value_error(
+                        cv::format("argument 'boxes' row %zd column %zd is %.17g: each value "
+                                   "must be an integer in the 32-bit range",
+                                   i, j, x));
                 v[j] = static_cast<int>(x);
             }
             out.emplace_back(v[0], v[1], v[2], v[3]);

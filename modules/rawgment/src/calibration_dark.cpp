@@ -131,11 +131,12 @@ GainData analyseGain(const std::vector<Mat>& frames, double gain, const RawForma
     }
     // Nothing varies: every statistic below would be 0/0 and the fit a NaN far from here.
     if (!(total.f2 > 0) && !(total.r2 > 0))
-        CV_Error(Error::StsBadArg,
-                 cv::format("calibrateDarkNoise: the %d frames at gain %g do not vary: every pixel has one value "
-                            "in every frame (constant or clipped frames, or copies of one frame); dark frames "
-                            "must hold the sensor's read noise",
-                            T, gain));
+        CV_Error(
+            Error::StsBadArg,
+            cv::format("calibrateDarkNoise: the %d frames at gain %g do not vary: every pixel has one value "
+                       "in every frame (constant or clipped frames, or copies of one frame); dark frames "
+                       "must hold the sensor's read noise",
+                       T, gain));
     DarkGainStatistics& st = d.stats;
     st.gain = gain;
     st.frames = T;

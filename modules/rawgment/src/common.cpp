@@ -5,14 +5,14 @@
 #include <cctype>
 #include <cerrno>
 #include <chrono>
-#include <csignal>
 #include <climits>
+#include <csignal>
 #include <cstring>
 #include <fcntl.h>
 #include <fstream>
 #include <iterator>
-#include <sstream>
 #include <poll.h>
+#include <sstream>
 #include <sys/stat.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
@@ -34,9 +34,9 @@ void checkBaseIso(double baseIso, const char* what, bool zeroIsUnknown)
     if (zeroIsUnknown && baseIso == 0)
         return;
     if (!(baseIso >= NoiseModel::MIN_BASE_ISO && baseIso <= NoiseModel::MAX_BASE_ISO))
-        CV_Error(Error::StsBadArg, format("%s must lie in [%g, %g]%s (got %g)", what, NoiseModel::MIN_BASE_ISO,
-                                          NoiseModel::MAX_BASE_ISO, zeroIsUnknown ? ", or be 0 for unknown" : "",
-                                          baseIso));
+        CV_Error(Error::StsBadArg,
+                 format("%s must lie in [%g, %g]%s (got %g)", what, NoiseModel::MIN_BASE_ISO,
+                        NoiseModel::MAX_BASE_ISO, zeroIsUnknown ? ", or be 0 for unknown" : "", baseIso));
 }
 
 void checkFiniteNonNegative(double value, const char* what)
@@ -274,8 +274,8 @@ void requireParseFinishes(const String& path, const std::string& text)
     // what follows starts with a '-' that is not '---' (its document loop then neither advances nor
     // fails). rejectUnsupportedStructure() refuses the shapes seen so far, but where the root ends
     // depends on the whole parser; so the text is parsed once in a child process, which is killed when
-    // it overruns a bound that no honest file needs: 44 MB of numbers parsed in 0.42 s (0.01 s/MB, the
-    // AVX2 host of docs/README.md's table, Release), and the bound is 2 s plus 0.25 s per MB, 25 times
+    // it overruns a bound that no honest file needs: 44 MB of numbers parsed in 0.42 s (0.01 s/MB on a
+    // 2-core AMD EPYC Zen 4, Release, 2026-11-24), and the bound is 2 s plus 0.25 s per MB, 25 times
     // that, for sanitizer builds and loaded machines. The child only parses and leaves with _exit(): it
     // runs no atexit handler and touches no file.
     const int boundSeconds = 2 + static_cast<int>(text.size() >> 22);
@@ -337,7 +337,8 @@ void checkRegularFile(const String& path, const String& what)
         CV_Error(Error::StsError, "cannot open " + what + " '" + path +
                                       "': " + (errno == ENOENT ? "no such file" : std::strerror(errno)));
     if (!S_ISREG(status.st_mode))
-        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': " + notRegularReason(status.st_mode));
+        CV_Error(Error::StsError,
+                 "cannot open " + what + " '" + path + "': " + notRegularReason(status.st_mode));
 }
 
 const char* notRegularReason(unsigned mode)
@@ -376,7 +377,8 @@ std::string readFileBounded(const String& path, long long maxBytes, const String
     if (::fstat(fd, &status) != 0)
         CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': " + std::strerror(errno));
     if (!S_ISREG(status.st_mode))
-        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': " + detail::notRegularReason(status.st_mode));
+        CV_Error(Error::StsError,
+                 "cannot open " + what + " '" + path + "': " + detail::notRegularReason(status.st_mode));
     const auto tooLarge = [&](long long bytes) {
         CV_Error(Error::StsError,
                  format("cannot open %s '%s': %lld bytes, more than the %lld bytes such a file may have",
@@ -442,7 +444,7 @@ FileStorage openFileStorageForReading(const String& path, const String& what)
     // OpenCV tells YAML from JSON by the first bytes only: JSON must start with its brace, and YAML
     // with a %YAML line, which hand-written files often lack.
     const size_t first = text.find_first_not_of(" \t\r\n");
-    const std::string parsed = text[first] == '{'                      ? text.substr(first)
+    const std::string parsed = text[first] == '{'                 ? text.substr(first)
                                : text.compare(0, 5, "%YAML") == 0 ? text
                                                                   : "%YAML:1.0\n" + text;
     detail::requireParseFinishes(path, parsed);

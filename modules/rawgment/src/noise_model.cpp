@@ -305,10 +305,11 @@ NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
         CV_Error(Error::StsParseError, "noise model: field 'format_version' is missing or not an integer");
     const int version = static_cast<int>(versionNode);
     if (version < 1)
-        CV_Error(Error::StsParseError,
-                 format("noise model: format_version %d is not a version of this format (versions start at 1; "
-                        "this build reads 1 to %d)",
-                        version, FORMAT_VERSION));
+        CV_Error(
+            Error::StsParseError,
+            format("noise model: format_version %d is not a version of this format (versions start at 1; "
+                   "this build reads 1 to %d)",
+                   version, FORMAT_VERSION));
     if (version > FORMAT_VERSION)
         CV_Error(Error::StsParseError,
                  format("noise model: format_version %d is not supported; this build reads versions 1 to %d "

@@ -76,12 +76,26 @@ public:
         for (uint32_t k = 0; k < count; ++k) {
             const uint64_t p = at + uint64_t(sizes[type]) * k;
             switch (type) {
-            case 3: v.push_back(u16(p)); break;
-            case 8: v.push_back(static_cast<int16_t>(u16(p))); break;
-            case 4: v.push_back(u32(p)); break;
-            case 9: v.push_back(static_cast<int32_t>(u32(p))); break;
-            case 5: v.push_back(u32(p)); v.push_back(u32(p + 4)); break;
-            case 10: v.push_back(static_cast<int32_t>(u32(p))); v.push_back(static_cast<int32_t>(u32(p + 4))); break;
+            case 3:
+                v.push_back(u16(p));
+                break;
+            case 8:
+                v.push_back(static_cast<int16_t>(u16(p)));
+                break;
+            case 4:
+                v.push_back(u32(p));
+                break;
+            case 9:
+                v.push_back(static_cast<int32_t>(u32(p)));
+                break;
+            case 5:
+                v.push_back(u32(p));
+                v.push_back(u32(p + 4));
+                break;
+            case 10:
+                v.push_back(static_cast<int32_t>(u32(p)));
+                v.push_back(static_cast<int32_t>(u32(p + 4)));
+                break;
             case 11: {
                 const uint32_t bits = u32(p);
                 float f;
@@ -89,8 +103,12 @@ public:
                 v.push_back(f);
                 break;
             }
-            case 12: v.push_back(f64(p)); break;
-            default: v.push_back(static_cast<double>(unsignedAt<1>(p))); break;
+            case 12:
+                v.push_back(f64(p));
+                break;
+            default:
+                v.push_back(static_cast<double>(unsignedAt<1>(p)));
+                break;
             }
         }
         return v;
@@ -276,13 +294,16 @@ void DngTag::validate(const char* what) const
         CV_Error(Error::StsBadArg, format("%s: tag %d is not one of the DNG colour tags", what, tag));
     const bool rational = type == 5 || type == 10;
     if (type != 3 && type != 4 && !rational && type != 11 && type != 12)
-        CV_Error(Error::StsBadArg, format("%s %d: TIFF type %d is not SHORT, LONG, RATIONAL, SRATIONAL, FLOAT or "
-                                          "DOUBLE",
-                                          what, tag, type));
+        CV_Error(Error::StsBadArg,
+                 format("%s %d: TIFF type %d is not SHORT, LONG, RATIONAL, SRATIONAL, FLOAT or "
+                        "DOUBLE",
+                        what, tag, type));
     if (count < 1 || count > 64 || values.size() != size_t(count) * (rational ? 2 : 1))
-        CV_Error(Error::StsBadArg, format("%s %d: %zu values for a count of %d%s", what, tag, values.size(), count,
-                                          rational ? " (rationals take two each)" : ""));
-    const double lo = type == 10 ? -2147483648.0 : 0, hi = type == 3 ? 65535.0 : type == 10 ? 2147483647.0 : 4294967295.0;
+        CV_Error(Error::StsBadArg, format("%s %d: %zu values for a count of %d%s", what, tag, values.size(),
+                                          count, rational ? " (rationals take two each)" : ""));
+    const double lo = type == 10 ? -2147483648.0 : 0, hi = type == 3    ? 65535.0
+                                                           : type == 10 ? 2147483647.0
+                                                                        : 4294967295.0;
     for (size_t k = 0; k < values.size(); ++k) {
         const double v = values[k];
         if (type == 11 || type == 12) {
@@ -291,8 +312,9 @@ void DngTag::validate(const char* what) const
             continue;
         }
         if (!(v == std::floor(v) && v >= lo && v <= hi) || (rational && k % 2 == 1 && v == 0))
-            CV_Error(Error::StsBadArg, format("%s %d: value %zu (%g) does not fit TIFF type %d%s", what, tag, k, v,
-                                              type, rational && k % 2 == 1 ? " (a denominator must not be 0)" : ""));
+            CV_Error(Error::StsBadArg,
+                     format("%s %d: value %zu (%g) does not fit TIFF type %d%s", what, tag, k, v, type,
+                            rational && k % 2 == 1 ? " (a denominator must not be 0)" : ""));
     }
 }
 
@@ -323,10 +345,11 @@ NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& profile, const RawFo
     line.b = so[1] * r * r;
     // S and O are finite, but S r or O r^2 need not be (S = 1e308 at a white level of 4095).
     if (!std::isfinite(line.a) || !std::isfinite(line.b))
-        CV_Error(Error::StsBadArg,
-                 cv::format("noiseLineFromDngProfile: the pair (%g, %g) gives the line a = %g, b = %g at a range "
-                        "of %g DN; a noise profile must give a finite line",
-                        so[0], so[1], line.a, line.b, r));
+        CV_Error(
+            Error::StsBadArg,
+            cv::format("noiseLineFromDngProfile: the pair (%g, %g) gives the line a = %g, b = %g at a range "
+                       "of %g DN; a noise profile must give a finite line",
+                       so[0], so[1], line.a, line.b, r));
     return line;
 }
 
@@ -471,10 +494,10 @@ NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format, 
             const double r = detail::rangeOfColourPlane(format, plane);
             if (!(std::isfinite(p.a[size_t(plane)]) && p.a[size_t(plane)] >= 0 &&
                   std::isfinite(p.b[size_t(plane)])))
-                CV_Error(Error::StsBadArg, cv::format("%s: ISO %g colour %d has a = %g, b = %g; a must be "
-                                                      "finite and >= 0, b finite",
-                                                      where.c_str(), p.iso, plane, p.a[size_t(plane)],
-                                                      p.b[size_t(plane)]));
+                CV_Error(Error::StsBadArg,
+                         cv::format("%s: ISO %g colour %d has a = %g, b = %g; a must be "
+                                    "finite and >= 0, b finite",
+                                    where.c_str(), p.iso, plane, p.a[size_t(plane)], p.b[size_t(plane)]));
             const double a = p.a[size_t(plane)] * r / g;
             if (!haveAlpha) {
                 alpha = a;

@@ -209,8 +209,9 @@ RawImage readRaw(const String& path)
         colorMatrix.count = 9;
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j)
-                colorMatrix.values.insert(colorMatrix.values.end(),
-                                          {static_cast<double>(std::llround(c.cam_xyz[i][j] * 10000.0)), 10000.0});
+                colorMatrix.values.insert(
+                    colorMatrix.values.end(),
+                    {static_cast<double>(std::llround(c.cam_xyz[i][j] * 10000.0)), 10000.0});
         DngTag illuminant;
         illuminant.tag = 50778;
         illuminant.type = 3;
@@ -313,7 +314,8 @@ CameraTags CameraTags::read(const FileNode& node)
     const FileNode colour = node["color_tags"];
     if (!colour.empty()) {
         if (!colour.isSeq() || colour.size() > 16)
-            CV_Error(Error::StsParseError, "camera tags: field 'color_tags' must be a list of at most 16 tags");
+            CV_Error(Error::StsParseError,
+                     "camera tags: field 'color_tags' must be a list of at most 16 tags");
         for (const FileNode& entry : colour) {
             rejectUnknownKeys(entry, {"tag", "type", "count", "values"});
             DngTag t;
@@ -322,8 +324,8 @@ CameraTags CameraTags::read(const FileNode& node)
             t.count = detail::readOptionalIntField(entry, "count", 0);
             const bool rational = t.type == 5 || t.type == 10;
             if (t.count < 1 || t.count > 64)
-                CV_Error(Error::StsParseError, format("camera tags: colour tag %d: count %d is not in [1, 64]",
-                                                      t.tag, t.count));
+                CV_Error(Error::StsParseError,
+                         format("camera tags: colour tag %d: count %d is not in [1, 64]", t.tag, t.count));
             t.values = detail::readRealList(entry, "values", t.count * (rational ? 2 : 1));
             try {
                 t.validate("camera tags: colour tag");

@@ -829,7 +829,8 @@ TEST(Augment, sceneAndPolicyFilesRejectWhatIsNotANumber)
     EXPECT_CV_ERROR_CONTAINS(readScene(", shift: [ 1.5, 2 ]"),
                              "field 'shift' must be a list of two integers");
     // max_shift is a fraction of each side: 4 (pixels meant?) loaded and failed only after 1-2 outputs.
-    FileStorage pixels("%YAML:1.0\nrandom_scene_policy: {max_shift: 4}\n", FileStorage::READ | FileStorage::MEMORY);
+    FileStorage pixels("%YAML:1.0\nrandom_scene_policy: {max_shift: 4}\n",
+                       FileStorage::READ | FileStorage::MEMORY);
     EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy::read(pixels["random_scene_policy"]),
                              "maxShift must lie in [0, 1), a fraction of each side (got 4)");
     // A kernel weight the reader cannot use (found by test/fuzz: -1e308 stored as a float is -inf).

@@ -179,7 +179,8 @@ TEST(NoiseModel, readingRejectsBadFilesNamingTheField)
     }
     NoiseModel far(1, 1, 1);
     far.baseIso = 1e300;
-    EXPECT_CV_ERROR_CONTAINS(far.validate(), "NoiseModel.baseIso must lie in [1, 1e+07], or be 0 for unknown");
+    EXPECT_CV_ERROR_CONTAINS(far.validate(),
+                             "NoiseModel.baseIso must lie in [1, 1e+07], or be 0 for unknown");
     // Version 0 was never written: it is no newer file.
     EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 0\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
                              "format_version 0 is not a version of this format");

@@ -617,8 +617,8 @@ TEST(RawIo, cameraTagsTravelInTheSidecarAndTheDngAndFirstVersionSidecarsStillLoa
     colorMatrix.tag = 50721;
     colorMatrix.type = 10;
     colorMatrix.count = 9;
-    colorMatrix.values = {6461, 10000, -1164, 10000, -857, 10000, -3825, 10000, 11597,
-                          10000, 2534, 10000, -416, 10000, 1540, 10000, 6039, 10000};
+    colorMatrix.values = {6461,  10000, -1164, 10000, -857,  10000, -3825, 10000, 11597,
+                          10000, 2534,  10000, -416,  10000, 1540,  10000, 6039,  10000};
     neutral.tag = 50728;
     neutral.type = 5;
     neutral.count = 3;
@@ -642,7 +642,8 @@ TEST(RawIo, cameraTagsTravelInTheSidecarAndTheDngAndFirstVersionSidecarsStillLoa
     // What no TIFF value holds is refused, naming the tag.
     DngTag bad = neutral;
     bad.values[1] = 0;
-    EXPECT_CV_ERROR_CONTAINS(bad.validate("x"), "x 50728: value 1 (0) does not fit TIFF type 5 (a denominator");
+    EXPECT_CV_ERROR_CONTAINS(bad.validate("x"),
+                             "x 50728: value 1 (0) does not fit TIFF type 5 (a denominator");
     bad = colorMatrix;
     bad.tag = 271;
     EXPECT_CV_ERROR_CONTAINS(bad.validate("x"), "tag 271 is not one of the DNG colour tags");
@@ -863,7 +864,8 @@ TEST(RawIo, everyReaderRefusesDevicesAndFifosWithoutBlocking)
     EXPECT_CV_ERROR_CONTAINS(readRaw("/dev/zero"), "it is a device");
     Mat mosaic;
     EXPECT_CV_ERROR_CONTAINS(readMosaic(fifo, mosaic), "it is a FIFO");
-    EXPECT_CV_ERROR_CONTAINS(readFileBounded("/dev/urandom", 10, "noise"), "cannot open noise '/dev/urandom'");
+    EXPECT_CV_ERROR_CONTAINS(readFileBounded("/dev/urandom", 10, "noise"),
+                             "cannot open noise '/dev/urandom'");
     EXPECT_CV_ERROR_CONTAINS(readFileBounded(dir, 10, "x"), "it is a directory");
     // A regular file: its bytes up to the bound, an error beyond it.
     const std::string text = textFile(dir, "ten.txt", "0123456789");

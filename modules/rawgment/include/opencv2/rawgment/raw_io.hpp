@@ -25,9 +25,9 @@ namespace rawgment {
  */
 struct CV_RAWGMENT_EXPORTS DngTag
 {
-    int tag = 0;                //!< TIFF tag number (one of the colour tags above)
-    int type = 0;               //!< TIFF type: 3 SHORT, 4 LONG, 5 RATIONAL, 10 SRATIONAL, 11 FLOAT or 12 DOUBLE
-    int count = 0;              //!< number of values as TIFF counts them (1 to 64)
+    int tag = 0;   //!< TIFF tag number (one of the colour tags above)
+    int type = 0;  //!< TIFF type: 3 SHORT, 4 LONG, 5 RATIONAL, 10 SRATIONAL, 11 FLOAT or 12 DOUBLE
+    int count = 0; //!< number of values as TIFF counts them (1 to 64)
     std::vector<double> values; //!< the values (numerator, denominator pairs for rationals)
     //! Throws cv::Exception (prefixed by `what`) unless the tag is one of the colour tags, of a type
     //! above, and its values fit the type (integers in range, non-zero denominators).
