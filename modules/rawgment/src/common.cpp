@@ -283,6 +283,8 @@ void requireParseFinishes(const String& path, const std::string& text)
     if (child < 0)
         return; // no process to spare (a limit on processes): the text checks alone must do
     if (child == 0) {
+        // The caller's SIGALRM handler (if any) is inherited: the default action ends the child.
+        ::signal(SIGALRM, SIG_DFL);
         ::alarm(static_cast<unsigned>(boundSeconds) + 1);
         try {
             FileStorage fs(text, FileStorage::READ | FileStorage::MEMORY);
@@ -291,38 +293,39 @@ void requireParseFinishes(const String& path, const std::string& text)
         ::_exit(0);
     }
     const auto start = std::chrono::steady_clock::now();
-    // A pidfd wakes the wait the moment the child ends; without one (kernels before 5.3), short naps.
+    // A pidfd becomes readable the moment the child ends, even where SIGCHLD is ignored and waitpid()
+    // cannot see it; without one (kernels before 5.3), waitpid() and short naps.
     const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, child, 0));
     long sleepNs = 20000;
-    for (;;) {
-        int status = 0;
-        const pid_t done = ::waitpid(child, &status, WNOHANG);
-        if (done == child || (done < 0 && errno != EINTR)) {
-            if (pidfd >= 0)
-                ::close(pidfd);
-            return;
-        }
-        if (std::chrono::steady_clock::now() - start > std::chrono::seconds(boundSeconds)) {
-            if (pidfd >= 0)
-                ::close(pidfd);
-            ::kill(child, SIGKILL);
-            while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
-            }
-            CV_Error(Error::StsParseError,
-                     format("'%s': OpenCV's YAML reader did not finish within %d s; the text is not a "
-                            "single YAML document of the shape this module reads (a line that ends the "
-                            "root collection early, followed by a '-'?)",
-                            path.c_str(), boundSeconds));
-        }
+    bool finished = false;
+    while (!finished && std::chrono::steady_clock::now() - start <= std::chrono::seconds(boundSeconds)) {
         if (pidfd >= 0) {
             pollfd ready = {pidfd, POLLIN, 0};
-            ::poll(&ready, 1, 100);
+            finished = ::poll(&ready, 1, 100) > 0;
         } else {
+            int status = 0;
+            const pid_t done = ::waitpid(child, &status, WNOHANG);
+            // ECHILD: SIGCHLD is ignored and the child reaped itself, so it has ended.
+            finished = done == child || (done < 0 && errno == ECHILD);
             const timespec pause = {0, sleepNs};
-            ::nanosleep(&pause, nullptr);
+            if (!finished)
+                ::nanosleep(&pause, nullptr);
             sleepNs = std::min(sleepNs * 2, 10000000L);
         }
     }
+    if (!finished)
+        ::kill(child, SIGKILL);
+    int status = 0;
+    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (pidfd >= 0)
+        ::close(pidfd);
+    if (!finished)
+        CV_Error(Error::StsParseError,
+                 format("'%s': OpenCV's YAML reader did not finish within %d s; the text is not a single "
+                        "YAML document of the shape this module reads (a line that ends the root "
+                        "collection early, followed by a '-'?)",
+                        path.c_str(), boundSeconds));
 }
 
 std::string readTextFile(const String& path)

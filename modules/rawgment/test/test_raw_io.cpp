@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <dirent.h>
@@ -885,6 +886,12 @@ TEST(RawIo, aYamlTextOnWhichOpenCvNeverFinishesIsAnErrorNotAHang)
     EXPECT_CV_ERROR_CONTAINS(detail::requireParseFinishes("hang.yml", "%YAML:1.0\n" + hang),
                              "OpenCV's YAML reader did not finish within 2 s");
     EXPECT_NO_THROW(detail::requireParseFinishes("ok.yml", "%YAML:1.0\n---\nm:\n   a: 1\n"));
+    // A program that ignores SIGCHLD (its children reap themselves) is guarded the same.
+    const auto previous = std::signal(SIGCHLD, SIG_IGN);
+    EXPECT_CV_ERROR_CONTAINS(detail::requireParseFinishes("hang.yml", "%YAML:1.0\n" + hang),
+                             "did not finish within 2 s");
+    EXPECT_NO_THROW(detail::requireParseFinishes("ok.yml", "%YAML:1.0\n---\nm:\n   a: 1\n"));
+    std::signal(SIGCHLD, previous);
 }
 
 TEST(RawIo, openFileStorageForReadingBoundsTheFileAndScansLongLines)
