@@ -658,10 +658,17 @@ CalibrationReport CalibrationReport::read(const FileNode& node)
     if (node.empty() || !node.isMap())
         CV_Error(Error::StsParseError, "calibration report: expected a map");
     const FileNode versionNode = node["format_version"];
-    if (!versionNode.isInt() || static_cast<int>(versionNode) < 1 ||
-        static_cast<int>(versionNode) > FORMAT_VERSION)
+    if (!versionNode.isInt())
         CV_Error(Error::StsParseError,
-                 format("calibration report: format_version is missing or newer than %d", FORMAT_VERSION));
+                 "calibration report: field 'format_version' is missing or not an integer");
+    if (static_cast<int>(versionNode) < 1 || static_cast<int>(versionNode) > FORMAT_VERSION)
+        CV_Error(
+            Error::StsParseError,
+            format("calibration report: format_version %d is not supported; this build reads versions 1 to "
+                   "%d%s",
+                   static_cast<int>(versionNode), FORMAT_VERSION,
+                   static_cast<int>(versionNode) > FORMAT_VERSION ? " (a newer cv::rawgment wrote the file)"
+                                                                  : ""));
     const int version = static_cast<int>(versionNode);
     CalibrationReport r;
     try {

@@ -591,6 +591,16 @@ TEST(Calibration, reportErrorsRoundTripAndFirstVersionReportsStillLoad)
     ASSERT_NE(source, std::string::npos);
     std::ofstream(dir + "/typo.yml") << text.substr(0, source) << "sauce:" << text.substr(source + 7);
     EXPECT_CV_ERROR_CONTAINS(CalibrationReport::load(dir + "/typo.yml"), "sauce");
+    // Version 0 was never written: not called newer; 9 is.
+    for (const char* version : {"0", "9"}) {
+        std::ofstream(dir + "/version.yml") << text.substr(0, at) << "format_version: " << version
+                                            << text.substr(at + std::strlen("format_version: 2"));
+        EXPECT_CV_ERROR_CONTAINS(CalibrationReport::load(dir + "/version.yml"),
+                                 std::string("format_version ") + version +
+                                     " is not supported; this build reads "
+                                     "versions 1 to 2" +
+                                     (version[0] == '9' ? " (a newer" : ""));
+    }
 }
 
 // A sensor with every dark-frame component (the same kind as the augmentation tests'), quantised.
