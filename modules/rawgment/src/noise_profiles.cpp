@@ -189,6 +189,17 @@ double rangeOfColourPlane(const RawFormat& format, int plane)
     return format.whiteLevel - black / sites;
 }
 
+//! Whether a regular file starts with a TIFF header of either byte order (DNG, NEF, ...).
+bool isTiffBased(const String& path)
+{
+    checkRegularFile(path, "RAW file");
+    std::ifstream probe(path, std::ios::binary);
+    char head[4] = {0, 0, 0, 0};
+    probe.read(head, 4);
+    return probe && ((head[0] == 'I' && head[1] == 'I' && head[2] == 42 && head[3] == 0) ||
+                     (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && head[3] == 42));
+}
+
 bool isColorTag(int tag)
 {
     static const int tags[] = {50721, 50722, 50723, 50724, 50725, 50726, 50727,
@@ -198,15 +209,8 @@ bool isColorTag(int tag)
 
 std::vector<DngTag> readDngColorTags(const String& path)
 {
-    checkRegularFile(path, "RAW file");
-    {
-        std::ifstream probe(path, std::ios::binary);
-        char head[4] = {0, 0, 0, 0};
-        probe.read(head, 4);
-        if (!probe || !((head[0] == 'I' && head[1] == 'I' && head[2] == 42 && head[3] == 0) ||
-                        (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && head[3] == 42)))
-            return {};
-    }
+    if (!isTiffBased(path))
+        return {};
     TiffFile tiff(path);
     // DNG keeps its colour tags in IFD0.
     const uint64_t ifd = tiff.u32(4);
@@ -240,16 +244,8 @@ std::vector<DngTag> readDngColorTags(const String& path)
 //! The NoiseProfile pairs of a TIFF-based file (DNG), empty when it has none or is not TIFF-based.
 std::vector<Vec2d> readDngNoiseProfile(const String& path)
 {
-    checkRegularFile(path, "RAW file");
-    {
-        std::ifstream probe(path, std::ios::binary);
-        char head[4] = {0, 0, 0, 0};
-        probe.read(head, 4);
-        const bool tiff = probe && ((head[0] == 'I' && head[1] == 'I' && head[2] == 42 && head[3] == 0) ||
-                                    (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && head[3] == 42));
-        if (!tiff)
-            return {};
-    }
+    if (!isTiffBased(path))
+        return {};
     TiffFile tiff(path);
     // IFD0 and the IFDs chained after it, then the SubIFDs they name. A hostile file's loops end at the
     // first revisit, and the search at 256 IFDs.
