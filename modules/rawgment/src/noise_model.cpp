@@ -427,14 +427,17 @@ void NoiseModel::save(const String& path) const
     try {
         for (size_t i = 0; i < images.size(); ++i) {
             const String image = folder + images[i];
-            // Same name, same checksum: a map an earlier save left is this one already.
-            if (detail::fileExists(image))
+            // Same name, same checksum: a map an earlier save left is this one already (when its pixels
+            // say so; a damaged one is replaced, as nothing can load it).
+            const bool present = detail::fileExists(image);
+            if (present && mapChecksum(imread(image, IMREAD_UNCHANGED)) == mapChecksum(*maps[i]))
                 continue;
             std::vector<uchar> bytes;
             if (!imencode(".tiff", *maps[i], bytes, {IMWRITE_TIFF_COMPRESSION, 1}) || bytes.empty())
                 CV_Error(Error::StsError, "NoiseModel::save: cannot encode the dark-shading image " + image);
-            writeFileAtomically(image, bytes.data(), bytes.size(), false);
-            created.push_back(image);
+            writeFileAtomically(image, bytes.data(), bytes.size(), present);
+            if (!present)
+                created.push_back(image);
         }
         writeFileAtomically(path, text.data(), text.size(), true);
     } catch (...) {

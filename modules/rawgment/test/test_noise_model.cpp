@@ -345,6 +345,11 @@ TEST(NoiseModel, aSaveWithMapsIsAllOrNothingAndModelsInOneFolderKeepTheirOwnMaps
     NoiseModel(0.25, 1.5, 0.8).save(dir + "/cam.yml");
     EXPECT_EQ(4u, filesOf(dir).size());
     EXPECT_NO_THROW(NoiseModel::load(dir + "/cam.json"));
+    // A damaged map of the same name is written again, not taken for this save's.
+    std::ofstream(dir + "/" + shadingImageOf(dir + "/cam.json", "offset"), std::ios::trunc) << "junk";
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/cam.json"), "dark-shading image");
+    b.save(dir + "/cam.json");
+    EXPECT_EQ(0, norm(b.darkShadingOffset, NoiseModel::load(dir + "/cam.json").darkShadingOffset, NORM_INF));
 }
 
 TEST(NoiseModel, darkShadingImagesOfAnotherSaveOrMissingAreErrors)
