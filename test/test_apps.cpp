@@ -424,8 +424,9 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
     ASSERT_EQ(0, r.status) << r.output;
     const cv::rawgment::NoiseModel truth = cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
     const cv::rawgment::NoiseModel fitted = cv::rawgment::NoiseModel::load(dir + "/cal/noise_model.yml");
-    // The joint fit's spread over seeds at 100 frames is 0.08% / 0.45% / 1.7% (README, study_calibration);
-    // a variance of 32 frames is sqrt(99/31) = 1.8x noisier. The bounds are about 5 of those spreads.
+    // The joint fit's spread over seeds at 100 frames is 0.08% / 0.45% / 1.7% (docs/performance.md,
+    // study_calibration); a variance of 32 frames is sqrt(99/31) = 1.8x noisier. The bounds are about 5 of
+    // those spreads.
     EXPECT_NEAR(truth.alpha, fitted.alpha, 0.01 * truth.alpha);
     EXPECT_NEAR(truth.sigmaD2, fitted.sigmaD2, 0.04 * truth.sigmaD2);
     EXPECT_NEAR(truth.sigmaR2, fitted.sigmaR2, 0.15 * truth.sigmaR2);
@@ -780,7 +781,7 @@ TEST(Apps, calibrateFromIsoTaggedFilesIsAsAccurateAsTheTradeoffReportSays)
 {
     // The trade-off report's campaign (apps/common/tradeoff_measures.cpp: alpha 0.4, sigma_d^2 0.5,
     // sigma_r^2 2, gains 6/12/24 dB, levels 0.2/0.65, 32 px patches sampled in 24 px squares) written as
-    // DNG files that carry their ISO and no sidecar, calibrated from the files alone. The README's
+    // DNG files that carry their ISO and no sidecar, calibrated from the files alone. docs/performance.md's
     // trade-off table gives 0.0591 at 16 frames: the RMS over 3 campaigns of the worst relative error of
     // the three parameters, against the effective truth (sigma_r^2 2 plus the 1/12 DN^2 of rounding), so
     // one campaign stays within 3 of it, 0.177. Sharper: each parameter lies within 4 of the standard
