@@ -271,21 +271,25 @@ void rejectUnsupportedStructure(const String& path, const std::string& text)
 void requireParseFinishes(const String& path, const std::string& text)
 {
     // OpenCV 4.6's YAML reader never returns when its root collection ends before the text does and
-    // what follows starts with a '-' that is not '---' (its document loop then neither advances nor
-    // fails). rejectUnsupportedStructure() refuses the shapes seen so far, but where the root ends
+    // what follows starts with a '-' that is not '---' (its document loop then spins, neither advancing
+    // nor failing). rejectUnsupportedStructure() refuses the shapes seen so far, but where the root ends
     // depends on the whole parser; so the text is parsed once in a child process, which is killed when
-    // it overruns a bound that no honest file needs: 44 MB of numbers parsed in 0.42 s (0.01 s/MB on a
-    // 2-core AMD EPYC Zen 4, Release, 2026-11-24), and the bound is 2 s plus 0.25 s per MB, 25 times
-    // that, for sanitizer builds and loaded machines. The child only parses and leaves with _exit(): it
-    // runs no atexit handler and touches no file.
-    const int boundSeconds = 2 + static_cast<int>(text.size() >> 22);
+    // it has spun longer than an honest file needs. 44 MB of numbers parse in 0.42 s (0.01 s/MB on a
+    // 2-core AMD EPYC Zen 4, Release, 2026-11-24); the bound is 2 s plus 0.25 s per MB of the child's
+    // CPU time, 25 times that, for sanitizer builds. CPU time, not wall time: under `ctest -j2` a
+    // sanitizer build's child took more than 2 s of wall time for 300 kB while waiting for a core. A
+    // child that neither ends nor spins for a long while (a lock another thread held at the fork) says
+    // nothing about the text: it is killed and the caller parses. The child only parses and leaves with
+    // _exit(): it runs no atexit handler and touches no file.
+    const double cpuBound = 2 + static_cast<double>(text.size()) / (4 << 20);
+    const double wallCap = 30 + 10 * cpuBound;
     const pid_t child = ::fork();
     if (child < 0)
         return; // no process to spare (a limit on processes): the text checks alone must do
     if (child == 0) {
         // The caller's SIGALRM handler (if any) is inherited: the default action ends the child.
         ::signal(SIGALRM, SIG_DFL);
-        ::alarm(static_cast<unsigned>(boundSeconds) + 1);
+        ::alarm(static_cast<unsigned>(wallCap) + 1);
         try {
             FileStorage fs(text, FileStorage::READ | FileStorage::MEMORY);
         } catch (...) {
@@ -293,15 +297,28 @@ void requireParseFinishes(const String& path, const std::string& text)
         ::_exit(0);
     }
     const auto start = std::chrono::steady_clock::now();
+    const auto wallSeconds = [&] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    clockid_t childClock;
+    const bool haveChildClock = ::clock_getcpuclockid(child, &childClock) == 0;
+    const auto cpuSeconds = [&] {
+        timespec t;
+        if (!haveChildClock)
+            return wallSeconds();
+        if (::clock_gettime(childClock, &t) != 0)
+            return 0.0; // the child has just ended: the next wait sees it
+        return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+    };
     // A pidfd becomes readable the moment the child ends, even where SIGCHLD is ignored and waitpid()
     // cannot see it; without one (kernels before 5.3), waitpid() and short naps.
     const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, child, 0));
     long sleepNs = 20000;
-    bool finished = false;
-    while (!finished && std::chrono::steady_clock::now() - start <= std::chrono::seconds(boundSeconds)) {
+    bool finished = false, spinning = false;
+    while (!finished && !spinning && wallSeconds() <= wallCap) {
         if (pidfd >= 0) {
             pollfd ready = {pidfd, POLLIN, 0};
-            finished = ::poll(&ready, 1, 100) > 0;
+            finished = ::poll(&ready, 1, 50) > 0;
         } else {
             int status = 0;
             const pid_t done = ::waitpid(child, &status, WNOHANG);
@@ -312,6 +329,7 @@ void requireParseFinishes(const String& path, const std::string& text)
                 ::nanosleep(&pause, nullptr);
             sleepNs = std::min(sleepNs * 2, 10000000L);
         }
+        spinning = !finished && cpuSeconds() > cpuBound;
     }
     if (!finished)
         ::kill(child, SIGKILL);
@@ -320,12 +338,12 @@ void requireParseFinishes(const String& path, const std::string& text)
     }
     if (pidfd >= 0)
         ::close(pidfd);
-    if (!finished)
+    if (spinning)
         CV_Error(Error::StsParseError,
-                 format("'%s': OpenCV's YAML reader did not finish within %d s; the text is not a single "
-                        "YAML document of the shape this module reads (a line that ends the root "
-                        "collection early, followed by a '-'?)",
-                        path.c_str(), boundSeconds));
+                 format("'%s': OpenCV's YAML reader spun for %.3g s of CPU time without finishing; the text "
+                        "is not a single YAML document of the shape this module reads (a line that ends the "
+                        "root collection early, followed by a '-'?)",
+                        path.c_str(), cpuBound));
 }
 
 std::string readTextFile(const String& path)

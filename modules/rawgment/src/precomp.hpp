@@ -85,8 +85,9 @@ void rejectWrappingIntegers(const String& path, const std::string& text);
  * whose root collection starts a line at column 0 (empty text and XML are refused too): OpenCV 4.6's
  * YAML parser loops forever on some streams with more than one document. */
 void rejectUnsupportedStructure(const String& path, const std::string& text);
-/** Throws StsParseError naming the file (`path`) when OpenCV's parser does not finish on `text` (as
- * FileStorage::MEMORY would be given it) within a bound: the parse runs first in a child process. */
+/** Throws StsParseError naming the file (`path`) when OpenCV's parser spins on `text` (as
+ * FileStorage::MEMORY would be given it) beyond a bound of CPU time: the parse runs first in a child
+ * process. */
 CV_RAWGMENT_EXPORTS void requireParseFinishes(const String& path, const std::string& text);
 
 //! The text that writeFileStorageAtomically() would write to `path`.
