@@ -22,6 +22,7 @@ packages=(
   pybind11-dev      # its C++ bindings
   python3-pybind11  # pybind11's CMake package as the Python side sees it
   python3-numpy     # arrays in and out
+  python3-opencv    # cv2: the Python example of the docs reads a mosaic as cv2 gives it (run by the tests)
   python3-pytest    # the Python tests
   python3-torch     # rawgment.torch: transform and dataset (CPU build)
   python3-dask      # rawgment.batch on a cluster
