@@ -63,6 +63,139 @@ std::string markdownTable(const std::vector<rawgment_apps::TradeoffRow>& rows)
 
 } // namespace
 
+namespace {
+
+// A gnuplot string in double quotes, so that the "\\n" of wrapped() breaks the line.
+std::string quoted(const std::string& text)
+{
+    std::string out = "\"";
+    for (char c : text)
+        out += c == '"' ? std::string("\\\"") : std::string(1, c);
+    return out + "\"";
+}
+
+// A data-block cell: the blocks are comma-separated.
+std::string cellText(std::string text)
+{
+    std::replace(text.begin(), text.end(), ',', ';');
+    return text;
+}
+
+// Breaks text into lines of at most `width` characters at spaces (gnuplot's "\n" in a title).
+std::string wrapped(const std::string& text, size_t width)
+{
+    std::string out, line;
+    std::istringstream words(text);
+    for (std::string word; words >> word;) {
+        if (!line.empty() && line.size() + 1 + word.size() > width) {
+            out += (out.empty() ? "" : "\\n") + line;
+            line.clear();
+        }
+        line += (line.empty() ? "" : " ") + word;
+    }
+    return out + (out.empty() ? "" : "\\n") + line;
+}
+
+// The setting a knob is measured against: the paper's or the library's default, else the model without
+// the component, else the first.
+size_t referenceOf(const std::vector<const rawgment_apps::TradeoffRow*>& settings)
+{
+    for (const char* mark : {"(paper)", "(default)", "absent"})
+        for (size_t k = 0; k < settings.size(); ++k)
+            if (settings[k]->setting.find(mark) != std::string::npos)
+                return k;
+    return 0;
+}
+
+/* The trade-off figure. On top, one view of every knob: each setting's error and time relative to its
+ * knob's reference setting (so that knobs with different measures and units share the axes), the
+ * reference at (1, 1): down is more accurate, left is faster. Below, one panel per knob in its own
+ * measure and unit, its settings told apart by the key instead of labels that overlap. */
+std::string tradeoffPlotScript(const std::vector<rawgment_apps::TradeoffRow>& rows)
+{
+    std::vector<std::string> knobs;
+    for (const rawgment_apps::TradeoffRow& r : rows)
+        if (std::find(knobs.begin(), knobs.end(), r.knob) == knobs.end())
+            knobs.push_back(r.knob);
+    const auto settingsOf = [&](const std::string& knob) {
+        std::vector<const rawgment_apps::TradeoffRow*> out;
+        for (const rawgment_apps::TradeoffRow& r : rows)
+            if (r.knob == knob)
+                out.push_back(&r);
+        return out;
+    };
+    // A log axis cannot show 0: an exact match is drawn at 1e-17.
+    const auto shown = [](double error) { return formatNumber(std::max(error, 1e-17)); };
+    const int columns = 4, panelRows = (static_cast<int>(knobs.size()) + columns - 1) / columns;
+    const double overviewHeight = 0.36, panelHeight = (1 - overviewHeight) / panelRows;
+    std::string script = "set multiplot\nset termoption noenhanced\nset logscale xy\nset grid\n";
+
+    // The overview.
+    script += cv::format("set origin 0,%g\nset size 1,%g\n", 1 - overviewHeight, overviewHeight);
+    script += "set title " +
+              quoted("Which knob buys the most accuracy per millisecond?\\nEvery setting against its knob's "
+                     "reference setting at (1, 1): the paper's or the library's default, for a dark-frame "
+                     "component the model without it.\\nDown is more accurate, left is faster. Knobs whose "
+                     "reference is exact (error 0) are in their own panels only.") +
+              " font ',12'\n";
+    script += "set xlabel " + quoted("time per MP / the reference setting's") + "\nset ylabel " +
+              quoted("error / the reference setting's error (each knob's own measure)") + "\n";
+    script += "set key outside right top vertical font ',9' spacing 1.1\nset offsets graph 0.03, graph 0.03, "
+              "graph 0.08, "
+              "graph 0.03\n";
+    script += "set arrow 1 from graph 0, first 1 to graph 1, first 1 nohead dt 2 lc rgb '#888888'\n"
+              "set arrow 2 from first 1, graph 0 to first 1, graph 1 nohead dt 2 lc rgb '#888888'\n";
+    std::string plots;
+    int style = 0;
+    for (size_t k = 0; k < knobs.size(); ++k) {
+        const std::vector<const rawgment_apps::TradeoffRow*> settings = settingsOf(knobs[k]);
+        const rawgment_apps::TradeoffRow& reference = *settings[referenceOf(settings)];
+        if (!(reference.error > 0) || !(reference.msPerMp > 0))
+            continue;
+        const std::string block = "$overview" + std::to_string(k);
+        script += block + " << EOD\n";
+        for (const rawgment_apps::TradeoffRow* r : settings)
+            if (r != &reference)
+                script += cellText(r->setting) + "," + shown(r->error / reference.error) + "," +
+                          formatNumber(r->msPerMp / reference.msPerMp) + "\n";
+        script += "EOD\n";
+        ++style;
+        plots += (plots.empty() ? "plot " : ", ") + block + " using 3:2 with points pt " +
+                 std::to_string(4 + style % 10) + " ps 1.8 lc " + std::to_string(style) + " title " +
+                 quoted(knobs[k]);
+    }
+    script += plots + ", '+' using (1):(1) every ::0::0 with points pt 7 ps 2 lc rgb 'black' title "
+                      "'every reference setting'\n";
+    script += "unset arrow 1\nunset arrow 2\n";
+
+    // One panel per knob, in its own measure.
+    // Room around the points, so that none sits on a panel's edge.
+    script += "set key below font ',8' spacing 0.9\nset xlabel 'ms per MP' font ',9'\n"
+              "set offsets graph 0.15, graph 0.15, graph 0.15, graph 0.15\n";
+    for (size_t k = 0; k < knobs.size(); ++k) {
+        const std::vector<const rawgment_apps::TradeoffRow*> settings = settingsOf(knobs[k]);
+        const int row = static_cast<int>(k) / columns, column = static_cast<int>(k) % columns;
+        script += cv::format("set origin %g,%g\nset size %g,%g\n", column * (1.0 / columns),
+                             (1 - overviewHeight) - (row + 1) * panelHeight, 1.0 / columns, panelHeight);
+        script += "set title " + quoted(wrapped(knobs[k], 44)) + " font ',10'\n";
+        script += "set ylabel " + quoted(wrapped(settings.front()->measure, 34)) + " font ',8'\n";
+        const std::string block = "$knob" + std::to_string(k);
+        script += block + " << EOD\n";
+        for (const rawgment_apps::TradeoffRow* r : settings)
+            script += cellText(r->setting) + "," + shown(r->error) + "," + formatNumber(r->msPerMp) + "\n";
+        script += "EOD\nplot ";
+        for (size_t i = 0; i < settings.size(); ++i)
+            script += std::string(i ? ", " : "") + block + " every ::" + std::to_string(i) +
+                      "::" + std::to_string(i) + " using 3:2 with points pt " +
+                      std::to_string(5 + static_cast<int>(i)) + " ps 1.6 lc " +
+                      std::to_string(static_cast<int>(i) + 1) + " title " + quoted(settings[i]->setting);
+        script += "\n";
+    }
+    return script + "unset multiplot\n";
+}
+
+} // namespace
+
 int main(int argc, char** argv)
 {
     const char* keys =
@@ -176,34 +309,11 @@ int main(int argc, char** argv)
         }
         rawgment_apps::writeTextAtomically(md, text.str());
         table.write(csv);
-        // One gnuplot data block per knob, inside the script: no extra files to write or clean.
-        std::vector<std::string> knobs;
-        for (const rawgment_apps::TradeoffRow& r : rows)
-            if (std::find(knobs.begin(), knobs.end(), r.knob) == knobs.end())
-                knobs.push_back(r.knob);
-        std::string script =
-            "set multiplot layout 3," + std::to_string((knobs.size() + 2) / 3) +
-            " title 'error against time per MP (log-log)'\nset logscale xy\nset grid\n"
-            "set termoption noenhanced\nset key off\nset xlabel 'ms per MP'\nset ylabel 'error'\n"
-            "set offsets graph 0.2, graph 0.2, graph 0.3, graph 0.2\n";
-        for (size_t k = 0; k < knobs.size(); ++k) {
-            const std::string block = "$knob" + std::to_string(k);
-            script += block + " << EOD\n";
-            for (const rawgment_apps::TradeoffRow& r : rows)
-                if (r.knob == knobs[k]) {
-                    // A log axis cannot show 0: an exact match is drawn at 1e-17.
-                    script += cell(r.setting) + "," + formatNumber(std::max(r.error, 1e-17)) + "," +
-                              formatNumber(r.msPerMp) + "\n";
-                }
-            script += "EOD\nset title '" + knobs[k] + "' noenhanced\nplot " + block +
-                      " using 3:2 with points pt 7 ps 1.2, " + block +
-                      " using 3:2:1 with labels noenhanced font ',8' offset char 0,1\n";
-        }
-        script += "unset multiplot\n";
+        const std::string script = tradeoffPlotScript(rows);
         std::cout << text.str();
         if (plots) {
             std::string message;
-            if (rawgment_apps::plotWithGnuplot(png, script, message))
+            if (rawgment_apps::plotWithGnuplot(png, script, message, 1800, 1700))
                 std::cout << "plot: " << png << "\n";
             else
                 std::cout << "note: " << message << "\n";

@@ -1074,6 +1074,13 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
          {"24x24, 3 gains |", "8x8, 3 gains |", "2 gains (6 and 24 dB) |", "+ dark frames |"})
         EXPECT_NE(std::string::npos, md.find(setup, precision)) << setup;
     expectPngDecodes(dir + "/t/tradeoffs.png");
+    // The figure: one view of every knob relative to its reference setting, then a panel per knob whose
+    // y axis names the knob's own measure (the axes once said only "error").
+    const std::string script = readText(dir + "/t/tradeoffs.png.gp");
+    EXPECT_NE(std::string::npos, script.find("Which knob buys the most accuracy per millisecond?"));
+    EXPECT_NE(std::string::npos, script.find("set ylabel \"KL(true || augmented)"));
+    EXPECT_NE(std::string::npos, script.find("set ylabel \"RMS fixed-pattern difference (DN)"));
+    EXPECT_EQ(std::string::npos, script.find("set ylabel 'error'"));
     // error and time of each (knob, setting) from the CSV: finite, and the orderings the knobs promise.
     std::map<std::string, double> error, errorOfKnob;
     std::istringstream csv(readText(dir + "/t/tradeoffs.csv"));

@@ -432,10 +432,13 @@ bool gnuplotAvailable()
     return std::system("gnuplot --version > /dev/null 2>&1") == 0;
 }
 
-bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, std::string& message)
+bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, std::string& message,
+                     int width, int height)
 {
     const std::string scriptPath = pngPath + ".gp";
-    const std::string preamble = "set terminal pngcairo size 1100,750 enhanced font 'DejaVu Sans,11'\n"
+    const std::string preamble = "set terminal pngcairo size " + std::to_string(width) + "," +
+                                 std::to_string(height) +
+                                 " enhanced font 'DejaVu Sans,11'\n"
                                  "set datafile separator ','\n";
     // The saved script writes the PNG itself, so that a user can re-run it as it is; the run writes
     // to standard output, and the PNG reaches its name through the one atomic writer.

@@ -120,8 +120,10 @@ std::string formatNumber(double value);
 
 /** Runs gnuplot on a script (written beside the PNG as `<png>.gp`) that must set its output to the
  * PNG's path. Returns false and explains how to plot by hand when gnuplot is missing or fails; the
- * data files stay either way. The PNG appears atomically (gnuplot writes a temporary, then rename). */
-bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, std::string& message);
+ * data files stay either way. The PNG appears atomically (gnuplot writes a temporary, then rename).
+ * The canvas is `width` x `height` pixels. */
+bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, std::string& message,
+                     int width = 1100, int height = 750);
 
 //! Whether gnuplot can be run.
 bool gnuplotAvailable();
