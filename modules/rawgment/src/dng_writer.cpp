@@ -1,6 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // writeDng(): one little-endian TIFF IFD with an uncompressed 16-bit CFA strip (raw_io topic).
-#include "precomp.hpp"
+#include "raw_io_detail.hpp"
 
 #include <opencv2/rawgment/raw_io.hpp>
 

@@ -190,6 +190,16 @@ void NoiseModel::variance(InputArray _mean, double gain, OutputArray _dst) const
 
 namespace detail {
 
+void checkBaseIso(double baseIso, const char* what, bool zeroIsUnknown)
+{
+    if (zeroIsUnknown && baseIso == 0)
+        return;
+    if (!(baseIso >= NoiseModel::MIN_BASE_ISO && baseIso <= NoiseModel::MAX_BASE_ISO))
+        CV_Error(Error::StsBadArg,
+                 format("%s must lie in [%g, %g]%s (got %g)", what, NoiseModel::MIN_BASE_ISO,
+                        NoiseModel::MAX_BASE_ISO, zeroIsUnknown ? ", or be 0 for unknown" : "", baseIso));
+}
+
 void checkDarkShadingFinite(const NoiseModel& model)
 {
     if (!model.hasDarkShading())

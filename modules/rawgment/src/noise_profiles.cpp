@@ -2,7 +2,7 @@
 // The noise model in the forms other tools read (raw_io topic): the DNG NoiseProfile tag (51041), read
 // from a DNG's IFDs because LibRaw 0.20 parses but does not expose it; darktable's noise-profile JSON;
 // the Android camera tests' form.
-#include "precomp.hpp"
+#include "raw_io_detail.hpp"
 
 #include <opencv2/rawgment/raw_io.hpp>
 

@@ -6,7 +6,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/core/utility.hpp>
-#include <opencv2/rawgment/raw_io.hpp>
+#include <opencv2/rawgment/files.hpp>
 
 #include <cmath>
 #include <string>
@@ -54,18 +54,6 @@ std::vector<double> readRealList(const FileNode& node, const char* field, int n)
  * (.yml/.yaml or .json); other extensions are rejected. */
 template <typename Writer> void writeFileStorageAtomically(const String& path, Writer&& writeBody);
 int fileStorageFormatOf(const String& path);
-//! The NoiseProfile (tag 51041) pairs of a DNG or other TIFF-based file, empty when it has none or is
-//! not TIFF-based; throws StsParseError naming the file when the tag or the IFDs are malformed.
-std::vector<Vec2d> readDngNoiseProfile(const String& path);
-//! White level minus the mean black level of the CFA sites of DNG colour plane 0 (red), 1 or 2.
-double rangeOfColourPlane(const RawFormat& format, int plane);
-//! Throws StsBadArg (prefixed by `what`) unless a NoiseProfile has 1 or 3 pairs, each S > 0, O >= 0.
-void checkDngNoiseProfile(const std::vector<Vec2d>& profile, const char* what);
-//! Whether `tag` is one of the DNG colour tags that DngTag holds.
-bool isColorTag(int tag);
-//! The colour tags of a DNG's IFD0 (sorted by tag), empty when the file has no ColorMatrix1 or is not
-//! TIFF-based; throws StsParseError naming the file when a tag or the IFD is malformed.
-std::vector<DngTag> readDngColorTags(const String& path);
 //! Throws StsBadArg naming `what` unless baseIso lies in [NoiseModel::MIN_BASE_ISO, MAX_BASE_ISO] (or is 0,
 //! for unknown, when zeroIsUnknown).
 CV_RAWGMENT_EXPORTS void checkBaseIso(double baseIso, const char* what, bool zeroIsUnknown);
@@ -86,9 +74,12 @@ void rejectWrappingIntegers(const String& path, const std::string& text);
  * YAML parser loops forever on some streams with more than one document. */
 void rejectUnsupportedStructure(const String& path, const std::string& text);
 /** Throws StsParseError naming the file (`path`) when OpenCV's parser spins on `text` (as
- * FileStorage::MEMORY would be given it) beyond a bound of CPU time: the parse runs first in a child
- * process. */
-CV_RAWGMENT_EXPORTS void requireParseFinishes(const String& path, const std::string& text);
+ * FileStorage::MEMORY would be given it) beyond `cpuBound` seconds of CPU time (0: parseCpuBound() of
+ * the text): the parse runs first in a child process. */
+CV_RAWGMENT_EXPORTS void requireParseFinishes(const String& path, const std::string& text,
+                                              double cpuBound = 0);
+//! The CPU time an honest parse of `bytes` of YAML/JSON never needs (requireParseFinishes()'s default).
+CV_RAWGMENT_EXPORTS double parseCpuBound(size_t bytes);
 
 //! The text that writeFileStorageAtomically() would write to `path`.
 template <typename Writer> std::string fileStorageText(const String& path, Writer&& writeBody)

@@ -8,6 +8,7 @@
 #include <opencv2/rawgment/simulate.hpp>
 
 #include <string>
+#include <vector>
 
 namespace cv {
 namespace rawgment {
@@ -22,6 +23,13 @@ std::string makeTempDir(const std::string& testName);
 
 /** Counts the elements of a float Mat that are NaN or infinite. */
 int countNonFinite(const Mat& m);
+
+//! The bytes of a file (empty when it cannot be read).
+std::vector<char> readBytes(const std::string& path);
+//! Writes bytes to a file, failing the test when it cannot.
+void writeBytes(const std::string& path, const std::vector<char>& bytes);
+//! The names in a folder, sorted, without the ones starting with '.'.
+std::vector<std::string> filesIn(const std::string& dir);
 
 /** The ground-truth sensor of the augmentation and calibration tests: alpha 0.4, sigma_d^2 0.5,
  * sigma_r^2 2 (plus 1/12 of quantisation), 12 bits, black 256. Its sigma_r^2 is small next to

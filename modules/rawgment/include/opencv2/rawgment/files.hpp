@@ -1,0 +1,94 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#ifndef OPENCV_RAWGMENT_FILES_HPP
+#define OPENCV_RAWGMENT_FILES_HPP
+
+#include <opencv2/core.hpp>
+#include <opencv2/rawgment/export.hpp>
+
+#include <string>
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+
+//! @addtogroup rawgment_files
+//! @{
+
+/** @brief Writes bytes to a file so that a reader, a crash or a full disk never leaves a partial file
+ * under `path`: the one writer of the library and its apps.
+ *
+ * The bytes go to a temporary file beside `path` (same directory, so the move is atomic); every write,
+ * the flush and an fsync are checked (a full disk is an error, not a short file); then the temporary
+ * is moved into place and the directory is synced, so the new name survives a power cut. With
+ * `replace` false the move fails when `path` exists, atomically too (a hard link), so an existing file
+ * is never overwritten; with `replace` true it replaces `path`. On any error the temporary is removed
+ * and `path` is left as it was.
+ * @param path destination file
+ * @param data the bytes (may be null when size is 0)
+ * @param size number of bytes
+ * @param replace whether an existing `path` may be replaced
+ * @throws cv::Exception naming the file and the system's reason.
+ */
+CV_RAWGMENT_EXPORTS void writeFileAtomically(const String& path, const void* data, size_t size,
+                                             bool replace = false);
+
+/** @brief Removes the temporary files of writeFileAtomically() calls still in progress in this process.
+ *
+ * Async-signal-safe: meant for a SIGINT or SIGTERM handler of a program that must leave no partial
+ * file behind when it is stopped (the apps install one). The target files are untouched: a write in
+ * progress simply never happened. Temporaries are named `<target>.tmp-<pid>-<n>`; a process killed
+ * with SIGKILL leaves its own, which a later run may remove once that pid is gone.
+ */
+CV_RAWGMENT_EXPORTS void removeTemporaryFilesInProgress();
+
+//! The largest YAML or JSON file openFileStorageForReading() (and so every reader of this module) opens.
+static constexpr long long MAX_TEXT_FILE_BYTES = 64LL << 20;
+
+/** @brief Reads a whole regular file of at most `maxBytes` bytes, the way every reader of this module
+ * reads its text files.
+ *
+ * A FIFO, a device (`/dev/zero`), a socket or a directory is refused before anything is read, without
+ * waiting for a FIFO's writer; a file larger than `maxBytes`, or one that grows beyond it while being
+ * read, is refused without reading more than `maxBytes + 1` bytes.
+ * @param path the file
+ * @param maxBytes the largest size accepted
+ * @param what what the file is, for the messages ("noise model file", "calibration manifest")
+ * @return the file's bytes
+ * @throws cv::Exception StsError naming `what` and `path`: missing, unreadable, not a regular file (and
+ * which kind it is), or larger than `maxBytes`; StsBadArg for an empty path or a negative limit.
+ */
+CV_RAWGMENT_EXPORTS std::string readFileBounded(const String& path, long long maxBytes, const String& what);
+
+/** @brief Opens a YAML or JSON file for reading the way every reader of this module does.
+ *
+ * What it adds to cv::FileStorage, which readers of your own files (manifests, job files) can use too:
+ * the file is at most MAX_TEXT_FILE_BYTES; an integer literal beyond 32 bits is an error naming the line
+ * (OpenCV's reader would wrap 4294967297 to 1); whatever OpenCV's parser throws, including the
+ * std::length_error of some malformed files, becomes a cv::Exception; and every error names the file.
+ *
+ * @param path the file (.yml, .yaml or .json; the content decides how it is parsed)
+ * @param what what the file is, for the messages ("scene", "calibration manifest")
+ * @return an opened storage
+ * @throws cv::Exception StsError for a missing, unreadable or oversized file, or anything but a regular
+ * file (a directory, a FIFO, a device: see readFileBounded());
+ * StsParseError for an empty file, XML, text that is not YAML or JSON, or a YAML stream that is not one
+ * document whose root collection starts a line at column 0 (OpenCV 4.6's parser never returns on some
+ * multi-document streams).
+ */
+CV_RAWGMENT_EXPORTS FileStorage openFileStorageForReading(const String& path, const String& what);
+
+/** @brief Refuses a map with a key outside `valid` or a key that appears twice: a misspelled key
+ * (`contrst_min`) must not fall back to a default, and of a repeated key OpenCV keeps both entries and a
+ * lookup finds one. Every reader of this module checks its maps so; use it for your own files too.
+ * @param map a map of a file opened with openFileStorageForReading() (anything else is not checked)
+ * @param valid the keys the map may have
+ * @throws cv::Exception StsParseError naming the key (and the valid ones).
+ */
+CV_RAWGMENT_EXPORTS void rejectUnknownKeys(const FileNode& map, const std::vector<String>& valid);
+
+//! @}
+
+} // namespace rawgment
+} // namespace cv
+
+#endif // OPENCV_RAWGMENT_FILES_HPP
