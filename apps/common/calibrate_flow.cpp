@@ -419,18 +419,11 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         // sampler's flatness test would only reject the pixels of a dark-shading pattern (with 4 DN of
         // shading it kept a third of them, and the offsets were then extrapolated from the light samples:
         // +2.3%).
-        std::vector<NoiseSample> burstSamples =
+        const std::vector<NoiseSample> burstSamples =
             singleFrame ? sampleSingleFramePatches(first.mosaic, burstFormat, squares, gain)
-            : spec.dark ? sampleBurstPatches(*stats, frameGridSquares(stats->size()), gain)
+            : spec.dark ? sampleDarkBurst(*stats, frameGridSquares(stats->size()), gain)
             : chartless ? sampleStaticScene(*stats, gain)
                         : sampleBurstPatches(*stats, squares, gain);
-        // Dark frames hold no photo-electrons: their variance is the read noise alone. Their temporal means
-        // scatter around 0 by sigma / sqrt(T) (and by any dark shading), and the model's shot term
-        // g alpha max(mu, 0) at those means would bias the read-noise terms low (2% at 16 frames and
-        // 24 dB, measured); so they count at mean 0.
-        if (spec.dark)
-            for (NoiseSample& sample : burstSamples)
-                sample.mean = 0;
         samples.insert(samples.end(), burstSamples.begin(), burstSamples.end());
         lightSample.insert(lightSample.end(), burstSamples.size(), !spec.dark);
         sampleFrame.insert(sampleFrame.end(), burstSamples.size(), stats->size());

@@ -442,7 +442,7 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
                 ++burstIndex;
                 progress.advance();
             }
-            // A burst of dark frames (counted at mean 0, as rawgment_calibrate counts them).
+            // A burst of dark frames (sampleDarkBurst(), as rawgment_calibrate samples them).
             BurstStatistics dark(fmt);
             const Mat black = Mat::zeros(scene.meanAtUnitGain.size(), CV_32FC1);
             for (int t = 0; t < maxFrames; ++t) {
@@ -454,10 +454,9 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
                 dark.add(raw);
                 if (std::find(set.burstLengths.begin(), set.burstLengths.end(), t + 1) !=
                     set.burstLengths.end())
-                    for (NoiseSample x : sampleBurstPatches(dark, cfaAlignedSquares(scene.patches, 24), g)) {
-                        x.mean = 0;
+                    for (const NoiseSample& x :
+                         sampleDarkBurst(dark, cfaAlignedSquares(scene.patches, 24), g))
                         darkSamples[t + 1].push_back(x);
-                    }
             }
             ++burstIndex;
             progress.advance();
@@ -563,45 +562,17 @@ void measureShapiroWilk(const TradeoffSettings& set, std::vector<TradeoffRow>& r
                     {}});
 }
 
-/* The dark-frame statistics of a float burst of a flat scene, black-subtracted: with e the residual from
- * each pixel's temporal mean, R its row means and f = e - R over T frames of H x W, the row-mean
- * variance sum R^2 / ((T - 1) H), the excess kurtosis of f, and the temporal mean (the fixed pattern). */
+// The dark-frame measures of a burst (darkBurstStatistics(), the library's) with its fixed pattern.
 struct DarkBurstStats
 {
     Mat pixelMean;
-    double rowMeanVar = 0, kurtosis = 0;
+    DarkGainStatistics stats;
 };
 
-DarkBurstStats darkBurstStats(const std::vector<Mat>& burst, double black)
+DarkBurstStats darkBurstStats(const std::vector<Mat>& burst, const RawFormat& format)
 {
-    const int T = static_cast<int>(burst.size()), H = burst[0].rows, W = burst[0].cols;
     DarkBurstStats d;
-    d.pixelMean = Mat::zeros(burst[0].size(), CV_64F);
-    std::vector<Mat> x(burst.size());
-    for (size_t t = 0; t < burst.size(); ++t) {
-        burst[t].convertTo(x[t], CV_64F, 1, -black);
-        d.pixelMean += x[t] / T;
-    }
-    double r2 = 0, f2 = 0, f4 = 0;
-    for (const Mat& frame : x) {
-        const Mat e = frame - d.pixelMean;
-        for (int r = 0; r < H; ++r) {
-            const double* p = e.ptr<double>(r);
-            double rowSum = 0;
-            for (int c = 0; c < W; ++c)
-                rowSum += p[c];
-            const double R = rowSum / W;
-            r2 += R * R;
-            for (int c = 0; c < W; ++c) {
-                const double v = (p[c] - R) * (p[c] - R);
-                f2 += v;
-                f4 += v * v;
-            }
-        }
-    }
-    const double n = static_cast<double>(T) * H * W;
-    d.rowMeanVar = r2 / ((T - 1.0) * H);
-    d.kurtosis = (f4 / n) / ((f2 / n) * (f2 / n)) - 3;
+    d.stats = darkBurstStatistics(burst, format, format.gain, d.pixelMean);
     return d;
 }
 
@@ -624,12 +595,11 @@ void measureDarkComponents(const TradeoffSettings& set, const Mat& timingRaw, co
     const SensorSimulator sensor(params, size);
     const NoiseModel full = sensor.effectiveModel();
     const RawFormat fmt = sensor.rawFormat(1);
-    const double black = fmt.blackLevel[0];
     const Mat scene(size, CV_32FC1, Scalar(400));
     std::vector<Mat> bright, target;
     sensor.captureBurst(scene, 1, 1, T, studySeed(set, DRAW_DARK_INPUT), bright);
     sensor.captureBurst(scene, 8, 1.0 / 200, T, studySeed(set, DRAW_DARK_TARGET), target);
-    const DarkBurstStats truth = darkBurstStats(target, black);
+    const DarkBurstStats truth = darkBurstStats(target, fmt);
     NoiseOptions options;
     options.shotSampling = ShotNoiseSampling::POISSON; // the capture's shot noise is a count
     const auto augmented = [&](const NoiseModel& m) {
@@ -638,7 +608,7 @@ void measureDarkComponents(const TradeoffSettings& set, const Mat& timingRaw, co
         for (int t = 0; t < T; ++t)
             colorJitter(bright[t], fmt, m, ColorJitter::exposureChange(1.0 / 200, 8), options,
                         studySeed(set, DRAW_DARK_STEP, uint64(t)), out[t], f);
-        return darkBurstStats(out, black);
+        return darkBurstStats(out, fmt);
     };
     // The time model: the timing frame's, with the component; the dark shading a map of its size.
     NoiseModel timingShading = timingModel;
@@ -673,7 +643,7 @@ void measureDarkComponents(const TradeoffSettings& set, const Mat& timingRaw, co
             const DarkBurstStats a = augmented(m);
             double error = 0;
             if (c == ROWS)
-                error = std::abs(a.rowMeanVar / truth.rowMeanVar - 1);
+                error = std::abs(a.stats.rowMeanVar / truth.stats.rowMeanVar - 1);
             if (c == SHADING) {
                 // RMS difference of the fixed patterns (the scene's level taken out), in DN: with equal
                 // patterns, what remains is the noise of the two 8-frame means (about 5-6 DN here).
@@ -682,7 +652,7 @@ void measureDarkComponents(const TradeoffSettings& set, const Mat& timingRaw, co
                 error = std::sqrt(d.dot(d) / static_cast<double>(d.total()));
             }
             if (c == TAILS)
-                error = std::abs(a.kurtosis - truth.kurtosis);
+                error = std::abs(a.stats.excessKurtosis - truth.stats.excessKurtosis);
             double active = 0;
             Mat out;
             RawFormat f;

@@ -66,6 +66,12 @@ void bindCalibration(py::module_& m)
         },
         py::arg("stats"), py::arg("squares"), py::arg("gain"), doc("sampleBurstPatches"));
     m.def(
+        "sampleDarkBurst",
+        [](const BurstStatistics& stats, const std::vector<cv::Rect>& squares, double gain) {
+            return withoutGil("sampleDarkBurst", [&] { return sampleDarkBurst(stats, squares, gain); });
+        },
+        py::arg("stats"), py::arg("squares"), py::arg("gain"), doc("sampleDarkBurst"));
+    m.def(
         "sampleStaticScene",
         [](const BurstStatistics& stats, double gain, int maxSamples) {
             return withoutGil("sampleStaticScene",
@@ -253,6 +259,18 @@ void bindCalibration(py::module_& m)
         doc("calibrateDarkNoise",
             "Python: `bursts` is a list (one per gain) of lists of uint16 or float32 HxW "
             "arrays."));
+    m.def(
+        "darkBurstStatistics",
+        [](const py::handle& frames, const RawFormat& format, double gain) {
+            const std::vector<cv::Mat> in = matsFromList(frames, "frames", {CV_16U, CV_32F});
+            cv::Mat pixelMean;
+            const DarkGainStatistics stats = withoutGil(
+                "darkBurstStatistics", [&] { return darkBurstStatistics(in, format, gain, pixelMean); });
+            return py::make_tuple(stats, arrayFromMat(pixelMean));
+        },
+        py::arg("frames"), py::arg("format"), py::arg("gain"),
+        doc("darkBurstStatistics", "Python: returns (stats, pixelMean); `frames` is a list of uint16 or "
+                                   "float32 HxW arrays."));
 
     m.def(
         "shapiroWilk",

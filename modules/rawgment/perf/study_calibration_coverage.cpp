@@ -82,7 +82,7 @@ int main(int argc, char** argv)
                     const std::vector<NoiseSample> s = sampleBurstPatches(stats, squares, g);
                     samples.insert(samples.end(), s.begin(), s.end());
                 }
-                // Dark frames (a lens cap), counted at mean 0 as rawgment_calibrate counts them.
+                // Dark frames (a lens cap), sampled as rawgment_calibrate samples them.
                 BurstStatistics dark(sensor.rawFormat(g));
                 for (int t = 0; t < frames; ++t) {
                     Mat raw;
@@ -90,10 +90,8 @@ int main(int argc, char** argv)
                     dark.add(raw);
                 }
                 ++seed;
-                for (NoiseSample x : sampleBurstPatches(dark, squares, g)) {
-                    x.mean = 0;
-                    samples.push_back(x);
-                }
+                const std::vector<NoiseSample> d = sampleDarkBurst(dark, squares, g);
+                samples.insert(samples.end(), d.begin(), d.end());
             }
             for (int m = 0; m < 2; ++m) {
                 CalibrationParams params;

@@ -308,6 +308,25 @@ void DarkCalibrationReport::write(FileStorage& fs, const String& name) const
     fs << "}";
 }
 
+DarkGainStatistics darkBurstStatistics(const std::vector<Mat>& frames, const RawFormat& format, double gain,
+                                       OutputArray pixelMean)
+{
+    format.validate();
+    detail::checkFinitePositive(gain, "darkBurstStatistics: gain");
+    if (frames.empty())
+        CV_Error(Error::StsBadArg, "darkBurstStatistics: no frames");
+    const int type = frames[0].type();
+    if (type != CV_16UC1 && type != CV_32FC1)
+        CV_Error(Error::StsBadArg,
+                 cv::format("darkBurstStatistics: frames must be CV_16UC1 or CV_32FC1 (got %s)",
+                            typeToString(type).c_str()));
+    GainData d =
+        analyseGain(frames, gain, format, DarkCalibrationParams().ppccSamples, frames[0].size(), type);
+    if (pixelMean.needed())
+        pixelMean.assign(d.mean);
+    return d.stats;
+}
+
 DarkCalibrationReport calibrateDarkNoise(const std::vector<std::vector<Mat>>& bursts,
                                          const std::vector<double>& gains, const RawFormat& format,
                                          const NoiseModel& base, const DarkCalibrationParams& params)

@@ -62,6 +62,15 @@ NoiseSample temporalSample(const BurstStatistics& stats, const Mat& mean, const 
 
 } // namespace
 
+std::vector<NoiseSample> sampleDarkBurst(const BurstStatistics& stats, const std::vector<Rect>& squares,
+                                         double gain)
+{
+    std::vector<NoiseSample> samples = sampleBurstPatches(stats, squares, gain);
+    for (NoiseSample& sample : samples)
+        sample.mean = 0;
+    return samples;
+}
+
 std::vector<NoiseSample> sampleBurstPatches(const BurstStatistics& stats, const std::vector<Rect>& squares,
                                             double gain)
 {

@@ -63,10 +63,8 @@ std::vector<NoiseSample> protocolSamples(const ProtocolOptions& o)
                 dark.add(raw);
             }
             ++seed;
-            for (NoiseSample x : sampleBurstPatches(dark, squares, g)) {
-                x.mean = 0;
-                all.push_back(x);
-            }
+            const std::vector<NoiseSample> d = sampleDarkBurst(dark, squares, g);
+            all.insert(all.end(), d.begin(), d.end());
         }
     }
     return all;
@@ -731,6 +729,43 @@ TEST(Calibration, darkFrameLambdaAccuracyPerNumberOfFrames)
                       << "\n";
         }
     }
+}
+
+TEST(Calibration, darkBurstsHaveOneHomeForTheirSamplesAndStatistics)
+{
+    // sampleDarkBurst(): sampleBurstPatches() at mean 0, nothing else changed.
+    const Size size(48, 32);
+    const SensorSimulator sensor(test::darkComponentSensorParams(size, -0.05, 3), size);
+    const double gain = 4;
+    std::vector<Mat> burst;
+    sensor.captureBurst(Mat::zeros(size, CV_32FC1), gain, 1.0, 8, 5, burst);
+    BurstStatistics stats(sensor.rawFormat(gain));
+    for (const Mat& f : burst)
+        stats.add(f);
+    const std::vector<Rect> region = {Rect(8, 8, 32, 16)};
+    const std::vector<NoiseSample> plain = sampleBurstPatches(stats, region, gain),
+                                   dark = sampleDarkBurst(stats, region, gain);
+    ASSERT_EQ(plain.size(), dark.size());
+    for (size_t k = 0; k < dark.size(); ++k) {
+        EXPECT_EQ(0.0, dark[k].mean);
+        EXPECT_EQ(plain[k].variance, dark[k].variance);
+        EXPECT_EQ(plain[k].pixel, dark[k].pixel);
+    }
+    // darkBurstStatistics(): the numbers calibrateDarkNoise() reports for that gain, bit for bit.
+    Mat pixelMean;
+    const DarkGainStatistics one = darkBurstStatistics(burst, sensor.rawFormat(gain), gain, pixelMean);
+    DarkCalibrationParams shapeOnly;
+    shapeOnly.rowNoise = shapeOnly.darkShading = false;
+    const DarkCalibrationReport report =
+        calibrateDarkNoise({burst}, {gain}, sensor.rawFormat(gain), sensor.effectiveModel(), shapeOnly);
+    ASSERT_EQ(1u, report.gains.size());
+    EXPECT_EQ(report.gains[0].rowMeanVar, one.rowMeanVar);
+    EXPECT_EQ(report.gains[0].pixelVariance, one.pixelVariance);
+    EXPECT_EQ(report.gains[0].excessKurtosis, one.excessKurtosis);
+    EXPECT_EQ(size, pixelMean.size());
+    EXPECT_EQ(CV_64FC1, pixelMean.type());
+    EXPECT_CV_ERROR_CONTAINS(darkBurstStatistics({burst[0], burst[1]}, sensor.rawFormat(gain), gain),
+                             "at least 3 are needed");
 }
 
 TEST(Calibration, darkFrameCalibrationRejectsWhatItCannotFit)

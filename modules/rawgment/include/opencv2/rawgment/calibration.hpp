@@ -95,6 +95,21 @@ CV_RAWGMENT_EXPORTS std::vector<Rect> cfaAlignedSquares(const std::vector<Rect>&
 CV_RAWGMENT_EXPORTS std::vector<NoiseSample>
 sampleBurstPatches(const BurstStatistics& stats, const std::vector<Rect>& squares, double gain);
 
+/** @brief The temporal noise samples of a burst of dark frames (a lens cap), each counted at mean 0.
+ *
+ * Dark frames hold no photo-electrons: their variance is the read noise alone. Their temporal means
+ * scatter around 0 by sigma / sqrt(T) (and by any dark shading), and the model's shot term
+ * \f$ g\alpha\max(\mu, 0) \f$ at those means would bias the read-noise terms low (2% at 16 frames and
+ * 24 dB, measured); so every sample's mean is 0. The one home of that rule: rawgment_calibrate, the
+ * trade-off report and the coverage study all take dark samples from here.
+ * @param stats statistics of a dark burst with at least 2 frames
+ * @param squares pixel rectangles inside the frame (for a dark frame, which has no scene, any region:
+ *        the apps take the whole frame less an 8-pixel border)
+ * @param gain linear gain of the burst (stored in the samples)
+ */
+CV_RAWGMENT_EXPORTS std::vector<NoiseSample> sampleDarkBurst(const BurstStatistics& stats,
+                                                             const std::vector<Rect>& squares, double gain);
+
 /** @brief The temporal noise samples of a burst of any static scene, without a chart: unclipped pixels
  * away from edges, on a regular grid of whole 2x2 blocks.
  *
@@ -361,6 +376,23 @@ struct CV_RAWGMENT_EXPORTS DarkGainStatistics
     ShapiroWilkResult before;  //!< Shapiro-Wilk of 5000 residuals with the row offsets still in
     ShapiroWilkResult after;   //!< ... and of the same residuals without them
 };
+
+/** @brief The statistics of one burst of a flat scene (dark frames, or any burst whose scene is
+ * constant over its frames), as calibrateDarkNoise() computes them per gain: with e the residual of
+ * each black-subtracted value from its pixel's temporal mean, R its row's mean and f = e - R over T
+ * frames of H x W, the row-mean variance sum R^2 / ((T - 1) H), the per-pixel variance without the rows,
+ * the excess kurtosis of f, and Shapiro-Wilk of the residuals with and without the rows. The one home of
+ * these measures: the trade-off report uses it too.
+ * @param frames 3 or more frames of one size, CV_16UC1 or CV_32FC1
+ * @param format black levels of the frames (per CFA site)
+ * @param gain linear gain of the burst (stored)
+ * @param pixelMean optional output: the black-subtracted temporal mean of each pixel, CV_64FC1 (the
+ *        fixed pattern plus the scene)
+ * @throws cv::Exception for fewer than 3 frames, frames of other sizes or types, NaN or Inf, or frames
+ *         that do not vary at all. */
+CV_RAWGMENT_EXPORTS DarkGainStatistics darkBurstStatistics(const std::vector<Mat>& frames,
+                                                           const RawFormat& format, double gain,
+                                                           OutputArray pixelMean = noArray());
 
 /** @brief Everything calibrateDarkNoise() found. */
 struct CV_RAWGMENT_EXPORTS DarkCalibrationReport
