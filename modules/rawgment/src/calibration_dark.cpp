@@ -257,6 +257,125 @@ double ppccAt(const std::vector<double>& sorted, const std::vector<double>& logM
     return vq > 0 && vy > 0 ? cov / std::sqrt(vq * vy) : 0;
 }
 
+/* The residuals the read noise's shape is judged from, scaled to unit variance and sorted, and what
+ * their excess kurtosis is made of: residualKurtosis = kurtosisScale x (the read noise's own) +
+ * kurtosisOffset. A residual is (1 - 1/T) of its frame's noise less 1/T of each of the T - 1 others:
+ * its excess kurtosis is c(T) = ((1 - 1/T)^4 + (T - 1) / T^4) / (1 - 1/T)^2 of the noise's. Rounding (for
+ * 16-bit frames) adds a uniform part, share q = (1/12) / variance, of excess kurtosis -1.2. Gains whose
+ * pixel noise is 2 DN or more take part (quantisation flattens the tails below); without any, the
+ * highest gain alone. */
+struct PooledResiduals
+{
+    std::vector<double> sorted;
+    double kurtosisScale = 0, kurtosisOffset = 0;
+};
+
+PooledResiduals poolResiduals(const std::vector<GainData>& data, int type, std::vector<std::string>& notes)
+{
+    const double minPixelVariance = 4;
+    const bool anyAboveQuantisation = std::any_of(data.begin(), data.end(), [&](const GainData& d) {
+        return d.stats.pixelVariance >= minPixelVariance;
+    });
+    PooledResiduals pooled;
+    for (size_t k = 0; k < data.size(); ++k) {
+        const GainData& d = data[k];
+        if (anyAboveQuantisation ? d.stats.pixelVariance < minPixelVariance : k + 1 != data.size())
+            continue;
+        const double sd = std::sqrt(std::max(d.stats.pixelVariance, 1e-300));
+        for (double v : d.ppccSample)
+            pooled.sorted.push_back(v / sd);
+        const double frames = d.stats.frames, keep = 1 - 1 / frames;
+        const double meanRemoval = (std::pow(keep, 4) + (frames - 1) / std::pow(frames, 4)) / (keep * keep);
+        const double roundingShare =
+            type == CV_16UC1 ? std::min(1.0 / 12 / std::max(d.stats.pixelVariance, 1e-300), 1.0) : 0;
+        const double weight = static_cast<double>(d.ppccSample.size());
+        pooled.kurtosisScale += weight * meanRemoval * (1 - roundingShare) * (1 - roundingShare);
+        pooled.kurtosisOffset += weight * meanRemoval * -1.2 * roundingShare * roundingShare;
+    }
+    pooled.kurtosisScale /= static_cast<double>(pooled.sorted.size());
+    pooled.kurtosisOffset /= static_cast<double>(pooled.sorted.size());
+    if (!anyAboveQuantisation)
+        notes.push_back("no gain has a pixel noise of 2 DN or more: lambda comes from the highest gain, "
+                        "where quantisation may still flatten the tails");
+    std::sort(pooled.sorted.begin(), pooled.sorted.end());
+    return pooled;
+}
+
+/* Filliben's medians of the uniform order statistics of n values, as the logs ppccAt() takes, and the
+ * probability-plot correlation of the sorted sample against a normal distribution. */
+struct ProbabilityPlot
+{
+    std::vector<double> logMedian, log1mMedian;
+    double ppccGaussian = 0;
+};
+
+ProbabilityPlot probabilityPlot(const std::vector<double>& sorted)
+{
+    const size_t n = sorted.size();
+    ProbabilityPlot plot;
+    plot.logMedian.resize(n);
+    plot.log1mMedian.resize(n);
+    double sz = 0, szz = 0, sy = 0, syy = 0, syz = 0;
+    const double last = std::pow(0.5, 1.0 / n);
+    for (size_t i = 0; i < n; ++i) {
+        const double median = i == 0 ? 1 - last : i + 1 == n ? last : (i + 1 - 0.3175) / (n + 0.365);
+        plot.logMedian[i] = std::log(median);
+        plot.log1mMedian[i] = std::log1p(-median);
+        const double z =
+            median <= 0.5 ? detail::lowerNormalQuantile(median) : -detail::lowerNormalQuantile(1 - median);
+        sz += z;
+        szz += z * z;
+        sy += sorted[i];
+        syy += sorted[i] * sorted[i];
+        syz += sorted[i] * z;
+    }
+    plot.ppccGaussian =
+        (syz - sy * sz / n) / std::sqrt(std::max((szz - sz * sz / n) * (syy - sy * sy / n), 1e-300));
+    return plot;
+}
+
+/* The lambda of the largest probability-plot correlation in [lambdaMin, lambdaMax]: a grid of step 0.01
+ * (kept in `grid` as (lambda, r) for the report's plot), then a golden-section search within one step of
+ * the grid's best. */
+double maximumPpccLambda(const std::vector<double>& sorted, const ProbabilityPlot& plot, double lambdaMin,
+                         double lambdaMax, std::vector<Vec2d>& grid)
+{
+    const auto ppcc = [&](double lambda) { return ppccAt(sorted, plot.logMedian, plot.log1mMedian, lambda); };
+    const double gridStep = 0.01;
+    double best = lambdaMin, bestR = -2;
+    const int steps = static_cast<int>(std::round((lambdaMax - lambdaMin) / gridStep));
+    for (int i = 0; i <= steps; ++i) {
+        const double lambda = lambdaMin + (lambdaMax - lambdaMin) * i / steps;
+        const double r = ppcc(lambda);
+        grid.push_back(Vec2d(lambda, r));
+        if (r > bestR) {
+            bestR = r;
+            best = lambda;
+        }
+    }
+    double lo = std::max(lambdaMin, best - gridStep), hi = std::min(lambdaMax, best + gridStep);
+    const double goldenRatio = (std::sqrt(5.0) - 1) / 2;
+    double left = hi - goldenRatio * (hi - lo), right = lo + goldenRatio * (hi - lo);
+    double rLeft = ppcc(left), rRight = ppcc(right);
+    // 40 steps shrink the bracket by 0.618^40, 4e-9 of a grid step.
+    for (int iteration = 0; iteration < 40; ++iteration) {
+        if (rLeft > rRight) {
+            hi = right;
+            right = left;
+            rRight = rLeft;
+            left = hi - goldenRatio * (hi - lo);
+            rLeft = ppcc(left);
+        } else {
+            lo = left;
+            left = right;
+            rLeft = rRight;
+            right = lo + goldenRatio * (hi - lo);
+            rRight = ppcc(right);
+        }
+    }
+    return 0.5 * (lo + hi);
+}
+
 } // namespace
 
 void DarkCalibrationParams::validate() const
@@ -396,94 +515,18 @@ DarkCalibrationReport calibrateDarkNoise(const std::vector<std::vector<Mat>>& bu
     if (params.darkShading)
         fitDarkShading(data, report.model.darkShadingPerGain, report.model.darkShadingOffset);
     if (params.tukeyShape) {
-        std::vector<double> pooled;
-        // The kurtosis the pooled residuals show, as A kappa + B of the read noise's own (see below).
-        double shrinkA = 0, shrinkB = 0;
-        bool any = false;
-        for (const GainData& d : data)
-            if (d.stats.pixelVariance >= 4)
-                any = true;
-        for (size_t k = 0; k < data.size(); ++k) {
-            const GainData& d = data[k];
-            if (any ? d.stats.pixelVariance < 4 : k + 1 != data.size())
-                continue;
-            const double sd = std::sqrt(std::max(d.stats.pixelVariance, 1e-300));
-            for (double v : d.ppccSample)
-                pooled.push_back(v / sd);
-            // A residual is (1 - 1/T) of its frame's noise less 1/T of each of the T - 1 others: its excess
-            // kurtosis is c(T) = ((1 - 1/T)^4 + (T - 1) / T^4) / (1 - 1/T)^2 of the noise's. Rounding (for
-            // 16-bit frames) adds a uniform part, share q = (1/12) / variance, of excess kurtosis -1.2.
-            const double T = d.stats.frames, keep = 1 - 1 / T;
-            const double c = (std::pow(keep, 4) + (T - 1) / std::pow(T, 4)) / (keep * keep);
-            const double q =
-                type == CV_16UC1 ? std::min(1.0 / 12 / std::max(d.stats.pixelVariance, 1e-300), 1.0) : 0;
-            const double share = static_cast<double>(d.ppccSample.size());
-            shrinkA += share * c * (1 - q) * (1 - q);
-            shrinkB += share * c * -1.2 * q * q;
-        }
-        shrinkA /= static_cast<double>(pooled.size());
-        shrinkB /= static_cast<double>(pooled.size());
-        if (!any)
-            report.notes.push_back(
-                "no gain has a pixel noise of 2 DN or more: lambda comes from the highest gain, "
-                "where quantisation may still flatten the tails");
-        std::sort(pooled.begin(), pooled.end());
-        const size_t n = pooled.size();
-        std::vector<double> logM(n), log1mM(n);
-        double sz = 0, szz = 0, sy = 0, syy = 0, syz = 0;
-        for (size_t i = 0; i < n; ++i) {
-            // Filliben's medians of the uniform order statistics.
-            const double last = std::pow(0.5, 1.0 / n);
-            const double m = i == 0 ? 1 - last : i + 1 == n ? last : (i + 1 - 0.3175) / (n + 0.365);
-            logM[i] = std::log(m);
-            log1mM[i] = std::log1p(-m);
-            const double z = m <= 0.5 ? detail::lowerNormalQuantile(m) : -detail::lowerNormalQuantile(1 - m);
-            sz += z;
-            szz += z * z;
-            sy += pooled[i];
-            syy += pooled[i] * pooled[i];
-            syz += pooled[i] * z;
-        }
-        report.ppccGaussian =
-            (syz - sy * sz / n) / std::sqrt(std::max((szz - sz * sz / n) * (syy - sy * sy / n), 1e-300));
-        double best = params.lambdaMin, bestR = -2;
-        const int steps = static_cast<int>(std::round((params.lambdaMax - params.lambdaMin) / 0.01));
-        for (int i = 0; i <= steps; ++i) {
-            const double l = params.lambdaMin + (params.lambdaMax - params.lambdaMin) * i / steps;
-            const double r = ppccAt(pooled, logM, log1mM, l);
-            report.ppcc.push_back(Vec2d(l, r));
-            if (r > bestR) {
-                bestR = r;
-                best = l;
-            }
-        }
-        // Golden-section search within a grid step of the best grid point.
-        double lo = std::max(params.lambdaMin, best - 0.01), hi = std::min(params.lambdaMax, best + 0.01);
-        const double phi = (std::sqrt(5.0) - 1) / 2;
-        double a = hi - phi * (hi - lo), b = lo + phi * (hi - lo);
-        double ra = ppccAt(pooled, logM, log1mM, a), rb = ppccAt(pooled, logM, log1mM, b);
-        for (int it = 0; it < 40; ++it) {
-            if (ra > rb) {
-                hi = b;
-                b = a;
-                rb = ra;
-                a = hi - phi * (hi - lo);
-                ra = ppccAt(pooled, logM, log1mM, a);
-            } else {
-                lo = a;
-                a = b;
-                ra = rb;
-                b = lo + phi * (hi - lo);
-                rb = ppccAt(pooled, logM, log1mM, b);
-            }
-        }
-        const double shown = 0.5 * (lo + hi);
-        report.ppccBest = ppccAt(pooled, logM, log1mM, shown);
+        const PooledResiduals pooled = poolResiduals(data, type, report.notes);
+        const ProbabilityPlot plot = probabilityPlot(pooled.sorted);
+        report.ppccGaussian = plot.ppccGaussian;
+        const double shown =
+            maximumPpccLambda(pooled.sorted, plot, params.lambdaMin, params.lambdaMax, report.ppcc);
+        report.ppccBest = ppccAt(pooled.sorted, plot.logMedian, plot.log1mMedian, shown);
         report.lambdaOfResiduals = shown;
         // The shape the residuals show, carried back to the read noise's own through its kurtosis.
         const double lambda =
             std::min(std::max(detail::tukeyLambdaOfExcessKurtosis(
-                                  (detail::tukeyLambdaExcessKurtosis(shown) - shrinkB) / shrinkA),
+                                  (detail::tukeyLambdaExcessKurtosis(shown) - pooled.kurtosisOffset) /
+                                  pooled.kurtosisScale),
                               params.lambdaMin),
                      params.lambdaMax);
         report.model.tukeyRead = true;
