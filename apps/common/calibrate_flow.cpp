@@ -246,6 +246,113 @@ std::vector<cv::Rect> frameGridSquares(cv::Size size)
     return {cv::Rect(border, border, (size.width - 2 * border) & ~1, (size.height - 2 * border) & ~1)};
 }
 
+/* darktable's noise-profile file and Android's form of the model, at the ISOs of the bursts (a file's ISO
+ * as it says it; a gain_db burst's from its gain, as dB are not exact). */
+void writeProfileExports(const std::string& outDir, const std::vector<CalibrationManifest::Burst>& specs,
+                         const std::vector<double>& gainsDb, const std::vector<double>& isos,
+                         const RawFormat& firstFormat, CalibrateResult& result)
+{
+    const CalibrationReport& report = result.report;
+    std::vector<double> profileIsos;
+    for (size_t i = 0; i < specs.size(); ++i) {
+        // The file's ISO as it says it; a gain_db burst's from the gain (dB are not exact).
+        const double iso = specs[i].hasGainDb ? result.baseIso * dbToLinearGain(gainsDb[i]) : isos[i];
+        if (std::none_of(profileIsos.begin(), profileIsos.end(),
+                         [&](double v) { return std::abs(v - iso) < 1e-9 * iso; }))
+            profileIsos.push_back(iso);
+    }
+    const std::string maker = result.camera.make.empty() ? "unknown" : result.camera.make,
+                      model = result.camera.model.empty() ? "unknown" : result.camera.model;
+    writeNewText(
+        outDir + "/darktable_noiseprofiles.json",
+        darktableNoiseProfiles(report.model, firstFormat, result.baseIso, profileIsos, maker, model));
+    const AndroidNoiseProfile android = androidNoiseProfile(report.model, firstFormat, result.baseIso);
+    writeNewText(outDir + "/android_noise_profile.yml", yamlToString([&](cv::FileStorage& fs) {
+                     fs << "android_noise_profile"
+                        << "{"
+                        << "comment"
+                        << "S = A s + B, O = C s^2 + D per CFA site (2x2 block row by row), s = ISO"
+                        << "base_iso" << result.baseIso;
+                     fs << "A" << std::vector<double>(android.A.val, android.A.val + 4);
+                     fs << "B" << std::vector<double>(android.B.val, android.B.val + 4);
+                     fs << "C" << std::vector<double>(android.C.val, android.C.val + 4);
+                     fs << "D" << std::vector<double>(android.D.val, android.D.val + 4) << "}";
+                 }));
+    result.notes.push_back("darktable_noiseprofiles.json and android_noise_profile.yml carry the model "
+                           "to darktable and Android's camera tests");
+}
+
+/* samples.csv, lines.csv, shapiro.csv and the histogram of variance / model variance per gain (a sample
+ * variance of T frames has mean 1 and relative spread sqrt(2 / (T - 1)) around a right model). Returns
+ * the number of gains in the histogram. */
+size_t writeSampleTables(const std::vector<NoiseSample>& samples, const CalibrationReport& report,
+                         const CsvTable& shapiro, const std::string& samplesCsv, const std::string& linesCsv,
+                         const std::string& shapiroCsv, const std::string& histCsv)
+{
+    CsvTable samplesTable({"mean", "variance", "gain_db", "channel", "dof"});
+    for (const NoiseSample& s : samples)
+        samplesTable.addRow(std::vector<double>{s.mean, s.variance, linearGainToDb(s.gain), double(s.channel),
+                                                double(s.dof)});
+    samplesTable.write(samplesCsv);
+    CsvTable lines({"gain_db", "gain", "a", "b", "r_squared", "inliers", "samples", "model_a", "model_b"});
+    for (const NoiseLineFit& l : report.perGain) {
+        const NoiseLine m = report.model.lineAtGain(l.gain);
+        lines.addRow(std::vector<double>{linearGainToDb(l.gain), l.gain, l.line.a, l.line.b, l.rSquared,
+                                         double(l.inliers), double(l.samples), m.a, m.b});
+    }
+    lines.write(linesCsv);
+    shapiro.write(shapiroCsv);
+
+    const int bins = 60;
+    const double hiRatio = 3.0;
+    std::map<double, std::vector<double>> counts;
+    for (const NoiseSample& s : samples) {
+        const double predicted = fittedVariance(report, s.mean, s.gain);
+        if (!(predicted > 0))
+            continue;
+        const int b = static_cast<int>(s.variance / predicted / hiRatio * bins);
+        std::vector<double>& c = counts[linearGainToDb(s.gain)];
+        c.resize(bins, 0.0);
+        if (b >= 0 && b < bins)
+            c[size_t(b)] += 1;
+    }
+    std::vector<std::string> histHeader = {"ratio"};
+    for (const auto& kv : counts)
+        histHeader.push_back(cv::format("%.1f dB", kv.first));
+    CsvTable hist(histHeader);
+    for (int b = 0; b < bins; ++b) {
+        std::vector<double> row = {(b + 0.5) * hiRatio / bins};
+        for (const auto& kv : counts)
+            row.push_back(kv.second[size_t(b)]);
+        hist.addRow(row);
+    }
+    hist.write(histCsv);
+
+    return counts.size();
+}
+
+// dark_calibration.yml, dark_rows.csv, dark_ppcc.csv and their plots.
+void writeDarkOutputs(const CalibrateOptions& o, CalibrateResult& result)
+{
+    const CalibrationReport& report = result.report;
+    writeNewText(o.outDir + "/dark_calibration.yml",
+                 yamlToString([&](cv::FileStorage& fs) { result.dark.write(fs, "dark_calibration"); }));
+    CsvTable rows({"gain_db", "gain", "row_variance", "row_variance_se", "model_row_variance",
+                   "pixel_variance", "excess_kurtosis", "sw_p_with_rows", "sw_p_without_rows"});
+    for (const DarkGainStatistics& g : result.dark.gains)
+        rows.addRow(std::vector<double>{linearGainToDb(g.gain), g.gain, g.rowVariance, g.rowVarianceSE,
+                                        report.model.rowVariance(g.gain), g.pixelVariance, g.excessKurtosis,
+                                        g.before.pValue, g.after.pValue});
+    rows.write(o.outDir + "/dark_rows.csv");
+    CsvTable ppcc({"lambda", "ppcc"});
+    for (const cv::Vec2d& p : result.dark.ppcc)
+        ppcc.addRow(std::vector<double>{p[0], p[1]});
+    ppcc.write(o.outDir + "/dark_ppcc.csv");
+    if (o.plots)
+        plotDarkComponents(o.outDir, result.dark, o.outDir + "/dark_rows.csv", o.outDir + "/dark_ppcc.csv",
+                           result.pngs, result.notes);
+}
+
 } // namespace
 
 CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
@@ -568,101 +675,17 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                              std::vector<cv::String>(shadingImages.begin(), shadingImages.end()));
                      }));
         // With gains from ISO the model carries over to the tools that index noise by ISO.
-        if (result.baseIso > 0 && report.model.alpha > 0) {
-            std::vector<double> profileIsos;
-            for (size_t i = 0; i < specs.size(); ++i) {
-                // The file's ISO as it says it; a gain_db burst's from the gain (dB are not exact).
-                const double iso = specs[i].hasGainDb ? result.baseIso * dbToLinearGain(gainsDb[i]) : isos[i];
-                if (std::none_of(profileIsos.begin(), profileIsos.end(),
-                                 [&](double v) { return std::abs(v - iso) < 1e-9 * iso; }))
-                    profileIsos.push_back(iso);
-            }
-            const std::string maker = result.camera.make.empty() ? "unknown" : result.camera.make,
-                              model = result.camera.model.empty() ? "unknown" : result.camera.model;
-            writeNewText(
-                o.outDir + "/darktable_noiseprofiles.json",
-                darktableNoiseProfiles(report.model, firstFormat, result.baseIso, profileIsos, maker, model));
-            const AndroidNoiseProfile android =
-                androidNoiseProfile(report.model, firstFormat, result.baseIso);
-            writeNewText(o.outDir + "/android_noise_profile.yml", yamlToString([&](cv::FileStorage& fs) {
-                             fs << "android_noise_profile"
-                                << "{"
-                                << "comment"
-                                << "S = A s + B, O = C s^2 + D per CFA site (2x2 block row by row), s = ISO"
-                                << "base_iso" << result.baseIso;
-                             fs << "A" << std::vector<double>(android.A.val, android.A.val + 4);
-                             fs << "B" << std::vector<double>(android.B.val, android.B.val + 4);
-                             fs << "C" << std::vector<double>(android.C.val, android.C.val + 4);
-                             fs << "D" << std::vector<double>(android.D.val, android.D.val + 4) << "}";
-                         }));
-            result.notes.push_back(
-                "darktable_noiseprofiles.json and android_noise_profile.yml carry the model "
-                "to darktable and Android's camera tests");
-        }
+        if (result.baseIso > 0 && report.model.alpha > 0)
+            writeProfileExports(o.outDir, specs, gainsDb, isos, firstFormat, result);
     } else
         result.notes.push_back(
             "sigma_d^2 and sigma_r^2 are not separable with these gains: no noise_model.yml "
             "written (see the report's notes)");
 
-    CsvTable samplesTable({"mean", "variance", "gain_db", "channel", "dof"});
-    for (const NoiseSample& s : samples)
-        samplesTable.addRow(std::vector<double>{s.mean, s.variance, linearGainToDb(s.gain), double(s.channel),
-                                                double(s.dof)});
-    samplesTable.write(samplesCsv);
-    CsvTable lines({"gain_db", "gain", "a", "b", "r_squared", "inliers", "samples", "model_a", "model_b"});
-    for (const NoiseLineFit& l : report.perGain) {
-        const NoiseLine m = report.model.lineAtGain(l.gain);
-        lines.addRow(std::vector<double>{linearGainToDb(l.gain), l.gain, l.line.a, l.line.b, l.rSquared,
-                                         double(l.inliers), double(l.samples), m.a, m.b});
-    }
-    lines.write(linesCsv);
-    shapiro.write(shapiroCsv);
-
-    // Histogram of variance / model variance per gain: a sample variance of T frames has mean 1 and
-    // relative spread sqrt(2 / (T - 1)) around the model when the model is right.
-    const int bins = 60;
-    const double hiRatio = 3.0;
-    std::map<double, std::vector<double>> counts;
-    for (const NoiseSample& s : samples) {
-        const double predicted = fittedVariance(report, s.mean, s.gain);
-        if (!(predicted > 0))
-            continue;
-        const int b = static_cast<int>(s.variance / predicted / hiRatio * bins);
-        std::vector<double>& c = counts[linearGainToDb(s.gain)];
-        c.resize(bins, 0.0);
-        if (b >= 0 && b < bins)
-            c[size_t(b)] += 1;
-    }
-    std::vector<std::string> histHeader = {"ratio"};
-    for (const auto& kv : counts)
-        histHeader.push_back(cv::format("%.1f dB", kv.first));
-    CsvTable hist(histHeader);
-    for (int b = 0; b < bins; ++b) {
-        std::vector<double> row = {(b + 0.5) * hiRatio / bins};
-        for (const auto& kv : counts)
-            row.push_back(kv.second[size_t(b)]);
-        hist.addRow(row);
-    }
-    hist.write(histCsv);
-
-    if (result.haveDark) {
-        writeNewText(o.outDir + "/dark_calibration.yml",
-                     yamlToString([&](cv::FileStorage& fs) { result.dark.write(fs, "dark_calibration"); }));
-        CsvTable rows({"gain_db", "gain", "row_variance", "row_variance_se", "model_row_variance",
-                       "pixel_variance", "excess_kurtosis", "sw_p_with_rows", "sw_p_without_rows"});
-        for (const DarkGainStatistics& g : result.dark.gains)
-            rows.addRow(std::vector<double>{linearGainToDb(g.gain), g.gain, g.rowVariance, g.rowVarianceSE,
-                                            report.model.rowVariance(g.gain), g.pixelVariance,
-                                            g.excessKurtosis, g.before.pValue, g.after.pValue});
-        rows.write(o.outDir + "/dark_rows.csv");
-        CsvTable ppcc({"lambda", "ppcc"});
-        for (const cv::Vec2d& p : result.dark.ppcc)
-            ppcc.addRow(std::vector<double>{p[0], p[1]});
-        ppcc.write(o.outDir + "/dark_ppcc.csv");
-        if (o.plots)
-            plotDarkComponents(o.outDir, result.dark, o.outDir + "/dark_rows.csv",
-                               o.outDir + "/dark_ppcc.csv", result.pngs, result.notes);
-    }
+    const size_t histogramGains =
+        writeSampleTables(samples, report, shapiro, samplesCsv, linesCsv, shapiroCsv, histCsv);
+    if (result.haveDark)
+        writeDarkOutputs(o, result);
     if (o.plots) {
         std::vector<double> distinctGainsDb;
         for (double g : gainsDb)
@@ -670,7 +693,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                              [&](double d) { return std::abs(g - d) < 1e-9; }))
                 distinctGainsDb.push_back(g);
         CalibrationPlotFiles files{samplesCsv, linesCsv, histCsv, shapiroCsv};
-        plotCalibration(o.outDir, report, files, counts.size(), distinctGainsDb, result.shapiroTested > 0,
+        plotCalibration(o.outDir, report, files, histogramGains, distinctGainsDb, result.shapiroTested > 0,
                         result.pngs, result.notes);
     }
     writeNewText(o.outDir + "/report.md", calibrationReportMarkdown(result, o.outDir));
