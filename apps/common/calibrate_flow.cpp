@@ -353,6 +353,66 @@ void writeDarkOutputs(const CalibrateOptions& o, CalibrateResult& result)
                            result.pngs, result.notes);
 }
 
+/* The gain of each burst: the manifest's gain_db, or the ISO of its first frame relative to the base ISO
+ * (the manifest's, or the lowest that a burst without gain_db has); with it the files' ISOs, the first
+ * frame's size and camera (into `result`), the base ISO and a note per burst. */
+struct BurstGains
+{
+    std::vector<double> isos, gainsDb;
+    cv::Size frameSize;
+};
+
+BurstGains burstGains(const CalibrationManifest& manifest, CalibrateResult& result)
+{
+    const std::vector<CalibrationManifest::Burst>& specs = manifest.bursts;
+    BurstGains gains;
+    std::vector<double>& isos = gains.isos;
+    isos.assign(specs.size(), 0.0);
+    for (size_t i = 0; i < specs.size(); ++i) {
+        const LoadedMosaic first = loadMosaicFile(specs[i].files.front());
+        if (i == 0) {
+            gains.frameSize = first.mosaic.size();
+            result.camera = first.camera;
+        }
+        isos[i] = first.camera.iso;
+    }
+    // Files that say no ISO and a manifest that gives no gain: one gain, whose value is unknown. The
+    // calibration then finds the noise line of that capture, and says what it cannot determine.
+    const bool noGainAnywhere =
+        std::none_of(specs.begin(), specs.end(),
+                     [](const CalibrationManifest::Burst& b) { return b.hasGainDb; }) &&
+        std::none_of(isos.begin(), isos.end(), [](double iso) { return iso > 0; });
+    for (size_t i = 0; i < specs.size() && !noGainAnywhere; ++i)
+        if (!specs[i].hasGainDb && !(isos[i] > 0))
+            throw std::runtime_error("'" + specs[i].files.front() +
+                                     "' does not say its ISO: give this burst a gain_db in a manifest");
+    if (noGainAnywhere)
+        result.notes.push_back(
+            "the files do not say their ISO and the manifest gives no gain_db: every burst is "
+            "taken at gain 1 (0 dB), so alpha is the slope at this unknown gain, and neither "
+            "the gain nor the split of the read noise into sigma_d^2 and sigma_r^2 can be "
+            "determined");
+    result.baseIso = manifest.hasBaseIso ? manifest.baseIso : 0.0;
+    for (size_t i = 0; i < specs.size(); ++i)
+        if (!manifest.hasBaseIso && !specs[i].hasGainDb && (result.baseIso == 0 || isos[i] < result.baseIso))
+            result.baseIso = isos[i];
+    std::vector<double>& gainsDb = gains.gainsDb;
+    gainsDb.assign(specs.size(), 0.0);
+    for (size_t i = 0; i < specs.size() && !noGainAnywhere; ++i) {
+        gainsDb[i] = specs[i].hasGainDb ? specs[i].gainDb : linearGainToDb(isos[i] / result.baseIso);
+        result.notes.push_back(
+            specs[i].hasGainDb
+                ? cv::format("burst %zu (%s%s): gain %.2f dB from the manifest", i + 1,
+                             specs[i].files.front().c_str(), specs[i].dark ? ", dark" : "", gainsDb[i])
+                : cv::format("burst %zu (%s%s): gain %.2f dB from ISO %g relative to base ISO %g%s", i + 1,
+                             specs[i].files.front().c_str(), specs[i].dark ? ", dark" : "", gainsDb[i],
+                             isos[i], result.baseIso,
+                             manifest.hasBaseIso ? " (manifest)" : " (the lowest in the files)"));
+    }
+
+    return gains;
+}
+
 } // namespace
 
 CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
@@ -382,50 +442,9 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     for (const CalibrationManifest::Burst& spec : specs)
         totalFrames += spec.files.size();
 
-    // The gain of each burst: the manifest's gain_db, or the ISO of its first frame relative to the base
-    // ISO (the manifest's, or the lowest that a burst without gain_db has).
-    std::vector<double> isos(specs.size(), 0.0);
-    cv::Size frameSize;
-    for (size_t i = 0; i < specs.size(); ++i) {
-        const LoadedMosaic first = loadMosaicFile(specs[i].files.front());
-        if (i == 0) {
-            frameSize = first.mosaic.size();
-            result.camera = first.camera;
-        }
-        isos[i] = first.camera.iso;
-    }
-    // Files that say no ISO and a manifest that gives no gain: one gain, whose value is unknown. The
-    // calibration then finds the noise line of that capture, and says what it cannot determine.
-    const bool noGainAnywhere =
-        std::none_of(specs.begin(), specs.end(),
-                     [](const CalibrationManifest::Burst& b) { return b.hasGainDb; }) &&
-        std::none_of(isos.begin(), isos.end(), [](double iso) { return iso > 0; });
-    for (size_t i = 0; i < specs.size() && !noGainAnywhere; ++i)
-        if (!specs[i].hasGainDb && !(isos[i] > 0))
-            throw std::runtime_error("'" + specs[i].files.front() +
-                                     "' does not say its ISO: give this burst a gain_db in a manifest");
-    if (noGainAnywhere)
-        result.notes.push_back(
-            "the files do not say their ISO and the manifest gives no gain_db: every burst is "
-            "taken at gain 1 (0 dB), so alpha is the slope at this unknown gain, and neither "
-            "the gain nor the split of the read noise into sigma_d^2 and sigma_r^2 can be "
-            "determined");
-    result.baseIso = manifest.hasBaseIso ? manifest.baseIso : 0.0;
-    for (size_t i = 0; i < specs.size(); ++i)
-        if (!manifest.hasBaseIso && !specs[i].hasGainDb && (result.baseIso == 0 || isos[i] < result.baseIso))
-            result.baseIso = isos[i];
-    std::vector<double> gainsDb(specs.size());
-    for (size_t i = 0; i < specs.size() && !noGainAnywhere; ++i) {
-        gainsDb[i] = specs[i].hasGainDb ? specs[i].gainDb : linearGainToDb(isos[i] / result.baseIso);
-        result.notes.push_back(
-            specs[i].hasGainDb
-                ? cv::format("burst %zu (%s%s): gain %.2f dB from the manifest", i + 1,
-                             specs[i].files.front().c_str(), specs[i].dark ? ", dark" : "", gainsDb[i])
-                : cv::format("burst %zu (%s%s): gain %.2f dB from ISO %g relative to base ISO %g%s", i + 1,
-                             specs[i].files.front().c_str(), specs[i].dark ? ", dark" : "", gainsDb[i],
-                             isos[i], result.baseIso,
-                             manifest.hasBaseIso ? " (manifest)" : " (the lowest in the files)"));
-    }
+    const BurstGains gains = burstGains(manifest, result);
+    const std::vector<double>&isos = gains.isos, &gainsDb = gains.gainsDb;
+    const cv::Size frameSize = gains.frameSize;
 
     const bool chartless = manifest.patches == "none";
     const std::vector<cv::Rect> squares =
