@@ -486,47 +486,26 @@ void addDarkComponents(std::vector<std::vector<cv::Mat>>& darkFrames, const std:
     result.haveDark = true;
 }
 
-} // namespace
-
-CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
+/* What the bursts give the calibration, read frame by frame: the noise samples (and per sample whether
+ * its burst had light and the size of its frame), the Shapiro-Wilk rows, the facts the verdict judges,
+ * the first burst's format, and the dark bursts' frames for the dark-frame components. */
+struct BurstInputs
 {
-    const CalibrationManifest manifest = readCalibrationManifest(o.manifest);
-    prepareOutputDirectory(o.outDir);
-    const std::string modelPath = o.outDir + "/noise_model.yml",
-                      reportPath = o.outDir + "/calibration_report.yml",
-                      samplesCsv = o.outDir + "/samples.csv", linesCsv = o.outDir + "/lines.csv",
-                      shapiroCsv = o.outDir + "/shapiro.csv",
-                      histCsv = o.outDir + "/variance_ratio_histogram.csv";
-    // A finished calibration is never redone into its folder. A run that died before its end is
-    // completed: the calibration is deterministic, outputs already there must be what this run writes
-    // (writeNewText refuses anything else) and the missing ones are added.
-    std::vector<std::string> finished = {reportPath, samplesCsv, linesCsv,
-                                         shapiroCsv, histCsv,    o.outDir + "/report.md"};
-    if (o.plots)
-        for (const char* png : {"calib_mean_variance.png", "calib_histograms.png", "calib_cross_gain.png",
-                                "shapiro_pvalue.png"})
-            finished.push_back(o.outDir + "/" + png);
-    if (std::all_of(finished.begin(), finished.end(), [](const std::string& p) { return pathExists(p); }))
-        refuseExisting(finished);
+    std::vector<NoiseSample> samples;
+    std::vector<bool> lightSample; // per sample: from a burst with light (its mean holds the dark shading)
+    std::vector<cv::Size> sampleFrame; // per sample: the size of the frame whose pixel it numbers
+    CsvTable shapiro{{"gain_db", "mean", "p_value", "W"}};
+    std::vector<BurstFacts> facts;
+    RawFormat firstFormat;
+    // The dark bursts' frames, kept for the dark-frame components (their statistics need every frame).
+    std::vector<std::vector<cv::Mat>> darkFrames;
+    std::vector<double> darkGains;
+};
 
-    CalibrateResult result;
-    const std::vector<CalibrationManifest::Burst>& specs = manifest.bursts;
-    size_t totalFrames = 0;
-    for (const CalibrationManifest::Burst& spec : specs)
-        totalFrames += spec.files.size();
-
-    const BurstGains gains = burstGains(manifest, result);
-    const std::vector<double>&isos = gains.isos, &gainsDb = gains.gainsDb;
-    const cv::Size frameSize = gains.frameSize;
-
-    const bool chartless = manifest.patches == "none";
-    const std::vector<cv::Rect> squares =
-        chartless ? std::vector<cv::Rect>()
-                  : manifestSquares(manifest.patches, specs.front().files.front(), o.side, result.notes);
-    if (chartless)
-        result.notes.push_back(
-            "no chart: every unclipped pixel away from edges is a sample (sampleStaticScene)");
-
+BurstInputs readBursts(const CalibrateOptions& o, const std::vector<CalibrationManifest::Burst>& specs,
+                       const std::vector<double>& gainsDb, const std::vector<cv::Rect>& squares,
+                       bool chartless, cv::Size frameSize, size_t totalFrames, CalibrateResult& result)
+{
     // Shapiro-Wilk positions: every k-th pixel of the squares (of each burst's own frame without a
     // chart), at most shapiroPixels of them. Bursts may differ in size (dark frames of a crop, say): each
     // is read only inside its own frame.
@@ -543,17 +522,9 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         return tested;
     };
 
-    std::vector<NoiseSample> samples;
-    CsvTable shapiro({"gain_db", "mean", "p_value", "W"});
+    BurstInputs in;
     int gaussian = 0;
     ProgressBar progress("calibrate", totalFrames);
-    RawFormat firstFormat;
-    std::vector<BurstFacts> facts;
-    // The dark bursts' frames, kept for the dark-frame components (their statistics need every frame).
-    std::vector<std::vector<cv::Mat>> darkFrames;
-    std::vector<double> darkGains;
-    std::vector<bool> lightSample; // per sample: from a burst with light (its mean holds the dark shading)
-    std::vector<cv::Size> sampleFrame; // per sample: the size of the frame whose pixel it numbers
     for (size_t i = 0; i < specs.size(); ++i) {
         const CalibrationManifest::Burst& spec = specs[i];
         const double gain = dbToLinearGain(gainsDb[i]);
@@ -568,7 +539,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                 f.gain = gain;
                 stats.reset(new BurstStatistics(f));
                 if (i == 0)
-                    firstFormat = m.format;
+                    in.firstFormat = m.format;
                 first = m;
             } else {
                 requireSameCapture(first, spec.files.front(), m, spec.files[t]);
@@ -576,10 +547,10 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             stats->add(m.mosaic);
             if (spec.dark && o.darkComponents) {
                 if (t == 0) {
-                    darkFrames.emplace_back();
-                    darkGains.push_back(gain);
+                    in.darkFrames.emplace_back();
+                    in.darkGains.push_back(gain);
                 }
-                darkFrames.back().push_back(m.mosaic);
+                in.darkFrames.back().push_back(m.mosaic);
             }
             if (t == 0) {
                 for (const cv::Rect& s : squares)
@@ -623,9 +594,9 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             : spec.dark ? sampleDarkBurst(*stats, frameGridSquares(stats->size()), gain)
             : chartless ? sampleStaticScene(*stats, gain)
                         : sampleBurstPatches(*stats, squares, gain);
-        samples.insert(samples.end(), burstSamples.begin(), burstSamples.end());
-        lightSample.insert(lightSample.end(), burstSamples.size(), !spec.dark);
-        sampleFrame.insert(sampleFrame.end(), burstSamples.size(), stats->size());
+        in.samples.insert(in.samples.end(), burstSamples.begin(), burstSamples.end());
+        in.lightSample.insert(in.lightSample.end(), burstSamples.size(), !spec.dark);
+        in.sampleFrame.insert(in.sampleFrame.end(), burstSamples.size(), stats->size());
         // Shapiro-Wilk needs 3 values per pixel.
         std::vector<ShapiroWilkResult> sw;
         if (series.rows >= 3)
@@ -642,11 +613,11 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             }
             burstFacts.clippedFraction = area > 0 ? clippedArea / area : 0.0;
         }
-        facts.push_back(burstFacts);
+        in.facts.push_back(burstFacts);
         for (size_t k = 0; k < sw.size(); ++k) {
             if (clipped.at<uchar>(tested[k]) || sw[k].constant)
                 continue;
-            shapiro.addRow(
+            in.shapiro.addRow(
                 std::vector<double>{gainsDb[i], mean.at<double>(tested[k]), sw[k].pValue, sw[k].W});
             ++result.shapiroTested;
             gaussian += sw[k].pValue > 0.05;
@@ -654,6 +625,53 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     }
     progress.finish();
     result.gaussianFraction = result.shapiroTested ? double(gaussian) / result.shapiroTested : 0.0;
+    return in;
+}
+
+} // namespace
+
+CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
+{
+    const CalibrationManifest manifest = readCalibrationManifest(o.manifest);
+    prepareOutputDirectory(o.outDir);
+    const std::string modelPath = o.outDir + "/noise_model.yml",
+                      reportPath = o.outDir + "/calibration_report.yml",
+                      samplesCsv = o.outDir + "/samples.csv", linesCsv = o.outDir + "/lines.csv",
+                      shapiroCsv = o.outDir + "/shapiro.csv",
+                      histCsv = o.outDir + "/variance_ratio_histogram.csv";
+    // A finished calibration is never redone into its folder. A run that died before its end is
+    // completed: the calibration is deterministic, outputs already there must be what this run writes
+    // (writeNewText refuses anything else) and the missing ones are added.
+    std::vector<std::string> finished = {reportPath, samplesCsv, linesCsv,
+                                         shapiroCsv, histCsv,    o.outDir + "/report.md"};
+    if (o.plots)
+        for (const char* png : {"calib_mean_variance.png", "calib_histograms.png", "calib_cross_gain.png",
+                                "shapiro_pvalue.png"})
+            finished.push_back(o.outDir + "/" + png);
+    if (std::all_of(finished.begin(), finished.end(), [](const std::string& p) { return pathExists(p); }))
+        refuseExisting(finished);
+
+    CalibrateResult result;
+    const std::vector<CalibrationManifest::Burst>& specs = manifest.bursts;
+    size_t totalFrames = 0;
+    for (const CalibrationManifest::Burst& spec : specs)
+        totalFrames += spec.files.size();
+
+    const BurstGains gains = burstGains(manifest, result);
+    const std::vector<double>&isos = gains.isos, &gainsDb = gains.gainsDb;
+    const cv::Size frameSize = gains.frameSize;
+
+    const bool chartless = manifest.patches == "none";
+    const std::vector<cv::Rect> squares =
+        chartless ? std::vector<cv::Rect>()
+                  : manifestSquares(manifest.patches, specs.front().files.front(), o.side, result.notes);
+    if (chartless)
+        result.notes.push_back(
+            "no chart: every unclipped pixel away from edges is a sample (sampleStaticScene)");
+
+    BurstInputs in = readBursts(o, specs, gainsDb, squares, chartless, frameSize, totalFrames, result);
+    std::vector<NoiseSample>& samples = in.samples;
+    const RawFormat& firstFormat = in.firstFormat;
 
     CalibrationParams params;
     params.method = o.method;
@@ -662,8 +680,8 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     // The ISO of gain 1 travels with the model, so a camera file's ISO gives its gain when augmenting.
     result.report.model.baseIso = result.baseIso;
     if (o.darkComponents)
-        addDarkComponents(darkFrames, darkGains, firstFormat, params, samples, lightSample, sampleFrame,
-                          result);
+        addDarkComponents(in.darkFrames, in.darkGains, firstFormat, params, samples, in.lightSample,
+                          in.sampleFrame, result);
     const CalibrationReport& report = result.report;
     {
         const double highest = report.perGain.back().gain;
@@ -679,12 +697,12 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         plan("2x the frames per burst", 2, 1, false, 0);
         plan("4x the frames per burst", 4, 1, false, 0);
         plan("2x the pixels (patches)", 1, 2, false, 0);
-        if (std::none_of(facts.begin(), facts.end(), [](const BurstFacts& b) { return b.dark; }))
+        if (std::none_of(in.facts.begin(), in.facts.end(), [](const BurstFacts& b) { return b.dark; }))
             plan("dark frames at each gain", 1, 1, true, 0);
         plan(cv::format("one more gain, %.1f dB", linearGainToDb(2 * highest)), 1, 1, false, 2 * highest);
     }
     result.verdict =
-        judgeCalibration(samples, report, facts,
+        judgeCalibration(samples, report, in.facts,
                          firstFormat.whiteLevel - (firstFormat.blackLevel[0] + firstFormat.blackLevel[1] +
                                                    firstFormat.blackLevel[2] + firstFormat.blackLevel[3]) /
                                                       4);
@@ -713,7 +731,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
             "written (see the report's notes)");
 
     const size_t histogramGains =
-        writeSampleTables(samples, report, shapiro, samplesCsv, linesCsv, shapiroCsv, histCsv);
+        writeSampleTables(samples, report, in.shapiro, samplesCsv, linesCsv, shapiroCsv, histCsv);
     if (result.haveDark)
         writeDarkOutputs(o, result);
     if (o.plots) {
