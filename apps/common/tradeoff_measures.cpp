@@ -373,6 +373,18 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
     const NoiseModel truth = sensor.effectiveModel();
     const int maxFrames = set.burstLengths.back();
     const double frameMp = megapixels(scene.meanAtUnitGain.size());
+    // A burst at light `level` puts a perfect white reflector at that fraction of the DN range above
+    // black (4095 - 256 = 3839 DN): exposure = level x range / (gain x the chart's illumination).
+    const RawFormat unitFormat = sensor.rawFormat(1);
+    const double rangeDn = unitFormat.whiteLevel - unitFormat.blackLevel[0];
+    const auto exposureFor = [&](double level, double gain) {
+        return level * rangeDn / (gain * chart.illumination);
+    };
+    // Every burst of a campaign has a seed of its own: campaign c's bursts are numbered from 100 c (9 of
+    // them: 3 gains x (2 light levels + 1 dark)).
+    const auto burstSeed = [&](int campaign, uint64 burstIndex) {
+        return studySeed(set, DRAW_CAMPAIGN_BURST, 100 * static_cast<uint64>(campaign) + burstIndex);
+    };
     struct Setting
     {
         std::string knob, name;
@@ -422,10 +434,8 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
                 BurstStatistics stats(fmt);
                 for (int t = 0; t < maxFrames; ++t) {
                     Mat raw;
-                    sensor.capture(
-                        scene.meanAtUnitGain, g, level * 3839 / (g * 1000),
-                        studySeed(set, DRAW_CAMPAIGN_BURST, 100 * static_cast<uint64>(campaign) + burstIndex),
-                        t, raw);
+                    sensor.capture(scene.meanAtUnitGain, g, exposureFor(level, g),
+                                   burstSeed(campaign, burstIndex), t, raw);
                     statsMsPerFrame += fastestMs(1, [&] { stats.add(raw); });
                     if (std::find(set.burstLengths.begin(), set.burstLengths.end(), t + 1) ==
                         set.burstLengths.end())
@@ -447,10 +457,7 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
             const Mat black = Mat::zeros(scene.meanAtUnitGain.size(), CV_32FC1);
             for (int t = 0; t < maxFrames; ++t) {
                 Mat raw;
-                sensor.capture(
-                    black, g, 1.0,
-                    studySeed(set, DRAW_CAMPAIGN_BURST, 100 * static_cast<uint64>(campaign) + burstIndex), t,
-                    raw);
+                sensor.capture(black, g, 1.0, burstSeed(campaign, burstIndex), t, raw);
                 dark.add(raw);
                 if (std::find(set.burstLengths.begin(), set.burstLengths.end(), t + 1) !=
                     set.burstLengths.end())
