@@ -55,9 +55,17 @@ std::string jobDescription(const SimulateOptions& o)
     });
 }
 
-} // namespace
+//! One burst to write: its folder under the output, gain, exposure and seed.
+struct PlannedBurst
+{
+    std::string dir;
+    double gainDb, exposure, level;
+    int frames;
+    uint64_t seed;
+    bool dark = false;
+};
 
-SimulateResult simulateBursts(const SimulateOptions& o)
+void checkSimulateOptions(const SimulateOptions& o)
 {
     if (o.outDir.empty())
         throw std::runtime_error("no output directory");
@@ -67,44 +75,30 @@ SimulateResult simulateBursts(const SimulateOptions& o)
     for (double level : o.levels)
         if (!(level > 0 && level <= 1))
             throw std::runtime_error(cv::format("level %g is outside (0, 1]", level));
-    prepareOutputDirectory(o.outDir);
-    SimulateResult result;
-    result.manifest = o.outDir + "/manifest.yml";
-    result.truthModel = o.outDir + "/truth_noise_model.yml";
-    const std::string patchesPath = o.outDir + "/patches.yml";
-    refuseExisting({result.manifest, result.truthModel, patchesPath});
+}
 
-    ColorCheckerOptions co;
-    co.pattern = o.sensor.pattern;
-    co.patchSize = o.patchSize;
-    const ColorCheckerScene scene = makeColorCheckerScene(co);
-    SensorParams params = o.sensor;
-    if (o.darkShading > 0)
-        addDarkShadingPattern(scene.meanAtUnitGain.size(), o.darkShading, o.seed, params.noise);
-    const SensorSimulator sensor(params, scene.meanAtUnitGain.size());
-    double sceneMax = 0;
-    cv::minMaxLoc(scene.meanAtUnitGain, nullptr, &sceneMax);
-    const RawFormat unit = sensor.rawFormat(1.0);
-    const double range = unit.whiteLevel - *std::max_element(unit.blackLevel.val, unit.blackLevel.val + 4);
-
+//! The ground-truth squares and grid corners of the chart, as rawgment_calibrate reads them.
+rawgment_helpers::ChartPatches chartPatchesOf(const ColorCheckerScene& scene, int patchSize)
+{
     rawgment_helpers::ChartPatches patches;
-    const int side = std::max(2, std::min(24, (o.patchSize - 8) & ~1));
+    const int side = std::max(2, std::min(24, (patchSize - 8) & ~1));
     patches.squares = cfaAlignedSquares(scene.patches, side);
     const cv::Rect& first = scene.patches.front();
     const cv::Rect& last = scene.patches.back();
     patches.gridCorners = {
         cv::Point2f(float(first.x), float(first.y)), cv::Point2f(float(last.br().x), float(first.y)),
         cv::Point2f(float(last.br().x), float(last.br().y)), cv::Point2f(float(first.x), float(last.br().y))};
+    return patches;
+}
 
-    struct Burst
-    {
-        std::string dir;
-        double gainDb, exposure, level;
-        int frames;
-        uint64_t seed;
-        bool dark = false;
-    };
-    std::vector<Burst> bursts;
+/** The calibration bursts (every gain and level, then the dark ones), followed by the validation bursts
+ * when asked; `calibrationBursts` is the count of the former.
+ * @param range white level minus the highest black level
+ * @param sceneMax the chart's largest mean at unit gain and exposure */
+std::vector<PlannedBurst> planBursts(const SimulateOptions& o, double range, double sceneMax,
+                                     size_t& calibrationBursts)
+{
+    std::vector<PlannedBurst> bursts;
     for (double gDb : o.gainsDb)
         for (double level : o.levels) {
             const double g = dbToLinearGain(gDb);
@@ -126,7 +120,7 @@ SimulateResult simulateBursts(const SimulateOptions& o)
                                "give gains and levels that differ by at least 0.01",
                                bursts[j].gainDb, bursts[i].gainDb, bursts[j].level, bursts[i].level,
                                bursts[i].dir.c_str()));
-    const size_t calibrationBursts = bursts.size();
+    calibrationBursts = bursts.size();
     if (o.validation) {
         const double g = dbToLinearGain(o.validationGainDb);
         const double bright = 0.9 * range / (g * sceneMax);
@@ -140,7 +134,12 @@ SimulateResult simulateBursts(const SimulateOptions& o)
         bursts.push_back(
             {"validation/x0.10", o.validationGainDb, 0.1 * bright, 0.09, o.validationFrames, seeds[2]});
     }
-    // The job before any frame: a folder holds the frames of one job, and a rerun continues only that job.
+    return bursts;
+}
+
+//! The job before any frame: a folder holds the frames of one job, and a rerun continues only that job.
+void claimJob(const SimulateOptions& o)
+{
     const std::string jobPath = o.outDir + "/simulation_job.yml", job = jobDescription(o);
     if (pathExists(jobPath)) {
         const std::string existing =
@@ -152,14 +151,22 @@ SimulateResult simulateBursts(const SimulateOptions& o)
     } else {
         writeTextAtomically(jobPath, job);
     }
-    const cv::Mat darkScene = cv::Mat::zeros(scene.meanAtUnitGain.size(), scene.meanAtUnitGain.type());
+}
+
+/** Writes every burst's frames that are not there yet and returns each burst's file names relative to
+ * the output folder. */
+std::vector<std::vector<std::string>> writeFrames(const SimulateOptions& o, const SensorSimulator& sensor,
+                                                  const cv::Mat& meanAtUnitGain,
+                                                  const std::vector<PlannedBurst>& bursts, int& written)
+{
+    const cv::Mat darkScene = cv::Mat::zeros(meanAtUnitGain.size(), meanAtUnitGain.type());
     size_t totalFrames = 0;
-    for (const Burst& b : bursts)
+    for (const PlannedBurst& b : bursts)
         totalFrames += size_t(b.frames);
     ProgressBar progress("simulate", totalFrames);
     std::vector<std::vector<std::string>> files(bursts.size());
     for (size_t i = 0; i < bursts.size(); ++i) {
-        const Burst& b = bursts[i];
+        const PlannedBurst& b = bursts[i];
         makeDirectories(o.outDir + "/" + b.dir);
         const double g = dbToLinearGain(b.gainDb);
         MosaicMetadata meta;
@@ -185,58 +192,105 @@ SimulateResult simulateBursts(const SimulateOptions& o)
                 if (b.dark)
                     sensor.capture(darkScene, g, 1.0, b.seed, t, raw);
                 else
-                    sensor.capture(scene.meanAtUnitGain, g, b.exposure, b.seed, t, raw);
+                    sensor.capture(meanAtUnitGain, g, b.exposure, b.seed, t, raw);
                 writeMosaic(path, raw, meta);
             }
-            ++result.files;
+            ++written;
             progress.advance();
         }
     }
     progress.finish();
+    return files;
+}
 
-    rawgment_helpers::writeChartPatches(patchesPath, patches);
+std::string validationManifestText(const SimulateOptions& o,
+                                   const std::vector<std::vector<std::string>>& files,
+                                   size_t calibrationBursts)
+{
+    return yamlToString([&](cv::FileStorage& fs) {
+        fs << "validation_manifest"
+           << "{";
+        fs << "patches"
+           << "patches.yml";
+        fs << "gain_db" << o.validationGainDb;
+        fs << "bright" << files[calibrationBursts];
+        fs << "targets"
+           << "[";
+        for (size_t k = 1; k <= 2; ++k) {
+            fs << "{"
+               << "factor" << (k == 1 ? 0.5 : 0.1);
+            fs << "files" << files[calibrationBursts + k] << "}";
+        }
+        fs << "]"
+           << "}";
+    });
+}
+
+std::string calibrationManifestText(const std::vector<PlannedBurst>& bursts,
+                                    const std::vector<std::vector<std::string>>& files,
+                                    size_t calibrationBursts)
+{
+    return yamlToString([&](cv::FileStorage& fs) {
+        fs << "calibration_manifest"
+           << "{";
+        fs << "patches"
+           << "patches.yml";
+        fs << "bursts"
+           << "[";
+        for (size_t i = 0; i < calibrationBursts; ++i) {
+            fs << "{"
+               << "gain_db" << bursts[i].gainDb << "level" << bursts[i].level;
+            if (bursts[i].dark)
+                fs << "dark" << 1;
+            fs << "files" << files[i] << "}";
+        }
+        fs << "]"
+           << "}";
+    });
+}
+
+} // namespace
+
+SimulateResult simulateBursts(const SimulateOptions& o)
+{
+    checkSimulateOptions(o);
+    prepareOutputDirectory(o.outDir);
+    SimulateResult result;
+    result.manifest = o.outDir + "/manifest.yml";
+    result.truthModel = o.outDir + "/truth_noise_model.yml";
+    const std::string patchesPath = o.outDir + "/patches.yml";
+    refuseExisting({result.manifest, result.truthModel, patchesPath});
+
+    ColorCheckerOptions co;
+    co.pattern = o.sensor.pattern;
+    co.patchSize = o.patchSize;
+    const ColorCheckerScene scene = makeColorCheckerScene(co);
+    SensorParams params = o.sensor;
+    if (o.darkShading > 0)
+        addDarkShadingPattern(scene.meanAtUnitGain.size(), o.darkShading, o.seed, params.noise);
+    const SensorSimulator sensor(params, scene.meanAtUnitGain.size());
+    double sceneMax = 0;
+    cv::minMaxLoc(scene.meanAtUnitGain, nullptr, &sceneMax);
+    const RawFormat unit = sensor.rawFormat(1.0);
+    const double range = unit.whiteLevel - *std::max_element(unit.blackLevel.val, unit.blackLevel.val + 4);
+
+    size_t calibrationBursts = 0;
+    const std::vector<PlannedBurst> bursts = planBursts(o, range, sceneMax, calibrationBursts);
+    claimJob(o);
+    const std::vector<std::vector<std::string>> files =
+        writeFrames(o, sensor, scene.meanAtUnitGain, bursts, result.files);
+
+    rawgment_helpers::writeChartPatches(patchesPath, chartPatchesOf(scene, o.patchSize));
     // The frames say ISO kSimulatedBaseIso g, so the truth's gain 1 is that ISO.
     NoiseModel truth = sensor.effectiveModel();
     truth.baseIso = kSimulatedBaseIso;
     truth.save(result.truthModel);
     if (o.validation) {
         result.validationManifest = o.outDir + "/validation_manifest.yml";
-        writeTextAtomically(result.validationManifest, yamlToString([&](cv::FileStorage& fs) {
-                                fs << "validation_manifest"
-                                   << "{";
-                                fs << "patches"
-                                   << "patches.yml";
-                                fs << "gain_db" << o.validationGainDb;
-                                fs << "bright" << files[calibrationBursts];
-                                fs << "targets"
-                                   << "[";
-                                for (size_t k = 1; k <= 2; ++k) {
-                                    fs << "{"
-                                       << "factor" << (k == 1 ? 0.5 : 0.1);
-                                    fs << "files" << files[calibrationBursts + k] << "}";
-                                }
-                                fs << "]"
-                                   << "}";
-                            }));
+        writeTextAtomically(result.validationManifest, validationManifestText(o, files, calibrationBursts));
     }
     // The manifest last: its presence marks a complete simulation.
-    writeTextAtomically(result.manifest, yamlToString([&](cv::FileStorage& fs) {
-                            fs << "calibration_manifest"
-                               << "{";
-                            fs << "patches"
-                               << "patches.yml";
-                            fs << "bursts"
-                               << "[";
-                            for (size_t i = 0; i < calibrationBursts; ++i) {
-                                fs << "{"
-                                   << "gain_db" << bursts[i].gainDb << "level" << bursts[i].level;
-                                if (bursts[i].dark)
-                                    fs << "dark" << 1;
-                                fs << "files" << files[i] << "}";
-                            }
-                            fs << "]"
-                               << "}";
-                        }));
+    writeTextAtomically(result.manifest, calibrationManifestText(bursts, files, calibrationBursts));
     return result;
 }
 
