@@ -1014,6 +1014,55 @@ TEST(Apps, calibrateReadsBurstsOfDifferentFrameSizesEachInsideItsOwnFrame)
     }
 }
 
+TEST(Apps, calibrateRefusesFramesOfTwoCamerasNamingBoth)
+{
+    // Bursts of two make/model tags were calibrated into one model named after the first camera.
+    const std::string dir = freshDir("two_cameras");
+    AppRun r = runApp("rawgment_simulate", "--frames=4 --levels=0.5 --format=png --validation=false "
+                                           "--gains=6,18 --out='" +
+                                               dir + "/sim'");
+    ASSERT_EQ(0, r.status) << r.output;
+    // Frame t of burst 18 dB copied, tagged as another camera's from frame `otherFrom` on.
+    const auto copyBurst = [&](const std::string& name, int otherFrom) {
+        std::string files;
+        for (int t = 0; t < 4; ++t) {
+            cv::Mat mosaic;
+            cv::rawgment::MosaicMetadata meta = cv::rawgment::readMosaic(
+                cv::format("%s/sim/g18dB_level0.50/frame_%03d.png", dir.c_str(), t), mosaic);
+            if (t >= otherFrom)
+                meta.camera.model = "other sensor";
+            const std::string out = cv::format("%s/%s_%03d.png", dir.c_str(), name.c_str(), t);
+            cv::rawgment::writeMosaic(out, mosaic, meta);
+            files += (t ? ", '" : "'") + out + "'";
+        }
+        return files;
+    };
+    const std::string first = "'" + dir + "/sim/g06dB_level0.50/frame_000.png', '" + dir +
+                              "/sim/g06dB_level0.50/frame_001.png', '" + dir +
+                              "/sim/g06dB_level0.50/frame_002.png', '" + dir +
+                              "/sim/g06dB_level0.50/frame_003.png'";
+    const struct
+    {
+        const char* name;
+        int otherFrom;
+        const char* firstNamed;
+    } cases[] = {{"across", 0, "g06dB_level0.50/frame_000.png' from camera 'cv::rawgment simulated sensor'"},
+                 {"within", 2, "within_000.png' from camera 'cv::rawgment simulated sensor'"}};
+    for (const auto& c : cases) {
+        std::ofstream(dir + "/" + c.name + ".yml")
+            << "%YAML:1.0\ncalibration_manifest:\n  patches: none\n  bursts:\n"
+            << "    - { gain_db: 6, files: [" << first << "] }\n"
+            << "    - { gain_db: 18, files: [" << copyBurst(c.name, c.otherFrom) << "] }\n";
+        r = runApp("rawgment_calibrate",
+                   "'" + dir + "/" + c.name + ".yml' --plots=false --out='" + dir + "/cal_" + c.name + "'");
+        EXPECT_EQ(1, r.status) << r.output;
+        EXPECT_NE(std::string::npos, r.output.find("from camera 'cv::rawgment other sensor'")) << r.output;
+        EXPECT_NE(std::string::npos, r.output.find(c.firstNamed)) << r.output;
+        EXPECT_NE(std::string::npos, r.output.find("calibrate each camera on its own")) << r.output;
+        EXPECT_FALSE(std::ifstream(dir + "/cal_" + std::string(c.name) + "/noise_model.yml").good());
+    }
+}
+
 TEST(Apps, readersRefuseDevicesAndFifosNamingThem)
 {
     const std::string dir = freshDir("not_regular");

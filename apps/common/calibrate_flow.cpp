@@ -111,10 +111,31 @@ CalibrationManifest readCalibrationManifest(const std::string& path)
 
 namespace {
 
+//! "make model" of a frame's camera, or "no camera tags".
+std::string cameraName(const LoadedMosaic& m)
+{
+    if (m.camera.make.empty() && m.camera.model.empty())
+        return "no camera tags";
+    return "camera '" + m.camera.make + " " + m.camera.model + "'";
+}
+
+/** A model describes one sensor: frames of two cameras (make or model tags that differ) are refused,
+ * naming both, instead of being calibrated into one model named after the first. */
+void requireSameCamera(const LoadedMosaic& first, const std::string& firstPath, const LoadedMosaic& m,
+                       const std::string& path)
+{
+    if (m.camera.make == first.camera.make && m.camera.model == first.camera.model)
+        return;
+    throw std::runtime_error("'" + path + "' comes from " + cameraName(m) + " and '" + firstPath + "' from " +
+                             cameraName(first) +
+                             ": a noise model describes one sensor, so calibrate each camera on its own");
+}
+
 //! What must be the same in every frame of a burst; the first frame's, compared with each other frame's.
 void requireSameCapture(const LoadedMosaic& first, const std::string& firstPath, const LoadedMosaic& m,
                         const std::string& path)
 {
+    requireSameCamera(first, firstPath, m, path);
     std::string what;
     if (m.mosaic.size() != first.mosaic.size())
         what = cv::format("is %dx%d where '%s' is %dx%d", m.mosaic.cols, m.mosaic.rows, firstPath.c_str(),
@@ -368,12 +389,15 @@ BurstGains burstGains(const CalibrationManifest& manifest, CalibrateResult& resu
     BurstGains gains;
     std::vector<double>& isos = gains.isos;
     isos.assign(specs.size(), 0.0);
+    LoadedMosaic firstOfAll;
     for (size_t i = 0; i < specs.size(); ++i) {
         const LoadedMosaic first = loadMosaicFile(specs[i].files.front());
         if (i == 0) {
             gains.frameSize = first.mosaic.size();
             result.camera = first.camera;
+            firstOfAll = first;
         }
+        requireSameCamera(firstOfAll, specs.front().files.front(), first, specs[i].files.front());
         isos[i] = first.camera.iso;
     }
     // Files that say no ISO and a manifest that gives no gain: one gain, whose value is unknown. The
