@@ -19,6 +19,7 @@ int main(int argc, char** argv)
         "{seed           | 1    | seed: same seed, same outputs, on any number of threads }"
         "{format         |      | output container: dng, png or tif (default: dng for RAW inputs) }"
         "{preview        | false| also write an sRGB preview PNG of each output }"
+        "{accept_failed_calibration | false | also use a model whose calibration's verdict was FAIL }"
         "{@inputs        |      | input files (RAW files, or mosaics with a .yml sidecar) }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_augment"))
         return 2;
@@ -41,6 +42,7 @@ int main(int argc, char** argv)
     o.seed = rawgment_apps::seedOption(parser, "rawgment_augment");
     const std::string format = parser.get<std::string>("format");
     o.previews = parser.get<bool>("preview");
+    o.acceptFailedCalibration = parser.get<bool>("accept_failed_calibration");
     // CommandLineParser keeps one positional value; the rest of the command line are inputs too.
     for (int i = 1; i < argc; ++i)
         if (argv[i][0] != '-')

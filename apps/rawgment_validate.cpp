@@ -15,7 +15,9 @@ int main(int argc, char** argv)
                        "{out o          |      | output directory (required) }"
                        "{bins           | 10   | mean bins of the table }"
                        "{seed           | 7    | noise seed of the conversions }"
-                       "{plots          | true | write a PNG plot with gnuplot }";
+                       "{plots          | true | write a PNG plot with gnuplot }"
+                       "{accept_failed_calibration | false | also use a model whose calibration's verdict "
+                       "was FAIL }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_validate"))
         return 2;
     rawgment_apps::installInterruptCleanup();
@@ -42,6 +44,7 @@ int main(int argc, char** argv)
     o.bins = parser.get<int>("bins");
     o.seed = rawgment_apps::seedOption(parser, "rawgment_validate");
     o.plots = parser.get<bool>("plots");
+    o.acceptFailedCalibration = parser.get<bool>("accept_failed_calibration");
     if (!parser.check() || o.manifest.empty() || o.model.empty() || o.outDir.empty() || o.bins < 1) {
         parser.printErrors();
         std::cerr << "usage: rawgment_validate <manifest.yml> --model=<model.yml> --out=<dir>\n";

@@ -937,8 +937,10 @@ TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
     expectPngDecodes(dir + "/cal/dark_shading.png");
     EXPECT_NE(std::string::npos, readText(dir + "/cal/report.md").find("## Dark-frame components"));
     // The model file and its maps load as a pair, and the truth's components come back (8 frames of
-    // 296 x 200 at two gains: the row variances to about 10%, lambda to 0.02).
-    const cv::rawgment::NoiseModel fitted = cv::rawgment::NoiseModel::load(dir + "/cal/noise_model.yml"),
+    // 296 x 200 at two gains: the row variances to about 10%, lambda to 0.02). 8 frames fail the verdict's
+    // 16, so the model is accepted explicitly.
+    const cv::rawgment::NoiseModel fitted =
+                                       cv::rawgment::NoiseModel::load(dir + "/cal/noise_model.yml", true),
                                    truth = cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
     ASSERT_TRUE(fitted.hasDarkShading());
     EXPECT_EQ(truth.darkShadingPerGain.size(), fitted.darkShadingPerGain.size());
@@ -1004,8 +1006,9 @@ TEST(Apps, calibrateReadsBurstsOfDifferentFrameSizesEachInsideItsOwnFrame)
                                              "/m.yml' --plots=false --dark_components=" + darkComponents +
                                              " --out='" + dir + "/cal_" + darkComponents + "'");
         ASSERT_EQ(0, r.status) << r.output;
+        // 4 frames fail the verdict's 16: the model is accepted explicitly.
         const cv::rawgment::NoiseModel fitted =
-            cv::rawgment::NoiseModel::load(dir + "/cal_" + darkComponents + "/noise_model.yml");
+            cv::rawgment::NoiseModel::load(dir + "/cal_" + darkComponents + "/noise_model.yml", true);
         const cv::rawgment::NoiseModel truth =
             cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
         // 4 frames: alpha within 10% (the trade-off report's worst parameter error at 8 frames is 8.8%;
@@ -1061,6 +1064,49 @@ TEST(Apps, calibrateRefusesFramesOfTwoCamerasNamingBoth)
         EXPECT_NE(std::string::npos, r.output.find("calibrate each camera on its own")) << r.output;
         EXPECT_FALSE(std::ifstream(dir + "/cal_" + std::string(c.name) + "/noise_model.yml").good());
     }
+}
+
+TEST(Apps, aFailedCalibrationLeavesNoFileThatSilentlyWorks)
+{
+    // A FAIL verdict (4 frames against the 16 the verdict asks for) wrote noise_model.yml and the
+    // darktable and Android exports with no mark, and rawgment_augment used them.
+    const std::string dir = freshDir("failed_verdict");
+    AppRun r =
+        runApp("rawgment_simulate", "--frames=4 --levels=0.3,0.9 --format=png --out='" + dir + "/sim'");
+    ASSERT_EQ(0, r.status) << r.output;
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --plots=false --out='" + dir + "/cal'");
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string report = readText(dir + "/cal/report.md");
+    EXPECT_NE(std::string::npos, report.find("**Verdict: FAIL**")) << report;
+    EXPECT_NE(std::string::npos, report.find("`failed_calibration` in noise_model.yml")) << report;
+    EXPECT_TRUE(exists(dir + "/cal/noise_model.yml"));
+    EXPECT_FALSE(exists(dir + "/cal/darktable_noiseprofiles.json"));
+    EXPECT_FALSE(exists(dir + "/cal/android_noise_profile.yml"));
+    EXPECT_NE(std::string::npos,
+              readText(dir + "/cal/noise_model.yml").find("failed_calibration: frames per burst"));
+    {
+        cv::rawgment::Scene scene;
+        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 1.0);
+        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
+        scene.write(fs, "scene");
+    }
+    const std::string frame = "'" + dir + "/sim/g06dB_level0.90/frame_000.png'";
+    r = runApp("rawgment_augment", "--model='" + dir + "/cal/noise_model.yml' --scene='" + dir +
+                                       "/scene.yml' --out='" + dir + "/aug' " + frame);
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("verdict was FAIL (frames per burst")) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("--accept_failed_calibration")) << r.output;
+    EXPECT_FALSE(exists(dir + "/aug/frame_000_v00.png"));
+    r = runApp("rawgment_validate", "'" + dir + "/sim/validation_manifest.yml' --model='" + dir +
+                                        "/cal/noise_model.yml' --plots=false --out='" + dir + "/val'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("verdict was FAIL")) << r.output;
+    // Asked for explicitly, it works.
+    r = runApp("rawgment_augment", "--accept_failed_calibration=true --model='" + dir +
+                                       "/cal/noise_model.yml' --scene='" + dir + "/scene.yml' --out='" + dir +
+                                       "/aug' " + frame);
+    EXPECT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("wrote 1 outputs")) << r.output;
 }
 
 TEST(Apps, readersRefuseDevicesAndFifosNamingThem)

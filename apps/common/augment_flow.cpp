@@ -85,7 +85,7 @@ AugmentRecipe loadAugmentRecipe(const AugmentOptions& o)
     if (o.scene.empty() == o.policy.empty())
         throw std::runtime_error("give exactly one of a scene file and a policy file");
     AugmentRecipe recipe;
-    recipe.model = NoiseModel::load(o.model);
+    recipe.model = NoiseModel::load(o.model, o.acceptFailedCalibration);
     recipe.randomScenes = o.scene.empty();
     if (recipe.randomScenes)
         recipe.policy = RandomScenePolicy::load(o.policy);

@@ -159,6 +159,12 @@ std::string calibrationReportMarkdown(const CalibrateResult& r, const std::strin
 {
     std::string md = "# Calibration report\n\n";
     md += std::string("**Verdict: ") + (r.verdict.pass ? "PASS" : "FAIL") + "**\n\n";
+    if (!r.verdict.pass)
+        md +=
+            "The model is marked with the failed checks (`failed_calibration` in noise_model.yml): "
+            "rawgment_augment, rawgment_validate, rawgment.batch and NoiseModel::load() refuse it unless "
+            "asked explicitly (`--accept_failed_calibration`, `acceptFailedCalibration`), and the darktable "
+            "and Android exports are not written.\n\n";
     md += "| check | result | measured figure and threshold |\n|---|---|---|\n";
     for (const VerdictCheck& c : r.verdict.checks)
         md += "| " + c.name + " | " + (c.pass ? "pass" : "**FAIL**") + " | " + c.figure + " |\n";
@@ -730,6 +736,16 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                          firstFormat.whiteLevel - (firstFormat.blackLevel[0] + firstFormat.blackLevel[1] +
                                                    firstFormat.blackLevel[2] + firstFormat.blackLevel[3]) /
                                                       4);
+    // A failed verdict travels in the model, so no file of this calibration works silently:
+    // NoiseModel::load() refuses it unless asked, and the exports, which other programs would read without
+    // asking, are not written.
+    if (!result.verdict.pass) {
+        std::string failed;
+        for (const VerdictCheck& c : result.verdict.checks)
+            if (!c.pass)
+                failed += (failed.empty() ? "" : ", ") + c.name;
+        result.report.model.failedCalibration = failed;
+    }
     writeNewText(reportPath,
                  yamlToString([&](cv::FileStorage& fs) { report.write(fs, "calibration_report"); }));
     if (report.separable) {
@@ -747,8 +763,13 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                              std::vector<cv::String>(shadingImages.begin(), shadingImages.end()));
                      }));
         // With gains from ISO the model carries over to the tools that index noise by ISO.
-        if (result.baseIso > 0 && report.model.alpha > 0)
+        if (result.baseIso > 0 && report.model.alpha > 0 && result.verdict.pass)
             writeProfileExports(o.outDir, specs, gainsDb, isos, firstFormat, result);
+        else if (result.baseIso > 0 && report.model.alpha > 0)
+            result.notes.push_back("the verdict is FAIL: darktable_noiseprofiles.json and "
+                                   "android_noise_profile.yml are not written, and noise_model.yml is marked "
+                                   "failed_calibration, so the apps and NoiseModel::load() refuse it unless "
+                                   "asked (--accept_failed_calibration)");
     } else
         result.notes.push_back(
             "sigma_d^2 and sigma_r^2 are not separable with these gains: no noise_model.yml "

@@ -158,6 +158,7 @@ struct ValidateOptions
     int bins = 10;
     uint64_t seed = 7;
     bool plots = true;
+    bool acceptFailedCalibration = false; //!< also a model whose calibration failed (NoiseModel::load())
 };
 
 //! Per mean bin and factor: the real dark burst's variance and each conversion's.
@@ -209,6 +210,7 @@ struct AugmentOptions
     uint64_t seed = 1;
     std::string extension; //!< output container; empty: .dng for RAW inputs, else the input's
     bool previews = false;
+    bool acceptFailedCalibration = false; //!< also a model whose calibration failed (NoiseModel::load())
 };
 
 struct AugmentResult

@@ -57,7 +57,7 @@ ValidationManifest readValidationManifest(const std::string& path)
 ValidateResult validateConversion(const ValidateOptions& o)
 {
     const ValidationManifest manifest = readValidationManifest(o.manifest);
-    const NoiseModel model = NoiseModel::load(o.model);
+    const NoiseModel model = NoiseModel::load(o.model, o.acceptFailedCalibration);
     prepareOutputDirectory(o.outDir);
     const std::string csvPath = o.outDir + "/validation.csv", mdPath = o.outDir + "/validation.md";
     refuseExisting({csvPath, mdPath});

@@ -28,14 +28,14 @@ RAW_EXTENSIONS = (".dng", ".nef", ".cr2", ".cr3", ".crw", ".arw", ".raf", ".rw2"
                   ".srw", ".3fr", ".iiq", ".erf", ".mef", ".mos", ".nrw", ".x3f")
 
 
-def _runJob(job, model, scene, policy):
+def _runJob(job, model, scene, policy, acceptFailedCalibration=False):
     """One output (runs on a worker). Returns its path."""
-    _rawgment._apps.runAugmentJob(job, model, scene, policy)
+    _rawgment._apps.runAugmentJob(job, model, scene, policy, acceptFailedCalibration)
     return job["out"]
 
 
 def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, seed=1, format=None,
-                 previews=False, client=None, progress=None):
+                 previews=False, client=None, progress=None, acceptFailedCalibration=False):
     """Augments every input `variants` times, as ``rawgment_augment`` does.
 
     Args:
@@ -47,6 +47,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
         previews: also write an sRGB preview PNG per output.
         client: a ``dask.distributed.Client`` to run the jobs on; None runs them here, one by one.
         progress: a callable(done, total), or None for a line on stderr per 5% when stderr is a terminal.
+        acceptFailedCalibration: also use a model whose calibration's verdict was FAIL (refused otherwise).
 
     Returns:
         dict with ``written``, ``skipped`` (finished by an earlier run) and ``outputs`` (every output path).
@@ -67,7 +68,8 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     policy = os.path.abspath(os.fspath(policy)) if policy is not None else ""
     scene = os.path.abspath(os.fspath(scene)) if scene is not None else ""
     plan = _rawgment._apps.planAugmentJobs(inputs, model, scene, policy, os.fspath(out), int(variants), int(seed),
-                                           "" if format is None else "." + format, bool(previews))
+                                           "" if format is None else "." + format, bool(previews),
+                                           bool(acceptFailedCalibration))
     jobs = plan["jobs"]
     total = len(jobs)
     if progress is None:
@@ -77,7 +79,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     if client is None:
         for job in jobs:
             try:
-                _runJob(job, model, scene, policy)
+                _runJob(job, model, scene, policy, bool(acceptFailedCalibration))
                 written += 1
             except Exception as e:  # the others still run; the first error is raised at the end
                 errors.append("'%s' variant %d: %s" % (job["input"], job["variant"], e))
@@ -85,7 +87,8 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     else:
         from distributed import as_completed
 
-        futures = client.map(_runJob, jobs, model=model, scene=scene, policy=policy, pure=False)
+        futures = client.map(_runJob, jobs, model=model, scene=scene, policy=policy,
+                             acceptFailedCalibration=bool(acceptFailedCalibration), pure=False)
         where = {f.key: job for f, job in zip(futures, jobs)}
         for future in as_completed(futures):
             job = where[future.key]
@@ -139,6 +142,8 @@ def main(argv=None):
                         help="seed from 0 to 2**64 - 1: same seed, same files (default 1)")
     parser.add_argument("--format", choices=("dng", "png", "tif"), help="output container")
     parser.add_argument("--preview", action="store_true", help="also write an sRGB preview PNG per output")
+    parser.add_argument("--accept_failed_calibration", action="store_true",
+                        help="also use a model whose calibration's verdict was FAIL")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     where.add_argument("--workers", type=int, help="start a local Dask cluster with this many worker processes")
@@ -173,7 +178,7 @@ def main(argv=None):
                 client = Client(cluster)
         result = augmentFiles(args.inputs, args.model, args.out, policy=args.policy, scene=args.scene,
                               variants=args.variants, seed=args.seed, format=args.format, previews=args.preview,
-                              client=client)
+                              client=client, acceptFailedCalibration=args.accept_failed_calibration)
     except (RuntimeError, ValueError, OSError) as e:
         sys.stderr.write("rawgment.batch: %s\n" % e)
         return 1

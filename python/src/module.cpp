@@ -312,6 +312,8 @@ void bindCore(py::module_& m)
         .def_readwrite("sigmaD2", &NoiseModel::sigmaD2, doc("NoiseModel::sigmaD2"))
         .def_readwrite("sigmaR2", &NoiseModel::sigmaR2, doc("NoiseModel::sigmaR2"))
         .def_readwrite("baseIso", &NoiseModel::baseIso, doc("NoiseModel::baseIso"))
+        .def_readwrite("failedCalibration", &NoiseModel::failedCalibration,
+                       doc("NoiseModel::failedCalibration"))
         .def_readwrite("rowSigmaD2", &NoiseModel::rowSigmaD2, doc("NoiseModel::rowSigmaD2"))
         .def_readwrite("rowSigmaR2", &NoiseModel::rowSigmaR2, doc("NoiseModel::rowSigmaR2"))
         .def_readwrite("tukeyRead", &NoiseModel::tukeyRead, doc("NoiseModel::tukeyRead"))
@@ -366,7 +368,8 @@ void bindCore(py::module_& m)
             doc("NoiseModel::variance", "Python: `mean` is a number (returns a float) or a float32/float64 "
                                         "array (returns an array of the same shape and dtype)."))
         .def("save", &NoiseModel::save, py::arg("path"), doc("NoiseModel::save"))
-        .def_static("load", &NoiseModel::load, py::arg("path"), doc("NoiseModel::load"));
+        .def_static("load", &NoiseModel::load, py::arg("path"), py::arg("acceptFailedCalibration") = false,
+                    doc("NoiseModel::load"));
 
     // ---- cpu ---------------------------------------------------------------------------------------
     py::enum_<CpuPath>(m, "CpuPath", doc("CpuPath"))

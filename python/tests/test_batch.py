@@ -197,3 +197,29 @@ def test_the_readme_commands_on_a_scheduler_and_workers(app_dir, job, tmp_path):
         logs.close()
     app_run(app_dir, job, tmp_path / "app")
     assert_same_files(tmp_path / "app", tmp_path / "cluster")
+
+
+def test_a_failed_calibrations_model_is_refused_unless_accepted(job, tmp_path):
+    model = rg.NoiseModel.load(job["model"])
+    model.failedCalibration = "frames per burst"
+    failed = str(tmp_path / "failed.yml")
+    model.save(failed)
+    with pytest.raises(rg.error, match=r"verdict was FAIL \(frames per burst\)"):
+        rg.NoiseModel.load(failed)
+    assert rg.NoiseModel.load(failed, acceptFailedCalibration=True).failedCalibration == "frames per burst"
+    with pytest.raises(rg.error, match="acceptFailedCalibration=True"):
+        batch.augmentFiles(job["inputs"][:1], failed, tmp_path / "refused", policy=job["policy"])
+    assert not (tmp_path / "refused").exists() or not os.listdir(tmp_path / "refused")
+    result = batch.augmentFiles(job["inputs"][:1], failed, tmp_path / "accepted", policy=job["policy"],
+                                acceptFailedCalibration=True)
+    assert result["written"] == 1
+    # The same from the command line, and the mark survives pickling (Dask ships models to workers).
+    run = subprocess.run([sys.executable, "-m", "rawgment.batch", "--model", failed, "--policy", job["policy"],
+                          "--out", str(tmp_path / "cli"), job["inputs"][0]], capture_output=True, text=True)
+    assert run.returncode == 1 and "verdict was FAIL" in run.stderr, run.stderr
+    run = subprocess.run([sys.executable, "-m", "rawgment.batch", "--model", failed, "--policy", job["policy"],
+                          "--accept_failed_calibration", "--out", str(tmp_path / "cli"), job["inputs"][0]],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    import pickle
+    assert pickle.loads(pickle.dumps(model)).failedCalibration == "frames per burst"

@@ -219,7 +219,7 @@ void NoiseModel::write(FileStorage& fs, const String& name, const std::vector<St
     if (hasDarkShading() && shadingImages.size() != 2)
         CV_Error(Error::StsBadArg, "NoiseModel::write: a model with dark shading needs the names of its two "
                                    "images (save() writes them)");
-    const int version = hasDarkComponents() ? 3 : baseIso > 0 ? 2 : 1;
+    const int version = !failedCalibration.empty() ? 4 : hasDarkComponents() ? 3 : baseIso > 0 ? 2 : 1;
     fs << name << "{";
     fs << "format_version" << version;
     fs << "alpha" << alpha;
@@ -242,6 +242,8 @@ void NoiseModel::write(FileStorage& fs, const String& name, const std::vector<St
                << "}";
         fs << "}";
     }
+    if (!failedCalibration.empty())
+        fs << "failed_calibration" << failedCalibration;
     fs << "}";
 }
 
@@ -331,6 +333,8 @@ NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
             keys.push_back("base_iso");
         if (version >= 3)
             keys.insert(keys.end(), {"row_sigma_d2", "row_sigma_r2", "tukey_lambda", "dark_shading"});
+        if (version >= 4)
+            keys.push_back("failed_calibration");
         rejectUnknownKeys(node, keys);
     } catch (const Exception& e) {
         CV_Error(e.code, "noise model: " + e.err);
@@ -368,6 +372,14 @@ NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
             CV_Error(Error::StsParseError,
                      format("noise model: field 'tukey_lambda' must lie in [%g, 1] (got %g)",
                             detail::kTukeyLambdaMin, m.tukeyLambda));
+    }
+    const FileNode failed = node["failed_calibration"];
+    if (!failed.empty()) {
+        if (!failed.isString() || failed.string().empty())
+            CV_Error(
+                Error::StsParseError,
+                "noise model: field 'failed_calibration' must be a non-empty string (the failed checks)");
+        m.failedCalibration = failed.string();
     }
     const FileNode shading = node["dark_shading"];
     if (!shading.empty()) {
@@ -464,10 +476,19 @@ void NoiseModel::save(const String& path) const
     }
 }
 
-NoiseModel NoiseModel::load(const String& path)
+NoiseModel NoiseModel::load(const String& path, bool acceptFailedCalibration)
 {
-    return detail::loadFileStorage(path, kTopLevelName, "noise model file",
-                                   [&](const FileNode& n) { return read(n, folderOf(path)); });
+    NoiseModel m = detail::loadFileStorage(path, kTopLevelName, "noise model file",
+                                           [&](const FileNode& n) { return read(n, folderOf(path)); });
+    if (!m.failedCalibration.empty() && !acceptFailedCalibration)
+        CV_Error(
+            Error::StsBadArg,
+            format("noise model file '%s' comes from a calibration whose verdict was FAIL (%s): see that "
+                   "calibration's report.md and calibrate again; to use it anyway, accept it "
+                   "explicitly (NoiseModel::load(path, true), acceptFailedCalibration=True in Python, "
+                   "--accept_failed_calibration in the apps)",
+                   path.c_str(), m.failedCalibration.c_str()));
+    return m;
 }
 
 namespace detail {

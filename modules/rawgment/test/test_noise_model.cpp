@@ -163,8 +163,8 @@ TEST(NoiseModel, readingRejectsBadFilesNamingTheField)
     EXPECT_CV_ERROR_CONTAINS(
         readFromYaml("  format_version: 1\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: abc\n"),
         "'sigma_r2' is not a number");
-    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 4\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
-                             "format_version 4 is not supported");
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 5\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
+                             "format_version 5 is not supported");
     // base_iso came with version 2: a version 1 file that has it was not written by this project.
     EXPECT_CV_ERROR_CONTAINS(
         readFromYaml("  format_version: 1\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n  base_iso: 100\n"),
@@ -188,6 +188,43 @@ TEST(NoiseModel, readingRejectsBadFilesNamingTheField)
                              "'format_version' is missing");
     FileStorage empty("%YAML:1.0\nother: 1\n", FileStorage::READ | FileStorage::MEMORY);
     EXPECT_CV_ERROR_CONTAINS(NoiseModel::read(empty["noise_model"]), "expected a map");
+}
+
+TEST(NoiseModel, aFailedCalibrationsModelIsMarkedAndRefusedUnlessAccepted)
+{
+    const std::string dir = test::makeTempDir("noise_model_failed_calibration");
+    NoiseModel m(0.25, 1.5, 0.8);
+    m.baseIso = 100;
+    m.failedCalibration = "frames per burst, residuals per gain and mean bin";
+    for (const char* name : {"/failed.yml", "/failed.json"}) {
+        SCOPED_TRACE(name);
+        const std::string path = dir + name;
+        m.save(path);
+        // The mark takes version 4, so an older build (which reads up to 3) refuses the file as well.
+        FileStorage written(path, FileStorage::READ);
+        EXPECT_EQ(4, int(written["noise_model"]["format_version"]));
+        EXPECT_EQ(m.failedCalibration, std::string(written["noise_model"]["failed_calibration"]));
+        EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(path),
+                                 "comes from a calibration whose verdict was FAIL "
+                                 "(frames per burst, residuals per gain and mean bin)");
+        EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(path), path);
+        const NoiseModel accepted = NoiseModel::load(path, true);
+        EXPECT_EQ(m.failedCalibration, accepted.failedCalibration);
+        EXPECT_EQ(m.alpha, accepted.alpha);
+        EXPECT_EQ(m.baseIso, accepted.baseIso);
+    }
+    // A model without the mark keeps its version and loads as before.
+    m.failedCalibration.clear();
+    m.save(dir + "/passed.yml");
+    EXPECT_EQ(2, int(FileStorage(dir + "/passed.yml", FileStorage::READ)["noise_model"]["format_version"]));
+    EXPECT_TRUE(NoiseModel::load(dir + "/passed.yml").failedCalibration.empty());
+    // The key belongs to version 4, and it must say what failed.
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 3\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"
+                                          "  failed_calibration: x\n"),
+                             "unknown key 'failed_calibration'");
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 4\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"
+                                          "  failed_calibration: \"\"\n"),
+                             "'failed_calibration' must be a non-empty string");
 }
 
 TEST(NoiseModel, loadNamesTheFileOnBadContent)

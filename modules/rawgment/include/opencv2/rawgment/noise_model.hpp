@@ -60,7 +60,7 @@ struct CV_RAWGMENT_EXPORTS NoiseLine
 struct CV_RAWGMENT_EXPORTS NoiseModel
 {
     //! Newest version of the file format; read() rejects newer versions (see write()).
-    static constexpr int FORMAT_VERSION = 3;
+    static constexpr int FORMAT_VERSION = 4;
     /** The range of a known baseIso, with room on both sides of every camera's (ISO 25 to 3,280,000):
      * beyond it a gain ISO / baseIso under- or overflows the noise terms (a base ISO of 1e300 wrote a
      * model of zeros, 1e-300 stopped the solver). */
@@ -75,6 +75,12 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      * lets a camera file give its own gain, \f$ g = \mathrm{ISO} / \mathrm{baseIso} \f$; the noise
      * terms do not depend on it. */
     double baseIso = 0;
+
+    /** Why the calibration that made this model failed its verdict (the failed checks), or empty when it
+     * is not known to have failed. A model that carries it is written with it (format version 4), and
+     * load() refuses it unless the caller accepts it explicitly, so that a failed calibration never
+     * leaves a file that silently works. */
+    String failedCalibration;
 
     /** @name Dark-frame components beyond the paper (each absent by default)
      * An absent component changes no output and costs nothing; see docs/mathematics.md, "Dark-frame
@@ -138,11 +144,12 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
     void variance(InputArray mean, double gain, OutputArray dst) const;
 
     /** @brief Writes the model as a map under `name`: format_version, alpha, sigma_d2, sigma_r2,
-     * base_iso when it is known, and the dark-frame components that are present (row_sigma_d2,
+     * base_iso when it is known, the dark-frame components that are present (row_sigma_d2,
      * row_sigma_r2, tukey_lambda, and dark_shading: the names, size and FNV-1a checksums of two
-     * CV_32FC1 TIFF images). The version is the lowest that holds what the model has (1 without a base
-     * ISO, 2 with one, 3 with a dark-frame component), so a model without them stays readable by older
-     * builds.
+     * CV_32FC1 TIFF images), and failed_calibration when it is set. The version is the lowest that holds
+     * what the model has (1 without a base ISO, 2 with one, 3 with a dark-frame component, 4 with
+     * failedCalibration), so a model without them stays readable by older builds, and an older build
+     * refuses a failed calibration's model instead of using it.
      * @param fs the storage
      * @param name the map's name
      * @param shadingImages the file names of the dark-shading images (per gain, offset) as the file
@@ -174,8 +181,13 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
     void save(const String& path) const;
 
     /** @brief Loads a model saved by save() (the top-level map is `noise_model`), with its dark-shading
-     * images. */
-    static NoiseModel load(const String& path);
+     * images.
+     * @param path the model file
+     * @param acceptFailedCalibration also load a model whose failedCalibration is set (the calibration
+     *        that made it failed its verdict); without it such a model is refused with an error that
+     *        names the file and the failed checks
+     */
+    static NoiseModel load(const String& path, bool acceptFailedCalibration = false);
 };
 
 //! @}
