@@ -5,6 +5,8 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
+#include <atomic>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <mutex>
@@ -129,6 +131,47 @@ void shiftMosaic(const Mat& src, Point shift, Mat& dst)
     });
 }
 
+/* The sensor's dark shading S stays where the sensor has it: the shifted content carries the input's S
+ * of its source pixel, which is swapped for the S of the pixel it lands on, dst(x) = src(x - d) - S(x - d)
+ * + S(x) (float arithmetic, the same on every path; integer mosaics rounded to nearest, ties to even, and
+ * kept in range). Clipped pixels stay clipped. Row by row, as shiftMosaic() chose the source. */
+template <typename T>
+void swapShiftedShading(const Mat& src, const RawFormat& format, const NoiseModel& model, Point shift,
+                        Mat& dst)
+{
+    const detail::ShadingRows shading(model, format.gain);
+    const int planeRows = src.rows / 2, planeCols = src.cols / 2, hy = shift.y / 2;
+    const int first = std::min(std::max(shift.x, 0), src.cols),
+              last = std::max(std::min(src.cols + shift.x, src.cols), 0);
+    const float white = static_cast<float>(format.whiteLevel);
+    const float highest = src.depth() == CV_16U ? 65535.f : std::numeric_limits<float>::max();
+    const float lowest = src.depth() == CV_16U ? 0.f : -std::numeric_limits<float>::max();
+    std::atomic<bool> nonFinite{false};
+    parallel_for_(Range(0, src.rows), [&](const Range& rows) {
+        for (int r = rows.start; r < rows.end; ++r) {
+            const int sr = 2 * std::min(std::max(r / 2 - hy, 0), planeRows - 1) + (r & 1);
+            const float *bdSrc = shading.perGainRow(sr), *brSrc = shading.offsetRow(sr);
+            const float *bdDst = shading.perGainRow(r), *brDst = shading.offsetRow(r);
+            T* d = dst.ptr<T>(r);
+            for (int c = 0; c < src.cols; ++c) {
+                const int sc = c < first ? (c & 1) : c < last ? c - shift.x : 2 * (planeCols - 1) + (c & 1);
+                const float value = static_cast<float>(d[c]);
+                const float swapped = value - shading.at(bdSrc, brSrc, sc) + shading.at(bdDst, brDst, c);
+                if (!std::isfinite(swapped)) {
+                    nonFinite = true;
+                    return;
+                }
+                if (value >= white)
+                    continue;
+                const float kept = std::min(std::max(swapped, lowest), highest);
+                d[c] = static_cast<T>(src.depth() == CV_16U ? std::nearbyint(kept) : kept);
+            }
+        }
+    });
+    if (nonFinite)
+        detail::throwNonFiniteShading("applyScene");
+}
+
 } // namespace
 
 void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& model, const Scene& scene,
@@ -151,6 +194,14 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
         // Into a new Mat: `current` still shares the caller's data, which must never be written.
         Mat shifted;
         shiftMosaic(current, shift, shifted);
+        // The dark shading belongs to the sensor, not to the content: it must not move with the shift.
+        if (model.hasDarkShading() && scene.noise.alignment != NoiseAlignment::NONE) {
+            detail::checkDarkShadingSize(model, current.size(), "applyScene");
+            if (current.depth() == CV_16U)
+                swapShiftedShading<ushort>(current, fmt, model, shift, shifted);
+            else
+                swapShiftedShading<float>(current, fmt, model, shift, shifted);
+        }
         current = shifted;
         if (boxes)
             for (Rect& b : *boxes)

@@ -338,6 +338,60 @@ SensorParams darkComponentSensor(Size size)
     return p;
 }
 
+TEST(Augment, aShiftKeepsTheSensorsDarkShadingWhereTheSensorHasIt)
+{
+    // applyScene shifted the dark-shading pattern together with the content: on a noiseless flat input
+    // carrying the pattern, a shift of (8, 6) changed the output by the pattern's own difference
+    // S(x - d) - S(x), where 0 is right because the pattern belongs to the sensor.
+    const Size size(96, 64);
+    const NoiseModel model = darkComponentSensor(size).noise;
+    ASSERT_TRUE(model.hasDarkShading());
+    const RawFormat fmt = SensorSimulator(darkComponentSensor(size), size).rawFormat(kGain);
+    const Mat pattern = model.darkShadingAt(kGain);
+    Mat flat(size, CV_32FC1);
+    for (int r = 0; r < size.height; ++r)
+        for (int c = 0; c < size.width; ++c)
+            flat.at<float>(r, c) = static_cast<float>(fmt.blackAt(r, c) + 500) + pattern.at<float>(r, c);
+    const Rect inside(8, 6, size.width - 8, size.height - 6);
+    const double patternMove =
+        norm(pattern(inside - Point(8, 6)), pattern(inside), NORM_L2) / std::sqrt(double(inside.area()));
+    ASSERT_GT(patternMove, 1.0) << "the test needs a pattern that a shift visibly moves";
+    Scene shifted;
+    shifted.shift = Point(8, 6);
+    Mat out;
+    RawFormat outFmt;
+    applyScene(flat, fmt, model, shifted, 3, out, outFmt);
+    // Float arithmetic of values below 2^12: a few ulps.
+    EXPECT_LT(norm(out, flat, NORM_INF), 1e-3) << "the pattern moved by " << patternMove << " DN RMS";
+    // An integer mosaic is rounded once more: within 1 DN, and a pixel differs (by 1) with probability
+    // E|rounding error| = 1/4, so the RMS is 0.5 on average; 4 standard errors of that share over 6144
+    // pixels (0.0055 each) allow 0.53.
+    Mat flat16, out16, diff;
+    flat.convertTo(flat16, CV_16U);
+    applyScene(flat16, fmt, model, shifted, 3, out16, outFmt);
+    absdiff(out16, flat16, diff);
+    EXPECT_LE(norm(diff, NORM_INF), 1);
+    EXPECT_LE(norm(diff, NORM_L2) / std::sqrt(double(diff.total())), 0.53);
+    // Shifted and darkened x0.5: over 24 seeds the mean output is the darker content plus the sensor's
+    // pattern in place; its residual is the mean's noise alone, below 1.5 sqrt(target variance / 24) RMS
+    // (the target's variance bounds what ACCOUNT_PRIOR adds to a noiseless input; 1.5 leaves room for the
+    // RMS over only 6144 pixels).
+    shifted.jitter = ColorJitter::exposureChange(0.5, 1);
+    const int seeds = 24;
+    Mat sum = Mat::zeros(size, CV_64FC1);
+    for (int seed = 0; seed < seeds; ++seed) {
+        applyScene(flat, fmt, model, shifted, uint64(seed), out, outFmt);
+        accumulate(out, sum);
+    }
+    Mat expected(size, CV_64FC1);
+    for (int r = 0; r < size.height; ++r)
+        for (int c = 0; c < size.width; ++c)
+            expected.at<double>(r, c) = fmt.blackAt(r, c) + 250 + pattern.at<float>(r, c);
+    const double residual = norm(sum / seeds, expected, NORM_L2) / std::sqrt(double(size.area()));
+    const double noise = std::sqrt((model.variance(250, kGain) + model.rowVariance(kGain)) / seeds);
+    EXPECT_LT(residual, 1.5 * noise) << "pattern move " << patternMove;
+}
+
 TEST(Augment, sameSeedSameBitsOnAnyThreadCount)
 {
     const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);

@@ -231,7 +231,9 @@ struct CV_RAWGMENT_EXPORTS Scene
 /** @brief Applies a scene: shift (vacated pixels replicate the edge, CFA phase kept), scale
  * (scaleMosaic()), colour jitter, then blur at the gain the jitter produced. Bounding boxes (x, y, w, h
  * in mosaic pixels) move with the shift and the scale (scaleBox()) and are clipped to the frame; a box
- * that leaves the frame becomes empty.
+ * that leaves the frame becomes empty. A model's dark shading belongs to the sensor and does not move:
+ * unless the alignment is NONE, the shift swaps each moved pixel's shading for that of the pixel it lands
+ * on (clipped pixels stay clipped), as scaleMosaic() and motionBlur() take it out and put it back.
  */
 CV_RAWGMENT_EXPORTS void applyScene(InputArray src, const RawFormat& format, const NoiseModel& model,
                                     const Scene& scene, uint64 seed, OutputArray dst, RawFormat& dstFormat,
