@@ -125,20 +125,26 @@ std::vector<NoiseSample> sampleStaticScene(const BurstStatistics& stats, double 
                 if (clipped.at<uchar>(r, c))
                     continue;
                 const double mp = mean.at<double>(r, c);
-                // The noise of the means from the median variance of the nine pixels: shake inflates the
-                // variance of the very pixels whose means it smears (at most three of the nine along an
-                // edge), which must not widen their own tolerance; the median ignores them and, unlike the
-                // least variance, stays near the truth for bursts of a few frames.
-                double v[9];
+                // The noise of the means from the median variance of the eight neighbours, never the
+                // pixel's own: a tolerance that grew with its own variance let noisier pixels pass more
+                // often, a selection on the very quantity the fit measures (alpha +0.4%, 5 standard errors,
+                // on natural scenes). The pixel's own mean, of Gaussian noise, is independent of its own
+                // variance. The median, because shake inflates the variance of the very pixels whose
+                // means it smears (at most three along an edge); unlike the least variance, it stays near
+                // the truth for bursts of a few frames.
+                double v[8];
                 int n = 0;
-                bool flat = true;
+                bool flat = !clipped.at<uchar>(r, c);
                 for (int dy = -2; dy <= 2; dy += 2)
                     for (int dx = -2; dx <= 2; dx += 2) {
+                        if (dy == 0 && dx == 0)
+                            continue;
                         flat = flat && !clipped.at<uchar>(r + dy, c + dx);
                         v[n++] = var.at<double>(r + dy, c + dx);
                     }
-                std::nth_element(v, v + 4, v + 9);
-                const double vmed = v[4];
+                std::nth_element(v, v + 4, v + 8);
+                const double upper = v[4], lower = *std::max_element(v, v + 4);
+                const double vmed = 0.5 * (lower + upper);
                 const double tolerance = 4 * std::sqrt(2 * vmed / frames) + 0.002 * std::abs(mp);
                 for (int dy = -2; dy <= 2 && flat; dy += 2)
                     for (int dx = -2; dx <= 2 && flat; dx += 2)
