@@ -96,7 +96,9 @@ void bindCalibration(py::module_& m)
                        doc("LineFitParams::ransacIterations"))
         .def_readwrite("inlierThreshold", &LineFitParams::inlierThreshold,
                        doc("LineFitParams::inlierThreshold"))
-        .def_readwrite("seed", &LineFitParams::seed, doc("LineFitParams::seed"));
+        .def_readwrite("seed", &LineFitParams::seed, doc("LineFitParams::seed"))
+        .def_readwrite("readExcessKurtosis", &LineFitParams::readExcessKurtosis,
+                       doc("LineFitParams::readExcessKurtosis"));
     py::class_<NoiseLineFit>(m, "NoiseLineFit", doc("NoiseLineFit"))
         .def(keywordInit<NoiseLineFit>())
         .def_readwrite("gain", &NoiseLineFit::gain, doc("NoiseLineFit::gain"))
@@ -128,6 +130,8 @@ void bindCalibration(py::module_& m)
         .def_readwrite("lossScale", &CalibrationParams::lossScale, doc("CalibrationParams::lossScale"))
         .def_readwrite("minGainRatio", &CalibrationParams::minGainRatio,
                        doc("CalibrationParams::minGainRatio"))
+        .def_readwrite("readExcessKurtosis", &CalibrationParams::readExcessKurtosis,
+                       doc("CalibrationParams::readExcessKurtosis"))
         .def_readwrite("bootstrapReplicates", &CalibrationParams::bootstrapReplicates,
                        doc("CalibrationParams::bootstrapReplicates"));
     py::enum_<NoiseModelParameter>(m, "NoiseModelParameter", doc("NoiseModelParameter"))
@@ -169,6 +173,10 @@ void bindCalibration(py::module_& m)
         .def_readwrite("samples", &CalibrationReport::samples, doc("CalibrationReport::samples"))
         .def_readwrite("samplesUsed", &CalibrationReport::samplesUsed, doc("CalibrationReport::samplesUsed"))
         .def_readwrite("notes", &CalibrationReport::notes, doc("CalibrationReport::notes"))
+        .def_readwrite("readExcessKurtosis", &CalibrationReport::readExcessKurtosis,
+                       doc("CalibrationReport::readExcessKurtosis"))
+        .def_readwrite("readExcessKurtosisEstimated", &CalibrationReport::readExcessKurtosisEstimated,
+                       doc("CalibrationReport::readExcessKurtosisEstimated"))
         .def_readwrite("uncertainty", &CalibrationReport::uncertainty, doc("CalibrationReport::uncertainty"))
         .def("interval", &CalibrationReport::interval, py::arg("parameter"), py::arg("level") = 0.95,
              doc("CalibrationReport::interval"))

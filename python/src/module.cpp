@@ -345,6 +345,7 @@ void bindCore(py::module_& m)
         .def("hasRowNoise", &NoiseModel::hasRowNoise, doc("NoiseModel::hasRowNoise"))
         .def("hasDarkShading", &NoiseModel::hasDarkShading, doc("NoiseModel::hasDarkShading"))
         .def("hasDarkComponents", &NoiseModel::hasDarkComponents, doc("NoiseModel::hasDarkComponents"))
+        .def("readExcessKurtosis", &NoiseModel::readExcessKurtosis, doc("NoiseModel::readExcessKurtosis"))
         .def("rowVariance", &NoiseModel::rowVariance, py::arg("gain"), doc("NoiseModel::rowVariance"))
         .def(
             "darkShadingAt",

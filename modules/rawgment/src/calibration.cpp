@@ -23,6 +23,10 @@ namespace rawgment {
 
 namespace {
 
+// Every distribution has excess kurtosis >= -2; above 1000 no sensor's read noise lies (Tukey lambda -0.2,
+// the heaviest NoiseModel takes, has 19).
+const double kMinExcessKurtosis = -2, kMaxExcessKurtosis = 1000;
+
 struct LineLS
 {
     double a = 0, b = 0, r2 = 0;
@@ -49,7 +53,8 @@ double ordinaryRSquared(const std::vector<NoiseSample>& s, const std::vector<int
  * around its expectation v, so each sample is weighted by dof / (2 v^2), Fisher scoring for the Gamma
  * likelihood of sample variances). Unlike ordinary least squares, the many precise dark samples then pin
  * the offset instead of the few noisy bright ones. False when the means do not vary. */
-bool weightedNoiseLine(const std::vector<NoiseSample>& s, const std::vector<int>& idx, LineLS& out)
+bool weightedNoiseLine(const std::vector<NoiseSample>& s, const std::vector<int>& idx, double readKurtosis,
+                       LineLS& out)
 {
     if (idx.size() < 2)
         return false;
@@ -74,7 +79,7 @@ bool weightedNoiseLine(const std::vector<NoiseSample>& s, const std::vector<int>
     for (int i : idx)
         chosen.push_back(s[i]);
     const Vec2d ab = detail::refineNoiseLine(chosen.data(), nullptr, static_cast<int>(chosen.size()),
-                                             Vec2d(sxy / sxx, my - sxy / sxx * mx), 4);
+                                             Vec2d(sxy / sxx, my - sxy / sxx * mx), 4, readKurtosis);
     out.a = ab[0];
     out.b = ab[1];
     out.r2 = ordinaryRSquared(s, idx, out.a, out.b);
@@ -139,8 +144,9 @@ double lowerGammaRegularized(double a, double x)
     return std::max(0.0, 1.0 - std::exp(logPrefix) * h);
 }
 
-//! The chi-square quantile of `dof` degrees of freedom at probability p, by bisection on log q.
-double chiSquareQuantile(int dof, double p)
+//! The chi-square quantile of `dof` (> 0, not necessarily whole) degrees of freedom at probability p, by
+//! bisection on log q.
+double chiSquareQuantile(double dof, double p)
 {
     double lo = std::log(1e-40), hi = std::log(100.0 * dof + 1000.0);
     for (int i = 0; i < 200; ++i) {
@@ -156,35 +162,73 @@ double chiSquareQuantile(int dof, double p)
  * freedom it never reaches -k = -4 (a variance of 0 is -2.7 standard errors) but exceeds +4 once in
  * 750 samples, so it kept every dead or stuck pixel and cut only the high tail, which biased alpha
  * low by 2-3 of its standard errors. Equal probability in both tails removes 2 Phi(-k) of the samples
- * and shifts the mean of the rest by a few parts in 10^5. Cached by (dof, k): a burst has one dof. */
+ * and shifts the mean of the rest by a few parts in 10^5.
+ * Heavy tails (read noise of excess kurtosis kappa, and the Poisson part at low counts) spread a sample
+ * variance further: each sample's band is that of the scaled chi-square with its effectiveDof(), so that
+ * the band does not trim the tails it should keep (a Gaussian band left sigma_d^2 4-8 standard errors low
+ * and called 1.6% of the pixels defects at lambda -0.05). Bands are cached by (effective dof to 0.5%, k). */
 struct ChiSquareBand
 {
     double lo = 0, hi = 0;
 };
 
-ChiSquareBand chiSquareBand(int dof, double k)
+ChiSquareBand chiSquareBand(double dof, double k)
 {
     static std::mutex mutex;
-    static std::map<std::pair<int, double>, ChiSquareBand> cache;
+    static std::map<std::pair<int64, double>, ChiSquareBand> cache;
+    const int64 key = static_cast<int64>(std::llround(std::log(std::max(dof, 0.5)) * 200));
     std::lock_guard<std::mutex> lock(mutex);
-    const auto key = std::make_pair(std::max(dof, 1), k);
-    auto it = cache.find(key);
+    auto it = cache.find(std::make_pair(key, k));
     if (it != cache.end())
         return it->second;
+    const double d = std::exp(static_cast<double>(key) / 200);
     const double p = 0.5 * std::erfc(k / std::sqrt(2.0));
     ChiSquareBand band;
-    band.lo = chiSquareQuantile(key.first, p) / key.first;
-    band.hi = chiSquareQuantile(key.first, 1 - p) / key.first;
-    cache.emplace(key, band);
+    band.lo = chiSquareQuantile(d, p) / d;
+    band.hi = chiSquareQuantile(d, 1 - p) / d;
+    cache.emplace(std::make_pair(key, k), band);
     return band;
 }
 
-//! The band of each sample (see chiSquareBand()).
-std::vector<ChiSquareBand> bandsOf(const std::vector<NoiseSample>& s, double k)
+/* The high edge that one extreme read value alone reaches with the band's probability: a sample variance
+ * of heavy-tailed data has a far longer right tail than the scaled chi-square of the same spread, because one
+ * value can carry it (at lambda -0.05 and 16 frames, 20 times the nominal share lay above that chi-square's
+ * edge, and cutting them took 0.29% from the mean variance). With the read noise's shape taken as the
+ * Tukey-lambda of its kurtosis, the standardised value exceeded by one of n frames with probability p is
+ * y = Q(1 - p / (2n)) / sd; in a sample of read share r = b / v it makes the sample variance about
+ * (r y^2 + (1 - r) + n - 2) / (n - 1) times its expectation. Each band's high edge is the larger of the two
+ * (the chi-square's for Gaussian or lighter tails, where one value cannot carry it). Returns y (0 when the
+ * read noise is not heavy-tailed). */
+double extremeReadValue(double readKurtosis, int frames, double k)
+{
+    if (!(readKurtosis > 0))
+        return 0.0;
+    const double lambda = detail::tukeyLambdaOfExcessKurtosis(readKurtosis);
+    const double p = 0.5 * std::erfc(k / std::sqrt(2.0));
+    return detail::tukeyLambdaQuantile(1 - p / (2.0 * frames), lambda) /
+           std::sqrt(detail::tukeyLambdaVariance(lambda));
+}
+
+//! The band of each sample around the line (a, b) (see chiSquareBand() and extremeReadValue()).
+std::vector<ChiSquareBand> bandsOf(const std::vector<NoiseSample>& s, double k, double a, double b,
+                                   double floor, double readKurtosis)
 {
     std::vector<ChiSquareBand> bands(s.size());
-    for (size_t i = 0; i < s.size(); ++i)
-        bands[i] = i > 0 && s[i].dof == s[i - 1].dof ? bands[i - 1] : chiSquareBand(s[i].dof, k);
+    std::map<int, double> extreme; // by dof
+    for (size_t i = 0; i < s.size(); ++i) {
+        const double v = std::max(detail::lineVariance(a, b, s[i].mean), floor);
+        const int dof = std::max(s[i].dof, 1);
+        bands[i] = chiSquareBand(
+            detail::effectiveDof(v, dof, floor, detail::pixelFourthCumulant(a, b, s[i].mean, readKurtosis)),
+            k);
+        auto it = extreme.find(dof);
+        if (it == extreme.end())
+            it = extreme.emplace(dof, extremeReadValue(readKurtosis, dof + 1, k)).first;
+        if (it->second > 0) {
+            const double share = std::min(std::max(b / v, 0.0), 1.0), y = it->second;
+            bands[i].hi = std::max(bands[i].hi, (share * y * y + (1 - share) + dof - 1) / dof);
+        }
+    }
     return bands;
 }
 
@@ -195,10 +239,11 @@ bool insideBand(const NoiseSample& s, const ChiSquareBand& band, double a, doubl
     return s.variance >= band.lo * predicted && s.variance <= band.hi * predicted;
 }
 
-std::vector<int> inliersOf(const std::vector<NoiseSample>& s, double a, double b, double threshold)
+std::vector<int> inliersOf(const std::vector<NoiseSample>& s, double a, double b, double threshold,
+                           double readKurtosis)
 {
     const double floor = lineVarianceFloor(a, b, meanRangeOf(s));
-    const std::vector<ChiSquareBand> bands = bandsOf(s, threshold);
+    const std::vector<ChiSquareBand> bands = bandsOf(s, threshold, a, b, floor, readKurtosis);
     std::vector<int> idx;
     for (int i = 0; i < static_cast<int>(s.size()); ++i)
         if (insideBand(s[i], bands[i], a, b, floor))
@@ -234,20 +279,26 @@ NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples, const LineFit
                             samples[0].gain, s.gain));
     if (params.ransacIterations < 1 || !(params.inlierThreshold > 0))
         CV_Error(Error::StsBadArg, "fitNoiseLine: ransacIterations must be >= 1 and inlierThreshold > 0");
+    if (!(params.readExcessKurtosis >= kMinExcessKurtosis && params.readExcessKurtosis <= kMaxExcessKurtosis))
+        CV_Error(Error::StsBadArg, format("fitNoiseLine: readExcessKurtosis must lie in [%g, %g] (got %g)",
+                                          kMinExcessKurtosis, kMaxExcessKurtosis, params.readExcessKurtosis));
+    const double kurtosis = params.readExcessKurtosis;
     NoiseLineFit fit;
     fit.gain = samples[0].gain;
     fit.samples = static_cast<int>(samples.size());
     std::vector<int> all(samples.size());
     std::iota(all.begin(), all.end(), 0);
     LineLS ls;
-    if (!weightedNoiseLine(samples, all, ls))
+    if (!weightedNoiseLine(samples, all, kurtosis, ls))
         CV_Error(Error::StsBadArg, "fitNoiseLine: all samples share one mean; the slope needs at least two "
                                    "distinct means");
     std::vector<int> chosen = all;
     if (params.robust) {
         const int n = static_cast<int>(samples.size());
         const MeanRange range = meanRangeOf(samples);
-        const std::vector<ChiSquareBand> bands = bandsOf(samples, params.inlierThreshold);
+        // Each sample's band from the least-squares line: the hypotheses are only scored with it.
+        const std::vector<ChiSquareBand> bands = bandsOf(samples, params.inlierThreshold, ls.a, ls.b,
+                                                         lineVarianceFloor(ls.a, ls.b, range), kurtosis);
         /* Each hypothesis is scored on at most kRansacScoringSamples samples spread evenly over the list
          * (which follows the patches and the frame): its inlier share is then known to 0.8% at worst,
          * enough to pick a line whose inliers the refinement below then takes from every sample, and a
@@ -279,9 +330,9 @@ NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples, const LineFit
         }
         // Refine: least squares on the inliers, then once more on the inliers of the refined line.
         for (int round = 0; round < 2; ++round) {
-            std::vector<int> inl = inliersOf(samples, bestA, bestB, params.inlierThreshold);
+            std::vector<int> inl = inliersOf(samples, bestA, bestB, params.inlierThreshold, kurtosis);
             LineLS refined;
-            if (!weightedNoiseLine(samples, inl, refined))
+            if (!weightedNoiseLine(samples, inl, kurtosis, refined))
                 break;
             chosen.swap(inl);
             ls = refined;
@@ -294,7 +345,7 @@ NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples, const LineFit
     fit.rSquared = ls.r2;
     fit.inliers = static_cast<int>(chosen.size());
     Matx22d cov;
-    if (detail::lineCovariance(samples, chosen, ls.a, ls.b, cov)) {
+    if (detail::lineCovariance(samples, chosen, ls.a, ls.b, kurtosis, cov)) {
         fit.slopeStdError = std::sqrt(cov(0, 0));
         fit.offsetStdError = std::sqrt(cov(1, 1));
         const double d = fit.slopeStdError * fit.offsetStdError;
@@ -379,6 +430,102 @@ void fitOffsets(const std::vector<NoiseLineFit>& lines, double& sigmaD2, double&
         CV_Error(Error::StsError, "calibrateNoiseModel: the offset fit failed: " + summary.BriefReport());
 }
 
+/* The read noise's excess kurtosis kappa from the spread of the sample variances around their gain's
+ * line, by the method of moments: for a sample of ratio u = s^2 / v to its line and n = dof + 1 frames,
+ * E[(u - 1)^2] = 2 / dof + (kappa w + c) / n with w = b^2 / v^2 (the read part's share of the variance,
+ * squared) and c = a^3 mu / v^2 (the Poisson part), so y = n ((u - 1)^2 - 2 / dof) - c has mean kappa w
+ * and kappa is the least-squares slope of y on w. A fourth moment is fragile to defects, so: a pixel whose
+ * median ratio over its bursts lies outside [0.5, 2] (a noisy, hot, dead or stuck pixel: a normal one's
+ * median over 3 or more bursts of 16 frames lies there but once in 10^5) is left out, and ratios more
+ * than 20 of their own standard errors (at the current kappa) above 1 are cut (a hot or noisy pixel in
+ * a dark burst), which leaves 0.6% of kappa out at lambda -0.05 and 3% at -0.1 (8 left 7% and 18%). Returns
+ * false, with the reason, when the read part is too small a share of too few samples (sum of w^2 below 50) to
+ * tell. */
+bool estimateReadKurtosis(const std::map<double, std::vector<NoiseSample>>& byGain,
+                          const std::vector<NoiseLineFit>& lines, double& kappa, std::string& why)
+{
+    struct Ratio
+    {
+        double u, w, c, n;
+        int dof;
+        int64 pixel;
+    };
+    std::vector<Ratio> ratios;
+    size_t g = 0;
+    for (const auto& entry : byGain) {
+        const NoiseLine& line = lines[g++].line;
+        const double a = std::max(line.a, 0.0), b = std::max(line.b, 0.0);
+        const double floor = lineVarianceFloor(a, b, meanRangeOf(entry.second));
+        for (const NoiseSample& x : entry.second) {
+            const double v = std::max(detail::lineVariance(a, b, x.mean), floor);
+            const int dof = std::max(x.dof, 1);
+            ratios.push_back({x.variance / v, b * b / (v * v), a * a * a * std::max(x.mean, 0.0) / (v * v),
+                              dof + 1.0, dof, x.pixel});
+        }
+    }
+    std::map<int64, std::vector<double>> byPixel;
+    std::map<int64, int> highReadRatios; // read-dominated samples more than 3 times their line
+    for (const Ratio& r : ratios)
+        if (r.pixel >= 0) {
+            byPixel[r.pixel].push_back(r.u);
+            if (r.w >= 0.25 && r.u > 3)
+                ++highReadRatios[r.pixel];
+        }
+    std::set<int64> defects;
+    for (auto& entry : byPixel) {
+        std::vector<double>& u = entry.second;
+        if (u.size() < 3)
+            continue;
+        std::nth_element(u.begin(), u.begin() + long(u.size() / 2), u.end());
+        const double median = u[u.size() / 2];
+        if (median < 0.5 || median > 2)
+            defects.insert(entry.first);
+    }
+    /* A noisy pixel (extra variance of its own) stands out only where the read noise dominates, so the
+     * median over every burst misses it, and its few dark samples would each look like a heavy tail.
+     * What tells it from a tail is that it stands out in more than one such burst: a pixel with two or
+     * more read-dominated samples above 3 times their line is a defect here. A normal pixel with three such
+     * samples does that with probability 3 P(u > 3)^2: 1e-8 for Gaussian noise, 3e-4 at lambda -0.1. */
+    for (const auto& entry : highReadRatios)
+        if (entry.second >= 2)
+            defects.insert(entry.first);
+    kappa = 0;
+    for (int iteration = 0; iteration < 20; ++iteration) {
+        double sww = 0, swy = 0;
+        for (const Ratio& r : ratios) {
+            if (r.pixel >= 0 && defects.count(r.pixel))
+                continue;
+            // The cut's kappa is held at 19 (Tukey lambda -0.2, the heaviest tail a NoiseModel takes), so
+            // that defects the rules above miss cannot widen the cut that lets them in.
+            const double se =
+                std::sqrt(std::max(2.0 / r.dof + (std::min(kappa, 19.0) * r.w + r.c) / r.n, 1e-12));
+            if (r.u - 1 > 20 * se)
+                continue;
+            const double y = r.n * ((r.u - 1) * (r.u - 1) - 2.0 / r.dof) - r.c;
+            sww += r.w * r.w;
+            swy += r.w * y;
+        }
+        if (sww < 50) {
+            why = format("too few samples where read noise dominates (sum of its squared share %.3g, 50 "
+                         "needed: dark frames or dark patches give them)",
+                         sww);
+            kappa = 0;
+            return false;
+        }
+        if (!std::isfinite(swy / sww)) {
+            why = "the spread of the sample variances is not finite";
+            kappa = 0;
+            return false;
+        }
+        const double next = std::min(std::max(swy / sww, kMinExcessKurtosis), kMaxExcessKurtosis);
+        const bool converged = std::abs(next - kappa) < 1e-4;
+        kappa = next;
+        if (converged)
+            break;
+    }
+    return true;
+}
+
 } // namespace
 
 CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
@@ -394,6 +541,14 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
         params.bootstrapReplicates < 0 || params.bootstrapReplicates == 1)
         CV_Error(Error::StsBadArg, "calibrateNoiseModel: lossScale must be >= 0, reweightIterations >= 1, "
                                    "minGainRatio >= 1, bootstrapReplicates 0 or >= 2");
+    const bool kurtosisGiven = !std::isnan(params.readExcessKurtosis);
+    if (kurtosisGiven &&
+        !(params.readExcessKurtosis >= kMinExcessKurtosis && params.readExcessKurtosis <= kMaxExcessKurtosis))
+        CV_Error(
+            Error::StsBadArg,
+            format("calibrateNoiseModel: readExcessKurtosis must be NaN (estimate it) or lie in [%g, %g] "
+                   "(got %g)",
+                   kMinExcessKurtosis, kMaxExcessKurtosis, params.readExcessKurtosis));
     CalibrationReport report;
     report.method = params.method;
     report.samples = static_cast<int>(samples.size());
@@ -404,6 +559,8 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
     std::vector<NoiseSample> inlierSamples;
     std::vector<detail::GainGroup> groups;
     std::set<int64> outlierPixels; // pixels outside the band of their gain's line in some burst
+    LineFitParams lineParams = params.line;
+    lineParams.readExcessKurtosis = kurtosisGiven ? params.readExcessKurtosis : 0.0;
     const auto fitEachGain = [&]() {
         report.perGain.clear();
         inlierSamples.clear();
@@ -411,7 +568,7 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
         for (auto& entry : byGain) {
             NoiseLineFit fit;
             try {
-                fit = fitNoiseLine(entry.second, params.line);
+                fit = fitNoiseLine(entry.second, lineParams);
             } catch (const Exception& e) {
                 CV_Error(Error::StsBadArg, format("calibrateNoiseModel: gain %g: ", entry.first) + e.err);
             }
@@ -420,7 +577,8 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
             group.begin = static_cast<int>(inlierSamples.size());
             if (params.line.robust) {
                 const std::vector<int> in =
-                    inliersOf(entry.second, fit.line.a, fit.line.b, params.line.inlierThreshold);
+                    inliersOf(entry.second, fit.line.a, fit.line.b, params.line.inlierThreshold,
+                              lineParams.readExcessKurtosis);
                 std::vector<bool> kept(entry.second.size(), false);
                 for (int i : in) {
                     inlierSamples.push_back(entry.second[i]);
@@ -437,6 +595,28 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
         }
     };
     fitEachGain();
+    /* Without a given kurtosis, it is estimated from the lines' residuals and the lines are fitted again
+     * with bands of that spread (twice: the first lines were cut with Gaussian bands). */
+    if (!kurtosisGiven) {
+        std::string why;
+        for (int round = 0; round < 2; ++round) {
+            double kappa = 0;
+            if (!estimateReadKurtosis(byGain, report.perGain, kappa, why))
+                break;
+            report.readExcessKurtosisEstimated = true;
+            if (std::abs(kappa - lineParams.readExcessKurtosis) < 1e-3)
+                break;
+            lineParams.readExcessKurtosis = kappa;
+            outlierPixels.clear();
+            fitEachGain();
+        }
+        if (!report.readExcessKurtosisEstimated)
+            report.notes.push_back("the read noise's excess kurtosis could not be estimated, " + why +
+                                   ": the fit takes it as 0 (Gaussian); give CalibrationParams::"
+                                   "readExcessKurtosis (for example from dark frames) if the read noise has "
+                                   "heavier tails");
+    }
+    report.readExcessKurtosis = lineParams.readExcessKurtosis;
     /* A noisy pixel (random telegraph noise) or a stuck one is the same pixel in every burst, but it stands
      * out of the noise band only where the normal noise is small (dark patches, dark frames, low gains);
      * in bright patches its extra variance hides inside the band, and kept there it biases the lines
@@ -465,9 +645,13 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
                                     entry.first));
             }
             fitEachGain();
-            report.notes.push_back(format("%d of %d pixels lay outside the noise band in at least one burst "
-                                          "(noisy, hot or stuck pixels) and were left out of every burst",
-                                          leftOut, static_cast<int>(pixels.size())));
+            report.notes.push_back(
+                format("%d of %d pixels lay outside the noise band in at least one burst "
+                       "(a band as wide as read noise of excess kurtosis %.3g makes it) "
+                       "and were left out of every burst, as noisy, hot or stuck pixels "
+                       "would be; normal pixels leave it by chance in %.2g of their bursts",
+                       leftOut, static_cast<int>(pixels.size()), report.readExcessKurtosis,
+                       std::erfc(params.line.inlierThreshold / std::sqrt(2.0))));
         } else {
             report.notes.push_back(
                 format("%d of %d pixels lay outside the noise band in at least one burst: too "
@@ -506,9 +690,10 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
     fitOffsets(report.perGain, sigmaD2, sigmaR2);
 
     if (params.method == NOISE_FIT_JOINT) {
-        const Vec3d p = detail::refineJointFit(
-            inlierSamples.data(), nullptr, static_cast<int>(inlierSamples.size()),
-            Vec3d(alpha, sigmaD2, sigmaR2), params.lossScale, params.line.robust, params.reweightIterations);
+        const Vec3d p =
+            detail::refineJointFit(inlierSamples.data(), nullptr, static_cast<int>(inlierSamples.size()),
+                                   Vec3d(alpha, sigmaD2, sigmaR2), params.lossScale, params.line.robust,
+                                   params.reweightIterations, report.readExcessKurtosis);
         alpha = p[0];
         sigmaD2 = p[1];
         sigmaR2 = p[2];
@@ -632,6 +817,8 @@ void CalibrationReport::write(FileStorage& fs, const String& name) const
         writeReals(fs, "bootstrap_std_error", uncertainty.bootstrapStdError.val, 3);
         fs << "bootstrap_replicates" << uncertainty.bootstrapReplicates;
         fs << "}";
+        fs << "read_excess_kurtosis" << readExcessKurtosis;
+        fs << "read_excess_kurtosis_estimated" << static_cast<int>(readExcessKurtosisEstimated);
     }
     fs << "per_gain"
        << "[";
@@ -676,6 +863,8 @@ CalibrationReport CalibrationReport::read(const FileNode& node)
             "format_version",   "method",  "separable",    "noise_model", "r_squared_slope",
             "r_squared_offset", "samples", "samples_used", "per_gain",    "notes"};
         std::vector<String> gainKeys = {"gain", "gain_db", "a", "b", "r_squared", "inliers", "samples"};
+        if (version >= 3)
+            keys.insert(keys.end(), {"read_excess_kurtosis", "read_excess_kurtosis_estimated"});
         if (version >= 2) {
             keys.push_back("uncertainty");
             gainKeys.insert(gainKeys.end(), {"a_std_error", "b_std_error", "ab_correlation"});
@@ -698,6 +887,15 @@ CalibrationReport CalibrationReport::read(const FileNode& node)
     r.samplesUsed = static_cast<int>(detail::readRealField(node, "samples_used"));
     if (version >= 2)
         r.uncertainty = readUncertainty(node["uncertainty"]);
+    if (version >= 3) {
+        r.readExcessKurtosis = detail::readRealField(node, "read_excess_kurtosis");
+        if (!(r.readExcessKurtosis >= kMinExcessKurtosis && r.readExcessKurtosis <= kMaxExcessKurtosis))
+            CV_Error(Error::StsParseError,
+                     format("calibration report: field 'read_excess_kurtosis' must lie in "
+                            "[%g, %g] (got %g)",
+                            kMinExcessKurtosis, kMaxExcessKurtosis, r.readExcessKurtosis));
+        r.readExcessKurtosisEstimated = detail::readRealField(node, "read_excess_kurtosis_estimated") != 0;
+    }
     const FileNode perGain = node["per_gain"];
     if (!perGain.isSeq())
         CV_Error(Error::StsParseError, "calibration report: field 'per_gain' is missing or not a list");

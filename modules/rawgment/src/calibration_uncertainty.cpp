@@ -63,6 +63,12 @@ Vec3d jointRegressors(const NoiseSample& s)
     return Vec3d(s.gain * std::max(s.mean, 0.0), s.gain * s.gain, 1.0);
 }
 
+//! pixelFourthCumulant() of a sample under the joint model p: a = g alpha, b = g^2 sigma_d^2 + sigma_r^2.
+double jointFourthCumulant(const NoiseSample& s, const Vec3d& p, double readKurtosis)
+{
+    return pixelFourthCumulant(s.gain * p[0], s.gain * s.gain * p[1] + p[2], s.mean, readKurtosis);
+}
+
 //! The largest variance the model predicts over the samples, floored as every weight of the fit is.
 double modelVarianceFloor(const std::vector<NoiseSample>& s, const Vec3d& p)
 {
@@ -114,12 +120,13 @@ Matx33d sandwichOfFree(const Matx33d& bread, const Matx33d& meat, const bool fre
 /* The joint fit's sandwich covariance at p: bread sum psi'(z) x x'/se^2, meat sum psi(z)^2 x x'/se^2,
  * with z the standardized residual (the Huber M-estimator's asymptotic covariance). */
 Matx33d jointCovariance(const std::vector<NoiseSample>& s, const Vec3d& p, double floor, double lossScale,
-                        bool robust, const bool free[3])
+                        bool robust, const bool free[3], double readKurtosis)
 {
     Matx33d bread = Matx33d::zeros(), meat = Matx33d::zeros();
     for (const NoiseSample& x : s) {
         const Vec3d r = jointRegressors(x);
-        const double se = sampleVarianceStdError(r.dot(p), x.dof, floor);
+        const double se =
+            sampleVarianceStdError(r.dot(p), x.dof, floor, jointFourthCumulant(x, p, readKurtosis));
         const double z = (x.variance - r.dot(p)) / se;
         const Matx33d outer = (r * r.t()) * (1.0 / (se * se));
         bread += outer * huberPsiSlope(z, lossScale, robust);
@@ -207,13 +214,15 @@ std::vector<Vec3d> bootstrapEstimates(const std::vector<NoiseSample>& s, const s
                     ++counts[g.begin + static_cast<int>((static_cast<uint64_t>(rng.nextU32()) * n) >> 32)];
             }
             if (joint) {
-                estimates[rep] = refineJointFit(s.data(), counts.data(), static_cast<int>(s.size()), p,
-                                                params.lossScale, params.line.robust, 2);
+                estimates[rep] =
+                    refineJointFit(s.data(), counts.data(), static_cast<int>(s.size()), p, params.lossScale,
+                                   params.line.robust, 2, report.readExcessKurtosis);
             } else {
                 for (size_t k = 0; k < groups.size(); ++k)
                     lines[k] = refineNoiseLine(s.data() + groups[k].begin, counts.data() + groups[k].begin,
                                                groups[k].end - groups[k].begin,
-                                               Vec2d(report.perGain[k].line.a, report.perGain[k].line.b), 2);
+                                               Vec2d(report.perGain[k].line.a, report.perGain[k].line.b), 2,
+                                               report.readExcessKurtosis);
                 estimates[rep] = twoStageOfLines(report.perGain, lines, report.separable);
             }
         }
@@ -254,7 +263,8 @@ double meanErrorFactor(const NoiseSample& s, double slope, double m, double w)
 
 } // namespace
 
-Vec2d refineNoiseLine(const NoiseSample* s, const uint32_t* counts, int n, Vec2d ab, int rounds)
+Vec2d refineNoiseLine(const NoiseSample* s, const uint32_t* counts, int n, Vec2d ab, int rounds,
+                      double readKurtosis)
 {
     for (int round = 0; round < rounds; ++round) {
         double largest = 0;
@@ -268,7 +278,8 @@ Vec2d refineNoiseLine(const NoiseSample* s, const uint32_t* counts, int n, Vec2d
             if (count == 0)
                 continue;
             const double m = std::max(lineVariance(ab[0], ab[1], s[i].mean), floor);
-            const double se = sampleVarianceStdError(m, s[i].dof, floor);
+            const double se = sampleVarianceStdError(
+                m, s[i].dof, floor, pixelFourthCumulant(ab[0], ab[1], s[i].mean, readKurtosis));
             const double w = count / (se * se);
             const Vec2d x(s[i].mean, 1.0);
             A += (x * x.t()) * w;
@@ -285,7 +296,7 @@ Vec2d refineNoiseLine(const NoiseSample* s, const uint32_t* counts, int n, Vec2d
 }
 
 Vec3d refineJointFit(const NoiseSample* s, const uint32_t* counts, int n, Vec3d p, double lossScale,
-                     bool robust, int rounds)
+                     bool robust, int rounds, double readKurtosis)
 {
     for (int round = 0; round < rounds; ++round) {
         double largest = 0;
@@ -300,7 +311,8 @@ Vec3d refineJointFit(const NoiseSample* s, const uint32_t* counts, int n, Vec3d 
                 continue;
             const Vec3d x = jointRegressors(s[i]);
             const double m = std::max(x.dot(p), floor);
-            const double se = sampleVarianceStdError(m, s[i].dof, floor);
+            const double se =
+                sampleVarianceStdError(m, s[i].dof, floor, jointFourthCumulant(s[i], p, readKurtosis));
             double w = count / (se * se);
             const double z = std::abs(s[i].variance - m) / se;
             if (robust && lossScale > 0 && z > lossScale)
@@ -316,7 +328,7 @@ Vec3d refineJointFit(const NoiseSample* s, const uint32_t* counts, int n, Vec3d 
 }
 
 bool lineCovariance(const std::vector<NoiseSample>& s, const std::vector<int>& idx, double a, double b,
-                    Matx22d& covariance)
+                    double readKurtosis, Matx22d& covariance)
 {
     const double n = static_cast<double>(idx.size());
     if (idx.size() < 3)
@@ -328,7 +340,8 @@ bool lineCovariance(const std::vector<NoiseSample>& s, const std::vector<int>& i
     Matx22d bread = Matx22d::zeros(), meat = Matx22d::zeros();
     for (int i : idx) {
         const double predicted = lineVariance(a, b, s[i].mean);
-        const double se = sampleVarianceStdError(predicted, s[i].dof, floor);
+        const double se = sampleVarianceStdError(predicted, s[i].dof, floor,
+                                                 pixelFourthCumulant(a, b, s[i].mean, readKurtosis));
         const Vec2d x(s[i].mean, 1.0);
         const double w = 1.0 / (se * se);
         const double e = s[i].variance - predicted;
@@ -352,10 +365,10 @@ ModelUncertainty modelUncertainty(const std::vector<NoiseSample>& inliers,
     const Vec3d p(report.model.alpha, report.model.sigmaD2, report.model.sigmaR2);
     const bool free[3] = {p[0] > 0, report.separable && p[1] > 0, report.separable && p[2] > 0};
     const double floor = modelVarianceFloor(inliers, p);
-    const Matx33d fitCov =
-        params.method == NOISE_FIT_JOINT && report.separable
-            ? jointCovariance(inliers, p, floor, params.lossScale, params.line.robust, free)
-            : twoStageCovariance(report.perGain, free);
+    const Matx33d fitCov = params.method == NOISE_FIT_JOINT && report.separable
+                               ? jointCovariance(inliers, p, floor, params.lossScale, params.line.robust,
+                                                 free, report.readExcessKurtosis)
+                               : twoStageCovariance(report.perGain, free);
     u.fitStdError = stdErrorsOf(fitCov);
     u.covariance = fitCov;
     u.source = UNCERTAINTY_COVARIANCE;

@@ -23,19 +23,23 @@ namespace detail {
  * by one to two standard errors (docs/mathematics.md). counts: each sample's multiplicity (a bootstrap
  * draw), or nullptr for one each. */
 
+/* readKurtosis: the read noise's excess kurtosis, which with the Poisson part sets each sample
+ * variance's spread (pixelFourthCumulant()); 0 for Gaussian read noise. */
+
 //! The line (a, b) of one gain, `rounds` rounds from `ab`.
-Vec2d refineNoiseLine(const NoiseSample* s, const uint32_t* counts, int n, Vec2d ab, int rounds);
+Vec2d refineNoiseLine(const NoiseSample* s, const uint32_t* counts, int n, Vec2d ab, int rounds,
+                      double readKurtosis);
 
 /** The joint model (alpha, sigma_d^2, sigma_r^2) >= 0, `rounds` rounds from `p`, exactly bounded (see
  * nonNegativeLeastSquares in the source); lossScale > 0 with `robust` adds Huber's loss by reweighting. */
 Vec3d refineJointFit(const NoiseSample* s, const uint32_t* counts, int n, Vec3d p, double lossScale,
-                     bool robust, int rounds);
+                     bool robust, int rounds, double readKurtosis);
 
 /** The sandwich covariance of the weighted line (a, b) fitted to s[idx], with the weights of its final
  * round (the inverse squared standard error of each sample variance around the line), scaled by
  * n / (n - 2) for the two fitted parameters. False with fewer than 3 samples or means that do not vary. */
 bool lineCovariance(const std::vector<NoiseSample>& s, const std::vector<int>& idx, double a, double b,
-                    Matx22d& covariance);
+                    double readKurtosis, Matx22d& covariance);
 
 //! The samples of one gain in a list grouped by gain: [begin, end).
 struct GainGroup

@@ -476,6 +476,11 @@ void NoiseModel::save(const String& path) const
     }
 }
 
+double NoiseModel::readExcessKurtosis() const
+{
+    return tukeyRead ? detail::tukeyLambdaExcessKurtosis(tukeyLambda) : 0.0;
+}
+
 NoiseModel NoiseModel::load(const String& path, bool acceptFailedCalibration)
 {
     NoiseModel m = detail::loadFileStorage(path, kTopLevelName, "noise model file",

@@ -103,12 +103,35 @@ inline double varianceFloor(double largestPredictedVariance)
     return std::max(1e-15 * largestPredictedVariance, 1e-300);
 }
 
-/** Standard error of an unbiased sample variance of `dof` degrees of freedom whose expectation is
- * `expected`, for Gaussian data: \f$ \sqrt{2/dof}\,v \f$ (the variance of a scaled chi-square). The
- * expectation is floored at `floor` (varianceFloor()); dof below 1 counts as 1. */
-inline double sampleVarianceStdError(double expected, int dof, double floor)
+/** The fourth cumulant (DN^4) of a pixel's value on the noise line (a, b) at `mean`: the read part's
+ * \f$ \kappa b^2 \f$ (kappa its excess kurtosis, 0 when Gaussian) plus the Poisson part's
+ * \f$ a^3 \mu \f$ (every cumulant of a count equals its mean, and a DN per electron scales the fourth
+ * by a^4). Fourth cumulants of independent parts add. */
+inline double pixelFourthCumulant(double a, double b, double mean, double readKurtosis)
 {
-    return std::sqrt(2.0 / std::max(dof, 1)) * std::max(expected, floor);
+    const double shot = std::max(a, 0.0);
+    return readKurtosis * b * b + shot * shot * shot * std::max(mean, 0.0);
+}
+
+/** Standard error of an unbiased sample variance of `dof` degrees of freedom whose expectation is
+ * `expected`: \f$ \sqrt{2 v^2/dof + \kappa_4/(dof + 1)} \f$, the exact variance of a sample variance of
+ * dof + 1 independent values whose fourth cumulant is kappa_4 (pixelFourthCumulant(); 0 gives the scaled
+ * chi-square of Gaussian data). The expectation is floored at `floor` (varianceFloor()); dof below 1
+ * counts as 1. */
+inline double sampleVarianceStdError(double expected, int dof, double floor, double fourthCumulant = 0)
+{
+    const double v = std::max(expected, floor);
+    const int d = std::max(dof, 1);
+    return std::sqrt(std::max(2.0 * v * v / d + fourthCumulant / (d + 1.0), 2.0 * v * v / d * 1e-6));
+}
+
+/** The degrees of freedom of the scaled chi-square with the same relative spread as such a sample
+ * variance, \f$ 2 v^2 / se^2 \f$ (dof itself for Gaussian data, fewer for heavy tails). */
+inline double effectiveDof(double expected, int dof, double floor, double fourthCumulant)
+{
+    const double v = std::max(expected, floor),
+                 se = sampleVarianceStdError(expected, dof, floor, fourthCumulant);
+    return 2.0 * v * v / (se * se);
 }
 
 } // namespace detail

@@ -571,7 +571,26 @@ TEST(Calibration, reportErrorsRoundTripAndFirstVersionReportsStillLoad)
         std::ifstream f(dir + "/report.yml");
         text.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
     }
-    EXPECT_NE(text.find("format_version: 2"), std::string::npos);
+    EXPECT_NE(text.find("format_version: 3"), std::string::npos);
+    EXPECT_EQ(back.readExcessKurtosis, r.readExcessKurtosis);
+    EXPECT_EQ(back.readExcessKurtosisEstimated, r.readExcessKurtosisEstimated);
+    // Version 3 added the read noise's kurtosis: a version 2 file without it loads with 0, and one with it
+    // names the key.
+    {
+        const size_t v = text.find("format_version: 3"), k = text.find("read_excess_kurtosis:"),
+                     end = text.find("per_gain:");
+        ASSERT_TRUE(v != std::string::npos && k != std::string::npos && end != std::string::npos && k < end);
+        const std::string v2 = text.substr(0, v) + "format_version: 2" + text.substr(v + 17);
+        std::ofstream(dir + "/v2_with_kurtosis.yml") << v2;
+        EXPECT_CV_ERROR_CONTAINS(CalibrationReport::load(dir + "/v2_with_kurtosis.yml"),
+                                 "unknown key 'read_excess_kurtosis'");
+        const size_t k2 = v2.find("read_excess_kurtosis:"), end2 = v2.find("per_gain:");
+        std::ofstream(dir + "/v2.yml") << v2.substr(0, k2) << v2.substr(end2);
+        const CalibrationReport v2back = CalibrationReport::load(dir + "/v2.yml");
+        EXPECT_EQ(0.0, v2back.readExcessKurtosis);
+        EXPECT_FALSE(v2back.readExcessKurtosisEstimated);
+        EXPECT_EQ(v2back.model.alpha, r.model.alpha);
+    }
     // A report without errors is written as version 1, which loads with none.
     CalibrationReport old = r;
     old.uncertainty = ModelUncertainty();
@@ -581,9 +600,9 @@ TEST(Calibration, reportErrorsRoundTripAndFirstVersionReportsStillLoad)
     EXPECT_EQ(oldBack.model.alpha, r.model.alpha);
     EXPECT_CV_ERROR_CONTAINS(oldBack.interval(NOISE_PARAM_ALPHA), "no uncertainty");
     // Version 2's keys are unknown to version 1, and a misspelt key of the uncertainty is named.
-    const size_t at = text.find("format_version: 2");
+    const size_t at = text.find("format_version: 3");
     std::ofstream(dir + "/mixed.yml")
-        << text.substr(0, at) << "format_version: 1" << text.substr(at + std::strlen("format_version: 2"));
+        << text.substr(0, at) << "format_version: 1" << text.substr(at + std::strlen("format_version: 3"));
     EXPECT_CV_ERROR_CONTAINS(CalibrationReport::load(dir + "/mixed.yml"), "uncertainty");
     const size_t source = text.find("source:");
     ASSERT_NE(source, std::string::npos);
@@ -592,11 +611,11 @@ TEST(Calibration, reportErrorsRoundTripAndFirstVersionReportsStillLoad)
     // Version 0 was never written: not called newer; 9 is.
     for (const char* version : {"0", "9"}) {
         std::ofstream(dir + "/version.yml") << text.substr(0, at) << "format_version: " << version
-                                            << text.substr(at + std::strlen("format_version: 2"));
+                                            << text.substr(at + std::strlen("format_version: 3"));
         EXPECT_CV_ERROR_CONTAINS(CalibrationReport::load(dir + "/version.yml"),
                                  std::string("format_version ") + version +
                                      " is not supported; this build reads "
-                                     "versions 1 to 2" +
+                                     "versions 1 to 3" +
                                      (version[0] == '9' ? " (a newer" : ""));
     }
 }

@@ -12,6 +12,7 @@
 #include <opencv2/rawgment/raw_io.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
+#include <algorithm>
 #include <limits>
 
 namespace cv {
@@ -338,7 +339,9 @@ TEST(NumericalStability, lineFitHardCases)
     falling.insert(falling.end(), rising.begin(), rising.end());
     const CalibrationReport neg = calibrateNoiseModel(falling);
     EXPECT_LT(neg.perGain[0].line.a, 0);
-    EXPECT_NE(neg.notes[0].find("negative slope"), std::string::npos);
+    EXPECT_TRUE(std::any_of(neg.notes.begin(), neg.notes.end(), [](const std::string& n) {
+        return n.find("negative slope") != std::string::npos;
+    }));
     // Bad samples.
     std::vector<NoiseSample> bad = linePoints({{1, 1}, {2, std::numeric_limits<double>::quiet_NaN()}});
     EXPECT_CV_ERROR_CONTAINS(fitNoiseLine(bad), "sample 1 is invalid");

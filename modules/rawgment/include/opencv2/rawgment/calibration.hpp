@@ -8,6 +8,7 @@
 #include <opencv2/rawgment/noise_model.hpp>
 #include <opencv2/rawgment/normality.hpp>
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -120,9 +121,10 @@ CV_RAWGMENT_EXPORTS std::vector<NoiseSample> sampleDarkBurst(const BurstStatisti
  * temporal variance of the eight neighbours (never the pixel's own, so that the selection does not depend on
  * the variance the fit measures: with it, noisier pixels passed more often and alpha came out 0.4% high)
  * and T the frames: a neighbourhood flat within the noise of a difference of means (the median sets it,
- * because shake inflates the variance of the very pixels it smears, at most three along an edge) and a 0.2% allowance for smooth shading, whose own shake
- * adds under 1% of the shot noise. Neither the pixels within 4 of the frame's border nor clipped pixels (or
- * pixels next to them) are sampled; dark frames (a lens cap) pass as flat scenes.
+ * because shake inflates the variance of the very pixels it smears, at most three along an edge) and a 0.2%
+ * allowance for smooth shading, whose own shake adds under 1% of the shot noise. Neither the pixels within 4
+ * of the frame's border nor clipped pixels (or pixels next to them) are sampled; dark frames (a lens cap)
+ * pass as flat scenes.
  * @param stats statistics of a burst with at least 2 frames
  * @param gain linear gain of the burst (stored in the samples)
  * @param maxSamples at most this many samples (>= 4): the grid's step in blocks grows until the frame's
@@ -159,6 +161,13 @@ struct CV_RAWGMENT_EXPORTS LineFitParams
      * skewed and a band of equal width keeps every zero variance and cuts only the high tail). */
     double inlierThreshold = 4.0;
     uint64 seed = 0; //!< seed of the RANSAC draws (deterministic)
+    /** Excess kurtosis of the read noise (\f$ g n_d + n_r \f$ together; 0: Gaussian, in [-2, 1000]).
+     * With the Poisson part it sets how far a sample variance spreads, \f$ Var(s^2) = 2v^2/dof +
+     * \kappa_4/(dof + 1) \f$ with fourth cumulant \f$ \kappa_4 = \kappa b^2 + a^3\mu \f$: the inlier
+     * band is that of the scaled chi-square with the same spread, and the weights are its inverse, so
+     * heavy tails are neither trimmed nor down-weighted as if they were defects.
+     * calibrateNoiseModel() sets it from CalibrationParams::readExcessKurtosis or its estimate. */
+    double readExcessKurtosis = 0;
 };
 
 /** @brief The line \f$ \sigma^2 = a\mu + b \f$ fitted to the samples of one gain.
@@ -226,6 +235,12 @@ struct CV_RAWGMENT_EXPORTS CalibrationParams
      * error to about 5% (\f$ 1/\sqrt{2R} \f$). Keyed by `line.seed`: the same seed gives the same
      * errors on any number of threads. */
     int bootstrapReplicates = 200;
+    /** Excess kurtosis of the read noise (see LineFitParams::readExcessKurtosis), or NaN (the default) to
+     * estimate it from the spread of the sample variances around their lines (CalibrationReport::
+     * readExcessKurtosis). Give it when dark frames have measured it: NoiseModel::readExcessKurtosis() of
+     * calibrateDarkNoise()'s model (0 for Gaussian read noise). The estimate needs samples where read
+     * noise dominates (dark frames or dark patches); without them the fit takes 0 and says so. */
+    double readExcessKurtosis = std::numeric_limits<double>::quiet_NaN();
 };
 
 /** @brief The parameters of a NoiseModel, as indices into the vectors and matrices of
@@ -275,9 +290,9 @@ struct CV_RAWGMENT_EXPORTS ModelUncertainty
 struct CV_RAWGMENT_EXPORTS CalibrationReport
 {
     /** Newest version of the file format. Version 2 adds the uncertainty and the per-gain standard
-     * errors; a report without an uncertainty (source UNCERTAINTY_NONE) is written as version 1, and
-     * files of version 1 still load. */
-    static constexpr int FORMAT_VERSION = 2;
+     * errors, version 3 the read noise's excess kurtosis; a report without an uncertainty (source
+     * UNCERTAINTY_NONE) is written as version 1, and files of versions 1 and 2 still load (kurtosis 0). */
+    static constexpr int FORMAT_VERSION = 3;
 
     NoiseFitMethod method = NOISE_FIT_JOINT; //!< the method that ran
     /** The fitted model. Valid only when `separable`; with a single gain (or gains closer than
@@ -291,6 +306,10 @@ struct CV_RAWGMENT_EXPORTS CalibrationReport
     int samplesUsed = 0;               //!< samples in the final fit
     std::vector<std::string> notes;    //!< what the user should know (bounds hit, not separable, ...)
     ModelUncertainty uncertainty;      //!< standard errors of the model's parameters
+    /** The read noise's excess kurtosis the bands, weights and errors used: the given one, or the
+     * estimate (see CalibrationParams::readExcessKurtosis). */
+    double readExcessKurtosis = 0;
+    bool readExcessKurtosisEstimated = false; //!< whether readExcessKurtosis was estimated from the samples
 
     /** @brief The two-sided confidence interval of a parameter, value \f$ \pm z_{(1+level)/2} \f$
      * standard errors (normal: each estimate is a weighted sum over thousands of samples). Not cut at

@@ -107,6 +107,10 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
     bool hasDarkShading() const { return !darkShadingPerGain.empty(); }   //!< whether dark shading is present
     //! Whether any dark-frame component is present.
     bool hasDarkComponents() const { return hasRowNoise() || hasDarkShading() || tukeyRead; }
+    /** @brief Excess kurtosis of the read noise: 0 unless tukeyRead, else that of the Tukey-lambda shape
+     * (19 at lambda -0.2, 1.2 at 0, about 0 at 0.14, -1.2 at 1). What CalibrationParams::
+     * readExcessKurtosis takes from a model that calibrateDarkNoise() fitted to dark frames. */
+    double readExcessKurtosis() const;
     /** @brief Variance of the row offset at linear gain g: \f$ g^2\sigma_{row,d}^2 + \sigma_{row,r}^2 \f$. */
     double rowVariance(double gain) const;
     /** @brief The dark shading at linear gain g, \f$ g B_d + B_r \f$ (CV_32FC1), or an empty Mat without
