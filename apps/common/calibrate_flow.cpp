@@ -443,9 +443,9 @@ BurstGains burstGains(const CalibrationManifest& manifest, CalibrateResult& resu
     return gains;
 }
 
-/* --dark_components: the components from the dark bursts (their frames are released after), each light
- * sample's mean corrected by its pixel's dark shading and the model fitted again, and the rows moved out
- * of the read terms. */
+/* --dark_components: calibrateWithDarkFrames() on the light and dark samples and the dark bursts (their
+ * frames are released after): the base fit, the components, the light samples' shading correction and
+ * refit, and the rows out of the read terms; `samples` become the final fit's. */
 void addDarkComponents(std::vector<std::vector<cv::Mat>>& darkFrames, const std::vector<double>& darkGains,
                        const RawFormat& firstFormat, const CalibrationParams& params,
                        std::vector<NoiseSample>& samples, const std::vector<bool>& lightSample,
@@ -455,64 +455,25 @@ void addDarkComponents(std::vector<std::vector<cv::Mat>>& darkFrames, const std:
         throw std::runtime_error(
             "--dark_components needs dark bursts (dark: true in the manifest, or folders "
             "named dark*) of 3 or more frames");
-    DarkCalibrationParams darkParams;
-    int distinct = 0;
-    for (size_t k = 0; k < darkGains.size(); ++k)
-        distinct += std::none_of(darkGains.begin(), darkGains.begin() + long(k),
-                                 [&](double g) { return std::abs(g - darkGains[k]) < 1e-9 * g; });
-    if (distinct < 2) {
-        darkParams.rowNoise = darkParams.darkShading = false;
-        result.notes.push_back(
-            "dark bursts at one gain only: row noise and dark shading change with the gain "
-            "and need dark bursts at 2 or more gains; only the read noise's shape is "
-            "calibrated");
+    std::vector<NoiseSample> light, dark;
+    std::vector<cv::Size> lightFrames;
+    for (size_t i = 0; i < samples.size(); ++i) {
+        (lightSample[i] ? light : dark).push_back(samples[i]);
+        if (lightSample[i])
+            lightFrames.push_back(sampleFrame[i]);
     }
-    result.dark = calibrateDarkNoise(darkFrames, darkGains, firstFormat, result.report.model, darkParams);
+    const DarkFrameCalibration fit = calibrateWithDarkFrames(light, dark, darkFrames, darkGains, firstFormat,
+                                                             params, DarkCalibrationParams(), lightFrames);
     darkFrames.clear();
-    if (result.dark.model.hasDarkShading()) {
-        // A light sample's mean holds the dark shading, which is no signal: its shot noise is that of the
-        // mean less g B_d + B_r. Uncorrected, a shading of mean s moves every light sample by s and takes
-        // g alpha s from the line's offset (docs/mathematics.md: with 4 DN, sigma_r^2 came out 59% low).
-        // Each light sample loses its pixel's shading at its gain (a sample that is no single pixel, the
-        // frame's mean shading), and the model is fitted again.
-        const cv::Mat& bd = result.dark.model.darkShadingPerGain;
-        const cv::Mat& br = result.dark.model.darkShadingOffset;
-        const double meanPerGain = cv::mean(bd)[0], meanOffset = cv::mean(br)[0];
-        for (size_t i = 0; i < samples.size(); ++i) {
-            if (!lightSample[i])
-                continue;
-            NoiseSample& sample = samples[i];
-            // A sample numbers its pixel row * width + column of its own frame: the maps' pixels only
-            // when that frame is of the dark frames' size.
-            if (sampleFrame[i] == bd.size() && sample.pixel >= 0 &&
-                sample.pixel < static_cast<int64>(bd.total())) {
-                const int r = static_cast<int>(sample.pixel / bd.cols),
-                          c = static_cast<int>(sample.pixel % bd.cols);
-                sample.mean -= sample.gain * bd.at<float>(r, c) + br.at<float>(r, c);
-            } else {
-                sample.mean -= sample.gain * meanPerGain + meanOffset;
-            }
-        }
-        result.report = calibrateNoiseModel(samples, params);
-        result.report.model.baseIso = result.baseIso;
-        result.notes.push_back(
-            "the light samples' means were corrected by their pixels' dark shading and the "
-            "model fitted again");
-    }
-    // The components with the (refitted) light model; the rows move out of its read terms, as
-    // calibrateDarkNoise() does (a pixel's temporal variance holds its row's offset).
-    NoiseModel withComponents = result.dark.model;
-    const NoiseModel& light = result.report.model;
-    withComponents.alpha = light.alpha;
-    withComponents.sigmaD2 = std::max(light.sigmaD2 - withComponents.rowSigmaD2, 0.0);
-    withComponents.sigmaR2 = std::max(light.sigmaR2 - withComponents.rowSigmaR2, 0.0);
-    if (withComponents.hasRowNoise())
-        result.notes.push_back(
-            cv::format("sigma_d^2 and sigma_r^2 of noise_model.yml are the pixel's own read "
-                       "noise: the calibrated %.4g and %.4g less the row noise %.4g and %.4g",
-                       light.sigmaD2, light.sigmaR2, withComponents.rowSigmaD2, withComponents.rowSigmaR2));
-    result.dark.model = withComponents;
-    result.report.model = withComponents;
+    // The samples as the final fit used them (light means without the shading), in the bursts' order.
+    size_t nextLight = 0, nextDark = light.size();
+    for (size_t i = 0; i < samples.size(); ++i)
+        samples[i] = fit.samples[lightSample[i] ? nextLight++ : nextDark++];
+    result.report = fit.report;
+    result.report.model.baseIso = result.baseIso;
+    result.dark = fit.dark;
+    result.dark.model.baseIso = result.baseIso;
+    result.notes.insert(result.notes.end(), fit.notes.begin(), fit.notes.end());
     result.haveDark = true;
 }
 
@@ -706,12 +667,13 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     CalibrationParams params;
     params.method = o.method;
     params.line.seed = o.seed;
-    result.report = calibrateNoiseModel(samples, params);
-    // The ISO of gain 1 travels with the model, so a camera file's ISO gives its gain when augmenting.
-    result.report.model.baseIso = result.baseIso;
     if (o.darkComponents)
         addDarkComponents(in.darkFrames, in.darkGains, firstFormat, params, samples, in.lightSample,
                           in.sampleFrame, result);
+    else
+        result.report = calibrateNoiseModel(samples, params);
+    // The ISO of gain 1 travels with the model, so a camera file's ISO gives its gain when augmenting.
+    result.report.model.baseIso = result.baseIso;
     const CalibrationReport& report = result.report;
     {
         const double highest = report.perGain.back().gain;

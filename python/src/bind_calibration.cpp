@@ -267,6 +267,31 @@ void bindCalibration(py::module_& m)
         doc("calibrateDarkNoise",
             "Python: `bursts` is a list (one per gain) of lists of uint16 or float32 HxW "
             "arrays."));
+    py::class_<DarkFrameCalibration>(m, "DarkFrameCalibration", doc("DarkFrameCalibration"))
+        .def(keywordInit<DarkFrameCalibration>())
+        .def_readwrite("report", &DarkFrameCalibration::report, doc("DarkFrameCalibration::report"))
+        .def_readwrite("dark", &DarkFrameCalibration::dark, doc("DarkFrameCalibration::dark"))
+        .def_readwrite("notes", &DarkFrameCalibration::notes, doc("DarkFrameCalibration::notes"))
+        .def_readwrite("samples", &DarkFrameCalibration::samples, doc("DarkFrameCalibration::samples"));
+    m.def(
+        "calibrateWithDarkFrames",
+        [](const std::vector<NoiseSample>& lightSamples, const std::vector<NoiseSample>& darkSamples,
+           const py::list& darkBursts, const std::vector<double>& darkGains, const RawFormat& format,
+           const CalibrationParams& params, const DarkCalibrationParams& darkParams,
+           const std::vector<cv::Size>& lightFrames) {
+            std::vector<std::vector<cv::Mat>> frames;
+            for (const py::handle& burst : darkBursts)
+                frames.push_back(matsFromList(burst, "darkBursts", {CV_16U, CV_32F}));
+            return withoutGil("calibrateWithDarkFrames", [&] {
+                return calibrateWithDarkFrames(lightSamples, darkSamples, frames, darkGains, format, params,
+                                               darkParams, lightFrames);
+            });
+        },
+        py::arg("lightSamples"), py::arg("darkSamples"), py::arg("darkBursts"), py::arg("darkGains"),
+        py::arg("format"), py::arg("params") = CalibrationParams(),
+        py::arg("darkParams") = DarkCalibrationParams(), py::arg("lightFrames") = std::vector<cv::Size>(),
+        doc("calibrateWithDarkFrames", "Python: `darkBursts` is a list (one per gain) of lists of uint16 or "
+                                       "float32 HxW arrays; `lightFrames` a list of (width, height)."));
     m.def(
         "darkBurstStatistics",
         [](const py::handle& frames, const RawFormat& format, double gain) {

@@ -539,5 +539,96 @@ DarkCalibrationReport calibrateDarkNoise(const std::vector<std::vector<Mat>>& bu
     return report;
 }
 
+namespace {
+
+//! A light sample's mean without its pixel's dark shading (the maps' mean where it numbers no pixel of them).
+void removeDarkShading(NoiseSample& sample, Size frame, const Mat& bd, const Mat& br, double meanPerGain,
+                       double meanOffset)
+{
+    if (frame == bd.size() && sample.pixel >= 0 && sample.pixel < static_cast<int64>(bd.total())) {
+        const int r = static_cast<int>(sample.pixel / bd.cols), c = static_cast<int>(sample.pixel % bd.cols);
+        sample.mean -= sample.gain * bd.at<float>(r, c) + br.at<float>(r, c);
+    } else {
+        sample.mean -= sample.gain * meanPerGain + meanOffset;
+    }
+}
+
+} // namespace
+
+DarkFrameCalibration calibrateWithDarkFrames(const std::vector<NoiseSample>& lightSamples,
+                                             const std::vector<NoiseSample>& darkSamples,
+                                             const std::vector<std::vector<Mat>>& darkBursts,
+                                             const std::vector<double>& darkGains,
+                                             const RawFormat& frameFormat, const CalibrationParams& params,
+                                             const DarkCalibrationParams& darkParams,
+                                             const std::vector<Size>& lightFrames)
+{
+    if (!lightFrames.empty() && lightFrames.size() != lightSamples.size())
+        CV_Error(Error::StsBadArg,
+                 format("calibrateWithDarkFrames: lightFrames has %d sizes for %d light "
+                        "samples (give one per sample, or none)",
+                        static_cast<int>(lightFrames.size()), static_cast<int>(lightSamples.size())));
+    if (darkBursts.empty())
+        CV_Error(Error::StsBadArg, "calibrateWithDarkFrames: no dark bursts");
+    DarkFrameCalibration out;
+    std::vector<NoiseSample> samples = lightSamples;
+    samples.insert(samples.end(), darkSamples.begin(), darkSamples.end());
+    const CalibrationReport base = calibrateNoiseModel(samples, params);
+    DarkCalibrationParams dp = darkParams;
+    int distinct = 0;
+    for (size_t k = 0; k < darkGains.size(); ++k)
+        distinct += std::none_of(darkGains.begin(), darkGains.begin() + static_cast<long>(k),
+                                 [&](double g) { return std::abs(g - darkGains[k]) < 1e-9 * g; });
+    if (distinct < 2 && (dp.rowNoise || dp.darkShading)) {
+        dp.rowNoise = dp.darkShading = false;
+        out.notes.push_back(
+            "dark bursts at one gain only: row noise and dark shading change with the gain and "
+            "need dark bursts at 2 or more gains; only the read noise's shape is calibrated");
+    }
+    out.dark = calibrateDarkNoise(darkBursts, darkGains, frameFormat, base.model, dp);
+    out.report = base;
+    const bool shading = out.dark.model.hasDarkShading();
+    const bool tails = out.dark.model.tukeyRead && std::isnan(params.readExcessKurtosis);
+    if (shading || tails) {
+        if (shading) {
+            const Mat &bd = out.dark.model.darkShadingPerGain, &br = out.dark.model.darkShadingOffset;
+            const double meanPerGain = mean(bd)[0], meanOffset = mean(br)[0];
+            for (size_t i = 0; i < lightSamples.size(); ++i)
+                removeDarkShading(samples[i], lightFrames.empty() ? bd.size() : lightFrames[i], bd, br,
+                                  meanPerGain, meanOffset);
+            out.notes.push_back("the light samples' means were corrected by their pixels' dark shading");
+        }
+        CalibrationParams refit = params;
+        if (tails) {
+            refit.readExcessKurtosis = out.dark.model.readExcessKurtosis();
+            out.notes.push_back(
+                format("the fit takes the read noise's excess kurtosis %.3g from the dark frames "
+                       "(Tukey lambda %.3f)",
+                       refit.readExcessKurtosis, out.dark.model.tukeyLambda));
+        }
+        out.report = calibrateNoiseModel(samples, refit);
+        out.report.model.baseIso = base.model.baseIso;
+        out.notes.push_back("the model was fitted again");
+    }
+    // The components with the (refitted) light model; the rows move out of its read terms, as
+    // calibrateDarkNoise() does (a pixel's temporal variance holds its row's offset).
+    NoiseModel withComponents = out.dark.model;
+    const NoiseModel& light = out.report.model;
+    withComponents.alpha = light.alpha;
+    withComponents.baseIso = light.baseIso;
+    withComponents.failedCalibration = light.failedCalibration;
+    withComponents.sigmaD2 = std::max(light.sigmaD2 - withComponents.rowSigmaD2, 0.0);
+    withComponents.sigmaR2 = std::max(light.sigmaR2 - withComponents.rowSigmaR2, 0.0);
+    if (withComponents.hasRowNoise())
+        out.notes.push_back(
+            format("sigma_d^2 and sigma_r^2 are the pixel's own read noise: the calibrated %.4g and "
+                   "%.4g less the row noise %.4g and %.4g",
+                   light.sigmaD2, light.sigmaR2, withComponents.rowSigmaD2, withComponents.rowSigmaR2));
+    out.dark.model = withComponents;
+    out.report.model = withComponents;
+    out.samples = std::move(samples);
+    return out;
+}
+
 } // namespace rawgment
 } // namespace cv

@@ -465,6 +465,53 @@ CV_RAWGMENT_EXPORTS DarkCalibrationReport calibrateDarkNoise(
     const std::vector<std::vector<Mat>>& bursts, const std::vector<double>& gains, const RawFormat& format,
     const NoiseModel& base, const DarkCalibrationParams& params = DarkCalibrationParams());
 
+/** @brief What calibrateWithDarkFrames() found: the final fit and the dark-frame components. */
+struct CV_RAWGMENT_EXPORTS DarkFrameCalibration
+{
+    /** The final fit of the light and dark samples; its model carries the dark-frame components, with the
+     * row parts moved out of sigma_d^2 and sigma_r^2 (the pixel's own read noise, as the simulator's). */
+    CalibrationReport report;
+    DarkCalibrationReport dark;     //!< the components' report (its model is report.model)
+    std::vector<std::string> notes; //!< what was done to the light samples and the fit, for the user
+    /** The samples of the final fit: the light samples (their means without the dark shading when it was
+     * fitted), then the dark samples, in the order given. */
+    std::vector<NoiseSample> samples;
+};
+
+/** @brief The whole model of a sensor from its light samples and its dark bursts, in one call: what
+ * calibrateNoiseModel() alone cannot know about dark frames.
+ *
+ * 1. calibrateNoiseModel() of the light and dark samples gives the base model;
+ * 2. calibrateDarkNoise() of the dark bursts gives row noise, dark shading and the read noise's shape;
+ * 3. with dark shading, each light sample's mean loses its pixel's \f$ g B_d + B_r \f$: the shading is
+ *    no signal, and left in the means it takes \f$ g\alpha s \f$ from each line's offset (with 4 DN of
+ *    shading sigma_r^2 came out 59% low, and a plain calibrateNoiseModel() of a shaded sensor's light and
+ *    dark samples gives sigma_d^2 about 2% low); with a heavy-tailed read noise, its excess kurtosis
+ *    (NoiseModel::readExcessKurtosis() of the dark fit) replaces the light samples' estimate unless
+ *    params gives one; the model is then fitted again;
+ * 4. the row noise, which every pixel's temporal variance holds, moves out of the read terms.
+ *
+ * @param lightSamples samples of bursts with light (sampleBurstPatches(), sampleStaticScene())
+ * @param darkSamples samples of the dark bursts (sampleDarkBurst(): means 0), or empty
+ * @param darkBursts darkBursts[k]: the dark frames at darkGains[k] (see calibrateDarkNoise())
+ * @param darkGains their linear gains
+ * @param format the CFA format of the frames (black levels)
+ * @param params the fit of the noise model
+ * @param darkParams what to fit of the dark-frame components (row noise and dark shading need 2 or more
+ *        distinct gains: with one, only the read noise's shape is fitted, with a note)
+ * @param lightFrames per light sample, the size of the frame whose pixel NoiseSample::pixel numbers;
+ *        empty: every light sample numbers a pixel of the dark frames. A sample of a frame of another size
+ *        (or of no single pixel) loses the maps' mean shading instead.
+ * @throws cv::Exception as calibrateNoiseModel() and calibrateDarkNoise() do, and when lightFrames is
+ *         neither empty nor one size per light sample.
+ */
+CV_RAWGMENT_EXPORTS DarkFrameCalibration calibrateWithDarkFrames(
+    const std::vector<NoiseSample>& lightSamples, const std::vector<NoiseSample>& darkSamples,
+    const std::vector<std::vector<Mat>>& darkBursts, const std::vector<double>& darkGains,
+    const RawFormat& format, const CalibrationParams& params = CalibrationParams(),
+    const DarkCalibrationParams& darkParams = DarkCalibrationParams(),
+    const std::vector<Size>& lightFrames = std::vector<Size>());
+
 //! @}
 
 } // namespace rawgment
