@@ -1109,6 +1109,43 @@ TEST(Apps, aFailedCalibrationLeavesNoFileThatSilentlyWorks)
     EXPECT_NE(std::string::npos, r.output.find("wrote 1 outputs")) << r.output;
 }
 
+TEST(Apps, theVerdictNamesTheBurstWhoseGainDisagreesWithItsSlope)
+{
+    // Bursts shot at 24 dB but tagged 21 dB: the report blamed the worst residual bin (of whichever gain)
+    // instead of the burst whose gain is wrong. Each gain's slope against the median alpha names it, with the
+    // gain the slope implies (24 dB: 1.41 times the tag).
+    const std::string dir = freshDir("wrong_gain");
+    AppRun r =
+        runApp("rawgment_simulate", "--frames=16 --format=png --validation=false --out='" + dir + "/sim'");
+    ASSERT_EQ(0, r.status) << r.output;
+    std::string manifest = readText(dir + "/sim/manifest.yml");
+    for (size_t at = manifest.find("gain_db: 24."); at != std::string::npos;
+         at = manifest.find("gain_db: 24."))
+        manifest.replace(at, 12, "gain_db: 21.");
+    std::ofstream(dir + "/sim/manifest.yml", std::ios::trunc) << manifest;
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --plots=false --out='" + dir + "/cal'");
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string report = readText(dir + "/cal/report.md");
+    const size_t row = report.find("| gain of each burst against its slope | **FAIL** | 21.00 dB (");
+    ASSERT_NE(std::string::npos, row) << report;
+    const std::string line = report.substr(row, report.find('\n', row) - row);
+    EXPECT_NE(std::string::npos, line.find("g24dB_level0.30/frame_000.png")) << line;
+    EXPECT_EQ(std::string::npos, line.find("g12dB")) << line;
+    // The implied gain is 24 dB within the slope's error (0.36%: 0.03 dB; 0.1 dB is 8 of them).
+    const size_t says = line.find("its slope says gain ");
+    ASSERT_NE(std::string::npos, says);
+    const double impliedDb = std::stod(line.substr(line.find('(', says) + 1));
+    EXPECT_NEAR(24.0, impliedDb, 0.1) << line;
+    // Tagged right, the same bursts pass the check.
+    r = runApp("rawgment_simulate", "--frames=16 --format=png --validation=false --out='" + dir + "/right'");
+    ASSERT_EQ(0, r.status) << r.output;
+    r = runApp("rawgment_calibrate",
+               "'" + dir + "/right/manifest.yml' --plots=false --out='" + dir + "/cal2'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos,
+              readText(dir + "/cal2/report.md").find("| gain of each burst against its slope | pass |"));
+}
+
 TEST(Apps, readersRefuseDevicesAndFifosNamingThem)
 {
     const std::string dir = freshDir("not_regular");
