@@ -160,3 +160,73 @@ def test_every_cxx_example_compiles_and_runs(where, line, code, example_files):
     assert built.returncode == 0, "%s:%d does not compile:\n%s" % (where, line, built.stderr)
     run = subprocess.run(["./example"], capture_output=True, text=True, timeout=60)
     assert run.returncode == 0, "%s:%d fails when run:\n%s" % (where, line, run.stderr)
+
+
+def test_the_calibration_guide_prints_what_it_shows(app_dir, tmp_path):
+    # docs/calibrate_your_camera.md, section 1, showed figures that the same commands no longer printed.
+    # Here its commands run as written (plus --plots=false, which changes no printed figure), every line of
+    # the block it shows must be a line of the output, and the paragraph's offsets from the truth must be
+    # those of the printed model (to its rounding).
+    guide = os.path.join(os.environ["RAWGMENT_SOURCE_DIR"], "docs", "calibrate_your_camera.md")
+    text = open(guide, encoding="utf-8").read()
+    section = text[text.index("## 1. Try it first on simulated files"):text.index("## 2. What to shoot")]
+    commands = re.findall(r"^    build/release/bin/(rawgment_\w+ .*?)(?<!\\)$", section.replace("\\\n", " "), re.M)
+    assert [c.split()[0] for c in commands] == ["rawgment_simulate", "rawgment_calibrate"], commands
+    outputs = []
+    for command in commands:
+        args = command.split()
+        if args[0] == "rawgment_calibrate":
+            args.append("--plots=false")
+        run = subprocess.run([os.path.join(app_dir, args[0])] + args[1:], cwd=tmp_path, capture_output=True,
+                             text=True)
+        assert run.returncode == 0, run.stdout + run.stderr
+        outputs.append(run.stdout)
+    printed = set(line.rstrip() for line in outputs[1].split("\n"))
+    shown = section[section.index("It says, among its notes:"):].split("\n\n")[1]
+    for line in shown.split("\n"):
+        assert line[4:].rstrip() in printed, "docs/calibrate_your_camera.md shows a line the command does not " \
+                                             "print:\n%s\nprinted:\n%s" % (line[4:], outputs[1])
+    model = re.search(r"model: alpha (\S+) \+- (\S+)  sigma_d\^2 (\S+) \+- (\S+) \[.*?\]  sigma_r\^2 (\S+) \+- (\S+) ",
+                      outputs[1])
+    truth = rg.NoiseModel.load(str(tmp_path / "sim" / "truth_noise_model.yml"))
+    # The truth at ISO 100; the calibration's gain 1 is ISO 200, twice the gain.
+    expected = (2 * truth.alpha, 4 * truth.sigmaD2, truth.sigmaR2)
+    values = [float(model.group(i)) for i in (1, 3, 5)]
+    errors = [float(model.group(i)) for i in (2, 4, 6)]
+    stated = re.search(r"the calibration is\s+(\S+),\s+(\S+)\s+and\s+(\S+)\s+of its standard errors off\s+"
+                       r"\((\S+)%,\s+(\S+)%,\s+(\S+)%\)", section)
+    assert stated, "the paragraph of offsets is missing"
+    for k in range(3):
+        z = (values[k] - expected[k]) / errors[k]
+        percent = 100 * (values[k] / expected[k] - 1)
+        assert abs(float(stated.group(1 + k)) - z) <= 0.051, (k, stated.group(1 + k), z)
+        assert abs(float(stated.group(4 + k)) - percent) <= 0.0051 + 0.01 * abs(percent), (k, stated.group(4 + k), percent)
+    samples = re.search(r"of (\d+) samples used", outputs[1]).group(1)
+    assert "(%s samples" % format(int(samples), ",") in section, samples
+
+
+def test_the_guides_colour_chart_example_prints_what_it_shows(app_dir, tmp_path):
+    # The single-frame example of docs/calibrate_your_camera.md on ../shared/data/colorchart.dng: its line and
+    # every row of its verdict table as the command prints them today.
+    data = os.path.join(os.environ["RAWGMENT_SOURCE_DIR"], "..", "shared", "data", "colorchart.dng")
+    if not os.path.exists(data):
+        pytest.skip("../shared/data/colorchart.dng is missing (see ../shared/data/SOURCES.md)")
+    guide = open(os.path.join(os.environ["RAWGMENT_SOURCE_DIR"], "docs", "calibrate_your_camera.md"),
+                 encoding="utf-8").read()
+    (tmp_path / "m.yml").write_text("%%YAML:1.0\ncalibration_manifest:\n  patches: detect\n  bursts:\n"
+                                    "    - { files: [ '%s' ] }\n" % os.path.abspath(data))
+    run = subprocess.run([os.path.join(app_dir, "rawgment_calibrate"), str(tmp_path / "m.yml"),
+                          "--out=" + str(tmp_path / "out"), "--plots=false"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stdout + run.stderr
+    line = re.search(r"variance = \((\S+) \+- (\S+)\) mean \+ \((\S+) \+- (\S+)\)  \(R\^2 (\S+),", run.stdout)
+    shown = re.search(r"variance = \((\S+) \+- (\S+)\) mean \+ \((\S+) \+- (\S+)\) \(DN above black, \+- one\s+"
+                      r"standard error, R\^2 (\S+) over", guide)
+    assert line and shown, run.stdout
+    for k in range(1, 6):
+        digits = len(shown.group(k).split(".")[1]) if "." in shown.group(k) else 0
+        assert round(float(line.group(k)), digits) == float(shown.group(k)), (k, line.group(k), shown.group(k))
+    report = (tmp_path / "out" / "report.md").read_text()
+    table = guide[guide.index("| check | result | measured figure and threshold |"):]
+    table = table[:table.index("\n\n")]
+    for row in table.split("\n")[2:]:
+        assert row.replace("../shared/data/colorchart.dng", os.path.abspath(data)) in report, row
