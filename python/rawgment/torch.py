@@ -148,9 +148,20 @@ class RawFolderDataset(torch.utils.data.Dataset):
         pack: return the four CFA planes instead of the mosaic.
         normalize: divide by the per-site range white - black.
         augment: False returns the files as they are (for validation sets).
+        crop: None, or (height, width), both even: a random crop of each file per sample (its own draw from
+            the sample's seed, at even offsets), taken before the augmentation with its place on the sensor
+            (RawFormat.cropped sets sensorOrigin), so that a model's dark shading is read at the crop's own
+            pixels. A file smaller than the crop is an error naming it.
     """
 
-    def __init__(self, folder, model, policy=None, baseSeed=0, pack=False, normalize=True, augment=True):
+    def __init__(self, folder, model, policy=None, baseSeed=0, pack=False, normalize=True, augment=True,
+                 crop=None):
+        if crop is not None:
+            if len(crop) != 2 or any(int(v) != v or v <= 0 or int(v) % 2 for v in crop):
+                raise ValueError("RawFolderDataset: crop must be (height, width), both even and > 0, not %r"
+                                 % (crop,))
+            crop = (int(crop[0]), int(crop[1]))
+        self.crop = crop
         folder = os.fspath(folder)
         if not os.path.isdir(folder):
             raise FileNotFoundError("RawFolderDataset: '%s' is not a folder" % folder)
@@ -190,6 +201,19 @@ class RawFolderDataset(torch.utils.data.Dataset):
     def __len__(self):
         return len(self.files)
 
+    def _cropped(self, mosaic, fmt, index):
+        """The sample's crop of `mosaic` (a view) and its format, placed on the sensor."""
+        h, w = self.crop
+        rows, cols = mosaic.shape
+        if h > rows or w > cols:
+            raise ValueError("RawFolderDataset: '%s' is %dx%d, smaller than the crop %dx%d (width x height)" %
+                             (self.files[index], cols, rows, w, h))
+        seed = sampleSeed(self.transform.baseSeed, self.epoch, index)
+        draw = np.random.default_rng([seed & 0xFFFFFFFF, seed >> 32, 0x63726F70])  # "crop": not the scene's
+        y = 2 * int(draw.integers(0, (rows - h) // 2 + 1))
+        x = 2 * int(draw.integers(0, (cols - w) // 2 + 1))
+        return mosaic[y:y + h, x:x + w], fmt.cropped(y, x)
+
     def __getitem__(self, index):
         if not 0 <= index < len(self.files):
             raise IndexError("RawFolderDataset index %d out of range (%d files)" % (index, len(self.files)))
@@ -198,6 +222,8 @@ class RawFolderDataset(torch.utils.data.Dataset):
             # would only oversubscribe the cores (the samples are the same on any thread count).
             _rg.setNumThreads(1)
         mosaic, fmt = loadMosaic(self.files[index])
+        if self.crop is not None:
+            mosaic, fmt = self._cropped(mosaic, fmt, index)
         if self.augment:
             result = self.transform(mosaic, fmt, index=index, epoch=self.epoch)
             mosaic, fmt = result.raw, result.format

@@ -249,6 +249,8 @@ void bindCore(py::module_& m)
         .def_readwrite("blackLevel", &RawFormat::blackLevel, doc("RawFormat::blackLevel"))
         .def_readwrite("whiteLevel", &RawFormat::whiteLevel, doc("RawFormat::whiteLevel"))
         .def_readwrite("gain", &RawFormat::gain, doc("RawFormat::gain"))
+        .def_readwrite("sensorOrigin", &RawFormat::sensorOrigin,
+                       doc("RawFormat::sensorOrigin", "Python: a tuple (x, y)."))
         .def("validate", &RawFormat::validate, doc("RawFormat::validate"))
         .def("blackAt", &RawFormat::blackAt, py::arg("row"), py::arg("col"), doc("RawFormat::blackAt"))
         .def("cropped", &RawFormat::cropped, py::arg("rowOffset"), py::arg("colOffset"),

@@ -203,6 +203,11 @@ def test_the_calibration_guide_prints_what_it_shows(app_dir, tmp_path):
         assert abs(float(stated.group(4 + k)) - percent) <= 0.0051 + 0.01 * abs(percent), (k, stated.group(4 + k), percent)
     samples = re.search(r"of (\d+) samples used", outputs[1]).group(1)
     assert "(%s samples" % format(int(samples), ",") in section, samples
+    # The table of what more data buys, later in the guide, is that run's report.md.
+    report = (tmp_path / "cal" / "report.md").read_text()
+    plan = text[text.index("| plan | alpha | sigma_d^2 | sigma_r^2 |"):]
+    for row in plan[:plan.index("\n\n")].split("\n")[2:]:
+        assert row in report, "docs/calibrate_your_camera.md shows a plan row report.md does not have: " + row
 
 
 def test_the_guides_colour_chart_example_prints_what_it_shows(app_dir, tmp_path):

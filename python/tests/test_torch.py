@@ -105,3 +105,45 @@ def test_dataset_options_and_errors(folder, tmp_path, sensor):
         rgt.RawFolderDataset(tmp_path, sensor.effectiveModel())
     with pytest.raises(FileNotFoundError, match="not a folder"):
         rgt.RawFolderDataset(tmp_path / "missing", sensor.effectiveModel())
+
+
+def test_a_crop_is_augmented_with_its_own_pixels_dark_shading(folder, sensor):
+    # A model with dark-shading maps worked only on whole frames. The dataset's crops carry their place on
+    # the sensor (RawFormat.sensorOrigin) and are augmented with the shading of their own pixels: each item
+    # is exactly what the transform makes of that crop with that format, and a pattern read at the origin
+    # instead would differ.
+    mosaic, fmt = rgt.loadMosaic(str(folder / "frame_00.dng"))
+    model = sensor.effectiveModel()
+    rng = np.random.default_rng(5)
+    model.darkShadingPerGain = rng.uniform(0, 4, mosaic.shape).astype(np.float32)
+    model.darkShadingOffset = rng.uniform(0, 8, mosaic.shape).astype(np.float32)
+    data = rgt.RawFolderDataset(folder, model, baseSeed=9, normalize=False, crop=(32, 48))
+    seen = set()
+    for index in range(len(data)):
+        item = data[index]
+        assert tuple(item["raw"].shape) == (1, 32, 48)
+        full, full_fmt = rgt.loadMosaic(data.files[index])
+        crop, crop_fmt = data._cropped(full, full_fmt, index)
+        x, y = crop_fmt.sensorOrigin
+        seen.add((x, y))
+        assert np.array_equal(crop, full[y:y + 32, x:x + 48]) and x % 2 == 0 and y % 2 == 0
+        expected = data.transform(crop, crop_fmt, index=index, epoch=0)
+        assert torch.equal(item["raw"][0], torch.from_numpy(rg.subtractBlackLevel(expected.raw, expected.format)))
+    assert len(seen) > 1, "crops are drawn per sample"
+    # The same crop read as if it were at the sensor's corner gets another pattern: a shift of the crop by
+    # (2, 2) must keep its own pixels' shading (a noiseless check, as in the C++ test).
+    flat = np.full((64, 96), 600.0, np.float32) + model.darkShadingAt(fmt.gain)[:64, :96]
+    crop_fmt = rg.RawFormat(pattern=fmt.pattern, blackLevel=fmt.blackLevel, whiteLevel=fmt.whiteLevel,
+                            gain=fmt.gain).cropped(8, 10)
+    scene = rg.Scene(shift=(2, 2))
+    out = rg.applyScene(flat[8:40, 10:58], crop_fmt, model, scene, seed=1)[0]
+    assert np.abs(out - flat[8:40, 10:58]).max() < 1e-3
+    with pytest.raises(ValueError, match="smaller than the crop"):
+        rgt.RawFolderDataset(folder, model, crop=(2000, 48))[0]
+    with pytest.raises(ValueError, match="both even"):
+        rgt.RawFolderDataset(folder, model, crop=(31, 48))
+    # Through a file: a crop written with writeMosaic keeps its origin in its sidecar.
+    first_crop, first_fmt = data._cropped(*rgt.loadMosaic(data.files[0]), 0)
+    path = folder.parent / "crop_origin.png"
+    rg.writeMosaic(str(path), np.ascontiguousarray(first_crop), rg.MosaicMetadata(format=first_fmt))
+    assert rgt.loadMosaic(str(path))[1].sensorOrigin == first_fmt.sensorOrigin

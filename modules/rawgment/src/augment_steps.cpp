@@ -72,8 +72,8 @@ bool darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, 
             extra[c] = amp[c & 1];
         return true;
     }
-    const float* bd = model.darkShadingPerGain.ptr<float>(r);
-    const float* br = model.darkShadingOffset.ptr<float>(r);
+    const float* bd = model.darkShadingPerGain.ptr<float>(r + d.origin.y) + d.origin.x;
+    const float* br = model.darkShadingOffset.ptr<float>(r + d.origin.y) + d.origin.x;
     // A pair of columns (both sites of the row) per iteration, each with its site's coefficients.
     const float g0 = d.shadingPerGain[even], g1 = d.shadingPerGain[even + 1];
     const float o0 = d.shadingOffset[even], o1 = d.shadingOffset[even + 1];
@@ -91,15 +91,18 @@ bool darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, 
     return check == 0;
 }
 
-void checkDarkShadingSize(const NoiseModel& model, Size size, const char* who)
+void checkDarkShadingSize(const NoiseModel& model, Size size, Point origin, const char* who)
 {
-    if (model.hasDarkShading() && model.darkShadingPerGain.size() != size)
+    if (!model.hasDarkShading())
+        return;
+    const Size maps = model.darkShadingPerGain.size();
+    if ((Rect(origin, size) & Rect(Point(), maps)) != Rect(origin, size))
         CV_Error(
             Error::StsBadArg,
-            format("%s: the model's dark shading is %dx%d but the mosaic %dx%d; the maps are per pixel of "
-                   "the sensor, so the mosaic must be a whole frame of it",
-                   who, model.darkShadingPerGain.cols, model.darkShadingPerGain.rows, size.width,
-                   size.height));
+            format("%s: the model's dark shading is %dx%d but the mosaic %dx%d at sensor origin (%d, %d) "
+                   "does not lie inside it; the maps are per pixel of the sensor: give a crop its offset "
+                   "(RawFormat::sensorOrigin, or RawFormat::cropped())",
+                   who, maps.width, maps.height, size.width, size.height, origin.x, origin.y));
 }
 
 bool isIdentityKernel(const Mat& kernel)

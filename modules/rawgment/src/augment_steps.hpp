@@ -88,6 +88,7 @@ struct DarkTerms
     bool row = false, shading = false, tails = false;
     float rowSigma[4] = {0, 0, 0, 0};
     float shadingPerGain[4] = {0, 0, 0, 0}, shadingOffset[4] = {0, 0, 0, 0};
+    Point origin; // where the mosaic lies on the sensor (RawFormat::sensorOrigin): the maps are read there
     TukeyUnitSampler tailSampler[4]; // the added read part's heavy-tailed shape per site, when `tails`
     bool any() const { return row || shading; }
 };
@@ -99,16 +100,18 @@ struct ShadingRows
     const Mat* perGain = nullptr; // null: no shading
     const Mat* offset = nullptr;
     float gain = 0;
+    Point origin; // the mosaic's (0, 0) on the sensor: row r, column c of the mosaic read the maps there
     ShadingRows() = default;
-    ShadingRows(const NoiseModel& model, double g)
-        : perGain(&model.darkShadingPerGain), offset(&model.darkShadingOffset), gain(static_cast<float>(g))
+    ShadingRows(const NoiseModel& model, double g, Point sensorOrigin)
+        : perGain(&model.darkShadingPerGain), offset(&model.darkShadingOffset), gain(static_cast<float>(g)),
+          origin(sensorOrigin)
     {
     }
     bool empty() const { return perGain == nullptr; }
     //! g B_d + B_r of mosaic row r, column c (float: the same on every CPU path).
     float at(const float* bd, const float* br, int c) const { return gain * bd[c] + br[c]; }
-    const float* perGainRow(int r) const { return perGain->ptr<float>(r); }
-    const float* offsetRow(int r) const { return offset->ptr<float>(r); }
+    const float* perGainRow(int r) const { return perGain->ptr<float>(r + origin.y) + origin.x; }
+    const float* offsetRow(int r) const { return offset->ptr<float>(r + origin.y) + origin.x; }
 };
 
 /** Row r's additive part of `d` into extra[0..cols): d.rowSigma[site] times the row's one draw from
@@ -118,8 +121,9 @@ bool darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, 
                   float* extra);
 //! The error of a step whose dark-shading rows held NaN or Inf (darkRowExtra() returned false).
 void throwNonFiniteShading(const char* who);
-//! Throws StsBadArg naming `who` when the model has dark shading of another size than the mosaic.
-void checkDarkShadingSize(const NoiseModel& model, Size size, const char* who);
+/** Throws StsBadArg naming `who` when the model has dark shading and a mosaic of `size` at the sensor
+ * origin `origin` (RawFormat::sensorOrigin) does not lie inside its maps. */
+void checkDarkShadingSize(const NoiseModel& model, Size size, Point origin, const char* who);
 
 // Rounds a float or a vector of floats in [0, 2^23] to the nearest integer, ties to even: adding and
 // subtracting 2^23 (where the float spacing is 1) leaves the rounding to IEEE's default mode, the same

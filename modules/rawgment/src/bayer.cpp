@@ -156,6 +156,9 @@ void RawFormat::validate() const
                             whiteLevel, s, blackLevel[s]));
     }
     detail::checkFinitePositive(gain, "RawFormat.gain");
+    if (sensorOrigin.x < 0 || sensorOrigin.y < 0)
+        CV_Error(Error::StsBadArg, format("RawFormat.sensorOrigin must be >= 0 (got (%d, %d))",
+                                          sensorOrigin.x, sensorOrigin.y));
 }
 
 RawFormat RawFormat::cropped(int rowOffset, int colOffset) const
@@ -165,6 +168,7 @@ RawFormat RawFormat::cropped(int rowOffset, int colOffset) const
     const int shift = cfaSite(rowOffset, colOffset);
     for (int s = 0; s < 4; ++s)
         out.blackLevel[s] = blackLevel[s ^ shift];
+    out.sensorOrigin += Point(colOffset, rowOffset);
     return out;
 }
 
@@ -177,6 +181,9 @@ void RawFormat::write(FileStorage& fs, const String& name) const
        << "[" << blackLevel[0] << blackLevel[1] << blackLevel[2] << blackLevel[3] << "]";
     fs << "white_level" << whiteLevel;
     fs << "gain" << gain;
+    if (sensorOrigin != Point(0, 0))
+        fs << "sensor_origin"
+           << "[:" << sensorOrigin.x << sensorOrigin.y << "]";
     fs << "}";
 }
 
@@ -191,12 +198,19 @@ RawFormat RawFormat::read(const FileNode& node)
         CV_Error(Error::StsParseError, "raw format: field 'pattern' is missing or not a string");
     f.pattern = cfaPatternFromName(patternNode.string());
     try {
-        rejectUnknownKeys(node, {"pattern", "black_level", "white_level", "gain"});
+        rejectUnknownKeys(node, {"pattern", "black_level", "white_level", "gain", "sensor_origin"});
         const std::vector<double> black = detail::readRealList(node, "black_level", 4);
         for (int s = 0; s < 4; ++s)
             f.blackLevel[s] = black[static_cast<size_t>(s)];
         f.whiteLevel = detail::readRealField(node, "white_level");
         f.gain = detail::readRealField(node, "gain");
+        if (!node["sensor_origin"].empty()) {
+            const std::vector<double> origin = detail::readRealList(node, "sensor_origin", 2);
+            for (double v : origin)
+                if (!(v >= 0 && v <= 1e9 && v == std::floor(v)))
+                    CV_Error(Error::StsParseError, "field 'sensor_origin' must be two whole numbers >= 0");
+            f.sensorOrigin = Point(static_cast<int>(origin[0]), static_cast<int>(origin[1]));
+        }
     } catch (const Exception& e) {
         CV_Error(e.code, "raw format: " + e.err);
     }

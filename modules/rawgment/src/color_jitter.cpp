@@ -373,12 +373,13 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
  *   adds the target's whole shading to the values as they are;
  * - tails: the added read part's lambda (addedReadLambda(): the prior's read p_c^2 b is kept); IGNORE_PRIOR
  *   the model's lambda. */
-detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, const ColorJitter& jitter,
-                                  NoiseAlignment alignment)
+detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, Point sensorOrigin,
+                                  const ColorJitter& jitter, NoiseAlignment alignment)
 {
     detail::DarkTerms d;
     if (alignment == NoiseAlignment::NONE)
         return d;
+    d.origin = sensorOrigin;
     d.row = model.hasRowNoise();
     d.shading = model.hasDarkShading();
     d.tails = model.tukeyRead;
@@ -443,7 +444,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     model.validate();
     noise.validate();
     if (noise.alignment != NoiseAlignment::NONE)
-        detail::checkDarkShadingSize(model, src.size(), "colorJitter");
+        detail::checkDarkShadingSize(model, src.size(), format.sensorOrigin, "colorJitter");
     for (int s = 0; s < 4; ++s)
         detail::checkFinitePositive(jitter.contrast[s], "colorJitter: contrast");
     if (!std::isfinite(jitter.brightness))
@@ -498,14 +499,14 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
 
     const detail::ShadingRows inputShading =
         noise.alignment == NoiseAlignment::ACCOUNT_PRIOR && model.hasDarkShading()
-            ? detail::ShadingRows(model, format.gain)
+            ? detail::ShadingRows(model, format.gain, format.sensorOrigin)
             : detail::ShadingRows();
     Mat prior = noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && noise.alignment != NoiseAlignment::NONE
                     ? localPriorMean(src, format)
                     : Mat();
     if (!prior.empty() && !inputShading.empty())
-        prior -= model.darkShadingAt(format.gain);
-    k.dark = jitterDarkTerms(model, format.gain, jitter, noise.alignment);
+        prior -= model.darkShadingAt(format.gain)(Rect(format.sensorOrigin, src.size()));
+    k.dark = jitterDarkTerms(model, format.gain, format.sensorOrigin, jitter, noise.alignment);
     Mat dst = detail::stepOutput(src, _dst);
     std::atomic<int64> brightening{0};
     std::atomic<bool> nonFinite{false};

@@ -309,11 +309,12 @@ void resampleDarkTerms(ResampleConstants& k, const NoiseModel& model, const RawF
 {
     if (k.alignment == NoiseAlignment::NONE)
         return;
-    detail::checkDarkShadingSize(model, size, "the resampling step");
+    detail::checkDarkShadingSize(model, size, format.sensorOrigin, "the resampling step");
     detail::DarkTerms& d = k.dark;
     d.row = model.hasRowNoise();
     d.shading = model.hasDarkShading();
     d.tails = model.tukeyRead;
+    d.origin = format.sensorOrigin;
     k.rowVariance = model.rowVariance(format.gain);
     k.rowKey = detail::stepKey(seed, rowStream);
     k.tukeyKey = detail::stepKey(seed, tukeyStream);
@@ -327,7 +328,7 @@ void resampleDarkTerms(ResampleConstants& k, const NoiseModel& model, const RawF
             d.tailSampler[s] = detail::TukeyUnitSampler(lambda);
     }
     if (d.shading) {
-        k.shading = detail::ShadingRows(model, format.gain);
+        k.shading = detail::ShadingRows(model, format.gain, format.sensorOrigin);
         if (account)
             k.inputShading = k.shading;
     }

@@ -139,7 +139,7 @@ template <typename T>
 void swapShiftedShading(const Mat& src, const RawFormat& format, const NoiseModel& model, Point shift,
                         Mat& dst)
 {
-    const detail::ShadingRows shading(model, format.gain);
+    const detail::ShadingRows shading(model, format.gain, format.sensorOrigin);
     const int planeRows = src.rows / 2, planeCols = src.cols / 2, hy = shift.y / 2;
     const int first = std::min(std::max(shift.x, 0), src.cols),
               last = std::max(std::min(src.cols + shift.x, src.cols), 0);
@@ -196,7 +196,7 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
         shiftMosaic(current, shift, shifted);
         // The dark shading belongs to the sensor, not to the content: it must not move with the shift.
         if (model.hasDarkShading() && scene.noise.alignment != NoiseAlignment::NONE) {
-            detail::checkDarkShadingSize(model, current.size(), "applyScene");
+            detail::checkDarkShadingSize(model, current.size(), fmt.sensorOrigin, "applyScene");
             if (current.depth() == CV_16U)
                 swapShiftedShading<ushort>(current, fmt, model, shift, shifted);
             else

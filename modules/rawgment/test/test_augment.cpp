@@ -392,6 +392,63 @@ TEST(Augment, aShiftKeepsTheSensorsDarkShadingWhereTheSensorHasIt)
     EXPECT_LT(residual, 1.5 * noise) << "pattern move " << patternMove;
 }
 
+TEST(Augment, aCropReadsTheDarkShadingOfItsOwnPixelsAtItsSensorOrigin)
+{
+    // A model with maps worked only on whole frames ("the mosaic must be a whole frame"). A crop now carries
+    // its offset (RawFormat::sensorOrigin, set by cropped()) and every step reads the maps there.
+    const Size size(96, 64);
+    const NoiseModel model = darkComponentSensor(size).noise;
+    const RawFormat fmt = SensorSimulator(darkComponentSensor(size), size).rawFormat(kGain);
+    const Mat pattern = model.darkShadingAt(kGain);
+    Mat flat(size, CV_32FC1);
+    for (int r = 0; r < size.height; ++r)
+        for (int c = 0; c < size.width; ++c)
+            flat.at<float>(r, c) = static_cast<float>(fmt.blackAt(r, c) + 500) + pattern.at<float>(r, c);
+    const Rect crop(10, 6, 48, 40); // an odd row offset and an even column offset: another CFA phase too
+    const RawFormat cropFmt = fmt.cropped(crop.y, crop.x);
+    EXPECT_EQ(Point(10, 6), cropFmt.sensorOrigin);
+    // A shift of the crop keeps its own pattern in place, exactly as on the whole frame.
+    Scene shifted;
+    shifted.shift = Point(4, -2);
+    Mat out;
+    RawFormat outFmt;
+    applyScene(flat(crop), cropFmt, model, shifted, 3, out, outFmt);
+    EXPECT_LT(norm(out, flat(crop), NORM_INF), 1e-3);
+    EXPECT_EQ(cropFmt.sensorOrigin, outFmt.sensorOrigin);
+    // Darkened x0.5 over 24 seeds: the crop's mean is the darker content plus its own pixels' pattern
+    // (tolerance as in aShiftKeepsTheSensorsDarkShadingWhereTheSensorHasIt); read at the origin (0, 0) the
+    // pattern would be off by its own RMS difference.
+    const int seeds = 24;
+    Mat sum = Mat::zeros(crop.size(), CV_64FC1);
+    for (int seed = 0; seed < seeds; ++seed) {
+        colorJitter(flat(crop), cropFmt, model, ColorJitter::exposureChange(0.5, 1), NoiseOptions(),
+                    uint64(seed), out, outFmt);
+        accumulate(out, sum);
+    }
+    Mat expected(crop.size(), CV_64FC1);
+    for (int r = 0; r < crop.height; ++r)
+        for (int c = 0; c < crop.width; ++c)
+            expected.at<double>(r, c) =
+                fmt.blackAt(r + crop.y, c + crop.x) + 250 + pattern.at<float>(r + crop.y, c + crop.x);
+    const double residual = norm(sum / seeds, expected, NORM_L2) / std::sqrt(double(crop.area()));
+    const double noise = std::sqrt((model.variance(250, kGain) + model.rowVariance(kGain)) / seeds);
+    EXPECT_LT(residual, 1.5 * noise);
+    // Blur and scale read there too: a crop's blur equals nothing off-sensor (no error), and a crop that
+    // does not lie inside the maps is an error naming the sizes and the origin.
+    EXPECT_NO_THROW(motionBlur(flat(crop), cropFmt, model, linearMotionKernel(5, 0), NoiseOptions(), 1, out));
+    EXPECT_NO_THROW(scaleMosaic(flat(crop), cropFmt, model, 1.05, NoiseOptions(), 1, out));
+    RawFormat outside = cropFmt;
+    outside.sensorOrigin = Point(60, 30);
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(flat(crop), outside, model, ColorJitter::exposureChange(0.5, 1),
+                                         NoiseOptions(), 1, out, outFmt),
+                             "colorJitter: the model's dark shading is 96x64 but the mosaic 48x40 at sensor "
+                             "origin (60, 30) does not "
+                             "lie inside it");
+    RawFormat negative = cropFmt;
+    negative.sensorOrigin = Point(-2, 0);
+    EXPECT_CV_ERROR_CONTAINS(negative.validate(), "RawFormat.sensorOrigin must be >= 0 (got (-2, 0))");
+}
+
 TEST(Augment, sameSeedSameBitsOnAnyThreadCount)
 {
     const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
@@ -480,11 +537,13 @@ TEST(Augment, anAbsentComponentChangesNoBitAndBrighteningWithComponentsIsClipped
             EXPECT_EQ(0, test::countNonFinite(asFloat)) << step;
         }
     }
-    // A model whose maps are of another sensor size is an error naming both sizes.
-    Mat small = src(Rect(0, 0, 32, 32));
-    EXPECT_CV_ERROR_CONTAINS(colorJitter(small, fmt, dark, jitter, NoiseOptions(), 5, out, f),
-                             "the model's dark shading is 96x64 but the mosaic 32x32");
-    EXPECT_CV_ERROR_CONTAINS(motionBlur(small, fmt, dark, linearMotionKernel(9, 10), NoiseOptions(), 7, out),
+    // A model whose maps are of a smaller sensor than the mosaic is an error naming both sizes (a crop
+    // inside them is read at its origin: aCropReadsTheDarkShadingOfItsOwnPixelsAtItsSensorOrigin).
+    Mat big(128, 96, src.type(), Scalar(300));
+    EXPECT_CV_ERROR_CONTAINS(
+        colorJitter(big, fmt, dark, jitter, NoiseOptions(), 5, out, f),
+        "the model's dark shading is 96x64 but the mosaic 96x128 at sensor origin (0, 0)");
+    EXPECT_CV_ERROR_CONTAINS(motionBlur(big, fmt, dark, linearMotionKernel(9, 10), NoiseOptions(), 7, out),
                              "the model's dark shading is 96x64");
     // A map value that is not finite is an error, never a NaN output.
     NoiseModel bad = dark;
@@ -497,7 +556,7 @@ TEST(Augment, anAbsentComponentChangesNoBitAndBrighteningWithComponentsIsClipped
     EXPECT_CV_ERROR_CONTAINS(scaleMosaic(src, fmt, bad, 1.1, NoiseAlignment::IGNORE_PRIOR, 7, out),
                              "scaleMosaic: the model's dark shading contains NaN or Inf");
     // Without noise (NONE) the maps are not used, so any size goes.
-    EXPECT_NO_THROW(colorJitter(small, fmt, dark, jitter, NoiseAlignment::NONE, 5, out, f));
+    EXPECT_NO_THROW(colorJitter(big, fmt, dark, jitter, NoiseAlignment::NONE, 5, out, f));
 }
 
 TEST(Augment, identityStepsAreSkippedAndReturnTheInputItself)

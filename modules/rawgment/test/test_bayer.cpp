@@ -162,6 +162,32 @@ TEST(Bayer, rawFormatFileStorageRoundTrip)
     EXPECT_CV_ERROR_CONTAINS(RawFormat::read(noGain["raw_format"]), "'gain' is missing");
 }
 
+TEST(Bayer, aCropsSensorOriginAccumulatesAndRoundTrips)
+{
+    const RawFormat whole = makeFormat(CFA_GRBG);
+    EXPECT_EQ(Point(0, 0), whole.sensorOrigin);
+    const RawFormat crop = whole.cropped(3, 10).cropped(2, 4);
+    EXPECT_EQ(Point(14, 5), crop.sensorOrigin);
+    EXPECT_EQ(whole.cropped(5, 14).pattern, crop.pattern);
+    for (const int format : {FileStorage::FORMAT_YAML, FileStorage::FORMAT_JSON}) {
+        FileStorage out("", FileStorage::WRITE | FileStorage::MEMORY | format);
+        crop.write(out, "raw_format");
+        whole.write(out, "whole");
+        const std::string text = out.releaseAndGetString();
+        FileStorage in(text, FileStorage::READ | FileStorage::MEMORY);
+        EXPECT_EQ(Point(14, 5), RawFormat::read(in["raw_format"]).sensorOrigin);
+        // A whole frame's format is written as before, so older readers keep reading it.
+        EXPECT_TRUE(in["whole"]["sensor_origin"].empty());
+    }
+    for (const char* origin : {"[-2, 0]", "[1.5, 0]", "[3]"}) {
+        FileStorage bad(std::string("%YAML:1.0\nraw_format: {pattern: RGGB, black_level: [1, 2, 3, 4], "
+                                    "white_level: 10, gain: 1, sensor_origin: ") +
+                            origin + "}",
+                        FileStorage::READ | FileStorage::MEMORY | FileStorage::FORMAT_YAML);
+        EXPECT_CV_ERROR_CONTAINS(RawFormat::read(bad["raw_format"]), "sensor_origin");
+    }
+}
+
 class BayerPlanes : public ::testing::TestWithParam<int>
 {
 };

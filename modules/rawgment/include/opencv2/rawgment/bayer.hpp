@@ -86,10 +86,14 @@ struct CV_RAWGMENT_EXPORTS RawFormat
     Vec4d blackLevel = Vec4d::all(0); //!< black level per site, in DN (index = cfaSite())
     double whiteLevel = 65535;        //!< saturation level in DN, on the stored (black-included) scale
     double gain = 1.0;                //!< linear analog gain of the capture (> 0)
+    /** Where the mosaic's top-left pixel lies on the sensor, (x, y) >= 0: (0, 0) for a whole frame, the
+     * crop's offset for a crop (cropped() adds it). Per-pixel maps of the sensor (a NoiseModel's dark
+     * shading) are read there, so a crop gets its own pixels' pattern. */
+    Point sensorOrigin = Point(0, 0);
 
     /** @brief Throws cv::Exception (StsBadArg) naming the field when the format is not usable: pattern
      * outside the enumeration, non-finite or negative black level, white level not above every black
-     * level, gain not finite and positive.
+     * level, gain not finite and positive, a negative sensorOrigin.
      */
     void validate() const;
 
@@ -97,11 +101,13 @@ struct CV_RAWGMENT_EXPORTS RawFormat
     double blackAt(int row, int col) const { return blackLevel[cfaSite(row, col)]; }
 
     /** @brief The format of a crop whose top-left corner is at (rowOffset, colOffset): the pattern and
-     * the per-site black levels follow the phase; levels and gain are unchanged.
+     * the per-site black levels follow the phase, sensorOrigin moves by the offset; levels and gain are
+     * unchanged.
      */
     RawFormat cropped(int rowOffset, int colOffset) const;
 
-    /** @brief Writes the format as a map under `name` (fields pattern, black_level, white_level, gain). */
+    /** @brief Writes the format as a map under `name` (fields pattern, black_level, white_level, gain,
+     * and sensor_origin [x, y] when it is not (0, 0)). */
     void write(FileStorage& fs, const String& name) const;
 
     /** @brief Reads a format written by write(), validating it.
