@@ -72,7 +72,7 @@ int main(int argc, char** argv)
         const rawgment_apps::CalibrateResult r = rawgment_apps::calibrateFromManifest(o);
         const cv::rawgment::CalibrationReport& rep = r.report;
         std::printf("verdict: %s\n", r.verdict.pass ? "PASS" : "FAIL");
-        for (const rawgment_apps::VerdictCheck& c : r.verdict.checks)
+        for (const cv::rawgment::VerdictCheck& c : r.verdict.checks)
             std::printf("  %s %s: %s\n", c.pass ? "pass" : "FAIL", c.name.c_str(), c.figure.c_str());
         std::printf("method %s, %d of %d samples used\n", method.c_str(), rep.samplesUsed, rep.samples);
         for (const cv::rawgment::NoiseLineFit& l : rep.perGain)

@@ -486,7 +486,7 @@ struct BurstInputs
     std::vector<bool> lightSample; // per sample: from a burst with light (its mean holds the dark shading)
     std::vector<cv::Size> sampleFrame; // per sample: the size of the frame whose pixel it numbers
     CsvTable shapiro{{"gain_db", "mean", "p_value", "W"}};
-    std::vector<BurstFacts> facts;
+    std::vector<CalibrationBurstFacts> facts;
     RawFormat firstFormat;
     // The dark bursts' frames, kept for the dark-frame components (their statistics need every frame).
     std::vector<std::vector<cv::Mat>> darkFrames;
@@ -595,7 +595,7 @@ BurstInputs readBursts(const CalibrateOptions& o, const std::vector<CalibrationM
         cv::Mat mean, clipped;
         stats->mean(mean);
         stats->clippedMask(clipped);
-        BurstFacts burstFacts{spec.files.front(), gainsDb[i], stats->frames(), 0.0, spec.dark};
+        CalibrationBurstFacts burstFacts{spec.files.front(), gainsDb[i], stats->frames(), 0.0, spec.dark};
         {
             double area = 0, clippedArea = 0;
             for (const cv::Rect& r : chartless || spec.dark ? frameGridSquares(stats->size()) : squares) {
@@ -689,7 +689,8 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         plan("2x the frames per burst", 2, 1, false, 0);
         plan("4x the frames per burst", 4, 1, false, 0);
         plan("2x the pixels (patches)", 1, 2, false, 0);
-        if (std::none_of(in.facts.begin(), in.facts.end(), [](const BurstFacts& b) { return b.dark; }))
+        if (std::none_of(in.facts.begin(), in.facts.end(),
+                         [](const CalibrationBurstFacts& b) { return b.dark; }))
             plan("dark frames at each gain", 1, 1, true, 0);
         plan(cv::format("one more gain, %.1f dB", linearGainToDb(2 * highest)), 1, 1, false, 2 * highest);
     }

@@ -71,44 +71,6 @@ struct CalibrateOptions
     bool darkComponents = false;
 };
 
-//! What the verdict of a calibration needs to know about one burst besides its samples.
-struct BurstFacts
-{
-    std::string name; //!< its first file
-    double gainDb = 0;
-    int frames = 0;
-    double clippedFraction = 0; //!< of the pixels it could sample (squares, or the frame without a chart)
-    bool dark = false;
-};
-
-//! One check of a calibration's verdict: a measured figure against a stated threshold.
-struct VerdictCheck
-{
-    std::string name;   //!< what is checked
-    bool pass = true;   //!< whether the figure meets the threshold
-    std::string figure; //!< the measured figure, the threshold and, on a failure, what to do
-};
-
-//! PASS when every check passes; the checks and their thresholds are in docs/calibrate_your_camera.md.
-struct CalibrationVerdict
-{
-    bool pass = true;
-    std::vector<VerdictCheck> checks;
-};
-
-/** The variance the calibration predicts at `mean` and `gain`: the model when sigma_d^2 and sigma_r^2
- * were separable; otherwise the line fitted at the nearest calibrated gain, since the model then
- * holds alpha alone and would leave out the read noise. */
-double fittedVariance(const cv::rawgment::CalibrationReport& report, double mean, double gain);
-
-/** Judges a calibration from its samples, its report and its bursts: residuals of the variance against
- * the model per gain and mean bin, distinct means per gain, clipped fraction, frames per burst,
- * curvature of variance against mean (a non-linear raw file), separability of sigma_d^2 and sigma_r^2.
- * @param signalRange white level minus black level of the frames */
-CalibrationVerdict judgeCalibration(const std::vector<cv::rawgment::NoiseSample>& samples,
-                                    const cv::rawgment::CalibrationReport& report,
-                                    const std::vector<BurstFacts>& bursts, double signalRange);
-
 struct CalibrateResult
 {
     cv::rawgment::CalibrationReport report;
@@ -118,7 +80,7 @@ struct CalibrateResult
     int shapiroTested = 0;
     double baseIso = 0;              //!< the ISO of gain 1 (0 when every gain came from the manifest)
     cv::rawgment::CameraTags camera; //!< the first frame's camera tags
-    CalibrationVerdict verdict;
+    cv::rawgment::CalibrationVerdict verdict;
     //! What more data would buy: a plan's name and the standard errors it would give (projectedStdError()).
     std::vector<std::pair<std::string, cv::Vec3d>> projections;
     bool haveDark = false;                    //!< whether the dark-frame components were calibrated

@@ -267,6 +267,36 @@ void bindCalibration(py::module_& m)
         doc("calibrateDarkNoise",
             "Python: `bursts` is a list (one per gain) of lists of uint16 or float32 HxW "
             "arrays."));
+    py::class_<CalibrationBurstFacts>(m, "CalibrationBurstFacts", doc("CalibrationBurstFacts"))
+        .def(keywordInit<CalibrationBurstFacts>())
+        .def_readwrite("name", &CalibrationBurstFacts::name, doc("CalibrationBurstFacts::name"))
+        .def_readwrite("gainDb", &CalibrationBurstFacts::gainDb, doc("CalibrationBurstFacts::gainDb"))
+        .def_readwrite("frames", &CalibrationBurstFacts::frames, doc("CalibrationBurstFacts::frames"))
+        .def_readwrite("clippedFraction", &CalibrationBurstFacts::clippedFraction,
+                       doc("CalibrationBurstFacts::clippedFraction"))
+        .def_readwrite("dark", &CalibrationBurstFacts::dark, doc("CalibrationBurstFacts::dark"));
+    py::class_<VerdictCheck>(m, "VerdictCheck", doc("VerdictCheck"))
+        .def(keywordInit<VerdictCheck>())
+        .def_readwrite("name", &VerdictCheck::name, doc("VerdictCheck::name"))
+        .def_readwrite("passed", &VerdictCheck::pass,
+                       doc("VerdictCheck::pass", "Python: `passed` (pass is a keyword)."))
+        .def_readwrite("figure", &VerdictCheck::figure, doc("VerdictCheck::figure"));
+    py::class_<CalibrationVerdict>(m, "CalibrationVerdict", doc("CalibrationVerdict"))
+        .def(keywordInit<CalibrationVerdict>())
+        .def_readwrite("passed", &CalibrationVerdict::pass,
+                       doc("CalibrationVerdict::pass", "Python: `passed` (pass is a keyword)."))
+        .def_readwrite("checks", &CalibrationVerdict::checks, doc("CalibrationVerdict::checks"));
+    m.def("fittedVariance", &fittedVariance, py::arg("report"), py::arg("mean"), py::arg("gain"),
+          doc("fittedVariance"));
+    m.def(
+        "judgeCalibration",
+        [](const std::vector<NoiseSample>& samples, const CalibrationReport& report,
+           const std::vector<CalibrationBurstFacts>& bursts, double signalRange) {
+            return withoutGil("judgeCalibration",
+                              [&] { return judgeCalibration(samples, report, bursts, signalRange); });
+        },
+        py::arg("samples"), py::arg("report"), py::arg("bursts"), py::arg("signalRange"),
+        doc("judgeCalibration"));
     py::class_<DarkFrameCalibration>(m, "DarkFrameCalibration", doc("DarkFrameCalibration"))
         .def(keywordInit<DarkFrameCalibration>())
         .def_readwrite("report", &DarkFrameCalibration::report, doc("DarkFrameCalibration::report"))

@@ -203,3 +203,27 @@ def test_dark_frames_with_shading_calibrate_in_one_library_call():
     assert np.all(np.abs(z_with.mean(axis=0)) < 2), z_with
     # The plain fit is what the one call exists for: its sigma_d^2 is several standard errors low (-5.0).
     assert z_plain.mean(axis=0)[1] < -2, z_plain
+
+
+def test_the_verdict_is_a_library_call():
+    # rawgment_calibrate's PASS/FAIL checks are judgeCalibration() of the library, here from Python on the
+    # numpy sensor's chart: Gaussian read noise and 16 frames pass every check; facts that say 4 frames fail
+    # the frames check, naming the burst.
+    rng = np.random.default_rng(6000)
+    scene, squares = flat_patches()
+    samples, facts = [], []
+    for gain in (1, 4, 16):
+        stats = burst(rng, scene * (WHITE - BLACK) / (0.25 * gain), gain, 16, 0.25, 2.0, 0.5)
+        samples += rg.sampleBurstPatches(stats, squares, float(gain))
+        facts.append(rg.CalibrationBurstFacts(name="iso%d" % (100 * gain), gainDb=rg.linearGainToDb(gain),
+                                              frames=16, clippedFraction=0.0, dark=False))
+    report = rg.calibrateNoiseModel(samples)
+    verdict = rg.judgeCalibration(samples, report, facts, WHITE - BLACK)
+    assert verdict.passed, [(c.name, c.figure) for c in verdict.checks if not c.passed]
+    assert "gain of each burst against its slope" in [c.name for c in verdict.checks]
+    assert abs(rg.fittedVariance(report, 1000.0, 4.0) - report.model.variance(1000.0, 4.0)) < 1e-9
+    facts[1].frames = 4
+    verdict = rg.judgeCalibration(samples, report, facts, WHITE - BLACK)
+    failed = [c for c in verdict.checks if not c.passed]
+    assert not verdict.passed and [c.name for c in failed] == ["frames per burst"]
+    assert "fewest 4 (iso400)" in failed[0].figure

@@ -1,16 +1,16 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// rawgment_calibrate's verdict: each check a measured figure against a stated threshold. Where each
-// threshold comes from is in docs/calibrate_your_camera.md.
-#include "pipeline.hpp"
+// The verdict of a calibration (judgeCalibration()): each check a measured figure against a stated
+// threshold. Where each threshold comes from is in docs/calibrate_your_camera.md.
+#include "opencv2/rawgment/calibration.hpp"
+#include "precomp.hpp"
 
 #include <algorithm>
 #include <climits>
 #include <cmath>
 #include <map>
 
-namespace rawgment_apps {
-
-using namespace cv::rawgment;
+namespace cv {
+namespace rawgment {
 
 namespace {
 
@@ -50,7 +50,8 @@ VerdictCheck check(const std::string& name, bool pass, const std::string& figure
  * whichever gain deviates most. alpha is taken as the median of a_g / g over the gains, so that one wrong
  * gain of three or more does not move it; a gain disagrees when a_g / (g alpha) is off by more than 5%
  * beyond 4 of its standard errors. With two gains the two can only disagree with each other. */
-VerdictCheck gainsAgreeWithSlopes(const CalibrationReport& report, const std::vector<BurstFacts>& bursts)
+VerdictCheck gainsAgreeWithSlopes(const CalibrationReport& report,
+                                  const std::vector<CalibrationBurstFacts>& bursts)
 {
     const char* name = "gain of each burst against its slope";
     std::vector<double> perGainAlpha;
@@ -62,7 +63,7 @@ VerdictCheck gainsAgreeWithSlopes(const CalibrationReport& report, const std::ve
     const double alpha = median(perGainAlpha);
     const auto burstsAt = [&](double gain) {
         std::string names;
-        for (const BurstFacts& b : bursts)
+        for (const CalibrationBurstFacts& b : bursts)
             if (!b.dark && std::abs(b.gainDb - linearGainToDb(gain)) < 0.01)
                 names += (names.empty() ? "" : ", ") + b.name;
         return names.empty() ? std::string("no burst") : names;
@@ -75,8 +76,7 @@ VerdictCheck gainsAgreeWithSlopes(const CalibrationReport& report, const std::ve
         const double ratio = f.line.a / (f.gain * alpha), se = f.slopeStdError / (f.gain * alpha);
         if (std::abs(ratio - 1) - 4 * se > kMaxGainDeviation && std::abs(ratio - 1) > std::abs(worst - 1)) {
             worst = ratio;
-            wrong =
-                cv::format("%.2f dB (%s): its slope says gain %.3g (%.2f dB), %.3f times the gain its ISO "
+            wrong = format("%.2f dB (%s): its slope says gain %.3g (%.2f dB), %.3f times the gain its ISO "
                            "or gain_db gives",
                            linearGainToDb(f.gain), burstsAt(f.gain).c_str(), f.gain * ratio,
                            linearGainToDb(f.gain * ratio), ratio);
@@ -84,12 +84,11 @@ VerdictCheck gainsAgreeWithSlopes(const CalibrationReport& report, const std::ve
     }
     if (wrong.empty())
         return check(name, true,
-                     cv::format("every gain's slope within %.0f%% (+4 standard errors) of g alpha, alpha the "
-                                "median over %zu gains",
-                                100 * kMaxGainDeviation, perGainAlpha.size()));
+                     format("every gain's slope within %.0f%% (+4 standard errors) of g alpha, alpha the "
+                            "median over %zu gains",
+                            100 * kMaxGainDeviation, perGainAlpha.size()));
     return check(name, false,
-                 wrong +
-                     cv::format("; threshold %.0f%% beyond 4 standard errors%s", 100 * kMaxGainDeviation,
+                 wrong + format("; threshold %.0f%% beyond 4 standard errors%s", 100 * kMaxGainDeviation,
                                 perGainAlpha.size() == 2
                                     ? ": with two gains either may be the wrong one; check both ISOs, or "
                                       "add a third gain"
@@ -111,7 +110,7 @@ double fittedVariance(const CalibrationReport& report, double mean, double gain)
 }
 
 CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, const CalibrationReport& report,
-                                    const std::vector<BurstFacts>& bursts, double signalRange)
+                                    const std::vector<CalibrationBurstFacts>& bursts, double signalRange)
 {
     CalibrationVerdict verdict;
     const auto add = [&](const VerdictCheck& c) {
@@ -123,7 +122,7 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
     std::string fewestName;
     double mostClipped = 0;
     std::string mostClippedName;
-    for (const BurstFacts& b : bursts) {
+    for (const CalibrationBurstFacts& b : bursts) {
         if (b.frames < fewest) {
             fewest = b.frames;
             fewestName = b.name;
@@ -134,13 +133,12 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
         }
     }
     add(check("frames per burst", fewest >= kMinFrames,
-              cv::format("fewest %d (%s); threshold %d%s", fewest, fewestName.c_str(), kMinFrames,
-                         fewest >= kMinFrames ? "" : ": shoot more frames per burst")));
+              format("fewest %d (%s); threshold %d%s", fewest, fewestName.c_str(), kMinFrames,
+                     fewest >= kMinFrames ? "" : ": shoot more frames per burst")));
     add(check("clipped fraction", mostClipped <= kMaxClippedFraction,
-              cv::format("largest %.1f%% (%s); threshold %.0f%%%s", 100 * mostClipped,
-                         mostClippedName.empty() ? "none" : mostClippedName.c_str(),
-                         100 * kMaxClippedFraction,
-                         mostClipped <= kMaxClippedFraction ? "" : ": lower the exposure of that burst")));
+              format("largest %.1f%% (%s); threshold %.0f%%%s", 100 * mostClipped,
+                     mostClippedName.empty() ? "none" : mostClippedName.c_str(), 100 * kMaxClippedFraction,
+                     mostClipped <= kMaxClippedFraction ? "" : ": lower the exposure of that burst")));
 
     // Separability: the spread of the gains.
     double gMin = INFINITY, gMax = 0;
@@ -153,21 +151,21 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
     bool intervalsClear = report.separable && report.uncertainty.source != UNCERTAINTY_NONE;
     std::string intervals;
     if (intervalsClear) {
-        const cv::Vec2d d = report.interval(NOISE_PARAM_SIGMA_D2), r = report.interval(NOISE_PARAM_SIGMA_R2);
+        const Vec2d d = report.interval(NOISE_PARAM_SIGMA_D2), r = report.interval(NOISE_PARAM_SIGMA_R2);
         intervalsClear = d[0] > 0 && r[0] > 0;
-        intervals = cv::format("; 95%% intervals sigma_d^2 [%.4g, %.4g], sigma_r^2 [%.4g, %.4g]", d[0], d[1],
-                               r[0], r[1]);
+        intervals =
+            format("; 95%% intervals sigma_d^2 [%.4g, %.4g], sigma_r^2 [%.4g, %.4g]", d[0], d[1], r[0], r[1]);
     }
     const bool separated = report.separable && ratio >= kMinGainRatio && intervalsClear;
     add(check(
         "separability of sigma_d^2 and sigma_r^2", separated,
-        cv::format("gain ratio %.2f (%.1f dB) over %zu gains%s; threshold %.1f (%.1f dB) and both intervals "
-                   "above 0%s",
-                   ratio, linearGainToDb(ratio), report.perGain.size(), intervals.c_str(), kMinGainRatio,
-                   linearGainToDb(kMinGainRatio),
-                   separated ? ""
-                             : ": add a burst at an ISO at least twice the lowest, and dark frames at "
-                               "each ISO")));
+        format("gain ratio %.2f (%.1f dB) over %zu gains%s; threshold %.1f (%.1f dB) and both intervals "
+               "above 0%s",
+               ratio, linearGainToDb(ratio), report.perGain.size(), intervals.c_str(), kMinGainRatio,
+               linearGainToDb(kMinGainRatio),
+               separated ? ""
+                         : ": add a burst at an ISO at least twice the lowest, and dark frames at "
+                           "each ISO")));
 
     add(gainsAgreeWithSlopes(report, bursts));
 
@@ -216,69 +214,68 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
             const double excess = std::abs(deviation) - 4 * standardError;
             if (excess > kMaxBinDeviation && std::abs(deviation) > std::abs(worstBin)) {
                 worstBin = deviation;
-                badBin = cv::format("%.2f dB, mean %.0f DN: %+.1f%%", linearGainToDb(g), meanOfBin,
-                                    100 * deviation);
+                badBin =
+                    format("%.2f dB, mean %.0f DN: %+.1f%%", linearGainToDb(g), meanOfBin, 100 * deviation);
             }
         }
         const bool spread = distinct >= kMinDistinctMeans && highest - lowest >= kMinMeanSpread * signalRange;
         if (!spread && distinct < worstDistinct) {
             worstDistinct = distinct;
-            fewMeans = cv::format("%.2f dB: %d mean bins of %d samples, spanning %.1f%% of the range",
-                                  linearGainToDb(g), distinct, kMinBinSamples,
-                                  distinct ? 100 * (highest - lowest) / signalRange : 0.0);
+            fewMeans =
+                format("%.2f dB: %d mean bins of %d samples, spanning %.1f%% of the range", linearGainToDb(g),
+                       distinct, kMinBinSamples, distinct ? 100 * (highest - lowest) / signalRange : 0.0);
         }
 
         // Curvature: weighted least squares of v = b + a mu + c mu^2 with weights dof / (2 model^2).
-        cv::Matx33d A = cv::Matx33d::zeros();
-        cv::Vec3d rhs(0, 0, 0);
+        Matx33d A = Matx33d::zeros();
+        Vec3d rhs(0, 0, 0);
         for (const NoiseSample* s : gs) {
             const double m = std::max(0.0, s->mean), predicted = fittedVariance(report, s->mean, g);
             if (!(predicted > 0))
                 continue;
             const double w = s->dof / (2 * predicted * predicted);
-            const cv::Vec3d x(1, m, m * m);
+            const Vec3d x(1, m, m * m);
             A += w * x * x.t();
             rhs += w * s->variance * x;
         }
-        cv::Matx33d cov;
-        if (cv::invert(A, cov, cv::DECOMP_SVD) == 0 || !(hi > 0))
+        Matx33d cov;
+        if (invert(A, cov, DECOMP_SVD) == 0 || !(hi > 0))
             continue;
-        const cv::Vec3d p = cov * rhs;
+        const Vec3d p = cov * rhs;
         const double top = fittedVariance(report, hi, g);
         const double share = p[2] * hi * hi / top, shareSe = std::sqrt(cov(2, 2)) * hi * hi / top;
         if (std::abs(share) - 4 * shareSe > kMaxCurvatureShare &&
             std::abs(share) > std::abs(worstCurvature)) {
             worstCurvature = share;
-            curved = cv::format("%.2f dB: %+.1f%% of the variance at the highest mean (%.0f DN) is curvature",
-                                linearGainToDb(g), 100 * share, hi);
+            curved = format("%.2f dB: %+.1f%% of the variance at the highest mean (%.0f DN) is curvature",
+                            linearGainToDb(g), 100 * share, hi);
         }
     }
     add(check("residuals per gain and mean bin", badBin.empty(),
-              badBin.empty()
-                  ? cv::format("every bin of >= %d samples within %.0f%% (+4 standard errors) of the "
-                               "model",
-                               kMinBinSamples, 100 * kMaxBinDeviation)
-                  : "worst " + badBin +
-                        cv::format("; threshold %.0f%% beyond 4 standard errors: the model does not "
-                                   "describe these data (see the mean-variance plot)",
-                                   100 * kMaxBinDeviation)));
+              badBin.empty() ? format("every bin of >= %d samples within %.0f%% (+4 standard errors) of the "
+                                      "model",
+                                      kMinBinSamples, 100 * kMaxBinDeviation)
+                             : "worst " + badBin +
+                                   format("; threshold %.0f%% beyond 4 standard errors: the model does not "
+                                          "describe these data (see the mean-variance plot)",
+                                          100 * kMaxBinDeviation)));
     add(check("distinct means per gain", fewMeans.empty(),
               fewMeans.empty()
-                  ? cv::format("every gain has >= %d mean bins spanning >= %.0f%% of the range",
-                               kMinDistinctMeans, 100 * kMinMeanSpread)
-                  : fewMeans +
-                        cv::format("; threshold %d bins spanning %.0f%%: use a chart or scene with darker "
-                                   "and brighter parts, or a second exposure",
-                                   kMinDistinctMeans, 100 * kMinMeanSpread)));
+                  ? format("every gain has >= %d mean bins spanning >= %.0f%% of the range",
+                           kMinDistinctMeans, 100 * kMinMeanSpread)
+                  : fewMeans + format("; threshold %d bins spanning %.0f%%: use a chart or scene with darker "
+                                      "and brighter parts, or a second exposure",
+                                      kMinDistinctMeans, 100 * kMinMeanSpread)));
     add(check(
         "linearity (curvature of variance against mean)", curved.empty(),
         curved.empty()
-            ? cv::format("no gain has curvature beyond %.0f%% (+4 standard errors)", 100 * kMaxCurvatureShare)
+            ? format("no gain has curvature beyond %.0f%% (+4 standard errors)", 100 * kMaxCurvatureShare)
             : "worst " + curved +
-                  cv::format("; threshold %.0f%%: the raw values are not linear in light (a tone curve, "
-                             "compression or a processed file?)",
-                             100 * kMaxCurvatureShare)));
+                  format("; threshold %.0f%%: the raw values are not linear in light (a tone curve, "
+                         "compression or a processed file?)",
+                         100 * kMaxCurvatureShare)));
     return verdict;
 }
 
-} // namespace rawgment_apps
+} // namespace rawgment
+} // namespace cv
