@@ -338,6 +338,16 @@ SensorParams darkComponentSensor(Size size)
     return p;
 }
 
+//! A noiseless CV_32FC1 capture of a flat scene `level` DN above black, carrying the sensor's `pattern`.
+Mat flatWithPattern(const RawFormat& fmt, const Mat& pattern, double level)
+{
+    Mat flat(pattern.size(), CV_32FC1);
+    for (int r = 0; r < flat.rows; ++r)
+        for (int c = 0; c < flat.cols; ++c)
+            flat.at<float>(r, c) = static_cast<float>(fmt.blackAt(r, c) + level) + pattern.at<float>(r, c);
+    return flat;
+}
+
 TEST(Augment, aShiftKeepsTheSensorsDarkShadingWhereTheSensorHasIt)
 {
     // applyScene shifted the dark-shading pattern together with the content: on a noiseless flat input
@@ -348,10 +358,7 @@ TEST(Augment, aShiftKeepsTheSensorsDarkShadingWhereTheSensorHasIt)
     ASSERT_TRUE(model.hasDarkShading());
     const RawFormat fmt = SensorSimulator(darkComponentSensor(size), size).rawFormat(kGain);
     const Mat pattern = model.darkShadingAt(kGain);
-    Mat flat(size, CV_32FC1);
-    for (int r = 0; r < size.height; ++r)
-        for (int c = 0; c < size.width; ++c)
-            flat.at<float>(r, c) = static_cast<float>(fmt.blackAt(r, c) + 500) + pattern.at<float>(r, c);
+    const Mat flat = flatWithPattern(fmt, pattern, 500);
     const Rect inside(8, 6, size.width - 8, size.height - 6);
     const double patternMove =
         norm(pattern(inside - Point(8, 6)), pattern(inside), NORM_L2) / std::sqrt(double(inside.area()));
@@ -400,10 +407,7 @@ TEST(Augment, aCropReadsTheDarkShadingOfItsOwnPixelsAtItsSensorOrigin)
     const NoiseModel model = darkComponentSensor(size).noise;
     const RawFormat fmt = SensorSimulator(darkComponentSensor(size), size).rawFormat(kGain);
     const Mat pattern = model.darkShadingAt(kGain);
-    Mat flat(size, CV_32FC1);
-    for (int r = 0; r < size.height; ++r)
-        for (int c = 0; c < size.width; ++c)
-            flat.at<float>(r, c) = static_cast<float>(fmt.blackAt(r, c) + 500) + pattern.at<float>(r, c);
+    const Mat flat = flatWithPattern(fmt, pattern, 500);
     const Rect crop(10, 6, 48, 40); // an odd row offset and an even column offset: another CFA phase too
     const RawFormat cropFmt = fmt.cropped(crop.y, crop.x);
     EXPECT_EQ(Point(10, 6), cropFmt.sensorOrigin);
