@@ -436,9 +436,10 @@ void fitOffsets(const std::vector<NoiseLineFit>& lines, double& sigmaD2, double&
  * squared) and c = a^3 mu / v^2 (the Poisson part), so y = n ((u - 1)^2 - 2 / dof) - c has mean kappa w
  * and kappa is the least-squares slope of y on w. A fourth moment is fragile to defects, so: a pixel whose
  * median ratio over its bursts lies outside [0.5, 2] (a noisy, hot, dead or stuck pixel: a normal one's
- * median over 3 or more bursts of 16 frames lies there but once in 10^5) is left out, and ratios more
- * than 20 of their own standard errors (at the current kappa) above 1 are cut (a hot or noisy pixel in
- * a dark burst), which leaves 0.6% of kappa out at lambda -0.05 and 3% at -0.1 (8 left 7% and 18%). Returns
+ * median over 3 or more bursts of 16 frames lies there but once in 10^5) and a pixel with two or more
+ * read-dominated samples above 3 (a noisy pixel) are left out, and ratios more than 20 of their own
+ * standard errors (at the current kappa, held at most 19) above 1 are cut (a hot or noisy pixel in a dark
+ * burst), which leaves 0.6% of kappa out at lambda -0.05 and 3% at -0.1 (8 left 7% and 18%). Returns
  * false, with the reason, when the read part is too small a share of too few samples (sum of w^2 below 50) to
  * tell. */
 bool estimateReadKurtosis(const std::map<double, std::vector<NoiseSample>>& byGain,
