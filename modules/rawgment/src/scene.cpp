@@ -101,32 +101,48 @@ Scene Scene::read(const FileNode& node)
 
 namespace {
 
-/* Each CFA plane moved by half the (even) shift, vacated pixels replicating the plane's edge, in one
- * pass: output pixel (r, c) is source pixel (2 clamp(r/2 - shift.y/2) + r%2, 2 clamp(c/2 - shift.x/2) +
- * c%2), the clamps to the plane's rows and columns. The same values as splitting the planes, moving each
- * with warpAffine (INTER_NEAREST, BORDER_REPLICATE) and merging them (Augment.shiftMatchesThePlaneWise
+/* Where each output pixel of a shift reads: each CFA plane moved by half the (even) shift, vacated pixels
+ * replicating the plane's edge. Output pixel (r, c) is source pixel (2 clamp(r/2 - shift.y/2) + r%2,
+ * 2 clamp(c/2 - shift.x/2) + c%2), the clamps to the plane's rows and columns; output columns
+ * [first, last) read source column c - shift.x, those left of them the first pair of source columns,
+ * those right of them the last pair. */
+struct ShiftSource
+{
+    int planeRows, planeCols, halfShiftY, shiftX, first, last;
+
+    ShiftSource(Size size, Point shift)
+        : planeRows(size.height / 2), planeCols(size.width / 2), halfShiftY(shift.y / 2), shiftX(shift.x),
+          first(std::min(std::max(shift.x, 0), size.width)),
+          last(std::max(std::min(size.width + shift.x, size.width), 0))
+    {
+    }
+    int row(int r) const { return 2 * std::min(std::max(r / 2 - halfShiftY, 0), planeRows - 1) + (r & 1); }
+    int column(int c) const
+    {
+        return c < first ? (c & 1) : c < last ? c - shiftX : 2 * (planeCols - 1) + (c & 1);
+    }
+};
+
+/* The shift in one pass (ShiftSource): the same values as splitting the planes, moving each with
+ * warpAffine (INTER_NEAREST, BORDER_REPLICATE) and merging them (Augment.shiftMatchesThePlaneWise
  * Composition), at the cost of a copy: the inner columns of a row are one memcpy. */
 void shiftMosaic(const Mat& src, Point shift, Mat& dst)
 {
     CV_Assert(shift.x % 2 == 0 && shift.y % 2 == 0 && src.rows % 2 == 0 && src.cols % 2 == 0);
     dst.create(src.size(), src.type());
-    const int planeRows = src.rows / 2, planeCols = src.cols / 2, hy = shift.y / 2;
+    const ShiftSource from(src.size(), shift);
     const size_t esz = src.elemSize();
-    // Output columns [first, last) read source column c - shift.x; those left of them read the first
-    // pair of source columns, those right of them the last pair.
-    const int first = std::min(std::max(shift.x, 0), src.cols),
-              last = std::max(std::min(src.cols + shift.x, src.cols), 0);
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         for (int r = rows.start; r < rows.end; ++r) {
-            const int planeRow = std::min(std::max(r / 2 - hy, 0), planeRows - 1);
-            const uchar* s = src.ptr(2 * planeRow + (r & 1));
+            const uchar* s = src.ptr(from.row(r));
             uchar* d = dst.ptr(r);
-            for (int c = 0; c < first; ++c)
-                std::memcpy(d + c * esz, s + (c & 1) * esz, esz);
-            if (last > first)
-                std::memcpy(d + first * esz, s + (first - shift.x) * esz, (last - first) * esz);
-            for (int c = std::max(last, first); c < src.cols; ++c)
-                std::memcpy(d + c * esz, s + (2 * (planeCols - 1) + (c & 1)) * esz, esz);
+            for (int c = 0; c < from.first; ++c)
+                std::memcpy(d + c * esz, s + from.column(c) * esz, esz);
+            if (from.last > from.first)
+                std::memcpy(d + from.first * esz, s + from.column(from.first) * esz,
+                            (from.last - from.first) * esz);
+            for (int c = std::max(from.last, from.first); c < src.cols; ++c)
+                std::memcpy(d + c * esz, s + from.column(c) * esz, esz);
         }
     });
 }
@@ -134,27 +150,26 @@ void shiftMosaic(const Mat& src, Point shift, Mat& dst)
 /* The sensor's dark shading S stays where the sensor has it: the shifted content carries the input's S
  * of its source pixel, which is swapped for the S of the pixel it lands on, dst(x) = src(x - d) - S(x - d)
  * + S(x) (float arithmetic, the same on every path; integer mosaics rounded to nearest, ties to even, and
- * kept in range). Clipped pixels stay clipped. Row by row, as shiftMosaic() chose the source. */
+ * kept in range). Clipped pixels stay clipped. Row by row, from ShiftSource's pixels as shiftMosaic() copied
+ * them. */
 template <typename T>
 void swapShiftedShading(const Mat& src, const RawFormat& format, const NoiseModel& model, Point shift,
                         Mat& dst)
 {
     const detail::ShadingRows shading(model, format.gain, format.sensorOrigin);
-    const int planeRows = src.rows / 2, planeCols = src.cols / 2, hy = shift.y / 2;
-    const int first = std::min(std::max(shift.x, 0), src.cols),
-              last = std::max(std::min(src.cols + shift.x, src.cols), 0);
+    const ShiftSource from(src.size(), shift);
     const float white = static_cast<float>(format.whiteLevel);
     const float highest = src.depth() == CV_16U ? 65535.f : std::numeric_limits<float>::max();
     const float lowest = src.depth() == CV_16U ? 0.f : -std::numeric_limits<float>::max();
     std::atomic<bool> nonFinite{false};
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         for (int r = rows.start; r < rows.end; ++r) {
-            const int sr = 2 * std::min(std::max(r / 2 - hy, 0), planeRows - 1) + (r & 1);
+            const int sr = from.row(r);
             const float *bdSrc = shading.perGainRow(sr), *brSrc = shading.offsetRow(sr);
             const float *bdDst = shading.perGainRow(r), *brDst = shading.offsetRow(r);
             T* d = dst.ptr<T>(r);
             for (int c = 0; c < src.cols; ++c) {
-                const int sc = c < first ? (c & 1) : c < last ? c - shift.x : 2 * (planeCols - 1) + (c & 1);
+                const int sc = from.column(c);
                 const float value = static_cast<float>(d[c]);
                 const float swapped = value - shading.at(bdSrc, brSrc, sc) + shading.at(bdDst, brDst, c);
                 if (!std::isfinite(swapped)) {
