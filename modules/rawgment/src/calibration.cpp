@@ -172,11 +172,16 @@ struct ChiSquareBand
     double lo = 0, hi = 0;
 };
 
-ChiSquareBand chiSquareBand(double dof, double k)
+//! The cache key of a band: its effective dof to 0.5%.
+int64 bandKey(double dof)
+{
+    return static_cast<int64>(std::llround(std::log(std::max(dof, 0.5)) * 200));
+}
+
+ChiSquareBand chiSquareBandOfKey(int64 key, double k)
 {
     static std::mutex mutex;
     static std::map<std::pair<int64, double>, ChiSquareBand> cache;
-    const int64 key = static_cast<int64>(std::llround(std::log(std::max(dof, 0.5)) * 200));
     std::lock_guard<std::mutex> lock(mutex);
     auto it = cache.find(std::make_pair(key, k));
     if (it != cache.end())
@@ -209,18 +214,23 @@ double extremeReadValue(double readKurtosis, int frames, double k)
            std::sqrt(detail::tukeyLambdaVariance(lambda));
 }
 
-//! The band of each sample around the line (a, b) (see chiSquareBand() and extremeReadValue()).
+//! The band of each sample around the line (a, b) (see ChiSquareBand and extremeReadValue()).
 std::vector<ChiSquareBand> bandsOf(const std::vector<NoiseSample>& s, double k, double a, double b,
                                    double floor, double readKurtosis)
 {
     std::vector<ChiSquareBand> bands(s.size());
     std::map<int, double> extreme; // by dof
+    std::map<int64, ChiSquareBand>
+        known; // by bandKey(): the shared cache's lock once per key, not per sample
     for (size_t i = 0; i < s.size(); ++i) {
         const double v = std::max(detail::lineVariance(a, b, s[i].mean), floor);
         const int dof = std::max(s[i].dof, 1);
-        bands[i] = chiSquareBand(
-            detail::effectiveDof(v, dof, floor, detail::pixelFourthCumulant(a, b, s[i].mean, readKurtosis)),
-            k);
+        const int64 key = bandKey(
+            detail::effectiveDof(v, dof, floor, detail::pixelFourthCumulant(a, b, s[i].mean, readKurtosis)));
+        auto band = known.find(key);
+        if (band == known.end())
+            band = known.emplace(key, chiSquareBandOfKey(key, k)).first;
+        bands[i] = band->second;
         auto it = extreme.find(dof);
         if (it == extreme.end())
             it = extreme.emplace(dof, extremeReadValue(readKurtosis, dof + 1, k)).first;
