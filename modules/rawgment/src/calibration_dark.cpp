@@ -13,6 +13,16 @@ namespace rawgment {
 
 namespace {
 
+//! How many distinct gains there are (gains within 1e-9 of each other count as one).
+int distinctGains(std::vector<double> gains)
+{
+    std::sort(gains.begin(), gains.end());
+    int distinct = gains.empty() ? 0 : 1;
+    for (size_t k = 1; k < gains.size(); ++k)
+        distinct += gains[k] > gains[k - 1] * (1 + 1e-9) ? 1 : 0;
+    return distinct;
+}
+
 // What one gain's burst gives: its statistics, its temporal mean and its residual samples.
 struct GainData
 {
@@ -472,15 +482,17 @@ DarkCalibrationReport calibrateDarkNoise(const std::vector<std::vector<Mat>>& bu
         CV_Error(Error::StsBadArg,
                  cv::format("calibrateDarkNoise: frames must have even sides >= 2 (got %dx%d)", size.width,
                             size.height));
+    // Before any burst is read: the check needs only the gains.
+    if ((params.rowNoise || params.darkShading) && distinctGains(gains) < 2)
+        CV_Error(Error::StsBadArg,
+                 "calibrateDarkNoise: row noise and dark shading are split by how they change "
+                 "with the gain: give bursts at 2 or more distinct gains (or turn both off)");
     std::vector<size_t> order(gains.size());
     std::iota(order.begin(), order.end(), size_t(0));
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return gains[a] < gains[b]; });
     std::vector<GainData> data;
     for (size_t k : order)
         data.push_back(analyseGain(bursts[k], gains[k], format, params.ppccSamples, size, type));
-    int distinct = 1;
-    for (size_t k = 1; k < data.size(); ++k)
-        distinct += data[k].stats.gain > data[k - 1].stats.gain * (1 + 1e-9) ? 1 : 0;
 
     DarkCalibrationReport report;
     report.model = base;
@@ -492,10 +504,6 @@ DarkCalibrationReport calibrateDarkNoise(const std::vector<std::vector<Mat>>& bu
                            "and lambda are noticeably less accurate (docs/calibrate_your_camera.md)",
                            d.stats.gain, d.stats.frames));
     }
-    if ((params.rowNoise || params.darkShading) && distinct < 2)
-        CV_Error(Error::StsBadArg,
-                 "calibrateDarkNoise: row noise and dark shading are split by how they change "
-                 "with the gain: give bursts at 2 or more distinct gains (or turn both off)");
     if (params.rowNoise) {
         const Vec2d uv = fitRowNoise(data, report.notes);
         report.model.rowSigmaD2 = uv[0];
@@ -575,11 +583,7 @@ DarkFrameCalibration calibrateWithDarkFrames(const std::vector<NoiseSample>& lig
     samples.insert(samples.end(), darkSamples.begin(), darkSamples.end());
     const CalibrationReport base = calibrateNoiseModel(samples, params);
     DarkCalibrationParams dp = darkParams;
-    int distinct = 0;
-    for (size_t k = 0; k < darkGains.size(); ++k)
-        distinct += std::none_of(darkGains.begin(), darkGains.begin() + static_cast<long>(k),
-                                 [&](double g) { return std::abs(g - darkGains[k]) < 1e-9 * g; });
-    if (distinct < 2 && (dp.rowNoise || dp.darkShading)) {
+    if (distinctGains(darkGains) < 2 && (dp.rowNoise || dp.darkShading)) {
         dp.rowNoise = dp.darkShading = false;
         out.notes.push_back(
             "dark bursts at one gain only: row noise and dark shading change with the gain and "
