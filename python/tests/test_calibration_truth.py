@@ -2,7 +2,10 @@
 Poisson electrons, Gaussian or Tukey-lambda read noise before and after the gain, rounding and clipping),
 whose truth is known, so that a bias of the library's sampling or fit shows against it. The statistics
 are fed from numpy frames through BurstStatistics, as the apps feed them from files."""
+import functools
+
 import numpy as np
+import pytest
 
 import rawgment as rg
 
@@ -24,18 +27,24 @@ def natural_scene(rng, h, w):
     return np.clip(s, 0.02, None) / s.max()
 
 
+def tukey_quantile(u, lam):
+    return (u ** lam - (1 - u) ** lam) / lam if lam != 0 else np.log(u / (1 - u))
+
+
+@functools.lru_cache(maxsize=None)
+def tukey_variance(lam):
+    """Variance of the unit Tukey-lambda variable, by midpoint quadrature of its squared quantile, so that
+    this simulator shares no formula with the library (within 1e-4 of the closed form at -0.05)."""
+    grid = (np.arange(200000) + 0.5) / 200000
+    return float(np.mean(tukey_quantile(grid, lam) ** 2))
+
+
 def read_noise(rng, shape, variance, tukey_lambda):
     """Zero-mean read noise of the given variance: Gaussian, or Tukey-lambda by its quantile function."""
     if tukey_lambda is None:
         return rng.normal(0, np.sqrt(variance), shape)
-    u = rng.uniform(0, 1, shape)
-    lam = tukey_lambda
-    q = (u ** lam - (1 - u) ** lam) / lam if lam != 0 else np.log(u / (1 - u))
-    # Variance of the unit Tukey-lambda variable (Beta closed form), by numerical quadrature here so
-    # that this simulator shares no formula with the library.
-    grid = (np.arange(200000) + 0.5) / 200000
-    unit = ((grid ** lam - (1 - grid) ** lam) / lam) if lam != 0 else np.log(grid / (1 - grid))
-    return q * np.sqrt(variance / np.mean(unit ** 2))
+    q = tukey_quantile(rng.uniform(0, 1, shape), tukey_lambda)
+    return q * np.sqrt(variance / tukey_variance(tukey_lambda))
 
 
 def burst(rng, lam, gain, frames, alpha, sd2, sr2, tukey_lambda=None, shading=None, keep=None):
@@ -151,12 +160,8 @@ def test_a_given_read_kurtosis_is_used_and_gaussian_noise_is_estimated_gaussian(
     _, left, report = heavy_tailed_campaign(3001, True, tukey_lambda=None)
     assert abs(report.readExcessKurtosis) < 0.2 and left < 20, (report.readExcessKurtosis, left)
     params.readExcessKurtosis = 1e9
-    try:
+    with pytest.raises(rg.error, match=r"readExcessKurtosis must be NaN \(estimate it\) or lie in \[-2, 1000\]"):
         heavy_tailed_campaign(3000, True, params=params)
-    except rg.error as e:
-        assert "readExcessKurtosis must be NaN (estimate it) or lie in [-2, 1000]" in str(e)
-    else:
-        raise AssertionError("a kurtosis of 1e9 was accepted")
 
 
 def test_dark_frames_with_shading_calibrate_in_one_library_call():
