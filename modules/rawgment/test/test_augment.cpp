@@ -437,8 +437,8 @@ TEST(Augment, aCropReadsTheDarkShadingOfItsOwnPixelsAtItsSensorOrigin)
     const double residual = norm(sum / seeds, expected, NORM_L2) / std::sqrt(double(crop.area()));
     const double noise = std::sqrt((model.variance(250, kGain) + model.rowVariance(kGain)) / seeds);
     EXPECT_LT(residual, 1.5 * noise);
-    // Blur and scale read there too: a crop's blur equals nothing off-sensor (no error), and a crop that
-    // does not lie inside the maps is an error naming the sizes and the origin.
+    // Blur and scale read the maps at the origin too (they refused any crop before), and a crop that does
+    // not lie inside the maps is an error naming the sizes and the origin.
     EXPECT_NO_THROW(motionBlur(flat(crop), cropFmt, model, linearMotionKernel(5, 0), NoiseOptions(), 1, out));
     EXPECT_NO_THROW(scaleMosaic(flat(crop), cropFmt, model, 1.05, NoiseOptions(), 1, out));
     RawFormat outside = cropFmt;
