@@ -257,9 +257,10 @@ void bindAugment(py::module_& m)
           py::arg("channel"), doc("noiseLineFromDngProfile"));
     m.def("darktableNoiseProfiles", &darktableNoiseProfiles, py::arg("model"), py::arg("format"),
           py::arg("baseIso"), py::arg("isos"), py::arg("maker"), py::arg("cameraModel"),
-          doc("darktableNoiseProfiles"));
+          py::arg("haarVarianceRatio") = DARKTABLE_HAAR_VARIANCE_RATIO, doc("darktableNoiseProfiles"));
     m.def("noiseModelFromDarktable", &noiseModelFromDarktable, py::arg("path"), py::arg("format"),
-          py::arg("baseIso"), py::arg("maker"), py::arg("cameraModel"), doc("noiseModelFromDarktable"));
+          py::arg("baseIso"), py::arg("maker"), py::arg("cameraModel"),
+          py::arg("haarVarianceRatio") = DARKTABLE_HAAR_VARIANCE_RATIO, doc("noiseModelFromDarktable"));
     py::class_<AndroidNoiseProfile>(m, "AndroidNoiseProfile", doc("AndroidNoiseProfile"))
         .def(keywordInit<AndroidNoiseProfile>())
         .def_readwrite("A", &AndroidNoiseProfile::A, doc("AndroidNoiseProfile::A"))

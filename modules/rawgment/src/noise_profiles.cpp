@@ -364,6 +364,12 @@ void checkBaseIso(double baseIso, const char* who)
     detail::checkBaseIso(baseIso, (String(who) + ": baseIso").c_str(), false);
 }
 
+void checkHaarVarianceRatio(double c, const char* who)
+{
+    if (!(c > 0 && c <= 1))
+        CV_Error(Error::StsBadArg, format("%s: haarVarianceRatio = %g must lie in (0, 1]", who, c));
+}
+
 String jsonString(const String& text)
 {
     String out = "\"";
@@ -386,10 +392,13 @@ String jsonNumber(double v)
 } // namespace
 
 String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format, double baseIso,
-                              const std::vector<double>& isos, const String& maker, const String& cameraModel)
+                              const std::vector<double>& isos, const String& maker, const String& cameraModel,
+                              double haarVarianceRatio)
 {
     const char* who = "darktableNoiseProfiles";
     checkBaseIso(baseIso, who);
+    checkHaarVarianceRatio(haarVarianceRatio, who);
+    const double c = haarVarianceRatio;
     if (isos.empty())
         CV_Error(Error::StsBadArg, "darktableNoiseProfiles: no ISO given");
     if (maker.empty() || cameraModel.empty())
@@ -408,15 +417,17 @@ String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format, 
         << ",\n      \"models\": [\n        {\n          \"model\": " << jsonString(cameraModel)
         << ",\n          \"comment\": \"cv::rawgment: alpha " << jsonNumber(model.alpha) << ", sigma_d^2 "
         << jsonNumber(model.sigmaD2) << ", sigma_r^2 " << jsonNumber(model.sigmaR2) << " at base ISO "
-        << jsonNumber(baseIso) << "\",\n          \"profiles\": [\n";
+        << jsonNumber(baseIso) << ", in darktable's units (Haar variance ratio " << jsonNumber(c)
+        << ")\",\n          \"profiles\": [\n";
     for (size_t k = 0; k < sorted.size(); ++k) {
         RawFormat atIso = format;
         atIso.gain = sorted[k] / baseIso;
         const std::vector<Vec2d> so = dngNoiseProfile(model, atIso);
         out << "            {\"name\": " << jsonString(cameraModel + cv::format(" iso %g", sorted[k]))
-            << ", \"iso\": " << jsonNumber(sorted[k]) << ",\n             \"a\": [" << jsonNumber(so[0][0])
-            << ", " << jsonNumber(so[1][0]) << ", " << jsonNumber(so[2][0]) << "],\n             \"b\": ["
-            << jsonNumber(so[0][1]) << ", " << jsonNumber(so[1][1]) << ", " << jsonNumber(so[2][1]) << "]}"
+            << ", \"iso\": " << jsonNumber(sorted[k]) << ",\n             \"a\": ["
+            << jsonNumber(c * so[0][0]) << ", " << jsonNumber(c * so[1][0]) << ", "
+            << jsonNumber(c * so[2][0]) << "],\n             \"b\": [" << jsonNumber(c * so[0][1]) << ", "
+            << jsonNumber(c * so[1][1]) << ", " << jsonNumber(c * so[2][1]) << "]}"
             << (k + 1 < sorted.size() ? ",\n" : "\n");
     }
     out << "          ]\n        }\n      ]\n    }\n  ]\n}\n";
@@ -424,9 +435,11 @@ String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format, 
 }
 
 NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format, double baseIso,
-                                   const String& maker, const String& cameraModel)
+                                   const String& maker, const String& cameraModel, double haarVarianceRatio)
 {
     checkBaseIso(baseIso, "noiseModelFromDarktable");
+    checkHaarVarianceRatio(haarVarianceRatio, "noiseModelFromDarktable");
+    const double c = haarVarianceRatio;
     format.validate();
     const String where = "noiseModelFromDarktable: '" + path + "'";
     FileStorage fs = openFileStorageForReading(path, "darktable noise profiles");
@@ -494,7 +507,7 @@ NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format, 
                          cv::format("%s: ISO %g colour %d has a = %g, b = %g; a must be "
                                     "finite and >= 0, b finite",
                                     where.c_str(), p.iso, plane, p.a[size_t(plane)], p.b[size_t(plane)]));
-            const double a = p.a[size_t(plane)] * r / g;
+            const double a = p.a[size_t(plane)] * r / (c * g);
             if (!haveAlpha) {
                 alpha = a;
                 haveAlpha = true;
@@ -506,7 +519,7 @@ NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format, 
                                "counterpart",
                                where.c_str(), p.iso, plane, a, alpha));
             x.push_back(g * g);
-            y.push_back(p.b[size_t(plane)] * r * r);
+            y.push_back(p.b[size_t(plane)] * r * r / c);
         }
     }
     if (distinct.size() < 2)

@@ -49,6 +49,9 @@ int readOptionalIntField(const FileNode& node, const char* field, int fallback);
 //! A required list of exactly `n` numbers, named (and the element) in the error.
 std::vector<double> readRealList(const FileNode& node, const char* field, int n);
 
+//! The extension of a path's file name, with its dot, in lower case ("" when it has none).
+String lowerExtensionOf(const String& path);
+
 /** Writes `path` with a FileStorage, replacing it: the text is built in memory, then written by
  * writeFileAtomically() (checked, synced, atomic). The format follows the extension of `path`
  * (.yml/.yaml or .json); other extensions are rejected. */

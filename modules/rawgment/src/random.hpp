@@ -258,6 +258,8 @@ enum class RandomStream : uint64_t
     BLUR_TUKEY = 12,
     SCALE_ROW = 13,
     SCALE_TUKEY = 14,
+    // Which real camera's noise a sample takes (drawCameraIndex(), one draw per seed).
+    CAMERA_DRAW = 15,
 };
 
 /** The key of one family under a user's seed: the SplitMix64 finaliser of seed + golden * (id + 1),

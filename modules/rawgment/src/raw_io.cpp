@@ -414,7 +414,7 @@ String sidecarPathOf(const String& path)
     return path + ".yml";
 }
 
-namespace {
+namespace detail {
 
 String lowerExtensionOf(const String& path)
 {
@@ -428,7 +428,9 @@ String lowerExtensionOf(const String& path)
     return ext;
 }
 
-} // namespace
+} // namespace detail
+
+using detail::lowerExtensionOf;
 
 void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& metadata)
 {

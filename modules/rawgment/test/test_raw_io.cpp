@@ -267,8 +267,9 @@ TEST(RawIo, darktableNoiseProfilesAreTheDngProfilesPerIsoAndGiveTheModelBack)
         const std::vector<Vec2d> dng = dngNoiseProfile(model, atIso);
         for (int c = 0; c < 3; ++c) {
             // 17 significant digits give the double back exactly.
-            EXPECT_EQ(double(profiles[k]["a"][c]), dng[size_t(c)][0]);
-            EXPECT_EQ(double(profiles[k]["b"][c]), dng[size_t(c)][1]);
+            // darktable's units: c times the per-pixel variance (DarktableImportParams).
+            EXPECT_EQ(double(profiles[k]["a"][c]), DARKTABLE_HAAR_VARIANCE_RATIO * dng[size_t(c)][0]);
+            EXPECT_EQ(double(profiles[k]["b"][c]), DARKTABLE_HAAR_VARIANCE_RATIO * dng[size_t(c)][1]);
         }
     }
 
@@ -306,7 +307,8 @@ TEST(RawIo, darktableFilesThatNoModelMatchesAreRefusedNamingWhy)
     g2.gain = 2;
     const std::vector<Vec2d> p1 = dngNoiseProfile(model, g1), p2 = dngNoiseProfile(model, g2);
     const auto list = [](const std::vector<Vec2d>& p, int k) {
-        return cv::format("[%.17g, %.17g, %.17g]", p[0][k], p[1][k], p[2][k]);
+        const double c = DARKTABLE_HAAR_VARIANCE_RATIO;
+        return cv::format("[%.17g, %.17g, %.17g]", c * p[0][k], c * p[1][k], c * p[2][k]);
     };
     const std::string good = write(
         "good.json",

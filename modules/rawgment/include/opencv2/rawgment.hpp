@@ -5,6 +5,7 @@
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/bayer.hpp>
 #include <opencv2/rawgment/calibration.hpp>
+#include <opencv2/rawgment/camera_profiles.hpp>
 #include <opencv2/rawgment/cpu.hpp>
 #include <opencv2/rawgment/files.hpp>
 #include <opencv2/rawgment/isp.hpp>

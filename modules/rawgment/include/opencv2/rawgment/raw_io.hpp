@@ -86,48 +86,60 @@ CV_RAWGMENT_EXPORTS std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, 
 CV_RAWGMENT_EXPORTS NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& profile,
                                                       const RawFormat& format, CfaChannel channel);
 
+/** @brief darktable's noise variance over the per-pixel raw variance (green channel), as its profiling
+ * tool measures: the Haar-MAD variance of a PPG-demosaiced export (docs/real_cameras.md). */
+constexpr double DARKTABLE_HAAR_VARIANCE_RATIO = 0.080;
+
 /** @brief A noise model as darktable's noise profiles (the `noiseprofiles.json` that its "denoise
  * (profiled)" module reads): one profile per ISO, each with per-colour `a` and `b` (red, green, blue)
- * such that the variance of a signal x normalised to [0, 1] by (white - black) is a x + b.
+ * in darktable's units: the variance darktable's profiling tool would measure on a signal x normalised
+ * to [0, 1] by (white - black) is a x + b.
  *
- * A profile at ISO s is the DNG NoiseProfile of the model at gain g = s / baseIso (dngNoiseProfile()):
- * \f$ a = g\alpha / r \f$, \f$ b = (g^2\sigma_d^2 + \sigma_r^2) / r^2 \f$, r = white - mean black of the
- * colour's sites. darktable measures its own profiles on raw data before white balance, which is
- * what this assumes.
+ * A profile at ISO s is c times the DNG NoiseProfile of the model at gain g = s / baseIso
+ * (dngNoiseProfile()): \f$ a = c g\alpha / r \f$, \f$ b = c (g^2\sigma_d^2 + \sigma_r^2) / r^2 \f$,
+ * r = white - mean black of the colour's sites, c = `haarVarianceRatio` (darktable measures the Haar
+ * coefficients of a demosaiced image, whose variance is c times the pixels'; see
+ * DarktableImportParams). darktable measures its own profiles on raw data before white balance, which
+ * is what this assumes.
  * @param model the calibrated model
  * @param format black and white levels of the camera's raw files (its gain is not used)
  * @param baseIso the ISO at which the model's gain is 1 (finite, > 0)
  * @param isos the ISOs to write a profile for (each finite and > 0, no repeats; at least one)
  * @param maker camera maker as darktable names it (e.g. "Canon"); not empty
  * @param cameraModel camera model as darktable names it (e.g. "EOS 5D Mark II"); not empty
+ * @param haarVarianceRatio c, in (0, 1]
  * @return the JSON text of a complete noise-profile file with one maker and one model entry; numbers are
- *         written with 17 significant digits, so noiseModelFromDarktable() gives the model back.
+ *         written with 17 significant digits, so noiseModelFromDarktable() (with the same c) gives the
+ *         model back, and readCameraProfiles() finds it GOOD.
  * @throws cv::Exception on an invalid argument or a model without shot noise (alpha = 0).
  */
 CV_RAWGMENT_EXPORTS String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format,
                                                   double baseIso, const std::vector<double>& isos,
-                                                  const String& maker, const String& cameraModel);
+                                                  const String& maker, const String& cameraModel,
+                                                  double haarVarianceRatio = DARKTABLE_HAAR_VARIANCE_RATIO);
 
 /** @brief The noise model whose darktable noise profiles a file holds, where the mapping is exact.
  *
  * Reads the profiles of one maker and model (profiles with `"skip": true` are ignored) and inverts
- * darktableNoiseProfiles(): \f$ \alpha = a r / g \f$ from every colour and ISO, and \f$ \sigma_d^2 \f$,
- * \f$ \sigma_r^2 \f$ from the line \f$ b r^2 = g^2\sigma_d^2 + \sigma_r^2 \f$ across ISOs (least squares).
+ * darktableNoiseProfiles(): \f$ \alpha = a r / (c g) \f$ from every colour and ISO, and \f$ \sigma_d^2 \f$,
+ * \f$ \sigma_r^2 \f$ from the line \f$ b r^2 / c = g^2\sigma_d^2 + \sigma_r^2 \f$ across ISOs (least
+ * squares).
  * The model has one alpha for all colours and no other terms, so the file's values must agree with one
  * model to 1e-9 relative; a profile measured by darktable's own tool generally does not, and is refused
- * with the spread it has rather than averaged silently.
+ * with the spread it has rather than averaged silently: readCameraProfiles() fits those.
  * @param path a darktable noise-profile JSON file (read with openFileStorageForReading(); every key is
  *        checked)
  * @param format black and white levels of the camera's raw files
  * @param baseIso the ISO at which the returned model's gain is 1 (its NoiseModel::baseIso)
  * @param maker, cameraModel the entry to read, compared exactly
+ * @param haarVarianceRatio c, in (0, 1], as the file was written with
  * @throws cv::Exception naming the file when it is unreadable or malformed, has no such entry, has
  *         fewer than two distinct ISOs (sigma_d^2 and sigma_r^2 cannot be told apart), or is not of the
  *         model's form.
  */
-CV_RAWGMENT_EXPORTS NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format,
-                                                       double baseIso, const String& maker,
-                                                       const String& cameraModel);
+CV_RAWGMENT_EXPORTS NoiseModel
+noiseModelFromDarktable(const String& path, const RawFormat& format, double baseIso, const String& maker,
+                        const String& cameraModel, double haarVarianceRatio = DARKTABLE_HAAR_VARIANCE_RATIO);
 
 /** @brief The noise model in the form of Android's camera tests (the CTS/ITS `dng_noise_model` output
  * behind `android.sensor.noiseProfile`): for sensitivity s (ISO), the DNG NoiseProfile of each CFA

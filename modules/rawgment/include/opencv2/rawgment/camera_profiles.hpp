@@ -1,0 +1,191 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+#ifndef OPENCV_RAWGMENT_CAMERA_PROFILES_HPP
+#define OPENCV_RAWGMENT_CAMERA_PROFILES_HPP
+
+#include <opencv2/rawgment/noise_model.hpp>
+#include <opencv2/rawgment/raw_io.hpp>
+
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+
+//! @addtogroup rawgment
+//! @{
+
+/** @brief What a camera's measured profiles say about the model of Eq. 5, and whether it is imported. */
+enum CameraProfileVerdict
+{
+    /** Every ISO's shot slope and offset follow the model closely (see DarktableImportParams for the
+     * bounds): the imported model stands for the camera. */
+    CAMERA_PROFILE_GOOD = 0,
+    /** Imported, but some ISO's profile departs from the model by more than the GOOD bounds (the reason
+     * says which): the model is the best fit, not a description. */
+    CAMERA_PROFILE_ROUGH = 1,
+    /** Not imported: the profiles cannot give a model (fewer than two usable ISOs, offsets that are all
+     * zero or negative, a malformed entry; the reason says which). */
+    CAMERA_PROFILE_REFUSED = 2
+};
+
+//! "GOOD", "ROUGH" or "REFUSED". @throws cv::Exception for another value.
+CV_RAWGMENT_EXPORTS String cameraProfileVerdictName(int verdict);
+
+/** @brief How darktable's measured noise profiles are read as per-pixel raw noise, and the bounds of the
+ * verdicts.
+ *
+ * darktable's profiling tool measures the noise of a demosaiced, un-white-balanced export normalised to
+ * [0, 1] by (value - black) / (white - black): the robust (MAD) variance of the one-level Haar HH
+ * coefficient of each colour, binned by brightness, fitted as a x + b. For independent pixel noise of
+ * variance v the HH coefficient's variance is c v, with c = 1/4 without demosaicing; darktable's PPG
+ * demosaic (the default when most profiles were made) interpolates half the green sites from their
+ * neighbours and lowers it. docs/real_cameras.md has the derivation and the reference. */
+struct CV_RAWGMENT_EXPORTS DarktableImportParams
+{
+    /** c: darktable's variance over the per-pixel raw variance, for the green channel. 0.080 is darktable's
+     * PPG green interpolation followed by its Haar-MAD measurement, simulated on white noise
+     * (`python/tools/darktable_haar_ratio.py`); 0.25 would assume no demosaicing. In (0, 1]. */
+    double haarVarianceRatio = 0.080;
+    /** The signal level, as a fraction of white, at which offsets are compared: an offset's residual is
+     * the error of the fitted offset over |b| + a x_ref, the profile's variance there. Offsets can be
+     * zero or negative, so they have no scale of their own. In (0, 1). */
+    double offsetReferenceLevel = 1e-3;
+    //! GOOD needs the median over ISOs of |slope residual| at most this ...
+    double goodMedianSlopeResidual = 0.10;
+    //! ... and the worst at most this ...
+    double goodWorstSlopeResidual = 0.35;
+    //! ... the worst |offset residual| at most this ...
+    double goodWorstOffsetResidual = 1.0;
+    //! ... and at least this many ISOs.
+    int goodMinIsos = 3;
+
+    //! @throws cv::Exception naming a value outside its range.
+    void validate() const;
+};
+
+/** @brief One ISO of a camera's profiles, as the fit sees it (green channel, per-pixel units normalised to
+ * white - black = 1). */
+struct CV_RAWGMENT_EXPORTS CameraIsoFit
+{
+    double iso = 0;            //!< the profile's ISO
+    double gain = 0;           //!< iso / CameraNoiseProfile::baseIso
+    double slope = 0;          //!< measured shot slope a / c
+    double offset = 0;         //!< measured offset b / c (may be negative)
+    double slopeResidual = 0;  //!< (fitted slope - measured) / measured
+    double offsetResidual = 0; //!< (fitted offset - measured) / (|measured| + slope x_ref)
+    /** Largest over smallest shot slope of the colours with a positive slope (1 when the colours agree,
+     * as in profiles that copy green to every colour). */
+    double colourSpread = 1;
+};
+
+/** @brief A real camera's noise, fitted to Eq. 5 from its measured profiles, in units of a raw range of 1.
+ *
+ * Per-pixel variance of a signal x in [0, 1] at gain g = ISO / baseIso:
+ * \f$ g\alpha x + g^2\sigma_d^2 + \sigma_r^2 \f$. modelFor() scales it to a RawFormat's range. */
+struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
+{
+    String maker; //!< maker as the file names it
+    String model; //!< model as the file names it
+    String place; //!< where the entry is in the file, e.g. "noiseprofiles[5].models[12]"
+    int verdict = CAMERA_PROFILE_REFUSED; //!< a CameraProfileVerdict
+    String reason;                        //!< why the verdict is not GOOD (empty when GOOD)
+    double baseIso = 0;                   //!< the lowest usable ISO: gain 1
+    double alpha = 0;               //!< shot slope at gain 1 over the range (1 / full well in electrons)
+    double sigmaD2 = 0;             //!< read variance before the gain, over the range squared
+    double sigmaR2 = 0;             //!< read variance after the gain, over the range squared
+    std::vector<CameraIsoFit> isos; //!< the usable profiles, by ascending ISO (an ISO measured twice twice)
+    int skippedProfiles = 0;        //!< profiles marked "skip" or without a positive green slope
+    double medianSlopeResidual = 0; //!< median over ISOs of |slope residual|
+    double worstSlopeResidual = 0;  //!< largest |slope residual|
+    double worstSlopeIso = 0;       //!< its ISO
+    double worstOffsetResidual = 0; //!< largest |offset residual|
+    double worstOffsetIso = 0;      //!< its ISO
+    double medianColourSpread = 1;  //!< median over ISOs of CameraIsoFit::colourSpread
+    int negativeOffsets = 0;        //!< ISOs whose measured offset is below zero
+    bool monotoneSlope = true;      //!< whether the measured slope never falls as the ISO rises
+
+    //! "maker model", the name cameras are selected by.
+    String name() const;
+    //! Whether the camera is imported (GOOD or ROUGH).
+    bool usable() const { return verdict != CAMERA_PROFILE_REFUSED; }
+    /** @brief The camera's noise model in DN for mosaics of `format`: alpha times r, the variances times
+     * r^2, with r = white - mean black, and NoiseModel::baseIso = baseIso.
+     * @throws cv::Exception when the camera is REFUSED (naming the reason) or the format is invalid. */
+    NoiseModel modelFor(const RawFormat& format) const;
+};
+
+/** @brief Every camera of a darktable noise-profile file (`noiseprofiles.json`), each fitted to Eq. 5 with
+ * its verdict.
+ *
+ * For each maker and model: the green channel's profiles at every ISO (profiles with `"skip": true` and
+ * those without a positive green slope are left out and counted), divided by
+ * DarktableImportParams::haarVarianceRatio to per-pixel units; alpha by least squares on the relative
+ * slope residuals through the origin; sigma_d^2 and sigma_r^2 >= 0 by weighted non-negative least
+ * squares of the offsets, each weighted by 1 / (|b| + a x_ref)^2. An entry that is malformed (a value
+ * that is not a number, a list of another length, an unknown key) is REFUSED with the reason naming its
+ * place, and the other cameras are still read. The project's own exports (darktableNoiseProfiles()) come
+ * back GOOD with their model.
+ * @param path the JSON file (at most the size openFileStorageForReading() allows)
+ * @param params how to read the values and the verdicts' bounds
+ * @throws cv::Exception naming the file when it cannot be read or its top level is not darktable's form
+ *         (a map with a list `noiseprofiles` of maps with `maker` and `models`).
+ */
+CV_RAWGMENT_EXPORTS std::vector<CameraNoiseProfile>
+readCameraProfiles(const String& path, const DarktableImportParams& params = DarktableImportParams());
+
+/** @brief The camera named `name` ("maker model", compared ignoring case and repeated spaces).
+ * @throws cv::Exception when no camera has that name, listing the five closest names; or when it is
+ *         REFUSED, with the reason.
+ */
+CV_RAWGMENT_EXPORTS CameraNoiseProfile findCameraProfile(const std::vector<CameraNoiseProfile>& cameras,
+                                                         const String& name);
+
+/** @brief The cameras a selection names: a comma-separated list of camera names, or one of the words
+ * "good" (every GOOD camera) and "usable" (every GOOD or ROUGH camera).
+ * @throws cv::Exception as findCameraProfile() for a name, or when the selection is empty.
+ */
+CV_RAWGMENT_EXPORTS std::vector<CameraNoiseProfile>
+selectCameraProfiles(const std::vector<CameraNoiseProfile>& cameras, const String& selection);
+
+/** @brief The index of the camera a sample with `seed` draws from `count` cameras: uniform, and the same
+ * for the same seed on every machine and from Python.
+ * @throws cv::Exception when count < 1. */
+CV_RAWGMENT_EXPORTS int drawCameraIndex(int count, uint64 seed);
+
+/** @brief The darktable noise-profile file of this machine: the environment variable
+ * RAWGMENT_DARKTABLE_PROFILES when set, else the install script's copy
+ * (`${RAWGMENT_CACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/rawgment}/darktable/noiseprofiles.json`), else an
+ * installed darktable's `/usr/share/darktable/noiseprofiles.json`; empty when none exists. */
+CV_RAWGMENT_EXPORTS String darktableProfilesPath();
+
+/** @brief Whether a file is a darktable noise-profile file rather than a NoiseModel or an Android profile:
+ * a `.json` file whose top level has the key `noiseprofiles`. */
+CV_RAWGMENT_EXPORTS bool isDarktableProfileFile(const String& path);
+
+/** @brief The noise model of an Android profile YAML as the project writes it (`android_noise_profile.yml`
+ * of rawgment_calibrate: a map `android_noise_profile` with `base_iso` and the lists A, B, C, D of four
+ * values), inverted by noiseModelFromAndroid(). The profile is normalised by each site's range, so the
+ * model in DN needs the format of the mosaics it is for.
+ * @throws cv::Exception naming the file and the field when it is malformed or has no exact model. */
+CV_RAWGMENT_EXPORTS NoiseModel noiseModelFromAndroidFile(const String& path, const RawFormat& format);
+
+/** @brief A noise model from any file the project reads models from: a NoiseModel YAML (NoiseModel::load()),
+ * an Android profile YAML (noiseModelFromAndroidFile()), or, with `camera` given, a darktable profile
+ * file's camera (readCameraProfiles(), then findCameraProfile() and CameraNoiseProfile::modelFor() with
+ * `format`).
+ * @param path the file
+ * @param camera the camera to take from a darktable file; must be empty for the other kinds
+ * @param format the range of the mosaics the model is for (used for a darktable camera only)
+ * @param acceptFailedCalibration as NoiseModel::load()
+ * @throws cv::Exception when the file cannot be read as any of them, a darktable file is given without a
+ *         camera, or a camera is given with another kind of file.
+ */
+CV_RAWGMENT_EXPORTS NoiseModel loadAnyNoiseModel(const String& path, const String& camera,
+                                                 const RawFormat& format,
+                                                 bool acceptFailedCalibration = false);
+
+//! @}
+
+} // namespace rawgment
+} // namespace cv
+
+#endif

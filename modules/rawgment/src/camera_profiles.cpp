@@ -1,0 +1,513 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Real cameras (camera_profiles topic): darktable's measured noise profiles fitted to Eq. 5, the camera
+// catalogue, camera draws, and the one loader that takes a model from any file the project reads.
+#include "precomp.hpp"
+#include "random.hpp"
+#include "raw_io_detail.hpp"
+
+#include <opencv2/rawgment/camera_profiles.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <numeric>
+#include <set>
+
+namespace cv {
+namespace rawgment {
+
+String cameraProfileVerdictName(int verdict)
+{
+    switch (verdict) {
+    case CAMERA_PROFILE_GOOD:
+        return "GOOD";
+    case CAMERA_PROFILE_ROUGH:
+        return "ROUGH";
+    case CAMERA_PROFILE_REFUSED:
+        return "REFUSED";
+    default:
+        CV_Error(Error::StsBadArg,
+                 format("cameraProfileVerdictName: %d is not a CameraProfileVerdict", verdict));
+    }
+}
+
+void DarktableImportParams::validate() const
+{
+    const auto check = [](bool ok, const char* what, double v, const char* range) {
+        if (!ok)
+            CV_Error(Error::StsBadArg,
+                     format("DarktableImportParams: %s = %g must lie in %s", what, v, range));
+    };
+    check(haarVarianceRatio > 0 && haarVarianceRatio <= 1, "haarVarianceRatio", haarVarianceRatio, "(0, 1]");
+    check(offsetReferenceLevel > 0 && offsetReferenceLevel < 1, "offsetReferenceLevel", offsetReferenceLevel,
+          "(0, 1)");
+    check(goodMedianSlopeResidual > 0 && goodMedianSlopeResidual <= goodWorstSlopeResidual,
+          "goodMedianSlopeResidual", goodMedianSlopeResidual, "(0, goodWorstSlopeResidual]");
+    check(std::isfinite(goodWorstSlopeResidual), "goodWorstSlopeResidual", goodWorstSlopeResidual,
+          "(0, inf)");
+    check(goodWorstOffsetResidual > 0 && std::isfinite(goodWorstOffsetResidual), "goodWorstOffsetResidual",
+          goodWorstOffsetResidual, "(0, inf)");
+    check(goodMinIsos >= 2, "goodMinIsos", goodMinIsos, "[2, inf)");
+}
+
+String CameraNoiseProfile::name() const
+{
+    return maker + " " + model;
+}
+
+NoiseModel CameraNoiseProfile::modelFor(const RawFormat& format) const
+{
+    if (!usable())
+        CV_Error(Error::StsBadArg, "camera '" + name() + "' is REFUSED: " + reason);
+    format.validate();
+    const double black =
+        (format.blackLevel[0] + format.blackLevel[1] + format.blackLevel[2] + format.blackLevel[3]) / 4;
+    const double r = format.whiteLevel - black;
+    NoiseModel m(alpha * r, sigmaD2 * r * r, sigmaR2 * r * r);
+    m.baseIso = baseIso;
+    m.validate();
+    return m;
+}
+
+namespace {
+
+double median(std::vector<double> v)
+{
+    if (v.empty())
+        return 0;
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+struct MeasuredProfile
+{
+    double iso = 0;
+    double a[3] = {0, 0, 0};
+    double b[3] = {0, 0, 0};
+};
+
+//! The profiles of one model entry; throws naming the profile's place on a malformed one.
+std::vector<MeasuredProfile> readProfiles(const FileNode& modelNode, const String& place, int& skipped)
+{
+    std::vector<MeasuredProfile> profiles;
+    int k = 0;
+    for (const FileNode& p : modelNode["profiles"]) {
+        const String where = place + format(".profiles[%d]", k++);
+        try {
+            if (!p.isMap())
+                CV_Error(Error::StsParseError, "expected a map");
+            rejectUnknownKeys(p, {"name", "iso", "a", "b", "skip", "comment"});
+            const FileNode skip = p["skip"];
+            if (!skip.empty() && !skip.isInt())
+                CV_Error(Error::StsParseError, "field 'skip' must be true or false");
+            if (!skip.empty() && int(skip) != 0) {
+                ++skipped;
+                continue;
+            }
+            MeasuredProfile m;
+            m.iso = detail::readRealField(p, "iso");
+            const std::vector<double> a = detail::readRealList(p, "a", 3),
+                                      b = detail::readRealList(p, "b", 3);
+            for (int c = 0; c < 3; ++c) {
+                m.a[c] = a[size_t(c)];
+                m.b[c] = b[size_t(c)];
+                if (!std::isfinite(m.a[c]) || !std::isfinite(m.b[c]))
+                    CV_Error(Error::StsParseError, format("colour %d has a non-finite a or b", c));
+            }
+            if (!(std::isfinite(m.iso) && m.iso > 0))
+                CV_Error(Error::StsParseError, format("ISO %g must be finite and > 0", m.iso));
+            profiles.push_back(m);
+        } catch (const Exception& e) {
+            CV_Error(Error::StsParseError, where + ": " + e.err);
+        }
+    }
+    return profiles;
+}
+
+/** sigma_d^2, sigma_r^2 >= 0 minimising sum w (g^2 sd + sr - b)^2: the unconstrained solution when it is
+ * feasible, else the best of the two faces and the origin (the problem is convex, so that is optimal). */
+Vec2d fitOffsets(const std::vector<double>& g2, const std::vector<double>& b, const std::vector<double>& w)
+{
+    double s00 = 0, s01 = 0, s11 = 0, t0 = 0, t1 = 0;
+    for (size_t k = 0; k < b.size(); ++k) {
+        s00 += w[k] * g2[k] * g2[k];
+        s01 += w[k] * g2[k];
+        s11 += w[k];
+        t0 += w[k] * g2[k] * b[k];
+        t1 += w[k] * b[k];
+    }
+    const auto cost = [&](Vec2d s) {
+        double c = 0;
+        for (size_t k = 0; k < b.size(); ++k)
+            c += w[k] * (g2[k] * s[0] + s[1] - b[k]) * (g2[k] * s[0] + s[1] - b[k]);
+        return c;
+    };
+    std::vector<Vec2d> candidates = {Vec2d(std::max(0.0, t0 / s00), 0), Vec2d(0, std::max(0.0, t1 / s11)),
+                                     Vec2d(0, 0)};
+    const double det = s00 * s11 - s01 * s01;
+    if (det > 1e-12 * s00 * s11) {
+        const Vec2d free((t0 * s11 - t1 * s01) / det, (s00 * t1 - s01 * t0) / det);
+        if (free[0] >= 0 && free[1] >= 0)
+            return free;
+    }
+    Vec2d best = candidates[0];
+    for (const Vec2d& c : candidates)
+        if (cost(c) < cost(best))
+            best = c;
+    return best;
+}
+
+void judge(CameraNoiseProfile& cam, const DarktableImportParams& params)
+{
+    std::vector<String> rough;
+    if (cam.medianSlopeResidual > params.goodMedianSlopeResidual)
+        rough.push_back(format("median shot-slope residual %.0f%% > %.0f%%", 100 * cam.medianSlopeResidual,
+                               100 * params.goodMedianSlopeResidual));
+    if (cam.worstSlopeResidual > params.goodWorstSlopeResidual)
+        rough.push_back(format("shot slope %.0f%% off at ISO %g (> %.0f%%)", 100 * cam.worstSlopeResidual,
+                               cam.worstSlopeIso, 100 * params.goodWorstSlopeResidual));
+    if (cam.worstOffsetResidual > params.goodWorstOffsetResidual)
+        rough.push_back(format("offset %.0f%% off at ISO %g (> %.0f%%)", 100 * cam.worstOffsetResidual,
+                               cam.worstOffsetIso, 100 * params.goodWorstOffsetResidual));
+    std::set<double> distinct;
+    for (const CameraIsoFit& f : cam.isos)
+        distinct.insert(f.iso);
+    if (int(distinct.size()) < params.goodMinIsos)
+        rough.push_back(format("%d ISOs (< %d)", int(distinct.size()), params.goodMinIsos));
+    if (2 * cam.negativeOffsets > int(cam.isos.size()))
+        rough.push_back(
+            format("negative offsets at %d of %d ISOs", cam.negativeOffsets, int(cam.isos.size())));
+    cam.verdict = rough.empty() ? CAMERA_PROFILE_GOOD : CAMERA_PROFILE_ROUGH;
+    for (const String& r : rough)
+        cam.reason += (cam.reason.empty() ? "" : "; ") + r;
+}
+
+//! Fits one camera from its measured profiles; sets REFUSED with the reason when it cannot.
+void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& profiles,
+               const DarktableImportParams& params)
+{
+    const double c = params.haarVarianceRatio;
+    // Two profiles at one ISO (19 of darktable's 4.2.1 cameras have some) are two measurements of it:
+    // both are fitted.
+    std::vector<const MeasuredProfile*> usable;
+    std::set<double> distinct;
+    for (const MeasuredProfile& p : profiles) {
+        if (!(p.a[1] > 0)) {
+            ++cam.skippedProfiles;
+            continue;
+        }
+        distinct.insert(p.iso);
+        usable.push_back(&p);
+    }
+    std::stable_sort(usable.begin(), usable.end(),
+                     [](const MeasuredProfile* x, const MeasuredProfile* y) { return x->iso < y->iso; });
+    if (distinct.size() < 2) {
+        cam.verdict = CAMERA_PROFILE_REFUSED;
+        cam.reason = usable.empty() ? String("no profile with a positive green shot slope")
+                                    : format("a single usable ISO (%g): the read noise before and after the "
+                                             "gain cannot be told apart",
+                                             usable[0]->iso);
+        return;
+    }
+    cam.baseIso = usable.front()->iso;
+    std::vector<double> g, a, b, g2, w;
+    for (const MeasuredProfile* p : usable) {
+        CameraIsoFit f;
+        f.iso = p->iso;
+        f.gain = p->iso / cam.baseIso;
+        f.slope = p->a[1] / c;
+        f.offset = p->b[1] / c;
+        double lo = HUGE_VAL, hi = 0;
+        for (int k = 0; k < 3; ++k)
+            if (p->a[k] > 0) {
+                lo = std::min(lo, p->a[k]);
+                hi = std::max(hi, p->a[k]);
+            }
+        f.colourSpread = hi / lo;
+        cam.isos.push_back(f);
+        g.push_back(f.gain);
+        a.push_back(f.slope);
+        b.push_back(f.offset);
+        g2.push_back(f.gain * f.gain);
+        const double scale = std::abs(f.offset) + f.slope * params.offsetReferenceLevel;
+        w.push_back(1 / (scale * scale));
+    }
+    // alpha minimises the relative slope residuals: sum ((g alpha - a) / a)^2.
+    double num = 0, den = 0;
+    for (size_t k = 0; k < g.size(); ++k) {
+        num += g[k] / a[k];
+        den += g[k] * g[k] / (a[k] * a[k]);
+    }
+    cam.alpha = num / den;
+    const Vec2d offsets = fitOffsets(g2, b, w);
+    cam.sigmaD2 = offsets[0];
+    cam.sigmaR2 = offsets[1];
+
+    std::vector<double> slopeResiduals, spreads;
+    for (size_t k = 0; k < cam.isos.size(); ++k) {
+        CameraIsoFit& f = cam.isos[k];
+        f.slopeResidual = (f.gain * cam.alpha - f.slope) / f.slope;
+        f.offsetResidual = (g2[k] * cam.sigmaD2 + cam.sigmaR2 - f.offset) / (1 / std::sqrt(w[k]));
+        slopeResiduals.push_back(std::abs(f.slopeResidual));
+        spreads.push_back(f.colourSpread);
+        if (std::abs(f.slopeResidual) > cam.worstSlopeResidual) {
+            cam.worstSlopeResidual = std::abs(f.slopeResidual);
+            cam.worstSlopeIso = f.iso;
+        }
+        if (std::abs(f.offsetResidual) > cam.worstOffsetResidual) {
+            cam.worstOffsetResidual = std::abs(f.offsetResidual);
+            cam.worstOffsetIso = f.iso;
+        }
+        cam.negativeOffsets += f.offset < 0;
+        if (k > 0 && f.iso > cam.isos[k - 1].iso && f.slope < cam.isos[k - 1].slope)
+            cam.monotoneSlope = false;
+    }
+    cam.medianSlopeResidual = median(slopeResiduals);
+    cam.medianColourSpread = median(spreads);
+    if (cam.negativeOffsets == int(cam.isos.size())) {
+        cam.verdict = CAMERA_PROFILE_REFUSED;
+        cam.reason = format("offsets below zero at all %d ISOs: the read noise was not measured",
+                            int(cam.isos.size()));
+        return;
+    }
+    if (cam.sigmaD2 == 0 && cam.sigmaR2 == 0) {
+        cam.verdict = CAMERA_PROFILE_REFUSED;
+        cam.reason = "the offsets fit no read noise at all (sigma_d^2 = sigma_r^2 = 0)";
+        return;
+    }
+    judge(cam, params);
+}
+
+String normalisedName(const String& name)
+{
+    String out;
+    for (char ch : name) {
+        const bool space = std::isspace(static_cast<unsigned char>(ch)) != 0;
+        if (space && (out.empty() || out.back() == ' '))
+            continue;
+        out += space ? ' ' : static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    }
+    while (!out.empty() && out.back() == ' ')
+        out.pop_back();
+    return out;
+}
+
+size_t editDistance(const String& x, const String& y)
+{
+    std::vector<size_t> row(y.size() + 1);
+    std::iota(row.begin(), row.end(), size_t(0));
+    for (size_t i = 1; i <= x.size(); ++i) {
+        size_t diagonal = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= y.size(); ++j) {
+            const size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (x[i - 1] == y[j - 1] ? 0 : 1)});
+            diagonal = up;
+        }
+    }
+    return row[y.size()];
+}
+
+} // namespace
+
+std::vector<CameraNoiseProfile> readCameraProfiles(const String& path, const DarktableImportParams& params)
+{
+    params.validate();
+    const String where = "readCameraProfiles: '" + path + "'";
+    FileStorage fs = openFileStorageForReading(path, "darktable noise profiles");
+    std::vector<CameraNoiseProfile> cameras;
+    const FileNode root = fs.root();
+    try {
+        rejectUnknownKeys(root, {"version", "noiseprofiles"});
+        if (!root["noiseprofiles"].isSeq())
+            CV_Error(Error::StsParseError, "expected a list 'noiseprofiles'");
+    } catch (const Exception& e) {
+        CV_Error(Error::StsParseError, where + ": " + e.err);
+    }
+    int i = 0;
+    for (const FileNode& makerNode : root["noiseprofiles"]) {
+        const String makerPlace = format("noiseprofiles[%d]", i++);
+        try {
+            if (!makerNode.isMap())
+                CV_Error(Error::StsParseError, "expected a map");
+            rejectUnknownKeys(makerNode, {"maker", "models", "comment"});
+            if (!makerNode["maker"].isString() || !makerNode["models"].isSeq())
+                CV_Error(Error::StsParseError, "a maker entry needs a string 'maker' and a list 'models'");
+        } catch (const Exception& e) {
+            CV_Error(Error::StsParseError, where + ": " + makerPlace + ": " + e.err);
+        }
+        int j = 0;
+        for (const FileNode& modelNode : makerNode["models"]) {
+            CameraNoiseProfile cam;
+            cam.maker = String(makerNode["maker"]);
+            cam.place = makerPlace + format(".models[%d]", j++);
+            try {
+                if (!modelNode.isMap())
+                    CV_Error(Error::StsParseError, "expected a map");
+                rejectUnknownKeys(modelNode, {"model", "comment", "profiles"});
+                if (!modelNode["model"].isString() || !modelNode["profiles"].isSeq())
+                    CV_Error(Error::StsParseError,
+                             "a model entry needs a string 'model' and a list 'profiles'");
+                cam.model = String(modelNode["model"]);
+                const std::vector<MeasuredProfile> profiles =
+                    readProfiles(modelNode, cam.place, cam.skippedProfiles);
+                fitCamera(cam, profiles, params);
+            } catch (const Exception& e) {
+                // One malformed camera is refused, naming its place; the others are still read.
+                CameraNoiseProfile refused;
+                refused.maker = cam.maker;
+                refused.model = cam.model;
+                refused.place = cam.place;
+                cam = refused;
+                cam.verdict = CAMERA_PROFILE_REFUSED;
+                cam.reason =
+                    "malformed: " +
+                    (e.err.compare(0, cam.place.size(), cam.place) == 0 ? e.err : cam.place + ": " + e.err);
+            }
+            cameras.push_back(cam);
+        }
+    }
+    std::set<String> names;
+    for (CameraNoiseProfile& cam : cameras)
+        if (!names.insert(normalisedName(cam.name())).second && cam.usable()) {
+            cam.verdict = CAMERA_PROFILE_REFUSED;
+            cam.reason = "its name repeats an earlier entry's: cameras are selected by name";
+        }
+    return cameras;
+}
+
+CameraNoiseProfile findCameraProfile(const std::vector<CameraNoiseProfile>& cameras, const String& name)
+{
+    const String wanted = normalisedName(name);
+    for (const CameraNoiseProfile& cam : cameras)
+        if (normalisedName(cam.name()) == wanted) {
+            if (!cam.usable())
+                CV_Error(Error::StsBadArg, "camera '" + cam.name() + "' is REFUSED: " + cam.reason);
+            return cam;
+        }
+    std::vector<std::pair<size_t, String>> near;
+    for (const CameraNoiseProfile& cam : cameras)
+        near.emplace_back(editDistance(wanted, normalisedName(cam.name())), cam.name());
+    std::sort(near.begin(), near.end());
+    String list;
+    for (size_t k = 0; k < near.size() && k < 5; ++k)
+        list += (k ? "', '" : "'") + near[k].second + (k + 1 == std::min<size_t>(near.size(), 5) ? "'" : "");
+    CV_Error(Error::StsBadArg, "no camera named '" + name + "' among " + std::to_string(cameras.size()) +
+                                   " cameras" + (list.empty() ? String() : "; the closest are " + list));
+}
+
+std::vector<CameraNoiseProfile> selectCameraProfiles(const std::vector<CameraNoiseProfile>& cameras,
+                                                     const String& selection)
+{
+    const String word = normalisedName(selection);
+    std::vector<CameraNoiseProfile> chosen;
+    if (word == "good" || word == "usable") {
+        for (const CameraNoiseProfile& cam : cameras)
+            if (cam.verdict == CAMERA_PROFILE_GOOD || (word == "usable" && cam.usable()))
+                chosen.push_back(cam);
+        if (chosen.empty())
+            CV_Error(Error::StsBadArg, "camera selection '" + selection + "': no camera has that verdict");
+        return chosen;
+    }
+    size_t start = 0;
+    while (start <= selection.size()) {
+        const size_t comma = std::min(selection.find(',', start), selection.size());
+        String one = selection.substr(start, comma - start);
+        one.erase(0, one.find_first_not_of(" \t"));
+        one.erase(one.find_last_not_of(" \t") + 1);
+        if (!one.empty())
+            chosen.push_back(findCameraProfile(cameras, one));
+        start = comma + 1;
+    }
+    if (chosen.empty())
+        CV_Error(Error::StsBadArg, "camera selection '" + selection + "' names no camera");
+    return chosen;
+}
+
+int drawCameraIndex(int count, uint64 seed)
+{
+    if (count < 1)
+        CV_Error(Error::StsBadArg,
+                 format("drawCameraIndex: %d cameras to draw from; need at least one", count));
+    const uint64_t key = detail::stepKey(seed, detail::RandomStream::CAMERA_DRAW);
+    const std::array<uint32_t, 4> words =
+        detail::philox4x32({0, 0, 0, 0}, {uint32_t(key), uint32_t(key >> 32)});
+    // Multiply-shift maps 32 uniform bits onto [0, count) with a bias below count / 2^32 (2e-7 for
+    // darktable's 374 cameras).
+    return static_cast<int>((uint64_t(words[0]) * static_cast<uint64_t>(count)) >> 32);
+}
+
+String darktableProfilesPath()
+{
+    const char* chosen = std::getenv("RAWGMENT_DARKTABLE_PROFILES");
+    if (chosen && *chosen)
+        return chosen;
+    const char* cache = std::getenv("RAWGMENT_CACHE_DIR");
+    const char* xdg = std::getenv("XDG_CACHE_HOME");
+    const char* home = std::getenv("HOME");
+    const String folder = cache && *cache ? String(cache)
+                          : xdg && *xdg   ? String(xdg) + "/rawgment"
+                          : home && *home ? String(home) + "/.cache/rawgment"
+                                          : String();
+    if (!folder.empty() && detail::fileExists(folder + "/darktable/noiseprofiles.json"))
+        return folder + "/darktable/noiseprofiles.json";
+    if (detail::fileExists("/usr/share/darktable/noiseprofiles.json"))
+        return "/usr/share/darktable/noiseprofiles.json";
+    return String();
+}
+
+bool isDarktableProfileFile(const String& path)
+{
+    if (detail::lowerExtensionOf(path) != ".json")
+        return false;
+    FileStorage fs = openFileStorageForReading(path, "noise model");
+    return !fs.root()["noiseprofiles"].empty();
+}
+
+NoiseModel noiseModelFromAndroidFile(const String& path, const RawFormat& format)
+{
+    FileStorage fs = openFileStorageForReading(path, "Android noise profile");
+    const FileNode node = fs["android_noise_profile"];
+    AndroidNoiseProfile profile;
+    double baseIso = 0;
+    try {
+        if (!node.isMap())
+            CV_Error(Error::StsParseError, "expected a map 'android_noise_profile'");
+        rejectUnknownKeys(node, {"comment", "base_iso", "A", "B", "C", "D"});
+        baseIso = detail::readRealField(node, "base_iso");
+        Vec4d* fields[4] = {&profile.A, &profile.B, &profile.C, &profile.D};
+        const char* names[4] = {"A", "B", "C", "D"};
+        for (int f = 0; f < 4; ++f) {
+            const std::vector<double> v = detail::readRealList(node, names[f], 4);
+            *fields[f] = Vec4d(v[0], v[1], v[2], v[3]);
+        }
+        return noiseModelFromAndroid(profile, format, baseIso);
+    } catch (const Exception& e) {
+        CV_Error(e.code, "noiseModelFromAndroidFile: '" + path + "': " + e.err);
+    }
+}
+
+NoiseModel loadAnyNoiseModel(const String& path, const String& camera, const RawFormat& format,
+                             bool acceptFailedCalibration)
+{
+    if (isDarktableProfileFile(path)) {
+        if (camera.empty())
+            CV_Error(Error::StsBadArg, "'" + path +
+                                           "' is a darktable noise-profile file of many cameras: choose one "
+                                           "(--camera in the apps; rawgment_cameras lists them)");
+        return findCameraProfile(readCameraProfiles(path), camera).modelFor(format);
+    }
+    if (!camera.empty())
+        CV_Error(Error::StsBadArg, "a camera ('" + camera + "') is chosen, but '" + path +
+                                       "' is not a darktable noise-profile file");
+    {
+        FileStorage fs = openFileStorageForReading(path, "noise model");
+        if (!fs["android_noise_profile"].empty())
+            return noiseModelFromAndroidFile(path, format);
+    }
+    return NoiseModel::load(path, acceptFailedCalibration);
+}
+
+} // namespace rawgment
+} // namespace cv

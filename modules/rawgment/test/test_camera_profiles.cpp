@@ -1,0 +1,356 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Real cameras: darktable's measured profiles fitted to Eq. 5, the catalogue, camera draws, and the
+// loader of every model file.
+#include "test_common.hpp"
+
+#include <opencv2/rawgment/camera_profiles.hpp>
+#include <opencv2/rawgment/files.hpp>
+
+#include <chrono>
+#include <cstdlib>
+#include <map>
+
+namespace cv {
+namespace rawgment {
+namespace test {
+namespace {
+
+RawFormat fourteenBitFormat()
+{
+    RawFormat f;
+    f.pattern = CFA_RGGB;
+    f.blackLevel = Vec4d(512, 512, 512, 512);
+    f.whiteLevel = 16383;
+    return f;
+}
+
+std::string writeText(const std::string& dir, const std::string& name, const std::string& text)
+{
+    writeFileAtomically(dir + "/" + name, text.data(), text.size());
+    return dir + "/" + name;
+}
+
+//! One camera entry of a darktable file: profiles (iso, green a, green b), red and blue as green.
+std::string cameraEntry(const std::string& model, const std::vector<Vec3d>& profiles,
+                        const std::string& extra = "")
+{
+    std::string text = "{\"model\": \"" + model + "\", \"profiles\": [";
+    for (size_t k = 0; k < profiles.size(); ++k)
+        text += cv::format("%s{\"name\": \"p\", \"iso\": %.17g, \"a\": [%.17g, %.17g, %.17g], \"b\": [%.17g, "
+                           "%.17g, %.17g]%s}",
+                           k ? ", " : "", profiles[k][0], profiles[k][1], profiles[k][1], profiles[k][1],
+                           profiles[k][2], profiles[k][2], profiles[k][2], extra.c_str());
+    return text + "]}";
+}
+
+std::string profileFile(const std::string& maker, const std::vector<std::string>& models)
+{
+    std::string text = "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"" + maker + "\", \"models\": [";
+    for (size_t k = 0; k < models.size(); ++k)
+        text += (k ? ", " : "") + models[k];
+    return text + "]}]}\n";
+}
+
+const CameraNoiseProfile& byModel(const std::vector<CameraNoiseProfile>& cams, const std::string& model)
+{
+    for (const CameraNoiseProfile& c : cams)
+        if (c.model == model)
+            return c;
+    throw std::runtime_error("no camera " + model);
+}
+
+} // namespace
+
+TEST(CameraProfiles, theProjectsOwnExportComesBackGoodWithItsModel)
+{
+    const std::string dir = makeTempDir("camera_profiles_own");
+    const NoiseModel model(0.42, 1.7, 3.1);
+    const RawFormat format = fourteenBitFormat();
+    const std::string path =
+        writeText(dir, "own.json",
+                  darktableNoiseProfiles(model, format, 100, {100, 400, 800, 3200}, "Rawgment", "Sim"));
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(path);
+    ASSERT_EQ(cams.size(), 1u);
+    const CameraNoiseProfile& cam = cams[0];
+    EXPECT_EQ(cam.name(), "Rawgment Sim");
+    EXPECT_EQ(cam.verdict, CAMERA_PROFILE_GOOD) << cam.reason;
+    EXPECT_EQ(cam.place, "noiseprofiles[0].models[0]");
+    ASSERT_EQ(cam.isos.size(), 4u);
+    EXPECT_EQ(cam.baseIso, 100);
+    // An exact model: every residual is rounding (17-digit text and one division by c).
+    EXPECT_LT(cam.worstSlopeResidual, 1e-12);
+    EXPECT_LT(cam.worstOffsetResidual, 1e-9);
+    EXPECT_EQ(cam.medianColourSpread, 1);
+    const NoiseModel back = cam.modelFor(format);
+    EXPECT_NEAR(back.alpha, model.alpha, 1e-12 * model.alpha);
+    EXPECT_NEAR(back.sigmaD2, model.sigmaD2, 1e-9 * model.sigmaD2);
+    EXPECT_NEAR(back.sigmaR2, model.sigmaR2, 1e-9 * model.sigmaR2);
+    EXPECT_EQ(back.baseIso, 100);
+    // The model is per unit of range: a 12-bit format of the same camera scales alpha by the range and the
+    // variances by its square.
+    RawFormat twelve = format;
+    twelve.blackLevel = Vec4d(128, 128, 128, 128);
+    twelve.whiteLevel = 4095;
+    const double ratio = (4095.0 - 128) / (16383 - 512);
+    EXPECT_NEAR(cam.modelFor(twelve).alpha, model.alpha * ratio, 1e-12);
+    EXPECT_NEAR(cam.modelFor(twelve).sigmaR2, model.sigmaR2 * ratio * ratio, 1e-9);
+    // And the exact loader of the same file agrees.
+    const NoiseModel exact = noiseModelFromDarktable(path, format, 100, "Rawgment", "Sim");
+    EXPECT_NEAR(exact.alpha, back.alpha, 1e-12 * model.alpha);
+}
+
+TEST(CameraProfiles, aFitOfNoisyProfilesRecoversTheModelAndMeasuresItsResiduals)
+{
+    // Profiles of a known camera (per pixel: alpha 1e-4, sigma_d^2 1e-8, sigma_r^2 4e-8, over the range)
+    // with each ISO's slope off by a known factor: the fit and the residuals follow the definitions.
+    const double c = DARKTABLE_HAAR_VARIANCE_RATIO;
+    const double alpha = 1e-4, sd = 1e-8, sr = 4e-8;
+    const double isos[] = {100, 200, 400, 800, 1600};
+    const double slopeError[] = {1.0, 0.95, 1.01, 0.99, 1.0};
+    std::vector<Vec3d> profiles;
+    for (int k = 0; k < 5; ++k) {
+        const double g = isos[k] / 100;
+        profiles.emplace_back(isos[k], c * g * alpha * slopeError[k], c * (g * g * sd + sr));
+    }
+    const std::string dir = makeTempDir("camera_profiles_fit");
+    const std::string path =
+        writeText(dir, "fit.json", profileFile("Maker", {cameraEntry("Five", profiles)}));
+    const CameraNoiseProfile cam = readCameraProfiles(path)[0];
+    ASSERT_EQ(cam.verdict, CAMERA_PROFILE_GOOD) << cam.reason;
+    // The relative least squares through the origin: alpha = sum(1/e) / sum(1/e^2) with e the errors.
+    double num = 0, den = 0;
+    for (double e : slopeError) {
+        num += 1 / e;
+        den += 1 / (e * e);
+    }
+    EXPECT_NEAR(cam.alpha, alpha * num / den, 1e-15);
+    for (int k = 0; k < 5; ++k)
+        EXPECT_NEAR(cam.isos[size_t(k)].slopeResidual, (num / den) / slopeError[k] - 1, 1e-12) << isos[k];
+    EXPECT_EQ(cam.worstSlopeIso, 200);
+    // Exact offsets are fitted exactly.
+    EXPECT_NEAR(cam.sigmaD2, sd, 1e-6 * sd);
+    EXPECT_NEAR(cam.sigmaR2, sr, 1e-6 * sr);
+    EXPECT_LT(cam.worstOffsetResidual, 1e-6);
+    EXPECT_TRUE(cam.monotoneSlope);
+}
+
+TEST(CameraProfiles, negativeOffsetsAreFittedWithNonNegativeTerms)
+{
+    // Offsets that dip below zero at low ISO (as 138 of darktable's cameras do): the fit keeps
+    // sigma_r^2 >= 0, and a camera whose offsets are all negative is refused.
+    const double c = DARKTABLE_HAAR_VARIANCE_RATIO;
+    std::vector<Vec3d> dipping, negative;
+    const double isos[] = {100, 200, 400, 800, 1600, 3200};
+    for (double iso : isos) {
+        const double g = iso / 100;
+        dipping.emplace_back(iso, c * g * 1e-4, c * (g * g * 1e-8 - 2e-8));
+        negative.emplace_back(iso, c * g * 1e-4, -c * 1e-8);
+    }
+    const std::string dir = makeTempDir("camera_profiles_negative");
+    const std::string path =
+        writeText(dir, "neg.json",
+                  profileFile("Maker", {cameraEntry("Dipping", dipping), cameraEntry("Negative", negative)}));
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(path);
+    const CameraNoiseProfile& dip = byModel(cams, "Dipping");
+    EXPECT_TRUE(dip.usable()) << dip.reason;
+    EXPECT_GE(dip.sigmaR2, 0);
+    EXPECT_GT(dip.sigmaD2, 0);
+    EXPECT_EQ(dip.negativeOffsets, 1); // ISO 100: 1e-8 - 2e-8
+    const CameraNoiseProfile& neg = byModel(cams, "Negative");
+    EXPECT_EQ(neg.verdict, CAMERA_PROFILE_REFUSED);
+    EXPECT_NE(neg.reason.find("offsets below zero at all 6 ISOs"), std::string::npos) << neg.reason;
+    EXPECT_CV_ERROR_CONTAINS(neg.modelFor(fourteenBitFormat()), "is REFUSED: offsets below zero");
+}
+
+TEST(CameraProfiles, malformedAndUnusableEntriesAreRefusedNamingTheirPlaceAndTheOthersRead)
+{
+    const double c = DARKTABLE_HAAR_VARIANCE_RATIO;
+    const std::vector<Vec3d> good = {Vec3d(100, c * 1e-4, c * 4e-8), Vec3d(200, c * 2e-4, c * 5e-8),
+                                     Vec3d(400, c * 4e-4, c * 8e-8)};
+    const std::string dir = makeTempDir("camera_profiles_malformed");
+    const std::string path = writeText(
+        dir, "mixed.json",
+        profileFile(
+            "Maker",
+            {cameraEntry("Good", good), cameraEntry("One ISO", {good[0]}),
+             "{\"model\": \"Short\", \"profiles\": [{\"name\": \"p\", \"iso\": 100, \"a\": [1e-5, 1e-5], "
+             "\"b\": [0, 0, 0]}]}",
+             cameraEntry("Unknown key", good, ", \"colour\": 1"),
+             "{\"model\": \"Text ISO\", \"profiles\": [{\"iso\": \"high\", \"a\": [1, 1, 1], \"b\": [1, 1, "
+             "1]}]}",
+             cameraEntry("Twice", {good[0], good[0], good[1]}), cameraEntry("good", good)}));
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(path);
+    ASSERT_EQ(cams.size(), 7u);
+    EXPECT_EQ(byModel(cams, "Good").verdict, CAMERA_PROFILE_GOOD);
+    const auto reasonOf = [&](const std::string& model) { return byModel(cams, model).reason; };
+    EXPECT_NE(reasonOf("One ISO").find("a single usable ISO (100)"), std::string::npos);
+    EXPECT_NE(
+        reasonOf("Short").find("malformed: noiseprofiles[0].models[2].profiles[0]: field 'a' must be a list "
+                               "of 3 numbers"),
+        std::string::npos)
+        << reasonOf("Short");
+    EXPECT_NE(reasonOf("Unknown key").find("noiseprofiles[0].models[3].profiles[0]: unknown key 'colour'"),
+              std::string::npos)
+        << reasonOf("Unknown key");
+    EXPECT_NE(reasonOf("Text ISO").find("models[4].profiles[0]"), std::string::npos) << reasonOf("Text ISO");
+    // Two profiles of one ISO are two measurements of it, both fitted.
+    EXPECT_TRUE(byModel(cams, "Twice").usable()) << reasonOf("Twice");
+    EXPECT_EQ(byModel(cams, "Twice").isos.size(), 3u);
+    // "Maker good" repeats "Maker Good" but for case: selection by name would be ambiguous.
+    EXPECT_NE(cams[6].reason.find("repeats an earlier entry"), std::string::npos);
+    for (const CameraNoiseProfile& cam : cams)
+        if (!cam.usable())
+            EXPECT_FALSE(cam.reason.empty()) << cam.name();
+
+    // A file that is not darktable's form is an error naming it.
+    const std::string notProfiles = writeText(dir, "other.json", "{\"noiseprofiles\": 3}\n");
+    EXPECT_CV_ERROR_CONTAINS(readCameraProfiles(notProfiles), "other.json': expected a list 'noiseprofiles'");
+    const std::string badMaker =
+        writeText(dir, "maker.json", "{\"noiseprofiles\": [{\"maker\": 3, \"models\": []}]}\n");
+    EXPECT_CV_ERROR_CONTAINS(readCameraProfiles(badMaker), "noiseprofiles[0]: a maker entry needs a string");
+    DarktableImportParams wrong;
+    wrong.haarVarianceRatio = 0;
+    EXPECT_CV_ERROR_CONTAINS(readCameraProfiles(path, wrong), "haarVarianceRatio = 0 must lie in (0, 1]");
+}
+
+TEST(CameraProfiles, camerasAreFoundByNameAndAMissingOneListsTheClosest)
+{
+    const double c = DARKTABLE_HAAR_VARIANCE_RATIO;
+    const std::vector<Vec3d> good = {Vec3d(100, c * 1e-4, c * 4e-8), Vec3d(200, c * 2e-4, c * 5e-8),
+                                     Vec3d(400, c * 4e-4, c * 8e-8)};
+    const std::vector<Vec3d> rough = {Vec3d(100, c * 1e-4, c * 4e-8), Vec3d(200, c * 4e-4, c * 5e-8),
+                                      Vec3d(400, c * 4e-4, c * 8e-8)};
+    const std::string dir = makeTempDir("camera_profiles_names");
+    const std::string path =
+        writeText(dir, "names.json",
+                  profileFile("Nikon", {cameraEntry("D3", good), cameraEntry("D300", good),
+                                        cameraEntry("D3S", rough), cameraEntry("Z 6", {good[0]})}));
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(path);
+    EXPECT_EQ(findCameraProfile(cams, "  nikon   d3 ").model, "D3");
+    EXPECT_CV_ERROR_CONTAINS(
+        findCameraProfile(cams, "Nikon D3x"),
+        "no camera named 'Nikon D3x' among 4 cameras; the closest are 'Nikon D3', 'Nikon D3S'");
+    EXPECT_CV_ERROR_CONTAINS(findCameraProfile(cams, "Nikon Z 6"),
+                             "'Nikon Z 6' is REFUSED: a single usable ISO");
+    EXPECT_EQ(byModel(cams, "D3S").verdict, CAMERA_PROFILE_ROUGH);
+    EXPECT_NE(byModel(cams, "D3S").reason.find("shot slope"), std::string::npos)
+        << byModel(cams, "D3S").reason;
+
+    EXPECT_EQ(selectCameraProfiles(cams, "good").size(), 2u);
+    EXPECT_EQ(selectCameraProfiles(cams, "usable").size(), 3u);
+    const std::vector<CameraNoiseProfile> listed = selectCameraProfiles(cams, "Nikon D300, nikon d3s");
+    ASSERT_EQ(listed.size(), 2u);
+    EXPECT_EQ(listed[1].model, "D3S");
+    EXPECT_CV_ERROR_CONTAINS(selectCameraProfiles(cams, " , "), "names no camera");
+    EXPECT_CV_ERROR_CONTAINS(selectCameraProfiles(cams, "Nikon D3, Canon X"), "no camera named 'Canon X'");
+}
+
+TEST(CameraProfiles, cameraDrawsAreUniformAndAFunctionOfTheSeed)
+{
+    const int count = 7, draws = 70000;
+    std::vector<int> hits(count, 0);
+    for (int s = 0; s < draws; ++s) {
+        const int k = drawCameraIndex(count, uint64(s));
+        ASSERT_GE(k, 0);
+        ASSERT_LT(k, count);
+        ++hits[size_t(k)];
+        ASSERT_EQ(k, drawCameraIndex(count, uint64(s)));
+    }
+    // Pearson's chi-square with 6 degrees of freedom: 22.46 is its 0.999 quantile, so a uniform draw
+    // fails this one time in a thousand; a draw that favoured one camera by 5% would give about 40.
+    double chi2 = 0;
+    const double expected = double(draws) / count;
+    for (int h : hits)
+        chi2 += (h - expected) * (h - expected) / expected;
+    EXPECT_LT(chi2, 22.46);
+    EXPECT_EQ(drawCameraIndex(1, 12345), 0);
+    EXPECT_CV_ERROR_CONTAINS(drawCameraIndex(0, 1), "0 cameras");
+}
+
+TEST(CameraProfiles, everyModelFileLoadsThroughOneCall)
+{
+    const std::string dir = makeTempDir("camera_profiles_any");
+    const RawFormat format = fourteenBitFormat();
+    const NoiseModel model(0.42, 1.7, 3.1);
+    // Android's form, as rawgment_calibrate writes it.
+    const AndroidNoiseProfile android = androidNoiseProfile(model, format, 100);
+    const std::string yml = writeText(
+        dir, "android_noise_profile.yml",
+        cv::format(
+            "%%YAML:1.0\n---\nandroid_noise_profile:\n   comment: \"x\"\n   base_iso: 100\n"
+            "   A: [%.17g, %.17g, %.17g, %.17g]\n   B: [0, 0, 0, 0]\n   C: [%.17g, %.17g, %.17g, %.17g]\n"
+            "   D: [%.17g, %.17g, %.17g, %.17g]\n",
+            android.A[0], android.A[1], android.A[2], android.A[3], android.C[0], android.C[1], android.C[2],
+            android.C[3], android.D[0], android.D[1], android.D[2], android.D[3]));
+    const NoiseModel fromAndroid = loadAnyNoiseModel(yml, "", format);
+    EXPECT_NEAR(fromAndroid.alpha, model.alpha, 1e-12);
+    EXPECT_NEAR(fromAndroid.sigmaD2, model.sigmaD2, 1e-9);
+    EXPECT_EQ(fromAndroid.baseIso, 100);
+    // A NoiseModel file.
+    NoiseModel withIso = model;
+    withIso.baseIso = 200;
+    withIso.save(dir + "/model.yml");
+    EXPECT_EQ(loadAnyNoiseModel(dir + "/model.yml", "", format).baseIso, 200);
+    // A darktable file needs a camera, and only it takes one.
+    const std::string json = writeText(
+        dir, "profiles.json", darktableNoiseProfiles(model, format, 100, {100, 800}, "Rawgment", "Sim"));
+    EXPECT_NEAR(loadAnyNoiseModel(json, "rawgment sim", format).alpha, model.alpha, 1e-12);
+    EXPECT_CV_ERROR_CONTAINS(loadAnyNoiseModel(json, "", format),
+                             "is a darktable noise-profile file of many cameras");
+    EXPECT_CV_ERROR_CONTAINS(loadAnyNoiseModel(yml, "Rawgment Sim", format),
+                             "is not a darktable noise-profile file");
+    const std::string broken =
+        writeText(dir, "broken_android.yml",
+                  "%YAML:1.0\n---\nandroid_noise_profile:\n   base_iso: 100\n   A: [1, 2]\n");
+    EXPECT_CV_ERROR_CONTAINS(loadAnyNoiseModel(broken, "", format),
+                             "broken_android.yml': field 'A' must be a list");
+}
+
+TEST(CameraProfiles, everyCameraOfDarktablesFileImportsOrIsRefusedWithAReason)
+{
+    const std::string path = darktableProfilesPath();
+    if (path.empty()) {
+        // CI runs the install script, which puts the file in place: there it must be found.
+        const char* ci = std::getenv("CI");
+        ASSERT_FALSE(ci && *ci) << "darktable's noiseprofiles.json is missing in CI (scripts/install-deps.sh "
+                                   "fetches it)";
+        GTEST_SKIP() << "darktable's noiseprofiles.json not found (run scripts/fetch-darktable-profiles.sh)";
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(path);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // Debian 12's darktable 4.2.1 has 374; a later darktable has more.
+    ASSERT_GE(cams.size(), 374u);
+    std::map<int, int> verdicts;
+    const RawFormat format = fourteenBitFormat();
+    for (const CameraNoiseProfile& cam : cams) {
+        ++verdicts[cam.verdict];
+        SCOPED_TRACE(cam.name() + " at " + cam.place);
+        EXPECT_FALSE(cam.maker.empty());
+        if (!cam.usable()) {
+            EXPECT_FALSE(cam.reason.empty());
+            continue;
+        }
+        EXPECT_GE(cam.isos.size(), 2u);
+        for (double v : {cam.alpha, cam.sigmaD2, cam.sigmaR2, cam.worstSlopeResidual, cam.worstOffsetResidual,
+                         cam.medianColourSpread})
+            EXPECT_TRUE(std::isfinite(v));
+        EXPECT_GT(cam.alpha, 0);
+        EXPECT_GE(cam.sigmaD2, 0);
+        EXPECT_GE(cam.sigmaR2, 0);
+        const NoiseModel m = cam.modelFor(format);
+        EXPECT_NO_THROW(m.validate());
+        // Every ISO's modelled variance at mid-grey is finite and positive.
+        for (const CameraIsoFit& f : cam.isos)
+            EXPECT_GT(m.variance(4000, f.gain), 0);
+    }
+    std::cout << "[ info ] " << cams.size() << " cameras in " << seconds
+              << " s: " << verdicts[CAMERA_PROFILE_GOOD] << " GOOD, " << verdicts[CAMERA_PROFILE_ROUGH]
+              << " ROUGH, " << verdicts[CAMERA_PROFILE_REFUSED] << " REFUSED\n";
+    // Most of darktable's cameras are usable: a change that refused them wholesale would be a regression.
+    EXPECT_GT(verdicts[CAMERA_PROFILE_GOOD] + verdicts[CAMERA_PROFILE_ROUGH], int(cams.size()) * 9 / 10);
+}
+
+} // namespace test
+} // namespace rawgment
+} // namespace cv
