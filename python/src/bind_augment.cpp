@@ -261,6 +261,91 @@ void bindAugment(py::module_& m)
     m.def("noiseModelFromDarktable", &noiseModelFromDarktable, py::arg("path"), py::arg("format"),
           py::arg("baseIso"), py::arg("maker"), py::arg("cameraModel"),
           py::arg("haarVarianceRatio") = DARKTABLE_HAAR_VARIANCE_RATIO, doc("noiseModelFromDarktable"));
+    // ---- real cameras (camera_profiles.hpp) -------------------------------------------------------
+    py::enum_<CameraProfileVerdict>(m, "CameraProfileVerdict", doc("CameraProfileVerdict"))
+        .value("CAMERA_PROFILE_GOOD", CAMERA_PROFILE_GOOD, doc("CameraProfileVerdict::CAMERA_PROFILE_GOOD"))
+        .value("CAMERA_PROFILE_ROUGH", CAMERA_PROFILE_ROUGH, doc("CameraProfileVerdict::CAMERA_PROFILE_ROUGH"))
+        .value("CAMERA_PROFILE_REFUSED", CAMERA_PROFILE_REFUSED, doc("CameraProfileVerdict::CAMERA_PROFILE_REFUSED"))
+        .export_values();
+    m.def("cameraProfileVerdictName", &cameraProfileVerdictName, py::arg("verdict"),
+          doc("cameraProfileVerdictName"));
+    m.attr("DARKTABLE_HAAR_VARIANCE_RATIO") = DARKTABLE_HAAR_VARIANCE_RATIO;
+    py::class_<DarktableImportParams>(m, "DarktableImportParams", doc("DarktableImportParams"))
+        .def(keywordInit<DarktableImportParams>())
+        .def_readwrite("haarVarianceRatio", &DarktableImportParams::haarVarianceRatio,
+                       doc("DarktableImportParams::haarVarianceRatio"))
+        .def_readwrite("offsetReferenceLevel", &DarktableImportParams::offsetReferenceLevel,
+                       doc("DarktableImportParams::offsetReferenceLevel"))
+        .def_readwrite("goodMedianSlopeResidual", &DarktableImportParams::goodMedianSlopeResidual,
+                       doc("DarktableImportParams::goodMedianSlopeResidual"))
+        .def_readwrite("goodWorstSlopeResidual", &DarktableImportParams::goodWorstSlopeResidual,
+                       doc("DarktableImportParams::goodWorstSlopeResidual"))
+        .def_readwrite("goodWorstOffsetResidual", &DarktableImportParams::goodWorstOffsetResidual,
+                       doc("DarktableImportParams::goodWorstOffsetResidual"))
+        .def_readwrite("goodMinIsos", &DarktableImportParams::goodMinIsos,
+                       doc("DarktableImportParams::goodMinIsos"))
+        .def("validate", &DarktableImportParams::validate, doc("DarktableImportParams::validate"));
+    py::class_<CameraIsoFit>(m, "CameraIsoFit", doc("CameraIsoFit"))
+        .def(keywordInit<CameraIsoFit>())
+        .def_readwrite("iso", &CameraIsoFit::iso, doc("CameraIsoFit::iso"))
+        .def_readwrite("gain", &CameraIsoFit::gain, doc("CameraIsoFit::gain"))
+        .def_readwrite("slope", &CameraIsoFit::slope, doc("CameraIsoFit::slope"))
+        .def_readwrite("offset", &CameraIsoFit::offset, doc("CameraIsoFit::offset"))
+        .def_readwrite("slopeResidual", &CameraIsoFit::slopeResidual, doc("CameraIsoFit::slopeResidual"))
+        .def_readwrite("offsetResidual", &CameraIsoFit::offsetResidual, doc("CameraIsoFit::offsetResidual"))
+        .def_readwrite("colourSpread", &CameraIsoFit::colourSpread, doc("CameraIsoFit::colourSpread"));
+    py::class_<CameraNoiseProfile>(m, "CameraNoiseProfile", doc("CameraNoiseProfile"))
+        .def(keywordInit<CameraNoiseProfile>())
+        .def_readwrite("maker", &CameraNoiseProfile::maker, doc("CameraNoiseProfile::maker"))
+        .def_readwrite("model", &CameraNoiseProfile::model, doc("CameraNoiseProfile::model"))
+        .def_readwrite("place", &CameraNoiseProfile::place, doc("CameraNoiseProfile::place"))
+        .def_readwrite("verdict", &CameraNoiseProfile::verdict, doc("CameraNoiseProfile::verdict"))
+        .def_readwrite("reason", &CameraNoiseProfile::reason, doc("CameraNoiseProfile::reason"))
+        .def_readwrite("baseIso", &CameraNoiseProfile::baseIso, doc("CameraNoiseProfile::baseIso"))
+        .def_readwrite("alpha", &CameraNoiseProfile::alpha, doc("CameraNoiseProfile::alpha"))
+        .def_readwrite("sigmaD2", &CameraNoiseProfile::sigmaD2, doc("CameraNoiseProfile::sigmaD2"))
+        .def_readwrite("sigmaR2", &CameraNoiseProfile::sigmaR2, doc("CameraNoiseProfile::sigmaR2"))
+        .def_readwrite("isos", &CameraNoiseProfile::isos, doc("CameraNoiseProfile::isos"))
+        .def_readwrite("skippedProfiles", &CameraNoiseProfile::skippedProfiles,
+                       doc("CameraNoiseProfile::skippedProfiles"))
+        .def_readwrite("medianSlopeResidual", &CameraNoiseProfile::medianSlopeResidual,
+                       doc("CameraNoiseProfile::medianSlopeResidual"))
+        .def_readwrite("worstSlopeResidual", &CameraNoiseProfile::worstSlopeResidual,
+                       doc("CameraNoiseProfile::worstSlopeResidual"))
+        .def_readwrite("worstSlopeIso", &CameraNoiseProfile::worstSlopeIso,
+                       doc("CameraNoiseProfile::worstSlopeIso"))
+        .def_readwrite("worstOffsetResidual", &CameraNoiseProfile::worstOffsetResidual,
+                       doc("CameraNoiseProfile::worstOffsetResidual"))
+        .def_readwrite("worstOffsetIso", &CameraNoiseProfile::worstOffsetIso,
+                       doc("CameraNoiseProfile::worstOffsetIso"))
+        .def_readwrite("medianColourSpread", &CameraNoiseProfile::medianColourSpread,
+                       doc("CameraNoiseProfile::medianColourSpread"))
+        .def_readwrite("negativeOffsets", &CameraNoiseProfile::negativeOffsets,
+                       doc("CameraNoiseProfile::negativeOffsets"))
+        .def_readwrite("monotoneSlope", &CameraNoiseProfile::monotoneSlope,
+                       doc("CameraNoiseProfile::monotoneSlope"))
+        .def("name", &CameraNoiseProfile::name, doc("CameraNoiseProfile::name"))
+        .def("usable", &CameraNoiseProfile::usable, doc("CameraNoiseProfile::usable"))
+        .def("modelFor", &CameraNoiseProfile::modelFor, py::arg("format"),
+             doc("CameraNoiseProfile::modelFor"));
+    m.def(
+        "readCameraProfiles",
+        [](const std::string& path, const DarktableImportParams& params) {
+            return withoutGil("readCameraProfiles", [&] { return readCameraProfiles(path, params); });
+        },
+        py::arg("path"), py::arg("params") = DarktableImportParams(), doc("readCameraProfiles"));
+    m.def("findCameraProfile", &findCameraProfile, py::arg("cameras"), py::arg("name"),
+          doc("findCameraProfile"));
+    m.def("selectCameraProfiles", &selectCameraProfiles, py::arg("cameras"), py::arg("selection"),
+          doc("selectCameraProfiles"));
+    m.def("drawCameraIndex", &drawCameraIndex, py::arg("count"), py::arg("seed"), doc("drawCameraIndex"));
+    m.def("darktableProfilesPath", &darktableProfilesPath, doc("darktableProfilesPath"));
+    m.def("isDarktableProfileFile", &isDarktableProfileFile, py::arg("path"), doc("isDarktableProfileFile"));
+    m.def("noiseModelFromAndroidFile", &noiseModelFromAndroidFile, py::arg("path"), py::arg("format"),
+          doc("noiseModelFromAndroidFile"));
+    m.def("loadAnyNoiseModel", &loadAnyNoiseModel, py::arg("path"), py::arg("camera") = std::string(),
+          py::arg("format") = RawFormat(), py::arg("acceptFailedCalibration") = false,
+          doc("loadAnyNoiseModel"));
     py::class_<AndroidNoiseProfile>(m, "AndroidNoiseProfile", doc("AndroidNoiseProfile"))
         .def(keywordInit<AndroidNoiseProfile>())
         .def_readwrite("A", &AndroidNoiseProfile::A, doc("AndroidNoiseProfile::A"))
@@ -310,6 +395,7 @@ void bindAugment(py::module_& m)
         .def_readwrite("source", &MosaicMetadata::source, doc("MosaicMetadata::source"))
         .def_readwrite("hasCamera", &MosaicMetadata::hasCamera, doc("MosaicMetadata::hasCamera"))
         .def_readwrite("camera", &MosaicMetadata::camera, doc("MosaicMetadata::camera"))
+        .def_readwrite("noiseCamera", &MosaicMetadata::noiseCamera, doc("MosaicMetadata::noiseCamera"))
         .def_readwrite("size", &MosaicMetadata::size, doc("MosaicMetadata::size"))
         .def_readwrite("type", &MosaicMetadata::type, doc("MosaicMetadata::type"));
     m.def("sidecarPathOf", &sidecarPathOf, py::arg("path"), doc("sidecarPathOf"));

@@ -359,6 +359,8 @@ void MosaicMetadata::write(FileStorage& fs, const String& name) const
     }
     if (hasCamera)
         camera.write(fs, "camera");
+    if (!noiseCamera.empty())
+        fs << "noise_camera" << noiseCamera;
     fs << "}";
 }
 
@@ -373,7 +375,7 @@ MosaicMetadata MosaicMetadata::read(const FileNode& node)
             cv::format("mosaic metadata: format_version is missing or not one of 1..%d", FORMAT_VERSION));
     try {
         rejectUnknownKeys(node, {"format_version", "raw_format", "size", "type", "source", "has_scene",
-                                 "scene", "seed", "camera"});
+                                 "scene", "seed", "camera", "noise_camera"});
     } catch (const Exception& e) {
         CV_Error(e.code, "mosaic metadata: " + e.err);
     }
@@ -403,6 +405,10 @@ MosaicMetadata MosaicMetadata::read(const FileNode& node)
                      "mosaic metadata: field 'seed' is missing or not a decimal integer");
         m.seed = static_cast<uint64>(v);
     }
+    const FileNode noiseCamera = node["noise_camera"];
+    if (!noiseCamera.empty() && !noiseCamera.isString())
+        CV_Error(Error::StsParseError, "mosaic metadata: field 'noise_camera' must be a string");
+    m.noiseCamera = noiseCamera.empty() ? String() : String(noiseCamera);
     m.hasCamera = !node["camera"].empty();
     if (m.hasCamera)
         m.camera = CameraTags::read(node["camera"]);

@@ -538,7 +538,7 @@ TEST(RawIo, cameraTagsTravelInTheSidecarAndTheDngAndFirstVersionSidecarsStillLoa
         const std::vector<char> bytes = readBytes(dir + "/plain.png.yml");
         text.assign(bytes.begin(), bytes.end());
     }
-    const size_t at = text.find("format_version: 2");
+    const size_t at = text.find("format_version: 3");
     ASSERT_NE(at, std::string::npos) << text;
     text.replace(at, 17, "format_version: 1");
     std::remove((dir + "/plain.png.yml").c_str());
@@ -552,6 +552,11 @@ TEST(RawIo, cameraTagsTravelInTheSidecarAndTheDngAndFirstVersionSidecarsStillLoa
     std::remove((dir + "/plain.png.yml").c_str());
     writeBytes(dir + "/plain.png.yml", std::vector<char>(text.begin(), text.end()));
     EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/plain.png", back), "exposure");
+
+    // The real camera whose noise a scene simulated travels in the sidecar (format version 3).
+    meta.noiseCamera = "Nikon D3";
+    writeMosaic(dir + "/camera.png", m16, meta);
+    EXPECT_EQ(readMosaic(dir + "/camera.png", back).noiseCamera, "Nikon D3");
 }
 
 TEST(RawIo, mosaicRoundTripsWithItsSidecarInEveryContainer)

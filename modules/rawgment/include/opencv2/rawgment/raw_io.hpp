@@ -232,8 +232,8 @@ struct CV_RAWGMENT_EXPORTS CameraTags
 /** @brief What a sidecar file says about a mosaic written by writeMosaic(). */
 struct CV_RAWGMENT_EXPORTS MosaicMetadata
 {
-    /** Version written to files; versions 1 (no camera tags) and 2 are read. */
-    static constexpr int FORMAT_VERSION = 2;
+    /** Version written to files; versions 1 (no camera tags), 2 (no noise camera) and 3 are read. */
+    static constexpr int FORMAT_VERSION = 3;
     RawFormat format;       //!< the mosaic's format, with the gain after augmentation
     bool hasScene = false;  //!< whether `scene` and `seed` describe how the mosaic was made
     Scene scene;            //!< the scene applied to the source
@@ -241,8 +241,11 @@ struct CV_RAWGMENT_EXPORTS MosaicMetadata
     String source;          //!< the file the mosaic was made from (informative)
     bool hasCamera = false; //!< whether `camera` describes the mosaic (a DNG then carries the tags)
     CameraTags camera;      //!< the camera and capture, when hasCamera
-    Size size;              //!< the mosaic's size; set by writeMosaic(), checked by readMosaic()
-    int type = CV_16UC1;    //!< the mosaic's type; set by writeMosaic(), checked by readMosaic()
+    /** The real camera whose measured noise the scene simulated (a darktable profile's "maker model",
+     * CameraNoiseProfile::name()); empty when the noise model came from elsewhere. */
+    String noiseCamera;
+    Size size;           //!< the mosaic's size; set by writeMosaic(), checked by readMosaic()
+    int type = CV_16UC1; //!< the mosaic's type; set by writeMosaic(), checked by readMosaic()
 
     //! Writes the metadata as a map under `name`.
     void write(FileStorage& fs, const String& name) const;
