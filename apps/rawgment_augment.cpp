@@ -11,7 +11,11 @@ int main(int argc, char** argv)
 {
     const char* keys =
         "{help h usage ? |      | print this message }"
-        "{model m        |      | noise model (YAML/JSON) of the camera (required) }"
+        "{model m        |      | noise model of the camera (required): a NoiseModel YAML/JSON, an Android "
+        "profile YAML, or darktable's noiseprofiles.json with --camera }"
+        "{camera         |      | with a darktable file: a camera name, a comma-separated list of names, "
+        "good "
+        "or usable (several: each output draws one, recorded in its sidecar) }"
         "{scene          |      | a scene file (map 'scene') applied to every input }"
         "{policy         |      | a random policy file (map 'random_scene_policy') }"
         "{out o          |      | output directory (required) }"
@@ -35,6 +39,7 @@ int main(int argc, char** argv)
     }
     rawgment_apps::AugmentOptions o;
     o.model = parser.get<std::string>("model");
+    o.camera = parser.get<std::string>("camera");
     o.scene = parser.get<std::string>("scene");
     o.policy = parser.get<std::string>("policy");
     o.outDir = parser.get<std::string>("out");
@@ -50,9 +55,8 @@ int main(int argc, char** argv)
     if (!parser.check() || o.model.empty() || o.outDir.empty() || o.inputs.empty() || o.variants < 1 ||
         (o.scene.empty() == o.policy.empty())) {
         parser.printErrors();
-        std::cerr
-            << "usage: rawgment_augment --model=<m.yml> (--scene=<s.yml> | --policy=<p.yml>) --out=<dir> "
-               "[--variants=N] <inputs...>\n";
+        std::cerr << "usage: rawgment_augment --model=<m.yml> | --model=<noiseprofiles.json> --camera=<name> "
+                     "(--scene=<s.yml> | --policy=<p.yml>) --out=<dir> [--variants=N] <inputs...>\n";
         return 2;
     }
     if (!format.empty()) {

@@ -85,7 +85,27 @@ AugmentRecipe loadAugmentRecipe(const AugmentOptions& o)
     if (o.scene.empty() == o.policy.empty())
         throw std::runtime_error("give exactly one of a scene file and a policy file");
     AugmentRecipe recipe;
-    recipe.model = NoiseModel::load(o.model, o.acceptFailedCalibration);
+    if (isDarktableProfileFile(o.model)) {
+        if (o.camera.empty())
+            throw std::runtime_error("'" + o.model +
+                                     "' is a darktable noise-profile file of many cameras: choose with "
+                                     "--camera (a name, a comma-separated list, good or usable; "
+                                     "rawgment_cameras lists them)");
+        recipe.cameras = selectCameraProfiles(readCameraProfiles(o.model), o.camera);
+    } else if (!o.camera.empty()) {
+        throw std::runtime_error(
+            "--camera chooses among the cameras of a darktable noise-profile file, and '" + o.model +
+            "' is not one");
+    } else {
+        cv::FileStorage fs = openFileStorageForReading(o.model, "noise model");
+        if (!fs["android_noise_profile"].empty()) {
+            recipe.android = o.model;
+            // Checked now, at a format of full range, so that a malformed file fails before any job.
+            noiseModelFromAndroidFile(o.model, RawFormat());
+        } else {
+            recipe.model = NoiseModel::load(o.model, o.acceptFailedCalibration);
+        }
+    }
     recipe.randomScenes = o.scene.empty();
     if (recipe.randomScenes)
         recipe.policy = RandomScenePolicy::load(o.policy);
@@ -153,25 +173,42 @@ AugmentPlan planAugmentJobs(const AugmentOptions& o)
     return plan;
 }
 
+NoiseModel modelOfJob(const AugmentRecipe& recipe, const RawFormat& format, uint64_t seed,
+                      std::string& cameraName)
+{
+    cameraName.clear();
+    if (!recipe.android.empty())
+        return noiseModelFromAndroidFile(recipe.android, format);
+    if (recipe.cameras.empty())
+        return recipe.model;
+    const CameraNoiseProfile& camera =
+        recipe.cameras[size_t(drawCameraIndex(int(recipe.cameras.size()), seed))];
+    cameraName = camera.name();
+    return camera.modelFor(format);
+}
+
 void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe)
 {
     LoadedMosaic m = loadMosaicFile(job.input);
+    std::string cameraName;
+    const NoiseModel model = modelOfJob(recipe, m.format, job.seed, cameraName);
     // A camera file read without a sidecar is at the gain its ISO says, relative to the ISO of the
     // model's gain 1 (a model calibrated from the camera's files knows it). A file that does not say its
     // ISO, or a model without a base ISO, leaves gain 1: the capture is taken to be at the base ISO.
-    if (m.fromCameraFile && m.camera.iso > 0 && recipe.model.baseIso > 0)
-        m.format.gain = m.camera.iso / recipe.model.baseIso;
+    if (m.fromCameraFile && m.camera.iso > 0 && model.baseIso > 0)
+        m.format.gain = m.camera.iso / model.baseIso;
     const Scene scene = recipe.randomScenes ? recipe.policy.draw(m.mosaic, m.format, job.seed) : recipe.scene;
     cv::Mat out;
     RawFormat outFormat;
     AugmentReport report;
-    applyScene(m.mosaic, m.format, recipe.model, scene, job.seed, out, outFormat, &report);
+    applyScene(m.mosaic, m.format, model, scene, job.seed, out, outFormat, &report);
     MosaicMetadata meta;
     meta.format = outFormat;
     meta.hasScene = true;
     meta.scene = scene;
     meta.seed = job.seed;
     meta.source = job.input;
+    meta.noiseCamera = cameraName;
     // The output is the camera's capture of the darker or brighter scene: the input's camera tags, with
     // the ISO scaled by the gain ratio, the exposure time by the photon ratio (of green, which hue leaves
     // alone) and the noise profile of the model at the output's gain.
@@ -180,8 +217,7 @@ void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe)
     meta.camera = m.camera;
     meta.camera.iso = m.camera.iso * outFormat.gain / m.format.gain;
     meta.camera.exposureTime = m.camera.exposureTime * signalRatio / scene.jitter.gainRatio;
-    meta.camera.noiseProfile =
-        recipe.model.alpha > 0 ? dngNoiseProfile(recipe.model, outFormat) : std::vector<cv::Vec2d>();
+    meta.camera.noiseProfile = model.alpha > 0 ? dngNoiseProfile(model, outFormat) : std::vector<cv::Vec2d>();
     // A preview brightened back to the input's level shows the noise the scene added, not a dark frame.
     if (!job.preview.empty())
         writeNewImage(job.preview, previewOf(out, outFormat, 1.0 / signalRatio));

@@ -164,7 +164,11 @@ ValidateResult validateConversion(const ValidateOptions& options);
 struct AugmentOptions
 {
     std::vector<std::string> inputs;
-    std::string model;
+    std::string model; //!< a NoiseModel file, an Android profile YAML, or a darktable profile file
+    /** With a darktable profile file: a camera name, a comma-separated list of names or "good" /
+     * "usable" (selectCameraProfiles()); with several cameras each output draws one
+     * (drawCameraIndex() of its seed). Must be empty for the other model files. */
+    std::string camera;
     std::string scene;  //!< a Scene file (map `scene`), or
     std::string policy; //!< a RandomScenePolicy file
     std::string outDir;
@@ -209,17 +213,41 @@ AugmentPlan planAugmentJobs(const AugmentOptions& options);
 //! What every job of a run applies: the model and either one scene or a random policy.
 struct AugmentRecipe
 {
-    cv::rawgment::NoiseModel model;
+    cv::rawgment::NoiseModel model; //!< from a NoiseModel file (when cameras and android are empty)
+    std::vector<cv::rawgment::CameraNoiseProfile> cameras; //!< real cameras: each output takes one
+    std::string android; //!< an Android profile YAML, whose model depends on each input's format
     bool randomScenes = false;
     cv::rawgment::Scene scene;              //!< when !randomScenes
     cv::rawgment::RandomScenePolicy policy; //!< when randomScenes
 };
 //! Loads the model and the scene or policy files of the options; errors name the file.
 AugmentRecipe loadAugmentRecipe(const AugmentOptions& options);
+/** The model of one job and, for a real camera, its name: a fixed model, the Android profile at the
+ * input's format, or the job's camera (the only one, or drawCameraIndex() of the seed) at that format. */
+cv::rawgment::NoiseModel modelOfJob(const AugmentRecipe& recipe, const cv::rawgment::RawFormat& format,
+                                    uint64_t seed, std::string& cameraName);
 //! Makes one output (and its preview); throws on any error. Atomic: a failed job leaves no output.
 void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe);
 //! The scene of a scene file (a map `scene`, as Scene::write() writes it); errors name the file.
 cv::rawgment::Scene readSceneFile(const std::string& path);
+
+// ---------------------------------------------------------------------------------------------------
+//! rawgment_cameras: what a darktable noise-profile file holds and what its cameras say about Eq. 5.
+struct CamerasOptions
+{
+    std::string profiles;        //!< the file; empty: darktableProfilesPath()
+    std::string verdict = "all"; //!< the catalogue's filter: all, good, rough, usable or refused
+    std::string camera;          //!< one camera (or a selection): its fit per ISO instead of the catalogue
+    std::string reportDir;       //!< write the report (report.md, CSVs, PNGs) here instead
+};
+
+struct CamerasResult
+{
+    std::string text; //!< the catalogue, the per-ISO tables or the report's Markdown
+    std::vector<std::string> pngs, notes;
+};
+
+CamerasResult runCameras(const CamerasOptions& options);
 
 //! An sRGB-like 8-bit preview of a mosaic (tone curve gamma 2.2 with the sRGB toe, white balance 1).
 cv::Mat previewOf(const cv::Mat& mosaic, const cv::rawgment::RawFormat& format, double exposure = 1.0);

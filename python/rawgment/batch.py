@@ -28,26 +28,29 @@ RAW_EXTENSIONS = (".dng", ".nef", ".cr2", ".cr3", ".crw", ".arw", ".raf", ".rw2"
                   ".srw", ".3fr", ".iiq", ".erf", ".mef", ".mos", ".nrw", ".x3f")
 
 
-def _runJob(job, model, scene, policy, acceptFailedCalibration=False):
+def _runJob(job, model, scene, policy, acceptFailedCalibration=False, camera=""):
     """One output (runs on a worker). Returns its path."""
-    _rawgment._apps.runAugmentJob(job, model, scene, policy, acceptFailedCalibration)
+    _rawgment._apps.runAugmentJob(job, model, scene, policy, acceptFailedCalibration, camera)
     return job["out"]
 
 
 def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, seed=1, format=None,
-                 previews=False, client=None, progress=None, acceptFailedCalibration=False):
+                 previews=False, client=None, progress=None, acceptFailedCalibration=False, camera=None):
     """Augments every input `variants` times, as ``rawgment_augment`` does.
 
     Args:
         inputs: input files (camera RAWs, or mosaics with a .yml sidecar). The paths are recorded in the
             outputs' sidecars as given: give the same strings as to the app for identical files.
-        model: the noise model file. policy / scene: exactly one, a file.
+        model: the noise model file: a NoiseModel, an Android profile YAML, or darktable's
+            noiseprofiles.json with ``camera``. policy / scene: exactly one, a file.
         out: output folder (created). variants: outputs per input. seed: the run's seed.
         format: output container "dng", "png" or "tif" (default: dng for RAW inputs, else the input's).
         previews: also write an sRGB preview PNG per output.
         client: a ``dask.distributed.Client`` to run the jobs on; None runs them here, one by one.
         progress: a callable(done, total), or None for a line on stderr per 5% when stderr is a terminal.
         acceptFailedCalibration: also use a model whose calibration's verdict was FAIL (refused otherwise).
+        camera: with a darktable file, a camera name, a comma-separated list of names, "good" or "usable";
+            with several, each output draws one from its seed and records it in its sidecar.
 
     Returns:
         dict with ``written``, ``skipped`` (finished by an earlier run) and ``outputs`` (every output path).
@@ -61,6 +64,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     if format not in (None, "dng", "png", "tif"):
         raise ValueError("format must be 'dng', 'png' or 'tif', not %r" % (format,))
     seed = _checkedSeed(seed)
+    camera = "" if camera is None else str(camera)
     inputs = [os.fspath(p) for p in inputs]
     # Workers may run elsewhere: the files every job reads are named absolutely (they are not recorded
     # in the outputs, so this changes no byte).
@@ -69,7 +73,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     scene = os.path.abspath(os.fspath(scene)) if scene is not None else ""
     plan = _rawgment._apps.planAugmentJobs(inputs, model, scene, policy, os.fspath(out), int(variants), int(seed),
                                            "" if format is None else "." + format, bool(previews),
-                                           bool(acceptFailedCalibration))
+                                           bool(acceptFailedCalibration), camera)
     jobs = plan["jobs"]
     total = len(jobs)
     if progress is None:
@@ -79,7 +83,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     if client is None:
         for job in jobs:
             try:
-                _runJob(job, model, scene, policy, bool(acceptFailedCalibration))
+                _runJob(job, model, scene, policy, bool(acceptFailedCalibration), camera)
                 written += 1
             except Exception as e:  # the others still run; the first error is raised at the end
                 errors.append("'%s' variant %d: %s" % (job["input"], job["variant"], e))
@@ -88,7 +92,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
         from distributed import as_completed
 
         futures = client.map(_runJob, jobs, model=model, scene=scene, policy=policy,
-                             acceptFailedCalibration=bool(acceptFailedCalibration), pure=False)
+                             acceptFailedCalibration=bool(acceptFailedCalibration), camera=camera, pure=False)
         where = {f.key: job for f, job in zip(futures, jobs)}
         for future in as_completed(futures):
             job = where[future.key]
@@ -132,7 +136,12 @@ def main(argv=None):
         description="Noise-accounted augmentation of RAW files (the job of rawgment_augment), in this process, "
                     "on a local Dask cluster (--workers) or on a running one (--scheduler).",
         allow_abbrev=False)
-    parser.add_argument("--model", required=True, help="noise model (YAML/JSON) of the camera")
+    parser.add_argument("--model", required=True,
+                        help="noise model of the camera: a NoiseModel YAML/JSON, an Android profile YAML, or "
+                             "darktable's noiseprofiles.json with --camera")
+    parser.add_argument("--camera",
+                        help="with a darktable file: a camera name, a comma-separated list, good or usable "
+                             "(several: each output draws one)")
     group = parser.add_mutually_exclusive_group(required=True)
     group.add_argument("--policy", help="a random policy file (map 'random_scene_policy')")
     group.add_argument("--scene", help="a scene file (map 'scene') applied to every input")
@@ -178,7 +187,8 @@ def main(argv=None):
                 client = Client(cluster)
         result = augmentFiles(args.inputs, args.model, args.out, policy=args.policy, scene=args.scene,
                               variants=args.variants, seed=args.seed, format=args.format, previews=args.preview,
-                              client=client, acceptFailedCalibration=args.accept_failed_calibration)
+                              client=client, acceptFailedCalibration=args.accept_failed_calibration,
+                              camera=args.camera)
     except (RuntimeError, ValueError, OSError) as e:
         sys.stderr.write("rawgment.batch: %s\n" % e)
         return 1

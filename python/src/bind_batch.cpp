@@ -17,11 +17,12 @@ rawgment_apps::AugmentOptions optionsFrom(const std::vector<std::string>& inputs
                                           const std::string& scene, const std::string& policy,
                                           const std::string& outDir, int variants, uint64 seed,
                                           const std::string& extension, bool previews,
-                                          bool acceptFailedCalibration)
+                                          bool acceptFailedCalibration, const std::string& camera)
 {
     rawgment_apps::AugmentOptions o;
     o.inputs = inputs;
     o.model = model;
+    o.camera = camera;
     o.scene = scene;
     o.policy = policy;
     o.outDir = outDir;
@@ -66,9 +67,10 @@ void bindBatch(py::module_& m)
         "planAugmentJobs",
         [](const std::vector<std::string>& inputs, const std::string& model, const std::string& scene,
            const std::string& policy, const std::string& outDir, int variants, uint64 seed,
-           const std::string& extension, bool previews, bool acceptFailedCalibration) {
+           const std::string& extension, bool previews, bool acceptFailedCalibration,
+           const std::string& camera) {
             const auto options = optionsFrom(inputs, model, scene, policy, outDir, variants, seed, extension,
-                                             previews, acceptFailedCalibration);
+                                             previews, acceptFailedCalibration, camera);
             rawgment_apps::loadAugmentRecipe(options); // the files are checked before any job is planned
             const rawgment_apps::AugmentPlan plan =
                 withoutGil("planAugmentJobs", [&] { return rawgment_apps::planAugmentJobs(options); });
@@ -83,24 +85,24 @@ void bindBatch(py::module_& m)
         },
         py::arg("inputs"), py::arg("model"), py::arg("scene"), py::arg("policy"), py::arg("outDir"),
         py::arg("variants"), py::arg("seed"), py::arg("extension"), py::arg("previews"),
-        py::arg("acceptFailedCalibration") = false,
+        py::arg("acceptFailedCalibration") = false, py::arg("camera") = std::string(),
         "The jobs of an augmentation run, as rawgment_augment plans them: a dict with 'jobs' (each a dict: "
         "input, name, variant, seed, out, preview), 'outputs' and 'skipped' (outputs a previous run "
         "finished).");
     apps.def(
         "runAugmentJob",
         [](const py::dict& job, const std::string& model, const std::string& scene, const std::string& policy,
-           bool acceptFailedCalibration) {
+           bool acceptFailedCalibration, const std::string& camera) {
             const rawgment_apps::AugmentJob j = jobFromDict(job);
-            const auto options =
-                optionsFrom({j.input}, model, scene, policy, "", 1, 0, "", false, acceptFailedCalibration);
+            const auto options = optionsFrom({j.input}, model, scene, policy, "", 1, 0, "", false,
+                                             acceptFailedCalibration, camera);
             withoutGil("runAugmentJob", [&] {
                 const rawgment_apps::AugmentRecipe recipe = rawgment_apps::loadAugmentRecipe(options);
                 rawgment_apps::runAugmentJob(j, recipe);
             });
         },
         py::arg("job"), py::arg("model"), py::arg("scene"), py::arg("policy"),
-        py::arg("acceptFailedCalibration") = false,
+        py::arg("acceptFailedCalibration") = false, py::arg("camera") = std::string(),
         "Makes one output of a plan, exactly as rawgment_augment does (atomic; never replaces a file).");
 
     py::module_ bench = m.def_submodule("_benchmark", "Hooks of the Python benchmark (not part of the API).");

@@ -1,0 +1,312 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// rawgment_cameras: the catalogue of a darktable noise-profile file, one camera's fit per ISO, and the
+// report of what the measured cameras say about the model of Eq. 5.
+#include "pipeline.hpp"
+
+#include "app_tools.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+namespace rawgment_apps {
+
+using namespace cv::rawgment;
+
+namespace {
+
+double quantile(std::vector<double> v, double q)
+{
+    if (v.empty())
+        return std::nan("");
+    std::sort(v.begin(), v.end());
+    const double at = q * double(v.size() - 1);
+    const size_t lo = size_t(std::floor(at)), hi = std::min(lo + 1, v.size() - 1);
+    return v[lo] + (at - double(lo)) * (v[hi] - v[lo]);
+}
+
+//! Share of the read variance that comes before the gain, at the camera's base or highest ISO.
+double preGainShare(const CameraNoiseProfile& cam, bool highest = true)
+{
+    const double g = highest ? cam.isos.back().gain : 1.0;
+    const double before = g * g * cam.sigmaD2, total = before + cam.sigmaR2;
+    return total > 0 ? before / total : std::nan("");
+}
+
+//! Read noise at the base ISO in electrons: sqrt(sigma_d^2 + sigma_r^2) / alpha.
+double readElectrons(const CameraNoiseProfile& cam)
+{
+    return std::sqrt(cam.sigmaD2 + cam.sigmaR2) / cam.alpha;
+}
+
+std::string catalogueLine(const CameraNoiseProfile& cam)
+{
+    if (!cam.usable())
+        return cv::format("%-34s %-8s %s", cam.name().c_str(), "REFUSED", cam.reason.c_str());
+    return cv::format("%-34s %-8s %4zu %6g %9.0f %7.2f %6.2f %6.1f%% %6.1f%% %6.1f%% %5.2f  %s",
+                      cam.name().c_str(), cameraProfileVerdictName(cam.verdict).c_str(), cam.isos.size(),
+                      cam.baseIso, 1 / cam.alpha, readElectrons(cam), preGainShare(cam),
+                      100 * cam.medianSlopeResidual, 100 * cam.worstSlopeResidual,
+                      100 * cam.worstOffsetResidual, cam.medianColourSpread, cam.reason.c_str());
+}
+
+const char* kCatalogueHeader =
+    "camera                             verdict  ISOs   base  full-well   read  pre-g  "
+    "slope~  slope^  offs^ colour  reason\n"
+    "                                                        (e-)   (e-)  share  "
+    " med    worst  worst  spread\n";
+
+std::string isoTable(const CameraNoiseProfile& cam)
+{
+    std::ostringstream out;
+    out << cam.name() << " (" << cam.place << "): " << cameraProfileVerdictName(cam.verdict)
+        << (cam.reason.empty() ? "" : " - " + cam.reason) << "\n";
+    if (!cam.usable())
+        return out.str();
+    out << cv::format(
+        "fit over a range of 1: alpha %.4g (full well %.0f e-), sigma_d^2 %.4g, sigma_r^2 %.4g, base "
+        "ISO %g\n",
+        cam.alpha, 1 / cam.alpha, cam.sigmaD2, cam.sigmaR2, cam.baseIso);
+    out << "     ISO    gain   slope (a/c)  fitted       resid   offset (b/c)  fitted       resid  colours\n";
+    for (const CameraIsoFit& f : cam.isos)
+        out << cv::format("%8g %7.3f  %11.4g  %11.4g %6.1f%%  %11.4g  %11.4g %6.1f%%  %5.2f\n", f.iso, f.gain,
+                          f.slope, f.gain * cam.alpha, 100 * f.slopeResidual, f.offset,
+                          f.gain * f.gain * cam.sigmaD2 + cam.sigmaR2, 100 * f.offsetResidual,
+                          f.colourSpread);
+    return out.str();
+}
+
+std::string formatShare(int part, int whole)
+{
+    return cv::format("%d of %d (%.0f%%)", part, whole, whole ? 100.0 * part / whole : 0.0);
+}
+
+//! The report's tables and conclusions, from the fitted cameras.
+std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::string& path, double seconds,
+                       const std::vector<std::string>& pngs)
+{
+    std::map<int, int> verdicts;
+    std::map<std::string, int> refusals;
+    std::vector<double> medianSlope, worstSlope, worstOffset, medianOffset, fullWell, read, share, baseShare,
+        spread;
+    int negative = 0, nonMonotone = 0, usable = 0, lowestWorst = 0;
+    for (const CameraNoiseProfile& cam : cams) {
+        ++verdicts[cam.verdict];
+        if (!cam.usable()) {
+            std::string kind = cam.reason.substr(0, cam.reason.find(':'));
+            for (char& ch : kind)
+                if (ch >= '0' && ch <= '9')
+                    ch = 'N';
+            ++refusals[kind];
+            continue;
+        }
+        ++usable;
+        medianSlope.push_back(cam.medianSlopeResidual);
+        worstSlope.push_back(cam.worstSlopeResidual);
+        worstOffset.push_back(cam.worstOffsetResidual);
+        std::vector<double> offsets;
+        for (const CameraIsoFit& f : cam.isos)
+            offsets.push_back(std::abs(f.offsetResidual));
+        medianOffset.push_back(quantile(offsets, 0.5));
+        fullWell.push_back(1 / cam.alpha);
+        read.push_back(readElectrons(cam));
+        share.push_back(preGainShare(cam));
+        baseShare.push_back(preGainShare(cam, false));
+        spread.push_back(cam.medianColourSpread);
+        negative += cam.negativeOffsets > 0;
+        nonMonotone += !cam.monotoneSlope;
+        lowestWorst += cam.worstSlopeIso == cam.isos.front().iso;
+    }
+    const auto row = [](const char* what, const std::vector<double>& v, double scale, const char* unit) {
+        return cv::format("| %s | %.3g%s | %.3g%s | %.3g%s | %.3g%s | %.3g%s |\n", what,
+                          scale * quantile(v, 0.1), unit, scale * quantile(v, 0.25), unit,
+                          scale * quantile(v, 0.5), unit, scale * quantile(v, 0.75), unit,
+                          scale * quantile(v, 0.9), unit);
+    };
+    std::ostringstream md;
+    md << "## The cameras\n\n"
+       << cv::format("`%s`: %zu cameras, read and fitted in %.2f s. ", path.c_str(), cams.size(), seconds)
+       << "Verdicts: " << verdicts[CAMERA_PROFILE_GOOD] << " GOOD, " << verdicts[CAMERA_PROFILE_ROUGH]
+       << " ROUGH, " << verdicts[CAMERA_PROFILE_REFUSED] << " REFUSED.\n\n";
+    if (!refusals.empty()) {
+        md << "| refused because | cameras |\n|---|---|\n";
+        for (const auto& r : refusals)
+            md << "| " << r.first << " | " << r.second << " |\n";
+        md << "\n";
+    }
+    md << "## How well Eq. 5 describes them\n\n"
+       << "Over the " << usable
+       << " imported cameras (GOOD and ROUGH), the distribution across cameras of each measure:\n\n"
+       << "| measure | 10% | 25% | median | 75% | 90% |\n|---|---|---|---|---|---|\n"
+       << row("median over ISOs of the shot-slope residual", medianSlope, 100, "%")
+       << row("worst shot-slope residual", worstSlope, 100, "%")
+       << row("median over ISOs of the offset residual", medianOffset, 100, "%")
+       << row("worst offset residual", worstOffset, 100, "%")
+       << row("colours' slope spread (largest / smallest)", spread, 1, "") << "\n"
+       << "- The shot slope's worst ISO is the camera's lowest for " << formatShare(lowestWorst, usable)
+       << " of the cameras.\n"
+       << "- Cameras with a negative offset at some ISO: " << formatShare(negative, usable) << ".\n"
+       << "- Cameras whose measured slope falls somewhere as the ISO rises: "
+       << formatShare(nonMonotone, usable) << ".\n\n"
+       << "## The fitted parameters\n\n"
+       << "| parameter | 10% | 25% | median | 75% | 90% |\n|---|---|---|---|---|---|\n"
+       << row("full well at base ISO, 1 / alpha (e-)", fullWell, 1, "")
+       << row("read noise at base ISO (e-)", read, 1, "")
+       << row("share of read variance before the gain, at the base ISO", baseShare, 1, "")
+       << row("share of read variance before the gain, at the highest ISO", share, 1, "") << "\n";
+    for (const std::string& png : pngs) {
+        const std::string name = png.substr(png.find_last_of('/') + 1);
+        md << "![" << name << "](" << name << ")\n\n";
+    }
+    return md.str();
+}
+
+//! The per-ISO points of every imported camera, and one line per camera, for the plots.
+void writeReportTables(const std::string& dir, const std::vector<CameraNoiseProfile>& cams)
+{
+    CsvTable points({"iso", "slope_over_fit", "offset_residual"});
+    CsvTable cameras({"camera",
+                      "verdict",
+                      "isos",
+                      "base_iso",
+                      "alpha",
+                      "sigma_d2",
+                      "sigma_r2",
+                      "full_well_e",
+                      "read_e",
+                      "pre_gain_share",
+                      "base_pre_gain_share",
+                      "median_slope_residual",
+                      "worst_slope_residual",
+                      "worst_slope_iso",
+                      "worst_offset_residual",
+                      "worst_offset_iso",
+                      "colour_spread",
+                      "negative_offsets",
+                      "monotone_slope",
+                      "reason"});
+    for (const CameraNoiseProfile& cam : cams) {
+        if (cam.usable())
+            for (const CameraIsoFit& f : cam.isos)
+                points.addRow(std::vector<double>{f.iso, f.slope / (f.gain * cam.alpha), f.offsetResidual});
+        std::string name = cam.name(), reason = cam.reason;
+        for (std::string* s : {&name, &reason})
+            std::replace(s->begin(), s->end(), ',', ';');
+        cameras.addRow(std::vector<std::string>{name,
+                                                cameraProfileVerdictName(cam.verdict),
+                                                std::to_string(cam.isos.size()),
+                                                formatNumber(cam.baseIso),
+                                                formatNumber(cam.alpha),
+                                                formatNumber(cam.sigmaD2),
+                                                formatNumber(cam.sigmaR2),
+                                                cam.usable() ? formatNumber(1 / cam.alpha) : "",
+                                                cam.usable() ? formatNumber(readElectrons(cam)) : "",
+                                                cam.usable() ? formatNumber(preGainShare(cam)) : "",
+                                                cam.usable() ? formatNumber(preGainShare(cam, false)) : "",
+                                                formatNumber(cam.medianSlopeResidual),
+                                                formatNumber(cam.worstSlopeResidual),
+                                                formatNumber(cam.worstSlopeIso),
+                                                formatNumber(cam.worstOffsetResidual),
+                                                formatNumber(cam.worstOffsetIso),
+                                                formatNumber(cam.medianColourSpread),
+                                                std::to_string(cam.negativeOffsets),
+                                                cam.monotoneSlope ? "1" : "0",
+                                                reason});
+    }
+    points.write(dir + "/iso_points.csv");
+    cameras.write(dir + "/cameras.csv");
+}
+
+void plotReport(const std::string& dir, std::vector<std::string>& pngs, std::vector<std::string>& notes)
+{
+    std::string message;
+    const std::string slope = dir + "/real_cameras_slope.png";
+    if (plotWithGnuplot(
+            slope,
+            "set logscale x\nset key off\n"
+            "set title 'Measured shot slope over the fitted g alpha, every ISO of every imported "
+            "camera'\nset xlabel 'ISO'\nset ylabel 'slope / (g alpha)'\nset yrange [0:2.5]\n"
+            "set grid\nplot '" +
+                dir +
+                "/iso_points.csv' every ::1 using 1:2 with points pt 7 ps 0.4 lc rgb '#3060a0', 1 "
+                "with lines lw 2 lc rgb 'black'\n",
+            message))
+        pngs.push_back(slope);
+    else
+        notes.push_back(message);
+    const std::string params = dir + "/real_cameras_parameters.png";
+    if (plotWithGnuplot(
+            params,
+            "set multiplot layout 1,2\nset key off\nset grid\n"
+            "set logscale x\nset title 'Full well and read noise at base ISO (imported cameras)'\n"
+            "set xlabel 'full well 1/alpha (e-)'\nset ylabel 'read noise (e-)'\nset logscale y\n"
+            "plot '" +
+                dir +
+                "/cameras.csv' every ::1 using 8:9 with points pt 7 ps 0.6 lc rgb '#a03030'\n"
+                "unset logscale\nset title 'Share of read variance before the gain, base ISO'\n"
+                "set xlabel 'share'\nset ylabel 'cameras'\nset xrange [0:1]\nset boxwidth 0.05\n"
+                "set style fill solid 0.6\nbin(x) = 0.05 * floor(x / 0.05) + 0.025\nplot '" +
+                dir +
+                "/cameras.csv' every ::1 using (bin($11)):(1) smooth frequency with boxes lc rgb "
+                "'#30a060'\nunset multiplot\n",
+            message, 1400, 600))
+        pngs.push_back(params);
+    else
+        notes.push_back(message);
+}
+
+} // namespace
+
+CamerasResult runCameras(const CamerasOptions& o)
+{
+    const std::string path = o.profiles.empty() ? darktableProfilesPath() : o.profiles;
+    if (path.empty())
+        throw std::runtime_error(
+            "no darktable noise-profile file: give --profiles=<noiseprofiles.json> (darktable "
+            "installs it in /usr/share/darktable; scripts/fetch-darktable-profiles.sh fetches "
+            "it without darktable)");
+    CamerasResult r;
+    const auto start = std::chrono::steady_clock::now();
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(path);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!o.camera.empty()) {
+        for (const CameraNoiseProfile& cam : selectCameraProfiles(cams, o.camera))
+            r.text += isoTable(cam);
+        return r;
+    }
+    if (!o.reportDir.empty()) {
+        prepareOutputDirectory(o.reportDir);
+        writeReportTables(o.reportDir, cams);
+        plotReport(o.reportDir, r.pngs, r.notes);
+        const std::string report = reportText(cams, path, seconds, r.pngs);
+        writeNewText(o.reportDir + "/report.md",
+                     "# What darktable's measured cameras say about Eq. 5\n\n" + report);
+        r.text = report;
+        return r;
+    }
+    const std::string verdict = o.verdict;
+    if (verdict != "all" && verdict != "good" && verdict != "rough" && verdict != "refused" &&
+        verdict != "usable")
+        throw std::runtime_error("--verdict must be all, good, rough, usable or refused (got '" + verdict +
+                                 "')");
+    r.text = kCatalogueHeader;
+    int listed = 0;
+    for (const CameraNoiseProfile& cam : cams) {
+        const bool show = verdict == "all" || (verdict == "usable" && cam.usable()) ||
+                          (verdict == "good" && cam.verdict == CAMERA_PROFILE_GOOD) ||
+                          (verdict == "rough" && cam.verdict == CAMERA_PROFILE_ROUGH) ||
+                          (verdict == "refused" && cam.verdict == CAMERA_PROFILE_REFUSED);
+        if (show) {
+            r.text += catalogueLine(cam) + "\n";
+            ++listed;
+        }
+    }
+    r.text += cv::format("%d of %zu cameras listed (%s), read and fitted in %.2f s\n", listed, cams.size(),
+                         path.c_str(), seconds);
+    return r;
+}
+
+} // namespace rawgment_apps
