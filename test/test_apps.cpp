@@ -94,7 +94,7 @@ void expectPngDecodes(const std::string& path)
 TEST(Apps, everyAppHasHelpAndRejectsBadArguments)
 {
     for (const char* app : {"rawgment_demo", "rawgment_simulate", "rawgment_calibrate", "rawgment_validate",
-                            "rawgment_augment", "rawgment_tradeoffs"}) {
+                            "rawgment_augment", "rawgment_tradeoffs", "rawgment_cameras"}) {
         const AppRun help = runApp(app, "--help");
         EXPECT_EQ(0, help.status) << app;
         EXPECT_NE(std::string::npos, help.output.find(app)) << app << " --help:\n" << help.output;
@@ -683,6 +683,94 @@ TEST(Apps, augmentTakesACameraFilesGainFromItsIsoAndTheModelsBaseIso)
                   cv::rawgment::dngNoiseProfile(withBase, meta.format))
             << c.first;
     }
+}
+
+TEST(Apps, augmentAsRealCamerasDrawsOnePerOutputAndRecordsIt)
+{
+    // A darktable file of two cameras (the project's own exports, joined), an Android profile, and the
+    // catalogue app over the file.
+    const std::string dir = freshDir("augment_cameras");
+    AppRun r = runApp("rawgment_simulate",
+                      "--out='" + dir + "/sim' --frames=3 --gains=6 --levels=0.5 --validation=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    cv::rawgment::RawFormat format;
+    format.blackLevel = cv::Vec4d(64, 64, 64, 64);
+    format.whiteLevel = 4095;
+    const auto modelsOf = [&](const cv::rawgment::NoiseModel& m, const std::string& name) {
+        const std::string text =
+            cv::rawgment::darktableNoiseProfiles(m, format, 100, {100, 400, 1600}, "Maker", name);
+        const size_t from = text.find("{\n          \"model\"");
+        const size_t to = text.rfind("      ]\n    }\n  ]");
+        return text.substr(from, to - from);
+    };
+    {
+        std::ofstream out(dir + "/noiseprofiles.json");
+        out << "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", \"models\": [\n"
+            << modelsOf(cv::rawgment::NoiseModel(0.3, 0.05, 0.2), "Quiet") << ",\n"
+            << modelsOf(cv::rawgment::NoiseModel(0.3, 2.0, 30.0), "Loud") << "]}]}\n";
+        ASSERT_TRUE(out.good());
+    }
+    {
+        cv::rawgment::Scene scene;
+        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 2.0);
+        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
+        scene.write(fs, "scene");
+    }
+    const std::string input = "'" + dir + "/sim/g06dB_level0.50/frame_000.dng'";
+    const std::string common = " --scene='" + dir + "/scene.yml' " + input;
+    r = runApp("rawgment_augment", "--model='" + dir +
+                                       "/noiseprofiles.json' --camera=usable --variants=8 --out='" + dir +
+                                       "/out'" + common);
+    ASSERT_EQ(0, r.status) << r.output;
+    std::set<std::string> cameras;
+    for (int v = 0; v < 8; ++v) {
+        cv::Mat mosaic;
+        const cv::rawgment::MosaicMetadata meta =
+            cv::rawgment::readMosaic(dir + cv::format("/out/frame_000_v%02d.dng", v), mosaic);
+        cameras.insert(meta.noiseCamera);
+    }
+    EXPECT_EQ(cameras, (std::set<std::string>{"Maker Loud", "Maker Quiet"}));
+    // The same run again gives the same cameras and bytes (a second folder, compared file by file).
+    r = runApp("rawgment_augment", "--model='" + dir +
+                                       "/noiseprofiles.json' --camera=usable --variants=8 --out='" + dir +
+                                       "/again'" + common);
+    ASSERT_EQ(0, r.status) << r.output;
+    for (int v = 0; v < 8; ++v)
+        EXPECT_EQ(readText(dir + cv::format("/out/frame_000_v%02d.dng", v)),
+                  readText(dir + cv::format("/again/frame_000_v%02d.dng", v)));
+
+    r = runApp("rawgment_augment", "--model='" + dir + "/noiseprofiles.json' --out='" + dir + "/x'" + common);
+    EXPECT_EQ(1, r.status);
+    EXPECT_NE(std::string::npos, r.output.find("choose with --camera")) << r.output;
+    r = runApp("rawgment_augment", "--model='" + dir + "/noiseprofiles.json' --camera='Maker Lod' --out='" +
+                                       dir + "/x'" + common);
+    EXPECT_EQ(1, r.status);
+    EXPECT_NE(std::string::npos,
+              r.output.find("no camera named 'Maker Lod' among 2 cameras; the closest are 'Maker "
+                            "Loud'"))
+        << r.output;
+    r = runApp("rawgment_augment", "--model='" + dir +
+                                       "/sim/truth_noise_model.yml' --camera='Maker Loud' --out='" + dir +
+                                       "/x'" + common);
+    EXPECT_EQ(1, r.status);
+    EXPECT_NE(std::string::npos, r.output.find("is not one")) << r.output;
+
+    // The catalogue and one camera's table.
+    r = runApp("rawgment_cameras", "--profiles='" + dir + "/noiseprofiles.json'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("Maker Quiet")) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("2 of 2 cameras listed")) << r.output;
+    r = runApp("rawgment_cameras", "--profiles='" + dir + "/noiseprofiles.json' --camera='maker loud'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("Maker Loud (noiseprofiles[0].models[1]): GOOD")) << r.output;
+    r = runApp("rawgment_cameras", "--profiles='" + dir + "/noiseprofiles.json' --verdict=best");
+    EXPECT_EQ(1, r.status);
+    EXPECT_NE(std::string::npos, r.output.find("--verdict must be")) << r.output;
+    r = runApp("rawgment_cameras",
+               "--profiles='" + dir + "/noiseprofiles.json' --report='" + dir + "/report'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, readText(dir + "/report/report.md").find("2 GOOD, 0 ROUGH, 0 REFUSED"));
+    expectPngDecodes(dir + "/report/real_cameras_slope.png");
 }
 
 TEST(Apps, calibrateTakesTheGainsFromTheFilesIsoWithOrWithoutAChart)

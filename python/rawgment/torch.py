@@ -25,9 +25,11 @@ __all__ = ["sampleSeed", "Augmented", "RandomNoiseScene", "RawFolderDataset", "p
 
 MOSAIC_EXTENSIONS = (".png", ".tif", ".tiff")
 
-Augmented = collections.namedtuple("Augmented", ["raw", "format", "boxes", "report", "scene"])
+Augmented = collections.namedtuple("Augmented", ["raw", "format", "boxes", "report", "scene", "camera"],
+                                   defaults=(None,))
 Augmented.__doc__ = """What RandomNoiseScene returns: the augmented mosaic (the input's kind: tensor or
-array), its RawFormat (the new gain), the boxes (the input's kind), the AugmentReport and the Scene."""
+array), its RawFormat (the new gain), the boxes (the input's kind), the AugmentReport, the Scene, and the
+name of the real camera whose noise it took (None when the model is not a real camera's)."""
 
 
 def sampleSeed(baseSeed, epoch, index):
@@ -65,22 +67,98 @@ def _toArray(raw):
     raise TypeError("argument 'raw' must be a torch.Tensor or a numpy array, not %s" % type(raw).__name__)
 
 
+class _ModelSource:
+    """Where each sample's NoiseModel comes from: one model, an Android profile (per mosaic format), or
+    real cameras (one drawn per sample from its seed, at the mosaic's format)."""
+
+    def __init__(self, model, camera):
+        self.model = self.android = None
+        self.cameras = []
+        if isinstance(model, _rg.NoiseModel):
+            if camera is not None:
+                raise ValueError("camera chooses among the cameras of a darktable profile file; model is a NoiseModel")
+            self.model = model
+            return
+        if isinstance(model, (list, tuple)) and model and all(isinstance(c, _rg.CameraNoiseProfile) for c in model):
+            if camera is not None:
+                raise ValueError("camera is for a darktable profile file; model is already a list of cameras")
+            for c in model:
+                if not c.usable():
+                    raise ValueError("camera '%s' is REFUSED: %s" % (c.name(), c.reason))
+            self.cameras = list(model)
+            return
+        if not isinstance(model, (str, os.PathLike)):
+            raise TypeError("model must be a rawgment.NoiseModel, a list of rawgment.CameraNoiseProfile or the path "
+                            "of a model file, not %s" % type(model).__name__)
+        path = os.fspath(model)
+        if _rg.isDarktableProfileFile(path):
+            if camera is None:
+                raise ValueError("'%s' is a darktable noise-profile file of many cameras: choose with camera= (a "
+                                 "name, a list of names, 'good' or 'usable')" % path)
+            selection = camera if isinstance(camera, str) else ",".join(camera)
+            self.cameras = _rg.selectCameraProfiles(_rg.readCameraProfiles(path), selection)
+        elif camera is not None:
+            raise ValueError("camera chooses among the cameras of a darktable profile file, and '%s' is not one" % path)
+        else:
+            try:
+                self.model = _rg.NoiseModel.load(path)
+            except _rg.error as notModel:
+                # An Android profile's model depends on each mosaic's levels: it is made per format.
+                try:
+                    _rg.noiseModelFromAndroidFile(path, _rg.RawFormat())
+                except _rg.error:
+                    raise notModel from None
+                self.android = path
+
+    def at(self, format, seed):
+        """The model of one sample, and its camera's name (None for a model that is not a camera's)."""
+        if self.model is not None:
+            return self.model, None
+        if self.android is not None:
+            return _rg.noiseModelFromAndroidFile(self.android, format), None
+        camera = self.cameras[_rg.drawCameraIndex(len(self.cameras), seed)]
+        return camera.modelFor(format), camera.name()
+
+    def __repr__(self):
+        if self.model is not None:
+            return repr(self.model)
+        if self.android is not None:
+            return repr(self.android)
+        return "[%s]" % ", ".join(repr(c.name()) for c in self.cameras)
+
+
 class RandomNoiseScene:
     """A transform that applies a random noise-accounted scene (RandomScenePolicy.draw, then
     applyScene) to a RAW mosaic: darker, noisier, blurred, shifted, with the noise the sensor would
     have given. Boxes follow the shift and the scale.
 
     Args:
-        model: the camera's NoiseModel, or the path of a saved one.
+        model: the camera's NoiseModel; the path of a NoiseModel file, an Android profile YAML or a darktable
+            noise-profile file (``rawgment.darktableProfilesPath()``, with ``camera``); or a list of
+            rawgment.CameraNoiseProfile.
         policy: a RandomScenePolicy, the path of a saved one, or None for the paper's defaults.
         baseSeed: the seed of the whole run; each sample's seed is sampleSeed(baseSeed, epoch, index).
+        camera: with a darktable file, a camera name, a list of names, or "good" / "usable" (every camera of
+            that verdict). With several cameras (here or in a list given as ``model``), each sample draws one
+            from its seed (rawgment.drawCameraIndex), so a network sees the noise of many real sensors; the
+            camera's model is scaled to each mosaic's black and white levels.
     """
 
-    def __init__(self, model, policy=None, baseSeed=0):
-        self.model = _loaded(model, _rg.NoiseModel, "model")
+    def __init__(self, model, policy=None, baseSeed=0, camera=None):
+        self._models = _ModelSource(model, camera)
         self.policy = _loaded(policy, _rg.RandomScenePolicy, "policy", _rg.RandomScenePolicy())
         self.policy.validate()
         self.baseSeed = int(baseSeed)
+
+    @property
+    def model(self):
+        """The one NoiseModel of every sample, or None when each sample's depends on its camera or format."""
+        return self._models.model
+
+    @property
+    def cameras(self):
+        """The real cameras samples draw from (empty when the model is not a real camera's)."""
+        return list(self._models.cameras)
 
     def __call__(self, raw, format, boxes=None, *, index, epoch=0):
         """Augments one mosaic.
@@ -100,7 +178,8 @@ class RandomNoiseScene:
         if isinstance(boxes, torch.Tensor):
             boxesIn = boxes.detach().cpu().numpy().astype(np.int64).reshape(-1, 4)
         scene = self.policy.draw(array, format, seed)
-        out, outFormat, report, outBoxes = _rg.applyScene(array, format, self.model, scene, seed=seed, boxes=boxesIn)
+        model, camera = self._models.at(format, seed)
+        out, outFormat, report, outBoxes = _rg.applyScene(array, format, model, scene, seed=seed, boxes=boxesIn)
         if isTensor:
             out = torch.from_numpy(out)
         if isinstance(boxes, torch.Tensor):
@@ -109,10 +188,10 @@ class RandomNoiseScene:
             outBoxes = np.asarray(outBoxes, dtype=boxes.dtype).reshape(-1, 4)
         elif boxes is None:
             outBoxes = None
-        return Augmented(out, outFormat, outBoxes, report, scene)
+        return Augmented(out, outFormat, outBoxes, report, scene, camera)
 
     def __repr__(self):
-        return "RandomNoiseScene(model=%r, policy=%r, baseSeed=%d)" % (self.model, self.policy, self.baseSeed)
+        return "RandomNoiseScene(model=%r, policy=%r, baseSeed=%d)" % (self._models, self.policy, self.baseSeed)
 
 
 def packCfaPlanes(signal, format):
@@ -139,12 +218,12 @@ class RawFolderDataset(torch.utils.data.Dataset):
 
     Each item is a dict: ``raw`` (float32 tensor: 1 x H x W of the mosaic, or 4 x H/2 x W/2 CFA planes
     with ``pack=True``; black-subtracted and divided by white - black, so 1 is saturation, unless
-    ``normalize=False``, which keeps DN above black), ``gain`` (the output's linear gain, float), ``index``
-    and ``path``.
+    ``normalize=False``, which keeps DN above black), ``gain`` (the output's linear gain, float), ``index``,
+    ``path`` and ``camera`` (the real camera whose noise the sample took, "" for none).
 
     Args:
         folder: the folder (files sorted by name; sub-folders are not read).
-        model, policy, baseSeed: as RandomNoiseScene.
+        model, policy, baseSeed, camera: as RandomNoiseScene.
         pack: return the four CFA planes instead of the mosaic.
         normalize: divide by the per-site range white - black.
         augment: False returns the files as they are (for validation sets).
@@ -155,7 +234,7 @@ class RawFolderDataset(torch.utils.data.Dataset):
     """
 
     def __init__(self, folder, model, policy=None, baseSeed=0, pack=False, normalize=True, augment=True,
-                 crop=None):
+                 crop=None, camera=None):
         if crop is not None:
             if len(crop) != 2 or any(int(v) != v or v <= 0 or int(v) % 2 for v in crop):
                 raise ValueError("RawFolderDataset: crop must be (height, width), both even and > 0, not %r"
@@ -177,7 +256,7 @@ class RawFolderDataset(torch.utils.data.Dataset):
             raise FileNotFoundError("RawFolderDataset: no RAW file (%s) and no mosaic with a sidecar in '%s'" %
                                     (", ".join(RAW_EXTENSIONS[:5]) + ", ...", folder))
         self.files = files
-        self.transform = RandomNoiseScene(model, policy, baseSeed)
+        self.transform = RandomNoiseScene(model, policy, baseSeed, camera=camera)
         self.pack = bool(pack)
         self.normalize = bool(normalize)
         self.augment = bool(augment)
@@ -224,9 +303,10 @@ class RawFolderDataset(torch.utils.data.Dataset):
         mosaic, fmt = loadMosaic(self.files[index])
         if self.crop is not None:
             mosaic, fmt = self._cropped(mosaic, fmt, index)
+        camera = ""
         if self.augment:
             result = self.transform(mosaic, fmt, index=index, epoch=self.epoch)
-            mosaic, fmt = result.raw, result.format
+            mosaic, fmt, camera = result.raw, result.format, result.camera or ""
         signal = _rg.subtractBlackLevel(mosaic, fmt, normalize=self.normalize)
         raw = packCfaPlanes(signal, fmt) if self.pack else torch.from_numpy(signal).unsqueeze(0)
-        return {"raw": raw, "gain": float(fmt.gain), "index": int(index), "path": self.files[index]}
+        return {"raw": raw, "gain": float(fmt.gain), "index": int(index), "path": self.files[index], "camera": camera}

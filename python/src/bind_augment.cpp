@@ -264,8 +264,10 @@ void bindAugment(py::module_& m)
     // ---- real cameras (camera_profiles.hpp) -------------------------------------------------------
     py::enum_<CameraProfileVerdict>(m, "CameraProfileVerdict", doc("CameraProfileVerdict"))
         .value("CAMERA_PROFILE_GOOD", CAMERA_PROFILE_GOOD, doc("CameraProfileVerdict::CAMERA_PROFILE_GOOD"))
-        .value("CAMERA_PROFILE_ROUGH", CAMERA_PROFILE_ROUGH, doc("CameraProfileVerdict::CAMERA_PROFILE_ROUGH"))
-        .value("CAMERA_PROFILE_REFUSED", CAMERA_PROFILE_REFUSED, doc("CameraProfileVerdict::CAMERA_PROFILE_REFUSED"))
+        .value("CAMERA_PROFILE_ROUGH", CAMERA_PROFILE_ROUGH,
+               doc("CameraProfileVerdict::CAMERA_PROFILE_ROUGH"))
+        .value("CAMERA_PROFILE_REFUSED", CAMERA_PROFILE_REFUSED,
+               doc("CameraProfileVerdict::CAMERA_PROFILE_REFUSED"))
         .export_values();
     m.def("cameraProfileVerdictName", &cameraProfileVerdictName, py::arg("verdict"),
           doc("cameraProfileVerdictName"));

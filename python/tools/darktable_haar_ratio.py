@@ -13,7 +13,7 @@ written here from the algorithm's description. Result (seed 1, 16 frames of 1024
     no demosaicing:       c = 0.2500 +- 0.0003
     darktable PPG green:  c = 0.0794 +- 0.0001
 
-cv::rawgment's DARKTABLE_HAAR_VARIANCE_RATIO is the second, rounded to 0.080.
+cv::rawgment's DARKTABLE_HAAR_VARIANCE_RATIO is the second.
 Run: /usr/bin/python3 python/tools/darktable_haar_ratio.py
 """
 import numpy as np
@@ -23,10 +23,11 @@ SIZE = 1024
 
 def ppg_green(mosaic):
     """Green of an RGGB mosaic: kept at green sites, interpolated at red and blue sites."""
+    rows_, cols_ = mosaic.shape
     pad = np.pad(mosaic, 3, mode="reflect")
 
     def at(dy, dx):
-        return pad[3 + dy:3 + dy + SIZE, 3 + dx:3 + dx + SIZE]
+        return pad[3 + dy:3 + dy + rows_, 3 + dx:3 + dx + cols_]
 
     c = at(0, 0)
     xm, xp, xm2, xp2, xm3, xp3 = at(0, -1), at(0, 1), at(0, -2), at(0, 2), at(0, -3), at(0, 3)
@@ -36,16 +37,25 @@ def ppg_green(mosaic):
     guess_x = np.clip(((xm + c + xp) * 2 - xp2 - xm2) / 4, np.minimum(xm, xp), np.maximum(xm, xp))
     guess_y = np.clip(((ym + c + yp) * 2 - yp2 - ym2) / 4, np.minimum(ym, yp), np.maximum(ym, yp))
     interpolated = np.where(grad_x > grad_y, guess_y, guess_x)
-    rows, cols = np.mgrid[0:SIZE, 0:SIZE]
+    rows, cols = np.mgrid[0:rows_, 0:cols_]
     green = mosaic.copy()
     red_or_blue = (rows + cols) % 2 == 0
     green[red_or_blue] = interpolated[red_or_blue]
     return green
 
 
+def haar_hh(channel):
+    """The one-level Haar HH coefficient of each 2 x 2 block, as darktable's lifting scheme gives it."""
+    return (channel[0::2, 0::2] - channel[0::2, 1::2] - channel[1::2, 0::2] + channel[1::2, 1::2]) / 4
+
+
+def haar_ll(channel):
+    """The block's mean, by which darktable bins the HH coefficients."""
+    return (channel[0::2, 0::2] + channel[0::2, 1::2] + channel[1::2, 0::2] + channel[1::2, 1::2]) / 4
+
+
 def haar_mad_variance(channel):
-    hh = (channel[0::2, 0::2] - channel[0::2, 1::2] - channel[1::2, 0::2] + channel[1::2, 1::2]) / 4
-    return (np.median(np.abs(hh)) / 0.6745) ** 2
+    return (np.median(np.abs(haar_hh(channel))) / 0.6745) ** 2
 
 
 def main():

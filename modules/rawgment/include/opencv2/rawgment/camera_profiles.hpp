@@ -41,10 +41,11 @@ CV_RAWGMENT_EXPORTS String cameraProfileVerdictName(int verdict);
  * neighbours and lowers it. docs/real_cameras.md has the derivation and the reference. */
 struct CV_RAWGMENT_EXPORTS DarktableImportParams
 {
-    /** c: darktable's variance over the per-pixel raw variance, for the green channel. 0.080 is darktable's
-     * PPG green interpolation followed by its Haar-MAD measurement, simulated on white noise
-     * (`python/tools/darktable_haar_ratio.py`); 0.25 would assume no demosaicing. In (0, 1]. */
-    double haarVarianceRatio = 0.080;
+    /** c: darktable's variance over the per-pixel raw variance, for the green channel. The default,
+     * DARKTABLE_HAAR_VARIANCE_RATIO = 0.0794, is darktable's PPG green interpolation followed by its Haar-MAD
+     * measurement, simulated on white noise (`python/tools/darktable_haar_ratio.py`); 0.25 would assume no
+     * demosaicing. In (0, 1]. */
+    double haarVarianceRatio = DARKTABLE_HAAR_VARIANCE_RATIO;
     /** The signal level, as a fraction of white, at which offsets are compared: an offset's residual is
      * the error of the fitted offset over |b| + a x_ref, the profile's variance there. Offsets can be
      * zero or negative, so they have no scale of their own. In (0, 1). */

@@ -88,7 +88,7 @@ CV_RAWGMENT_EXPORTS NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& 
 
 /** @brief darktable's noise variance over the per-pixel raw variance (green channel), as its profiling
  * tool measures: the Haar-MAD variance of a PPG-demosaiced export (docs/real_cameras.md). */
-constexpr double DARKTABLE_HAAR_VARIANCE_RATIO = 0.080;
+constexpr double DARKTABLE_HAAR_VARIANCE_RATIO = 0.0794;
 
 /** @brief A noise model as darktable's noise profiles (the `noiseprofiles.json` that its "denoise
  * (profiled)" module reads): one profile per ISO, each with per-colour `a` and `b` (red, green, blue)

@@ -1,0 +1,187 @@
+"""Real cameras: darktable's measured profiles as models, against a sensor of known noise measured the way
+darktable measures, against an independent numpy fit, and as a per-sample camera draw in the torch
+transform and dataset."""
+import importlib.util
+import json
+import os
+
+import numpy as np
+import pytest
+
+import rawgment as rg
+
+
+def _darktable_tool(source_dir):
+    """python/tools/darktable_haar_ratio.py: darktable's PPG green and Haar transform, written in numpy."""
+    spec = importlib.util.spec_from_file_location(
+        "darktable_haar_ratio", os.path.join(source_dir, "python", "tools", "darktable_haar_ratio.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _darktable_profile(tool, mosaic):
+    """What darktable's profiling tool reports for one RGGB frame normalised to [0, 1]: the variance of the
+    green Haar HH coefficients (MAD, 300 brightness bins of LL) fitted as a x + b on [0, 0.8], each bin
+    weighted by its count squared (gnuplot's fit with an error of 1 / count)."""
+    green = tool.ppg_green(np.maximum(mosaic, 0))  # darktable's PFM reader clamps below zero
+    hh = np.abs(tool.haar_hh(green)).ravel()
+    bins = np.clip((tool.haar_ll(green) * 300).astype(int), 0, 299).ravel()
+    order = np.argsort(bins, kind="stable")
+    bins, hh = bins[order], hh[order]
+    edges = np.searchsorted(bins, np.arange(301))
+    x, y, w = [], [], []
+    for b in range(240):  # brightness < 0.8
+        seg = hh[edges[b]:edges[b + 1]]
+        if len(seg):
+            x.append(b / 300)
+            y.append((np.median(seg) / 0.6745) ** 2)
+            w.append(len(seg))
+    x, y, w = np.array(x), np.array(y), np.array(w, float)
+    design = np.stack([x, np.ones_like(x)], 1) * w[:, None]
+    a, b = np.linalg.lstsq(design, y * w, rcond=None)[0]
+    return a, b
+
+
+def test_a_sensor_measured_the_way_darktable_measures_is_imported_with_its_noise(tmp_path, source_dir):
+    # A sensor of 20,000 e- full well, 5 e- of read noise before the gain and 20 e- after, at ISO 100
+    # to 1600; Gaussian noise of the model's variance on a ramp from black to 0.8 of white.
+    tool = _darktable_tool(source_dir)
+    full_well = 20000.0
+    alpha, sd, sr = 1 / full_well, (5 / full_well) ** 2, (20 / full_well) ** 2
+    ramp = np.tile(np.linspace(0.0, 0.8, 1024), (1024, 1))
+    got = []
+    for campaign in range(2):
+        rng = np.random.default_rng(100 + campaign)
+        profiles = []
+        for iso in (100, 200, 400, 800, 1600):
+            g = iso / 100
+            noisy = ramp + rng.standard_normal(ramp.shape) * np.sqrt(g * alpha * ramp + g * g * sd + sr)
+            a, b = _darktable_profile(tool, noisy)
+            profiles.append({"name": "sim iso %d" % iso, "iso": iso, "a": [a] * 3, "b": [b] * 3})
+        path = tmp_path / ("sim%d.json" % campaign)
+        path.write_text(json.dumps({"version": 0, "noiseprofiles": [
+            {"maker": "Sim", "models": [{"model": "Sensor", "profiles": profiles}]}]}))
+        camera = rg.readCameraProfiles(str(path))[0]
+        assert camera.verdict == rg.CAMERA_PROFILE_GOOD, camera.reason
+        got.append((camera.alpha / alpha, camera.sigmaD2 / sd, camera.sigmaR2 / sr))
+    ratio = np.mean(got, axis=0)
+    # Eight campaigns of this test's sensor (seeds 1-8) gave alpha 0.993 +- 0.001 with c rounded to 0.080,
+    # i.e. 1.000 with c = 0.0794: the shot slope comes back exact, so 1.5% is ~10 standard errors of a
+    # two-campaign mean. The read variances came back 18 +- 4% (sigma_r^2) and 23 +- 6% (sigma_d^2) high:
+    # darktable's measurement itself (noisy LL bins, the PPG clamp, the clamp at black) overstates them at
+    # this sensor, so the bounds are the truth to +60% / -20% (about 3 standard errors of a two-campaign
+    # mean around that bias) and the bias is stated in docs/real_cameras.md.
+    assert abs(ratio[0] - 1) < 0.015, got
+    assert 0.8 < ratio[1] < 1.6, got
+    assert 0.8 < ratio[2] < 1.6, got
+
+
+def _profiles_path():
+    path = rg.darktableProfilesPath()
+    if not path:
+        if os.environ.get("CI"):
+            pytest.fail("darktable's noiseprofiles.json is missing in CI (scripts/install-deps.sh fetches it)")
+        pytest.skip("darktable's noiseprofiles.json not found (run scripts/fetch-darktable-profiles.sh)")
+    return path
+
+
+def _numpy_fit(profiles, c=rg.DARKTABLE_HAAR_VARIANCE_RATIO, x_ref=1e-3):
+    """The fit's definitions, written again: green a / c and b / c; alpha by relative least squares through
+    the origin; (sigma_d^2, sigma_r^2) >= 0 by weighted least squares, the best feasible point of the
+    interior and the boundary."""
+    used = sorted((p for p in profiles if not p.get("skip") and p["a"][1] > 0), key=lambda p: p["iso"])
+    iso = np.array([p["iso"] for p in used], float)
+    a = np.array([p["a"][1] for p in used]) / c
+    b = np.array([p["b"][1] for p in used]) / c
+    g = iso / iso.min()
+    fitted_alpha = np.sum(g / a) / np.sum(g * g / (a * a))
+    w = 1 / (np.abs(b) + a * x_ref) ** 2
+    design = np.stack([g * g, np.ones_like(g)], 1)
+    candidates = [np.array([max(0.0, np.sum(w * g ** 2 * b) / np.sum(w * g ** 4)), 0.0]),
+                  np.array([0.0, max(0.0, np.sum(w * b) / np.sum(w))]), np.zeros(2)]
+    free = np.linalg.solve(design.T @ (design * w[:, None]), design.T @ (w * b))
+    if free.min() >= 0:
+        best = free
+    else:
+        best = min(candidates, key=lambda s: np.sum(w * (design @ s - b) ** 2))
+    return fitted_alpha, best[0], best[1], np.abs(g * fitted_alpha / a - 1).max()
+
+
+def test_every_camera_of_darktables_file_matches_an_independent_fit():
+    path = _profiles_path()
+    with open(path) as f:
+        data = json.load(f)
+    cameras = {c.place: c for c in rg.readCameraProfiles(path)}
+    checked = 0
+    for i, maker in enumerate(data["noiseprofiles"]):
+        for j, model in enumerate(maker["models"]):
+            camera = cameras["noiseprofiles[%d].models[%d]" % (i, j)]
+            assert camera.maker == maker["maker"] and camera.model == model["model"]
+            if not camera.usable():
+                continue
+            alpha, sd, sr, worst = _numpy_fit(model["profiles"])
+            # The same arithmetic in another order: agreement to rounding, relative to each term's scale.
+            assert camera.alpha == pytest.approx(alpha, rel=1e-9)
+            assert camera.sigmaD2 == pytest.approx(sd, rel=1e-6, abs=1e-9 * (sd + sr))
+            assert camera.sigmaR2 == pytest.approx(sr, rel=1e-6, abs=1e-9 * (sd + sr))
+            assert camera.worstSlopeResidual == pytest.approx(worst, rel=1e-9)
+            checked += 1
+    assert checked >= 300
+
+
+@pytest.fixture(scope="module")
+def two_cameras(tmp_path_factory):
+    """A darktable file of two cameras of very different read noise (the project's own exports)."""
+    fmt = rg.RawFormat(blackLevel=(64, 64, 64, 64), whiteLevel=4095)
+    quiet = rg.darktableNoiseProfiles(rg.NoiseModel(0.3, 0.05, 0.2), fmt, 100, [100, 800], "Maker", "Quiet")
+    loud = rg.darktableNoiseProfiles(rg.NoiseModel(0.3, 2.0, 30.0), fmt, 100, [100, 800], "Maker", "Loud")
+    models = json.loads(quiet)["noiseprofiles"][0]["models"] + json.loads(loud)["noiseprofiles"][0]["models"]
+    path = tmp_path_factory.mktemp("cameras") / "noiseprofiles.json"
+    path.write_text(json.dumps({"version": 0, "noiseprofiles": [{"maker": "Maker", "models": models}]}))
+    return str(path), fmt
+
+
+def test_the_transform_draws_a_camera_per_sample_from_its_seed(two_cameras, sensor):
+    torch_module = pytest.importorskip("rawgment.torch")
+    path, _ = two_cameras
+    mosaic = sensor.capture(np.full((96, 128), 600, np.float32), 1.0, 1.0, seed=3)
+    fmt = sensor.rawFormat(1.0)
+    transform = torch_module.RandomNoiseScene(path, camera="usable", baseSeed=11)
+    assert [c.name() for c in transform.cameras] == ["Maker Quiet", "Maker Loud"]
+    seen = set()
+    for index in range(16):
+        out = transform(mosaic, fmt, index=index)
+        seed = torch_module.sampleSeed(11, 0, index)
+        expected = transform.cameras[rg.drawCameraIndex(2, seed)]
+        assert out.camera == expected.name()
+        # Bit for bit the C++ call with that camera's model at this mosaic's levels.
+        direct = rg.applyScene(mosaic, fmt, expected.modelFor(fmt), out.scene, seed=seed)[0]
+        np.testing.assert_array_equal(out.raw, direct)
+        seen.add(out.camera)
+    assert seen == {"Maker Quiet", "Maker Loud"}
+    # One named camera, and the errors.
+    one = torch_module.RandomNoiseScene(path, camera="maker loud")
+    assert one(mosaic, fmt, index=0).camera == "Maker Loud"
+    with pytest.raises(ValueError, match="choose with camera="):
+        torch_module.RandomNoiseScene(path)
+    with pytest.raises(rg.error, match="no camera named 'Maker Lod'.*closest are 'Maker Loud'"):
+        torch_module.RandomNoiseScene(path, camera="Maker Lod")
+    with pytest.raises(ValueError, match="camera chooses among"):
+        torch_module.RandomNoiseScene(rg.NoiseModel(0.3, 1, 1), camera="Maker Loud")
+
+
+def test_the_dataset_records_each_samples_camera(two_cameras, sensor, tmp_path):
+    torch_module = pytest.importorskip("rawgment.torch")
+    path, _ = two_cameras
+    folder = tmp_path / "raws"
+    folder.mkdir()
+    for i in range(6):
+        raw = sensor.capture(np.full((96, 128), 500, np.float32), 1.0, 1.0, seed=40 + i)
+        rg.writeDng(str(folder / ("frame_%02d.dng" % i)), rg.RawImage(mosaic=raw, format=sensor.rawFormat(1.0)))
+    dataset = torch_module.RawFolderDataset(folder, path, camera=["Maker Quiet", "Maker Loud"], baseSeed=3)
+    names = [dataset[i]["camera"] for i in range(len(dataset))]
+    assert set(names) <= {"Maker Quiet", "Maker Loud"} and all(names)
+    assert names == [dataset[i]["camera"] for i in range(len(dataset))]
+    plain = torch_module.RawFolderDataset(folder, rg.NoiseModel(0.3, 1, 1))
+    assert plain[0]["camera"] == ""
