@@ -1265,6 +1265,15 @@ TEST(Apps, demoWritesAReportAndAGallery)
     EXPECT_NE(std::string::npos, report.find("## Dark-frame noise beyond the paper")) << report;
     EXPECT_NE(std::string::npos, report.find("| read-noise Tukey lambda | -0.080 |")) << report;
     expectPngDecodes(dir + "/demo/dark_components.png");
+    // The same dark scene as two real cameras, when darktable's profiles are on the machine (CI: always).
+    EXPECT_NE(std::string::npos, report.find("## Real cameras")) << report;
+    if (!cv::rawgment::darktableProfilesPath().empty()) {
+        EXPECT_NE(std::string::npos, report.find("| camera | verdict | full well (e-) |")) << report;
+        expectPngDecodes(dir + "/demo/real_cameras.png");
+        cv::Mat mosaic;
+        EXPECT_FALSE(
+            cv::rawgment::readMosaic(dir + "/demo/gallery/camera_0.dng", mosaic).noiseCamera.empty());
+    }
     r = runApp("rawgment_demo", "--out='" + dir + "/demo' --frames=8");
     EXPECT_EQ(1, r.status) << "an existing report is never overwritten";
 }
