@@ -96,10 +96,16 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
     for (const CameraNoiseProfile& cam : cams) {
         ++verdicts[cam.verdict];
         if (!cam.usable()) {
-            std::string kind = cam.reason.substr(0, cam.reason.find(':'));
-            for (char& ch : kind)
-                if (ch >= '0' && ch <= '9')
-                    ch = 'N';
+            // The kind of refusal: the reason up to its colon, with each count ("at all 12 ISOs") as N.
+            const std::string reason = cam.reason.substr(0, cam.reason.find(':'));
+            std::string kind;
+            for (size_t k = 0; k < reason.size(); ++k) {
+                const bool digit = reason[k] >= '0' && reason[k] <= '9';
+                if (digit && k > 0 && reason[k - 1] == ' ')
+                    kind += 'N';
+                else if (!digit || kind.empty() || kind.back() != 'N')
+                    kind += reason[k];
+            }
             ++refusals[kind];
             continue;
         }
@@ -128,7 +134,8 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
     };
     std::ostringstream md;
     md << "## The cameras\n\n"
-       << cv::format("`%s`: %zu cameras, read and fitted in %.2f s. ", path.c_str(), cams.size(), seconds)
+       << cv::format("`%s`: %zu cameras, read and fitted in %.2f s. ",
+                     path.substr(path.find_last_of('/') + 1).c_str(), cams.size(), seconds)
        << "Verdicts: " << verdicts[CAMERA_PROFILE_GOOD] << " GOOD, " << verdicts[CAMERA_PROFILE_ROUGH]
        << " ROUGH, " << verdicts[CAMERA_PROFILE_REFUSED] << " REFUSED.\n\n";
     if (!refusals.empty()) {

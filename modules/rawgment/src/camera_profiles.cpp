@@ -273,7 +273,7 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
     }
     if (cam.sigmaD2 == 0 && cam.sigmaR2 == 0) {
         cam.verdict = CAMERA_PROFILE_REFUSED;
-        cam.reason = "the offsets fit no read noise at all (sigma_d^2 = sigma_r^2 = 0)";
+        cam.reason = "the offsets fit no read noise at all (sigma_d^2 and sigma_r^2 both zero)";
         return;
     }
     judge(cam, params);
