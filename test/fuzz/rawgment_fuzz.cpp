@@ -209,6 +209,43 @@ std::vector<Target> targets(const std::string& dataDir)
                                       [](const std::string& p) { seedDarkModel().save(p); });
                  },
                  [](const std::string& in) { return checkModel(NoiseModel::load(in)); }});
+    t.push_back(
+        {"camera_profiles", "input.json", false, Errors::LIBRARY,
+         [](const std::string&) {
+             // darktable's layout: two makers, a skipped profile, negative offsets, comments.
+             RawFormat format;
+             format.blackLevel = cv::Vec4d(64, 64, 64, 64);
+             format.whiteLevel = 4095;
+             const std::string own =
+                 darktableNoiseProfiles(seedModel(), format, 100, {100, 400, 1600}, "Maker", "Own");
+             const std::string measured =
+                 "{\"version\": 0, \"noiseprofiles\": [\n"
+                 " {\"maker\": \"A\", \"models\": [{\"comment\": \"c\", \"model\": \"M 1\", \"profiles\": [\n"
+                 "  {\"name\": \"M 1 iso 100\", \"iso\": 100, \"a\": [4.6e-06, 2.5e-06, 3.3e-06], \"b\": "
+                 "[2.0e-07, -1.2e-07, -1.0e-07]},\n"
+                 "  {\"name\": \"M 1 iso 200\", \"iso\": 200, \"skip\": true, \"a\": [1, 1, 1], \"b\": [0, "
+                 "0, "
+                 "0]},\n"
+                 "  {\"name\": \"M 1 iso 800\", \"iso\": 800, \"a\": [2.3e-05, 1.3e-05, 1.8e-05], \"b\": "
+                 "[1.4e-06, 3.9e-07, 1.1e-07]}]}]},\n"
+                 " {\"maker\": \"B\", \"models\": [{\"model\": \"N\", \"profiles\": []}]}]}\n";
+             return std::vector<std::string>{own, measured};
+         },
+         [](const std::string& in) {
+             RawFormat format;
+             format.whiteLevel = 16383;
+             for (const CameraNoiseProfile& cam : readCameraProfiles(in)) {
+                 if (!cam.usable()) {
+                     if (cam.reason.empty())
+                         return "refused camera '" + cam.name() + "' without a reason";
+                     continue;
+                 }
+                 const std::string bad = checkModel(cam.modelFor(format));
+                 if (!bad.empty())
+                     return cam.name() + ": " + bad;
+             }
+             return std::string();
+         }});
     t.push_back({"report", "input.yml", false, Errors::LIBRARY,
                  [](const std::string& work) {
                      const CalibrationReport report = calibrateNoiseModel(seedSamples());
