@@ -9,15 +9,19 @@
 
 int main(int argc, char** argv)
 {
-    const char* keys = "{help h usage ? |      | print this message }"
-                       "{@manifest      |      | validation manifest (YAML) }"
-                       "{model m        |      | noise model (YAML/JSON, from rawgment_calibrate) }"
-                       "{out o          |      | output directory (required) }"
-                       "{bins           | 10   | mean bins of the table }"
-                       "{seed           | 7    | noise seed of the conversions }"
-                       "{plots          | true | write a PNG plot with gnuplot }"
-                       "{accept_failed_calibration | false | also use a model whose calibration's verdict "
-                       "was FAIL }";
+    const char* keys =
+        "{help h usage ? |      | print this message }"
+        "{@manifest      |      | validation manifest (YAML) }"
+        "{model m        |      | noise model: YAML/JSON from rawgment_calibrate, an Android "
+        "profile YAML, or darktable's noiseprofiles.json with --camera }"
+        "{camera         |      | the camera of a darktable noise-profile file (rawgment_cameras "
+        "lists them) }"
+        "{out o          |      | output directory (required) }"
+        "{bins           | 10   | mean bins of the table }"
+        "{seed           | 7    | noise seed of the conversions }"
+        "{plots          | true | write a PNG plot with gnuplot }"
+        "{accept_failed_calibration | false | also use a model whose calibration's verdict "
+        "was FAIL }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_validate"))
         return 2;
     rawgment_apps::installInterruptCleanup();
@@ -40,6 +44,7 @@ int main(int argc, char** argv)
     rawgment_apps::ValidateOptions o;
     o.manifest = parser.get<std::string>("@manifest");
     o.model = parser.get<std::string>("model");
+    o.camera = parser.get<std::string>("camera");
     o.outDir = parser.get<std::string>("out");
     o.bins = parser.get<int>("bins");
     o.seed = rawgment_apps::seedOption(parser, "rawgment_validate");

@@ -690,8 +690,7 @@ TEST(Apps, augmentAsRealCamerasDrawsOnePerOutputAndRecordsIt)
     // A darktable file of two cameras (the project's own exports, joined), an Android profile, and the
     // catalogue app over the file.
     const std::string dir = freshDir("augment_cameras");
-    AppRun r = runApp("rawgment_simulate",
-                      "--out='" + dir + "/sim' --frames=3 --gains=6 --levels=0.5 --validation=false");
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=3 --gains=6 --levels=0.5");
     ASSERT_EQ(0, r.status) << r.output;
     cv::rawgment::RawFormat format;
     format.blackLevel = cv::Vec4d(64, 64, 64, 64);
@@ -754,6 +753,17 @@ TEST(Apps, augmentAsRealCamerasDrawsOnePerOutputAndRecordsIt)
                                        "/x'" + common);
     EXPECT_EQ(1, r.status);
     EXPECT_NE(std::string::npos, r.output.find("is not one")) << r.output;
+
+    // The validation takes a camera too, made at the bright burst's levels.
+    r = runApp("rawgment_validate", "'" + dir + "/sim/validation_manifest.yml' --model='" + dir +
+                                        "/noiseprofiles.json' --camera='Maker Quiet' --plots=false --out='" +
+                                        dir + "/val'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, readText(dir + "/val/validation.md").find("ACCOUNT_PRIOR"));
+    r = runApp("rawgment_validate", "'" + dir + "/sim/validation_manifest.yml' --model='" + dir +
+                                        "/noiseprofiles.json' --plots=false --out='" + dir + "/val2'");
+    EXPECT_EQ(1, r.status);
+    EXPECT_NE(std::string::npos, r.output.find("darktable noise-profile file of many cameras")) << r.output;
 
     // The catalogue and one camera's table.
     r = runApp("rawgment_cameras", "--profiles='" + dir + "/noiseprofiles.json'");

@@ -115,7 +115,8 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& options);
 struct ValidateOptions
 {
     std::string manifest;
-    std::string model;
+    std::string model;  //!< a NoiseModel file, an Android profile YAML, or a darktable file with `camera`
+    std::string camera; //!< the camera of a darktable profile file (loadAnyNoiseModel())
     std::string outDir;
     int bins = 10;
     uint64_t seed = 7;

@@ -57,7 +57,12 @@ ValidationManifest readValidationManifest(const std::string& path)
 ValidateResult validateConversion(const ValidateOptions& o)
 {
     const ValidationManifest manifest = readValidationManifest(o.manifest);
-    const NoiseModel model = NoiseModel::load(o.model, o.acceptFailedCalibration);
+    // A NoiseModel file is read (and refused) before any frame; a darktable camera's or an Android
+    // profile's model is made at the bright frames' levels once they are read.
+    const bool modelFromLevels =
+        !o.camera.empty() || isDarktableProfileFile(o.model) ||
+        !openFileStorageForReading(o.model, "noise model")["android_noise_profile"].empty();
+    NoiseModel model = modelFromLevels ? NoiseModel() : NoiseModel::load(o.model, o.acceptFailedCalibration);
     prepareOutputDirectory(o.outDir);
     const std::string csvPath = o.outDir + "/validation.csv", mdPath = o.outDir + "/validation.md";
     refuseExisting({csvPath, mdPath});
@@ -81,6 +86,8 @@ ValidateResult validateConversion(const ValidateOptions& o)
     for (const std::string& f : brightFiles)
         bright.push_back(loadMatching(f));
     RawFormat format = bright.front().format;
+    if (modelFromLevels)
+        model = loadAnyNoiseModel(o.model, o.camera, format, o.acceptFailedCalibration);
     if (manifest.hasGainDb)
         format.gain = dbToLinearGain(manifest.gainDb);
     cv::Mat mask(bright.front().mosaic.size(), CV_8U, cv::Scalar(manifest.patches.empty() ? 255 : 0));
