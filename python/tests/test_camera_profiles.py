@@ -151,3 +151,17 @@ def test_the_dataset_records_each_samples_camera(two_cameras, sensor, tmp_path):
     assert names == [dataset[i]["camera"] for i in range(len(dataset))]
     plain = torch_module.RawFolderDataset(folder, rg.NoiseModel(0.3, 1, 1))
     assert plain[0]["camera"] == ""
+
+
+def test_a_noise_model_from_any_model_file(two_cameras, tmp_path):
+    path, fmt = two_cameras
+    loud = rg.loadAnyNoiseModel(path, "Maker Loud", fmt)
+    assert (loud.alpha, loud.sigmaD2, loud.sigmaR2) == pytest.approx((0.3, 2.0, 30.0), rel=1e-9)
+    assert loud.baseIso == 100
+    assert rg.findCameraProfile(rg.readCameraProfiles(path), "maker loud").modelFor(fmt).sigmaR2 == \
+        pytest.approx(30.0, rel=1e-9)
+    model = rg.NoiseModel(0.3, 2.0, 30.0)
+    model.save(str(tmp_path / "model.yml"))
+    assert rg.loadAnyNoiseModel(str(tmp_path / "model.yml")).sigmaR2 == 30.0
+    with pytest.raises(rg.error, match="of many cameras"):
+        rg.loadAnyNoiseModel(path)
