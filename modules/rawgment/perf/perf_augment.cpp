@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Augmentation of a 4000x3000 CV_16UC1 mosaic, all in one run:
-//   colour jitter (ACCOUNT_PRIOR), motion blur (length 13), scaling by 3%, a full random scene,
+//   colour jitter (ACCOUNT_PRIOR; also with Tukey-lambda read noise and with Poisson shot draws), motion
+//   blur (length 13), scaling by 3%, a full random scene,
 //   the same colour jitter composed naively with OpenCV calls (convertTo, RNG::fill NORMAL, Mat
 //   arithmetic, sqrt), and a memcpy of the frame (the floor); and standard normals alone
 //   (fillStandardNormal). Every benchmark of the library runs once per CpuPath this CPU has
@@ -41,6 +42,42 @@ void BM_Augment_colorJitter(benchmark::State& state)
     uint64 seed = 0;
     for (auto _ : state) {
         colorJitter(frame(), frameFormat(), kModel, kJitter, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out, f);
+        benchmark::DoNotOptimize(out.data);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+}
+
+//! kModel with heavy-tailed read noise (Tukey lambda -0.1, excess kurtosis about 3.4).
+NoiseModel heavyTailedModel()
+{
+    NoiseModel m = kModel;
+    m.tukeyRead = true;
+    m.tukeyLambda = -0.1;
+    return m;
+}
+
+void BM_Augment_colorJitterTukeyRead(benchmark::State& state)
+{
+    const NoiseModel model = heavyTailedModel();
+    Mat out;
+    RawFormat f;
+    uint64 seed = 0;
+    for (auto _ : state) {
+        colorJitter(frame(), frameFormat(), model, kJitter, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out, f);
+        benchmark::DoNotOptimize(out.data);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+}
+
+void BM_Augment_colorJitterPoisson(benchmark::State& state)
+{
+    NoiseOptions noise(NoiseAlignment::ACCOUNT_PRIOR);
+    noise.shotSampling = ShotNoiseSampling::POISSON;
+    Mat out;
+    RawFormat f;
+    uint64 seed = 0;
+    for (auto _ : state) {
+        colorJitter(frame(), frameFormat(), kModel, kJitter, noise, ++seed, out, f);
         benchmark::DoNotOptimize(out.data);
     }
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
@@ -141,6 +178,8 @@ int main(int argc, char** argv)
     const std::pair<const char*, void (*)(benchmark::State&)> library[] = {
         {"BM_Augment_standardNormals", BM_Augment_standardNormals},
         {"BM_Augment_colorJitter", BM_Augment_colorJitter},
+        {"BM_Augment_colorJitterTukeyRead", BM_Augment_colorJitterTukeyRead},
+        {"BM_Augment_colorJitterPoisson", BM_Augment_colorJitterPoisson},
         {"BM_Augment_motionBlur13", BM_Augment_motionBlur13},
         {"BM_Augment_scale103", BM_Augment_scale103},
         {"BM_Augment_randomScene", BM_Augment_randomScene}};

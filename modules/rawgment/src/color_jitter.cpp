@@ -114,10 +114,13 @@ template <int W> struct PixelLanes<W, float>
     }
 };
 
+// t: the row's unit-variance heavy-tailed draws (NoiseModel::tukeyRead), or null. With them the read
+// part of the variance (the rest, never more than the total) takes t and the shot part z, as
+// sampledNoiseWithTails() does; kLineBySite is never set then, since it does not split the two.
 template <int W, typename T, NoiseAlignment A, bool kLocalMean, bool kLineBySite>
-RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* prior, const float* extra,
-                                 const JitterColumns& col, int c, const JitterConstants& k,
-                                 typename detail::Lanes<W>::I& bright)
+RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* t, const float* prior,
+                                 const float* extra, const JitterColumns& col, int c,
+                                 const JitterConstants& k, typename detail::Lanes<W>::I& bright)
 {
     typedef typename detail::Lanes<W>::F F;
     typedef PixelLanes<W, T> P;
@@ -127,7 +130,7 @@ RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* 
     const F x = P::load(s + c) - blackv;
     F out = pcv * x + k.pb;
     if (A != NoiseAlignment::NONE) {
-        F xm = x, zv, total;
+        F xm = x, zv;
         if (kLocalMean)
             std::memcpy(&xm, prior + c, sizeof(xm));
         std::memcpy(&zv, z + c, sizeof(zv));
@@ -135,13 +138,23 @@ RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* 
             F slope, offset;
             std::memcpy(&slope, col.slope + c, sizeof(slope));
             std::memcpy(&offset, col.offset + c, sizeof(offset));
-            total = slope * detail::maxLanes(xm, F{}) + offset;
+            const F total = slope * detail::maxLanes(xm, F{}) + offset;
+            bright -= total < 0; // -1 per brightening lane
+            out += detail::sqrtLanes(detail::maxLanes(total, F{})) * zv;
         } else {
             const detail::AddedVarianceOf<F> v = jitterVariance<A>(xm, pcv, k);
-            total = v.shot + v.rest;
+            const F total = v.shot + v.rest;
+            bright -= total < 0;
+            if (t) {
+                F tv;
+                std::memcpy(&tv, t + c, sizeof(tv));
+                const F all = detail::maxLanes(total, F{});
+                const F read = detail::minLanes(detail::maxLanes(v.rest, F{}), all);
+                out += detail::sqrtLanes(all - read) * zv + detail::sqrtLanes(read) * tv;
+            } else {
+                out += detail::sqrtLanes(detail::maxLanes(total, F{})) * zv;
+            }
         }
-        bright -= total < 0; // -1 per brightening lane
-        out += detail::sqrtLanes(detail::maxLanes(total, F{})) * zv;
     }
     if (extra) { // the dark-frame components (row offset, dark shading), when the model has them
         F e;
@@ -152,13 +165,14 @@ RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* 
 }
 
 template <int W, typename T, NoiseAlignment A, bool kLocalMean, bool kLineBySite>
-RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float* prior, const float* extra,
-                                  const JitterColumns& col, const JitterConstants& k, int cols)
+RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float* t, const float* prior,
+                                  const float* extra, const JitterColumns& col, const JitterConstants& k,
+                                  int cols)
 {
     typename detail::Lanes<W>::I bright = {};
     int c = 0;
     for (; c + W <= cols; c += W)
-        jitterBlock<W, T, A, kLocalMean, kLineBySite>(s, d, z, prior, extra, col, c, k, bright);
+        jitterBlock<W, T, A, kLocalMean, kLineBySite>(s, d, z, t, prior, extra, col, c, k, bright);
     int total = 0;
     for (int i = 0; i < W; ++i)
         total += bright[i];
@@ -166,11 +180,12 @@ RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float*
     if (rest > 0) {
         // Padded copies: the extra lanes compute on zeros and are neither stored nor counted.
         T sPad[W] = {}, dPad[W];
-        float zPad[W] = {}, priorPad[W] = {}, extraPad[W] = {}, pcPad[W] = {}, blackPad[W] = {},
+        float zPad[W] = {}, tPad[W] = {}, priorPad[W] = {}, extraPad[W] = {}, pcPad[W] = {}, blackPad[W] = {},
               slopePad[W] = {}, offsetPad[W] = {};
         for (int i = 0; i < rest; ++i) {
             sPad[i] = s[c + i];
             zPad[i] = z ? z[c + i] : 0.0f;
+            tPad[i] = t ? t[c + i] : 0.0f;
             priorPad[i] = kLocalMean ? prior[c + i] : 0.0f;
             extraPad[i] = extra ? extra[c + i] : 0.0f;
             pcPad[i] = col.pc[c + i];
@@ -180,8 +195,8 @@ RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float*
         }
         const JitterColumns padded = {pcPad, blackPad, slopePad, offsetPad};
         typename detail::Lanes<W>::I tail = {};
-        jitterBlock<W, T, A, kLocalMean, kLineBySite>(sPad, dPad, zPad, priorPad, extra ? extraPad : nullptr,
-                                                      padded, 0, k, tail);
+        jitterBlock<W, T, A, kLocalMean, kLineBySite>(sPad, dPad, zPad, t ? tPad : nullptr, priorPad,
+                                                      extra ? extraPad : nullptr, padded, 0, k, tail);
         for (int i = 0; i < rest; ++i) {
             d[c + i] = dPad[i];
             total += tail[i];
@@ -191,55 +206,55 @@ RAWGMENT_KERNEL int jitterRowBody(const T* s, T* d, const float* z, const float*
 }
 
 template <int W, typename T, bool kLocalMean>
-RAWGMENT_KERNEL int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* prior,
-                                          const float* extra, const JitterColumns& col,
+RAWGMENT_KERNEL int jitterRowAnyAlignment(const T* s, T* d, const float* z, const float* t,
+                                          const float* prior, const float* extra, const JitterColumns& col,
                                           const JitterConstants& k, int cols)
 {
     switch (k.alignment) {
     case NoiseAlignment::ACCOUNT_PRIOR:
-        if (k.lineBySite)
-            return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, true>(s, d, z, prior, extra,
-                                                                                        col, k, cols);
-        return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, false>(s, d, z, prior, extra,
+        if (k.lineBySite && !t)
+            return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, true>(s, d, z, t, prior,
+                                                                                        extra, col, k, cols);
+        return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, false>(s, d, z, t, prior, extra,
                                                                                      col, k, cols);
     case NoiseAlignment::IGNORE_PRIOR:
-        return jitterRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, kLocalMean, false>(s, d, z, prior, extra,
+        return jitterRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, kLocalMean, false>(s, d, z, t, prior, extra,
                                                                                     col, k, cols);
     default:
-        return jitterRowBody<W, T, NoiseAlignment::NONE, kLocalMean, false>(s, d, z, prior, extra, col, k,
+        return jitterRowBody<W, T, NoiseAlignment::NONE, kLocalMean, false>(s, d, z, t, prior, extra, col, k,
                                                                             cols);
     }
 }
 
 template <int W>
-RAWGMENT_KERNEL int jitterRowKernel(const ushort* s, ushort* d, const float* z, const float* prior,
-                                    const float* extra, const JitterColumns& col, const JitterConstants& k,
-                                    int cols)
+RAWGMENT_KERNEL int jitterRowKernel(const ushort* s, ushort* d, const float* z, const float* t,
+                                    const float* prior, const float* extra, const JitterColumns& col,
+                                    const JitterConstants& k, int cols)
 {
-    return prior ? jitterRowAnyAlignment<W, ushort, true>(s, d, z, prior, extra, col, k, cols)
-                 : jitterRowAnyAlignment<W, ushort, false>(s, d, z, prior, extra, col, k, cols);
+    return prior ? jitterRowAnyAlignment<W, ushort, true>(s, d, z, t, prior, extra, col, k, cols)
+                 : jitterRowAnyAlignment<W, ushort, false>(s, d, z, t, prior, extra, col, k, cols);
 }
 
 template <int W>
-RAWGMENT_KERNEL int jitterRowKernel(const float* s, float* d, const float* z, const float* prior,
-                                    const float* extra, const JitterColumns& col, const JitterConstants& k,
-                                    int cols)
+RAWGMENT_KERNEL int jitterRowKernel(const float* s, float* d, const float* z, const float* t,
+                                    const float* prior, const float* extra, const JitterColumns& col,
+                                    const JitterConstants& k, int cols)
 {
-    return prior ? jitterRowAnyAlignment<W, float, true>(s, d, z, prior, extra, col, k, cols)
-                 : jitterRowAnyAlignment<W, float, false>(s, d, z, prior, extra, col, k, cols);
+    return prior ? jitterRowAnyAlignment<W, float, true>(s, d, z, t, prior, extra, col, k, cols)
+                 : jitterRowAnyAlignment<W, float, false>(s, d, z, t, prior, extra, col, k, cols);
 }
 
 // One dispatched entry point per pixel type (cpu_dispatch.hpp).
 RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
-                             (const ushort* s, ushort* d, const float* z, const float* prior,
+                             (const ushort* s, ushort* d, const float* z, const float* t, const float* prior,
                               const float* extra, const JitterColumns& col, const JitterConstants& k,
                               int cols),
-                             (s, d, z, prior, extra, col, k, cols))
+                             (s, d, z, t, prior, extra, col, k, cols))
 RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
-                             (const float* s, float* d, const float* z, const float* prior,
+                             (const float* s, float* d, const float* z, const float* t, const float* prior,
                               const float* extra, const JitterColumns& col, const JitterConstants& k,
                               int cols),
-                             (s, d, z, prior, extra, col, k, cols))
+                             (s, d, z, t, prior, extra, col, k, cols))
 
 // The scalar rows: ShotNoiseSampling::POISSON (a rejection loop per pixel) or Tukey-lambda read noise
 // (NoiseModel::tukeyRead: t holds the row's unit-variance heavy-tailed draws), with the dark terms'
@@ -329,17 +344,17 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
     const bool tails = noise && k.dark.tails, dark = noise && k.dark.any();
     std::vector<float> z(static_cast<size_t>(cols)), t(tails ? cols : 0), extra(dark ? cols : 0),
         blackAndShading(inputShading.empty() ? 0 : static_cast<size_t>(cols));
-    const bool scalar = noise && (k.sampling == ShotNoiseSampling::POISSON || tails);
+    const bool scalar = noise && k.sampling == ShotNoiseSampling::POISSON;
     int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
         if (noise)
             detail::fillGaussian(keys.gaussian, static_cast<uint64_t>(r), z.data(), cols);
         if (tails) {
-            detail::CounterRng uniforms(keys.tukey, static_cast<uint64_t>(r));
             const int even = 2 * (r & 1);
-            for (int c = 0; c < cols; ++c)
-                t[static_cast<size_t>(c)] =
-                    static_cast<float>(k.dark.tailSampler[even + (c & 1)](uniforms.uniform()));
+            const detail::TukeyUnitSampler &s0 = k.dark.tailSampler[even], &s1 = k.dark.tailSampler[even + 1];
+            detail::fillTukeyUnit(keys.tukey, static_cast<uint64_t>(r), static_cast<float>(s0.lambda),
+                                  static_cast<float>(s0.invSd), static_cast<float>(s1.lambda),
+                                  static_cast<float>(s1.invSd), t.data(), cols);
         }
         if (dark && !detail::darkRowExtra(k.dark, model, keys.row, r, cols, extra.data()))
             nonFinite = true;
@@ -357,8 +372,8 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
             localBright += jitterRowScalar(src.ptr<T>(r), dst.ptr<T>(r), z.data(), tails ? t.data() : nullptr,
                                            priorRow, extraRow, col.pc, col.black, k, rng, cols);
         } else {
-            localBright +=
-                jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), priorRow, extraRow, col, k, cols);
+            localBright += jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), tails ? t.data() : nullptr,
+                                     priorRow, extraRow, col, k, cols);
         }
     }
     brightening += localBright;

@@ -160,10 +160,100 @@ template <int W> RAWGMENT_KERNEL void fillGaussianKernel(uint64_t seed, uint64_t
     }
 }
 
+/* e^x for x in [-80, 80]: n = x log2(e) rounded to nearest (the 1.5 * 2^23 trick, exact in float), the
+ * remainder r = x - n ln 2 in two parts (Cody and Waite), Cephes' polynomial for e^r on |r| <= ln(2) / 2,
+ * then 2^n through the exponent bits. About 1 float ulp. */
+template <int W> RAWGMENT_KERNEL typename Lanes<W>::F expLanes(typename Lanes<W>::F x)
+{
+    typedef typename Lanes<W>::F F;
+    typedef typename Lanes<W>::I I;
+    const F shifter = F{} + 12582912.0f;
+    const F n = (x * 1.44269504088896341f + shifter) - shifter;
+    const F r = (x - n * 0.693359375f) - n * -2.12194440e-4f;
+    const F r2 = r * r;
+    const F p =
+        ((((1.9875691500e-4f * r + 1.3981999507e-3f) * r + 8.3334519073e-3f) * r + 4.1665795894e-2f) * r +
+         1.6666665459e-1f) *
+            r +
+        5.0000001201e-1f;
+    const F er = p * r2 + r + 1.0f;
+    const I scale = (__builtin_convertvector(n, I) + 127) << 23;
+    return er * (F)scale;
+}
+
+/* (e^(lambda l) - 1) / lambda, the term of a Tukey-lambda quantile, for l = ln(u) <= 0: for |lambda l| < 1/2
+ * l (1 + x/2 + ... + x^7/8!) with x = lambda l (truncation below 1e-8 relative, and exactly l when lambda
+ * is 0, the logistic limit), else (e^x - 1) / lambda, where no cancellation remains. */
+template <int W>
+RAWGMENT_KERNEL typename Lanes<W>::F tukeyTermLanes(typename Lanes<W>::F l, typename Lanes<W>::F lambda,
+                                                    typename Lanes<W>::F safeLambda)
+{
+    typedef typename Lanes<W>::F F;
+    typedef typename Lanes<W>::I I;
+    const F x = lambda * l;
+    const F series =
+        l *
+        (1.0f + x * (0.5f + x * (1.6666667e-1f +
+                                 x * (4.1666667e-2f +
+                                      x * (8.3333333e-3f +
+                                           x * (1.3888889e-3f + x * (1.9841270e-4f + x * 2.4801587e-5f)))))));
+    const F direct = (expLanes<W>(x) - 1.0f) / safeLambda;
+    const F ax = detail::maxLanes(x, -x);
+    const I small = ax < 0.5f;
+    return small ? series : direct;
+}
+
+/* n unit-variance Tukey-lambda values from the stream, two Philox words each: the sign from the top bit
+ * of the first, u in (0, 1/2) from its other 31 bits and 24 of the second (u down to 2^-57, so the
+ * tails reach as far as a double uniform's), then the quantile Q(u) = (u^lambda - (1 - u)^lambda) /
+ * lambda with the symmetry Q(1 - u) = -Q(u). Even columns take lambda0, odd columns lambda1 (the two
+ * CFA sites of a row). */
+template <int W>
+RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, float lambda0, float invSd0,
+                                         float lambda1, float invSd1, float* out, int n)
+{
+    typedef typename Lanes<W>::F F;
+    typedef typename Lanes<W>::I I;
+    typedef typename Lanes<W>::U U;
+    const int kChunk = 16; // values per 8 Philox blocks: 16 first words, then 16 second words
+    alignas(64) uint32_t words[32];
+    alignas(64) float chunk[kChunk];
+    const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
+    F lambda, invSd;
+    for (int i = 0; i < W; ++i) {
+        lambda[i] = (i & 1) ? lambda1 : lambda0;
+        invSd[i] = (i & 1) ? invSd1 : invSd0;
+    }
+    const F safeLambda = lambda == 0.0f ? F{} + 1.0f : lambda;
+    for (int base = 0; base < n; base += kChunk) {
+        philox8BlocksFor<W>(static_cast<uint32_t>(base / 2), stream, key, words);
+        float* const dst = n - base >= kChunk ? out + base : chunk;
+        for (int h = 0; h < kChunk; h += W) {
+            U w1, w2;
+            std::memcpy(&w1, words + h, sizeof(w1));
+            std::memcpy(&w2, words + kChunk + h, sizeof(w2));
+            const F hi = __builtin_convertvector((I)(w1 & 0x7fffffffu), F);
+            const F lo = (__builtin_convertvector((I)(w2 >> 8), F) + 0.5f) * (1.0f / 16777216.0f);
+            const F u = (hi + lo) * (1.0f / 4294967296.0f);
+            const F q = tukeyTermLanes<W>(logPositiveLanes<W>(u), lambda, safeLambda) -
+                        tukeyTermLanes<W>(logPositiveLanes<W>(1.0f - u), lambda, safeLambda);
+            const I negative = (I)(w1 >> 31) != 0;
+            const F v = invSd * (negative ? -q : q);
+            std::memcpy(dst + h, &v, sizeof(v));
+        }
+        if (dst == chunk)
+            std::memcpy(out + base, chunk, sizeof(float) * static_cast<size_t>(n - base));
+    }
+}
+
 } // namespace
 
 RAWGMENT_DISPATCHED_BY_WIDTH(void, fillGaussian, (uint64_t seed, uint64_t stream, float* out, int n),
                              (seed, stream, out, n))
+RAWGMENT_DISPATCHED_BY_WIDTH(void, fillTukeyUnit,
+                             (uint64_t seed, uint64_t stream, float lambda0, float invSd0, float lambda1,
+                              float invSd1, float* out, int n),
+                             (seed, stream, lambda0, invSd0, lambda1, invSd1, out, n))
 
 } // namespace detail
 } // namespace rawgment

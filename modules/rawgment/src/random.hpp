@@ -386,6 +386,16 @@ double logFactorial(int64_t k);
  * model; the uniforms have 24 bits, so |z| <= 5.8 (probability of a larger |z| for a true normal: 7e-9). */
 void fillGaussian(uint64_t seed, uint64_t stream, float* out, int n);
 
+/** Fills out[0..n) with unit-variance Tukey-lambda float32 values from the stream (seed, stream): even
+ * indices of shape lambda0 (scaled by invSd0, 1 / the shape's standard deviation), odd ones of lambda1
+ * (the two CFA sites of a mosaic row). Vector lanes on every path, the same bits on each: the quantile's
+ * logarithms and exponentials are polynomials (no library calls). Value i uses words 2i and 2i + 1 of the
+ * stream's chunk (16 values per 8 Philox blocks). Accuracy: within 2e-6 relative (or 1e-6 absolute near
+ * 0) of the double quantile of the same uniform (Simulate.fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath);
+ * the uniforms reach 2^-57, so the tails are drawn as far as a double uniform's would be. */
+CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, float lambda0, float invSd0,
+                                       float lambda1, float invSd1, float* out, int n);
+
 } // namespace detail
 } // namespace rawgment
 } // namespace cv

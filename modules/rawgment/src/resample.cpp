@@ -261,9 +261,10 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
     }
     if (noise && k.dark.tails) {
         t.resize(static_cast<size_t>(n));
-        detail::CounterRng uniforms(k.tukeyKey, stream);
-        for (int j = 0; j < n; ++j)
-            t[static_cast<size_t>(j)] = static_cast<float>(k.dark.tailSampler[site](uniforms.uniform()));
+        // A plane row is one CFA site: the same shape in every column.
+        const float lambda = static_cast<float>(k.dark.tailSampler[site].lambda),
+                    invSd = static_cast<float>(k.dark.tailSampler[site].invSd);
+        detail::fillTukeyUnit(k.tukeyKey, stream, lambda, invSd, lambda, invSd, t.data(), n);
     }
     const float* extraRow = extra.empty() ? nullptr : extra.data();
     if (noise && (k.sampling == ShotNoiseSampling::POISSON || k.dark.tails)) {

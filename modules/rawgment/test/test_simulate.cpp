@@ -6,6 +6,7 @@
 #include <opencv2/rawgment/cpu.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
+#include <cstring>
 #include <set>
 
 namespace cv {
@@ -369,6 +370,62 @@ TEST(Simulate, derivedSeedsAreStableAndDistinctPerPurposeAndIndex)
                 seen.insert(deriveSeed(seed, static_cast<SeedPurpose>(p), index));
     EXPECT_EQ(seen.size(), 3u * 9u * 1000u);
     EXPECT_CV_ERROR_CONTAINS(deriveSeed(1, static_cast<SeedPurpose>(3), 0), "unknown purpose 3");
+}
+
+TEST(Simulate, fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath)
+{
+    // Each value against the Tukey-lambda quantile in double precision of the uniform its two Philox words
+    // give, in the layout random.hpp documents (value h of a chunk of 16: words h and 16 + h of the
+    // chunk's 8 blocks, word j of block b at 8 j + b % 8), at both lambdas of a row (even and odd
+    // columns), for the lightest, the logistic and the heaviest shapes a model takes.
+    const uint64_t seed = 0x0fedcba987654321ull, stream = 3;
+    const int n = 16 * 8192 + 11; // a partial last chunk too
+    const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
+    auto word = [&](int chunk, int w) {
+        const uint32_t block = static_cast<uint32_t>(8 * chunk + w % 8);
+        const std::array<uint32_t, 4> counter = {block, 0, static_cast<uint32_t>(stream),
+                                                 static_cast<uint32_t>(stream >> 32)};
+        return detail::philox4x32(counter, key)[static_cast<size_t>(w / 8)];
+    };
+    const auto quantile = [](double u, double lambda) {
+        return lambda == 0 ? std::log(u / (1 - u)) : (std::pow(u, lambda) - std::pow(1 - u, lambda)) / lambda;
+    };
+    for (const Vec2f& lambdas : {Vec2f(1.0f, 0.14f), Vec2f(0.0f, -0.05f), Vec2f(-0.2f, 0.5f)}) {
+        const float invSd[2] = {0.7f, 1.3f};
+        std::vector<double> reference(static_cast<size_t>(n));
+        for (int i = 0; i < n; ++i) {
+            const int chunk = i / 16, h = i % 16;
+            const uint32_t w1 = word(chunk, h), w2 = word(chunk, 16 + h);
+            const double u =
+                (static_cast<double>(w1 & 0x7fffffffu) + (static_cast<double>(w2 >> 8) + 0.5) / 16777216.0) /
+                4294967296.0;
+            const double q = quantile(u, lambdas[i & 1]) * invSd[i & 1];
+            reference[static_cast<size_t>(i)] = (w1 >> 31) ? -q : q;
+        }
+        // The float quantile rounds in the two logarithms (each a few ulps of |ln u| <= 40), the
+        // exponential and the difference: 2e-6 of max(1, |value|) bounds it (5e-7 seen on every path); a
+        // wrong word, sign or branch of the series errs by order one.
+        std::vector<float> first;
+        for (CpuPath path : availableCpuPaths()) {
+            setCpuPath(path);
+            std::vector<float> t(static_cast<size_t>(n));
+            detail::fillTukeyUnit(seed, stream, lambdas[0], invSd[0], lambdas[1], invSd[1], t.data(), n);
+            double worst = 0;
+            for (int i = 0; i < n; ++i) {
+                const double ref = reference[static_cast<size_t>(i)];
+                const double error = std::abs(t[static_cast<size_t>(i)] - ref) / std::max(1.0, std::abs(ref));
+                worst = std::max(worst, error);
+                ASSERT_LE(error, 2e-6) << cpuPathName(path) << ", lambdas " << lambdas << ", value " << i;
+            }
+            std::cout << cpuPathName(path) << ", lambdas " << lambdas << ": largest error " << worst << "\n";
+            if (first.empty())
+                first = t;
+            else
+                ASSERT_EQ(0, std::memcmp(first.data(), t.data(), sizeof(float) * first.size()))
+                    << cpuPathName(path);
+        }
+        setCpuPath(CpuPath::AUTO);
+    }
 }
 
 TEST(Simulate, fillGaussianIsBoxMullerOfItsPhiloxWordsOnEveryPath)
