@@ -40,40 +40,10 @@ RAWGMENT_KERNEL void groupSumsBody(const T* const* rows, int m, int n, double* s
     }
 }
 
-/* 16-bit frames in integers: d = v_k - v_0 lies in [-65535, 65535], so d^2 < 2^32 is exact in uint32 and
- * the sums are exact in int32 (m <= 256 frames: |sum d| < 2^24) and uint64. Integer lanes are twice as
- * many per vector as doubles and need no conversion per value, and the result is the same exact
- * integers the double loop gives, so every CpuPath returns the same bits. */
 RAWGMENT_KERNEL void groupSumsKernel(const ushort* const* rows, int m, int n, double* s1, double* s2,
                                      double* lo, double* hi)
 {
-    const int kMax = 256; // mergeGroupRows()'s block
-    int32_t i1[kMax];
-    uint64_t i2[kMax];
-    ushort l[kMax], h[kMax];
-    const ushort* first = rows[0];
-    for (int c = 0; c < n; ++c) {
-        i1[c] = 0;
-        i2[c] = 0;
-        l[c] = h[c] = first[c];
-    }
-    for (int k = 1; k < m; ++k) {
-        const ushort* v = rows[k];
-        for (int c = 0; c < n; ++c) {
-            const int32_t d = static_cast<int32_t>(v[c]) - static_cast<int32_t>(first[c]);
-            const uint32_t ud = static_cast<uint32_t>(d);
-            i1[c] += d;
-            i2[c] += static_cast<uint64_t>(ud * ud); // (d mod 2^32)^2 mod 2^32 = d^2, which fits
-            l[c] = std::min(l[c], v[c]);
-            h[c] = std::max(h[c], v[c]);
-        }
-    }
-    for (int c = 0; c < n; ++c) {
-        s1[c] = static_cast<double>(i1[c]);
-        s2[c] = static_cast<double>(i2[c]);
-        lo[c] = l[c];
-        hi[c] = h[c];
-    }
+    groupSumsBody(rows, m, n, s1, s2, lo, hi);
 }
 RAWGMENT_DISPATCHED(void, groupSums,
                     (const ushort* const* rows, int m, int n, double* s1, double* s2, double* lo, double* hi),
@@ -137,7 +107,7 @@ template <typename T, typename S>
 void mergeGroupRows(const std::vector<Mat>& group, int merged, const Vec4d& black, double white, Mat& mean,
                     Mat& m2, Mat& clipped, int r0, int r1)
 {
-    const int kBlock = 256; // groupSumsKernel() for 16-bit frames holds this many columns
+    const int kBlock = 256;
     const int m = static_cast<int>(group.size()), cols = mean.cols;
     double s1[kBlock], s2[kBlock], lo[kBlock], hi[kBlock], first[kBlock], blackOfColumn[kBlock];
     std::vector<const T*> rows(static_cast<size_t>(m));

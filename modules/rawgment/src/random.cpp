@@ -183,7 +183,9 @@ template <int W> RAWGMENT_KERNEL typename Lanes<W>::F expLanes(typename Lanes<W>
 
 /* (e^(lambda l) - 1) / lambda, the term of a Tukey-lambda quantile, for l = ln(u) <= 0: for |lambda l| < 1/2
  * l (1 + x/2 + ... + x^7/8!) with x = lambda l (truncation below 1e-8 relative, and exactly l when lambda
- * is 0, the logistic limit), else (e^x - 1) / lambda, where no cancellation remains. */
+ * is 0, the logistic limit), else (e^x - 1) / lambda, where no cancellation remains. The exponential is
+ * computed only for a vector that has such a lane (a few in a hundred for the tails of sensors); the
+ * choice is per lane either way, so the bits do not depend on the width. */
 template <int W>
 RAWGMENT_KERNEL typename Lanes<W>::F tukeyTermLanes(typename Lanes<W>::F l, typename Lanes<W>::F lambda,
                                                     typename Lanes<W>::F safeLambda)
@@ -197,10 +199,14 @@ RAWGMENT_KERNEL typename Lanes<W>::F tukeyTermLanes(typename Lanes<W>::F l, type
                                  x * (4.1666667e-2f +
                                       x * (8.3333333e-3f +
                                            x * (1.3888889e-3f + x * (1.9841270e-4f + x * 2.4801587e-5f)))))));
+    const I large = detail::maxLanes(x, -x) >= 0.5f;
+    int anyLarge = 0;
+    for (int i = 0; i < W; ++i)
+        anyLarge |= large[i];
+    if (!anyLarge)
+        return series;
     const F direct = (expLanes<W>(x) - 1.0f) / safeLambda;
-    const F ax = detail::maxLanes(x, -x);
-    const I small = ax < 0.5f;
-    return small ? series : direct;
+    return large ? direct : series;
 }
 
 /* n unit-variance Tukey-lambda values from the stream, two Philox words each: the sign from the top bit
