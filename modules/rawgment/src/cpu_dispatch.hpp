@@ -114,10 +114,18 @@ template <typename V> inline __attribute__((always_inline)) V sqrtLanes(V v)
 #define RAWGMENT_DISPATCHED(ret, name, params, args) RAWGMENT_DISPATCHED_AS(ret, name, params, args, , , )
 
 /** As RAWGMENT_DISPATCHED, for a kernel template on its vector width in floats: `name##Kernel<W> args`
- * with W = 16 (AVX-512), 8 (AVX2) or 4 (SSE). GCC lowers vectors wider than the registers piecewise,
- * and their comparisons and selections lane by lane in scalar code: a kernel with those runs at the
- * native width of each path. */
+ * with W = 8 (AVX-512 and AVX2) or 4 (SSE). GCC lowers vectors wider than the registers piecewise, and
+ * their comparisons and selections lane by lane in scalar code: a kernel with those runs at the native
+ * width of each path.
+ *
+ * The AVX-512 path runs the 256-bit kernels compiled for AVX-512 (EVEX encodings, 32 vector registers,
+ * masked operations), not 512-bit ones: on host H1 (Intel Xeon) 512-bit multiplies and float arithmetic
+ * lower the core's clock, and 12 M standard normals took 12.9 ms at 16 lanes, 9.4 ms with 512-bit
+ * Philox and 256-bit floats and 7.8 ms at 8 lanes (the AVX2 path: 8.8 ms), the jitter 14.7 ms at 16
+ * lanes and 10.5 ms at 8 (docs/performance.md). On AMD's Zen 4 a 512-bit operation is two 256-bit ones,
+ * so 16 lanes buy nothing there either. The kernels take any W, so a CPU where 512 bits pay needs only
+ * <16> here. */
 #define RAWGMENT_DISPATCHED_BY_WIDTH(ret, name, params, args)                                                \
-    RAWGMENT_DISPATCHED_AS(ret, name, params, args, <16>, <8>, <4>)
+    RAWGMENT_DISPATCHED_AS(ret, name, params, args, <8>, <8>, <4>)
 
 #endif // OPENCV_RAWGMENT_SRC_CPU_DISPATCH_HPP
