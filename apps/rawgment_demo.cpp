@@ -180,17 +180,25 @@ std::vector<GalleryEntry> galleryEntries(const RawFormat& format)
     return entries;
 }
 
+//! The bright capture of the gallery's chart that the gallery and the real cameras augment, and its format.
+cv::Mat galleryCapture(const DemoOptions& o, const SensorParams& sensorParams, RawFormat& format)
+{
+    const ColorCheckerScene chart = galleryChart();
+    const SensorSimulator sensor(sensorParams, chart.meanAtUnitGain.size());
+    format = sensor.rawFormat(1.0);
+    cv::Mat bright;
+    sensor.capture(chart.meanAtUnitGain, 1.0, brightExposure(chart, format), deriveSeed(o.seed, SEED_DEMO, 0),
+                   0, bright);
+    return bright;
+}
+
 //! Augments a bright capture into the gallery's scenes (DNGs, previews, gallery.png) and returns the
 //! report's section.
 std::string gallerySection(const DemoOptions& o, const SensorParams& sensorParams, const NoiseModel& model)
 {
     rawgment_apps::makeDirectories(o.out + "/gallery");
-    const ColorCheckerScene chart = galleryChart();
-    const SensorSimulator sensor(sensorParams, chart.meanAtUnitGain.size());
-    const RawFormat format = sensor.rawFormat(1.0);
-    cv::Mat bright;
-    sensor.capture(chart.meanAtUnitGain, 1.0, brightExposure(chart, format), deriveSeed(o.seed, SEED_DEMO, 0),
-                   0, bright);
+    RawFormat format;
+    const cv::Mat bright = galleryCapture(o, sensorParams, format);
     const std::vector<GalleryEntry> entries = galleryEntries(format);
     std::vector<cv::Mat> tiles = {
         labelled(rawgment_apps::previewOf(bright, format), "before: bright capture")};
@@ -270,12 +278,8 @@ std::string realCamerasSection(const DemoOptions& o, const SensorParams& sensorP
     const std::vector<CameraNoiseProfile> chosen = contrastingCameras(readCameraProfiles(path));
     if (chosen.empty())
         return md + "`" + path + "` has no two GOOD cameras to compare.\n\n";
-    const ColorCheckerScene chart = galleryChart();
-    const SensorSimulator sensor(sensorParams, chart.meanAtUnitGain.size());
-    const RawFormat format = sensor.rawFormat(1.0);
-    cv::Mat bright;
-    sensor.capture(chart.meanAtUnitGain, 1.0, brightExposure(chart, format), deriveSeed(o.seed, SEED_DEMO, 0),
-                   0, bright);
+    RawFormat format;
+    const cv::Mat bright = galleryCapture(o, sensorParams, format);
     Scene scene;
     scene.jitter = ColorJitter::exposureChange(0.01, 8.0);
     md +=
