@@ -111,6 +111,9 @@ class AblationConfig:
     testScenes: int = 8
     testSceneSize: int = 256
     width: int = 16                 # channels of the network's first level
+    # Whether the network is told the noise level (a noise map per plane, as the default denoiser) or is
+    # blind, seeing only the image, as the paper's detectors do (--blind).
+    noiseMaps: bool = True
     learningRate: float = 2e-3
     threads: int = 0                # torch threads (0: all cores)
 
@@ -215,14 +218,17 @@ def mosaicOfScene(rgb, pattern, level):
 
 
 class Denoiser(torch.nn.Module):
-    """A compact two-level U-Net on the packed R, G1, G2, B planes and their noise-level map that
-    predicts the residual in units of the noise: input 8 x H x W (the planes, then each plane's noise
-    standard deviation; H, W even), output the 4 denoised planes."""
+    """A compact two-level U-Net on the packed R, G1, G2, B planes. Told the noise (noiseMaps, the
+    default) it also takes each plane's noise-level map and predicts the residual in units of the noise:
+    input 8 x H x W (the planes, then each plane's noise standard deviation; H, W even). Blind
+    (noiseMaps=False) it takes the 4 planes alone and predicts the residual itself, so it must infer the
+    noise level from the image. Output: the 4 denoised planes."""
 
-    def __init__(self, width=16):
+    def __init__(self, width=16, noiseMaps=True):
         super().__init__()
+        self.noiseMaps = bool(noiseMaps)
         conv = torch.nn.Conv2d
-        self.encode = torch.nn.Sequential(conv(8, width, 3, padding=1), torch.nn.ReLU(),
+        self.encode = torch.nn.Sequential(conv(8 if self.noiseMaps else 4, width, 3, padding=1), torch.nn.ReLU(),
                                           conv(width, width, 3, padding=1), torch.nn.ReLU())
         self.down = torch.nn.Sequential(conv(width, 2 * width, 3, stride=2, padding=1), torch.nn.ReLU(),
                                         conv(2 * width, 2 * width, 3, padding=1), torch.nn.ReLU(),
@@ -237,10 +243,13 @@ class Denoiser(torch.nn.Module):
 
     def forward(self, x):
         skip = self.encode(x)
+        residual = self.decode(torch.cat([skip, self.up(self.down(skip))], dim=1))
+        if not self.noiseMaps:
+            return x + residual
         # The correction is predicted in units of the noise standard deviation: the same network then
         # serves a 40 dB and an 18 dB input equally well, which a plain residual does not learn in a
         # short budget (its corrections for the darkest inputs spoil the brightest).
-        return x[:, :4] + x[:, 4:] * self.decode(torch.cat([skip, self.up(self.down(skip))], dim=1))
+        return x[:, :4] + x[:, 4:] * residual
 
 
 def psnr(output, clean):
@@ -347,6 +356,8 @@ class _Study:
         planes = packCfaPlanes(signal / np.float32(condition.photonRatio * condition.gainRatio), fmt)
         m = self.model
         meanDn = planes.clamp(min=0.0).double() * scale
+        if not self.config.noiseMaps:
+            return planes
         sigma = torch.sqrt(gain * m.alpha * meanDn + gain * gain * m.sigmaD2 + m.sigmaR2) / scale
         return torch.cat([planes, sigma.float()])
 
@@ -397,7 +408,7 @@ def _train(study, arms, replicate, trainMeans, log=None):
     nets, optimisers, schedules = {}, {}, {}
     for arm in arms:
         torch.manual_seed(_seed(config.seed, _ROLE_NETWORK, replicate) & 0x7FFFFFFFFFFFFFFF)
-        nets[arm] = Denoiser(config.width)
+        nets[arm] = Denoiser(config.width, config.noiseMaps)
         optimisers[arm] = torch.optim.Adam(nets[arm].parameters(), lr=config.learningRate)
         schedules[arm] = torch.optim.lr_scheduler.CosineAnnealingLR(optimisers[arm], config.iterations)
     limit = (config.trainSceneSize - config.patch) // 2 + 1
@@ -586,12 +597,14 @@ def _report(results, rows, plotNote):
     out.append("Sensor model: alpha = %.6g DN/e-, sigma_d^2 = %.6g DN^2, sigma_r^2 = %.6g DN^2 (quantisation "
                "included), %d bits, black level %g, bright captures at gain %g. %d training replicate(s) "
                "(seed %d), %d iterations of %d crops of %dx%d, tested on %d scenes of %dx%d simulated directly "
-               "at each target. %d torch thread(s), torch %s, CPU path %s; %.0f s." % (
+               "at each target. %d torch thread(s), torch %s, CPU path %s; %.0f s. The networks are %s." % (
                    m["alpha"], m["sigmaD2"], m["sigmaR2"], config["bitDepth"], config["blackLevel"],
                    config["baseGain"], config["seeds"], config["seed"], config["iterations"], config["batch"],
                    config["patch"], config["patch"], config["testScenes"], config["testSceneSize"],
                    config["testSceneSize"], config["threads"], results["torch"], results["cpuPath"],
-                   results["seconds"]))
+                   results["seconds"],
+                   "told the noise level (a noise map per plane)" if config.get("noiseMaps", True)
+                   else "blind: they see the image only (--blind)"))
     out += ["", "![PSNR against darkening](psnr.png)" if plotNote is None else "Plot: " + plotNote, ""]
     out += ["## PSNR (dB), mean ± s.d. over seeds", "",
             "| condition | prior share | " + " | ".join(arms) + " |",
@@ -685,7 +698,8 @@ def _parser():
                     "the noisy input as the floor; tests all on captures simulated at the target; writes "
                     "report.md, results.json, results.csv and psnr.png.",
         epilog="The default budget (9 conditions x 4 trained arms x 3 seeds) takes about 12 minutes on 2 cores; "
-               "--quick about 40 s. See docs/ablation.md.")
+               "--quick, a smoke test that learns almost nothing, about 13 s on a quiet machine. "
+               "See docs/ablation.md.")
     parser.add_argument("--model", help="a calibrated noise model (rawgment_calibrate's model.yml); default: "
                                         "the simulator's default sensor")
     parser.add_argument("--bit-depth", type=int, default=12, help="ADC bits of the sensor (default 12)")
@@ -704,6 +718,9 @@ def _parser():
                         help="comma-separated subset of the conditions, by name (%s); one condition alone "
                              "trains a network for that condition only" % ",".join(c.name for c in defaultConditions()))
     parser.add_argument("--threads", type=int, default=0, help="torch threads (default: all cores)")
+    parser.add_argument("--blind", action="store_true",
+                        help="networks that see the image only, not its noise-level maps (as the paper's "
+                             "detectors); by default each is told the noise level")
     return parser
 
 
@@ -721,6 +738,7 @@ def main(argv=None):
     config.bitDepth, config.blackLevel = args.bit_depth, args.black_level
     config.baseGain = _rg.dbToLinearGain(args.base_gain_db)
     config.seed, config.threads = args.seed, args.threads
+    config.noiseMaps = not args.blind
     if args.seeds is not None:
         config.seeds = args.seeds
     if args.iterations is not None:

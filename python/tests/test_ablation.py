@@ -55,6 +55,26 @@ def test_the_same_seeds_give_the_same_numbers_and_another_seed_does_not():
     assert scores[0] != scores[2]
 
 
+def test_a_blind_study_feeds_its_networks_the_image_only(tmp_path):
+    # --blind: the networks take the four planes without noise maps (the paper's detectors see only the
+    # image), start as the identity like the told networks, and the run and its report say so.
+    blind = ab.Denoiser(width=4, noiseMaps=False)
+    x = torch.rand(2, 4, 8, 8)
+    assert torch.equal(blind(x), x)
+    with pytest.raises(RuntimeError):
+        blind(torch.rand(2, 8, 8, 8))  # a noise map is not an input it takes
+    results = ab.runAblation(tiny_config(noiseMaps=False))
+    assert results["config"]["noiseMaps"] is False
+    for entry in results["conditions"]:
+        for runs in entry["arms"].values():
+            assert all(math.isfinite(v) for v in runs["psnr"])
+    written, _ = ab.writeOutputs(results, str(tmp_path / "blind"))
+    assert "blind: they see the image only (--blind)" in (tmp_path / "blind" / "report.md").read_text()
+    told = ab.runAblation(tiny_config())
+    assert [e["arms"]["ORACLE"]["psnr"] for e in told["conditions"]] != \
+        [e["arms"]["ORACLE"]["psnr"] for e in results["conditions"]]
+
+
 def test_the_arms_are_fed_the_noise_they_claim():
     """On a flat mid-grey scene, the training inputs' noise variance (green planes, network scale) is the
     target's for ORACLE and ACCOUNT_PRIOR, (1 + prior share) times it for IGNORE_PRIOR and the share alone
