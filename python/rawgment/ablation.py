@@ -18,6 +18,7 @@ Every random number derives from ``--seed`` through deriveSeed(deriveSeed(seed, 
 SEED_ABLATION, item), so the same seeds give the same numbers.
 """
 import argparse
+import copy
 import dataclasses
 import json
 import math
@@ -116,18 +117,28 @@ class AblationConfig:
     noiseMaps: bool = True
     learningRate: float = 2e-3
     threads: int = 0                # torch threads (0: all cores)
+    camera: str = ""                # the real camera of a darktable profile file the model came from
 
-    def sensorParams(self):
+    def sensorParams(self, size=None):
         """The simulator's parameters: the model without the rounding's 1/12 DN^2, which the simulator
-        adds back by quantising (so effectiveModel() is the model given)."""
-        model = self.model if self.model is not None else _rg.SensorParams().noise
+        adds back by quantising (so effectiveModel() is the model given), with every dark-frame component
+        of the model (row noise, heavy-tailed read noise, dark shading). The shading maps are the sensor's:
+        a simulator of `size` (height and width, the study's square crops) takes their top-left corner,
+        where the augmentation reads them too (sensorOrigin 0); without `size`, the whole maps."""
         if self.model is None:
-            noise = model
-        else:
-            noise = _rg.NoiseModel(alpha=model.alpha, sigmaD2=model.sigmaD2,
-                                   sigmaR2=max(model.sigmaR2 - 1.0 / 12.0, 0.0))
-        return _rg.SensorParams(noise=noise, bitDepth=int(self.bitDepth),
-                                blackLevel=(float(self.blackLevel),) * 4, quantize=True)
+            return _rg.SensorParams(bitDepth=int(self.bitDepth), blackLevel=(float(self.blackLevel),) * 4,
+                                    quantize=True)
+        noise = copy.deepcopy(self.model)
+        noise.sigmaR2 = max(self.model.sigmaR2 - 1.0 / 12.0, 0.0)
+        if size is not None and noise.hasDarkShading():
+            rows, cols = noise.darkShadingPerGain.shape
+            if size > rows or size > cols:
+                raise ValueError("the model's dark shading is %dx%d, smaller than the study's %dx%d captures"
+                                 % (cols, rows, size, size))
+            noise.darkShadingPerGain = noise.darkShadingPerGain[:size, :size]
+            noise.darkShadingOffset = noise.darkShadingOffset[:size, :size]
+        return _rg.SensorParams(noise=noise, bitDepth=int(self.bitDepth), blackLevel=(float(self.blackLevel),) * 4,
+                                quantize=True)
 
     def validate(self):
         if not self.conditions:
@@ -151,7 +162,8 @@ class AblationConfig:
             raise ValueError("patch (%d) is larger than trainSceneSize (%d)" % (self.patch, self.trainSceneSize))
         if self.baseGain <= 0 or not (self.learningRate > 0):
             raise ValueError("baseGain and learningRate must be > 0")
-        self.sensorParams().validate()
+        for size in (16, self.patch, self.trainSceneSize, self.testSceneSize):
+            self.sensorParams(int(size)).validate()
 
 
 def _randomColour(rng):
@@ -283,9 +295,14 @@ class _Study:
 
     def __init__(self, config):
         self.config = config
-        self.params = config.sensorParams()
+        self.params = config.sensorParams(16)
         probe = _rg.SensorSimulator(self.params, (16, 16))
+        # The augmentation's model: the probe's effective model (quantisation included) with the sensor's
+        # whole shading maps, read at each crop's place (its top-left corner, as the simulators).
         self.model = probe.effectiveModel()
+        if config.model is not None and config.model.hasDarkShading():
+            self.model.darkShadingPerGain = config.model.darkShadingPerGain
+            self.model.darkShadingOffset = config.model.darkShadingOffset
         self.format = probe.rawFormat(config.baseGain)
         self.range = self.format.whiteLevel - self.format.blackLevel[0]
         # DN at gain 1 for reflectance 1 under the brightest channel: the bright captures fill _FILL of
@@ -296,7 +313,7 @@ class _Study:
 
     def simulator(self, size):
         if size not in self.simulators:
-            self.simulators[size] = _rg.SensorSimulator(self.params, (size, size))
+            self.simulators[size] = _rg.SensorSimulator(self.config.sensorParams(size), (size, size))
         return self.simulators[size]
 
     def kernel(self, condition):
@@ -487,8 +504,15 @@ def runAblation(config, log=None):
     conditions = [{"condition": dataclasses.asdict(c), "priorShare": study.priorShare(c),
                    "arms": {arm: scores[arm][ci] for arm in config.arms}} for ci, c in enumerate(config.conditions)]
     configDict = {k: v for k, v in dataclasses.asdict(config).items() if k not in ("model", "conditions")}
-    configDict["model"] = {"alpha": study.model.alpha, "sigmaD2": study.model.sigmaD2,
-                           "sigmaR2": study.model.sigmaR2}
+    m = study.model
+    configDict["model"] = {"alpha": m.alpha, "sigmaD2": m.sigmaD2, "sigmaR2": m.sigmaR2}
+    if m.rowSigmaD2 > 0 or m.rowSigmaR2 > 0:
+        configDict["model"].update({"rowSigmaD2": m.rowSigmaD2, "rowSigmaR2": m.rowSigmaR2})
+    if m.tukeyRead:
+        configDict["model"]["tukeyLambda"] = m.tukeyLambda
+    if m.hasDarkShading():
+        configDict["model"]["darkShading"] = list(m.darkShadingPerGain.shape)
+    configDict["camera"] = config.camera
     configDict["arms"] = list(config.arms)
     configDict["threads"] = threads
     return {"config": configDict, "conditions": conditions, "seconds": time.monotonic() - started,
@@ -605,6 +629,19 @@ def _report(results, rows, plotNote):
                    results["seconds"],
                    "told the noise level (a noise map per plane)" if config.get("noiseMaps", True)
                    else "blind: they see the image only (--blind)"))
+    extras = []
+    if "rowSigmaD2" in m:
+        extras.append("row noise %.4g g^2 + %.4g DN^2" % (m["rowSigmaD2"], m["rowSigmaR2"]))
+    if "tukeyLambda" in m:
+        extras.append("Tukey-lambda read noise (lambda %.3g)" % m["tukeyLambda"])
+    if "darkShading" in m:
+        extras.append("dark shading (maps %dx%d)" % (m["darkShading"][1], m["darkShading"][0]))
+    if extras or config.get("camera"):
+        out.append("")
+        out.append(("The noise of the real camera '%s' (darktable's profiles). " % config["camera"]
+                    if config.get("camera") else "") +
+                   ("Dark-frame components in every capture and augmentation: %s." % ", ".join(extras)
+                    if extras else ""))
     out += ["", "![PSNR against darkening](psnr.png)" if plotNote is None else "Plot: " + plotNote, ""]
     out += ["## PSNR (dB), mean ± s.d. over seeds", "",
             "| condition | prior share | " + " | ".join(arms) + " |",
@@ -700,8 +737,11 @@ def _parser():
         epilog="The default budget (9 conditions x 4 trained arms x 3 seeds) takes about 12 minutes on 2 cores; "
                "--quick, a smoke test that learns almost nothing, about 13 s on a quiet machine. "
                "See docs/ablation.md.")
-    parser.add_argument("--model", help="a calibrated noise model (rawgment_calibrate's model.yml); default: "
-                                        "the simulator's default sensor")
+    parser.add_argument("--model", help="the sensor's noise model: rawgment_calibrate's model.yml (with its "
+                                        "dark-frame components, if any), an Android profile YAML, or darktable's "
+                                        "noiseprofiles.json with --camera; default: the simulator's default "
+                                        "sensor")
+    parser.add_argument("--camera", help="with a darktable profile file: the camera (rawgment_cameras lists them)")
     parser.add_argument("--bit-depth", type=int, default=12, help="ADC bits of the sensor (default 12)")
     parser.add_argument("--black-level", type=float, default=256.0, help="black level in DN (default 256)")
     parser.add_argument("--base-gain-db", type=float, default=12.0,
@@ -730,12 +770,22 @@ def main(argv=None):
     if args.quick:
         config.conditions = quickConditions()
         config.seeds, config.iterations, config.batch, config.testScenes, config.trainScenes = 2, 100, 8, 4, 12
+    config.bitDepth, config.blackLevel = args.bit_depth, args.black_level
     if args.model is not None:
         if not os.path.isfile(args.model):
             print("rawgment.ablation: --model '%s' is not a file" % args.model, file=sys.stderr)
             return 2
-        config.model = _rg.NoiseModel.load(args.model)
-    config.bitDepth, config.blackLevel = args.bit_depth, args.black_level
+        # A darktable camera's and an Android profile's model is made at the study's levels.
+        fmt = _rg.RawFormat(blackLevel=(float(args.black_level),) * 4, whiteLevel=2 ** int(args.bit_depth) - 1)
+        try:
+            config.model = _rg.loadAnyNoiseModel(args.model, args.camera or "", fmt)
+        except _rg.error as e:
+            print("rawgment.ablation: %s" % e, file=sys.stderr)
+            return 2
+        config.camera = args.camera or ""
+    elif args.camera is not None:
+        print("rawgment.ablation: --camera needs --model (a darktable profile file)", file=sys.stderr)
+        return 2
     config.baseGain = _rg.dbToLinearGain(args.base_gain_db)
     config.seed, config.threads = args.seed, args.threads
     config.noiseMaps = not args.blind

@@ -135,6 +135,53 @@ def test_a_calibrated_model_is_the_one_simulated(tmp_path):
     assert written == pytest.approx({"alpha": 0.4, "sigmaD2": 2.0, "sigmaR2": 3.0}, rel=1e-6)
 
 
+def test_a_model_with_every_dark_frame_component_reaches_the_captures_and_the_report(tmp_path):
+    # Row noise, heavy-tailed read noise and dark shading of the model: the study's simulators draw them
+    # (their effective model has them, the maps cropped to each capture), the augmentation adds them, and
+    # results.json and the report say so.
+    model = rg.NoiseModel(alpha=0.4, sigmaD2=2.0, sigmaR2=3.0)
+    model.rowSigmaD2, model.rowSigmaR2 = 0.2, 0.5
+    model.tukeyRead, model.tukeyLambda = True, -0.05
+    rng = np.random.default_rng(3)
+    model.darkShadingPerGain = rng.normal(0, 0.5, (64, 64)).astype(np.float32)
+    model.darkShadingOffset = rng.normal(0, 1.0, (64, 64)).astype(np.float32)
+    config = tiny_config(model=model)
+    for size in (16, 32):
+        effective = rg.SensorSimulator(config.sensorParams(size), (size, size)).effectiveModel()
+        assert effective.rowSigmaD2 == pytest.approx(0.2) and effective.tukeyRead
+        np.testing.assert_array_equal(effective.darkShadingPerGain, model.darkShadingPerGain[:size, :size])
+    results = ab.runAblation(config)
+    written = results["config"]["model"]
+    assert written["rowSigmaD2"] == pytest.approx(0.2) and written["tukeyLambda"] == pytest.approx(-0.05)
+    assert written["darkShading"] == [64, 64]
+    ab.writeOutputs(results, str(tmp_path / "dark"))
+    report = (tmp_path / "dark" / "report.md").read_text()
+    assert "Dark-frame components in every capture and augmentation: row noise" in report
+    assert "dark shading (maps 64x64)" in report
+    # Maps smaller than the study's captures are refused, naming both sizes.
+    small = rg.NoiseModel(alpha=0.4, sigmaD2=2.0, sigmaR2=3.0)
+    small.darkShadingPerGain = np.zeros((16, 16), np.float32)
+    small.darkShadingOffset = np.zeros((16, 16), np.float32)
+    with pytest.raises(ValueError, match="16x16, smaller than the study's 32x32"):
+        tiny_config(model=small).validate()
+
+
+def test_a_real_camera_from_darktables_profiles_is_the_one_simulated(tmp_path):
+    fmt = rg.RawFormat(blackLevel=(256, 256, 256, 256), whiteLevel=4095)
+    truth = rg.NoiseModel(alpha=0.3, sigmaD2=1.0, sigmaR2=4.0)
+    (tmp_path / "noiseprofiles.json").write_text(
+        rg.darktableNoiseProfiles(truth, fmt, 100, [100, 400, 1600], "Maker", "Cam"))
+    out = tmp_path / "out"
+    assert ab.main(["--model", str(tmp_path / "noiseprofiles.json"), "--camera", "Maker Cam", "--quick", "--seeds",
+                    "1", "--iterations", "1", "--arms", "ORACLE,NOISY", "--out", str(out)]) == 0
+    config = json.loads((out / "results.json").read_text())["config"]
+    assert config["camera"] == "Maker Cam"
+    assert config["model"] == pytest.approx({"alpha": 0.3, "sigmaD2": 1.0, "sigmaR2": 4.0}, rel=1e-6)
+    assert "The noise of the real camera 'Maker Cam'" in (out / "report.md").read_text()
+    assert ab.main(["--model", str(tmp_path / "noiseprofiles.json"), "--out", str(tmp_path / "x")]) == 2
+    assert ab.main(["--camera", "Maker Cam", "--out", str(tmp_path / "y")]) == 2
+
+
 @pytest.mark.parametrize("argv, message", [
     (["--bogus"], "unrecognized arguments: --bogus"),
     (["--arms", "ACCOUNT_PRIOR,SOMETIMES"], "SOMETIMES"),
