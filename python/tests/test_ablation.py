@@ -112,15 +112,35 @@ def test_ssim_and_psnr_on_known_cases():
     assert ab.ssim(noisy, clean) > ab.ssim(clean + 0.2 * torch.randn(4, 40, 40, generator=generator, dtype=torch.float64), clean)
 
 
-def test_the_verdict_compares_the_difference_with_the_seed_spread():
+def test_the_verdict_is_the_paired_bootstrap_interval():
     results = {"conditions": [{"condition": dataclasses.asdict(ab.Condition("c", 0.2)), "priorShare": 0.2, "arms": {
         "ACCOUNT_PRIOR": {"psnr": [30.0, 30.2, 30.4], "ssim": [0.9] * 3},
         "IGNORE_PRIOR": {"psnr": [29.9, 30.3, 30.3], "ssim": [0.9] * 3},
         "NONE": {"psnr": [28.0, 28.1, 28.3], "ssim": [0.8] * 3},
         "ORACLE": {"psnr": [31.0, 31.2, 31.4], "ssim": [0.95] * 3}}}]}
-    verdicts = {row["arm"]: row.get("verdict") for row in ab.summarize(results)}
-    assert verdicts == {"ACCOUNT_PRIOR": None, "IGNORE_PRIOR": "tie", "NONE": "ACCOUNT_PRIOR better",
-                        "ORACLE": "ACCOUNT_PRIOR worse"}
+    rows = {row["arm"]: row for row in ab.summarize(results)}
+    assert {arm: row.get("verdict") for arm, row in rows.items()} == {
+        "ACCOUNT_PRIOR": None, "IGNORE_PRIOR": "tie", "NONE": "ACCOUNT_PRIOR better", "ORACLE": "ACCOUNT_PRIOR worse"}
+    # ACCOUNT_PRIOR minus IGNORE_PRIOR is +0.1, -0.1, +0.1 by seed: the interval holds 0, and every sign
+    # pattern's mean (+-0.033 or +-0.1) is at least the observed 0.033 in size (p = 1).
+    assert rows["IGNORE_PRIOR"]["accountMinusLow"] < 0 < rows["IGNORE_PRIOR"]["accountMinusHigh"]
+    assert rows["IGNORE_PRIOR"]["pValue"] == pytest.approx(1.0)
+    # NONE is worse by 2.0, 2.1, 2.1: the interval is the range of the resampled means.
+    assert rows["NONE"]["accountMinusLow"] == pytest.approx(2.0, abs=1e-9)
+    assert rows["NONE"]["accountMinusHigh"] == pytest.approx(2.1, abs=1e-9)
+    assert rows["NONE"]["pValue"] == pytest.approx(0.25)  # 2 / 2^3, the smallest 3 seeds allow
+
+
+def test_paired_significance_against_known_cases():
+    # Six seeds all +1: the interval is [1, 1] and only the all-positive and all-negative patterns reach
+    # the observed mean (p = 2/64). Differences centred on 0 give p = 1 and an interval around 0.
+    low, high, p = ab.pairedSignificance([1.0] * 6, seed=1)
+    assert (low, high) == (1.0, 1.0) and p == pytest.approx(2 / 64)
+    low, high, p = ab.pairedSignificance([0.5, -0.5, 0.3, -0.3], seed=1)
+    assert low < 0 < high and p == pytest.approx(1.0)
+    # The same seed, the same interval.
+    assert ab.pairedSignificance([0.2, 0.5, -0.1, 0.4, 0.3], seed=9) == ab.pairedSignificance(
+        [0.2, 0.5, -0.1, 0.4, 0.3], seed=9)
 
 
 def test_a_calibrated_model_is_the_one_simulated(tmp_path):
