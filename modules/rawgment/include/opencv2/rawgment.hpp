@@ -27,7 +27,7 @@ subtraction; gains are linear (0 dB = 1).
     @defgroup rawgment_normality Shapiro-Wilk tests of the Gaussian noise assumption
     @defgroup rawgment_isp The paper's simple ISPs: tone curves, white balance, demosaicing for previews
     @defgroup rawgment_raw_io Camera RAW files in (LibRaw) and augmented mosaics out (PNG, TIFF, DNG)
-    @defgroup rawgment_files Files of every topic: atomic writes, bounded reads of regular files, guarded YAML/JSON
+    @defgroup rawgment_files Files of every topic: atomic writes, bounded reads, guarded YAML/JSON
     @defgroup rawgment_calibration Noise calibration from bursts: statistics, line fits, cross-gain fits
     @defgroup rawgment_cpu Instruction-set paths of the hot loops: one binary, the same bits on every CPU
     @defgroup rawgment_simulate A physical sensor simulator and a ColorChecker scene: the ground truth
