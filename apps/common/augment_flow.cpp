@@ -85,7 +85,8 @@ AugmentRecipe loadAugmentRecipe(const AugmentOptions& o)
     if (o.scene.empty() == o.policy.empty())
         throw std::runtime_error("give exactly one of a scene file and a policy file");
     AugmentRecipe recipe;
-    if (isDarktableProfileFile(o.model)) {
+    const int kind = noiseModelFileKind(o.model);
+    if (kind == DARKTABLE_PROFILE_FILE) {
         if (o.camera.empty())
             throw std::runtime_error("'" + o.model +
                                      "' is a darktable noise-profile file of many cameras: choose with "
@@ -96,15 +97,12 @@ AugmentRecipe loadAugmentRecipe(const AugmentOptions& o)
         throw std::runtime_error(
             "--camera chooses among the cameras of a darktable noise-profile file, and '" + o.model +
             "' is not one");
+    } else if (kind == ANDROID_PROFILE_FILE) {
+        recipe.android = o.model;
+        // Checked now, at a format of full range, so that a malformed file fails before any job.
+        noiseModelFromAndroidFile(o.model, RawFormat());
     } else {
-        cv::FileStorage fs = openFileStorageForReading(o.model, "noise model");
-        if (!fs["android_noise_profile"].empty()) {
-            recipe.android = o.model;
-            // Checked now, at a format of full range, so that a malformed file fails before any job.
-            noiseModelFromAndroidFile(o.model, RawFormat());
-        } else {
-            recipe.model = NoiseModel::load(o.model, o.acceptFailedCalibration);
-        }
+        recipe.model = NoiseModel::load(o.model, o.acceptFailedCalibration);
     }
     recipe.randomScenes = o.scene.empty();
     if (recipe.randomScenes)

@@ -59,9 +59,7 @@ ValidateResult validateConversion(const ValidateOptions& o)
     const ValidationManifest manifest = readValidationManifest(o.manifest);
     // A NoiseModel file is read (and refused) before any frame; a darktable camera's or an Android
     // profile's model is made at the bright frames' levels once they are read.
-    const bool modelFromLevels =
-        !o.camera.empty() || isDarktableProfileFile(o.model) ||
-        !openFileStorageForReading(o.model, "noise model")["android_noise_profile"].empty();
+    const bool modelFromLevels = !o.camera.empty() || noiseModelFileKind(o.model) != NOISE_MODEL_FILE;
     NoiseModel model = modelFromLevels ? NoiseModel() : NoiseModel::load(o.model, o.acceptFailedCalibration);
     prepareOutputDirectory(o.outDir);
     const std::string csvPath = o.outDir + "/validation.csv", mdPath = o.outDir + "/validation.md";

@@ -91,7 +91,8 @@ class _ModelSource:
             raise TypeError("model must be a rawgment.NoiseModel, a list of rawgment.CameraNoiseProfile or the path "
                             "of a model file, not %s" % type(model).__name__)
         path = os.fspath(model)
-        if _rg.isDarktableProfileFile(path):
+        kind = _rg.noiseModelFileKind(path)
+        if kind == _rg.DARKTABLE_PROFILE_FILE:
             if camera is None:
                 raise ValueError("'%s' is a darktable noise-profile file of many cameras: choose with camera= (a "
                                  "name, a list of names, 'good' or 'usable')" % path)
@@ -99,16 +100,13 @@ class _ModelSource:
             self.cameras = _rg.selectCameraProfiles(_rg.readCameraProfiles(path), selection)
         elif camera is not None:
             raise ValueError("camera chooses among the cameras of a darktable profile file, and '%s' is not one" % path)
+        elif kind == _rg.ANDROID_PROFILE_FILE:
+            # An Android profile's model depends on each mosaic's levels: it is made per format (and checked
+            # now, at a format of full range).
+            _rg.noiseModelFromAndroidFile(path, _rg.RawFormat())
+            self.android = path
         else:
-            try:
-                self.model = _rg.NoiseModel.load(path)
-            except _rg.error as notModel:
-                # An Android profile's model depends on each mosaic's levels: it is made per format.
-                try:
-                    _rg.noiseModelFromAndroidFile(path, _rg.RawFormat())
-                except _rg.error:
-                    raise notModel from None
-                self.android = path
+            self.model = _rg.NoiseModel.load(path)
 
     def at(self, format, seed):
         """The model of one sample, and its camera's name (None for a model that is not a camera's)."""

@@ -342,7 +342,13 @@ void bindAugment(py::module_& m)
           doc("selectCameraProfiles"));
     m.def("drawCameraIndex", &drawCameraIndex, py::arg("count"), py::arg("seed"), doc("drawCameraIndex"));
     m.def("darktableProfilesPath", &darktableProfilesPath, doc("darktableProfilesPath"));
-    m.def("isDarktableProfileFile", &isDarktableProfileFile, py::arg("path"), doc("isDarktableProfileFile"));
+    py::enum_<NoiseModelFileKind>(m, "NoiseModelFileKind", doc("NoiseModelFileKind"))
+        .value("NOISE_MODEL_FILE", NOISE_MODEL_FILE, doc("NoiseModelFileKind::NOISE_MODEL_FILE"))
+        .value("ANDROID_PROFILE_FILE", ANDROID_PROFILE_FILE, doc("NoiseModelFileKind::ANDROID_PROFILE_FILE"))
+        .value("DARKTABLE_PROFILE_FILE", DARKTABLE_PROFILE_FILE,
+               doc("NoiseModelFileKind::DARKTABLE_PROFILE_FILE"))
+        .export_values();
+    m.def("noiseModelFileKind", &noiseModelFileKind, py::arg("path"), doc("noiseModelFileKind"));
     m.def("noiseModelFromAndroidFile", &noiseModelFromAndroidFile, py::arg("path"), py::arg("format"),
           doc("noiseModelFromAndroidFile"));
     m.def("loadAnyNoiseModel", &loadAnyNoiseModel, py::arg("path"), py::arg("camera") = std::string(),

@@ -457,12 +457,12 @@ String darktableProfilesPath()
     return String();
 }
 
-bool isDarktableProfileFile(const String& path)
+int noiseModelFileKind(const String& path)
 {
-    if (detail::lowerExtensionOf(path) != ".json")
-        return false;
     FileStorage fs = openFileStorageForReading(path, "noise model");
-    return !fs.root()["noiseprofiles"].empty();
+    if (detail::lowerExtensionOf(path) == ".json" && !fs.root()["noiseprofiles"].empty())
+        return DARKTABLE_PROFILE_FILE;
+    return fs["android_noise_profile"].empty() ? NOISE_MODEL_FILE : ANDROID_PROFILE_FILE;
 }
 
 NoiseModel noiseModelFromAndroidFile(const String& path, const RawFormat& format)
@@ -491,7 +491,8 @@ NoiseModel noiseModelFromAndroidFile(const String& path, const RawFormat& format
 NoiseModel loadAnyNoiseModel(const String& path, const String& camera, const RawFormat& format,
                              bool acceptFailedCalibration)
 {
-    if (isDarktableProfileFile(path)) {
+    const int kind = noiseModelFileKind(path);
+    if (kind == DARKTABLE_PROFILE_FILE) {
         if (camera.empty())
             CV_Error(Error::StsBadArg, "'" + path +
                                            "' is a darktable noise-profile file of many cameras: choose one "
@@ -501,11 +502,8 @@ NoiseModel loadAnyNoiseModel(const String& path, const String& camera, const Raw
     if (!camera.empty())
         CV_Error(Error::StsBadArg, "a camera ('" + camera + "') is chosen, but '" + path +
                                        "' is not a darktable noise-profile file");
-    {
-        FileStorage fs = openFileStorageForReading(path, "noise model");
-        if (!fs["android_noise_profile"].empty())
-            return noiseModelFromAndroidFile(path, format);
-    }
+    if (kind == ANDROID_PROFILE_FILE)
+        return noiseModelFromAndroidFile(path, format);
     return NoiseModel::load(path, acceptFailedCalibration);
 }
 

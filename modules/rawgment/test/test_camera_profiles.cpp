@@ -294,6 +294,9 @@ TEST(CameraProfiles, everyModelFileLoadsThroughOneCall)
     // A darktable file needs a camera, and only it takes one.
     const std::string json = writeText(
         dir, "profiles.json", darktableNoiseProfiles(model, format, 100, {100, 800}, "Rawgment", "Sim"));
+    EXPECT_EQ(noiseModelFileKind(yml), ANDROID_PROFILE_FILE);
+    EXPECT_EQ(noiseModelFileKind(dir + "/model.yml"), NOISE_MODEL_FILE);
+    EXPECT_EQ(noiseModelFileKind(json), DARKTABLE_PROFILE_FILE);
     EXPECT_NEAR(loadAnyNoiseModel(json, "rawgment sim", format).alpha, model.alpha, 1e-12);
     EXPECT_CV_ERROR_CONTAINS(loadAnyNoiseModel(json, "", format),
                              "is a darktable noise-profile file of many cameras");

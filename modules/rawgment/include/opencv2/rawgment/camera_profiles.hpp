@@ -158,9 +158,19 @@ CV_RAWGMENT_EXPORTS int drawCameraIndex(int count, uint64 seed);
  * installed darktable's `/usr/share/darktable/noiseprofiles.json`; empty when none exists. */
 CV_RAWGMENT_EXPORTS String darktableProfilesPath();
 
-/** @brief Whether a file is a darktable noise-profile file rather than a NoiseModel or an Android profile:
- * a `.json` file whose top level has the key `noiseprofiles`. */
-CV_RAWGMENT_EXPORTS bool isDarktableProfileFile(const String& path);
+//! The kinds of file a noise model is taken from (noiseModelFileKind()).
+enum NoiseModelFileKind
+{
+    NOISE_MODEL_FILE = 0,      //!< a NoiseModel (NoiseModel::load())
+    ANDROID_PROFILE_FILE = 1,  //!< an Android profile YAML (noiseModelFromAndroidFile())
+    DARKTABLE_PROFILE_FILE = 2 //!< darktable's noise profiles, many cameras (readCameraProfiles())
+};
+
+/** @brief The NoiseModelFileKind of a model file, from its top-level keys: `noiseprofiles` (in a `.json`
+ * file) is darktable's, `android_noise_profile` an Android profile, anything else a NoiseModel (whose
+ * reader then names what is wrong with it).
+ * @throws cv::Exception when the file cannot be read as YAML or JSON. */
+CV_RAWGMENT_EXPORTS int noiseModelFileKind(const String& path);
 
 /** @brief The noise model of an Android profile YAML as the project writes it (`android_noise_profile.yml`
  * of rawgment_calibrate: a map `android_noise_profile` with `base_iso` and the lists A, B, C, D of four
@@ -169,10 +179,10 @@ CV_RAWGMENT_EXPORTS bool isDarktableProfileFile(const String& path);
  * @throws cv::Exception naming the file and the field when it is malformed or has no exact model. */
 CV_RAWGMENT_EXPORTS NoiseModel noiseModelFromAndroidFile(const String& path, const RawFormat& format);
 
-/** @brief A noise model from any file the project reads models from: a NoiseModel YAML (NoiseModel::load()),
- * an Android profile YAML (noiseModelFromAndroidFile()), or, with `camera` given, a darktable profile
- * file's camera (readCameraProfiles(), then findCameraProfile() and CameraNoiseProfile::modelFor() with
- * `format`).
+/** @brief A noise model from any file the project reads models from (noiseModelFileKind()): a NoiseModel
+ * YAML (NoiseModel::load()), an Android profile YAML (noiseModelFromAndroidFile()), or, with `camera`
+ * given, a darktable profile file's camera (readCameraProfiles(), then findCameraProfile() and
+ * CameraNoiseProfile::modelFor() with `format`).
  * @param path the file
  * @param camera the camera to take from a darktable file; must be empty for the other kinds
  * @param format the range of the mosaics the model is for (used for a darktable camera only)
