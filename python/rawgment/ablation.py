@@ -378,10 +378,10 @@ class _Study:
         scale = self.range * condition.photonRatio * condition.gainRatio
         signal = _rg.subtractBlackLevel(raw, fmt, normalize=True)
         planes = packCfaPlanes(signal / np.float32(condition.photonRatio * condition.gainRatio), fmt)
-        m = self.model
-        meanDn = planes.clamp(min=0.0).double() * scale
         if not self.config.noiseMaps:
             return planes
+        m = self.model
+        meanDn = planes.clamp(min=0.0).double() * scale
         sigma = torch.sqrt(gain * m.alpha * meanDn + gain * gain * m.sigmaD2 + m.sigmaR2) / scale
         return torch.cat([planes, sigma.float()])
 
