@@ -35,52 +35,38 @@ const Mat& frame()
 
 const ColorJitter kJitter = ColorJitter::exposureChange(0.2, 2.0);
 
-void BM_Augment_colorJitter(benchmark::State& state)
+//! The jitter of kJitter with `model` and `noise`, a new seed per iteration, into one reused output.
+void timeColorJitter(benchmark::State& state, const NoiseModel& model, const NoiseOptions& noise)
 {
     Mat out;
     RawFormat f;
     uint64 seed = 0;
     for (auto _ : state) {
-        colorJitter(frame(), frameFormat(), kModel, kJitter, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out, f);
+        colorJitter(frame(), frameFormat(), model, kJitter, noise, ++seed, out, f);
         benchmark::DoNotOptimize(out.data);
     }
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
 }
 
-//! kModel with heavy-tailed read noise (Tukey lambda -0.1, excess kurtosis about 3.4).
-NoiseModel heavyTailedModel()
+void BM_Augment_colorJitter(benchmark::State& state)
 {
-    NoiseModel m = kModel;
-    m.tukeyRead = true;
-    m.tukeyLambda = -0.1;
-    return m;
+    timeColorJitter(state, kModel, NoiseAlignment::ACCOUNT_PRIOR);
 }
 
 void BM_Augment_colorJitterTukeyRead(benchmark::State& state)
 {
-    const NoiseModel model = heavyTailedModel();
-    Mat out;
-    RawFormat f;
-    uint64 seed = 0;
-    for (auto _ : state) {
-        colorJitter(frame(), frameFormat(), model, kJitter, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out, f);
-        benchmark::DoNotOptimize(out.data);
-    }
-    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+    // kModel with heavy-tailed read noise (Tukey lambda -0.1, excess kurtosis about 3.4).
+    NoiseModel model = kModel;
+    model.tukeyRead = true;
+    model.tukeyLambda = -0.1;
+    timeColorJitter(state, model, NoiseAlignment::ACCOUNT_PRIOR);
 }
 
 void BM_Augment_colorJitterPoisson(benchmark::State& state)
 {
     NoiseOptions noise(NoiseAlignment::ACCOUNT_PRIOR);
     noise.shotSampling = ShotNoiseSampling::POISSON;
-    Mat out;
-    RawFormat f;
-    uint64 seed = 0;
-    for (auto _ : state) {
-        colorJitter(frame(), frameFormat(), kModel, kJitter, noise, ++seed, out, f);
-        benchmark::DoNotOptimize(out.data);
-    }
-    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+    timeColorJitter(state, kModel, noise);
 }
 
 void BM_Augment_colorJitterNaiveOpenCV(benchmark::State& state)
