@@ -36,7 +36,7 @@ from rawgment.torch import packCfaPlanes
 
 __all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "defaultConditions", "quickConditions",
            "renderScene", "mosaicOfScene", "Denoiser", "psnr", "ssim", "runAblation", "pairedSignificance",
-           "summarize", "writeOutputs", "main"]
+           "summarize", "writeOutputs", "NETWORKS", "writeNetworksOutputs", "main"]
 
 ARMS = ("NONE", "IGNORE_PRIOR", "ACCOUNT_PRIOR", "ORACLE", "NOISY")
 TRAINED_ARMS = ARMS[:4]
@@ -762,6 +762,66 @@ def writeOutputs(results, outDir):
     return written, [] if note is None else [note]
 
 
+#: The kinds of network the study trains: told the noise level (noise maps) or blind (the image only).
+NETWORKS = ("told", "blind")
+
+
+def writeNetworksOutputs(byNetwork, outDir):
+    """Writes one study per kind of network (a dict from NETWORKS' names to runAblation's results) into
+    outDir/<network>/ (writeOutputs()) and, beside them, report.md: each condition's ACCOUNT_PRIOR minus
+    the other trained arms for every network side by side, so the one page answers whether accounting
+    matters when the network is told the noise level and when it is not. Returns the paths written and
+    the notes."""
+    os.makedirs(outDir, exist_ok=True)
+    written, notes, rowsOf = [], [], {}
+    for network, results in byNetwork.items():
+        paths, more = writeOutputs(results, os.path.join(outDir, network))
+        written += paths
+        notes += ["%s: %s" % (network, n) for n in more]
+        rowsOf[network] = summarize(results)
+    path = os.path.join(outDir, "report.md")
+    _rg.writeFileAtomically(path, _networksReport(byNetwork, rowsOf).encode())
+    return written + [path], notes
+
+
+def _networksReport(byNetwork, rowsOf):
+    networks = list(byNetwork)
+    first = byNetwork[networks[0]]
+    config = first["config"]
+    conditions = [entry["condition"]["name"] for entry in first["conditions"]]
+    arms = config["arms"]
+    others = [a for a in arms if a in TRAINED_ARMS and a != "ACCOUNT_PRIOR"]
+    out = ["# Noise-alignment ablation: networks told the noise level and blind ones", "",
+           "The same study (sensor, scenes, seeds, budget) run for each kind of network; each has its own "
+           "full report. A told network takes a noise-level map per plane beside the image; a blind one "
+           "sees the image only, as the paper's detectors do.", ""]
+    for network in networks:
+        r = byNetwork[network]
+        out.append("- **%s**: [%s/report.md](%s/report.md), %d seed(s), %.0f s, CPU path %s." % (
+            network, network, network, r["config"]["seeds"], r["seconds"], r["cpuPath"]))
+    if "ACCOUNT_PRIOR" in arms and others:
+        out += ["", "## ACCOUNT_PRIOR minus each arm, by network (PSNR dB, paired by seed)", "",
+                "Mean difference [95% bootstrap interval over the paired seeds], the exact sign-flip test's "
+                "two-sided p and the verdict (a difference counts when its interval excludes 0).", ""]
+        header = ["condition", "prior share"] + ["%s: minus %s" % (n, a) for a in others for n in networks]
+        out += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        for name in conditions:
+            byKey = {n: {(r["condition"], r["arm"]): r for r in rowsOf[n]} for n in networks}
+            cells = [name, "%.3f" % byKey[networks[0]][(name, "ACCOUNT_PRIOR")]["priorShare"]]
+            for a in others:
+                for n in networks:
+                    r = byKey[n][(name, a)]
+                    cells.append("%+.2f [%+.2f, %+.2f], p %.3g (%s)" % (
+                        r["accountMinus"], r["accountMinusLow"], r["accountMinusHigh"], r["pValue"],
+                        r["verdict"]))
+            out.append("| " + " | ".join(cells) + " |")
+    for network in networks:
+        out += ["", "## %s networks" % network.capitalize(), ""]
+        out += _findings(rowsOf[network], conditions, arms)
+        out += ["", "![PSNR against darkening, %s](%s/psnr.png)" % (network, network)]
+    return "\n".join(out) + "\n"
+
+
 def _parser():
     parser = argparse.ArgumentParser(
         prog="python3 -m rawgment.ablation",
@@ -769,8 +829,9 @@ def _parser():
                     "IGNORE_PRIOR, ACCOUNT_PRIOR), an oracle trained on captures simulated at the target, and "
                     "the noisy input as the floor; tests all on captures simulated at the target; writes "
                     "report.md, results.json, results.csv and psnr.png.",
-        epilog="The default budget (9 conditions x 4 trained arms x 3 seeds) takes about 12 minutes on 2 cores; "
-               "--quick, a smoke test that learns almost nothing, about 13 s on a quiet machine. "
+        epilog="The default budget (9 conditions x 4 trained arms x 3 seeds, told and blind networks) takes "
+               "about 25 minutes on 2 cores; --quick, a smoke test that learns almost nothing, about 25 s on a "
+               "quiet machine. "
                "See docs/ablation.md.")
     parser.add_argument("--model", help="the sensor's noise model: rawgment_calibrate's model.yml (with its "
                                         "dark-frame components, if any), an Android profile YAML, or darktable's "
@@ -793,9 +854,12 @@ def _parser():
                         help="comma-separated subset of the conditions, by name (%s); one condition alone "
                              "trains a network for that condition only" % ",".join(c.name for c in defaultConditions()))
     parser.add_argument("--threads", type=int, default=0, help="torch threads (default: all cores)")
-    parser.add_argument("--blind", action="store_true",
-                        help="networks that see the image only, not its noise-level maps (as the paper's "
-                             "detectors); by default each is told the noise level")
+    parser.add_argument("--networks", default="told,blind",
+                        help="which networks to train, comma-separated: told (a noise-level map per plane "
+                             "beside the image) and blind (the image only, as the paper's detectors); "
+                             "default both, each in its own subfolder with a report.md beside them that "
+                             "sets them side by side; one alone writes its report into --out itself")
+    parser.add_argument("--blind", action="store_true", help="the same as --networks blind")
     return parser
 
 
@@ -823,7 +887,11 @@ def main(argv=None):
         return 2
     config.baseGain = _rg.dbToLinearGain(args.base_gain_db)
     config.seed, config.threads = args.seed, args.threads
-    config.noiseMaps = not args.blind
+    networks = ["blind"] if args.blind else [n.strip() for n in args.networks.split(",") if n.strip()]
+    if not networks or any(n not in NETWORKS for n in networks) or len(set(networks)) != len(networks):
+        print("rawgment.ablation: --networks must be told, blind or told,blind, got '%s'" % args.networks,
+              file=sys.stderr)
+        return 2
     if args.seeds is not None:
         config.seeds = args.seeds
     if args.iterations is not None:
@@ -848,8 +916,15 @@ def main(argv=None):
     def log(line):
         print(line, file=sys.stderr, flush=True)
 
-    results = runAblation(config, log)
-    written, notes = writeOutputs(results, args.out)
+    byNetwork = {}
+    for network in networks:
+        if len(networks) > 1:
+            log("rawgment.ablation: %s networks" % network)
+        byNetwork[network] = runAblation(dataclasses.replace(config, noiseMaps=network == "told"), log)
+    if len(networks) == 1:
+        written, notes = writeOutputs(byNetwork[networks[0]], args.out)
+    else:
+        written, notes = writeNetworksOutputs(byNetwork, args.out)
     for note in notes:
         log("rawgment.ablation: " + note)
     for path in written:

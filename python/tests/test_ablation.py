@@ -28,22 +28,50 @@ def test_quick_run_writes_the_report_and_the_oracle_beats_the_noisy_input(tmp_pa
     run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--quick", "--out", str(out)],
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
-    for name in ("report.md", "results.json", "results.csv", "psnr.png"):
-        assert (out / name).stat().st_size > 0, name
-    assert (out / "psnr.png").read_bytes().startswith(b"\x89PNG")
-    results = json.loads((out / "results.json").read_text())
-    assert [c["condition"]["name"] for c in results["conditions"]] == [c.name for c in ab.quickConditions()]
-    for entry in results["conditions"]:
-        arms = entry["arms"]
-        assert set(arms) == set(ab.ARMS)
-        assert all(len(runs["psnr"]) == 2 and all(math.isfinite(v) for v in runs["psnr"]) for runs in arms.values())
-        # The floor and the ceiling of the study: a network trained on exactly the test's kind of input
-        # must improve on that input in every condition, or nothing else in the table means anything.
-        assert np.mean(arms["ORACLE"]["psnr"]) > np.mean(arms["NOISY"]["psnr"]), entry["condition"]["name"]
-    report = (out / "report.md").read_text()
-    assert "![PSNR against darkening](psnr.png)" in report
-    assert "ACCOUNT_PRIOR minus each arm" in report
-    assert "x0.01 +12dB" in report
+    # By default both kinds of network, each a full study in its own folder.
+    for network, noiseMaps in (("told", True), ("blind", False)):
+        for name in ("report.md", "results.json", "results.csv", "psnr.png"):
+            assert (out / network / name).stat().st_size > 0, (network, name)
+        assert (out / network / "psnr.png").read_bytes().startswith(b"\x89PNG")
+        results = json.loads((out / network / "results.json").read_text())
+        assert results["config"]["noiseMaps"] is noiseMaps
+        assert [c["condition"]["name"] for c in results["conditions"]] == [c.name for c in ab.quickConditions()]
+        for entry in results["conditions"]:
+            arms = entry["arms"]
+            assert set(arms) == set(ab.ARMS)
+            assert all(len(runs["psnr"]) == 2 and all(math.isfinite(v) for v in runs["psnr"])
+                       for runs in arms.values())
+            # The floor and the ceiling of the study: a network trained on exactly the test's kind of input
+            # must improve on that input in every condition, or nothing else in the table means anything.
+            assert np.mean(arms["ORACLE"]["psnr"]) > np.mean(arms["NOISY"]["psnr"]), entry["condition"]["name"]
+        report = (out / network / "report.md").read_text()
+        assert "![PSNR against darkening](psnr.png)" in report
+        assert "ACCOUNT_PRIOR minus each arm" in report
+        assert "x0.01 +12dB" in report
+    both = (out / "report.md").read_text()
+    assert "[told/report.md](told/report.md)" in both and "[blind/report.md](blind/report.md)" in both
+    assert "| condition | prior share | told: minus NONE | blind: minus NONE | told: minus IGNORE_PRIOR |" in both
+    assert both.count("| x0.01 +12dB |") == 1
+    assert "![PSNR against darkening, blind](blind/psnr.png)" in both
+
+
+def test_the_networks_report_sets_each_networks_differences_side_by_side(tmp_path):
+    # The side-by-side table takes each cell from its own network's summary: a cell is that network's
+    # ACCOUNT_PRIOR minus the arm, interval and verdict, as summarize() gives it.
+    byNetwork = {"told": ab.runAblation(tiny_config()), "blind": ab.runAblation(tiny_config(noiseMaps=False))}
+    written, _ = ab.writeNetworksOutputs(byNetwork, str(tmp_path / "both"))
+    assert str(tmp_path / "both" / "report.md") in written
+    report = (tmp_path / "both" / "report.md").read_text()
+    for network, results in byNetwork.items():
+        for r in ab.summarize(results):
+            if r["arm"] == "IGNORE_PRIOR":
+                cell = "%+.2f [%+.2f, %+.2f], p %.3g (%s)" % (r["accountMinus"], r["accountMinusLow"],
+                                                             r["accountMinusHigh"], r["pValue"], r["verdict"])
+                line = next(l for l in report.splitlines() if l.startswith("| %s |" % r["condition"]))
+                # Columns: condition, share, then per arm (NONE, IGNORE_PRIOR, ORACLE) told and blind.
+                column = 2 + 2 * 1 + (0 if network == "told" else 1)
+                assert line.strip("|").split(" | ")[column].strip() == cell, (network, line)
+        assert (tmp_path / "both" / network / "results.json").exists()
 
 
 def test_the_same_seeds_give_the_same_numbers_and_another_seed_does_not():
@@ -148,7 +176,7 @@ def test_a_calibrated_model_is_the_one_simulated(tmp_path):
     model.save(str(tmp_path / "model.yml"))
     out = tmp_path / "out"
     assert ab.main(["--model", str(tmp_path / "model.yml"), "--quick", "--seeds", "1", "--iterations", "1",
-                    "--arms", "ORACLE,NOISY", "--out", str(out)]) == 0
+                    "--arms", "ORACLE,NOISY", "--networks", "told", "--out", str(out)]) == 0
     written = json.loads((out / "results.json").read_text())["config"]["model"]
     # The simulator re-adds the rounding's 1/12 DN^2 that the study takes out: the effective model is
     # the file's, up to the float rounding of the file.
@@ -193,7 +221,8 @@ def test_a_real_camera_from_darktables_profiles_is_the_one_simulated(tmp_path):
         rg.darktableNoiseProfiles(truth, fmt, 100, [100, 400, 1600], "Maker", "Cam"))
     out = tmp_path / "out"
     assert ab.main(["--model", str(tmp_path / "noiseprofiles.json"), "--camera", "Maker Cam", "--quick", "--seeds",
-                    "1", "--iterations", "1", "--arms", "ORACLE,NOISY", "--out", str(out)]) == 0
+                    "1", "--iterations", "1", "--arms", "ORACLE,NOISY", "--networks", "told",
+                    "--out", str(out)]) == 0
     config = json.loads((out / "results.json").read_text())["config"]
     assert config["camera"] == "Maker Cam"
     assert config["model"] == pytest.approx({"alpha": 0.3, "sigmaD2": 1.0, "sigmaR2": 4.0}, rel=1e-6)
@@ -208,6 +237,7 @@ def test_a_real_camera_from_darktables_profiles_is_the_one_simulated(tmp_path):
     (["--model", "/nonexistent/model.yml"], "/nonexistent/model.yml"),
     (["--seeds", "0"], "seeds must be >= 1"),
     (["--conditions", "x0.2,x0.3"], "unknown condition(s) x0.3"),
+    (["--networks", "told,deaf"], "--networks must be told, blind or told,blind, got 'told,deaf'"),
 ])
 def test_the_command_refuses_what_it_does_not_understand(argv, message, tmp_path):
     run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--out", str(tmp_path / "x"), *argv],

@@ -196,6 +196,76 @@ double parseCpuBound(size_t bytes)
     return factor * (2 + static_cast<double>(bytes) / (4 << 20));
 }
 
+ChildWait waitForChild(int child, double cpuBound, double wallCap, double stallSeconds)
+{
+    const auto start = std::chrono::steady_clock::now();
+    const auto wallSeconds = [&] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    clockid_t childClock;
+    const bool haveChildClock = ::clock_getcpuclockid(child, &childClock) == 0;
+    // Without the child's clock nothing tells spinning from blocked: wall time stands in for CPU time
+    // (so a blocked child counts as spinning) and the stall rule is off.
+    const auto cpuSeconds = [&] {
+        timespec t;
+        if (!haveChildClock)
+            return wallSeconds();
+        if (::clock_gettime(childClock, &t) != 0)
+            return -1.0; // the child has just ended: the next wait sees it
+        return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+    };
+    // A pidfd becomes readable the moment the child ends, even where SIGCHLD is ignored and waitpid()
+    // cannot see it; without one (kernels before 5.3), waitpid() and short naps.
+    const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, child, 0));
+    long sleepNs = 20000;
+    // A runnable child gets its share of a core within milliseconds, even behind a few busy processes
+    // (the scheduler is fair): one that gains less than a millisecond of CPU time in stallSeconds of
+    // wall time is asleep, waiting for something that will not come.
+    const double progressStep = 1e-3;
+    double lastCpu = 0, lastProgress = 0;
+    ChildWait outcome = ChildWait::OVERTIME;
+    while (wallSeconds() <= wallCap) {
+        bool finished = false;
+        if (pidfd >= 0) {
+            pollfd ready = {pidfd, POLLIN, 0};
+            finished = ::poll(&ready, 1, 50) > 0;
+        } else {
+            int status = 0;
+            const pid_t done = ::waitpid(child, &status, WNOHANG);
+            // ECHILD: SIGCHLD is ignored and the child reaped itself, so it has ended.
+            finished = done == child || (done < 0 && errno == ECHILD);
+            const timespec pause = {0, sleepNs};
+            if (!finished)
+                ::nanosleep(&pause, nullptr);
+            sleepNs = std::min(sleepNs * 2, 10000000L);
+        }
+        if (finished) {
+            outcome = ChildWait::FINISHED;
+            break;
+        }
+        const double cpu = cpuSeconds(), now = wallSeconds();
+        if (cpu > cpuBound) {
+            outcome = ChildWait::SPINNING;
+            break;
+        }
+        if (cpu >= lastCpu + progressStep) {
+            lastCpu = cpu;
+            lastProgress = now;
+        } else if (haveChildClock && cpu >= 0 && now - lastProgress > stallSeconds) {
+            outcome = ChildWait::STALLED;
+            break;
+        }
+    }
+    if (outcome != ChildWait::FINISHED)
+        ::kill(child, SIGKILL);
+    int status = 0;
+    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (pidfd >= 0)
+        ::close(pidfd);
+    return outcome;
+}
+
 void requireParseFinishes(const String& path, const std::string& text, double cpuBound)
 {
     // OpenCV 4.6's YAML reader never returns when its root collection ends before the text does and
@@ -204,9 +274,11 @@ void requireParseFinishes(const String& path, const std::string& text, double cp
     // depends on the whole parser; so the text is parsed once in a child process, which is killed when
     // it has spun for longer than an honest file needs (parseCpuBound()). CPU time, not wall time: under
     // `ctest -j2` a sanitizer build's child took more than 2 s of wall time for 300 kB while waiting for
-    // a core. A child that neither ends nor spins for a long while (a lock another thread held at the
-    // fork) says nothing about the text: it is killed and the caller parses. The child only parses and
-    // leaves with _exit(): it runs no atexit handler and touches no file.
+    // a core. The child of a multi-threaded caller can block for good on a lock that another thread
+    // held at the fork (an AddressSanitizer build's allocator did, in an app whose workers read sidecars
+    // in parallel, and the caller waited out the whole wall-time cap): such a child says nothing about
+    // the text, so it is killed as soon as it is seen asleep and the caller parses. The child only
+    // parses and leaves with _exit(): it runs no atexit handler and touches no file.
     if (!(cpuBound > 0))
         cpuBound = parseCpuBound(text.size());
     const double wallCap = 30 + 10 * cpuBound;
@@ -223,49 +295,7 @@ void requireParseFinishes(const String& path, const std::string& text, double cp
         }
         ::_exit(0);
     }
-    const auto start = std::chrono::steady_clock::now();
-    const auto wallSeconds = [&] {
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    };
-    clockid_t childClock;
-    const bool haveChildClock = ::clock_getcpuclockid(child, &childClock) == 0;
-    const auto cpuSeconds = [&] {
-        timespec t;
-        if (!haveChildClock)
-            return wallSeconds();
-        if (::clock_gettime(childClock, &t) != 0)
-            return 0.0; // the child has just ended: the next wait sees it
-        return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-    };
-    // A pidfd becomes readable the moment the child ends, even where SIGCHLD is ignored and waitpid()
-    // cannot see it; without one (kernels before 5.3), waitpid() and short naps.
-    const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, child, 0));
-    long sleepNs = 20000;
-    bool finished = false, spinning = false;
-    while (!finished && !spinning && wallSeconds() <= wallCap) {
-        if (pidfd >= 0) {
-            pollfd ready = {pidfd, POLLIN, 0};
-            finished = ::poll(&ready, 1, 50) > 0;
-        } else {
-            int status = 0;
-            const pid_t done = ::waitpid(child, &status, WNOHANG);
-            // ECHILD: SIGCHLD is ignored and the child reaped itself, so it has ended.
-            finished = done == child || (done < 0 && errno == ECHILD);
-            const timespec pause = {0, sleepNs};
-            if (!finished)
-                ::nanosleep(&pause, nullptr);
-            sleepNs = std::min(sleepNs * 2, 10000000L);
-        }
-        spinning = !finished && cpuSeconds() > cpuBound;
-    }
-    if (!finished)
-        ::kill(child, SIGKILL);
-    int status = 0;
-    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
-    }
-    if (pidfd >= 0)
-        ::close(pidfd);
-    if (spinning)
+    if (waitForChild(child, cpuBound, wallCap, CHILD_STALL_SECONDS) == ChildWait::SPINNING)
         CV_Error(Error::StsParseError,
                  format("'%s': OpenCV's YAML reader spun for %.3g s of CPU time without finishing; the text "
                         "is not a single YAML document of the shape this module reads (a line that ends the "

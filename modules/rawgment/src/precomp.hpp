@@ -76,6 +76,20 @@ void rejectWrappingIntegers(const String& path, const std::string& text);
  * whose root collection starts a line at column 0 (empty text and XML are refused too): OpenCV 4.6's
  * YAML parser loops forever on some streams with more than one document. */
 void rejectUnsupportedStructure(const String& path, const std::string& text);
+//! How waitForChild() saw a child process end.
+enum class ChildWait
+{
+    FINISHED, //!< it ended by itself
+    SPINNING, //!< it used more than its bound of CPU time and was killed
+    STALLED,  //!< it gained no CPU time for a while (blocked, as on a lock held at the fork) and was killed
+    OVERTIME  //!< the wall-time cap passed and it was killed
+};
+//! Seconds without CPU progress after which requireParseFinishes() takes its child as blocked.
+constexpr double CHILD_STALL_SECONDS = 3.0;
+/** Waits for the forked `child` until it ends, spins beyond `cpuBound` seconds of its CPU time, gains
+ * less than a millisecond of CPU time in `stallSeconds` of wall time, or `wallCap` seconds of wall time
+ * pass; kills it unless it ended, and reaps it (also where SIGCHLD is ignored). */
+CV_RAWGMENT_EXPORTS ChildWait waitForChild(int child, double cpuBound, double wallCap, double stallSeconds);
 /** Throws StsParseError naming the file (`path`) when OpenCV's parser spins on `text` (as
  * FileStorage::MEMORY would be given it) beyond `cpuBound` seconds of CPU time (0: parseCpuBound() of
  * the text): the parse runs first in a child process. */
