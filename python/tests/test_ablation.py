@@ -4,6 +4,7 @@ command refuses what it does not understand."""
 import dataclasses
 import json
 import math
+import os
 import subprocess
 import sys
 
@@ -252,3 +253,18 @@ def test_help_names_the_options():
     assert run.returncode == 0
     for option in ("--model", "--quick", "--out", "--seeds", "--arms"):
         assert option in run.stdout
+
+
+def test_the_dark_components_model_of_the_results_page_serves_the_default_study(tmp_path, source_dir):
+    # python/tools/dark_components_model.py writes the model of docs/results.md's run with every
+    # dark-frame component: the file it writes must load with all of them, and its maps must cover the
+    # default study's largest capture (or that run would be refused).
+    path = tmp_path / "dark.yml"
+    run = subprocess.run([sys.executable, os.path.join(source_dir, "python", "tools", "dark_components_model.py"),
+                          str(path)], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    model = rg.NoiseModel.load(str(path))
+    assert model.rowSigmaD2 > 0 and model.rowSigmaR2 > 0 and model.tukeyRead and model.hasDarkShading()
+    config = ab.AblationConfig(model=model)
+    assert model.darkShadingPerGain.shape[0] >= config.testSceneSize
+    config.validate()
