@@ -36,7 +36,7 @@ from rawgment.torch import packCfaPlanes
 
 __all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "defaultConditions", "quickConditions",
            "renderScene", "mosaicOfScene", "Denoiser", "psnr", "ssim", "runAblation", "pairedSignificance",
-           "summarize", "writeOutputs", "NETWORKS", "writeNetworksOutputs", "main"]
+           "summarize", "writeOutputs", "NETWORKS", "BLIND_STEP", "writeNetworksOutputs", "main"]
 
 ARMS = ("NONE", "IGNORE_PRIOR", "ACCOUNT_PRIOR", "ORACLE", "NOISY")
 TRAINED_ARMS = ARMS[:4]
@@ -55,6 +55,10 @@ _ILLUMINANT = (0.55, 1.0, 0.75)
 _FILL = 0.8
 # The reflectance at which the report states each condition's prior share (mid-grey).
 _MID_GREY = 0.18
+#: The blind network's default residual unit: about the noise standard deviation of the study's
+#: conditions on the network's scale (normalised planes). Unscaled, the first Adam steps moved the output
+#: by far more than the noise, the ReLUs died and 11 of 12 trainings stayed the identity.
+BLIND_STEP = 0.02
 
 
 def _seed(base, role, item):
@@ -116,6 +120,9 @@ class AblationConfig:
     # Whether the network is told the noise level (a noise map per plane, as the default denoiser) or is
     # blind, seeing only the image, as the paper's detectors do (--blind).
     noiseMaps: bool = True
+    # The blind network's residual unit (Denoiser.blindScale): a design choice, so a run can vary it to
+    # see whether a verdict depends on it.
+    blindStep: float = BLIND_STEP
     learningRate: float = 2e-3
     threads: int = 0                # torch threads (0: all cores)
     camera: str = ""                # the real camera of a darktable profile file the model came from
@@ -161,8 +168,8 @@ class AblationConfig:
                 raise ValueError("%s must be a multiple of 4 and >= 16, got %r" % (name, value))
         if self.patch > self.trainSceneSize:
             raise ValueError("patch (%d) is larger than trainSceneSize (%d)" % (self.patch, self.trainSceneSize))
-        if self.baseGain <= 0 or not (self.learningRate > 0):
-            raise ValueError("baseGain and learningRate must be > 0")
+        if self.baseGain <= 0 or not (self.learningRate > 0) or not (0 < self.blindStep <= 1):
+            raise ValueError("baseGain and learningRate must be > 0, blindStep in (0, 1]")
         for size in (16, self.patch, self.trainSceneSize, self.testSceneSize):
             self.sensorParams(int(size)).validate()
 
@@ -238,14 +245,14 @@ class Denoiser(torch.nn.Module):
     `blindScale`, the same for every input (so it carries no noise information): it must infer the noise
     level from the image. Output: the 4 denoised planes."""
 
-    #: The blind network's fixed residual unit: about the noise standard deviation of the study's
-    #: conditions on the network's scale (normalised planes). Unscaled, the first Adam steps moved the
-    #: output by far more than the noise, the ReLUs died and 11 of 12 trainings stayed the identity.
-    blindScale = 0.02
+    #: The blind network's default fixed residual unit (BLIND_STEP).
+    blindScale = BLIND_STEP
 
-    def __init__(self, width=16, noiseMaps=True):
+    def __init__(self, width=16, noiseMaps=True, blindScale=None):
         super().__init__()
         self.noiseMaps = bool(noiseMaps)
+        if blindScale is not None:
+            self.blindScale = float(blindScale)
         conv = torch.nn.Conv2d
         self.encode = torch.nn.Sequential(conv(8 if self.noiseMaps else 4, width, 3, padding=1), torch.nn.ReLU(),
                                           conv(width, width, 3, padding=1), torch.nn.ReLU())
@@ -432,7 +439,7 @@ def _train(study, arms, replicate, trainMeans, log=None):
     nets, optimisers, schedules = {}, {}, {}
     for arm in arms:
         torch.manual_seed(_seed(config.seed, _ROLE_NETWORK, replicate) & 0x7FFFFFFFFFFFFFFF)
-        nets[arm] = Denoiser(config.width, config.noiseMaps)
+        nets[arm] = Denoiser(config.width, config.noiseMaps, config.blindStep)
         optimisers[arm] = torch.optim.Adam(nets[arm].parameters(), lr=config.learningRate)
         schedules[arm] = torch.optim.lr_scheduler.CosineAnnealingLR(optimisers[arm], config.iterations)
     limit = (config.trainSceneSize - config.patch) // 2 + 1
@@ -661,7 +668,8 @@ def _report(results, rows, plotNote):
                    config["testSceneSize"], config["threads"], results["torch"], results["cpuPath"],
                    results["seconds"],
                    "told the noise level (a noise map per plane)" if config.get("noiseMaps", True)
-                   else "blind: they see the image only (--blind)"))
+                   else "blind: they see the image only (--blind), residual step %g"
+                   % config.get("blindStep", BLIND_STEP)))
     extras = []
     if "rowSigmaD2" in m:
         extras.append("row noise %.4g g^2 + %.4g DN^2" % (m["rowSigmaD2"], m["rowSigmaR2"]))
@@ -860,6 +868,8 @@ def _parser():
                              "default both, each in its own subfolder with a report.md beside them that "
                              "sets them side by side; one alone writes its report into --out itself")
     parser.add_argument("--blind", action="store_true", help="the same as --networks blind")
+    parser.add_argument("--blind-step", type=float, default=BLIND_STEP,
+                        help="the blind network's residual unit, a fraction of white - black (default 0.02)")
     return parser
 
 
@@ -892,6 +902,7 @@ def main(argv=None):
         print("rawgment.ablation: --networks must be told, blind or told,blind, got '%s'" % args.networks,
               file=sys.stderr)
         return 2
+    config.blindStep = args.blind_step
     if args.seeds is not None:
         config.seeds = args.seeds
     if args.iterations is not None:

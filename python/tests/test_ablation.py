@@ -102,6 +102,13 @@ def test_a_blind_study_feeds_its_networks_the_image_only(tmp_path):
     told = ab.runAblation(tiny_config())
     assert [e["arms"]["ORACLE"]["psnr"] for e in told["conditions"]] != \
         [e["arms"]["ORACLE"]["psnr"] for e in results["conditions"]]
+    # The blind residual unit is the run's, and it changes what the blind networks learn.
+    assert ab.Denoiser(width=4, noiseMaps=False, blindScale=0.05).blindScale == 0.05
+    assert results["config"]["blindStep"] == ab.BLIND_STEP
+    coarser = ab.runAblation(tiny_config(noiseMaps=False, blindStep=0.05))
+    assert coarser["config"]["blindStep"] == 0.05
+    assert [e["arms"]["ORACLE"]["psnr"] for e in coarser["conditions"]] != \
+        [e["arms"]["ORACLE"]["psnr"] for e in results["conditions"]]
 
 
 def test_the_arms_are_fed_the_noise_they_claim():
@@ -239,6 +246,7 @@ def test_a_real_camera_from_darktables_profiles_is_the_one_simulated(tmp_path):
     (["--seeds", "0"], "seeds must be >= 1"),
     (["--conditions", "x0.2,x0.3"], "unknown condition(s) x0.3"),
     (["--networks", "told,deaf"], "--networks must be told, blind or told,blind, got 'told,deaf'"),
+    (["--blind-step", "0"], "blindStep in (0, 1]"),
 ])
 def test_the_command_refuses_what_it_does_not_understand(argv, message, tmp_path):
     run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--out", str(tmp_path / "x"), *argv],
