@@ -124,7 +124,7 @@ class AblationConfig:
     # see whether a verdict depends on it.
     blindStep: float = BLIND_STEP
     learningRate: float = 2e-3
-    threads: int = 0                # torch threads (0: all cores)
+    threads: int = 0                # torch threads (0: torch's default, OMP_NUM_THREADS or the cores)
     camera: str = ""                # the real camera of a darktable profile file the model came from
 
     def sensorParams(self, size=None):
@@ -481,11 +481,22 @@ def _evaluate(net, testSet):
     return float(np.mean(psnrs)), float(np.mean(ssims))
 
 
+def _defaultThreads():
+    """OMP_NUM_THREADS where it is a positive integer (the test suite sets 1, so that a study beside other
+    tests does not fight them for the cores), else every core (torch's own default can be fewer: 1 of 2 on
+    a 2-core virtual machine)."""
+    try:
+        value = int(os.environ.get("OMP_NUM_THREADS", ""))
+    except ValueError:
+        value = 0
+    return value if value > 0 else (os.cpu_count() or 1)
+
+
 def runAblation(config, log=None):
     """Runs the study and returns its results as a dict (see results.json): for every condition and
     arm, the PSNR and SSIM of each replicate. `log` (a function of one string) receives progress."""
     config.validate()
-    threads = int(config.threads) if config.threads else (os.cpu_count() or 1)
+    threads = int(config.threads) if config.threads else _defaultThreads()
     torch.set_num_threads(threads)
     torch.use_deterministic_algorithms(True)
     started = time.monotonic()
@@ -861,7 +872,7 @@ def _parser():
     parser.add_argument("--conditions",
                         help="comma-separated subset of the conditions, by name (%s); one condition alone "
                              "trains a network for that condition only" % ",".join(c.name for c in defaultConditions()))
-    parser.add_argument("--threads", type=int, default=0, help="torch threads (default: all cores)")
+    parser.add_argument("--threads", type=int, default=0, help="torch threads (default: OMP_NUM_THREADS if set, else all cores)")
     parser.add_argument("--networks", default="told,blind",
                         help="which networks to train, comma-separated: told (a noise-level map per plane "
                              "beside the image) and blind (the image only, as the paper's detectors); "

@@ -276,3 +276,15 @@ def test_the_dark_components_model_of_the_results_page_serves_the_default_study(
     config = ab.AblationConfig(model=model)
     assert model.darkShadingPerGain.shape[0] >= config.testSceneSize
     config.validate()
+
+
+def test_the_default_thread_count_honours_omp_num_threads(monkeypatch):
+    # The test suite sets OMP_NUM_THREADS=1 so that a study beside other tests does not fight them for
+    # the cores; without it (or with nonsense) a study takes every core.
+    monkeypatch.setenv("OMP_NUM_THREADS", "1")
+    assert ab._defaultThreads() == 1
+    assert ab.runAblation(tiny_config(threads=0, seeds=1, arms=("NOISY",)))["config"]["threads"] == 1
+    monkeypatch.setenv("OMP_NUM_THREADS", "many")
+    assert ab._defaultThreads() == (os.cpu_count() or 1)
+    monkeypatch.delenv("OMP_NUM_THREADS")
+    assert ab._defaultThreads() == (os.cpu_count() or 1)
