@@ -255,11 +255,24 @@ TEST(Files, aYamlTextOnWhichOpenCvNeverFinishesIsAnErrorNotAHang)
     std::signal(SIGCHLD, previous);
 }
 
+void spinForever()
+{
+    volatile unsigned long k = 0;
+    for (;;)
+        k = k + 1;
+}
+
+void sleepForever()
+{
+    for (;;)
+        ::pause();
+}
+
 TEST(Files, aParseChildIsToldFinishedSpinningOrStalledFromItsCpuTime)
 {
-    // The three ways a guarded parse's child can go, with children that do each on purpose: end at
-    // once, spin (CPU time beyond the bound), or sleep (as one blocked on a lock held at the fork would,
-    // which must not hold its caller for the whole wall-time cap).
+    // The ways a guarded parse's child can go, with children that do each on purpose: end at once,
+    // spin (CPU time beyond the bound), sleep (as one blocked on a lock held at the fork would, which
+    // must not hold its caller for the whole wall-time cap), or outlast the cap.
     const auto forked = [](void (*body)()) {
         const pid_t child = ::fork();
         if (child == 0) {
@@ -268,36 +281,23 @@ TEST(Files, aParseChildIsToldFinishedSpinningOrStalledFromItsCpuTime)
         }
         return child;
     };
-    const auto seconds = [](std::chrono::steady_clock::time_point from) {
+    const auto secondsSince = [](std::chrono::steady_clock::time_point from) {
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - from).count();
     };
     EXPECT_EQ(detail::ChildWait::FINISHED, detail::waitForChild(forked([] {}), 10, 60, 3));
-    auto start = std::chrono::steady_clock::now();
-    EXPECT_EQ(detail::ChildWait::SPINNING, detail::waitForChild(forked([] {
-                                                                    volatile unsigned long k = 0;
-                                                                    for (;;)
-                                                                        k = k + 1;
-                                                                }),
-                                                                0.3, 60, 3));
     // 0.3 s of CPU time takes at least that long; a stalled verdict would need 3 s without progress.
-    EXPECT_GE(seconds(start), 0.3);
-    EXPECT_LT(seconds(start), 30.0);
-    start = std::chrono::steady_clock::now();
-    EXPECT_EQ(detail::ChildWait::STALLED, detail::waitForChild(forked([] {
-                                                                   for (;;)
-                                                                       ::pause();
-                                                               }),
-                                                               10, 60, 0.5));
+    auto start = std::chrono::steady_clock::now();
+    EXPECT_EQ(detail::ChildWait::SPINNING, detail::waitForChild(forked(spinForever), 0.3, 60, 3));
+    EXPECT_GE(secondsSince(start), 0.3);
+    EXPECT_LT(secondsSince(start), 30.0);
     // Seen asleep after 0.5 s, long before the 60 s cap (a loaded machine may add seconds, not tens).
-    EXPECT_GE(seconds(start), 0.5);
-    EXPECT_LT(seconds(start), 30.0);
     start = std::chrono::steady_clock::now();
-    EXPECT_EQ(detail::ChildWait::OVERTIME, detail::waitForChild(forked([] {
-                                                                    for (;;)
-                                                                        ::pause();
-                                                                }),
-                                                                10, 0.2, 5));
-    EXPECT_LT(seconds(start), 30.0);
+    EXPECT_EQ(detail::ChildWait::STALLED, detail::waitForChild(forked(sleepForever), 10, 60, 0.5));
+    EXPECT_GE(secondsSince(start), 0.5);
+    EXPECT_LT(secondsSince(start), 30.0);
+    start = std::chrono::steady_clock::now();
+    EXPECT_EQ(detail::ChildWait::OVERTIME, detail::waitForChild(forked(sleepForever), 10, 0.2, 5));
+    EXPECT_LT(secondsSince(start), 30.0);
 }
 
 TEST(Files, openFileStorageForReadingBoundsTheFileAndScansLongLines)
