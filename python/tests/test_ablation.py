@@ -39,7 +39,7 @@ def test_quick_run_writes_the_report_and_the_oracle_beats_the_noisy_input(tmp_pa
         assert [c["condition"]["name"] for c in results["conditions"]] == [c.name for c in ab.quickConditions()]
         for entry in results["conditions"]:
             arms = entry["arms"]
-            assert set(arms) == set(ab.ARMS)
+            assert set(arms) == set(ab.DEFAULT_ARMS)
             assert all(len(runs["psnr"]) == 2 and all(math.isfinite(v) for v in runs["psnr"])
                        for runs in arms.values())
             # The floor and the ceiling of the study: a network trained on exactly the test's kind of input
@@ -51,7 +51,8 @@ def test_quick_run_writes_the_report_and_the_oracle_beats_the_noisy_input(tmp_pa
         assert "x0.01 +12dB" in report
     both = (out / "report.md").read_text()
     assert "[told/report.md](told/report.md)" in both and "[blind/report.md](blind/report.md)" in both
-    assert "| condition | prior share | told: minus NONE | blind: minus NONE | told: minus IGNORE_PRIOR |" in both
+    assert "| condition | prior share | told: minus IGNORE_PRIOR | blind: minus IGNORE_PRIOR | told: minus ORACLE |" \
+        in both
     assert both.count("| x0.01 +12dB |") == 1
     assert "![PSNR against darkening, blind](blind/psnr.png)" in both
 
@@ -69,8 +70,9 @@ def test_the_networks_report_sets_each_networks_differences_side_by_side(tmp_pat
                 cell = "%+.2f [%+.2f, %+.2f], p %.3g (%s)" % (r["accountMinus"], r["accountMinusLow"],
                                                              r["accountMinusHigh"], r["pValue"], r["verdict"])
                 line = next(l for l in report.splitlines() if l.startswith("| %s |" % r["condition"]))
-                # Columns: condition, share, then per arm (NONE, IGNORE_PRIOR, ORACLE) told and blind.
-                column = 2 + 2 * 1 + (0 if network == "told" else 1)
+                # Columns: condition, share, then per trained arm but ACCOUNT_PRIOR, told and blind.
+                others = [a for a in results["config"]["arms"] if a in ab.TRAINED_ARMS and a != "ACCOUNT_PRIOR"]
+                column = 2 + 2 * others.index("IGNORE_PRIOR") + (0 if network == "told" else 1)
                 assert line.strip("|").split(" | ")[column].strip() == cell, (network, line)
         assert (tmp_path / "both" / network / "results.json").exists()
 
@@ -148,15 +150,17 @@ def test_ssim_and_psnr_on_known_cases():
     assert ab.ssim(noisy, clean) > ab.ssim(clean + 0.2 * torch.randn(4, 40, 40, generator=generator, dtype=torch.float64), clean)
 
 
-def test_the_verdict_is_the_paired_bootstrap_interval():
+def test_the_verdict_needs_the_interval_and_the_sign_flip_test():
     results = {"conditions": [{"condition": dataclasses.asdict(ab.Condition("c", 0.2)), "priorShare": 0.2, "arms": {
         "ACCOUNT_PRIOR": {"psnr": [30.0, 30.2, 30.4], "ssim": [0.9] * 3},
         "IGNORE_PRIOR": {"psnr": [29.9, 30.3, 30.3], "ssim": [0.9] * 3},
         "NONE": {"psnr": [28.0, 28.1, 28.3], "ssim": [0.8] * 3},
         "ORACLE": {"psnr": [31.0, 31.2, 31.4], "ssim": [0.95] * 3}}}]}
     rows = {row["arm"]: row for row in ab.summarize(results)}
+    # Three seeds of one sign put the interval off 0, but p cannot fall below 0.25: a lean, no verdict.
     assert {arm: row.get("verdict") for arm, row in rows.items()} == {
-        "ACCOUNT_PRIOR": None, "IGNORE_PRIOR": "tie", "NONE": "ACCOUNT_PRIOR better", "ORACLE": "ACCOUNT_PRIOR worse"}
+        "ACCOUNT_PRIOR": None, "IGNORE_PRIOR": "tie", "NONE": "ACCOUNT_PRIOR leans better",
+        "ORACLE": "ACCOUNT_PRIOR leans worse"}
     # ACCOUNT_PRIOR minus IGNORE_PRIOR is +0.1, -0.1, +0.1 by seed: the interval holds 0, and every sign
     # pattern's mean (+-0.033 or +-0.1) is at least the observed 0.033 in size (p = 1).
     assert rows["IGNORE_PRIOR"]["accountMinusLow"] < 0 < rows["IGNORE_PRIOR"]["accountMinusHigh"]
@@ -165,6 +169,17 @@ def test_the_verdict_is_the_paired_bootstrap_interval():
     assert rows["NONE"]["accountMinusLow"] == pytest.approx(2.0, abs=1e-9)
     assert rows["NONE"]["accountMinusHigh"] == pytest.approx(2.1, abs=1e-9)
     assert rows["NONE"]["pValue"] == pytest.approx(0.25)  # 2 / 2^3, the smallest 3 seeds allow
+    # Six seeds of one sign: p = 2 / 2^6 = 0.031 <= 0.05, a verdict. Five of -1 and one of +0.3 leave
+    # the interval off 0, but the sign patterns whose mean is as large are 4 of 64 (these two and their
+    # mirror images: flipping a -1 shrinks the mean), p = 0.0625: a lean.
+    six = {"conditions": [{"condition": dataclasses.asdict(ab.Condition("c", 0.2)), "priorShare": 0.2, "arms": {
+        "ACCOUNT_PRIOR": {"psnr": [30.0, 30.2, 30.4, 30.1, 30.3, 30.2], "ssim": [0.9] * 6},
+        "NONE": {"psnr": [29.0, 29.1, 29.3, 29.0, 29.2, 29.1], "ssim": [0.8] * 6},
+        "ORACLE": {"psnr": [31.0, 31.2, 31.4, 31.1, 31.3, 29.9], "ssim": [0.95] * 6}}}]}
+    rows = {row["arm"]: row for row in ab.summarize(six)}
+    assert rows["NONE"]["pValue"] == pytest.approx(2 / 64) and rows["NONE"]["verdict"] == "ACCOUNT_PRIOR better"
+    assert rows["ORACLE"]["accountMinusHigh"] < 0 and rows["ORACLE"]["pValue"] == pytest.approx(4 / 64)
+    assert rows["ORACLE"]["verdict"] == "ACCOUNT_PRIOR leans worse"
 
 
 def test_paired_significance_against_known_cases():
