@@ -895,7 +895,8 @@ def _parser():
     parser.add_argument("--conditions",
                         help="comma-separated subset of the conditions, by name (%s); one condition alone "
                              "trains a network for that condition only" % ",".join(c.name for c in defaultConditions()))
-    parser.add_argument("--threads", type=int, default=0, help="torch threads (default: OMP_NUM_THREADS if set, else all cores)")
+    parser.add_argument("--threads", type=int, default=0,
+                        help="torch threads (default: OMP_NUM_THREADS if set, else all cores)")
     parser.add_argument("--networks", default="told,blind",
                         help="which networks to train, comma-separated: told (a noise-level map per plane "
                              "beside the image) and blind (the image only, as the paper's detectors); "
