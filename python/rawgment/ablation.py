@@ -129,7 +129,7 @@ class AblationConfig:
     # see whether a verdict depends on it.
     blindStep: float = BLIND_STEP
     learningRate: float = 2e-3
-    threads: int = 0                # torch threads (0: torch's default, OMP_NUM_THREADS or the cores)
+    threads: int = 0                # torch threads (0: OMP_NUM_THREADS if set, else every core)
     camera: str = ""                # the real camera of a darktable profile file the model came from
 
     def sensorParams(self, size=None):
@@ -847,8 +847,8 @@ def _networksReport(byNetwork, rowsOf):
                 "the interval excludes 0, p is larger; tie: the interval holds 0)." % SIGNIFICANCE, ""]
         header = ["condition", "prior share"] + ["%s: minus %s" % (n, a) for a in others for n in networks]
         out += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        byKey = {n: {(r["condition"], r["arm"]): r for r in rowsOf[n]} for n in networks}
         for name in conditions:
-            byKey = {n: {(r["condition"], r["arm"]): r for r in rowsOf[n]} for n in networks}
             cells = [name, "%.3f" % byKey[networks[0]][(name, "ACCOUNT_PRIOR")]["priorShare"]]
             for a in others:
                 for n in networks:
