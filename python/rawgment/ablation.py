@@ -128,6 +128,11 @@ class AblationConfig:
     # The blind network's residual unit (Denoiser.blindScale): a design choice, so a run can vary it to
     # see whether a verdict depends on it.
     blindStep: float = BLIND_STEP
+    # How the augmented arms draw their added noise (NoiseOptions): the library's defaults, or the exact
+    # Poisson shape of the shot part and the local mean as the prior's level, to see what a result owes
+    # to either.
+    shotSampling: str = "GAUSSIAN"
+    priorMean: str = "PIXEL_VALUE"
     learningRate: float = 2e-3
     threads: int = 0                # torch threads (0: OMP_NUM_THREADS if set, else every core)
     camera: str = ""                # the real camera of a darktable profile file the model came from
@@ -175,6 +180,9 @@ class AblationConfig:
             raise ValueError("patch (%d) is larger than trainSceneSize (%d)" % (self.patch, self.trainSceneSize))
         if self.baseGain <= 0 or not (self.learningRate > 0) or not (0 < self.blindStep <= 1):
             raise ValueError("baseGain and learningRate must be > 0, blindStep in (0, 1]")
+        if self.shotSampling not in ("GAUSSIAN", "POISSON") or self.priorMean not in ("PIXEL_VALUE", "LOCAL_MEAN"):
+            raise ValueError("shotSampling must be GAUSSIAN or POISSON and priorMean PIXEL_VALUE or LOCAL_MEAN, "
+                             "got %r and %r" % (self.shotSampling, self.priorMean))
         for size in (16, self.patch, self.trainSceneSize, self.testSceneSize):
             self.sensorParams(int(size)).validate()
 
@@ -372,6 +380,8 @@ class _Study:
     def augmented(self, bright, condition, arm, seed):
         """The bright capture darkened (and blurred) by the library with the arm's alignment."""
         options = _rg.NoiseOptions(ALIGNMENTS[arm])
+        options.shotSampling = getattr(_rg.ShotNoiseSampling, self.config.shotSampling)
+        options.priorMean = getattr(_rg.PriorMeanEstimate, self.config.priorMean)
         stepSeeds = [_rg.deriveSeed(seed, _rg.SEED_ABLATION, step) for step in (1, 2)]
         if condition.blurLength > 0:
             bright, _ = _rg.motionBlur(bright, self.format, self.model, self.kernel(condition), options,
@@ -701,6 +711,10 @@ def _report(results, rows, plotNote):
                    "told the noise level (a noise map per plane)" if config.get("noiseMaps", True)
                    else "blind: they see the image only (--blind), residual step %g"
                    % config.get("blindStep", BLIND_STEP)))
+    if (config.get("shotSampling", "GAUSSIAN"), config.get("priorMean", "PIXEL_VALUE")) != ("GAUSSIAN", "PIXEL_VALUE"):
+        out += ["", "The augmented arms draw the shot part of their added noise as ShotNoiseSampling::%s and take "
+                "the prior's level as PriorMeanEstimate::%s (the paper's: GAUSSIAN, PIXEL_VALUE)."
+                % (config["shotSampling"], config["priorMean"])]
     extras = []
     if "rowSigmaD2" in m:
         extras.append("row noise %.4g g^2 + %.4g DN^2" % (m["rowSigmaD2"], m["rowSigmaR2"]))
@@ -903,6 +917,11 @@ def _parser():
                              "default both, each in its own subfolder with a report.md beside them that "
                              "sets them side by side; one alone writes its report into --out itself")
     parser.add_argument("--blind", action="store_true", help="the same as --networks blind")
+    parser.add_argument("--shot-sampling", default="GAUSSIAN", type=str.upper,
+                        help="the augmented arms' shot noise: GAUSSIAN (the paper's, default) or POISSON")
+    parser.add_argument("--prior-mean", default="PIXEL_VALUE", type=str.upper,
+                        help="the augmented arms' estimate of the prior's level: PIXEL_VALUE (the paper's, "
+                             "default) or LOCAL_MEAN")
     parser.add_argument("--blind-step", type=float, default=BLIND_STEP,
                         help="the blind network's residual unit, a fraction of white - black (default 0.02)")
     return parser
@@ -938,6 +957,7 @@ def main(argv=None):
               file=sys.stderr)
         return 2
     config.blindStep = args.blind_step
+    config.shotSampling, config.priorMean = args.shot_sampling, args.prior_mean
     if args.seeds is not None:
         config.seeds = args.seeds
     if args.iterations is not None:

@@ -262,6 +262,7 @@ def test_a_real_camera_from_darktables_profiles_is_the_one_simulated(tmp_path):
     (["--conditions", "x0.2,x0.3"], "unknown condition(s) x0.3"),
     (["--networks", "told,deaf"], "--networks must be told, blind or told,blind, got 'told,deaf'"),
     (["--blind-step", "0"], "blindStep in (0, 1]"),
+    (["--shot-sampling", "binomial"], "shotSampling must be GAUSSIAN or POISSON"),
 ])
 def test_the_command_refuses_what_it_does_not_understand(argv, message, tmp_path):
     run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--out", str(tmp_path / "x"), *argv],
@@ -303,3 +304,17 @@ def test_the_default_thread_count_honours_omp_num_threads(monkeypatch):
     assert ab._defaultThreads() == (os.cpu_count() or 1)
     monkeypatch.delenv("OMP_NUM_THREADS")
     assert ab._defaultThreads() == (os.cpu_count() or 1)
+
+
+def test_the_augmentation_options_reach_the_augmented_arms_only(tmp_path):
+    # POISSON shot draws and the local mean change what the augmented arms are fed (so what they learn),
+    # not the oracle, whose captures the simulator makes; the run and its report say which were used.
+    plain = ab.runAblation(tiny_config(arms=("ACCOUNT_PRIOR", "ORACLE")))
+    other = ab.runAblation(tiny_config(arms=("ACCOUNT_PRIOR", "ORACLE"), shotSampling="POISSON",
+                                       priorMean="LOCAL_MEAN"))
+    assert other["config"]["shotSampling"] == "POISSON" and other["config"]["priorMean"] == "LOCAL_MEAN"
+    arm = lambda r, name: [e["arms"][name]["psnr"] for e in r["conditions"]]
+    assert arm(plain, "ORACLE") == arm(other, "ORACLE")
+    assert arm(plain, "ACCOUNT_PRIOR") != arm(other, "ACCOUNT_PRIOR")
+    ab.writeOutputs(other, str(tmp_path / "options"))
+    assert "ShotNoiseSampling::POISSON" in (tmp_path / "options" / "report.md").read_text()
