@@ -886,7 +886,7 @@ def _parser():
                     "the noisy input as the floor; tests all on captures simulated at the target; writes "
                     "report.md, results.json, results.csv and psnr.png.",
         epilog="The default budget (9 conditions x 3 trained arms x 6 seeds, told and blind networks) takes "
-               "about 25 minutes on 2 cores; --quick, a smoke test that learns almost nothing, about a minute. "
+               "about 20 minutes on 2 cores; --quick, a smoke test that learns almost nothing, about 30 s. "
                "See docs/ablation.md.")
     parser.add_argument("--model", help="the sensor's noise model: rawgment_calibrate's model.yml (with its "
                                         "dark-frame components, if any), an Android profile YAML, or darktable's "
