@@ -46,28 +46,49 @@ template <typename V> struct AddedVarianceOf
 //! One pixel's; the vector kernels use AddedVarianceOf their lanes.
 typedef AddedVarianceOf<float> AddedVariance;
 
-// Gaussian noise of variance `rest` plus the shot part as an electron count: q (K - m) with
-// K ~ Poisson(m), m = shot / q^2 (ShotNoiseSampling::POISSON). A negative total (brightening) adds
-// nothing; a negative rest (the gain grew) is taken from the Poisson part, so the variance added is
-// always max(shot + rest, 0), the same as the Gaussian path.
-inline float sampledNoise(AddedVariance v, float q, float z, detail::CounterRng& rng)
+/* Gaussian noise of variance `rest` plus the shot part as an electron count: q (K - m) with
+ * K ~ Poisson(m), m = shot / q^2 (ShotNoiseSampling::POISSON). A negative total (brightening) adds
+ * nothing; a negative rest (the gain grew) is taken from the Poisson part, so the variance added is
+ * always max(shot + rest, 0), the same as the Gaussian path.
+ * A row draws in two passes: poissonMean() of every pixel, one fillPoisson() of the row (vector lanes),
+ * then sampledNoise() with each pixel's count. */
+inline double poissonMean(AddedVariance v, float q)
+{
+    const float total = std::max(v.shot + v.rest, 0.0f);
+    const float shot = q > 0 ? std::min(std::max(v.shot, 0.0f), total) : 0.0f;
+    const double m = shot > 0 ? static_cast<double>(shot) / (static_cast<double>(q) * q) : 0.0;
+    // Beyond kMaxPoissonMean electrons the count is Gaussian to double precision: sampledNoise() draws the
+    // whole variance as one Gaussian then (with a tiny q, m can be any size), and no count is needed.
+    return m <= detail::kMaxPoissonMean ? m : 0.0;
+}
+
+//! The noise of one pixel from its Gaussian z and its count K ~ Poisson(poissonMean(v, q)).
+inline float sampledNoise(AddedVariance v, float q, float z, double count)
 {
     const float total = std::max(v.shot + v.rest, 0.0f);
     const float shot = q > 0 ? std::min(std::max(v.shot, 0.0f), total) : 0.0f;
     const double m = static_cast<double>(shot) / (static_cast<double>(q) * q);
-    // Beyond kMaxPoissonMean electrons the count is Gaussian to double precision: the whole variance
-    // is drawn as one Gaussian then (with a tiny q, m can be any size).
     if (!(m <= detail::kMaxPoissonMean))
         return std::sqrt(total) * z;
-    const float count = shot > 0 ? static_cast<float>(static_cast<double>(rng.poisson(m)) - m) : 0.0f;
-    return q * count + std::sqrt(total - shot) * z;
+    const float centred = shot > 0 ? static_cast<float>(count - m) : 0.0f;
+    return q * centred + std::sqrt(total - shot) * z;
 }
 
 /* sampledNoise() with the read part from the unit-variance heavy-tailed draw t (NoiseModel::tukeyRead)
- * and the shot part from z, or as an electron count when `poisson`. The variance added is
- * max(shot + rest, 0) as on every path; the read part is the rest, never more than that total. */
-inline float sampledNoiseWithTails(AddedVariance v, float q, bool poisson, float z, float t,
-                                   detail::CounterRng& rng)
+ * and the shot part from z, or as an electron count when `poisson` (the mean of that count:
+ * poissonMeanWithTails()). The variance added is max(shot + rest, 0) as on every path; the read part is
+ * the rest, never more than that total. */
+inline double poissonMeanWithTails(AddedVariance v, float q)
+{
+    const float total = std::max(v.shot + v.rest, 0.0f);
+    const float read = std::min(std::max(v.rest, 0.0f), total), shot = total - read;
+    if (!(q > 0 && shot > 0))
+        return 0.0;
+    const double m = static_cast<double>(shot) / (static_cast<double>(q) * q);
+    return m <= detail::kMaxPoissonMean ? m : 0.0;
+}
+
+inline float sampledNoiseWithTails(AddedVariance v, float q, bool poisson, float z, float t, double count)
 {
     const float total = std::max(v.shot + v.rest, 0.0f);
     const float read = std::min(std::max(v.rest, 0.0f), total), shot = total - read;
@@ -75,7 +96,7 @@ inline float sampledNoiseWithTails(AddedVariance v, float q, bool poisson, float
     if (poisson && q > 0 && shot > 0) {
         const double m = static_cast<double>(shot) / (static_cast<double>(q) * q);
         if (m <= detail::kMaxPoissonMean)
-            shotNoise = q * static_cast<float>(static_cast<double>(rng.poisson(m)) - m);
+            shotNoise = q * static_cast<float>(count - m);
     }
     return shotNoise + std::sqrt(read) * t;
 }

@@ -256,23 +256,36 @@ RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
                               int cols),
                              (s, d, z, t, prior, extra, col, k, cols))
 
-// The scalar rows: ShotNoiseSampling::POISSON (a rejection loop per pixel) or Tukey-lambda read noise
-// (NoiseModel::tukeyRead: t holds the row's unit-variance heavy-tailed draws), with the dark terms'
-// `extra` when present. The same code on every CpuPath.
+// The rows of ShotNoiseSampling::POISSON, with Tukey-lambda read noise (NoiseModel::tukeyRead: t holds
+// the row's unit-variance heavy-tailed draws) or without, and the dark terms' `extra` when present: the
+// variance and the count's mean of every pixel, the row's counts in vector lanes (detail::fillPoisson()),
+// then each pixel. The same code on every CpuPath. `vars` and `counts` are the caller's, reused row after
+// row.
 template <typename T, NoiseAlignment A>
-int jitterRowScalarBody(const T* s, T* d, const float* z, const float* t, const float* prior,
-                        const float* extra, const float* pc, const float* black, const JitterConstants& k,
-                        detail::CounterRng& rng, int cols)
+int jitterRowPoissonBody(const T* s, T* d, const float* z, const float* t, const float* prior,
+                         const float* extra, const float* pc, const float* black, const JitterConstants& k,
+                         uint64_t key, uint64_t stream, std::vector<AddedVariance>& vars,
+                         std::vector<double>& means, std::vector<double>& counts, int cols)
 {
     const float q = k.pg * k.in.shot; // DN per electron at the output gain: g alpha p_g
-    const bool poisson = k.sampling == ShotNoiseSampling::POISSON;
+    vars.resize(static_cast<size_t>(cols));
+    means.resize(static_cast<size_t>(cols));
+    counts.resize(static_cast<size_t>(cols));
     int bright = 0;
     for (int c = 0; c < cols; ++c) {
         const float x = static_cast<float>(s[c]) - black[c];
         const AddedVariance v = jitterVariance<A>(prior ? prior[c] : x, pc[c], k);
         bright += v.shot + v.rest < 0 ? 1 : 0;
-        const float noise =
-            t ? detail::sampledNoiseWithTails(v, q, poisson, z[c], t[c], rng) : sampledNoise(v, q, z[c], rng);
+        vars[static_cast<size_t>(c)] = v;
+        means[static_cast<size_t>(c)] = t ? detail::poissonMeanWithTails(v, q) : detail::poissonMean(v, q);
+    }
+    detail::fillPoisson(key, stream, means.data(), counts.data(), cols);
+    for (int c = 0; c < cols; ++c) {
+        const AddedVariance v = vars[static_cast<size_t>(c)];
+        const double count = counts[static_cast<size_t>(c)];
+        const float noise = t ? detail::sampledNoiseWithTails(v, q, true, z[c], t[c], count)
+                              : sampledNoise(v, q, z[c], count);
+        const float x = static_cast<float>(s[c]) - black[c];
         float out = pc[c] * x + k.pb + noise;
         if (extra)
             out += extra[c];
@@ -282,15 +295,16 @@ int jitterRowScalarBody(const T* s, T* d, const float* z, const float* t, const 
 }
 
 template <typename T>
-int jitterRowScalar(const T* s, T* d, const float* z, const float* t, const float* prior, const float* extra,
-                    const float* pc, const float* black, const JitterConstants& k, detail::CounterRng& rng,
-                    int cols)
+int jitterRowPoisson(const T* s, T* d, const float* z, const float* t, const float* prior, const float* extra,
+                     const float* pc, const float* black, const JitterConstants& k, uint64_t key,
+                     uint64_t stream, std::vector<AddedVariance>& vars, std::vector<double>& means,
+                     std::vector<double>& counts, int cols)
 {
     if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR)
-        return jitterRowScalarBody<T, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, t, prior, extra, pc, black, k,
-                                                                     rng, cols);
-    return jitterRowScalarBody<T, NoiseAlignment::IGNORE_PRIOR>(s, d, z, t, prior, extra, pc, black, k, rng,
-                                                                cols);
+        return jitterRowPoissonBody<T, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, t, prior, extra, pc, black, k,
+                                                                      key, stream, vars, means, counts, cols);
+    return jitterRowPoissonBody<T, NoiseAlignment::IGNORE_PRIOR>(s, d, z, t, prior, extra, pc, black, k, key,
+                                                                 stream, vars, means, counts, cols);
 }
 
 // The column arrays of even rows (sites 0, 1) and odd rows (sites 2, 3), made once per call: a
@@ -344,7 +358,9 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
     const bool tails = noise && k.dark.tails, dark = noise && k.dark.any();
     std::vector<float> z(static_cast<size_t>(cols)), t(tails ? cols : 0), extra(dark ? cols : 0),
         blackAndShading(inputShading.empty() ? 0 : static_cast<size_t>(cols));
-    const bool scalar = noise && k.sampling == ShotNoiseSampling::POISSON;
+    const bool poisson = noise && k.sampling == ShotNoiseSampling::POISSON;
+    std::vector<AddedVariance> vars;
+    std::vector<double> means, counts;
     int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
         if (noise)
@@ -367,10 +383,10 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
         }
         const float* priorRow = prior.empty() ? nullptr : prior.ptr<float>(r);
         const float* extraRow = dark ? extra.data() : nullptr;
-        if (scalar) {
-            detail::CounterRng rng(keys.poisson, static_cast<uint64_t>(r));
-            localBright += jitterRowScalar(src.ptr<T>(r), dst.ptr<T>(r), z.data(), tails ? t.data() : nullptr,
-                                           priorRow, extraRow, col.pc, col.black, k, rng, cols);
+        if (poisson) {
+            localBright += jitterRowPoisson(
+                src.ptr<T>(r), dst.ptr<T>(r), z.data(), tails ? t.data() : nullptr, priorRow, extraRow,
+                col.pc, col.black, k, keys.poisson, static_cast<uint64_t>(r), vars, means, counts, cols);
         } else {
             localBright += jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), tails ? t.data() : nullptr,
                                      priorRow, extraRow, col, k, cols);

@@ -193,17 +193,14 @@ RAWGMENT_KERNEL typename Lanes<W>::F tukeyTermLanes(typename Lanes<W>::F l, type
     typedef typename Lanes<W>::F F;
     typedef typename Lanes<W>::I I;
     const F x = lambda * l;
-    const F series =
-        l *
-        (1.0f + x * (0.5f + x * (1.6666667e-1f +
-                                 x * (4.1666667e-2f +
-                                      x * (8.3333333e-3f +
-                                           x * (1.3888889e-3f + x * (1.9841270e-4f + x * 2.4801587e-5f)))))));
+    // 1 + x/2! + ... + x^7/8! by Estrin's scheme: a dependency chain of 3 multiply-adds, not Horner's 7
+    // (the quantile's two series were the latency that bounded the fill).
+    const F x2 = x * x, x4 = x2 * x2;
+    const F c01 = 1.0f + x * 0.5f, c23 = 1.6666667e-1f + x * 4.1666667e-2f;
+    const F c45 = 8.3333333e-3f + x * 1.3888889e-3f, c67 = 1.9841270e-4f + x * 2.4801587e-5f;
+    const F series = l * ((c01 + x2 * c23) + x4 * (c45 + x2 * c67));
     const I large = detail::maxLanes(x, -x) >= 0.5f;
-    int anyLarge = 0;
-    for (int i = 0; i < W; ++i)
-        anyLarge |= large[i];
-    if (!anyLarge)
+    if (!maskBits(large))
         return series;
     const F direct = (expLanes<W>(x) - 1.0f) / safeLambda;
     return large ? direct : series;
@@ -252,6 +249,383 @@ RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, float l
     }
 }
 
+/* The double lanes of a kernel of width W floats: W / 2 doubles, one register on every path (wider
+ * vectors would compare and select lane by lane in scalar code, cpu_dispatch.hpp). */
+template <int W> struct DoubleLanes
+{
+    typedef double D __attribute__((vector_size(4 * W)));
+    typedef int64_t L __attribute__((vector_size(4 * W)));
+    typedef uint64_t UL __attribute__((vector_size(4 * W)));
+    typedef uint32_t U32 __attribute__((vector_size(2 * W))); // a 32-bit word per double lane
+    static constexpr int kCount = W / 2;
+};
+
+// 2^52 and 2^52 + 2^51: adding one to a double in range leaves an integer in the low mantissa bits.
+constexpr double kTwo52 = 4503599627370496.0, kTwo52And51 = 6755399441055744.0;
+// ln 2 in two parts (Cody and Waite): the high part has 32 trailing zero bits, so n ln2Hi is exact for
+// any exponent n of a double.
+constexpr double kLn2Hi = 6.93147180369123816490e-01, kLn2Lo = 1.90821492927058770002e-10;
+
+//! An int64 lane in [-2^51, 2^51) as a double, with integer operations only (x86 before AVX-512 has no
+//! vector int64 -> double).
+template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D int64ToDoubleLanes(typename DoubleLanes<W>::L v)
+{
+    typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::UL UL;
+    const UL bits = (UL)(v + (int64_t(1) << 51)) | 0x4330000000000000ull;
+    return (D)bits - kTwo52And51;
+}
+
+/* ln(x) for finite normal x > 0, to about 2 double ulps: x = 2^e m with m in [sqrt(1/2), sqrt(2)), then
+ * ln m = 2 atanh(s), s = (m - 1) / (m + 1), |s| <= 0.1716, by its series to s^19 (the next term is below
+ * 2^-56 relative); m - 1 is exact, so the result stays accurate relative to ln m near 1. */
+template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D logLanesD(typename DoubleLanes<W>::D x)
+{
+    typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::L L;
+    typedef typename DoubleLanes<W>::UL UL;
+    const UL bits = (UL)x;
+    L e = (L)(bits >> 52) - 1023;
+    D m = (D)((bits & 0x000fffffffffffffull) | 0x3ff0000000000000ull); // in [1, 2)
+    const L big = m > 1.4142135623730951;
+    m = big ? m * 0.5 : m;
+    e -= big;
+    const D s = (m - 1.0) / (m + 1.0), s2 = s * s, s4 = s2 * s2, s8 = s4 * s4;
+    // 1 + s2/3 + ... + s2^9/19 by Estrin's scheme (a short dependency chain, as logPositiveLanes()).
+    const D p01 = 1.0 + s2 * (1.0 / 3), p23 = 1.0 / 5 + s2 * (1.0 / 7), p45 = 1.0 / 9 + s2 * (1.0 / 11),
+            p67 = 1.0 / 13 + s2 * (1.0 / 15), p89 = 1.0 / 17 + s2 * (1.0 / 19);
+    const D poly = (p01 + s4 * p23) + s8 * ((p45 + s4 * p67) + s8 * p89);
+    const D ed = int64ToDoubleLanes<W>(e);
+    return ed * kLn2Hi + (2.0 * s * poly + ed * kLn2Lo);
+}
+
+/* e^x for x in [-700, 0], to about 2 double ulps: n = x / ln 2 rounded to nearest, r = x - n ln 2 (two
+ * parts), |r| <= ln(2) / 2, e^r by its Taylor series to r^13 (the remainder is below 2^-55), then 2^n
+ * through the exponent bits. */
+template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D expLanesD(typename DoubleLanes<W>::D x)
+{
+    typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::UL UL;
+    const D n = (x * 1.4426950408889634 + kTwo52And51) - kTwo52And51;
+    const D r = (x - n * kLn2Hi) - n * kLn2Lo;
+    const D r2 = r * r, r4 = r2 * r2, r8 = r4 * r4;
+    const D q01 = 1.0 + r, q23 = 1.0 / 2 + r * (1.0 / 6), q45 = 1.0 / 24 + r * (1.0 / 120),
+            q67 = 1.0 / 720 + r * (1.0 / 5040), q89 = 1.0 / 40320 + r * (1.0 / 362880),
+            q1011 = 1.0 / 3628800 + r * (1.0 / 39916800), q1213 = 1.0 / 479001600 + r * (1.0 / 6227020800.0);
+    const D er = ((q01 + r2 * q23) + r4 * (q45 + r2 * q67)) + r8 * ((q89 + r2 * q1011) + r4 * q1213);
+    const UL scale = (UL)(n + (kTwo52 + 1023.0)) << 52;
+    return er * (D)scale;
+}
+
+//! floor(x) for x in [0, 2^52): rounded to nearest by the 2^52 trick, then one down where that went up.
+template <int W>
+RAWGMENT_KERNEL typename DoubleLanes<W>::D floorNonNegativeLanesD(typename DoubleLanes<W>::D x)
+{
+    typedef typename DoubleLanes<W>::D D;
+    const D r = (x + kTwo52) - kTwo52;
+    return r > x ? r - 1.0 : r;
+}
+
+//! Uniforms of 32 bits in (0, 1): (w + 1/2) 2^-32, exact, through 64-bit lanes (no vector uint32 -> double
+//! before AVX-512).
+template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D uniform32LanesD(typename DoubleLanes<W>::UL w)
+{
+    typedef typename DoubleLanes<W>::D D;
+    return (((D)(w | 0x4330000000000000ull) - kTwo52) + 0.5) * (1.0 / 4294967296.0);
+}
+
+//! IEEE square roots of double lanes, compiled to (v)sqrtpd.
+template <typename V> inline __attribute__((always_inline)) V sqrtLanesD(V v)
+{
+    V r;
+    for (int i = 0; i < static_cast<int>(sizeof(V) / sizeof(double)); ++i)
+        r[i] = __builtin_sqrt(v[i]);
+    return r;
+}
+
+// The largest mean fillPoisson() draws in lanes, 2^40: PTRS's floor then stays below 2^52. Larger means go
+// to CounterRng::poisson() (which takes up to kMaxPoissonMean).
+constexpr double kMaxLaneMean = 1099511627776.0;
+
+/* One PTRS try (Hormann 1993; CounterRng::poisson() has the same constants) per lane, for means lambda in
+ * [10, 2^40], from 32-bit words for u and v: its count kd, the lanes that the fast test accepts, and those
+ * the try refuses outright (a negative count, or the tail the hat cuts). Lanes in neither take
+ * ptrsFullTestLanes(). */
+template <int W> struct PtrsTryLanes
+{
+    typename DoubleLanes<W>::D kd;
+    typename DoubleLanes<W>::L accept, refuse;
+};
+
+template <int W> struct PtrsShape
+{
+    typedef typename DoubleLanes<W>::D D;
+    D a, b, u, v, us;
+    PtrsShape(D lambda, typename DoubleLanes<W>::UL w1, typename DoubleLanes<W>::UL w2)
+    {
+        b = 0.931 + 2.53 * sqrtLanesD(lambda);
+        a = -0.059 + 0.02483 * b;
+        u = uniform32LanesD<W>(w1) - 0.5;
+        v = uniform32LanesD<W>(w2);
+        us = 0.5 - (u < 0.0 ? -u : u); // at least 2^-33
+    }
+};
+
+template <int W>
+RAWGMENT_KERNEL PtrsTryLanes<W> ptrsTryLanes(typename DoubleLanes<W>::D lambda,
+                                             typename DoubleLanes<W>::UL w1, typename DoubleLanes<W>::UL w2)
+{
+    typedef typename DoubleLanes<W>::D D;
+    const PtrsShape<W> h(lambda, w1, w2);
+    const D vr = 0.9277 - 3.6224 / (h.b - 2.0);
+    const D x = (2.0 * h.a / h.us + h.b) * h.u + lambda + 0.43;
+    PtrsTryLanes<W> t;
+    const D largest = D{} + 4503599627370495.0; // 2^52 - 1: a count that large is refused by the full test
+    t.kd = floorNonNegativeLanesD<W>(x < 0.0 ? D{} : (x < largest ? x : largest));
+    t.accept = (h.us >= 0.07) & (h.v <= vr) & (x >= 0.0);
+    t.refuse = (x < 0.0) | ((h.us < 0.013) & (h.v > h.us));
+    return t;
+}
+
+/* log k! - (k ln k - k + ln(2 pi k) / 2), the remainder of Stirling's formula, for k >= 1: exact below 32
+ * (from the table of logFactorial()), its series 1/(12k) - 1/(360k^3) + 1/(1260k^5) above, as
+ * logFactorial() (error below 1e-13 relative to log k!). */
+const std::array<double, 32>& stirlingRemainderTable()
+{
+    static const std::array<double, 32> table = [] {
+        std::array<double, 32> t{};
+        for (int k = 1; k < 32; ++k) {
+            const double x = k;
+            t[static_cast<size_t>(k)] =
+                logFactorial(k) - (x * std::log(x) - x + 0.5 * std::log(2.0 * CV_PI * x));
+        }
+        return t;
+    }();
+    return table;
+}
+
+/* PTRS's full test for the lanes of a try that ptrsTryLanes() left undecided: log(v / alpha / (a / us^2 +
+ * b)) <= -lambda + kd ln lambda - log kd!, with log kd! as Stirling's formula plus its remainder, so that
+ * ln sqrt(2 pi kd) joins the left side's logarithm and kd ln(lambda / kd) + kd - lambda stays accurate
+ * where kd is near lambda. */
+template <int W>
+RAWGMENT_KERNEL typename DoubleLanes<W>::L
+ptrsFullTestLanes(typename DoubleLanes<W>::D lambda, typename DoubleLanes<W>::UL w1,
+                  typename DoubleLanes<W>::UL w2, typename DoubleLanes<W>::D kd)
+{
+    typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::L L;
+    const PtrsShape<W> h(lambda, w1, w2);
+    const D invAlpha = 1.1239 + 1.1328 / (h.b - 3.4);
+    const std::array<double, 32>& table = stirlingRemainderTable();
+    const D one = D{} + 1.0;
+    const L positive = kd >= 1.0;
+    const D k = positive ? kd : one;
+    const D inv = one / k, inv2 = inv * inv;
+    D remainder = inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260)));
+    for (int i = 0; i < DoubleLanes<W>::kCount; ++i)
+        if (k[i] < 32)
+            remainder[i] = table[static_cast<size_t>(k[i])];
+    const D root = positive ? sqrtLanesD(2.0 * CV_PI * k) : one;
+    const D lhs = logLanesD<W>(h.v * invAlpha * root / (h.a / (h.us * h.us) + h.b));
+    const D rhs = (positive ? k * logLanesD<W>(lambda / k) + k - remainder : D{}) - lambda;
+    return lhs <= rhs;
+}
+
+/* Inversion by sequential search for the means below 10 among a chunk's G groups of lanes, the groups'
+ * chains interleaved (one multiply-add chain each, so together they hide each other's latency): u of
+ * 53 bits from both words, as CounterRng::uniform(), and p_k = p_(k-1) (lambda / k) as
+ * CounterRng::poisson(). Lanes of larger means run with mean 0 and give 0. */
+template <int W, int G>
+RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint32_t* words,
+                                           double* chunkCounts)
+{
+    typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::L L;
+    typedef typename DoubleLanes<W>::UL UL;
+    typedef typename DoubleLanes<W>::U32 U32;
+    const int kLanes = DoubleLanes<W>::kCount;
+    D u[G], lambda[G], p[G], cdf[G], k[G];
+    L small[G];
+    for (int g = 0; g < G; ++g) {
+        D m;
+        U32 a, b;
+        std::memcpy(&m, chunkMeans + g * kLanes, sizeof(m));
+        std::memcpy(&a, words + g * kLanes, sizeof(a));
+        std::memcpy(&b, words + 16 + g * kLanes, sizeof(b));
+        small[g] = m < 10.0;
+        lambda[g] = small[g] ? m : D{};
+        // bits = w1 2^21 + (w2 >> 11) < 2^53 as a double, exactly, from two exact conversions.
+        const UL w1 = __builtin_convertvector(a, UL), w2 = __builtin_convertvector(b, UL);
+        const D high = ((D)(w1 | 0x4330000000000000ull) - kTwo52) * 2097152.0;
+        const D bits53 = high + ((D)((w2 >> 11) | 0x4330000000000000ull) - kTwo52);
+        u[g] = (bits53 + 0.5) * (1.0 / 9007199254740992.0);
+        p[g] = expLanesD<W>(-lambda[g]);
+        cdf[g] = p[g];
+        k[g] = D{};
+    }
+    // An active lane has taken every step so far (its cdf grew each time; an inactive one never changes
+    // again), so its count is the step number.
+    for (int step = 1; step <= 200; ++step) {
+        L any = {};
+        const double next = step;
+        for (int g = 0; g < G; ++g) {
+            const L active = u[g] > cdf[g];
+            any |= active;
+            const D pNext = p[g] * (lambda[g] / next);
+            p[g] = active ? pNext : p[g];
+            cdf[g] = active ? cdf[g] + pNext : cdf[g];
+            k[g] = active ? D{} + next : k[g];
+        }
+        if (!maskBits(any))
+            break;
+    }
+    for (int g = 0; g < G; ++g)
+        for (int i = 0; i < kLanes; ++i)
+            if (small[g][i])
+                chunkCounts[g * kLanes + i] = k[g][i];
+}
+
+//! Bit i set where lane i of a mask is.
+template <int W> RAWGMENT_KERNEL int laneBits(typename DoubleLanes<W>::L mask)
+{
+    return maskBits(mask);
+}
+
+//! Appends base + i to list[size..] for every bit i of `bits` (of `lanes`), without branches: each lane is
+//! written, and the size advances past the set ones (list has room for `lanes` more).
+inline void appendBits(int bits, int lanes, int base, int* list, int& size)
+{
+    for (int i = 0; i < lanes; ++i) {
+        list[size] = base + i;
+        size += (bits >> i) & 1;
+    }
+}
+
+template <int W>
+RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const double* means, double* counts,
+                                       int n)
+{
+    typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::L L;
+    typedef typename DoubleLanes<W>::UL UL;
+    typedef typename DoubleLanes<W>::U32 U32;
+    const int kLanes = DoubleLanes<W>::kCount, kChunk = 16; // 16 values per 8 Philox blocks
+    const int kGroups = kChunk / kLanes;
+    alignas(64) uint32_t words[32];
+    alignas(64) double chunkMeans[kChunk], chunkCounts[kChunk];
+    const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
+    // Every value's two words, kept for the full tests; the values whose first try needs the full test,
+    // and those to retry.
+    std::vector<uint32_t> firstWords(static_cast<size_t>(n) + kChunk),
+        secondWords(static_cast<size_t>(n) + kChunk);
+    std::vector<int> fullTest(static_cast<size_t>(n) + kChunk), retry(static_cast<size_t>(n) + kChunk);
+    int fullTests = 0, retries = 0;
+    for (int base = 0; base < n; base += kChunk) {
+        philox8BlocksFor<W>(static_cast<uint32_t>(base / 2), stream, key, words);
+        std::memcpy(firstWords.data() + base, words, sizeof(uint32_t) * kChunk);
+        std::memcpy(secondWords.data() + base, words + kChunk, sizeof(uint32_t) * kChunk);
+        const int count = std::min(kChunk, n - base);
+        for (int i = 0; i < kChunk; ++i) {
+            const double m = i < count ? means[base + i] : 0.0;
+            chunkMeans[i] = m > 0 ? m : 0.0;
+        }
+        int smallBits = 0;
+        for (int g = 0; g < kGroups; ++g) {
+            D lambda;
+            U32 a, b;
+            std::memcpy(&lambda, chunkMeans + g * kLanes, sizeof(lambda));
+            std::memcpy(&a, words + g * kLanes, sizeof(a));
+            std::memcpy(&b, words + kChunk + g * kLanes, sizeof(b));
+            const L small = lambda<10.0, beyond = lambda> kMaxLaneMean;
+            const L ptrs = ~small & ~beyond;
+            smallBits |= laneBits<W>(small) << (g * kLanes);
+            const int live = std::max(0, std::min(kLanes, count - g * kLanes));
+            const int liveBits = (1 << live) - 1;
+            const int base0 = base + g * kLanes;
+            appendBits(laneBits<W>(beyond) & liveBits, kLanes, base0, retry.data(), retries);
+            if (!laneBits<W>(ptrs))
+                continue;
+            const PtrsTryLanes<W> t = ptrsTryLanes<W>(
+                ptrs ? lambda : D{} + 10.0, __builtin_convertvector(a, UL), __builtin_convertvector(b, UL));
+            std::memcpy(chunkCounts + g * kLanes, &t.kd, sizeof(t.kd));
+            appendBits(laneBits<W>(ptrs & ~t.accept & ~t.refuse) & liveBits, kLanes, base0, fullTest.data(),
+                       fullTests);
+            appendBits(laneBits<W>(ptrs & t.refuse) & liveBits, kLanes, base0, retry.data(), retries);
+        }
+        if (smallBits)
+            poissonInversionLanes<W, kChunk / DoubleLanes<W>::kCount>(chunkMeans, words, chunkCounts);
+        std::memcpy(counts + base, chunkCounts, sizeof(double) * static_cast<size_t>(count));
+    }
+    // The full tests of first tries, gathered into whole vectors; the values they reject join the retries.
+    for (int start = 0; start < fullTests; start += kLanes) {
+        const int live = std::min(kLanes, fullTests - start);
+        D lambda = D{} + 10.0;
+        UL w1 = {}, w2 = {};
+        for (int i = 0; i < live; ++i) {
+            const int index = fullTest[static_cast<size_t>(start + i)];
+            lambda[i] = means[index];
+            w1[i] = firstWords[static_cast<size_t>(index)];
+            w2[i] = secondWords[static_cast<size_t>(index)];
+        }
+        const PtrsTryLanes<W> t = ptrsTryLanes<W>(lambda, w1, w2);
+        const int accepted = laneBits<W>(ptrsFullTestLanes<W>(lambda, w1, w2, t.kd));
+        for (int i = 0; i < live; ++i) {
+            const int index = fullTest[static_cast<size_t>(start + i)];
+            if (accepted & (1 << i))
+                counts[index] = t.kd[i];
+            else
+                retry[static_cast<size_t>(retries++)] = index;
+        }
+    }
+    if (retries == 0)
+        return;
+    // A retried value draws from its own CounterRng (poissonRetryKey(seed, stream), index): two more tries
+    // on its first four words, in lanes, then the scalar sampler on the rest. A mean beyond the lanes'
+    // range goes straight to the scalar sampler.
+    const uint64_t retryKey = poissonRetryKey(seed, stream);
+    std::vector<CounterRng> rngs(static_cast<size_t>(retries));
+    std::vector<int> open;
+    for (int r = 0; r < retries; ++r) {
+        const int index = retry[static_cast<size_t>(r)];
+        rngs[static_cast<size_t>(r)] = CounterRng(retryKey, static_cast<uint64_t>(index));
+        if (means[index] > kMaxLaneMean)
+            counts[index] = static_cast<double>(rngs[static_cast<size_t>(r)].poisson(means[index]));
+        else
+            open.push_back(r);
+    }
+    for (int attempt = 0; attempt < 2 && !open.empty(); ++attempt) {
+        std::vector<int> still;
+        for (size_t start = 0; start < open.size(); start += kLanes) {
+            const int live = static_cast<int>(std::min<size_t>(kLanes, open.size() - start));
+            D lambda = D{} + 10.0;
+            UL w1 = {}, w2 = {};
+            for (int i = 0; i < live; ++i) {
+                const size_t r = static_cast<size_t>(open[start + static_cast<size_t>(i)]);
+                lambda[i] = means[retry[r]];
+                w1[i] = rngs[r].nextU32();
+                w2[i] = rngs[r].nextU32();
+            }
+            const PtrsTryLanes<W> t = ptrsTryLanes<W>(lambda, w1, w2);
+            L accept = t.accept;
+            if (laneBits<W>(~t.accept & ~t.refuse))
+                accept |= ~t.refuse & ptrsFullTestLanes<W>(lambda, w1, w2, t.kd);
+            for (int i = 0; i < live; ++i) {
+                const int r = open[start + static_cast<size_t>(i)];
+                if (accept[i])
+                    counts[retry[static_cast<size_t>(r)]] = t.kd[i];
+                else
+                    still.push_back(r);
+            }
+        }
+        open.swap(still);
+    }
+    for (int r : open) {
+        const int index = retry[static_cast<size_t>(r)];
+        counts[index] = static_cast<double>(rngs[static_cast<size_t>(r)].poisson(means[index]));
+    }
+}
+
 } // namespace
 
 RAWGMENT_DISPATCHED_BY_WIDTH(void, fillGaussian, (uint64_t seed, uint64_t stream, float* out, int n),
@@ -260,6 +634,9 @@ RAWGMENT_DISPATCHED_BY_WIDTH(void, fillTukeyUnit,
                              (uint64_t seed, uint64_t stream, float lambda0, float invSd0, float lambda1,
                               float invSd1, float* out, int n),
                              (seed, stream, lambda0, invSd0, lambda1, invSd1, out, n))
+RAWGMENT_DISPATCHED_BY_WIDTH(void, fillPoisson,
+                             (uint64_t seed, uint64_t stream, const double* means, double* counts, int n),
+                             (seed, stream, means, counts, n))
 
 } // namespace detail
 } // namespace rawgment

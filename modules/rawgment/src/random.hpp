@@ -225,7 +225,9 @@ RAWGMENT_KERNEL void philox8BlocksFor(uint32_t firstBlock, uint64_t stream,
  * numbers gets an entry here, never a literal id or an ad-hoc constant at the call site.
  *
  * - augmentation steps (RandomStream below): key stepKey(user seed, family); stream: the row (jitter),
- *   planeRowStream(site, plane row) (blur, scale), 0 (policy draw).
+ *   planeRowStream(site, plane row) (blur, scale), 0 (policy draw). A Poisson draw that fillPoisson()
+ *   retries: key poissonRetryKey(family key, row stream) = stepKey(family key, row stream); stream: the
+ *   value's index in its row.
  * - simulator captures: key the capture's seed; stream captureStream(frame, row).
  * - simulator fixed pattern (PRNU, DSNU, defects): key SensorParams::fixedPatternSeed; stream
  *   fixedPatternStream(row).
@@ -317,6 +319,8 @@ constexpr double kMaxPoissonMean = 4503599627370496.0;
 class CounterRng
 {
 public:
+    //! The stream (0, 0), to be assigned a real one before use.
+    CounterRng() : CounterRng(0, 0) {}
     CounterRng(uint64_t seed, uint64_t stream)
         : key_{static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)},
           counter_{0u, 0u, static_cast<uint32_t>(stream), static_cast<uint32_t>(stream >> 32)}
@@ -360,7 +364,7 @@ public:
      * approximation, which matters at the few-electron counts of dark pixels. lambda must not exceed
      * kMaxPoissonMean (callers check before their loops: above it, a count no longer fits the integers
      * that a double holds exactly, and a Gaussian is exact to double precision anyway). */
-    int64_t poisson(double lambda);
+    CV_RAWGMENT_EXPORTS int64_t poisson(double lambda);
 
 private:
     std::array<uint32_t, 2> key_;
@@ -395,6 +399,33 @@ void fillGaussian(uint64_t seed, uint64_t stream, float* out, int n);
  * the uniforms reach 2^-57, so the tails are drawn as far as a double uniform's would be. */
 CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, float lambda0, float invSd0,
                                        float lambda1, float invSd1, float* out, int n);
+
+/** Fills counts[0..n) with exact Poisson variates of means[0..n) from the stream (seed, stream), the
+ * vector version of CounterRng::poisson() that ShotNoiseSampling::POISSON draws with. Every mean must lie
+ * in [0, kMaxPoissonMean] (0 gives 0).
+ *
+ * Value i uses words i and 16 + i of its chunk (16 values per 8 Philox blocks) and depends only on
+ * (seed, stream, i, means[i]), on every path, whatever its neighbours' means. Below a mean of 10, inversion
+ * by sequential search with u of 53 bits from both words, as CounterRng::poisson(); from 10 up, one try of
+ * Hormann's PTRS with u and v of 32 bits each, all in vector lanes: the fast test for every value, then the
+ * full test for the values it left undecided (20-65% of them), gathered into whole vectors. A value whose
+ * try is rejected (a share 1 - alpha, PTRS's acceptance constant: 25% at a mean of 10, 12% at 1000) tries
+ * again in lanes with the first four words of its own CounterRng (poissonRetryKey(seed, stream), i),
+ * twice, then calls CounterRng::poisson() on the rest of that stream; a mean beyond 2^40 calls it at once.
+ * Retrying with fresh numbers
+ * is what a rejection sampler does anyway, so the draw stays exact. The logarithms and the exponential are
+ * double polynomials (no library calls), so every path gives the same bits
+ * (Simulate.fillPoissonIsExactAndTheSameOnEveryPath). Exactness: up to double rounding, and the 32-bit u and
+ * v of the PTRS try: each count's probability is exact to about 2^-31 absolute. counts must not overlap
+ * means. */
+CV_RAWGMENT_EXPORTS void fillPoisson(uint64_t seed, uint64_t stream, const double* means, double* counts,
+                                     int n);
+
+//! The key of fillPoisson()'s retries for the stream (seed, stream); a retried value i draws from (key, i).
+inline uint64_t poissonRetryKey(uint64_t seed, uint64_t stream)
+{
+    return stepKey(seed, stream);
+}
 
 } // namespace detail
 } // namespace rawgment

@@ -199,15 +199,28 @@ template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int
 // read noise (t: the row's unit-variance draws, the read part's shape), with the dark terms' `extra`.
 void finishResampledRowScalar(float* mean, const float* shotSum, const float* readFactor, const float* z,
                               const float* t, const float* extra, const ResampleConstants& k, float black,
-                              detail::CounterRng& rng, int n)
+                              uint64_t stream, int n)
 {
     const bool poisson = k.sampling == ShotNoiseSampling::POISSON;
+    std::vector<AddedVariance> vars(static_cast<size_t>(n));
+    std::vector<double> means(poisson ? n : 0), counts(poisson ? n : 0);
+    for (int j = 0; j < n; ++j)
+        vars[static_cast<size_t>(j)] = k.alignment == NoiseAlignment::ACCOUNT_PRIOR
+                                           ? AddedVariance{k.shot * shotSum[j], readFactor[j] * k.floorVar}
+                                           : AddedVariance{k.shot * std::max(mean[j], 0.0f), k.floorVar};
+    if (poisson) {
+        // The means first, then the whole row's counts in vector lanes (detail::fillPoisson()).
+        for (int j = 0; j < n; ++j)
+            means[static_cast<size_t>(j)] =
+                t ? detail::poissonMeanWithTails(vars[static_cast<size_t>(j)], k.shot)
+                  : detail::poissonMean(vars[static_cast<size_t>(j)], k.shot);
+        detail::fillPoisson(k.poissonKey, stream, means.data(), counts.data(), n);
+    }
     for (int j = 0; j < n; ++j) {
-        const AddedVariance v = k.alignment == NoiseAlignment::ACCOUNT_PRIOR
-                                    ? AddedVariance{k.shot * shotSum[j], readFactor[j] * k.floorVar}
-                                    : AddedVariance{k.shot * std::max(mean[j], 0.0f), k.floorVar};
-        const float noise = t ? detail::sampledNoiseWithTails(v, k.shot, poisson, z[j], t[j], rng)
-                              : sampledNoise(v, k.shot, z[j], rng);
+        const AddedVariance v = vars[static_cast<size_t>(j)];
+        const double count = poisson ? counts[static_cast<size_t>(j)] : 0.0;
+        const float noise = t ? detail::sampledNoiseWithTails(v, k.shot, poisson, z[j], t[j], count)
+                              : sampledNoise(v, k.shot, z[j], count);
         float out = mean[j] + noise;
         if (extra)
             out += extra[j];
@@ -268,9 +281,8 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
     }
     const float* extraRow = extra.empty() ? nullptr : extra.data();
     if (noise && (k.sampling == ShotNoiseSampling::POISSON || k.dark.tails)) {
-        detail::CounterRng rng(k.poissonKey, stream);
         finishResampledRowScalar(mean.data(), shotSum, readFactor, z.data(), t.empty() ? nullptr : t.data(),
-                                 extraRow, k, k.black[site], rng, n);
+                                 extraRow, k, k.black[site], stream, n);
     } else {
         finishResampledRow(mean.data(), shotSum, readFactor, z.data(), extraRow, k, k.black[site], n);
     }

@@ -7,6 +7,7 @@
 #include <opencv2/rawgment/simulate.hpp>
 
 #include <cstring>
+#include <map>
 #include <set>
 
 namespace cv {
@@ -370,6 +371,173 @@ TEST(Simulate, derivedSeedsAreStableAndDistinctPerPurposeAndIndex)
                 seen.insert(deriveSeed(seed, static_cast<SeedPurpose>(p), index));
     EXPECT_EQ(seen.size(), 3u * 9u * 1000u);
     EXPECT_CV_ERROR_CONTAINS(deriveSeed(1, static_cast<SeedPurpose>(3), 0), "unknown purpose 3");
+}
+
+//! The words of fillPoisson()'s value i in the stream (seed, stream): words i % 16 and 16 + i % 16 of its
+//! chunk of 8 Philox blocks (word j of block b at 8 j + b % 8), as random.hpp documents.
+std::pair<uint32_t, uint32_t> poissonWords(uint64_t seed, uint64_t stream, int i)
+{
+    const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
+    auto word = [&](int chunk, int w) {
+        const std::array<uint32_t, 4> counter = {static_cast<uint32_t>(8 * chunk + w % 8), 0,
+                                                 static_cast<uint32_t>(stream),
+                                                 static_cast<uint32_t>(stream >> 32)};
+        return detail::philox4x32(counter, key)[static_cast<size_t>(w / 8)];
+    };
+    return {word(i / 16, i % 16), word(i / 16, 16 + i % 16)};
+}
+
+//! One PTRS try (Hormann 1993) at mean lambda >= 10 from 32-bit words for u and v, with the C library's
+//! log and lgamma; false when the try is rejected.
+bool ptrsTry(double lambda, uint32_t wu, uint32_t wv, double& k)
+{
+    const double b = 0.931 + 2.53 * std::sqrt(lambda), a = -0.059 + 0.02483 * b;
+    const double invAlpha = 1.1239 + 1.1328 / (b - 3.4), vr = 0.9277 - 3.6224 / (b - 2);
+    const double u = (wu + 0.5) / 4294967296.0 - 0.5, v = (wv + 0.5) / 4294967296.0;
+    const double us = 0.5 - std::abs(u), x = (2 * a / us + b) * u + lambda + 0.43;
+    k = std::floor(x);
+    if (x < 0)
+        return false;
+    if (us >= 0.07 && v <= vr)
+        return true;
+    return !(us < 0.013 && v > us) && std::log(v * invAlpha / (a / (us * us) + b)) <=
+                                          -lambda + k * std::log(lambda) - std::lgamma(k + 1);
+}
+
+/* fillPoisson()'s value i written out with the C library's exp and log: inversion from the 53-bit u of
+ * both words below a mean of 10; else a PTRS try on the two words, two more on the first four words of
+ * the value's retry stream, and the scalar sampler on the rest of that stream (on all of it beyond 2^40).
+ * `tries` counts the tries beyond the first (3 for the scalar sampler). */
+double referencePoisson(uint64_t seed, uint64_t stream, int i, double lambda, int* tries = nullptr)
+{
+    if (!(lambda > 0))
+        return 0;
+    const std::pair<uint32_t, uint32_t> w = poissonWords(seed, stream, i);
+    if (lambda < 10) {
+        const uint64_t bits = (static_cast<uint64_t>(w.first) << 21) ^ (w.second >> 11);
+        const double u = (static_cast<double>(bits) + 0.5) / 9007199254740992.0;
+        double p = std::exp(-lambda), cdf = p;
+        int k = 0;
+        while (u > cdf && k < 200) {
+            ++k;
+            p *= lambda / k;
+            cdf += p;
+        }
+        return k;
+    }
+    double k = 0;
+    detail::CounterRng retry(detail::poissonRetryKey(seed, stream), static_cast<uint64_t>(i));
+    if (lambda > 1099511627776.0) { // beyond 2^40: the scalar sampler alone
+        if (tries)
+            *tries = 3;
+        return static_cast<double>(retry.poisson(lambda));
+    }
+    if (ptrsTry(lambda, w.first, w.second, k))
+        return k;
+    for (int attempt = 1; attempt <= 2; ++attempt) {
+        const uint32_t wu = retry.nextU32(), wv = retry.nextU32();
+        if (tries)
+            *tries = attempt;
+        if (ptrsTry(lambda, wu, wv, k))
+            return k;
+    }
+    if (tries)
+        *tries = 3;
+    return static_cast<double>(retry.poisson(lambda));
+}
+
+TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
+{
+    const uint64_t seed = 0x1234abcd5678ef01ull, stream = 7;
+    // Means on both sides of the switch at 10 and around it, the retry beyond 2^40, and 0.
+    const std::vector<double> lambdas = {0.05, 0.7, 3.0, 9.99, 10.0, 37.5, 1000.0, 2e6, 0.0, 3e12};
+    const int perMean = 40000;
+    const int n = static_cast<int>(lambdas.size()) * perMean + 5; // a partial last chunk too
+    std::vector<double> means(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i)
+        means[static_cast<size_t>(i)] = lambdas[static_cast<size_t>(i) % lambdas.size()];
+    std::vector<double> first;
+    for (CpuPath path : availableCpuPaths()) {
+        setCpuPath(path);
+        std::vector<double> counts(static_cast<size_t>(n));
+        detail::fillPoisson(seed, stream, means.data(), counts.data(), n);
+        if (first.empty())
+            first = counts;
+        else
+            ASSERT_EQ(0, std::memcmp(first.data(), counts.data(), sizeof(double) * first.size()))
+                << cpuPathName(path);
+    }
+    setCpuPath(CpuPath::AUTO);
+    // Value by value against the reference: the polynomial exp and log differ from the C library's by an
+    // ulp or two, which moves a count only when a uniform falls within about 1e-15 of a boundary of the
+    // CDF or of the acceptance test (chance about 1e-14 per value): none of these 400,005 may differ.
+    std::map<double, std::array<int, 4>> tries;
+    for (int i = 0; i < n; ++i) {
+        const double lambda = means[static_cast<size_t>(i)];
+        int extra = 0;
+        ASSERT_EQ(first[static_cast<size_t>(i)], referencePoisson(seed, stream, i, lambda, &extra))
+            << "value " << i << ", mean " << lambda;
+        ++tries[lambda][static_cast<size_t>(extra)];
+    }
+    // A PTRS try is accepted with probability at most alpha = 1 / (1.1239 + 1.1328 / (b - 3.4)), the area
+    // under its hat (the (u, v) square maps onto the hat with Jacobian a / us^2 + b), less only the far
+    // tails it cuts (below 1e-3 here): 1 - alpha of first tries are retried. 5 binomial standard errors.
+    // A share far from that would mean the vector try drops or keeps lanes it should not.
+    for (double lambda : {10.0, 37.5, 1000.0, 2e6}) {
+        const std::array<int, 4>& t = tries[lambda];
+        const double b = 0.931 + 2.53 * std::sqrt(lambda), alpha = 1 / (1.1239 + 1.1328 / (b - 3.4));
+        const double share = (perMean - t[0]) / static_cast<double>(perMean);
+        std::cout << "fillPoisson at mean " << lambda << ": retried " << share << " (1 - alpha " << 1 - alpha
+                  << "), after a third try " << t[3] / static_cast<double>(perMean) << "\n";
+        EXPECT_NEAR(share, 1 - alpha, 5 * std::sqrt(alpha * (1 - alpha) / perMean)) << lambda;
+    }
+    EXPECT_EQ(tries[3e12][3], perMean); // beyond 2^40: always the scalar sampler
+    // A value depends on its own mean only: the same means in another order give each value its count.
+    std::vector<double> reversed(means.rbegin(), means.rend()), again(static_cast<size_t>(n));
+    detail::fillPoisson(seed, stream, reversed.data(), again.data(), n);
+    for (int i = 0; i < n; i += 997)
+        ASSERT_EQ(again[static_cast<size_t>(i)],
+                  referencePoisson(seed, stream, i, reversed[static_cast<size_t>(i)]))
+            << "value " << i;
+    // The distribution against the Poisson probabilities, at every mean that is not too large to bin:
+    // cells grown from the left until their expected count reaches 20, as poissonHistogramPassesChiSquare.
+    for (size_t m = 0; m < lambdas.size(); ++m) {
+        const double lambda = lambdas[m];
+        double sum = 0, sum2 = 0;
+        std::map<int64_t, int> hist;
+        for (size_t i = m; i < static_cast<size_t>(perMean) * lambdas.size(); i += lambdas.size()) {
+            const double k = first[i];
+            ASSERT_EQ(k, std::floor(k));
+            sum += k;
+            sum2 += k * k;
+            if (lambda <= 1e4)
+                ++hist[static_cast<int64_t>(k)];
+        }
+        const double mean = sum / perMean, var = sum2 / perMean - mean * mean;
+        if (lambda == 0) {
+            EXPECT_EQ(sum, 0);
+            continue;
+        }
+        // Mean and variance are lambda; their standard errors sqrt(lambda / N) and
+        // sqrt((2 lambda^2 + lambda) / N): 5 of them.
+        EXPECT_NEAR(mean, lambda, 5 * std::sqrt(lambda / perMean)) << lambda;
+        EXPECT_NEAR(var, lambda, 5 * std::sqrt((2 * lambda * lambda + lambda) / perMean)) << lambda;
+        if (lambda > 1e4)
+            continue;
+        double chi2 = 0, cellP = 0, cellObs = 0;
+        int dof = -1;
+        for (int k = 0; k < 2 * lambda + 60; ++k) {
+            cellP += std::exp(-lambda + k * std::log(lambda) - std::lgamma(k + 1.0));
+            cellObs += hist[k];
+            if (cellP * perMean >= 20) {
+                chi2 += (cellObs - cellP * perMean) * (cellObs - cellP * perMean) / (cellP * perMean);
+                ++dof;
+                cellP = cellObs = 0;
+            }
+        }
+        // chi^2 with dof degrees of freedom: mean dof, sd sqrt(2 dof); 6 sd, as the simulator's test.
+        EXPECT_LT(chi2, dof + 6 * std::sqrt(2.0 * dof)) << "lambda " << lambda << " dof " << dof;
+    }
 }
 
 TEST(Simulate, fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath)
