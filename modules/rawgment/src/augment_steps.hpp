@@ -46,59 +46,54 @@ template <typename V> struct AddedVarianceOf
 //! One pixel's; the vector kernels use AddedVarianceOf their lanes.
 typedef AddedVarianceOf<float> AddedVariance;
 
-/* Gaussian noise of variance `rest` plus the shot part as an electron count: q (K - m) with
- * K ~ Poisson(m), m = shot / q^2 (ShotNoiseSampling::POISSON). A negative total (brightening) adds
- * nothing; a negative rest (the gain grew) is taken from the Poisson part, so the variance added is
- * always max(shot + rest, 0), the same as the Gaussian path.
- * A row draws in two passes: poissonMean() of every pixel, one fillPoisson() of the row (vector lanes),
- * then sampledNoise() with each pixel's count. */
-inline double poissonMean(AddedVariance v, float q)
+/* How a pixel's added variance is drawn: a Poisson count of mean `mean` electrons
+ * (ShotNoiseSampling::POISSON), Gaussian noise of variance zVar from the step's normals, and, with
+ * heavy-tailed read noise (NoiseModel::tukeyRead), variance tVar from its unit-variance Tukey-lambda draws.
+ * The noise is then q (K - mean) + sqrt(zVar) z + sqrt(tVar) t, K ~ Poisson(mean), q the DN per electron
+ * (poissonNoise()). The variance added is always max(shot + rest, 0), as on the Gaussian path:
+ * - a negative total (brightening) adds nothing;
+ * - with POISSON the shot part is the count: mean = shot / q^2; a negative rest (the gain grew) is taken
+ *   from it;
+ * - with tails the read part (the rest, never more than the total) takes t, the shot part z or the count;
+ * - a mean beyond kMaxPoissonMean electrons (a tiny q) is Gaussian to double precision: z takes it all.
+ * A row is drawn in passes: the split of every pixel, one fillPoisson() of the row's means (vector lanes),
+ * then the noise of every pixel. Plain float arithmetic without branches, so each pass is a simple loop. */
+struct NoiseSplit
 {
-    const float total = std::max(v.shot + v.rest, 0.0f);
-    const float shot = q > 0 ? std::min(std::max(v.shot, 0.0f), total) : 0.0f;
-    const double m = shot > 0 ? static_cast<double>(shot) / (static_cast<double>(q) * q) : 0.0;
-    // Beyond kMaxPoissonMean electrons the count is Gaussian to double precision: sampledNoise() draws the
-    // whole variance as one Gaussian then (with a tiny q, m can be any size), and no count is needed.
-    return m <= detail::kMaxPoissonMean ? m : 0.0;
-}
+    double mean;
+    float zVar, tVar;
+};
 
-//! The noise of one pixel from its Gaussian z and its count K ~ Poisson(poissonMean(v, q)).
-inline float sampledNoise(AddedVariance v, float q, float z, double count)
+//! A row's constants for splitNoise(): q, 1 / q^2 in double, and the largest shot variance drawn as a
+//! count (kMaxPoissonMean electrons; 0 when q is not positive, so that nothing is).
+struct PoissonScale
 {
-    const float total = std::max(v.shot + v.rest, 0.0f);
-    const float shot = q > 0 ? std::min(std::max(v.shot, 0.0f), total) : 0.0f;
-    const double m = static_cast<double>(shot) / (static_cast<double>(q) * q);
-    if (!(m <= detail::kMaxPoissonMean))
-        return std::sqrt(total) * z;
-    const float centred = shot > 0 ? static_cast<float>(count - m) : 0.0f;
-    return q * centred + std::sqrt(total - shot) * z;
-}
-
-/* sampledNoise() with the read part from the unit-variance heavy-tailed draw t (NoiseModel::tukeyRead)
- * and the shot part from z, or as an electron count when `poisson` (the mean of that count:
- * poissonMeanWithTails()). The variance added is max(shot + rest, 0) as on every path; the read part is
- * the rest, never more than that total. */
-inline double poissonMeanWithTails(AddedVariance v, float q)
-{
-    const float total = std::max(v.shot + v.rest, 0.0f);
-    const float read = std::min(std::max(v.rest, 0.0f), total), shot = total - read;
-    if (!(q > 0 && shot > 0))
-        return 0.0;
-    const double m = static_cast<double>(shot) / (static_cast<double>(q) * q);
-    return m <= detail::kMaxPoissonMean ? m : 0.0;
-}
-
-inline float sampledNoiseWithTails(AddedVariance v, float q, bool poisson, float z, float t, double count)
-{
-    const float total = std::max(v.shot + v.rest, 0.0f);
-    const float read = std::min(std::max(v.rest, 0.0f), total), shot = total - read;
-    float shotNoise = std::sqrt(shot) * z;
-    if (poisson && q > 0 && shot > 0) {
-        const double m = static_cast<double>(shot) / (static_cast<double>(q) * q);
-        if (m <= detail::kMaxPoissonMean)
-            shotNoise = q * static_cast<float>(count - m);
+    float q = 0, maxShot = 0;
+    double invQ2 = 0;
+    explicit PoissonScale(float dnPerElectron)
+        : q(dnPerElectron), maxShot(dnPerElectron > 0 ? static_cast<float>(kMaxPoissonMean * dnPerElectron *
+                                                                           static_cast<double>(dnPerElectron))
+                                                      : 0.0f),
+          invQ2(dnPerElectron > 0 ? 1.0 / (static_cast<double>(dnPerElectron) * dnPerElectron) : 0.0)
+    {
     }
-    return shotNoise + std::sqrt(read) * t;
+};
+
+// The vector kernels (color_jitter.cpp) do the same operations in the same order, lane by lane.
+inline NoiseSplit splitNoise(AddedVariance v, const PoissonScale& scale, bool poisson, bool tails)
+{
+    const float total = std::max(v.shot + v.rest, 0.0f);
+    const float read = tails ? std::min(std::max(v.rest, 0.0f), total) : 0.0f;
+    const float shot = tails ? total - read : (scale.q > 0 ? std::min(std::max(v.shot, 0.0f), total) : 0.0f);
+    const bool drawn = poisson && shot > 0 && shot <= scale.maxShot;
+    const float shotDrawn = drawn ? shot : 0.0f;
+    return {static_cast<double>(shotDrawn) * scale.invQ2, (total - read) - shotDrawn, read};
+}
+
+//! The noise of a split pixel from its normal z, its Tukey-lambda draw t and its count K ~ Poisson(mean).
+inline float poissonNoise(const NoiseSplit& s, float q, double count, float z, float t)
+{
+    return q * static_cast<float>(count - s.mean) + std::sqrt(s.zVar) * z + std::sqrt(s.tVar) * t;
 }
 
 /** The dark-frame components a noise step adds (NoiseModel's row noise, dark shading and Tukey read),

@@ -15,7 +15,6 @@ namespace rawgment {
 namespace {
 
 using detail::AddedVariance;
-using detail::sampledNoise;
 using detail::storeValue;
 
 struct JitterConstants
@@ -116,7 +115,7 @@ template <int W> struct PixelLanes<W, float>
 
 // t: the row's unit-variance heavy-tailed draws (NoiseModel::tukeyRead), or null. With them the read
 // part of the variance (the rest, never more than the total) takes t and the shot part z, as
-// sampledNoiseWithTails() does; kLineBySite is never set then, since it does not split the two.
+// detail::splitNoise() does; kLineBySite is never set then, since it does not split the two.
 template <int W, typename T, NoiseAlignment A, bool kLocalMean, bool kLineBySite>
 RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* t, const float* prior,
                                  const float* extra, const JitterColumns& col, int c,
@@ -256,55 +255,249 @@ RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
                               int cols),
                              (s, d, z, t, prior, extra, col, k, cols))
 
-// The rows of ShotNoiseSampling::POISSON, with Tukey-lambda read noise (NoiseModel::tukeyRead: t holds
-// the row's unit-variance heavy-tailed draws) or without, and the dark terms' `extra` when present: the
-// variance and the count's mean of every pixel, the row's counts in vector lanes (detail::fillPoisson()),
-// then each pixel. The same code on every CpuPath. `vars` and `counts` are the caller's, reused row after
-// row.
-template <typename T, NoiseAlignment A>
-int jitterRowPoissonBody(const T* s, T* d, const float* z, const float* t, const float* prior,
-                         const float* extra, const float* pc, const float* black, const JitterConstants& k,
-                         uint64_t key, uint64_t stream, std::vector<AddedVariance>& vars,
-                         std::vector<double>& means, std::vector<double>& counts, int cols)
+/* The rows of ShotNoiseSampling::POISSON, with Tukey-lambda read noise (NoiseModel::tukeyRead: t holds
+ * the row's unit-variance heavy-tailed draws) or without, and the dark terms' `extra` when present, in
+ * three passes: every pixel's split (detail::splitNoise(), here in vector lanes: the same operations),
+ * the row's counts (detail::fillPoisson()), every pixel's noise and output. Like jitterRowBody(), the
+ * last partial block runs through the vector code on padded copies. */
+template <int W> struct PoissonLanes
 {
-    const float q = k.pg * k.in.shot; // DN per electron at the output gain: g alpha p_g
-    vars.resize(static_cast<size_t>(cols));
-    means.resize(static_cast<size_t>(cols));
-    counts.resize(static_cast<size_t>(cols));
-    int bright = 0;
-    for (int c = 0; c < cols; ++c) {
-        const float x = static_cast<float>(s[c]) - black[c];
-        const AddedVariance v = jitterVariance<A>(prior ? prior[c] : x, pc[c], k);
-        bright += v.shot + v.rest < 0 ? 1 : 0;
-        vars[static_cast<size_t>(c)] = v;
-        means[static_cast<size_t>(c)] = t ? detail::poissonMeanWithTails(v, q) : detail::poissonMean(v, q);
-    }
-    detail::fillPoisson(key, stream, means.data(), counts.data(), cols);
-    for (int c = 0; c < cols; ++c) {
-        const AddedVariance v = vars[static_cast<size_t>(c)];
-        const double count = counts[static_cast<size_t>(c)];
-        const float noise = t ? detail::sampledNoiseWithTails(v, q, true, z[c], t[c], count)
-                              : sampledNoise(v, q, z[c], count);
-        const float x = static_cast<float>(s[c]) - black[c];
-        float out = pc[c] * x + k.pb + noise;
-        if (extra)
-            out += extra[c];
-        d[c] = storeValue<T>(out + black[c], k.white);
-    }
-    return bright;
+    typedef typename detail::Lanes<W>::F F;
+    typedef double D __attribute__((vector_size(8 * W))); // one double per float lane (arithmetic only)
+};
+
+template <int W, typename T, NoiseAlignment A, bool kLocalMean>
+RAWGMENT_KERNEL void poissonSplitBlock(const T* s, const float* prior, const JitterColumns& col, int c,
+                                       const JitterConstants& k, const detail::PoissonScale& scale,
+                                       bool tails, double* means, float* zVar, float* tVar,
+                                       typename detail::Lanes<W>::I& bright)
+{
+    typedef typename detail::Lanes<W>::F F;
+    typedef typename detail::Lanes<W>::I I;
+    typedef typename PoissonLanes<W>::D D;
+    typedef PixelLanes<W, T> P;
+    F pcv, blackv;
+    std::memcpy(&pcv, col.pc + c, sizeof(pcv));
+    std::memcpy(&blackv, col.black + c, sizeof(blackv));
+    const F x = P::load(s + c) - blackv;
+    F xm = x;
+    if (kLocalMean)
+        std::memcpy(&xm, prior + c, sizeof(xm));
+    const detail::AddedVarianceOf<F> v = jitterVariance<A>(xm, pcv, k);
+    const F sum = v.shot + v.rest;
+    bright -= sum < 0;
+    const F zero = F{}, total = detail::maxLanes(sum, zero);
+    const F read = tails ? detail::minLanes(detail::maxLanes(v.rest, zero), total) : zero;
+    const F shot =
+        tails ? total - read : (scale.q > 0 ? detail::minLanes(detail::maxLanes(v.shot, zero), total) : zero);
+    const I drawn = (shot > 0.0f) & (shot <= scale.maxShot);
+    const F shotDrawn = drawn ? shot : zero;
+    const F z = (total - read) - shotDrawn;
+    const D mean = __builtin_convertvector(shotDrawn, D) * scale.invQ2;
+    std::memcpy(means + c, &mean, sizeof(mean));
+    std::memcpy(zVar + c, &z, sizeof(z));
+    std::memcpy(tVar + c, &read, sizeof(read));
 }
+
+template <int W, typename T>
+RAWGMENT_KERNEL void poissonNoiseBlock(const T* s, T* d, const float* z, const float* t, const float* extra,
+                                       const JitterColumns& col, int c, const JitterConstants& k, float q,
+                                       const double* means, const double* counts, const float* zVar,
+                                       const float* tVar)
+{
+    typedef typename detail::Lanes<W>::F F;
+    typedef typename PoissonLanes<W>::D D;
+    typedef PixelLanes<W, T> P;
+    F pcv, blackv, zv, tv = {}, zVarv, tVarv;
+    D mean, count;
+    std::memcpy(&pcv, col.pc + c, sizeof(pcv));
+    std::memcpy(&blackv, col.black + c, sizeof(blackv));
+    std::memcpy(&zv, z + c, sizeof(zv));
+    if (t)
+        std::memcpy(&tv, t + c, sizeof(tv));
+    std::memcpy(&zVarv, zVar + c, sizeof(zVarv));
+    std::memcpy(&tVarv, tVar + c, sizeof(tVarv));
+    std::memcpy(&mean, means + c, sizeof(mean));
+    std::memcpy(&count, counts + c, sizeof(count));
+    const F noise = q * __builtin_convertvector(count - mean, F) + detail::sqrtLanes(zVarv) * zv +
+                    detail::sqrtLanes(tVarv) * tv;
+    const F x = P::load(s + c) - blackv;
+    F out = pcv * x + k.pb + noise;
+    if (extra) {
+        F e;
+        std::memcpy(&e, extra + c, sizeof(e));
+        out += e;
+    }
+    P::store(d + c, out + blackv, F{} + k.white);
+}
+
+template <int W, typename T, NoiseAlignment A, bool kLocalMean>
+RAWGMENT_KERNEL int poissonSplitRowBody(const T* s, const float* prior, const JitterColumns& col,
+                                        const JitterConstants& k, const detail::PoissonScale& scale,
+                                        bool tails, double* means, float* zVar, float* tVar, int cols)
+{
+    typename detail::Lanes<W>::I bright = {};
+    int c = 0;
+    for (; c + W <= cols; c += W)
+        poissonSplitBlock<W, T, A, kLocalMean>(s, prior, col, c, k, scale, tails, means, zVar, tVar, bright);
+    int total = 0;
+    for (int i = 0; i < W; ++i)
+        total += bright[i];
+    const int rest = cols - c;
+    if (rest > 0) {
+        // Padded copies: the extra lanes compute on zeros and are neither kept nor counted.
+        T sPad[W] = {};
+        float priorPad[W] = {}, pcPad[W] = {}, blackPad[W] = {}, zPad[W], tPad[W];
+        double meanPad[W];
+        for (int i = 0; i < rest; ++i) {
+            sPad[i] = s[c + i];
+            priorPad[i] = kLocalMean ? prior[c + i] : 0.0f;
+            pcPad[i] = col.pc[c + i];
+            blackPad[i] = col.black[c + i];
+        }
+        const JitterColumns padded = {pcPad, blackPad, nullptr, nullptr};
+        typename detail::Lanes<W>::I tail = {};
+        poissonSplitBlock<W, T, A, kLocalMean>(sPad, priorPad, padded, 0, k, scale, tails, meanPad, zPad,
+                                               tPad, tail);
+        for (int i = 0; i < rest; ++i) {
+            means[c + i] = meanPad[i];
+            zVar[c + i] = zPad[i];
+            tVar[c + i] = tPad[i];
+            total += tail[i];
+        }
+    }
+    return total;
+}
+
+template <int W, typename T>
+RAWGMENT_KERNEL int poissonSplitRowAny(const T* s, const float* prior, const JitterColumns& col,
+                                       const JitterConstants& k, const detail::PoissonScale& scale,
+                                       bool tails, double* means, float* zVar, float* tVar, int cols)
+{
+    if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR)
+        return prior ? poissonSplitRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, true>(
+                           s, prior, col, k, scale, tails, means, zVar, tVar, cols)
+                     : poissonSplitRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, false>(
+                           s, prior, col, k, scale, tails, means, zVar, tVar, cols);
+    return prior ? poissonSplitRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, true>(
+                       s, prior, col, k, scale, tails, means, zVar, tVar, cols)
+                 : poissonSplitRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, false>(
+                       s, prior, col, k, scale, tails, means, zVar, tVar, cols);
+}
+
+template <int W, typename T>
+RAWGMENT_KERNEL void poissonNoiseRowAny(const T* s, T* d, const float* z, const float* t, const float* extra,
+                                        const JitterColumns& col, const JitterConstants& k, float q,
+                                        const double* means, const double* counts, const float* zVar,
+                                        const float* tVar, int cols)
+{
+    int c = 0;
+    for (; c + W <= cols; c += W)
+        poissonNoiseBlock<W, T>(s, d, z, t, extra, col, c, k, q, means, counts, zVar, tVar);
+    const int rest = cols - c;
+    if (rest <= 0)
+        return;
+    T sPad[W] = {}, dPad[W];
+    float zPad[W] = {}, tPad[W] = {}, extraPad[W] = {}, pcPad[W] = {}, blackPad[W] = {}, zVarPad[W] = {},
+          tVarPad[W] = {};
+    double meanPad[W] = {}, countPad[W] = {};
+    for (int i = 0; i < rest; ++i) {
+        sPad[i] = s[c + i];
+        zPad[i] = z[c + i];
+        tPad[i] = t ? t[c + i] : 0.0f;
+        extraPad[i] = extra ? extra[c + i] : 0.0f;
+        pcPad[i] = col.pc[c + i];
+        blackPad[i] = col.black[c + i];
+        zVarPad[i] = zVar[c + i];
+        tVarPad[i] = tVar[c + i];
+        meanPad[i] = means[c + i];
+        countPad[i] = counts[c + i];
+    }
+    const JitterColumns padded = {pcPad, blackPad, nullptr, nullptr};
+    poissonNoiseBlock<W, T>(sPad, dPad, zPad, t ? tPad : nullptr, extra ? extraPad : nullptr, padded, 0, k, q,
+                            meanPad, countPad, zVarPad, tVarPad);
+    for (int i = 0; i < rest; ++i)
+        d[c + i] = dPad[i];
+}
+
+template <int W>
+RAWGMENT_KERNEL int poissonSplitRowKernel(const ushort* s, const float* prior, const JitterColumns& col,
+                                          const JitterConstants& k, const detail::PoissonScale& scale,
+                                          bool tails, double* means, float* zVar, float* tVar, int cols)
+{
+    return poissonSplitRowAny<W, ushort>(s, prior, col, k, scale, tails, means, zVar, tVar, cols);
+}
+template <int W>
+RAWGMENT_KERNEL int poissonSplitRowKernel(const float* s, const float* prior, const JitterColumns& col,
+                                          const JitterConstants& k, const detail::PoissonScale& scale,
+                                          bool tails, double* means, float* zVar, float* tVar, int cols)
+{
+    return poissonSplitRowAny<W, float>(s, prior, col, k, scale, tails, means, zVar, tVar, cols);
+}
+template <int W>
+RAWGMENT_KERNEL void
+poissonNoiseRowKernel(const ushort* s, ushort* d, const float* z, const float* t, const float* extra,
+                      const JitterColumns& col, const JitterConstants& k, float q, const double* means,
+                      const double* counts, const float* zVar, const float* tVar, int cols)
+{
+    poissonNoiseRowAny<W, ushort>(s, d, z, t, extra, col, k, q, means, counts, zVar, tVar, cols);
+}
+template <int W>
+RAWGMENT_KERNEL void
+poissonNoiseRowKernel(const float* s, float* d, const float* z, const float* t, const float* extra,
+                      const JitterColumns& col, const JitterConstants& k, float q, const double* means,
+                      const double* counts, const float* zVar, const float* tVar, int cols)
+{
+    poissonNoiseRowAny<W, float>(s, d, z, t, extra, col, k, q, means, counts, zVar, tVar, cols);
+}
+
+RAWGMENT_DISPATCHED_BY_WIDTH(int, poissonSplitRow,
+                             (const ushort* s, const float* prior, const JitterColumns& col,
+                              const JitterConstants& k, const detail::PoissonScale& scale, bool tails,
+                              double* means, float* zVar, float* tVar, int cols),
+                             (s, prior, col, k, scale, tails, means, zVar, tVar, cols))
+RAWGMENT_DISPATCHED_BY_WIDTH(int, poissonSplitRow,
+                             (const float* s, const float* prior, const JitterColumns& col,
+                              const JitterConstants& k, const detail::PoissonScale& scale, bool tails,
+                              double* means, float* zVar, float* tVar, int cols),
+                             (s, prior, col, k, scale, tails, means, zVar, tVar, cols))
+RAWGMENT_DISPATCHED_BY_WIDTH(void, poissonNoiseRow,
+                             (const ushort* s, ushort* d, const float* z, const float* t, const float* extra,
+                              const JitterColumns& col, const JitterConstants& k, float q,
+                              const double* means, const double* counts, const float* zVar, const float* tVar,
+                              int cols),
+                             (s, d, z, t, extra, col, k, q, means, counts, zVar, tVar, cols))
+RAWGMENT_DISPATCHED_BY_WIDTH(void, poissonNoiseRow,
+                             (const float* s, float* d, const float* z, const float* t, const float* extra,
+                              const JitterColumns& col, const JitterConstants& k, float q,
+                              const double* means, const double* counts, const float* zVar, const float* tVar,
+                              int cols),
+                             (s, d, z, t, extra, col, k, q, means, counts, zVar, tVar, cols))
+
+// The passes' arrays of one thread, reused row after row.
+struct PoissonRowBuffers
+{
+    std::vector<double> means, counts;
+    std::vector<float> zVar, tVar;
+};
 
 template <typename T>
 int jitterRowPoisson(const T* s, T* d, const float* z, const float* t, const float* prior, const float* extra,
-                     const float* pc, const float* black, const JitterConstants& k, uint64_t key,
-                     uint64_t stream, std::vector<AddedVariance>& vars, std::vector<double>& means,
-                     std::vector<double>& counts, int cols)
+                     const JitterColumns& col, const JitterConstants& k, uint64_t key, uint64_t stream,
+                     PoissonRowBuffers& rows, int cols)
 {
-    if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR)
-        return jitterRowPoissonBody<T, NoiseAlignment::ACCOUNT_PRIOR>(s, d, z, t, prior, extra, pc, black, k,
-                                                                      key, stream, vars, means, counts, cols);
-    return jitterRowPoissonBody<T, NoiseAlignment::IGNORE_PRIOR>(s, d, z, t, prior, extra, pc, black, k, key,
-                                                                 stream, vars, means, counts, cols);
+    const detail::PoissonScale scale(k.pg * k.in.shot); // DN per electron at the output gain: g alpha p_g
+    const size_t n = static_cast<size_t>(cols);
+    rows.means.resize(n);
+    rows.counts.resize(n);
+    rows.zVar.resize(n);
+    rows.tVar.resize(n);
+    const int bright = poissonSplitRow(s, prior, col, k, scale, t != nullptr, rows.means.data(),
+                                       rows.zVar.data(), rows.tVar.data(), cols);
+    detail::fillPoisson(key, stream, rows.means.data(), rows.counts.data(), cols);
+    poissonNoiseRow(s, d, z, t, extra, col, k, scale.q, rows.means.data(), rows.counts.data(),
+                    rows.zVar.data(), rows.tVar.data(), cols);
+    return bright;
 }
 
 // The column arrays of even rows (sites 0, 1) and odd rows (sites 2, 3), made once per call: a
@@ -359,8 +552,7 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
     std::vector<float> z(static_cast<size_t>(cols)), t(tails ? cols : 0), extra(dark ? cols : 0),
         blackAndShading(inputShading.empty() ? 0 : static_cast<size_t>(cols));
     const bool poisson = noise && k.sampling == ShotNoiseSampling::POISSON;
-    std::vector<AddedVariance> vars;
-    std::vector<double> means, counts;
+    PoissonRowBuffers poissonRows;
     int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
         if (noise)
@@ -384,9 +576,9 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
         const float* priorRow = prior.empty() ? nullptr : prior.ptr<float>(r);
         const float* extraRow = dark ? extra.data() : nullptr;
         if (poisson) {
-            localBright += jitterRowPoisson(
-                src.ptr<T>(r), dst.ptr<T>(r), z.data(), tails ? t.data() : nullptr, priorRow, extraRow,
-                col.pc, col.black, k, keys.poisson, static_cast<uint64_t>(r), vars, means, counts, cols);
+            localBright +=
+                jitterRowPoisson(src.ptr<T>(r), dst.ptr<T>(r), z.data(), tails ? t.data() : nullptr, priorRow,
+                                 extraRow, col, k, keys.poisson, static_cast<uint64_t>(r), poissonRows, cols);
         } else {
             localBright += jitterRow(src.ptr<T>(r), dst.ptr<T>(r), z.data(), tails ? t.data() : nullptr,
                                      priorRow, extraRow, col, k, cols);

@@ -407,7 +407,8 @@ const std::array<double, 32>& stirlingRemainderTable()
 /* PTRS's full test for the lanes of a try that ptrsTryLanes() left undecided: log(v / alpha / (a / us^2 +
  * b)) <= -lambda + kd ln lambda - log kd!, with log kd! as Stirling's formula plus its remainder, so that
  * ln sqrt(2 pi kd) joins the left side's logarithm and kd ln(lambda / kd) + kd - lambda stays accurate
- * where kd is near lambda. */
+ * where kd is near lambda. Five divisions (two inside the logarithms): the divider bounds this test, so
+ * a / us^2 + b is taken as (a + b us^2) / us^2 into the one quotient, and lambda / kd as lambda (1 / kd). */
 template <int W>
 RAWGMENT_KERNEL typename DoubleLanes<W>::L
 ptrsFullTestLanes(typename DoubleLanes<W>::D lambda, typename DoubleLanes<W>::UL w1,
@@ -417,18 +418,21 @@ ptrsFullTestLanes(typename DoubleLanes<W>::D lambda, typename DoubleLanes<W>::UL
     typedef typename DoubleLanes<W>::L L;
     const PtrsShape<W> h(lambda, w1, w2);
     const D invAlpha = 1.1239 + 1.1328 / (h.b - 3.4);
-    const std::array<double, 32>& table = stirlingRemainderTable();
     const D one = D{} + 1.0;
     const L positive = kd >= 1.0;
     const D k = positive ? kd : one;
     const D inv = one / k, inv2 = inv * inv;
     D remainder = inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260)));
-    for (int i = 0; i < DoubleLanes<W>::kCount; ++i)
-        if (k[i] < 32)
-            remainder[i] = table[static_cast<size_t>(k[i])];
+    if (maskBits(k < 32.0)) {
+        const std::array<double, 32>& table = stirlingRemainderTable();
+        for (int i = 0; i < DoubleLanes<W>::kCount; ++i)
+            if (k[i] < 32)
+                remainder[i] = table[static_cast<size_t>(k[i])];
+    }
     const D root = positive ? sqrtLanesD(2.0 * CV_PI * k) : one;
-    const D lhs = logLanesD<W>(h.v * invAlpha * root / (h.a / (h.us * h.us) + h.b));
-    const D rhs = (positive ? k * logLanesD<W>(lambda / k) + k - remainder : D{}) - lambda;
+    const D us2 = h.us * h.us;
+    const D lhs = logLanesD<W>(h.v * invAlpha * root * us2 / (h.a + h.b * us2));
+    const D rhs = (positive ? k * logLanesD<W>(lambda * inv) + k - remainder : D{}) - lambda;
     return lhs <= rhs;
 }
 
@@ -560,23 +564,20 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
     // The full tests of first tries, gathered into whole vectors; the values they reject join the retries.
     for (int start = 0; start < fullTests; start += kLanes) {
         const int live = std::min(kLanes, fullTests - start);
-        D lambda = D{} + 10.0;
+        // The try's count is in counts already (phase one wrote it).
+        D lambda = D{} + 10.0, kd = D{} + 10.0;
         UL w1 = {}, w2 = {};
         for (int i = 0; i < live; ++i) {
             const int index = fullTest[static_cast<size_t>(start + i)];
             lambda[i] = means[index];
+            kd[i] = counts[index];
             w1[i] = firstWords[static_cast<size_t>(index)];
             w2[i] = secondWords[static_cast<size_t>(index)];
         }
-        const PtrsTryLanes<W> t = ptrsTryLanes<W>(lambda, w1, w2);
-        const int accepted = laneBits<W>(ptrsFullTestLanes<W>(lambda, w1, w2, t.kd));
-        for (int i = 0; i < live; ++i) {
-            const int index = fullTest[static_cast<size_t>(start + i)];
-            if (accepted & (1 << i))
-                counts[index] = t.kd[i];
-            else
-                retry[static_cast<size_t>(retries++)] = index;
-        }
+        const int accepted = laneBits<W>(ptrsFullTestLanes<W>(lambda, w1, w2, kd));
+        for (int i = 0; i < live; ++i)
+            if (!(accepted & (1 << i)))
+                retry[static_cast<size_t>(retries++)] = fullTest[static_cast<size_t>(start + i)];
     }
     if (retries == 0)
         return;

@@ -49,7 +49,6 @@ Mat linearMotionKernel(double length, double angleDegrees)
 namespace {
 
 using detail::AddedVariance;
-using detail::sampledNoise;
 
 // Constants of a resampling step (blur or scale) on one mosaic: Eq. 15 with the step's weights.
 struct ResampleConstants
@@ -195,32 +194,30 @@ template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int
 }
 
 // The scalar rows: ShotNoiseSampling::POISSON for a resampled row (the shot part of Eq. 15, or of the
-// model for IGNORE_PRIOR, as an electron count at the input gain, see sampledNoise) and Tukey-lambda
+// model for IGNORE_PRIOR, as an electron count at the input gain, see detail::splitNoise()) and Tukey-lambda
 // read noise (t: the row's unit-variance draws, the read part's shape), with the dark terms' `extra`.
 void finishResampledRowScalar(float* mean, const float* shotSum, const float* readFactor, const float* z,
                               const float* t, const float* extra, const ResampleConstants& k, float black,
                               uint64_t stream, int n)
 {
     const bool poisson = k.sampling == ShotNoiseSampling::POISSON;
-    std::vector<AddedVariance> vars(static_cast<size_t>(n));
-    std::vector<double> means(poisson ? n : 0), counts(poisson ? n : 0);
-    for (int j = 0; j < n; ++j)
-        vars[static_cast<size_t>(j)] = k.alignment == NoiseAlignment::ACCOUNT_PRIOR
-                                           ? AddedVariance{k.shot * shotSum[j], readFactor[j] * k.floorVar}
-                                           : AddedVariance{k.shot * std::max(mean[j], 0.0f), k.floorVar};
-    if (poisson) {
-        // The means first, then the whole row's counts in vector lanes (detail::fillPoisson()).
-        for (int j = 0; j < n; ++j)
-            means[static_cast<size_t>(j)] =
-                t ? detail::poissonMeanWithTails(vars[static_cast<size_t>(j)], k.shot)
-                  : detail::poissonMean(vars[static_cast<size_t>(j)], k.shot);
-        detail::fillPoisson(k.poissonKey, stream, means.data(), counts.data(), n);
-    }
+    std::vector<detail::NoiseSplit> splits(static_cast<size_t>(n));
+    std::vector<double> means(poisson ? n : 0), counts(static_cast<size_t>(n), 0.0);
+    const detail::PoissonScale scale(k.shot);
     for (int j = 0; j < n; ++j) {
-        const AddedVariance v = vars[static_cast<size_t>(j)];
-        const double count = poisson ? counts[static_cast<size_t>(j)] : 0.0;
-        const float noise = t ? detail::sampledNoiseWithTails(v, k.shot, poisson, z[j], t[j], count)
-                              : sampledNoise(v, k.shot, z[j], count);
+        const AddedVariance v = k.alignment == NoiseAlignment::ACCOUNT_PRIOR
+                                    ? AddedVariance{k.shot * shotSum[j], readFactor[j] * k.floorVar}
+                                    : AddedVariance{k.shot * std::max(mean[j], 0.0f), k.floorVar};
+        splits[static_cast<size_t>(j)] = detail::splitNoise(v, scale, poisson, t != nullptr);
+        if (poisson)
+            means[static_cast<size_t>(j)] = splits[static_cast<size_t>(j)].mean;
+    }
+    // The whole row's counts at once, in vector lanes.
+    if (poisson)
+        detail::fillPoisson(k.poissonKey, stream, means.data(), counts.data(), n);
+    for (int j = 0; j < n; ++j) {
+        const float noise = detail::poissonNoise(splits[static_cast<size_t>(j)], k.shot,
+                                                 counts[static_cast<size_t>(j)], z[j], t ? t[j] : 0.0f);
         float out = mean[j] + noise;
         if (extra)
             out += extra[j];
