@@ -219,8 +219,6 @@ RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, float l
     typedef typename Lanes<W>::I I;
     typedef typename Lanes<W>::U U;
     const int kChunk = 16; // values per 8 Philox blocks: 16 first words, then 16 second words
-    alignas(64) uint32_t words[32];
-    alignas(64) float chunk[kChunk];
     const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
     F lambda, invSd;
     for (int i = 0; i < W; ++i) {
@@ -228,24 +226,32 @@ RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, float l
         invSd[i] = (i & 1) ? invSd1 : invSd0;
     }
     const F safeLambda = lambda == 0.0f ? F{} + 1.0f : lambda;
-    for (int base = 0; base < n; base += kChunk) {
-        philox8BlocksFor<W>(static_cast<uint32_t>(base / 2), stream, key, words);
-        float* const dst = n - base >= kChunk ? out + base : chunk;
-        for (int h = 0; h < kChunk; h += W) {
-            U w1, w2;
-            std::memcpy(&w1, words + h, sizeof(w1));
-            std::memcpy(&w2, words + kChunk + h, sizeof(w2));
-            const F hi = __builtin_convertvector((I)(w1 & 0x7fffffffu), F);
-            const F lo = (__builtin_convertvector((I)(w2 >> 8), F) + 0.5f) * (1.0f / 16777216.0f);
-            const F u = (hi + lo) * (1.0f / 4294967296.0f);
-            const F q = tukeyTermLanes<W>(logPositiveLanes<W>(u), lambda, safeLambda) -
-                        tukeyTermLanes<W>(logPositiveLanes<W>(1.0f - u), lambda, safeLambda);
-            const I negative = (I)(w1 >> 31) != 0;
-            const F v = invSd * (negative ? -q : q);
-            std::memcpy(dst + h, &v, sizeof(v));
-        }
-        if (dst == chunk)
-            std::memcpy(out + base, chunk, sizeof(float) * static_cast<size_t>(n - base));
+    // Four chunks per step: their words first, then their values, so that the quantiles' chains of
+    // dependent operations overlap (the layout of values in words is the chunk's, as documented).
+    const int kStep = 4 * kChunk;
+    alignas(64) uint32_t stepWords[4 * 32];
+    alignas(64) float stepValues[kStep];
+    for (int base = 0; base < n; base += kStep) {
+        for (int c = 0; c < 4; ++c)
+            philox8BlocksFor<W>(static_cast<uint32_t>((base + c * kChunk) / 2), stream, key,
+                                stepWords + 32 * c);
+        float* const dst = n - base >= kStep ? out + base : stepValues;
+        for (int c = 0; c < 4; ++c)
+            for (int h = 0; h < kChunk; h += W) {
+                U w1, w2;
+                std::memcpy(&w1, stepWords + 32 * c + h, sizeof(w1));
+                std::memcpy(&w2, stepWords + 32 * c + kChunk + h, sizeof(w2));
+                const F hi = __builtin_convertvector((I)(w1 & 0x7fffffffu), F);
+                const F lo = (__builtin_convertvector((I)(w2 >> 8), F) + 0.5f) * (1.0f / 16777216.0f);
+                const F u = (hi + lo) * (1.0f / 4294967296.0f);
+                const F q = tukeyTermLanes<W>(logPositiveLanes<W>(u), lambda, safeLambda) -
+                            tukeyTermLanes<W>(logPositiveLanes<W>(1.0f - u), lambda, safeLambda);
+                const I negative = (I)(w1 >> 31) != 0;
+                const F v = invSd * (negative ? -q : q);
+                std::memcpy(dst + c * kChunk + h, &v, sizeof(v));
+            }
+        if (dst == stepValues)
+            std::memcpy(out + base, stepValues, sizeof(float) * static_cast<size_t>(n - base));
     }
 }
 
@@ -561,20 +567,30 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
             poissonInversionLanes<W, kChunk / DoubleLanes<W>::kCount>(chunkMeans, words, chunkCounts);
         std::memcpy(counts + base, chunkCounts, sizeof(double) * static_cast<size_t>(count));
     }
-    // The full tests of first tries, gathered into whole vectors; the values they reject join the retries.
-    for (int start = 0; start < fullTests; start += kLanes) {
-        const int live = std::min(kLanes, fullTests - start);
-        // The try's count is in counts already (phase one wrote it).
-        D lambda = D{} + 10.0, kd = D{} + 10.0;
-        UL w1 = {}, w2 = {};
-        for (int i = 0; i < live; ++i) {
-            const int index = fullTest[static_cast<size_t>(start + i)];
-            lambda[i] = means[index];
-            kd[i] = counts[index];
-            w1[i] = firstWords[static_cast<size_t>(index)];
-            w2[i] = secondWords[static_cast<size_t>(index)];
+    // The full tests of first tries, gathered into whole vectors, a chunk's worth at a time so that the
+    // groups' long chains of divisions and logarithms overlap; the values they reject join the retries.
+    for (int start = 0; start < fullTests; start += kChunk) {
+        const int live = std::min(kChunk, fullTests - start);
+        alignas(64) double lambdas[kChunk], kds[kChunk];
+        alignas(64) uint64_t firsts[kChunk], seconds[kChunk];
+        for (int i = 0; i < kChunk; ++i) {
+            // The try's count is in counts already (phase one wrote it); padding lanes test a valid try.
+            const int index = i < live ? fullTest[static_cast<size_t>(start + i)] : -1;
+            lambdas[i] = index >= 0 ? means[index] : 10.0;
+            kds[i] = index >= 0 ? counts[index] : 10.0;
+            firsts[i] = index >= 0 ? firstWords[static_cast<size_t>(index)] : 0u;
+            seconds[i] = index >= 0 ? secondWords[static_cast<size_t>(index)] : 0u;
         }
-        const int accepted = laneBits<W>(ptrsFullTestLanes<W>(lambda, w1, w2, kd));
+        int accepted = 0;
+        for (int g = 0; g < kGroups; ++g) {
+            D lambda, kd;
+            UL w1, w2;
+            std::memcpy(&lambda, lambdas + g * kLanes, sizeof(lambda));
+            std::memcpy(&kd, kds + g * kLanes, sizeof(kd));
+            std::memcpy(&w1, firsts + g * kLanes, sizeof(w1));
+            std::memcpy(&w2, seconds + g * kLanes, sizeof(w2));
+            accepted |= laneBits<W>(ptrsFullTestLanes<W>(lambda, w1, w2, kd)) << (g * kLanes);
+        }
         for (int i = 0; i < live; ++i)
             if (!(accepted & (1 << i)))
                 retry[static_cast<size_t>(retries++)] = fullTest[static_cast<size_t>(start + i)];
@@ -582,48 +598,62 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
     if (retries == 0)
         return;
     // A retried value draws from its own CounterRng (poissonRetryKey(seed, stream), index): two more tries
-    // on its first four words, in lanes, then the scalar sampler on the rest. A mean beyond the lanes'
-    // range goes straight to the scalar sampler.
+    // on its first four words (the stream's first Philox block), in lanes, then the scalar sampler on the
+    // rest. A mean beyond the lanes' range goes straight to the scalar sampler.
     const uint64_t retryKey = poissonRetryKey(seed, stream);
-    std::vector<CounterRng> rngs(static_cast<size_t>(retries));
-    std::vector<int> open;
+    const std::array<uint32_t, 2> retryWordsKey = {static_cast<uint32_t>(retryKey),
+                                                   static_cast<uint32_t>(retryKey >> 32)};
+    std::vector<std::array<uint32_t, 4>> blocks(static_cast<size_t>(retries));
+    int open = 0;
     for (int r = 0; r < retries; ++r) {
         const int index = retry[static_cast<size_t>(r)];
-        rngs[static_cast<size_t>(r)] = CounterRng(retryKey, static_cast<uint64_t>(index));
-        if (means[index] > kMaxLaneMean)
-            counts[index] = static_cast<double>(rngs[static_cast<size_t>(r)].poisson(means[index]));
-        else
-            open.push_back(r);
+        if (means[index] > kMaxLaneMean) {
+            CounterRng rng(retryKey, static_cast<uint64_t>(index));
+            counts[index] = static_cast<double>(rng.poisson(means[index]));
+            continue;
+        }
+        blocks[static_cast<size_t>(open)] =
+            philox4x32({0u, 0u, static_cast<uint32_t>(index), 0u}, retryWordsKey);
+        retry[static_cast<size_t>(open++)] = index;
     }
-    for (int attempt = 0; attempt < 2 && !open.empty(); ++attempt) {
-        std::vector<int> still;
-        for (size_t start = 0; start < open.size(); start += kLanes) {
-            const int live = static_cast<int>(std::min<size_t>(kLanes, open.size() - start));
+    for (int attempt = 0; attempt < 2 && open > 0; ++attempt) {
+        // The values still open are compacted in place: a batch is read whole before any is written back.
+        int still = 0;
+        for (int start = 0; start < open; start += kLanes) {
+            const int live = std::min(kLanes, open - start);
             D lambda = D{} + 10.0;
             UL w1 = {}, w2 = {};
+            int index[DoubleLanes<W>::kCount];
+            std::array<uint32_t, 4> block[DoubleLanes<W>::kCount];
             for (int i = 0; i < live; ++i) {
-                const size_t r = static_cast<size_t>(open[start + static_cast<size_t>(i)]);
-                lambda[i] = means[retry[r]];
-                w1[i] = rngs[r].nextU32();
-                w2[i] = rngs[r].nextU32();
+                index[i] = retry[static_cast<size_t>(start + i)];
+                block[i] = blocks[static_cast<size_t>(start + i)];
+                lambda[i] = means[index[i]];
+                w1[i] = block[i][static_cast<size_t>(2 * attempt)];
+                w2[i] = block[i][static_cast<size_t>(2 * attempt + 1)];
             }
             const PtrsTryLanes<W> t = ptrsTryLanes<W>(lambda, w1, w2);
             L accept = t.accept;
             if (laneBits<W>(~t.accept & ~t.refuse))
                 accept |= ~t.refuse & ptrsFullTestLanes<W>(lambda, w1, w2, t.kd);
+            const int accepted = laneBits<W>(accept);
             for (int i = 0; i < live; ++i) {
-                const int r = open[start + static_cast<size_t>(i)];
-                if (accept[i])
-                    counts[retry[static_cast<size_t>(r)]] = t.kd[i];
-                else
-                    still.push_back(r);
+                if (accepted & (1 << i)) {
+                    counts[index[i]] = t.kd[i];
+                } else {
+                    retry[static_cast<size_t>(still)] = index[i];
+                    blocks[static_cast<size_t>(still++)] = block[i];
+                }
             }
         }
-        open.swap(still);
+        open = still;
     }
-    for (int r : open) {
+    for (int r = 0; r < open; ++r) {
         const int index = retry[static_cast<size_t>(r)];
-        counts[index] = static_cast<double>(rngs[static_cast<size_t>(r)].poisson(means[index]));
+        CounterRng rng(retryKey, static_cast<uint64_t>(index));
+        for (int used = 0; used < 4; ++used) // the words of the two tries above
+            rng.nextU32();
+        counts[index] = static_cast<double>(rng.poisson(means[index]));
     }
 }
 
