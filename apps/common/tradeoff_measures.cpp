@@ -195,12 +195,14 @@ void measureColorJitterKnobs(const TradeoffSettings& set, const Mat& timingRaw, 
         const bool poisson = sampling == ShotNoiseSampling::POISSON;
         std::vector<double> byPath;
         const double msPerMp = time(noise, byPath);
-        rows.push_back({"Shot-noise sampling (colour jitter)", poisson ? "POISSON" : "GAUSSIAN (paper)",
-                        "KL(true || augmented) of the values at 2 e-",
-                        kullbackLeibler(truthDistribution, valueDistribution(out, black, -24, 64)), msPerMp,
-                        poisson ? "the electron lattice of a real dark capture; pays per pixel"
-                                : "right variance, wrong shape below ~10 e-",
-                        byPath});
+        rows.push_back(
+            {"Shot-noise sampling (colour jitter)", poisson ? "POISSON" : "GAUSSIAN (paper)",
+             "KL(true || augmented) of the values at 2 e-",
+             kullbackLeibler(truthDistribution, valueDistribution(out, black, -24, 64)), msPerMp,
+             poisson
+                 ? "the electron lattice of a real dark capture; an exact count per pixel, in vector lanes"
+                 : "right variance, wrong shape below ~10 e-",
+             byPath});
     }
     for (PriorMeanEstimate prior : {PriorMeanEstimate::PIXEL_VALUE, PriorMeanEstimate::LOCAL_MEAN}) {
         NoiseOptions noise;
@@ -766,7 +768,7 @@ void measureDarkComponents(const TradeoffSettings& set, const Mat& timingRaw, co
                 : c == SHADING
                     ? (present ? "the target gain's dark offset pattern; costs a map read per pixel"
                                : "the input's pattern, scaled down by the darkening")
-                    : (present ? "heavy-tailed added read noise; scalar Tukey draws per pixel"
+                    : (present ? "heavy-tailed added read noise; Tukey-lambda draws in vector lanes"
                                : "Gaussian added read noise: too few outliers in the dark");
             rows.push_back({knob, present ? "in the model" : "absent from the model", measure, error,
                             active / megapixels(timingRaw.size()), meaning, byPath});

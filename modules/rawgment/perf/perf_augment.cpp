@@ -4,12 +4,16 @@
 //   blur (length 13), scaling by 3%, a full random scene,
 //   the same colour jitter composed naively with OpenCV calls (convertTo, RNG::fill NORMAL, Mat
 //   arithmetic, sqrt), and a memcpy of the frame (the floor); and standard normals alone
-//   (fillStandardNormal). Every benchmark of the library runs once per CpuPath this CPU has
-//   (name suffix /baseline, /sse4.2, /avx2, /avx512), so the paths are compared in one run.
+//   (fillStandardNormal); and exact Poisson draws alone, in vector lanes (detail::fillPoisson) against the
+//   scalar sampler they replaced (CounterRng::poisson, a loop per value). Every benchmark of the library runs
+//   once per CpuPath this CPU has (name suffix /baseline, /sse4.2, /avx2, /avx512), so the paths are compared
+//   in one run.
+#include "../src/random.hpp"
 #include "perf_common.hpp"
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/cpu.hpp>
 #include <opencv2/rawgment/simulate.hpp>
@@ -143,6 +147,59 @@ void BM_Augment_standardNormals(benchmark::State& state)
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(z.total()));
 }
 
+//! The Poisson means of the POISSON jitter benchmark: the electrons its exposure change adds to each pixel
+//! of the frame (0 to about 750), one row of doubles per mosaic row.
+const Mat& poissonMeans()
+{
+    static const Mat m = [] {
+        const double q = kJitter.gainRatio * kModel.lineAtGain(frameFormat().gain).a;
+        const double pu = kJitter.contrast[0] / kJitter.gainRatio;
+        Mat x;
+        frame().convertTo(x, CV_64F, 1.0, -256.0);
+        return Mat(max(x, 0.0) * (pu * (1 - pu) * kJitter.gainRatio * kJitter.gainRatio *
+                                  kModel.lineAtGain(frameFormat().gain).a / (q * q)));
+    }();
+    return m;
+}
+
+void BM_Augment_poissonDraws(benchmark::State& state)
+{
+    const Mat& means = poissonMeans();
+    Mat counts(means.size(), CV_64F);
+    uint64 seed = 0;
+    for (auto _ : state) {
+        const uint64 key = ++seed;
+        parallel_for_(Range(0, means.rows), [&](const Range& rows) {
+            for (int r = rows.start; r < rows.end; ++r)
+                rawgment::detail::fillPoisson(key, static_cast<uint64_t>(r), means.ptr<double>(r),
+                                              counts.ptr<double>(r), means.cols);
+        });
+        benchmark::DoNotOptimize(counts.data);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(means.total()));
+}
+
+void BM_Augment_poissonDrawsScalar(benchmark::State& state)
+{
+    const Mat& means = poissonMeans();
+    Mat counts(means.size(), CV_64F);
+    uint64 seed = 0;
+    for (auto _ : state) {
+        const uint64 key = ++seed;
+        parallel_for_(Range(0, means.rows), [&](const Range& rows) {
+            for (int r = rows.start; r < rows.end; ++r) {
+                rawgment::detail::CounterRng rng(key, static_cast<uint64_t>(r));
+                const double* m = means.ptr<double>(r);
+                double* k = counts.ptr<double>(r);
+                for (int c = 0; c < means.cols; ++c)
+                    k[c] = static_cast<double>(rng.poisson(m[c]));
+            }
+        });
+        benchmark::DoNotOptimize(counts.data);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(means.total()));
+}
+
 void BM_Augment_memcpy(benchmark::State& state)
 {
     Mat out(frame().size(), frame().type());
@@ -161,11 +218,13 @@ int main(int argc, char** argv)
     // "CPU" is the process's CPU time over all threads; "stolen" the hypervisor's share (perf_common.hpp).
     perf::registerTimed("BM_Augment_memcpy", BM_Augment_memcpy);
     perf::registerTimed("BM_Augment_colorJitterNaiveOpenCV", BM_Augment_colorJitterNaiveOpenCV);
+    perf::registerTimed("BM_Augment_poissonDrawsScalar", BM_Augment_poissonDrawsScalar);
     const std::pair<const char*, void (*)(benchmark::State&)> library[] = {
         {"BM_Augment_standardNormals", BM_Augment_standardNormals},
         {"BM_Augment_colorJitter", BM_Augment_colorJitter},
         {"BM_Augment_colorJitterTukeyRead", BM_Augment_colorJitterTukeyRead},
         {"BM_Augment_colorJitterPoisson", BM_Augment_colorJitterPoisson},
+        {"BM_Augment_poissonDraws", BM_Augment_poissonDraws},
         {"BM_Augment_motionBlur13", BM_Augment_motionBlur13},
         {"BM_Augment_scale103", BM_Augment_scale103},
         {"BM_Augment_randomScene", BM_Augment_randomScene}};

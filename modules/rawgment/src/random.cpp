@@ -547,7 +547,8 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
             std::memcpy(&lambda, chunkMeans + g * kLanes, sizeof(lambda));
             std::memcpy(&a, words + g * kLanes, sizeof(a));
             std::memcpy(&b, words + kChunk + g * kLanes, sizeof(b));
-            const L small = lambda<10.0, beyond = lambda> kMaxLaneMean;
+            const L small = lambda < 10.0;
+            const L beyond = lambda > kMaxLaneMean;
             const L ptrs = ~small & ~beyond;
             smallBits |= laneBits<W>(small) << (g * kLanes);
             const int live = std::max(0, std::min(kLanes, count - g * kLanes));

@@ -412,9 +412,8 @@ CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, float lam
  * try is rejected (a share 1 - alpha, PTRS's acceptance constant: 25% at a mean of 10, 12% at 1000) tries
  * again in lanes with the first four words of its own CounterRng (poissonRetryKey(seed, stream), i),
  * twice, then calls CounterRng::poisson() on the rest of that stream; a mean beyond 2^40 calls it at once.
- * Retrying with fresh numbers
- * is what a rejection sampler does anyway, so the draw stays exact. The logarithms and the exponential are
- * double polynomials (no library calls), so every path gives the same bits
+ * Retrying with fresh numbers is what a rejection sampler does anyway, so the draw stays exact. The
+ * logarithms and the exponential are double polynomials (no library calls), so every path gives the same bits
  * (Simulate.fillPoissonIsExactAndTheSameOnEveryPath). Exactness: up to double rounding, and the 32-bit u and
  * v of the PTRS try: each count's probability is exact to about 2^-31 absolute. counts must not overlap
  * means. */
