@@ -2,6 +2,7 @@
 #include "test_common.hpp"
 
 #include <functional>
+#include <map>
 
 #include "../src/random.hpp"
 #include <opencv2/core/utility.hpp>
@@ -1165,6 +1166,58 @@ TEST(Augment, blurNoiseFromTheBlurredMeanIsExactWhereTheTapsAgree)
         const float e = exact.at<float>(r, c), a = approx.at<float>(r, c);
         if (std::abs(e) > 1) // far from zero, so the ratio is well conditioned
             EXPECT_NEAR(a / e, std::sqrt(vApprox / vExact), 1e-3);
+    }
+}
+
+TEST(Augment, poissonJitterAddsExactPoissonCountsAtEveryMean)
+{
+    // End to end through the POISSON rows of colorJitter (split, vector draws, noise pass): a sensor
+    // without read noise at 1 DN per electron, a noiseless float input, exposure x0.2. ACCOUNT_PRIOR adds
+    // shot variance p_u (1 - p_u) x = 0.16 x, drawn as K - m with m = 0.16 x electrons, so each output is
+    // 0.2 x + K - 0.16 x = 0.04 x + K: an integer K above 0.04 x that must be Poisson(0.16 x). Means on
+    // both sides of the inversion/rejection switch at 10 and far above it.
+    const std::vector<double> means = {2.0, 8.0, 10.0, 40.0, 1000.0};
+    const int blockCols = 100, rows = 400;
+    Mat src(rows, blockCols * static_cast<int>(means.size()), CV_32FC1);
+    for (int c = 0; c < src.cols; ++c)
+        src.col(c).setTo(means[static_cast<size_t>(c / blockCols)] / 0.16);
+    const NoiseModel model(1.0, 0.0, 0.0);
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d::all(0);
+    fmt.whiteLevel = 1e9;
+    fmt.gain = 1;
+    NoiseOptions noise;
+    noise.shotSampling = ShotNoiseSampling::POISSON;
+    Mat out;
+    RawFormat outFmt;
+    colorJitter(src, fmt, model, ColorJitter::exposureChange(0.2, 1.0), noise, 11, out, outFmt);
+    for (size_t m = 0; m < means.size(); ++m) {
+        const double lambda = means[m];
+        std::map<int, int> hist;
+        double worst = 0;
+        for (int r = 0; r < rows; ++r)
+            for (int c = static_cast<int>(m) * blockCols; c < static_cast<int>(m + 1) * blockCols; ++c) {
+                const double k = out.at<float>(r, c) - 0.04 * src.at<float>(r, c);
+                const double rounded = std::round(k);
+                worst = std::max(worst, std::abs(k - rounded));
+                ++hist[static_cast<int>(rounded)];
+            }
+        // The float output holds 0.04 x + K to a few float ulps of values below 1100 (1e-4).
+        EXPECT_LT(worst, 1e-3) << "mean " << lambda;
+        const double n = static_cast<double>(rows * blockCols);
+        double chi2 = 0, cellP = 0, cellObs = 0;
+        int dof = -1;
+        for (int k = 0; k < 2 * lambda + 60; ++k) {
+            cellP += std::exp(-lambda + k * std::log(lambda) - std::lgamma(k + 1.0));
+            cellObs += hist[k];
+            if (cellP * n >= 20) {
+                chi2 += (cellObs - cellP * n) * (cellObs - cellP * n) / (cellP * n);
+                ++dof;
+                cellP = cellObs = 0;
+            }
+        }
+        // chi^2 with dof degrees of freedom: mean dof, sd sqrt(2 dof); 6 sd, as the samplers' own tests.
+        EXPECT_LT(chi2, dof + 6 * std::sqrt(2.0 * dof)) << "mean " << lambda << ", dof " << dof;
     }
 }
 
