@@ -442,10 +442,23 @@ ptrsFullTestLanes(typename DoubleLanes<W>::D lambda, typename DoubleLanes<W>::UL
     return lhs <= rhs;
 }
 
+//! 1 / k for k = 1..200 (index 0 unused): the steps of the inversion's search.
+const std::array<double, 201>& inverseIntegers()
+{
+    static const std::array<double, 201> table = [] {
+        std::array<double, 201> t{};
+        for (size_t k = 1; k < t.size(); ++k)
+            t[k] = 1.0 / static_cast<double>(k);
+        return t;
+    }();
+    return table;
+}
+
 /* Inversion by sequential search for the means below 10 among a chunk's G groups of lanes, the groups'
  * chains interleaved (one multiply-add chain each, so together they hide each other's latency): u of
- * 53 bits from both words, as CounterRng::uniform(), and p_k = p_(k-1) (lambda / k) as
- * CounterRng::poisson(). Lanes of larger means run with mean 0 and give 0. */
+ * 53 bits from both words, as CounterRng::uniform(), and p_k = p_(k-1) lambda (1 / k) (CounterRng::poisson()
+ * divides: the two differ by an ulp at times, which moves a count only when u falls within about 1e-13 of
+ * the CDF's boundary). Lanes of larger means run with mean 0 and give 0. */
 template <int W, int G>
 RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint32_t* words,
                                            double* chunkCounts)
@@ -475,14 +488,16 @@ RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint3
         k[g] = D{};
     }
     // An active lane has taken every step so far (its cdf grew each time; an inactive one never changes
-    // again), so its count is the step number.
+    // again), so its count is the step number. lambda / k as lambda (1 / k), 1 / k from a table: a division
+    // per group and step cost more than the rest of the search.
+    const std::array<double, 201>& inverse = inverseIntegers();
     for (int step = 1; step <= 200; ++step) {
         L any = {};
-        const double next = step;
+        const double next = step, invNext = inverse[static_cast<size_t>(step)];
         for (int g = 0; g < G; ++g) {
             const L active = u[g] > cdf[g];
             any |= active;
-            const D pNext = p[g] * (lambda[g] / next);
+            const D pNext = p[g] * (lambda[g] * invNext);
             p[g] = active ? pNext : p[g];
             cdf[g] = active ? cdf[g] + pNext : cdf[g];
             k[g] = active ? D{} + next : k[g];

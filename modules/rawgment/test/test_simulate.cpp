@@ -420,7 +420,7 @@ double referencePoisson(uint64_t seed, uint64_t stream, int i, double lambda, in
         int k = 0;
         while (u > cdf && k < 200) {
             ++k;
-            p *= lambda / k;
+            p *= lambda * (1.0 / k); // as fillPoisson(): 1 / k from a table
             cdf += p;
         }
         return k;
