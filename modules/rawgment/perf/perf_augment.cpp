@@ -162,7 +162,9 @@ const Mat& poissonMeans()
     return m;
 }
 
-void BM_Augment_poissonDraws(benchmark::State& state)
+//! Times `drawRow(key, row, means, counts, cols)` over every row of poissonMeans(), rows split among
+//! threads as the noise steps split them, a new key per iteration.
+template <typename DrawRow> void timePoissonRows(benchmark::State& state, DrawRow drawRow)
 {
     const Mat& means = poissonMeans();
     Mat counts(means.size(), CV_64F);
@@ -171,33 +173,27 @@ void BM_Augment_poissonDraws(benchmark::State& state)
         const uint64 key = ++seed;
         parallel_for_(Range(0, means.rows), [&](const Range& rows) {
             for (int r = rows.start; r < rows.end; ++r)
-                rawgment::detail::fillPoisson(key, static_cast<uint64_t>(r), means.ptr<double>(r),
-                                              counts.ptr<double>(r), means.cols);
+                drawRow(key, r, means.ptr<double>(r), counts.ptr<double>(r), means.cols);
         });
         benchmark::DoNotOptimize(counts.data);
     }
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(means.total()));
 }
 
+void BM_Augment_poissonDraws(benchmark::State& state)
+{
+    timePoissonRows(state, [](uint64 key, int r, const double* m, double* k, int cols) {
+        rawgment::detail::fillPoisson(key, static_cast<uint64_t>(r), m, k, cols);
+    });
+}
+
 void BM_Augment_poissonDrawsScalar(benchmark::State& state)
 {
-    const Mat& means = poissonMeans();
-    Mat counts(means.size(), CV_64F);
-    uint64 seed = 0;
-    for (auto _ : state) {
-        const uint64 key = ++seed;
-        parallel_for_(Range(0, means.rows), [&](const Range& rows) {
-            for (int r = rows.start; r < rows.end; ++r) {
-                rawgment::detail::CounterRng rng(key, static_cast<uint64_t>(r));
-                const double* m = means.ptr<double>(r);
-                double* k = counts.ptr<double>(r);
-                for (int c = 0; c < means.cols; ++c)
-                    k[c] = static_cast<double>(rng.poisson(m[c]));
-            }
-        });
-        benchmark::DoNotOptimize(counts.data);
-    }
-    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(means.total()));
+    timePoissonRows(state, [](uint64 key, int r, const double* m, double* k, int cols) {
+        rawgment::detail::CounterRng rng(key, static_cast<uint64_t>(r));
+        for (int c = 0; c < cols; ++c)
+            k[c] = static_cast<double>(rng.poisson(m[c]));
+    });
 }
 
 void BM_Augment_memcpy(benchmark::State& state)

@@ -370,9 +370,9 @@ RAWGMENT_KERNEL int poissonSplitRowBody(const T* s, const float* prior, const Ji
 }
 
 template <int W, typename T>
-RAWGMENT_KERNEL int poissonSplitRowAny(const T* s, const float* prior, const JitterColumns& col,
-                                       const JitterConstants& k, const detail::PoissonScale& scale,
-                                       bool tails, double* means, float* zVar, float* tVar, int cols)
+RAWGMENT_KERNEL int poissonSplitRowKernel(const T* s, const float* prior, const JitterColumns& col,
+                                          const JitterConstants& k, const detail::PoissonScale& scale,
+                                          bool tails, double* means, float* zVar, float* tVar, int cols)
 {
     if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR)
         return prior ? poissonSplitRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, true>(
@@ -386,10 +386,10 @@ RAWGMENT_KERNEL int poissonSplitRowAny(const T* s, const float* prior, const Jit
 }
 
 template <int W, typename T>
-RAWGMENT_KERNEL void poissonNoiseRowAny(const T* s, T* d, const float* z, const float* t, const float* extra,
-                                        const JitterColumns& col, const JitterConstants& k, float q,
-                                        const double* means, const double* counts, const float* zVar,
-                                        const float* tVar, int cols)
+RAWGMENT_KERNEL void
+poissonNoiseRowKernel(const T* s, T* d, const float* z, const float* t, const float* extra,
+                      const JitterColumns& col, const JitterConstants& k, float q, const double* means,
+                      const double* counts, const float* zVar, const float* tVar, int cols)
 {
     int c = 0;
     for (; c + W <= cols; c += W)
@@ -418,37 +418,6 @@ RAWGMENT_KERNEL void poissonNoiseRowAny(const T* s, T* d, const float* z, const 
                             meanPad, countPad, zVarPad, tVarPad);
     for (int i = 0; i < rest; ++i)
         d[c + i] = dPad[i];
-}
-
-template <int W>
-RAWGMENT_KERNEL int poissonSplitRowKernel(const ushort* s, const float* prior, const JitterColumns& col,
-                                          const JitterConstants& k, const detail::PoissonScale& scale,
-                                          bool tails, double* means, float* zVar, float* tVar, int cols)
-{
-    return poissonSplitRowAny<W, ushort>(s, prior, col, k, scale, tails, means, zVar, tVar, cols);
-}
-template <int W>
-RAWGMENT_KERNEL int poissonSplitRowKernel(const float* s, const float* prior, const JitterColumns& col,
-                                          const JitterConstants& k, const detail::PoissonScale& scale,
-                                          bool tails, double* means, float* zVar, float* tVar, int cols)
-{
-    return poissonSplitRowAny<W, float>(s, prior, col, k, scale, tails, means, zVar, tVar, cols);
-}
-template <int W>
-RAWGMENT_KERNEL void
-poissonNoiseRowKernel(const ushort* s, ushort* d, const float* z, const float* t, const float* extra,
-                      const JitterColumns& col, const JitterConstants& k, float q, const double* means,
-                      const double* counts, const float* zVar, const float* tVar, int cols)
-{
-    poissonNoiseRowAny<W, ushort>(s, d, z, t, extra, col, k, q, means, counts, zVar, tVar, cols);
-}
-template <int W>
-RAWGMENT_KERNEL void
-poissonNoiseRowKernel(const float* s, float* d, const float* z, const float* t, const float* extra,
-                      const JitterColumns& col, const JitterConstants& k, float q, const double* means,
-                      const double* counts, const float* zVar, const float* tVar, int cols)
-{
-    poissonNoiseRowAny<W, float>(s, d, z, t, extra, col, k, q, means, counts, zVar, tVar, cols);
 }
 
 RAWGMENT_DISPATCHED_BY_WIDTH(int, poissonSplitRow,

@@ -2,6 +2,7 @@
 #include "test_common.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <dirent.h>
 #include <filesystem>
@@ -95,6 +96,28 @@ SensorParams darkComponentSensorParams(Size size, double lambda, uint64 seed)
     p.noise.darkShadingPerGain = bd;
     p.noise.darkShadingOffset = br;
     return p;
+}
+
+double poissonChiSquare(const std::map<int64_t, int>& counts, double lambda, double n, int& dof, double* mass)
+{
+    double chi2 = 0, cellP = 0, cellObs = 0, covered = 0;
+    dof = -1;
+    for (int64_t k = 0; k < 4 * lambda + 60; ++k) {
+        const double pk = std::exp(-lambda + static_cast<double>(k) * std::log(lambda) -
+                                   std::lgamma(static_cast<double>(k) + 1.0));
+        cellP += pk;
+        covered += pk;
+        const auto it = counts.find(k);
+        cellObs += it == counts.end() ? 0 : it->second;
+        if (cellP * n >= 20) {
+            chi2 += (cellObs - cellP * n) * (cellObs - cellP * n) / (cellP * n);
+            ++dof;
+            cellP = cellObs = 0;
+        }
+    }
+    if (mass)
+        *mass = covered;
+    return chi2;
 }
 
 } // namespace test

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,13 @@ SensorParams referenceSensorParams();
  * the gain: the banding of high-gain captures), Tukey-lambda read noise of `lambda`, and dark shading of
  * `size` (B_d: scatter 0.8 plus a ramp of 2 across the columns; B_r: scatter 2 DN) drawn from `seed`. */
 SensorParams darkComponentSensorParams(Size size, double lambda, uint64 seed);
+
+/** Pearson's chi-square of integer counts against Poisson(lambda): cells grown from 0 upwards until their
+ * expected count in n draws reaches 20 (the remainder above, below 20, is left out). `dof` is set to the
+ * cells less one, and `mass` to the Poisson probability of the counts looked at, 0 to 4 lambda + 59. A
+ * correct sampler gives about dof, with standard deviation sqrt(2 dof). */
+double poissonChiSquare(const std::map<int64_t, int>& counts, double lambda, double n, int& dof,
+                        double* mass = nullptr);
 
 } // namespace test
 } // namespace rawgment

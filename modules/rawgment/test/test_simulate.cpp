@@ -103,30 +103,17 @@ TEST(Simulate, poissonHistogramPassesChiSquare)
     for (double lambda : {3.0, 40.0}) {
         Mat raw;
         sensor.capture(Mat(size, CV_32FC1, Scalar(lambda)), 1.0, 1.0, 99, 0, raw);
-        std::map<int, int> counts;
+        std::map<int64_t, int> counts;
         for (auto it = raw.begin<float>(); it != raw.end<float>(); ++it)
-            ++counts[static_cast<int>(*it)];
-        // Cells grown from the left until their expected count reaches 20; the upper remainder, whose
-        // expected count is below 20, is left out.
-        const double n = static_cast<double>(size.area());
-        double chi2 = 0, lowTailP = 0, lowTailObs = 0;
-        int dof = -1;
-        double cdf = 0;
-        for (int k = 0; k < 4 * lambda + 40; ++k) {
-            const double pk = std::exp(-lambda + k * std::log(lambda) - std::lgamma(k + 1.0));
-            cdf += pk;
-            lowTailP += pk;
-            lowTailObs += counts[k];
-            if (lowTailP * n >= 20) {
-                chi2 += (lowTailObs - lowTailP * n) * (lowTailObs - lowTailP * n) / (lowTailP * n);
-                ++dof;
-                lowTailP = lowTailObs = 0;
-            }
-        }
+            ++counts[static_cast<int64_t>(*it)];
+        int dof = 0;
+        double mass = 0;
+        const double chi2 =
+            test::poissonChiSquare(counts, lambda, static_cast<double>(size.area()), dof, &mass);
         // chi^2 with dof degrees of freedom has mean dof and sd sqrt(2 dof): 6 sd covers any sane run
         // and still catches a Gaussian approximation (which fails at lambda = 3 by hundreds).
         EXPECT_LT(chi2, dof + 6 * std::sqrt(2.0 * dof)) << "lambda " << lambda << " dof " << dof;
-        EXPECT_GT(cdf, 1 - 1e-9);
+        EXPECT_GT(mass, 1 - 1e-9);
     }
 }
 
@@ -524,18 +511,10 @@ TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
         EXPECT_NEAR(var, lambda, 5 * std::sqrt((2 * lambda * lambda + lambda) / perMean)) << lambda;
         if (lambda > 1e4)
             continue;
-        double chi2 = 0, cellP = 0, cellObs = 0;
-        int dof = -1;
-        for (int k = 0; k < 2 * lambda + 60; ++k) {
-            cellP += std::exp(-lambda + k * std::log(lambda) - std::lgamma(k + 1.0));
-            cellObs += hist[k];
-            if (cellP * perMean >= 20) {
-                chi2 += (cellObs - cellP * perMean) * (cellObs - cellP * perMean) / (cellP * perMean);
-                ++dof;
-                cellP = cellObs = 0;
-            }
-        }
-        // chi^2 with dof degrees of freedom: mean dof, sd sqrt(2 dof); 6 sd, as the simulator's test.
+        int dof = 0;
+        const double chi2 = test::poissonChiSquare(hist, lambda, perMean, dof);
+        // chi^2 with dof degrees of freedom: mean dof, sd sqrt(2 dof); 6 sd, as
+        // poissonHistogramPassesChiSquare.
         EXPECT_LT(chi2, dof + 6 * std::sqrt(2.0 * dof)) << "lambda " << lambda << " dof " << dof;
     }
 }
