@@ -51,8 +51,9 @@ std::vector<Mat> everyDispatchedLoop()
     sensor.capture(scene, 4.0, 1.0, 11, 0, src); // the simulator's Gaussian draws
     outs.push_back(src);
     const NoiseModel plain(0.4, 0.5, 2.0);
-    // The dark-frame components add a row term and shading to the vector rows and take the scalar rows
-    // for the Tukey draws (NoiseModel).
+    // The dark-frame components add a row term and shading to the vector rows, and Tukey draws to the
+    // jitter's vector rows and to the scalar rows of blur and scale (NoiseModel); POISSON takes the
+    // jitter's split and noise kernels around the vector draws.
     NoiseModel dark = plain;
     dark.rowSigmaD2 = 0.2;
     dark.rowSigmaR2 = 0.4;
