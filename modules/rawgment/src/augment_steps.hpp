@@ -57,7 +57,7 @@ typedef AddedVarianceOf<float> AddedVariance;
  * - with tails the read part (the rest, never more than the total) takes t, the shot part z or the count;
  * - a mean beyond kMaxPoissonMean electrons (a tiny q) is Gaussian to double precision: z takes it all.
  * A row is drawn in passes: the split of every pixel, one fillPoisson() of the row's means (vector lanes),
- * then the noise of every pixel. Plain float arithmetic without branches, so each pass is a simple loop. */
+ * then the noise of every pixel. */
 struct NoiseSplit
 {
     double mean;

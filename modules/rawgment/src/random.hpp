@@ -319,8 +319,6 @@ constexpr double kMaxPoissonMean = 4503599627370496.0;
 class CounterRng
 {
 public:
-    //! The stream (0, 0), to be assigned a real one before use.
-    CounterRng() : CounterRng(0, 0) {}
     CounterRng(uint64_t seed, uint64_t stream)
         : key_{static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)},
           counter_{0u, 0u, static_cast<uint32_t>(stream), static_cast<uint32_t>(stream >> 32)}
