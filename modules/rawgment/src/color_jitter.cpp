@@ -262,7 +262,6 @@ RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
  * last partial block runs through the vector code on padded copies. */
 template <int W> struct PoissonLanes
 {
-    typedef typename detail::Lanes<W>::F F;
     typedef double D __attribute__((vector_size(8 * W))); // one double per float lane (arithmetic only)
 };
 

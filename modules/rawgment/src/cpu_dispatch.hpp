@@ -52,12 +52,18 @@ template <typename V> inline __attribute__((always_inline)) V minLanes(V a, V b)
     return b < a ? b : a;
 }
 
-//! IEEE square roots lane by lane: exact to the rounding on every path, compiled to (v)sqrtps.
+//! IEEE square roots lane by lane, of float or double lanes: exact to the rounding on every path,
+//! compiled to (v)sqrtps or (v)sqrtpd.
 template <typename V> inline __attribute__((always_inline)) V sqrtLanes(V v)
 {
+    constexpr bool isDouble = sizeof(v[0]) == sizeof(double);
     V r;
-    for (int i = 0; i < static_cast<int>(sizeof(V) / sizeof(float)); ++i)
-        r[i] = __builtin_sqrtf(v[i]);
+    for (int i = 0; i < static_cast<int>(sizeof(V) / sizeof(v[0])); ++i) {
+        if constexpr (isDouble)
+            r[i] = __builtin_sqrt(v[i]);
+        else
+            r[i] = __builtin_sqrtf(v[i]);
+    }
     return r;
 }
 

@@ -340,15 +340,6 @@ template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D uniform32LanesD(type
     return (((D)(w | 0x4330000000000000ull) - kTwo52) + 0.5) * (1.0 / 4294967296.0);
 }
 
-//! IEEE square roots of double lanes, compiled to (v)sqrtpd.
-template <typename V> inline __attribute__((always_inline)) V sqrtLanesD(V v)
-{
-    V r;
-    for (int i = 0; i < static_cast<int>(sizeof(V) / sizeof(double)); ++i)
-        r[i] = __builtin_sqrt(v[i]);
-    return r;
-}
-
 // The largest mean fillPoisson() draws in lanes, 2^40: PTRS's floor then stays below 2^52. Larger means go
 // to CounterRng::poisson() (which takes up to kMaxPoissonMean).
 constexpr double kMaxLaneMean = 1099511627776.0;
@@ -369,7 +360,7 @@ template <int W> struct PtrsShape
     D a, b, u, v, us;
     PtrsShape(D lambda, typename DoubleLanes<W>::UL w1, typename DoubleLanes<W>::UL w2)
     {
-        b = 0.931 + 2.53 * sqrtLanesD(lambda);
+        b = 0.931 + 2.53 * sqrtLanes(lambda);
         a = -0.059 + 0.02483 * b;
         u = uniform32LanesD<W>(w1) - 0.5;
         v = uniform32LanesD<W>(w2);
@@ -435,7 +426,7 @@ ptrsFullTestLanes(typename DoubleLanes<W>::D lambda, typename DoubleLanes<W>::UL
             if (k[i] < 32)
                 remainder[i] = table[static_cast<size_t>(k[i])];
     }
-    const D root = positive ? sqrtLanesD(2.0 * CV_PI * k) : one;
+    const D root = positive ? sqrtLanes(2.0 * CV_PI * k) : one;
     const D us2 = h.us * h.us;
     const D lhs = logLanesD<W>(h.v * invAlpha * root * us2 / (h.a + h.b * us2));
     const D rhs = (positive ? k * logLanesD<W>(lambda * inv) + k - remainder : D{}) - lambda;
@@ -511,12 +502,6 @@ RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint3
                 chunkCounts[g * kLanes + i] = k[g][i];
 }
 
-//! Bit i set where lane i of a mask is.
-template <int W> RAWGMENT_KERNEL int laneBits(typename DoubleLanes<W>::L mask)
-{
-    return maskBits(mask);
-}
-
 //! Appends base + i to list[size..] for every bit i of `bits` (of `lanes`), without branches: each lane is
 //! written, and the size advances past the set ones (list has room for `lanes` more).
 inline void appendBits(int bits, int lanes, int base, int* list, int& size)
@@ -565,19 +550,19 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
             const L small = lambda < 10.0;
             const L beyond = lambda > kMaxLaneMean;
             const L ptrs = ~small & ~beyond;
-            smallBits |= laneBits<W>(small) << (g * kLanes);
+            smallBits |= maskBits(small) << (g * kLanes);
             const int live = std::max(0, std::min(kLanes, count - g * kLanes));
             const int liveBits = (1 << live) - 1;
             const int base0 = base + g * kLanes;
-            appendBits(laneBits<W>(beyond) & liveBits, kLanes, base0, retry.data(), retries);
-            if (!laneBits<W>(ptrs))
+            appendBits(maskBits(beyond) & liveBits, kLanes, base0, retry.data(), retries);
+            if (!maskBits(ptrs))
                 continue;
             const PtrsTryLanes<W> t = ptrsTryLanes<W>(
                 ptrs ? lambda : D{} + 10.0, __builtin_convertvector(a, UL), __builtin_convertvector(b, UL));
             std::memcpy(chunkCounts + g * kLanes, &t.kd, sizeof(t.kd));
-            appendBits(laneBits<W>(ptrs & ~t.accept & ~t.refuse) & liveBits, kLanes, base0, fullTest.data(),
+            appendBits(maskBits(ptrs & ~t.accept & ~t.refuse) & liveBits, kLanes, base0, fullTest.data(),
                        fullTests);
-            appendBits(laneBits<W>(ptrs & t.refuse) & liveBits, kLanes, base0, retry.data(), retries);
+            appendBits(maskBits(ptrs & t.refuse) & liveBits, kLanes, base0, retry.data(), retries);
         }
         if (smallBits)
             poissonInversionLanes<W, kChunk / DoubleLanes<W>::kCount>(chunkMeans, words, chunkCounts);
@@ -605,7 +590,7 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
             std::memcpy(&kd, kds + g * kLanes, sizeof(kd));
             std::memcpy(&w1, firsts + g * kLanes, sizeof(w1));
             std::memcpy(&w2, seconds + g * kLanes, sizeof(w2));
-            accepted |= laneBits<W>(ptrsFullTestLanes<W>(lambda, w1, w2, kd)) << (g * kLanes);
+            accepted |= maskBits(ptrsFullTestLanes<W>(lambda, w1, w2, kd)) << (g * kLanes);
         }
         for (int i = 0; i < live; ++i)
             if (!(accepted & (1 << i)))
@@ -650,9 +635,9 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
             }
             const PtrsTryLanes<W> t = ptrsTryLanes<W>(lambda, w1, w2);
             L accept = t.accept;
-            if (laneBits<W>(~t.accept & ~t.refuse))
+            if (maskBits(~t.accept & ~t.refuse))
                 accept |= ~t.refuse & ptrsFullTestLanes<W>(lambda, w1, w2, t.kd);
-            const int accepted = laneBits<W>(accept);
+            const int accepted = maskBits(accept);
             for (int i = 0; i < live; ++i) {
                 if (accepted & (1 << i)) {
                     counts[index[i]] = t.kd[i];
