@@ -47,8 +47,13 @@ AppRun runApp(const std::string& app, const std::string& args)
     static int counter = 0;
     const std::string log = ::testing::TempDir() + "/rawgment_app_" + std::to_string(::getpid()) + "_" +
                             std::to_string(counter++) + ".log";
-    const std::string command =
-        std::string(RAWGMENT_APP_DIR) + "/" + app + " " + args + " > '" + log + "' 2>&1";
+    std::string command = std::string(RAWGMENT_APP_DIR) + "/" + app + " " + args + " > '" + log + "' 2>&1";
+#ifdef RAWGMENT_LSAN_SUPPRESSIONS
+    // The apps' own processes need the suppressions of OpenCV's process-lifetime caches too, also when
+    // ctest runs here directly rather than through scripts/test.sh (whose LSAN_OPTIONS, if set, wins).
+    if (!std::getenv("LSAN_OPTIONS"))
+        command = "LSAN_OPTIONS='suppressions=" + std::string(RAWGMENT_LSAN_SUPPRESSIONS) + "' " + command;
+#endif
     const int raw = std::system(command.c_str());
     AppRun r;
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
