@@ -604,7 +604,6 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
     const uint64_t retryKey = poissonRetryKey(seed, stream);
     const std::array<uint32_t, 2> retryWordsKey = {static_cast<uint32_t>(retryKey),
                                                    static_cast<uint32_t>(retryKey >> 32)};
-    std::vector<std::array<uint32_t, 4>> blocks(static_cast<size_t>(retries));
     int open = 0;
     for (int r = 0; r < retries; ++r) {
         const int index = retry[static_cast<size_t>(r)];
@@ -613,9 +612,20 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
             counts[index] = static_cast<double>(rng.poisson(means[index]));
             continue;
         }
-        blocks[static_cast<size_t>(open)] =
-            philox4x32({0u, 0u, static_cast<uint32_t>(index), 0u}, retryWordsKey);
         retry[static_cast<size_t>(open++)] = index;
+    }
+    // The first blocks of eight values' streams at a time, in lanes (one block of a scalar Philox per value
+    // cost more than all the tries).
+    std::vector<std::array<uint32_t, 4>> blocks(static_cast<size_t>(open));
+    for (int start = 0; start < open; start += 8) {
+        alignas(64) uint64_t streams[8];
+        alignas(64) uint32_t blockWords[32];
+        for (int b = 0; b < 8; ++b)
+            streams[b] = start + b < open ? static_cast<uint64_t>(retry[static_cast<size_t>(start + b)]) : 0u;
+        philox8StreamsFor<W>(0, streams, retryWordsKey, blockWords);
+        for (int b = 0; b < 8 && start + b < open; ++b)
+            blocks[static_cast<size_t>(start + b)] = {blockWords[b], blockWords[8 + b], blockWords[16 + b],
+                                                      blockWords[24 + b]};
     }
     for (int attempt = 0; attempt < 2 && open > 0; ++attempt) {
         // The values still open are compacted in place: a batch is read whole before any is written back.

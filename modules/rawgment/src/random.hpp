@@ -49,17 +49,13 @@ inline std::array<uint32_t, 4> philox4x32(std::array<uint32_t, 4> c, std::array<
 // (cpu_dispatch.hpp); x86 uses the intrinsic versions below, which compute the same words.
 typedef uint64_t U64x8 __attribute__((vector_size(64)));
 
-/** The blocks (firstBlock + b, 0, stream) for b in 0..7, as philox4x32() computes them one by one:
- * word j of block b goes to words[8 j + b]. */
-inline __attribute__((always_inline)) void philox8Blocks(uint32_t firstBlock, uint64_t stream,
+//! Ten rounds on eight blocks whose counters are in c0..c3 (one block per lane, words in the low
+//! halves), then word j of block b to words[8 j + b].
+inline __attribute__((always_inline)) void philox8Rounds(U64x8 c0, U64x8 c1, U64x8 c2, U64x8 c3,
                                                          const std::array<uint32_t, 2>& key, uint32_t* words)
 {
     const U64x8 low = {0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu,
                        0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu};
-    const U64x8 zero = {};
-    const U64x8 lanes = {0, 1, 2, 3, 4, 5, 6, 7};
-    U64x8 c0 = (lanes + firstBlock) & low, c1 = zero, c2 = zero + static_cast<uint32_t>(stream),
-          c3 = zero + static_cast<uint32_t>(stream >> 32);
     uint64_t k0 = key[0], k1 = key[1];
     for (int round = 0; round < kPhiloxRounds; ++round) {
         const U64x8 p0 = (c0 & low) * kPhiloxM0;
@@ -81,6 +77,27 @@ inline __attribute__((always_inline)) void philox8Blocks(uint32_t firstBlock, ui
     std::memcpy(words + 24, &w3, sizeof(w3));
 }
 
+/** The blocks (firstBlock + b, 0, stream) for b in 0..7, as philox4x32() computes them one by one:
+ * word j of block b goes to words[8 j + b]. */
+inline __attribute__((always_inline)) void philox8Blocks(uint32_t firstBlock, uint64_t stream,
+                                                         const std::array<uint32_t, 2>& key, uint32_t* words)
+{
+    const U64x8 zero = {}, lanes = {0, 1, 2, 3, 4, 5, 6, 7};
+    philox8Rounds((lanes + firstBlock) & 0xffffffffu, zero, zero + static_cast<uint32_t>(stream),
+                  zero + static_cast<uint32_t>(stream >> 32), key, words);
+}
+
+/** The blocks (block, 0, streams[b]) for b in 0..7: block `block` of eight streams, one from each, in the
+ * layout of philox8Blocks(). */
+inline __attribute__((always_inline)) void philox8Streams(uint32_t block, const uint64_t* streams,
+                                                          const std::array<uint32_t, 2>& key, uint32_t* words)
+{
+    U64x8 s;
+    std::memcpy(&s, streams, sizeof(s));
+    const U64x8 zero = {};
+    philox8Rounds(zero + block, zero, s & 0xffffffffu, s >> 32, key, words);
+}
+
 #if RAWGMENT_HAVE_CPU_PATHS
 /* philox8Blocks() with x86 intrinsics: GCC multiplies generic 64-bit lanes with three 32-bit
  * multiplies and shifts below AVX-512, and with the slow vpmullq on it, although both factors fit 32
@@ -93,19 +110,13 @@ inline __attribute__((always_inline)) void philox8Blocks(uint32_t firstBlock, ui
  * masks per product of philox8Blocks() are not needed (about 7% of the normals' time on AVX2, Zen 3). */
 constexpr int kSwapHalves = _MM_SHUFFLE(2, 3, 0, 1);
 constexpr _MM_PERM_ENUM kSwapHalves512 = _MM_PERM_CDAB;
-inline void philox8BlocksSse2(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key,
-                              uint32_t* words)
+//! Ten rounds on eight blocks in four registers of two 64-bit lanes (counters in the low halves), then
+//! word j of block b to words[8 j + b].
+inline __attribute__((always_inline)) void philox8RoundsSse2(__m128i* c0, __m128i* c1, __m128i* c2,
+                                                             __m128i* c3, const std::array<uint32_t, 2>& key,
+                                                             uint32_t* words)
 {
-    // Eight blocks in four registers of two 64-bit lanes, each 32-bit word in a lane's low half.
     const __m128i m0 = _mm_set1_epi64x(kPhiloxM0), m1 = _mm_set1_epi64x(kPhiloxM1);
-    __m128i c0[4], c1[4], c2[4], c3[4];
-    for (int p = 0; p < 4; ++p) {
-        c0[p] = _mm_set_epi64x(static_cast<uint32_t>(firstBlock + 2 * p + 1),
-                               static_cast<uint32_t>(firstBlock + 2 * p));
-        c1[p] = _mm_setzero_si128();
-        c2[p] = _mm_set1_epi64x(static_cast<uint32_t>(stream));
-        c3[p] = _mm_set1_epi64x(static_cast<uint32_t>(stream >> 32));
-    }
     uint32_t k0 = key[0], k1 = key[1];
     for (int round = 0; round < kPhiloxRounds; ++round) {
         const __m128i kv0 = _mm_set1_epi64x(k0), kv1 = _mm_set1_epi64x(k1);
@@ -128,20 +139,40 @@ inline void philox8BlocksSse2(uint32_t firstBlock, uint64_t stream, const std::a
         }
 }
 
-__attribute__((target("arch=x86-64-v3"))) inline void
-philox8BlocksAvx2(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key, uint32_t* words)
+inline void philox8BlocksSse2(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key,
+                              uint32_t* words)
 {
-    // Eight blocks in two registers of four 64-bit lanes, each 32-bit word in a lane's low half.
-    const __m256i m0 = _mm256_set1_epi64x(kPhiloxM0), m1 = _mm256_set1_epi64x(kPhiloxM1);
-    __m256i c0[2], c1[2], c2[2], c3[2];
-    for (int p = 0; p < 2; ++p) {
-        const uint32_t b = firstBlock + 4 * p;
-        c0[p] = _mm256_set_epi64x(static_cast<uint32_t>(b + 3), static_cast<uint32_t>(b + 2),
-                                  static_cast<uint32_t>(b + 1), static_cast<uint32_t>(b));
-        c1[p] = _mm256_setzero_si256();
-        c2[p] = _mm256_set1_epi64x(static_cast<uint32_t>(stream));
-        c3[p] = _mm256_set1_epi64x(static_cast<uint32_t>(stream >> 32));
+    __m128i c0[4], c1[4], c2[4], c3[4];
+    for (int p = 0; p < 4; ++p) {
+        c0[p] = _mm_set_epi64x(static_cast<uint32_t>(firstBlock + 2 * p + 1),
+                               static_cast<uint32_t>(firstBlock + 2 * p));
+        c1[p] = _mm_setzero_si128();
+        c2[p] = _mm_set1_epi64x(static_cast<uint32_t>(stream));
+        c3[p] = _mm_set1_epi64x(static_cast<uint32_t>(stream >> 32));
     }
+    philox8RoundsSse2(c0, c1, c2, c3, key, words);
+}
+
+//! philox8Streams() with SSE2.
+inline void philox8StreamsSse2(uint32_t block, const uint64_t* streams, const std::array<uint32_t, 2>& key,
+                               uint32_t* words)
+{
+    __m128i c0[4], c1[4], c2[4], c3[4];
+    for (int p = 0; p < 4; ++p) {
+        c0[p] = _mm_set1_epi64x(block);
+        c1[p] = _mm_setzero_si128();
+        c2[p] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(streams + 2 * p)); // high halves unread
+        c3[p] = _mm_srli_epi64(c2[p], 32);
+    }
+    philox8RoundsSse2(c0, c1, c2, c3, key, words);
+}
+
+//! Ten rounds on eight blocks in two registers of four 64-bit lanes, as philox8RoundsSse2().
+__attribute__((target("arch=x86-64-v3"))) inline __attribute__((always_inline)) void
+philox8RoundsAvx2(__m256i* c0, __m256i* c1, __m256i* c2, __m256i* c3, const std::array<uint32_t, 2>& key,
+                  uint32_t* words)
+{
+    const __m256i m0 = _mm256_set1_epi64x(kPhiloxM0), m1 = _mm256_set1_epi64x(kPhiloxM1);
     uint32_t k0 = key[0], k1 = key[1];
     for (int round = 0; round < kPhiloxRounds; ++round) {
         const __m256i kv0 = _mm256_set1_epi64x(k0), kv1 = _mm256_set1_epi64x(k1);
@@ -166,22 +197,48 @@ philox8BlocksAvx2(uint32_t firstBlock, uint64_t stream, const std::array<uint32_
     }
 }
 
+__attribute__((target("arch=x86-64-v3"))) inline void
+philox8BlocksAvx2(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key, uint32_t* words)
+{
+    __m256i c0[2], c1[2], c2[2], c3[2];
+    for (int p = 0; p < 2; ++p) {
+        const uint32_t b = firstBlock + 4 * p;
+        c0[p] = _mm256_set_epi64x(static_cast<uint32_t>(b + 3), static_cast<uint32_t>(b + 2),
+                                  static_cast<uint32_t>(b + 1), static_cast<uint32_t>(b));
+        c1[p] = _mm256_setzero_si256();
+        c2[p] = _mm256_set1_epi64x(static_cast<uint32_t>(stream));
+        c3[p] = _mm256_set1_epi64x(static_cast<uint32_t>(stream >> 32));
+    }
+    philox8RoundsAvx2(c0, c1, c2, c3, key, words);
+}
+
+//! philox8Streams() with AVX2.
+__attribute__((target("arch=x86-64-v3"))) inline void philox8StreamsAvx2(uint32_t block,
+                                                                         const uint64_t* streams,
+                                                                         const std::array<uint32_t, 2>& key,
+                                                                         uint32_t* words)
+{
+    __m256i c0[2], c1[2], c2[2], c3[2];
+    for (int p = 0; p < 2; ++p) {
+        c0[p] = _mm256_set1_epi64x(block);
+        c1[p] = _mm256_setzero_si256();
+        c2[p] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(streams + 4 * p)); // high halves unread
+        c3[p] = _mm256_srli_epi64(c2[p], 32);
+    }
+    philox8RoundsAvx2(c0, c1, c2, c3, key, words);
+}
+
 // GCC 12's avx512fintrin.h warns that _mm512_mul_epu32's masked builtin reads an uninitialised
 // pass-through operand, which the full mask never uses.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #pragma GCC diagnostic ignored "-Wuninitialized"
-__attribute__((target("arch=x86-64-v4"))) inline void
-philox8BlocksAvx512(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key, uint32_t* words)
+//! Ten rounds on eight blocks in one register of eight 64-bit lanes; vpmuludq, not AVX-512's slower vpmullq.
+__attribute__((target("arch=x86-64-v4"))) inline __attribute__((always_inline)) void
+philox8RoundsAvx512(__m512i c0, __m512i c1, __m512i c2, __m512i c3, const std::array<uint32_t, 2>& key,
+                    uint32_t* words)
 {
-    // Eight blocks in one register of eight 64-bit lanes; vpmuludq, not AVX-512's slower vpmullq.
-    const __m512i low = _mm512_set1_epi64(0xffffffffLL), m0 = _mm512_set1_epi64(kPhiloxM0),
-                  m1 = _mm512_set1_epi64(kPhiloxM1);
-    __m512i c0 = _mm512_and_si512(
-                _mm512_add_epi64(_mm512_set1_epi64(firstBlock), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7)),
-                low),
-            c1 = _mm512_setzero_si512(), c2 = _mm512_set1_epi64(static_cast<uint32_t>(stream)),
-            c3 = _mm512_set1_epi64(static_cast<uint32_t>(stream >> 32));
+    const __m512i m0 = _mm512_set1_epi64(kPhiloxM0), m1 = _mm512_set1_epi64(kPhiloxM1);
     uint32_t k0 = key[0], k1 = key[1];
     for (int round = 0; round < kPhiloxRounds; ++round) {
         const __m512i p0 = _mm512_mul_epu32(c0, m0), p1 = _mm512_mul_epu32(c2, m1);
@@ -197,6 +254,28 @@ philox8BlocksAvx512(uint32_t firstBlock, uint64_t stream, const std::array<uint3
     const __m512i state[4] = {c0, c1, c2, c3};
     for (int j = 0; j < 4; ++j)
         _mm256_storeu_si256(reinterpret_cast<__m256i*>(words + 8 * j), _mm512_cvtepi64_epi32(state[j]));
+}
+
+__attribute__((target("arch=x86-64-v4"))) inline void
+philox8BlocksAvx512(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key, uint32_t* words)
+{
+    const __m512i low = _mm512_set1_epi64(0xffffffffLL);
+    philox8RoundsAvx512(
+        _mm512_and_si512(
+            _mm512_add_epi64(_mm512_set1_epi64(firstBlock), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7)), low),
+        _mm512_setzero_si512(), _mm512_set1_epi64(static_cast<uint32_t>(stream)),
+        _mm512_set1_epi64(static_cast<uint32_t>(stream >> 32)), key, words);
+}
+
+//! philox8Streams() with AVX-512.
+__attribute__((target("arch=x86-64-v4"))) inline void philox8StreamsAvx512(uint32_t block,
+                                                                           const uint64_t* streams,
+                                                                           const std::array<uint32_t, 2>& key,
+                                                                           uint32_t* words)
+{
+    const __m512i s = _mm512_loadu_si512(streams); // high halves unread
+    philox8RoundsAvx512(_mm512_set1_epi64(block), _mm512_setzero_si512(), s, _mm512_srli_epi64(s, 32), key,
+                        words);
 }
 #pragma GCC diagnostic pop
 #endif
@@ -215,6 +294,22 @@ RAWGMENT_KERNEL void philox8BlocksFor(uint32_t firstBlock, uint64_t stream,
         return philox8BlocksAvx512(firstBlock, stream, key, words);
 #endif
     philox8Blocks(firstBlock, stream, key, words);
+}
+
+//! Block `block` of eight streams (philox8Streams()) by the fastest exact means of a path of width W.
+template <int W>
+RAWGMENT_KERNEL void philox8StreamsFor(uint32_t block, const uint64_t* streams,
+                                       const std::array<uint32_t, 2>& key, uint32_t* words)
+{
+#if RAWGMENT_HAVE_CPU_PATHS
+    if (W == 4)
+        return philox8StreamsSse2(block, streams, key, words);
+    if (W == 8)
+        return philox8StreamsAvx2(block, streams, key, words);
+    if (W == 16)
+        return philox8StreamsAvx512(block, streams, key, words);
+#endif
+    philox8Streams(block, streams, key, words);
 }
 
 // clang-format off

@@ -60,6 +60,34 @@ TEST(Simulate, everyPhiloxVersionGivesTheBlocksOfTheScalarOne)
                                 << version.first << ", block " << b << ", word " << j;
                     }
                 }
+    // One block of eight streams (fillPoisson's retries), with streams whose high words differ too.
+    typedef void (*EightStreams)(uint32_t, const uint64_t*, const A2&, uint32_t*);
+    std::vector<std::pair<const char*, EightStreams>> streamVersions = {
+        {"vector extensions", [](uint32_t b, const uint64_t* s, const A2& k, uint32_t* w) {
+             detail::philox8Streams(b, s, k, w);
+         }}};
+#if RAWGMENT_HAVE_CPU_PATHS
+    streamVersions.push_back({"SSE2", detail::philox8StreamsSse2});
+    if (isCpuPathAvailable(CpuPath::AVX2))
+        streamVersions.push_back({"AVX2", detail::philox8StreamsAvx2});
+    if (isCpuPathAvailable(CpuPath::AVX512))
+        streamVersions.push_back({"AVX-512", detail::philox8StreamsAvx512});
+#endif
+    const uint64_t streams[8] = {0, 1, 7, 4000, 0xffffffffull, 0x100000000ull, 0xfedcba9876543210ull, 42};
+    for (const auto& version : streamVersions)
+        for (const A2 key : {A2{0, 0}, A2{42, 7}, A2{0xffffffff, 0xffffffff}})
+            for (const uint32_t block : {0u, 3u, 0xffffffffu}) {
+                uint32_t words[32];
+                version.second(block, streams, key, words);
+                for (int b = 0; b < 8; ++b) {
+                    const A4 expected = detail::philox4x32(A4{block, 0, static_cast<uint32_t>(streams[b]),
+                                                              static_cast<uint32_t>(streams[b] >> 32)},
+                                                           key);
+                    for (int j = 0; j < 4; ++j)
+                        ASSERT_EQ(words[8 * j + b], expected[static_cast<size_t>(j)])
+                            << version.first << ", stream " << streams[b] << ", word " << j;
+                }
+            }
 }
 
 //! A noiseless-readout sensor: with alpha = 1 and no rounding, a capture is Poisson(mean) + black.
