@@ -71,6 +71,10 @@ template <typename V> inline __attribute__((always_inline)) V sqrtLanes(V v)
 } // namespace rawgment
 } // namespace cv
 
+/* A kernel's helpers are inlined into each path's entry point and so compiled for its target. Not so a
+ * lambda's body: it is a function of its own, compiled for the baseline, which on AVX2 then passes 256-bit
+ * vectors to the AVX helpers by another ABI (GCC's -Wpsabi, which the build silences). Such a lambda once
+ * gave wrong Poisson counts on the AVX2 path only; a kernel's helper is a RAWGMENT_KERNEL function. */
 #define RAWGMENT_KERNEL static inline __attribute__((always_inline))
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(RAWGMENT_NO_MULTIVERSIONING)

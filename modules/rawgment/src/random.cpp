@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstring>
 #include <limits>
+#include <memory>
 
 namespace cv {
 namespace rawgment {
@@ -512,6 +513,45 @@ inline void appendBits(int bits, int lanes, int base, int* list, int& size)
     }
 }
 
+/* PTRS's full test for the values of list[0..size), whose try's count is in counts and whose words are in
+ * firstWords and secondWords, gathered into whole vectors a chunk's worth at a time so that the groups'
+ * long chains of divisions and logarithms overlap; the values it rejects go to out[outSize..). (A kernel,
+ * not a lambda: a lambda would not take the target of the kernel it is in.) */
+template <int W>
+RAWGMENT_KERNEL void ptrsFullTestPass(const double* means, const double* counts, const uint32_t* firstWords,
+                                      const uint32_t* secondWords, const int* list, int size, int* out,
+                                      int& outSize)
+{
+    typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::UL UL;
+    const int kLanes = DoubleLanes<W>::kCount, kChunk = 16, kGroups = kChunk / kLanes;
+    for (int start = 0; start < size; start += kChunk) {
+        const int live = std::min(kChunk, size - start);
+        alignas(64) double lambdas[kChunk], kds[kChunk];
+        alignas(64) uint64_t firsts[kChunk], seconds[kChunk];
+        for (int i = 0; i < kChunk; ++i) {
+            const int index = i < live ? list[start + i] : -1; // padding lanes test a valid try
+            lambdas[i] = index >= 0 ? means[index] : 10.0;
+            kds[i] = index >= 0 ? counts[index] : 10.0;
+            firsts[i] = index >= 0 ? firstWords[index] : 0u;
+            seconds[i] = index >= 0 ? secondWords[index] : 0u;
+        }
+        int accepted = 0;
+        for (int g = 0; g < kGroups; ++g) {
+            D lambda, kd;
+            UL w1, w2;
+            std::memcpy(&lambda, lambdas + g * kLanes, sizeof(lambda));
+            std::memcpy(&kd, kds + g * kLanes, sizeof(kd));
+            std::memcpy(&w1, firsts + g * kLanes, sizeof(w1));
+            std::memcpy(&w2, seconds + g * kLanes, sizeof(w2));
+            accepted |= maskBits(ptrsFullTestLanes<W>(lambda, w1, w2, kd)) << (g * kLanes);
+        }
+        for (int i = 0; i < live; ++i)
+            if (!(accepted & (1 << i)))
+                out[outSize++] = list[start + i];
+    }
+}
+
 template <int W>
 RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const double* means, double* counts,
                                        int n)
@@ -527,14 +567,15 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
     const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
     // Every value's two words, kept for the full tests; the values whose first try needs the full test,
     // and those to retry.
-    std::vector<uint32_t> firstWords(static_cast<size_t>(n) + kChunk),
-        secondWords(static_cast<size_t>(n) + kChunk);
-    std::vector<int> fullTest(static_cast<size_t>(n) + kChunk), retry(static_cast<size_t>(n) + kChunk);
+    // Left uninitialised: zeroing them cost about 0.5 ns per value, and only written entries are read.
+    const size_t room = static_cast<size_t>(n) + kChunk;
+    const std::unique_ptr<uint32_t[]> firstWords(new uint32_t[room]), secondWords(new uint32_t[room]);
+    const std::unique_ptr<int[]> fullTest(new int[room]), retry(new int[room]);
     int fullTests = 0, retries = 0;
     for (int base = 0; base < n; base += kChunk) {
         philox8BlocksFor<W>(static_cast<uint32_t>(base / 2), stream, key, words);
-        std::memcpy(firstWords.data() + base, words, sizeof(uint32_t) * kChunk);
-        std::memcpy(secondWords.data() + base, words + kChunk, sizeof(uint32_t) * kChunk);
+        std::memcpy(firstWords.get() + base, words, sizeof(uint32_t) * kChunk);
+        std::memcpy(secondWords.get() + base, words + kChunk, sizeof(uint32_t) * kChunk);
         const int count = std::min(kChunk, n - base);
         for (int i = 0; i < kChunk; ++i) {
             const double m = i < count ? means[base + i] : 0.0;
@@ -554,48 +595,24 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
             const int live = std::max(0, std::min(kLanes, count - g * kLanes));
             const int liveBits = (1 << live) - 1;
             const int base0 = base + g * kLanes;
-            appendBits(maskBits(beyond) & liveBits, kLanes, base0, retry.data(), retries);
+            if (maskBits(beyond))
+                appendBits(maskBits(beyond) & liveBits, kLanes, base0, retry.get(), retries);
             if (!maskBits(ptrs))
                 continue;
             const PtrsTryLanes<W> t = ptrsTryLanes<W>(
                 ptrs ? lambda : D{} + 10.0, __builtin_convertvector(a, UL), __builtin_convertvector(b, UL));
             std::memcpy(chunkCounts + g * kLanes, &t.kd, sizeof(t.kd));
-            appendBits(maskBits(ptrs & ~t.accept & ~t.refuse) & liveBits, kLanes, base0, fullTest.data(),
+            appendBits(maskBits(ptrs & ~t.accept & ~t.refuse) & liveBits, kLanes, base0, fullTest.get(),
                        fullTests);
-            appendBits(maskBits(ptrs & t.refuse) & liveBits, kLanes, base0, retry.data(), retries);
+            appendBits(maskBits(ptrs & t.refuse) & liveBits, kLanes, base0, retry.get(), retries);
         }
         if (smallBits)
             poissonInversionLanes<W, kChunk / DoubleLanes<W>::kCount>(chunkMeans, words, chunkCounts);
         std::memcpy(counts + base, chunkCounts, sizeof(double) * static_cast<size_t>(count));
     }
-    // The full tests of first tries, gathered into whole vectors, a chunk's worth at a time so that the
-    // groups' long chains of divisions and logarithms overlap; the values they reject join the retries.
-    for (int start = 0; start < fullTests; start += kChunk) {
-        const int live = std::min(kChunk, fullTests - start);
-        alignas(64) double lambdas[kChunk], kds[kChunk];
-        alignas(64) uint64_t firsts[kChunk], seconds[kChunk];
-        for (int i = 0; i < kChunk; ++i) {
-            // The try's count is in counts already (phase one wrote it); padding lanes test a valid try.
-            const int index = i < live ? fullTest[static_cast<size_t>(start + i)] : -1;
-            lambdas[i] = index >= 0 ? means[index] : 10.0;
-            kds[i] = index >= 0 ? counts[index] : 10.0;
-            firsts[i] = index >= 0 ? firstWords[static_cast<size_t>(index)] : 0u;
-            seconds[i] = index >= 0 ? secondWords[static_cast<size_t>(index)] : 0u;
-        }
-        int accepted = 0;
-        for (int g = 0; g < kGroups; ++g) {
-            D lambda, kd;
-            UL w1, w2;
-            std::memcpy(&lambda, lambdas + g * kLanes, sizeof(lambda));
-            std::memcpy(&kd, kds + g * kLanes, sizeof(kd));
-            std::memcpy(&w1, firsts + g * kLanes, sizeof(w1));
-            std::memcpy(&w2, seconds + g * kLanes, sizeof(w2));
-            accepted |= maskBits(ptrsFullTestLanes<W>(lambda, w1, w2, kd)) << (g * kLanes);
-        }
-        for (int i = 0; i < live; ++i)
-            if (!(accepted & (1 << i)))
-                retry[static_cast<size_t>(retries++)] = fullTest[static_cast<size_t>(start + i)];
-    }
+    // The full tests of the first tries; the values they reject join the retries.
+    ptrsFullTestPass<W>(means, counts, firstWords.get(), secondWords.get(), fullTest.get(), fullTests,
+                        retry.get(), retries);
     if (retries == 0)
         return;
     // A retried value draws from its own CounterRng (poissonRetryKey(seed, stream), index): two more tries
@@ -615,48 +632,66 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
         retry[static_cast<size_t>(open++)] = index;
     }
     // The first blocks of eight values' streams at a time, in lanes (one block of a scalar Philox per value
-    // cost more than all the tries).
-    std::vector<std::array<uint32_t, 4>> blocks(static_cast<size_t>(open));
+    // cost more than all the tries). The first try's words are spent, so the second try's take their
+    // place; the third try's wait in the lists' place (fullTest is free now, and retry has its own).
+    const std::unique_ptr<uint32_t[]> thirdWords(new uint32_t[room]), fourthWords(new uint32_t[room]);
     for (int start = 0; start < open; start += 8) {
         alignas(64) uint64_t streams[8];
         alignas(64) uint32_t blockWords[32];
         for (int b = 0; b < 8; ++b)
             streams[b] = start + b < open ? static_cast<uint64_t>(retry[static_cast<size_t>(start + b)]) : 0u;
         philox8StreamsFor<W>(0, streams, retryWordsKey, blockWords);
-        for (int b = 0; b < 8 && start + b < open; ++b)
-            blocks[static_cast<size_t>(start + b)] = {blockWords[b], blockWords[8 + b], blockWords[16 + b],
-                                                      blockWords[24 + b]};
+        for (int b = 0; b < 8 && start + b < open; ++b) {
+            const size_t index = static_cast<size_t>(retry[static_cast<size_t>(start + b)]);
+            firstWords[index] = blockWords[b];
+            secondWords[index] = blockWords[8 + b];
+            thirdWords[index] = blockWords[16 + b];
+            fourthWords[index] = blockWords[24 + b];
+        }
     }
     for (int attempt = 0; attempt < 2 && open > 0; ++attempt) {
-        // The values still open are compacted in place: a batch is read whole before any is written back.
-        int still = 0;
-        for (int start = 0; start < open; start += kLanes) {
-            const int live = std::min(kLanes, open - start);
-            D lambda = D{} + 10.0;
-            UL w1 = {}, w2 = {};
-            int index[DoubleLanes<W>::kCount];
-            std::array<uint32_t, 4> block[DoubleLanes<W>::kCount];
-            for (int i = 0; i < live; ++i) {
-                index[i] = retry[static_cast<size_t>(start + i)];
-                block[i] = blocks[static_cast<size_t>(start + i)];
-                lambda[i] = means[index[i]];
-                w1[i] = block[i][static_cast<size_t>(2 * attempt)];
-                w2[i] = block[i][static_cast<size_t>(2 * attempt + 1)];
+        if (attempt == 1)
+            for (int r = 0; r < open; ++r) {
+                const size_t index = static_cast<size_t>(retry[static_cast<size_t>(r)]);
+                firstWords[index] = thirdWords[index];
+                secondWords[index] = fourthWords[index];
             }
-            const PtrsTryLanes<W> t = ptrsTryLanes<W>(lambda, w1, w2);
-            L accept = t.accept;
-            if (maskBits(~t.accept & ~t.refuse))
-                accept |= ~t.refuse & ptrsFullTestLanes<W>(lambda, w1, w2, t.kd);
-            const int accepted = maskBits(accept);
+        // The tries, gathered a chunk at a time as the first ones; the values they refuse are compacted in
+        // place (a chunk is read whole before any is written back), those the full test rejects join them.
+        int still = 0, undecided = 0;
+        for (int start = 0; start < open; start += kChunk) {
+            const int live = std::min(kChunk, open - start);
+            alignas(64) double lambdas[kChunk], kds[kChunk];
+            alignas(64) uint64_t firsts[kChunk], seconds[kChunk];
+            int index[kChunk];
+            for (int i = 0; i < kChunk; ++i) {
+                index[i] = i < live ? retry[static_cast<size_t>(start + i)] : -1;
+                lambdas[i] = index[i] >= 0 ? means[index[i]] : 10.0;
+                firsts[i] = index[i] >= 0 ? firstWords[static_cast<size_t>(index[i])] : 0u;
+                seconds[i] = index[i] >= 0 ? secondWords[static_cast<size_t>(index[i])] : 0u;
+            }
+            int decidedBits = 0, refusedBits = 0;
+            for (int g = 0; g < kGroups; ++g) {
+                D lambda;
+                UL w1, w2;
+                std::memcpy(&lambda, lambdas + g * kLanes, sizeof(lambda));
+                std::memcpy(&w1, firsts + g * kLanes, sizeof(w1));
+                std::memcpy(&w2, seconds + g * kLanes, sizeof(w2));
+                const PtrsTryLanes<W> t = ptrsTryLanes<W>(lambda, w1, w2);
+                std::memcpy(kds + g * kLanes, &t.kd, sizeof(t.kd));
+                decidedBits |= maskBits(t.accept | t.refuse) << (g * kLanes);
+                refusedBits |= maskBits(t.refuse) << (g * kLanes);
+            }
             for (int i = 0; i < live; ++i) {
-                if (accepted & (1 << i)) {
-                    counts[index[i]] = t.kd[i];
-                } else {
-                    retry[static_cast<size_t>(still)] = index[i];
-                    blocks[static_cast<size_t>(still++)] = block[i];
-                }
+                counts[index[i]] = kds[i];
+                if (refusedBits & (1 << i))
+                    retry[static_cast<size_t>(still++)] = index[i];
+                else if (!(decidedBits & (1 << i)))
+                    fullTest[static_cast<size_t>(undecided++)] = index[i];
             }
         }
+        ptrsFullTestPass<W>(means, counts, firstWords.get(), secondWords.get(), fullTest.get(), undecided,
+                            retry.get(), still);
         open = still;
     }
     for (int r = 0; r < open; ++r) {
