@@ -107,25 +107,28 @@ void bindAugment(py::module_& m)
     m.def(
         "colorJitter",
         [](const py::object& src, const RawFormat& format, const NoiseModel& model, const ColorJitter& jitter,
-           const NoiseOptions& noise, uint64 seed, bool saturatedMask) -> py::tuple {
+           const NoiseOptions& noise, uint64 seed, bool saturatedMask, const py::object& dst) -> py::tuple {
             const cv::Mat in = matFromArray(src, "src", kMosaicDepths);
-            cv::Mat dst, mask;
+            const cv::Mat target = outputMatLike(dst, "dst", in);
+            cv::Mat out = target, mask;
             RawFormat dstFormat;
             AugmentReport report;
             withoutGil("colorJitter", [&] {
-                colorJitter(in, format, model, jitter, noise, seed, dst, dstFormat, &report,
+                colorJitter(in, format, model, jitter, noise, seed, out, dstFormat, &report,
                             saturatedMask ? cv::_OutputArray(mask) : cv::_OutputArray(cv::noArray()));
             });
             if (saturatedMask)
-                return py::make_tuple(arrayFromMat(dst), dstFormat, report, arrayFromMat(mask));
-            return py::make_tuple(arrayFromMat(dst), dstFormat, report);
+                return py::make_tuple(resultInto(dst, target, out), dstFormat, report, arrayFromMat(mask));
+            return py::make_tuple(resultInto(dst, target, out), dstFormat, report);
         },
         py::arg("src"), py::arg("format"), py::arg("model"), py::arg("jitter"),
         py::arg("noise") = NoiseOptions(), py::kw_only(), py::arg("seed"), py::arg("saturatedMask") = false,
+        py::arg("dst") = py::none(),
         doc("colorJitter",
             "Python: colorJitter(src, format, model, jitter, noise=NoiseOptions(), *, seed, "
-            "saturatedMask=False) returns (dst, dstFormat, report), and the mask last when "
-            "saturatedMask is True. dst is a new array (a copy of src for an identity step)."));
+            "saturatedMask=False, dst=None) returns (dst, dstFormat, report), and the mask last when "
+            "saturatedMask is True. dst is a new array (a copy of src for an identity step), or the "
+            "caller's dst (an array of src's shape and dtype, padded rows allowed), written in place."));
     m.attr("MAX_MOTION_LENGTH") = MAX_MOTION_LENGTH;
     m.def(
         "linearMotionKernel",
@@ -137,17 +140,19 @@ void bindAugment(py::module_& m)
     m.def(
         "motionBlur",
         [](const py::object& src, const RawFormat& format, const NoiseModel& model, const py::object& kernel,
-           const NoiseOptions& noise, uint64 seed) {
+           const NoiseOptions& noise, uint64 seed, const py::object& dst) {
             const cv::Mat in = matFromArray(src, "src", kMosaicDepths);
             const cv::Mat k = matFromArray(kernel, "kernel", {CV_32F, CV_64F});
-            cv::Mat dst;
+            const cv::Mat target = outputMatLike(dst, "dst", in);
+            cv::Mat out = target;
             AugmentReport report;
-            withoutGil("motionBlur", [&] { motionBlur(in, format, model, k, noise, seed, dst, &report); });
-            return py::make_tuple(arrayFromMat(dst), report);
+            withoutGil("motionBlur", [&] { motionBlur(in, format, model, k, noise, seed, out, &report); });
+            return py::make_tuple(resultInto(dst, target, out), report);
         },
         py::arg("src"), py::arg("format"), py::arg("model"), py::arg("kernel"),
-        py::arg("noise") = NoiseOptions(), py::kw_only(), py::arg("seed"),
-        doc("motionBlur", "Python: returns (dst, report)."));
+        py::arg("noise") = NoiseOptions(), py::kw_only(), py::arg("seed"), py::arg("dst") = py::none(),
+        doc("motionBlur", "Python: motionBlur(src, format, model, kernel, noise=NoiseOptions(), *, seed, "
+                          "dst=None) returns (dst, report); dst as colorJitter's."));
     m.def(
         "scaleMosaic",
         [](const py::object& src, const RawFormat& format, const NoiseModel& model, double scale,

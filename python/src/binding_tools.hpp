@@ -44,6 +44,16 @@ cv::Mat sampleFromArray(const py::handle& array, const char* argument);
 std::vector<cv::Mat> matsFromList(const py::handle& list, const char* argument,
                                   const std::vector<int>& depths);
 
+/** The Mat over a caller's output array (the `dst=` keyword, as cv2's dst arguments): of the dtype and
+ * shape of `like` (the input), contiguous rows and writable, else a TypeError or ValueError naming
+ * `argument`. None gives an empty Mat, which the call allocates. */
+cv::Mat outputMatLike(const py::object& dst, const char* argument, const cv::Mat& like);
+
+/** The result of a call that wrote `out`, given the caller's output `dst` and its Mat `target`
+ * (outputMatLike()): dst itself, with out copied in where the call could not write in place (an
+ * identity step returns the input; dst sharing memory with the input), or a new array without dst. */
+py::object resultInto(const py::object& dst, const cv::Mat& target, const cv::Mat& out);
+
 /** A numpy array of a Mat: shares the data when OpenCV allocated it (no copy), copies it when the Mat
  * points into memory it does not own (an input's, which an identity step returns). */
 py::array arrayFromMat(const cv::Mat& mat);

@@ -170,6 +170,30 @@ std::vector<cv::Mat> matsFromList(const py::handle& list, const char* argument,
     return mats;
 }
 
+cv::Mat outputMatLike(const py::object& dst, const char* argument, const cv::Mat& like)
+{
+    if (dst.is_none())
+        return cv::Mat();
+    const cv::Mat m = matFromArray(dst, argument, {like.depth()}, like.channels() > 1);
+    if (m.size() != like.size() || m.type() != like.type())
+        throw py::value_error(std::string("argument '") + argument + "' has shape " +
+                              shapeOf(py::reinterpret_borrow<py::array>(dst)) + "; expected " +
+                              std::to_string(like.rows) + " x " + std::to_string(like.cols) +
+                              ", the shape of src");
+    if (!py::reinterpret_borrow<py::array>(dst).writeable())
+        throw py::value_error(std::string("argument '") + argument + "' is read-only");
+    return m;
+}
+
+py::object resultInto(const py::object& dst, const cv::Mat& target, const cv::Mat& out)
+{
+    if (dst.is_none())
+        return arrayFromMat(out);
+    if (out.data != target.data)
+        out.copyTo(target);
+    return dst;
+}
+
 py::array arrayFromMat(const cv::Mat& mat)
 {
     const int depth = mat.depth();

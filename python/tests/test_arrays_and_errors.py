@@ -38,6 +38,59 @@ def test_outputs_own_their_memory_and_never_alias_an_input(sensor, capture):
     assert not np.shares_memory(scene_out, capture)
 
 
+def test_dst_is_written_in_place_and_gives_the_same_bits(sensor, capture):
+    fmt, model = sensor.rawFormat(2.0), sensor.effectiveModel()
+    jitter = rg.ColorJitter.exposureChange(0.3, 2.0)
+    expected = rg.colorJitter(capture, fmt, model, jitter, seed=4)[0]
+    buffer = np.full_like(capture, 7)
+    result = rg.colorJitter(capture, fmt, model, jitter, seed=4, dst=buffer)
+    assert result[0] is buffer and np.array_equal(buffer, expected)
+    assert result[1].gain == rg.colorJitter(capture, fmt, model, jitter, seed=4)[1].gain
+    # Reused: the next seed overwrites every pixel.
+    rg.colorJitter(capture, fmt, model, jitter, seed=5, dst=buffer)
+    assert np.array_equal(buffer, rg.colorJitter(capture, fmt, model, jitter, seed=5)[0])
+    # A crop of a wider array (padded rows): only the crop is written.
+    wide = np.zeros((capture.shape[0], capture.shape[1] + 2), np.uint16)
+    rg.colorJitter(capture, fmt, model, jitter, seed=4, dst=wide[:, 1:-1])
+    assert np.array_equal(wide[:, 1:-1], expected) and not wide[:, 0].any() and not wide[:, -1].any()
+    # In place over the input, and an identity step: the result still lands in dst.
+    same = capture.copy()
+    assert rg.colorJitter(same, fmt, model, jitter, seed=4, dst=same)[0] is same
+    assert np.array_equal(same, expected)
+    identity = np.zeros_like(capture)
+    rg.colorJitter(capture, fmt, model, rg.ColorJitter(), seed=4, dst=identity)
+    assert np.array_equal(identity, capture)
+    # motionBlur takes dst too.
+    kernel = rg.linearMotionKernel(5, 30)
+    blurred = np.zeros_like(capture)
+    assert rg.motionBlur(capture, fmt, model, kernel, seed=2, dst=blurred)[0] is blurred
+    assert np.array_equal(blurred, rg.motionBlur(capture, fmt, model, kernel, seed=2)[0])
+
+
+@pytest.mark.parametrize("dst, error, words", [
+    ([[0]], TypeError, ["'dst'", "numpy array", "list"]),
+    (np.zeros((96, 128), np.float32), TypeError, ["'dst'", "float32", "uint16"]),
+    (np.zeros((96, 100), np.uint16), ValueError, ["'dst'", "(96, 100)", "96 x 128, the shape of src"]),
+    (np.zeros((96, 256), np.uint16)[:, ::2], ValueError, ["'dst'", "not contiguous"]),
+])
+def test_bad_dst_names_the_argument(sensor, capture, dst, error, words):
+    assert capture.shape == (96, 128)
+    with pytest.raises(error) as info:
+        rg.colorJitter(capture, sensor.rawFormat(1.0), sensor.effectiveModel(),
+                       rg.ColorJitter.exposureChange(0.5, 1.0), seed=1, dst=dst)
+    for w in words:
+        assert w in str(info.value)
+
+
+def test_read_only_dst_is_refused(sensor, capture):
+    frozen = np.zeros_like(capture)
+    frozen.flags.writeable = False
+    with pytest.raises(ValueError, match="'dst' is read-only"):
+        rg.colorJitter(capture, sensor.rawFormat(1.0), sensor.effectiveModel(),
+                       rg.ColorJitter.exposureChange(0.5, 1.0), seed=1, dst=frozen)
+    assert not frozen.any()
+
+
 @pytest.mark.parametrize("bad, error, words", [
     ([[1, 2], [3, 4]], TypeError, ["'src'", "numpy array", "list"]),
     (np.zeros((8, 8), np.int32), TypeError, ["'src'", "int32", "uint16 or float32"]),
