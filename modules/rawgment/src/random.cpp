@@ -513,17 +513,80 @@ inline void appendBits(int bits, int lanes, int base, int* list, int& size)
     }
 }
 
+/* The largest mean and count the float pre-test takes: counts stay exact in float (below 2^24), and the
+ * margin below holds (its analysis assumes them). Others take the double test only. */
+constexpr double kMaxFloatTestMean = 4194304.0, kMaxFloatTestCount = 8388608.0;
+
+/* PTRS's full test of ptrsFullTestLanes() in float lanes, for 16 values given as the double quantities
+ * the double test starts from (us, v, lambda, k; q = lambda / k, s = 1 - q and Stirling's remainder, from
+ * the same double division 1 / k), rounded to float. Both sides are written so that no cancellation is
+ * left to float: k ln(lambda / k) + k - lambda = -k psi(s) with psi(s) = -ln(1 - s) - s = s^2 (1/2 + s/3 +
+ * ... + s^11/13) below |s| = 1/4 (the series' next term is below 1e-8 relative), -ln q - s above (psi >=
+ * 0.026 there, so the roundings of q and s, about 1e-7 absolute, are below 4e-6 of it). Every float
+ * operation errs by at most half an ulp (logPositiveLanes(): about one ulp, plus ln 2 in float times the
+ * exponent, below 3e-7), so each side is within 5e-6 absolute plus 2e-5 of its own size of the double test's
+ * value, and the double test within 1e-9 of the exact one. A value is decided where the two sides differ by
+ * more than the margin 2^-10 + 2^-14 (|lhs| + k psi + |rhs|): 190 times the absolute bound, and since |rhs|
+ * >= k psi, 6 times the relative one. The rest (0.3-0.8% of the values tested, at means 15 to 5000) and the
+ * values beyond the float range take the double test, so the counts are the double test's. Bit i of
+ * `decided` and `accepted` is value i. */
+template <int W>
+RAWGMENT_KERNEL void ptrsFullTestFloatLanes(const float* lambdas, const float* ks, const float* qs,
+                                            const float* ss, const float* remainders, const float* uss,
+                                            const float* vs, int& decided, int& accepted)
+{
+    typedef typename Lanes<W>::F F;
+    typedef typename Lanes<W>::I I;
+    decided = accepted = 0;
+    for (int h = 0; h < 16; h += W) {
+        F lambda, k, q, s, remainder, us, v;
+        std::memcpy(&lambda, lambdas + h, sizeof(F));
+        std::memcpy(&remainder, remainders + h, sizeof(F));
+        std::memcpy(&k, ks + h, sizeof(F));
+        std::memcpy(&q, qs + h, sizeof(F));
+        std::memcpy(&s, ss + h, sizeof(F));
+        std::memcpy(&us, uss + h, sizeof(F));
+        std::memcpy(&v, vs + h, sizeof(F));
+        const F one = F{} + 1.0f;
+        const I positive = k >= 1.0f;
+        const F kk = positive ? k : one;
+        const F b = 0.931f + 2.53f * sqrtLanes(lambda);
+        const F a = -0.059f + 0.02483f * b;
+        const F invAlpha = 1.1239f + 1.1328f / (b - 3.4f);
+        const F us2 = us * us;
+        const F root = positive ? sqrtLanes(6.283185307f * kk) : one;
+        const F lhs = logPositiveLanes<W>(v * invAlpha * root * us2 / (a + b * us2));
+        // psi(s): the series by Estrin's scheme where |s| < 1/4, else from ln q.
+        const F s2 = s * s, s4 = s2 * s2, s8 = s4 * s4;
+        const F p01 = 0.5f + s * (1.0f / 3), p23 = 0.25f + s * 0.2f, p45 = (1.0f / 6) + s * (1.0f / 7),
+                p67 = 0.125f + s * (1.0f / 9), p89 = 0.1f + s * (1.0f / 11),
+                p1011 = (1.0f / 12) + s * (1.0f / 13);
+        const F series = s2 * ((p01 + s2 * p23) + s4 * (p45 + s2 * p67) + s8 * (p89 + s2 * p1011));
+        const I small = maxLanes(s, -s) < 0.25f;
+        const F direct = -logPositiveLanes<W>(positive ? q : one) - s;
+        const F kPsi = positive ? kk * (small ? series : direct) : F{};
+        const F rhs = positive ? -kPsi - remainder : -lambda;
+        const F gap = lhs - rhs;
+        const F margin = 9.765625e-4f + 6.103515625e-5f * (maxLanes(lhs, -lhs) + kPsi + maxLanes(rhs, -rhs));
+        decided |= maskBits(maxLanes(gap, -gap) > margin) << h;
+        accepted |= maskBits(gap < 0.0f) << h;
+    }
+}
+
 /* PTRS's full test for the values of list[0..size), whose try's count is in counts and whose words are in
- * firstWords and secondWords, gathered into whole vectors a chunk's worth at a time so that the groups'
- * long chains of divisions and logarithms overlap; the values it rejects go to out[outSize..). (A kernel,
- * not a lambda: a lambda would not take the target of the kernel it is in.) */
+ * firstWords and secondWords, gathered a chunk's worth at a time: in float lanes with a margin
+ * (ptrsFullTestFloatLanes()), then in double lanes for the groups with a value the float test left
+ * undecided. The values it rejects go to out[outSize..). (A kernel, not a lambda: a lambda would not take
+ * the target of the kernel it is in.) */
 template <int W>
 RAWGMENT_KERNEL void ptrsFullTestPass(const double* means, const double* counts, const uint32_t* firstWords,
                                       const uint32_t* secondWords, const int* list, int size, int* out,
                                       int& outSize)
 {
     typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::L L;
     typedef typename DoubleLanes<W>::UL UL;
+    typedef float F4 __attribute__((vector_size(2 * W))); // the floats of one double vector's lanes
     const int kLanes = DoubleLanes<W>::kCount, kChunk = 16, kGroups = kChunk / kLanes;
     for (int start = 0; start < size; start += kChunk) {
         const int live = std::min(kChunk, size - start);
@@ -536,7 +599,11 @@ RAWGMENT_KERNEL void ptrsFullTestPass(const double* means, const double* counts,
             firsts[i] = index >= 0 ? firstWords[index] : 0u;
             seconds[i] = index >= 0 ? secondWords[index] : 0u;
         }
-        int accepted = 0;
+        // The float test's inputs, from the double quantities of the double test.
+        alignas(64) float lambdaF[kChunk], kF[kChunk], qF[kChunk], sF[kChunk], remainderF[kChunk],
+            usF[kChunk], vF[kChunk];
+        alignas(64) double remainders[kChunk];
+        int eligible = 0;
         for (int g = 0; g < kGroups; ++g) {
             D lambda, kd;
             UL w1, w2;
@@ -544,11 +611,61 @@ RAWGMENT_KERNEL void ptrsFullTestPass(const double* means, const double* counts,
             std::memcpy(&kd, kds + g * kLanes, sizeof(kd));
             std::memcpy(&w1, firsts + g * kLanes, sizeof(w1));
             std::memcpy(&w2, seconds + g * kLanes, sizeof(w2));
-            accepted |= maskBits(ptrsFullTestLanes<W>(lambda, w1, w2, kd)) << (g * kLanes);
+            const D u = uniform32LanesD<W>(w1) - 0.5;
+            const D us = 0.5 - (u < 0.0 ? -u : u);
+            const D v = uniform32LanesD<W>(w2);
+            const L positive = kd >= 1.0;
+            const D inv = 1.0 / (positive ? kd : D{} + 1.0), inv2 = inv * inv;
+            const D q = positive ? lambda * inv : D{} + 1.0;
+            const D s = 1.0 - q;
+            // Stirling's remainder as ptrsFullTestLanes() has it (the table below 32, filled in below).
+            const D remainder = inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260)));
+            std::memcpy(remainders + g * kLanes, &remainder, sizeof(remainder));
+            eligible |= maskBits((lambda <= kMaxFloatTestMean) & (kd <= kMaxFloatTestCount)) << (g * kLanes);
+            const F4 lf = __builtin_convertvector(lambda, F4), kf = __builtin_convertvector(kd, F4),
+                     qf = __builtin_convertvector(q, F4), sf = __builtin_convertvector(s, F4),
+                     usf = __builtin_convertvector(us, F4), vf = __builtin_convertvector(v, F4);
+            std::memcpy(lambdaF + g * kLanes, &lf, sizeof(lf));
+            std::memcpy(kF + g * kLanes, &kf, sizeof(kf));
+            std::memcpy(qF + g * kLanes, &qf, sizeof(qf));
+            std::memcpy(sF + g * kLanes, &sf, sizeof(sf));
+            std::memcpy(usF + g * kLanes, &usf, sizeof(usf));
+            std::memcpy(vF + g * kLanes, &vf, sizeof(vf));
         }
-        for (int i = 0; i < live; ++i)
-            if (!(accepted & (1 << i)))
-                out[outSize++] = list[start + i];
+        const std::array<double, 32>& table = stirlingRemainderTable();
+        for (int i = 0; i < kChunk; ++i) {
+            const double k = kds[i];
+            remainderF[i] =
+                static_cast<float>(k < 32 ? table[static_cast<size_t>(k < 1 ? 1 : k)] : remainders[i]);
+        }
+        // Lanes beyond the float range hold values float cannot represent well; they are never decided.
+        for (int i = 0; i < kChunk; ++i)
+            if (!(eligible & (1 << i))) {
+                lambdaF[i] = kF[i] = qF[i] = usF[i] = vF[i] = 1.0f;
+                sF[i] = 0.0f;
+            }
+        int decided = 0, accepted = 0;
+        ptrsFullTestFloatLanes<W>(lambdaF, kF, qF, sF, remainderF, usF, vF, decided, accepted);
+        decided &= eligible;
+        accepted &= decided;
+        for (int g = 0; g < kGroups; ++g) {
+            const int groupBits = ((1 << kLanes) - 1) << (g * kLanes);
+            if ((decided & groupBits) == groupBits)
+                continue;
+            D lambda, kd;
+            UL w1, w2;
+            std::memcpy(&lambda, lambdas + g * kLanes, sizeof(lambda));
+            std::memcpy(&kd, kds + g * kLanes, sizeof(kd));
+            std::memcpy(&w1, firsts + g * kLanes, sizeof(w1));
+            std::memcpy(&w2, seconds + g * kLanes, sizeof(w2));
+            const int exact = maskBits(ptrsFullTestLanes<W>(lambda, w1, w2, kd)) << (g * kLanes);
+            accepted |= exact & groupBits & ~decided;
+        }
+        // Without branches (out has room for one more): which values are rejected is a coin flip.
+        for (int i = 0; i < live; ++i) {
+            out[outSize] = list[start + i];
+            outSize += ((accepted >> i) & 1) ^ 1;
+        }
     }
 }
 
@@ -682,12 +799,12 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
                 decidedBits |= maskBits(t.accept | t.refuse) << (g * kLanes);
                 refusedBits |= maskBits(t.refuse) << (g * kLanes);
             }
-            for (int i = 0; i < live; ++i) {
+            for (int i = 0; i < live; ++i) { // without branches, as in ptrsFullTestPass()
                 counts[index[i]] = kds[i];
-                if (refusedBits & (1 << i))
-                    retry[static_cast<size_t>(still++)] = index[i];
-                else if (!(decidedBits & (1 << i)))
-                    fullTest[static_cast<size_t>(undecided++)] = index[i];
+                retry[static_cast<size_t>(still)] = index[i];
+                still += (refusedBits >> i) & 1;
+                fullTest[static_cast<size_t>(undecided)] = index[i];
+                undecided += ((decidedBits >> i) & 1) ^ 1;
             }
         }
         ptrsFullTestPass<W>(means, counts, firstWords.get(), secondWords.get(), fullTest.get(), undecided,

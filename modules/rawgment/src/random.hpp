@@ -501,7 +501,10 @@ CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, float lam
  * (seed, stream, i, means[i]), on every path, whatever its neighbours' means. Below a mean of 10, inversion
  * by sequential search with u of 53 bits from both words, as CounterRng::poisson(); from 10 up, one try of
  * Hormann's PTRS with u and v of 32 bits each, all in vector lanes: the fast test for every value, then the
- * full test for the values it left undecided (20-65% of them), gathered into whole vectors. A value whose
+ * full test for the values it left undecided (20-65% of them), gathered into whole vectors: first in float
+ * lanes, which decide a value only where the two sides differ by more than a margin that bounds float's
+ * rounding 6 to 190 times over, then in double lanes for the rest (0.3-0.8%), so the counts are the double
+ * test's. A value whose
  * try is rejected (a share 1 - alpha, PTRS's acceptance constant: 25% at a mean of 10, 12% at 1000) tries
  * again in lanes with the first four words of its own CounterRng (poissonRetryKey(seed, stream), i),
  * twice, then calls CounterRng::poisson() on the rest of that stream; a mean beyond 2^40 calls it at once.
