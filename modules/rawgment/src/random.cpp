@@ -207,19 +207,38 @@ RAWGMENT_KERNEL typename Lanes<W>::F tukeyTermLanes(typename Lanes<W>::F l, type
     return large ? direct : series;
 }
 
-/* n unit-variance Tukey-lambda values from the stream, two Philox words each: the sign from the top bit
- * of the first, u in (0, 1/2) from its other 31 bits and 24 of the second (u down to 2^-57, so the
- * tails reach as far as a double uniform's), then the quantile Q(u) = (u^lambda - (1 - u)^lambda) /
- * lambda with the symmetry Q(1 - u) = -Q(u). Even columns take lambda0, odd columns lambda1 (the two
- * CFA sites of a row). */
+/* W unit-variance Tukey-lambda values from W pairs of words: the sign from the top bit of the first, u in
+ * (0, 1/2) from its other 31 bits m plus 24 bits of the second as a fraction of m's last place, in float,
+ * then the quantile Q(u) = (u^lambda - (1 - u)^lambda) / lambda with the symmetry Q(1 - u) = -Q(u). */
+template <int W>
+RAWGMENT_KERNEL typename Lanes<W>::F tukeyValuesLanes(typename Lanes<W>::U w1, typename Lanes<W>::U w2,
+                                                      typename Lanes<W>::F lambda, typename Lanes<W>::F invSd,
+                                                      typename Lanes<W>::F safeLambda)
+{
+    typedef typename Lanes<W>::F F;
+    typedef typename Lanes<W>::I I;
+    const F hi = __builtin_convertvector((I)(w1 & 0x7fffffffu), F);
+    const F lo = (__builtin_convertvector((I)(w2 >> 8), F) + 0.5f) * (1.0f / 16777216.0f);
+    const F u = (hi + lo) * (1.0f / 4294967296.0f);
+    const F q = tukeyTermLanes<W>(logPositiveLanes<W>(u), lambda, safeLambda) -
+                tukeyTermLanes<W>(logPositiveLanes<W>(1.0f - u), lambda, safeLambda);
+    const I negative = (I)(w1 >> 31) != 0;
+    return invSd * (negative ? -q : q);
+}
+
+/* n unit-variance Tukey-lambda values from the stream, one Philox word each (value h of a chunk of 32 takes
+ * word h of its 8 blocks), as tukeyValuesLanes() makes them from two. Where m, the word's 31 bits of u, is
+ * 2^24 or more (u >= 2^-8), float's 24 bits hold m alone and the second word's fraction cannot change u, so
+ * none is drawn; below (a share 2^-7), the second word is the first of the value's own stream
+ * (tukeyRefineKey(seed, stream), index), so u reaches 2^-57 and the tails are drawn as far as a double
+ * uniform's would be. Even columns take lambda0, odd columns lambda1 (the two CFA sites of a row). */
 template <int W>
 RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, float lambda0, float invSd0,
                                          float lambda1, float invSd1, float* out, int n)
 {
     typedef typename Lanes<W>::F F;
-    typedef typename Lanes<W>::I I;
     typedef typename Lanes<W>::U U;
-    const int kChunk = 16; // values per 8 Philox blocks: 16 first words, then 16 second words
+    const int kChunk = 32; // values per 8 Philox blocks
     const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
     F lambda, invSd;
     for (int i = 0; i < W; ++i) {
@@ -227,32 +246,74 @@ RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, float l
         invSd[i] = (i & 1) ? invSd1 : invSd0;
     }
     const F safeLambda = lambda == 0.0f ? F{} + 1.0f : lambda;
-    // Four chunks per step: their words first, then their values, so that the quantiles' chains of
-    // dependent operations overlap (the layout of values in words is the chunk's, as documented).
-    const int kStep = 4 * kChunk;
-    alignas(64) uint32_t stepWords[4 * 32];
+    const U fine = U{} + (1u << 24);
+    // Two chunks per step: their words first, then their values, so that the quantiles' chains of dependent
+    // operations overlap. The values to refine, and their words, are kept for the end.
+    const int kStep = 2 * kChunk;
+    alignas(64) uint32_t stepWords[kStep];
     alignas(64) float stepValues[kStep];
+    std::vector<int> refine;
+    std::vector<uint32_t> refineWords;
+    refine.reserve(static_cast<size_t>(n / 64 + 16)); // a share 2^-7, and its spread
+    refineWords.reserve(static_cast<size_t>(n / 64 + 16));
     for (int base = 0; base < n; base += kStep) {
-        for (int c = 0; c < 4; ++c)
-            philox8BlocksFor<W>(static_cast<uint32_t>((base + c * kChunk) / 2), stream, key,
-                                stepWords + 32 * c);
+        philox8BlocksFor<W>(static_cast<uint32_t>(base / 4), stream, key, stepWords);
+        philox8BlocksFor<W>(static_cast<uint32_t>(base / 4 + 8), stream, key, stepWords + kChunk);
         float* const dst = n - base >= kStep ? out + base : stepValues;
-        for (int c = 0; c < 4; ++c)
-            for (int h = 0; h < kChunk; h += W) {
-                U w1, w2;
-                std::memcpy(&w1, stepWords + 32 * c + h, sizeof(w1));
-                std::memcpy(&w2, stepWords + 32 * c + kChunk + h, sizeof(w2));
-                const F hi = __builtin_convertvector((I)(w1 & 0x7fffffffu), F);
-                const F lo = (__builtin_convertvector((I)(w2 >> 8), F) + 0.5f) * (1.0f / 16777216.0f);
-                const F u = (hi + lo) * (1.0f / 4294967296.0f);
-                const F q = tukeyTermLanes<W>(logPositiveLanes<W>(u), lambda, safeLambda) -
-                            tukeyTermLanes<W>(logPositiveLanes<W>(1.0f - u), lambda, safeLambda);
-                const I negative = (I)(w1 >> 31) != 0;
-                const F v = invSd * (negative ? -q : q);
-                std::memcpy(dst + c * kChunk + h, &v, sizeof(v));
-            }
+        for (int h = 0; h < kStep; h += W) {
+            U w1;
+            std::memcpy(&w1, stepWords + h, sizeof(w1));
+            const F v = tukeyValuesLanes<W>(w1, U{}, lambda, invSd, safeLambda);
+            std::memcpy(dst + h, &v, sizeof(v));
+            if (int coarse = maskBits((w1 & 0x7fffffffu) < fine))
+                for (; coarse; coarse &= coarse - 1) {
+                    const int lane = __builtin_ctz(static_cast<unsigned>(coarse));
+                    if (base + h + lane < n) {
+                        refine.push_back(base + h + lane);
+                        refineWords.push_back(stepWords[h + lane]);
+                    }
+                }
+        }
         if (dst == stepValues)
             std::memcpy(out + base, stepValues, sizeof(float) * static_cast<size_t>(n - base));
+    }
+    if (refine.empty())
+        return;
+    // The refined values, eight streams' first words at a time, recomputed in lanes as the others.
+    const uint64_t refineKey = tukeyRefineKey(seed, stream);
+    const std::array<uint32_t, 2> refineWordsKey = {static_cast<uint32_t>(refineKey),
+                                                    static_cast<uint32_t>(refineKey >> 32)};
+    const int count = static_cast<int>(refine.size());
+    for (int start = 0; start < count; start += 8) {
+        const int live = std::min(8, count - start);
+        alignas(64) uint64_t streams[8];
+        alignas(64) uint32_t blockWords[32];
+        alignas(64) uint32_t firsts[16] = {}, seconds[16] = {};
+        alignas(64) float lambdas[16], invSds[16], values[16];
+        for (int i = 0; i < 16; ++i) {
+            const int index = i < live ? refine[static_cast<size_t>(start + i)] : 0;
+            if (i < 8)
+                streams[i] = static_cast<uint64_t>(index);
+            lambdas[i] = (index & 1) ? lambda1 : lambda0;
+            invSds[i] = (index & 1) ? invSd1 : invSd0;
+            if (i < live)
+                firsts[i] = refineWords[static_cast<size_t>(start + i)];
+        }
+        philox8StreamsFor<W>(0, streams, refineWordsKey, blockWords);
+        for (int i = 0; i < live; ++i)
+            seconds[i] = blockWords[i];
+        for (int h = 0; h < 8; h += W) {
+            U w1, w2;
+            F l, sd;
+            std::memcpy(&w1, firsts + h, sizeof(w1));
+            std::memcpy(&w2, seconds + h, sizeof(w2));
+            std::memcpy(&l, lambdas + h, sizeof(l));
+            std::memcpy(&sd, invSds + h, sizeof(sd));
+            const F v = tukeyValuesLanes<W>(w1, w2, l, sd, l == 0.0f ? F{} + 1.0f : l);
+            std::memcpy(values + h, &v, sizeof(v));
+        }
+        for (int i = 0; i < live; ++i)
+            out[refine[static_cast<size_t>(start + i)]] = values[i];
     }
 }
 

@@ -322,7 +322,8 @@ RAWGMENT_KERNEL void philox8StreamsFor(uint32_t block, const uint64_t* streams,
  * - augmentation steps (RandomStream below): key stepKey(user seed, family); stream: the row (jitter),
  *   planeRowStream(site, plane row) (blur, scale), 0 (policy draw). A Poisson draw that fillPoisson()
  *   retries: key poissonRetryKey(family key, row stream) = stepKey(family key, row stream); stream: the
- *   value's index in its row.
+ *   value's index in its row. A Tukey-lambda value that fillTukeyUnit() refines: key tukeyRefineKey(family
+ *   key, row stream), the same derivation under the Tukey family's key; stream: the value's index.
  * - simulator captures: key the capture's seed; stream captureStream(frame, row).
  * - simulator fixed pattern (PRNU, DSNU, defects): key SensorParams::fixedPatternSeed; stream
  *   fixedPatternStream(row).
@@ -486,10 +487,13 @@ void fillGaussian(uint64_t seed, uint64_t stream, float* out, int n);
 /** Fills out[0..n) with unit-variance Tukey-lambda float32 values from the stream (seed, stream): even
  * indices of shape lambda0 (scaled by invSd0, 1 / the shape's standard deviation), odd ones of lambda1
  * (the two CFA sites of a mosaic row). Vector lanes on every path, the same bits on each: the quantile's
- * logarithms and exponentials are polynomials (no library calls). Value i uses words 2i and 2i + 1 of the
- * stream's chunk (16 values per 8 Philox blocks). Accuracy: within 2e-6 relative (or 1e-6 absolute near
- * 0) of the double quantile of the same uniform (Simulate.fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath);
- * the uniforms reach 2^-57, so the tails are drawn as far as a double uniform's would be. */
+ * logarithms and exponentials are polynomials (no library calls). Value i uses word i % 32 of its chunk
+ * (32 values per 8 Philox blocks): its top bit the sign, the other 31 bits m the uniform u = m 2^-32 in
+ * (0, 1/2), all float keeps of it from u = 2^-8 up. Below (m < 2^24, a share 2^-7), 24 bits of the first
+ * word of the value's own stream (tukeyRefineKey(seed, stream), i) extend u, so the uniforms reach 2^-57
+ * and the tails are drawn as far as a double uniform's would be. Accuracy: within 2e-6 relative (or 1e-6
+ * absolute near 0) of the double quantile of the same uniform
+ * (Simulate.fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath). */
 CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, float lambda0, float invSd0,
                                        float lambda1, float invSd1, float* out, int n);
 
@@ -518,6 +522,13 @@ CV_RAWGMENT_EXPORTS void fillPoisson(uint64_t seed, uint64_t stream, const doubl
 
 //! The key of fillPoisson()'s retries for the stream (seed, stream); a retried value i draws from (key, i).
 inline uint64_t poissonRetryKey(uint64_t seed, uint64_t stream)
+{
+    return stepKey(seed, stream);
+}
+
+//! The key of fillTukeyUnit()'s refinements for the stream (seed, stream); a refined value i draws from (key,
+//! i).
+inline uint64_t tukeyRefineKey(uint64_t seed, uint64_t stream)
 {
     return stepKey(seed, stream);
 }

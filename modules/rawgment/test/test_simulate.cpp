@@ -552,33 +552,43 @@ TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
 
 TEST(Simulate, fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath)
 {
-    // Each value against the Tukey-lambda quantile in double precision of the uniform its two Philox words
-    // give, in the layout random.hpp documents (value h of a chunk of 16: words h and 16 + h of the
-    // chunk's 8 blocks, word j of block b at 8 j + b % 8), at both lambdas of a row (even and odd
-    // columns), for the lightest, the logistic and the heaviest shapes a model takes.
+    // Each value against the Tukey-lambda quantile in double precision of the uniform its words give, in the
+    // layout random.hpp documents (value h of a chunk of 32: word h of the chunk's 8 blocks, word j of
+    // block b at 8 j + b; below u = 2^-8, 24 more bits from the first word of the value's own stream), at
+    // both lambdas of a row (even and odd columns), for the lightest, the logistic and the heaviest shapes
+    // a model takes.
     const uint64_t seed = 0x0fedcba987654321ull, stream = 3;
-    const int n = 16 * 8192 + 11; // a partial last chunk too
     const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
-    auto word = [&](int chunk, int w) {
-        const uint32_t block = static_cast<uint32_t>(8 * chunk + w % 8);
-        const std::array<uint32_t, 4> counter = {block, 0, static_cast<uint32_t>(stream),
+    const uint64_t refineKey = detail::tukeyRefineKey(seed, stream);
+    const std::array<uint32_t, 2> refineWordKey = {static_cast<uint32_t>(refineKey),
+                                                   static_cast<uint32_t>(refineKey >> 32)};
+    // The uniform of value i, and the one it would have without its refinement (the fraction 1/2).
+    auto uniforms = [&](int i, double& u, double& unrefined) {
+        const int chunk = i / 32, h = i % 32;
+        const std::array<uint32_t, 4> counter = {static_cast<uint32_t>(8 * chunk + h % 8), 0,
+                                                 static_cast<uint32_t>(stream),
                                                  static_cast<uint32_t>(stream >> 32)};
-        return detail::philox4x32(counter, key)[static_cast<size_t>(w / 8)];
+        const uint32_t w1 = detail::philox4x32(counter, key)[static_cast<size_t>(h / 8)];
+        const uint32_t m = w1 & 0x7fffffffu;
+        const uint32_t w2 = m < (1u << 24)
+                                ? detail::philox4x32({0, 0, static_cast<uint32_t>(i), 0}, refineWordKey)[0]
+                                : 0x80000000u;
+        u = (m + (static_cast<double>(w2 >> 8) + 0.5) / 16777216.0) / 4294967296.0;
+        unrefined = (m + 0.5) / 4294967296.0;
+        return (w1 >> 31) != 0;
     };
     const auto quantile = [](double u, double lambda) {
         return lambda == 0 ? std::log(u / (1 - u)) : (std::pow(u, lambda) - std::pow(1 - u, lambda)) / lambda;
     };
+    const int n = 32 * 4096 + 11; // a partial last chunk too
     for (const Vec2f& lambdas : {Vec2f(1.0f, 0.14f), Vec2f(0.0f, -0.05f), Vec2f(-0.2f, 0.5f)}) {
         const float invSd[2] = {0.7f, 1.3f};
         std::vector<double> reference(static_cast<size_t>(n));
         for (int i = 0; i < n; ++i) {
-            const int chunk = i / 16, h = i % 16;
-            const uint32_t w1 = word(chunk, h), w2 = word(chunk, 16 + h);
-            const double u =
-                (static_cast<double>(w1 & 0x7fffffffu) + (static_cast<double>(w2 >> 8) + 0.5) / 16777216.0) /
-                4294967296.0;
+            double u, unrefined;
+            const bool negative = uniforms(i, u, unrefined);
             const double q = quantile(u, lambdas[i & 1]) * invSd[i & 1];
-            reference[static_cast<size_t>(i)] = (w1 >> 31) ? -q : q;
+            reference[static_cast<size_t>(i)] = negative ? -q : q;
         }
         // The float quantile rounds in the two logarithms (each a few ulps of |ln u| <= 40), the
         // exponential and the difference: 2e-6 of max(1, |value|) bounds it (5e-7 seen on every path); a
@@ -604,6 +614,30 @@ TEST(Simulate, fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath)
         }
         setCpuPath(CpuPath::AUTO);
     }
+    // The refinement is there: the refined share is 2^-7, and where it moves u by more than 1e-4 (31 bits of
+    // u below 2^13, a few in 2^22 values), the logistic's output gives back the refined u, not the unrefined
+    // one (|v| = ln((1 - u) / u) within 4e-5 here, so u within 5e-5 relative).
+    const int many = 1 << 22;
+    std::vector<float> t(static_cast<size_t>(many));
+    detail::fillTukeyUnit(seed, stream, 0.0f, 1.0f, 0.0f, 1.0f, t.data(), many);
+    int refined = 0, telling = 0;
+    for (int i = 0; i < many; ++i) {
+        double u, unrefined;
+        uniforms(i, u, unrefined);
+        if (u >= 1.0 / 256)
+            continue;
+        ++refined;
+        if (std::abs(u - unrefined) <= 1e-4 * u)
+            continue;
+        ++telling;
+        const double fromValue = 1 / (1 + std::exp(std::abs(static_cast<double>(t[static_cast<size_t>(i)]))));
+        EXPECT_NEAR(fromValue, u, 5e-5 * u) << "value " << i << " (unrefined u " << unrefined << ")";
+    }
+    // Binomial(2^22, 2^-7): mean 32768, sd 180.
+    EXPECT_NEAR(refined, many / 128, 5 * 181);
+    EXPECT_GT(telling, 0);
+    std::cout << "refined " << refined << " of " << many << ", " << telling
+              << " where it moves u by over 1e-4\n";
 }
 
 TEST(Simulate, fillGaussianIsBoxMullerOfItsPhiloxWordsOnEveryPath)
