@@ -110,106 +110,132 @@ inline __attribute__((always_inline)) void philox8Streams(uint32_t block, const 
  * masks per product of philox8Blocks() are not needed (about 7% of the normals' time on AVX2, Zen 3). */
 constexpr int kSwapHalves = _MM_SHUFFLE(2, 3, 0, 1);
 constexpr _MM_PERM_ENUM kSwapHalves512 = _MM_PERM_CDAB;
-//! Ten rounds on eight blocks in four registers of two 64-bit lanes (counters in the low halves), then
-//! word j of block b to words[8 j + b].
-inline __attribute__((always_inline)) void philox8RoundsSse2(__m128i* c0, __m128i* c1, __m128i* c2,
-                                                             __m128i* c3, const std::array<uint32_t, 2>& key,
-                                                             uint32_t* words)
+//! One Philox round on two blocks in four registers (state words in the low halves of 64-bit lanes).
+inline __attribute__((always_inline)) void philoxRoundSse2(__m128i& c0, __m128i& c1, __m128i& c2, __m128i& c3,
+                                                           __m128i m0, __m128i m1, __m128i kv0, __m128i kv1)
+{
+    const __m128i p0 = _mm_mul_epu32(c0, m0), p1 = _mm_mul_epu32(c2, m1);
+    c0 = _mm_xor_si128(_mm_shuffle_epi32(p1, kSwapHalves), _mm_xor_si128(c1, kv0));
+    c2 = _mm_xor_si128(_mm_shuffle_epi32(p0, kSwapHalves), _mm_xor_si128(c3, kv1));
+    c1 = p1;
+    c3 = p0;
+}
+
+//! The low halves of the two lanes of `pair` (two blocks of one state word), side by side at `to`.
+inline __attribute__((always_inline)) void storeWordPairSse2(__m128i pair, uint32_t* to)
+{
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(to), _mm_shuffle_epi32(pair, _MM_SHUFFLE(3, 1, 2, 0)));
+}
+
+/* Ten rounds on eight blocks, two per register (blocks 2p and 2p + 1 in the registers p*), then word j of
+ * block b to words[8 j + b]. Named registers, not arrays, as philox8RoundsAvx2(). */
+inline __attribute__((always_inline)) void
+philox8RoundsSse2(__m128i a0, __m128i a1, __m128i a2, __m128i a3, __m128i b0, __m128i b1, __m128i b2,
+                  __m128i b3, __m128i c0, __m128i c1, __m128i c2, __m128i c3, __m128i d0, __m128i d1,
+                  __m128i d2, __m128i d3, const std::array<uint32_t, 2>& key, uint32_t* words)
 {
     const __m128i m0 = _mm_set1_epi64x(kPhiloxM0), m1 = _mm_set1_epi64x(kPhiloxM1);
     uint32_t k0 = key[0], k1 = key[1];
     for (int round = 0; round < kPhiloxRounds; ++round) {
         const __m128i kv0 = _mm_set1_epi64x(k0), kv1 = _mm_set1_epi64x(k1);
-        for (int p = 0; p < 4; ++p) {
-            const __m128i p0 = _mm_mul_epu32(c0[p], m0), p1 = _mm_mul_epu32(c2[p], m1);
-            c0[p] = _mm_xor_si128(_mm_xor_si128(_mm_shuffle_epi32(p1, kSwapHalves), c1[p]), kv0);
-            c2[p] = _mm_xor_si128(_mm_xor_si128(_mm_shuffle_epi32(p0, kSwapHalves), c3[p]), kv1);
-            c1[p] = p1;
-            c3[p] = p0;
-        }
+        philoxRoundSse2(a0, a1, a2, a3, m0, m1, kv0, kv1);
+        philoxRoundSse2(b0, b1, b2, b3, m0, m1, kv0, kv1);
+        philoxRoundSse2(c0, c1, c2, c3, m0, m1, kv0, kv1);
+        philoxRoundSse2(d0, d1, d2, d3, m0, m1, kv0, kv1);
         k0 += kPhiloxW0;
         k1 += kPhiloxW1;
     }
-    const __m128i* const state[4] = {c0, c1, c2, c3};
+    const __m128i state[4][4] = {{a0, b0, c0, d0}, {a1, b1, c1, d1}, {a2, b2, c2, d2}, {a3, b3, c3, d3}};
     for (int j = 0; j < 4; ++j)
-        for (int p = 0; p < 4; ++p) {
-            // The low halves of the two lanes, side by side.
-            const __m128i packed = _mm_shuffle_epi32(state[j][p], _MM_SHUFFLE(3, 1, 2, 0));
-            _mm_storel_epi64(reinterpret_cast<__m128i*>(words + 8 * j + 2 * p), packed);
-        }
+        for (int p = 0; p < 4; ++p)
+            storeWordPairSse2(state[j][p], words + 8 * j + 2 * p);
 }
 
 inline void philox8BlocksSse2(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key,
                               uint32_t* words)
 {
-    __m128i c0[4], c1[4], c2[4], c3[4];
-    for (int p = 0; p < 4; ++p) {
-        c0[p] = _mm_set_epi64x(static_cast<uint32_t>(firstBlock + 2 * p + 1),
-                               static_cast<uint32_t>(firstBlock + 2 * p));
-        c1[p] = _mm_setzero_si128();
-        c2[p] = _mm_set1_epi64x(static_cast<uint32_t>(stream));
-        c3[p] = _mm_set1_epi64x(static_cast<uint32_t>(stream >> 32));
-    }
-    philox8RoundsSse2(c0, c1, c2, c3, key, words);
+    const __m128i zero = _mm_setzero_si128(), s0 = _mm_set1_epi64x(static_cast<uint32_t>(stream)),
+                  s1 = _mm_set1_epi64x(static_cast<uint32_t>(stream >> 32));
+    const auto pair = [firstBlock](uint32_t b) {
+        return _mm_set_epi64x(static_cast<uint32_t>(firstBlock + b + 1),
+                              static_cast<uint32_t>(firstBlock + b));
+    };
+    philox8RoundsSse2(pair(0), zero, s0, s1, pair(2), zero, s0, s1, pair(4), zero, s0, s1, pair(6), zero, s0,
+                      s1, key, words);
 }
 
 //! philox8Streams() with SSE2.
 inline void philox8StreamsSse2(uint32_t block, const uint64_t* streams, const std::array<uint32_t, 2>& key,
                                uint32_t* words)
 {
-    __m128i c0[4], c1[4], c2[4], c3[4];
-    for (int p = 0; p < 4; ++p) {
-        c0[p] = _mm_set1_epi64x(block);
-        c1[p] = _mm_setzero_si128();
-        c2[p] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(streams + 2 * p)); // high halves unread
-        c3[p] = _mm_srli_epi64(c2[p], 32);
-    }
-    philox8RoundsSse2(c0, c1, c2, c3, key, words);
+    const __m128i zero = _mm_setzero_si128(), b = _mm_set1_epi64x(block);
+    // The streams' high halves sit in the lanes' high halves, which (v)pmuludq never reads.
+    const auto load = [streams](int p) {
+        return _mm_loadu_si128(reinterpret_cast<const __m128i*>(streams + 2 * p));
+    };
+    const __m128i s0 = load(0), s1 = load(1), s2 = load(2), s3 = load(3);
+    philox8RoundsSse2(b, zero, s0, _mm_srli_epi64(s0, 32), b, zero, s1, _mm_srli_epi64(s1, 32), b, zero, s2,
+                      _mm_srli_epi64(s2, 32), b, zero, s3, _mm_srli_epi64(s3, 32), key, words);
 }
 
-//! Ten rounds on eight blocks in two registers of four 64-bit lanes, as philox8RoundsSse2().
+//! One Philox round on four blocks in four registers (state words in the low halves of 64-bit lanes).
 __attribute__((target("arch=x86-64-v3"))) inline __attribute__((always_inline)) void
-philox8RoundsAvx2(__m256i* c0, __m256i* c1, __m256i* c2, __m256i* c3, const std::array<uint32_t, 2>& key,
-                  uint32_t* words)
+philoxRoundAvx2(__m256i& c0, __m256i& c1, __m256i& c2, __m256i& c3, __m256i m0, __m256i m1, __m256i kv0,
+                __m256i kv1)
+{
+    const __m256i p0 = _mm256_mul_epu32(c0, m0), p1 = _mm256_mul_epu32(c2, m1);
+    c0 = _mm256_xor_si256(_mm256_shuffle_epi32(p1, kSwapHalves), _mm256_xor_si256(c1, kv0));
+    c2 = _mm256_xor_si256(_mm256_shuffle_epi32(p0, kSwapHalves), _mm256_xor_si256(c3, kv1));
+    c1 = p1;
+    c3 = p0;
+}
+
+//! The low halves of the eight lanes of one state word (blocks 0-3 in `first`, 4-7 in `second`), in order.
+__attribute__((target("arch=x86-64-v3"))) inline __attribute__((always_inline)) void
+storeWordAvx2(__m256i first, __m256i second, uint32_t* to)
+{
+    const __m256i gather = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(to),
+                     _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(first, gather)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(to + 4),
+                     _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(second, gather)));
+}
+
+/* Ten rounds on eight blocks in two sets of four registers (blocks 0-3 in a*, 4-7 in b*), then word j of
+ * block b to words[8 j + b]. The state is in named registers, not arrays: with arrays GCC kept it on the
+ * stack and every round waited for its stores to be read back, which cost half the time. */
+__attribute__((target("arch=x86-64-v3"))) inline __attribute__((always_inline)) void
+philox8RoundsAvx2(__m256i a0, __m256i a1, __m256i a2, __m256i a3, __m256i b0, __m256i b1, __m256i b2,
+                  __m256i b3, const std::array<uint32_t, 2>& key, uint32_t* words)
 {
     const __m256i m0 = _mm256_set1_epi64x(kPhiloxM0), m1 = _mm256_set1_epi64x(kPhiloxM1);
     uint32_t k0 = key[0], k1 = key[1];
     for (int round = 0; round < kPhiloxRounds; ++round) {
         const __m256i kv0 = _mm256_set1_epi64x(k0), kv1 = _mm256_set1_epi64x(k1);
-        for (int p = 0; p < 2; ++p) {
-            const __m256i p0 = _mm256_mul_epu32(c0[p], m0), p1 = _mm256_mul_epu32(c2[p], m1);
-            c0[p] = _mm256_xor_si256(_mm256_xor_si256(_mm256_shuffle_epi32(p1, kSwapHalves), c1[p]), kv0);
-            c2[p] = _mm256_xor_si256(_mm256_xor_si256(_mm256_shuffle_epi32(p0, kSwapHalves), c3[p]), kv1);
-            c1[p] = p1;
-            c3[p] = p0;
-        }
+        philoxRoundAvx2(a0, a1, a2, a3, m0, m1, kv0, kv1);
+        philoxRoundAvx2(b0, b1, b2, b3, m0, m1, kv0, kv1);
         k0 += kPhiloxW0;
         k1 += kPhiloxW1;
     }
-    // The low halves of the eight lanes of a word, in block order.
-    const __m256i gather = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
-    const __m256i* const state[4] = {c0, c1, c2, c3};
-    for (int j = 0; j < 4; ++j) {
-        const __m128i lo = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(state[j][0], gather));
-        const __m128i hi = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(state[j][1], gather));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(words + 8 * j), lo);
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(words + 8 * j + 4), hi);
-    }
+    storeWordAvx2(a0, b0, words);
+    storeWordAvx2(a1, b1, words + 8);
+    storeWordAvx2(a2, b2, words + 16);
+    storeWordAvx2(a3, b3, words + 24);
 }
 
 __attribute__((target("arch=x86-64-v3"))) inline void
 philox8BlocksAvx2(uint32_t firstBlock, uint64_t stream, const std::array<uint32_t, 2>& key, uint32_t* words)
 {
-    __m256i c0[2], c1[2], c2[2], c3[2];
-    for (int p = 0; p < 2; ++p) {
-        const uint32_t b = firstBlock + 4 * p;
-        c0[p] = _mm256_set_epi64x(static_cast<uint32_t>(b + 3), static_cast<uint32_t>(b + 2),
-                                  static_cast<uint32_t>(b + 1), static_cast<uint32_t>(b));
-        c1[p] = _mm256_setzero_si256();
-        c2[p] = _mm256_set1_epi64x(static_cast<uint32_t>(stream));
-        c3[p] = _mm256_set1_epi64x(static_cast<uint32_t>(stream >> 32));
-    }
-    philox8RoundsAvx2(c0, c1, c2, c3, key, words);
+    const __m256i zero = _mm256_setzero_si256();
+    const __m256i s0 = _mm256_set1_epi64x(static_cast<uint32_t>(stream)),
+                  s1 = _mm256_set1_epi64x(static_cast<uint32_t>(stream >> 32));
+    const __m256i first =
+        _mm256_set_epi64x(static_cast<uint32_t>(firstBlock + 3), static_cast<uint32_t>(firstBlock + 2),
+                          static_cast<uint32_t>(firstBlock + 1), static_cast<uint32_t>(firstBlock));
+    const __m256i second =
+        _mm256_set_epi64x(static_cast<uint32_t>(firstBlock + 7), static_cast<uint32_t>(firstBlock + 6),
+                          static_cast<uint32_t>(firstBlock + 5), static_cast<uint32_t>(firstBlock + 4));
+    philox8RoundsAvx2(first, zero, s0, s1, second, zero, s0, s1, key, words);
 }
 
 //! philox8Streams() with AVX2.
@@ -218,14 +244,12 @@ __attribute__((target("arch=x86-64-v3"))) inline void philox8StreamsAvx2(uint32_
                                                                          const std::array<uint32_t, 2>& key,
                                                                          uint32_t* words)
 {
-    __m256i c0[2], c1[2], c2[2], c3[2];
-    for (int p = 0; p < 2; ++p) {
-        c0[p] = _mm256_set1_epi64x(block);
-        c1[p] = _mm256_setzero_si256();
-        c2[p] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(streams + 4 * p)); // high halves unread
-        c3[p] = _mm256_srli_epi64(c2[p], 32);
-    }
-    philox8RoundsAvx2(c0, c1, c2, c3, key, words);
+    const __m256i zero = _mm256_setzero_si256(), b = _mm256_set1_epi64x(block);
+    // The streams' high halves sit in the lanes' high halves, which (v)pmuludq never reads.
+    const __m256i first = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(streams)),
+                  second = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(streams + 4));
+    philox8RoundsAvx2(b, zero, first, _mm256_srli_epi64(first, 32), b, zero, second,
+                      _mm256_srli_epi64(second, 32), key, words);
 }
 
 // GCC 12's avx512fintrin.h warns that _mm512_mul_epu32's masked builtin reads an uninitialised
