@@ -634,6 +634,19 @@ RAWGMENT_KERNEL void ptrsFullTestFloatLanes(const float* lambdas, const float* k
     }
 }
 
+//! The double lanes at `at` of a gathered chunk: means, tries' counts and both words of each value.
+template <int W>
+RAWGMENT_KERNEL void loadGatheredLanes(const double* lambdas, const double* kds, const uint64_t* firsts,
+                                       const uint64_t* seconds, int at, typename DoubleLanes<W>::D& lambda,
+                                       typename DoubleLanes<W>::D& kd, typename DoubleLanes<W>::UL& w1,
+                                       typename DoubleLanes<W>::UL& w2)
+{
+    std::memcpy(&lambda, lambdas + at, sizeof(lambda));
+    std::memcpy(&kd, kds + at, sizeof(kd));
+    std::memcpy(&w1, firsts + at, sizeof(w1));
+    std::memcpy(&w2, seconds + at, sizeof(w2));
+}
+
 /* PTRS's full test for the values of list[0..size), whose try's count is in counts and whose words are in
  * firstWords and secondWords, gathered a chunk's worth at a time: in float lanes with a margin
  * (ptrsFullTestFloatLanes()), then in double lanes for the groups with a value the float test left
@@ -668,10 +681,7 @@ RAWGMENT_KERNEL void ptrsFullTestPass(const double* means, const double* counts,
         for (int g = 0; g < kGroups; ++g) {
             D lambda, kd;
             UL w1, w2;
-            std::memcpy(&lambda, lambdas + g * kLanes, sizeof(lambda));
-            std::memcpy(&kd, kds + g * kLanes, sizeof(kd));
-            std::memcpy(&w1, firsts + g * kLanes, sizeof(w1));
-            std::memcpy(&w2, seconds + g * kLanes, sizeof(w2));
+            loadGatheredLanes<W>(lambdas, kds, firsts, seconds, g * kLanes, lambda, kd, w1, w2);
             const D u = uniform32LanesD<W>(w1) - 0.5;
             const D us = 0.5 - (u < 0.0 ? -u : u);
             const D v = uniform32LanesD<W>(w2);
@@ -715,10 +725,7 @@ RAWGMENT_KERNEL void ptrsFullTestPass(const double* means, const double* counts,
                 continue;
             D lambda, kd;
             UL w1, w2;
-            std::memcpy(&lambda, lambdas + g * kLanes, sizeof(lambda));
-            std::memcpy(&kd, kds + g * kLanes, sizeof(kd));
-            std::memcpy(&w1, firsts + g * kLanes, sizeof(w1));
-            std::memcpy(&w2, seconds + g * kLanes, sizeof(w2));
+            loadGatheredLanes<W>(lambdas, kds, firsts, seconds, g * kLanes, lambda, kd, w1, w2);
             const int exact = maskBits(ptrsFullTestLanes<W>(lambda, w1, w2, kd)) << (g * kLanes);
             accepted |= exact & groupBits & ~decided;
         }
