@@ -507,11 +507,18 @@ const std::array<double, 201>& inverseIntegers()
     return table;
 }
 
-/* Inversion by sequential search for the means below 10 among a chunk's G groups of lanes, the groups'
- * chains interleaved (one multiply-add chain each, so together they hide each other's latency): u of
- * 53 bits from both words, as CounterRng::uniform(), and p_k = p_(k-1) lambda (1 / k) (CounterRng::poisson()
- * divides: the two differ by an ulp at times, which moves a count only when u falls within about 1e-13 of
- * the CDF's boundary). Lanes of larger means run with mean 0 and give 0. */
+/* The mean below which fillPoisson() inverts the CDF, and from which it takes PTRS: on host H2 (AVX2) the
+ * search in lanes cost less than PTRS's tries and tests up to a mean of about 35 (10 ns against 20 at a
+ * mean of 10, 16 against 18 at 30, 19 against 16 at 40, per value on one core). CounterRng::poisson(),
+ * one value at a time, keeps Hormann's switch at 10. */
+constexpr double kInversionBelow = 30.0;
+
+/* Inversion by sequential search for the means below kInversionBelow among a chunk's G groups of lanes,
+ * the groups' chains interleaved (one multiply-add chain each, so together they hide each other's
+ * latency): u of 53 bits from both words, as CounterRng::uniform(), and p_k = p_(k-1) lambda (1 / k)
+ * (CounterRng::poisson() divides: the two differ by an ulp at times, which moves a count only when u falls
+ * within about 1e-13 of the CDF's boundary; e^-30 and the sums of up to 200 terms stay far inside double's
+ * range and precision). Lanes of larger means run with mean 0 and give 0. */
 template <int W, int G>
 RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint32_t* words,
                                            double* chunkCounts)
@@ -529,7 +536,7 @@ RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint3
         std::memcpy(&m, chunkMeans + g * kLanes, sizeof(m));
         std::memcpy(&a, words + g * kLanes, sizeof(a));
         std::memcpy(&b, words + 16 + g * kLanes, sizeof(b));
-        small[g] = m < 10.0;
+        small[g] = m < kInversionBelow;
         lambda[g] = small[g] ? m : D{};
         // bits = w1 2^21 + (w2 >> 11) < 2^53 as a double, exactly, from two exact conversions.
         const UL w1 = __builtin_convertvector(a, UL), w2 = __builtin_convertvector(b, UL);
@@ -750,50 +757,82 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
     alignas(64) uint32_t words[32];
     alignas(64) double chunkMeans[kChunk], chunkCounts[kChunk];
     const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
-    // Every value's two words, kept for the full tests; the values whose first try needs the full test,
-    // and those to retry.
+    // Every value's two words, kept for the inversion and the full tests; the values to invert, those whose
+    // first try needs the full test, and those to retry.
     // Left uninitialised: zeroing them cost about 0.5 ns per value, and only written entries are read.
     const size_t room = static_cast<size_t>(n) + kChunk;
     const std::unique_ptr<uint32_t[]> firstWords(new uint32_t[room]), secondWords(new uint32_t[room]);
-    const std::unique_ptr<int[]> fullTest(new int[room]), retry(new int[room]);
-    int fullTests = 0, retries = 0;
+    const std::unique_ptr<int[]> fullTest(new int[room]), retry(new int[room]), invert(new int[room]);
+    int fullTests = 0, retries = 0, inverts = 0;
     for (int base = 0; base < n; base += kChunk) {
         philox8BlocksFor<W>(static_cast<uint32_t>(base / 2), stream, key, words);
         std::memcpy(firstWords.get() + base, words, sizeof(uint32_t) * kChunk);
         std::memcpy(secondWords.get() + base, words + kChunk, sizeof(uint32_t) * kChunk);
         const int count = std::min(kChunk, n - base);
-        for (int i = 0; i < kChunk; ++i) {
-            const double m = i < count ? means[base + i] : 0.0;
-            chunkMeans[i] = m > 0 ? m : 0.0;
+        if (count == kChunk) {
+            for (int g = 0; g < kGroups; ++g) { // as the loop below, in lanes (NaN and negatives give 0)
+                D m;
+                std::memcpy(&m, means + base + g * kLanes, sizeof(m));
+                m = m > 0.0 ? m : D{};
+                std::memcpy(chunkMeans + g * kLanes, &m, sizeof(m));
+            }
+        } else {
+            for (int i = 0; i < kChunk; ++i) {
+                const double m = i < count ? means[base + i] : 0.0;
+                chunkMeans[i] = m > 0 ? m : 0.0;
+            }
         }
-        int smallBits = 0;
+        int invertBits = 0, smallBits = 0;
         for (int g = 0; g < kGroups; ++g) {
             D lambda;
             U32 a, b;
             std::memcpy(&lambda, chunkMeans + g * kLanes, sizeof(lambda));
             std::memcpy(&a, words + g * kLanes, sizeof(a));
             std::memcpy(&b, words + kChunk + g * kLanes, sizeof(b));
-            const L small = lambda < 10.0;
+            const L small = lambda < kInversionBelow;
             const L beyond = lambda > kMaxLaneMean;
             const L ptrs = ~small & ~beyond;
-            smallBits |= maskBits(small) << (g * kLanes);
             const int live = std::max(0, std::min(kLanes, count - g * kLanes));
             const int liveBits = (1 << live) - 1;
+            invertBits |= (maskBits(small & (lambda > 0.0)) & liveBits) << (g * kLanes);
+            smallBits |= (maskBits(small) & liveBits) << (g * kLanes);
             const int base0 = base + g * kLanes;
             if (maskBits(beyond))
                 appendBits(maskBits(beyond) & liveBits, kLanes, base0, retry.get(), retries);
-            if (!maskBits(ptrs))
-                continue;
-            const PtrsTryLanes<W> t = ptrsTryLanes<W>(
-                ptrs ? lambda : D{} + 10.0, __builtin_convertvector(a, UL), __builtin_convertvector(b, UL));
-            std::memcpy(chunkCounts + g * kLanes, &t.kd, sizeof(t.kd));
-            appendBits(maskBits(ptrs & ~t.accept & ~t.refuse) & liveBits, kLanes, base0, fullTest.get(),
-                       fullTests);
-            appendBits(maskBits(ptrs & t.refuse) & liveBits, kLanes, base0, retry.get(), retries);
+            D kd = {}; // a mean of 0 (or below, or NaN) gives 0; the inversion fills in the small ones
+            if (maskBits(ptrs)) {
+                const PtrsTryLanes<W> t =
+                    ptrsTryLanes<W>(ptrs ? lambda : D{} + 10.0, __builtin_convertvector(a, UL),
+                                    __builtin_convertvector(b, UL));
+                kd = ptrs ? t.kd : kd;
+                appendBits(maskBits(ptrs & ~t.accept & ~t.refuse) & liveBits, kLanes, base0, fullTest.get(),
+                           fullTests);
+                appendBits(maskBits(ptrs & t.refuse) & liveBits, kLanes, base0, retry.get(), retries);
+            }
+            std::memcpy(chunkCounts + g * kLanes, &kd, sizeof(kd));
         }
-        if (smallBits)
-            poissonInversionLanes<W, kChunk / DoubleLanes<W>::kCount>(chunkMeans, words, chunkCounts);
+        // A chunk of small means only (a dark region) is inverted in place; the small means of a mixed chunk
+        // are gathered, so that one value's search does not hold up fifteen others of large means.
+        if (smallBits == (1 << count) - 1)
+            poissonInversionLanes<W, kGroups>(chunkMeans, words, chunkCounts);
+        else
+            appendBits(invertBits, kChunk, base, invert.get(), inverts);
         std::memcpy(counts + base, chunkCounts, sizeof(double) * static_cast<size_t>(count));
+    }
+    // The small means of mixed chunks, gathered into whole chunks (in a row of means spread from 0 to 750,
+    // half the chunks have one).
+    for (int start = 0; start < inverts; start += kChunk) {
+        const int live = std::min(kChunk, inverts - start);
+        alignas(64) uint32_t gatheredWords[2 * kChunk];
+        for (int i = 0; i < kChunk; ++i) {
+            const int index = i < live ? invert[start + i] : -1; // padding lanes: mean 0, no count
+            chunkMeans[i] = index >= 0 ? means[index] : 0.0;
+            gatheredWords[i] = index >= 0 ? firstWords[index] : 0u;
+            gatheredWords[kChunk + i] = index >= 0 ? secondWords[index] : 0u;
+        }
+        poissonInversionLanes<W, kGroups>(chunkMeans, gatheredWords, chunkCounts);
+        for (int i = 0; i < live; ++i)
+            counts[invert[start + i]] = chunkCounts[i];
     }
     // The full tests of the first tries; the values they reject join the retries.
     ptrsFullTestPass<W>(means, counts, firstWords.get(), secondWords.get(), fullTest.get(), fullTests,

@@ -526,8 +526,10 @@ CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, float lam
  * in [0, kMaxPoissonMean] (0 gives 0).
  *
  * Value i uses words i and 16 + i of its chunk (16 values per 8 Philox blocks) and depends only on
- * (seed, stream, i, means[i]), on every path, whatever its neighbours' means. Below a mean of 10, inversion
- * by sequential search with u of 53 bits from both words, as CounterRng::poisson(); from 10 up, one try of
+ * (seed, stream, i, means[i]), on every path, whatever its neighbours' means. Below a mean of 30 (in lanes
+ * the search costs less than PTRS there; CounterRng::poisson() switches at 10), inversion by sequential
+ * search with u of 53 bits from both words, in place for a chunk of small means only and gathered into
+ * whole chunks from mixed ones; from 30 up, one try of
  * Hormann's PTRS with u and v of 32 bits each, all in vector lanes: the fast test for every value, then the
  * full test for the values it left undecided (20-65% of them), gathered into whole vectors: first in float
  * lanes, which decide a value only where the two sides differ by more than a margin that bounds float's

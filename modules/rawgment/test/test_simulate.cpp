@@ -420,7 +420,7 @@ bool ptrsTry(double lambda, uint32_t wu, uint32_t wv, double& k)
 }
 
 /* fillPoisson()'s value i written out with the C library's exp and log: inversion from the 53-bit u of
- * both words below a mean of 10; else a PTRS try on the two words, two more on the first four words of
+ * both words below a mean of 30; else a PTRS try on the two words, two more on the first four words of
  * the value's retry stream, and the scalar sampler on the rest of that stream (on all of it beyond 2^40).
  * `tries` counts the tries beyond the first (3 for the scalar sampler). */
 double referencePoisson(uint64_t seed, uint64_t stream, int i, double lambda, int* tries = nullptr)
@@ -428,7 +428,7 @@ double referencePoisson(uint64_t seed, uint64_t stream, int i, double lambda, in
     if (!(lambda > 0))
         return 0;
     const std::pair<uint32_t, uint32_t> w = poissonWords(seed, stream, i);
-    if (lambda < 10) {
+    if (lambda < 30) { // fillPoisson's switch (CounterRng::poisson()'s is at 10)
         const uint64_t bits = (static_cast<uint64_t>(w.first) << 21) ^ (w.second >> 11);
         const double u = (static_cast<double>(bits) + 0.5) / 9007199254740992.0;
         double p = std::exp(-lambda), cdf = p;
@@ -464,9 +464,11 @@ double referencePoisson(uint64_t seed, uint64_t stream, int i, double lambda, in
 TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
 {
     const uint64_t seed = 0x1234abcd5678ef01ull, stream = 7;
-    // Means on both sides of the switch at 10 and around it, inside (2e6) and beyond (5e6) the range of the
-    // full test's float pre-test, the retry beyond 2^40, and 0.
-    const std::vector<double> lambdas = {0.05, 0.7, 3.0, 9.99, 10.0, 37.5, 1000.0, 2e6, 0.0, 3e12, 5e6};
+    // Means on both sides of the switch from inversion to PTRS at 30 (and of CounterRng::poisson()'s at 10),
+    // inside (2e6) and beyond (5e6) the range of the full test's float pre-test, the retry beyond 2^40, and
+    // 0, interleaved, so that the small means are gathered from mixed chunks.
+    const std::vector<double> lambdas = {0.05, 0.7,    3.0, 9.99, 10.0, 29.99, 30.0,
+                                         37.5, 1000.0, 2e6, 0.0,  3e12, 5e6};
     const int perMean = 40000;
     const int n = static_cast<int>(lambdas.size()) * perMean + 5; // a partial last chunk too
     std::vector<double> means(static_cast<size_t>(n));
@@ -486,7 +488,7 @@ TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
     setCpuPath(CpuPath::AUTO);
     // Value by value against the reference: the polynomial exp and log differ from the C library's by an
     // ulp or two, which moves a count only when a uniform falls within about 1e-15 of a boundary of the
-    // CDF or of the acceptance test (chance about 1e-14 per value): none of these 440,005 may differ. The
+    // CDF or of the acceptance test (chance about 1e-14 per value): none of these 520,005 may differ. The
     // float pre-test of PTRS's full test decides only outside a margin of 1e-3 or more, so it never moves
     // one.
     std::map<double, std::array<int, 4>> tries;
@@ -501,7 +503,7 @@ TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
     // under its hat (the (u, v) square maps onto the hat with Jacobian a / us^2 + b), less only the far
     // tails it cuts (below 1e-3 here): 1 - alpha of first tries are retried. 5 binomial standard errors.
     // A share far from that would mean the vector try drops or keeps lanes it should not.
-    for (double lambda : {10.0, 37.5, 1000.0, 2e6}) {
+    for (double lambda : {30.0, 37.5, 1000.0, 2e6}) {
         const std::array<int, 4>& t = tries[lambda];
         const double b = 0.931 + 2.53 * std::sqrt(lambda), alpha = 1 / (1.1239 + 1.1328 / (b - 3.4));
         const double share = (perMean - t[0]) / static_cast<double>(perMean);
@@ -510,6 +512,14 @@ TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
         EXPECT_NEAR(share, 1 - alpha, 5 * std::sqrt(alpha * (1 - alpha) / perMean)) << lambda;
     }
     EXPECT_EQ(tries[3e12][3], perMean); // beyond 2^40: always the scalar sampler
+    // A chunk of small means only is inverted in place, not gathered: the same values as the reference.
+    std::vector<double> dark(4096 + 7), darkCounts(dark.size());
+    for (size_t i = 0; i < dark.size(); ++i)
+        dark[i] = 0.05 + 29.9 * static_cast<double>((i * 37) % 101) / 100.0; // 0.05 to 29.95
+    detail::fillPoisson(seed, stream, dark.data(), darkCounts.data(), static_cast<int>(dark.size()));
+    for (size_t i = 0; i < dark.size(); ++i)
+        ASSERT_EQ(darkCounts[i], referencePoisson(seed, stream, static_cast<int>(i), dark[i]))
+            << "value " << i;
     // A value depends on its own mean only: the same means in another order give each value its count.
     std::vector<double> reversed(means.rbegin(), means.rend()), again(static_cast<size_t>(n));
     detail::fillPoisson(seed, stream, reversed.data(), again.data(), n);
