@@ -172,7 +172,8 @@ std::vector<cv::Mat> matsFromList(const py::handle& list, const char* argument,
 
 cv::Mat outputMatLike(const py::object& dst, const char* argument, const cv::Mat& like)
 {
-    if (dst.is_none())
+    // Without an input there is nothing to be like: the call itself reports the empty input.
+    if (dst.is_none() || like.empty())
         return cv::Mat();
     const cv::Mat m = matFromArray(dst, argument, {like.depth()}, like.channels() > 1);
     if (m.size() != like.size() || m.type() != like.type())

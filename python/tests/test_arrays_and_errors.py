@@ -135,6 +135,9 @@ def test_arguments_that_do_not_convert_are_named(sensor):
     # An array without elements is empty, whatever numpy's strides: no advice to copy it.
     with pytest.raises(rg.error, match="src is empty"):
         rg.colorJitter(np.zeros((0, 4), np.uint16), fmt, model, rg.ColorJitter(), seed=1)
+    with pytest.raises(rg.error, match="src is empty"):  # the empty input is the error, not dst's dtype
+        rg.colorJitter(np.zeros((0, 4), np.uint16), fmt, model, rg.ColorJitter(), seed=1,
+                       dst=np.zeros((2, 2), np.float32))
 
 
 @pytest.mark.parametrize("boxes, words", [
