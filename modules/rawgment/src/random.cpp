@@ -446,6 +446,18 @@ RAWGMENT_KERNEL PtrsTryLanes<W> ptrsTryLanes(typename DoubleLanes<W>::D lambda,
     return t;
 }
 
+//! ptrsTryLanes() on the 32-bit words firsts[0..) (u) and seconds[0..) (v) of the lanes' values.
+template <int W>
+RAWGMENT_KERNEL PtrsTryLanes<W> ptrsTryOfWords(typename DoubleLanes<W>::D lambda, const uint32_t* firsts,
+                                               const uint32_t* seconds)
+{
+    typedef typename DoubleLanes<W>::UL UL;
+    typename DoubleLanes<W>::U32 a, b;
+    std::memcpy(&a, firsts, sizeof(a));
+    std::memcpy(&b, seconds, sizeof(b));
+    return ptrsTryLanes<W>(lambda, __builtin_convertvector(a, UL), __builtin_convertvector(b, UL));
+}
+
 /* log k! - (k ln k - k + ln(2 pi k) / 2), the remainder of Stirling's formula, for k >= 1: exact below 32
  * (from the table of logFactorial()), its series 1/(12k) - 1/(360k^3) + 1/(1260k^5) above, as
  * logFactorial() (error below 1e-13 relative to log k!). */
@@ -750,8 +762,6 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
 {
     typedef typename DoubleLanes<W>::D D;
     typedef typename DoubleLanes<W>::L L;
-    typedef typename DoubleLanes<W>::UL UL;
-    typedef typename DoubleLanes<W>::U32 U32;
     const int kLanes = DoubleLanes<W>::kCount, kChunk = 16; // 16 values per 8 Philox blocks
     const int kGroups = kChunk / kLanes;
     alignas(64) uint32_t words[32];
@@ -785,10 +795,7 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
         int invertBits = 0, smallBits = 0;
         for (int g = 0; g < kGroups; ++g) {
             D lambda;
-            U32 a, b;
             std::memcpy(&lambda, chunkMeans + g * kLanes, sizeof(lambda));
-            std::memcpy(&a, words + g * kLanes, sizeof(a));
-            std::memcpy(&b, words + kChunk + g * kLanes, sizeof(b));
             const L small = lambda < kInversionBelow;
             const L beyond = lambda > kMaxLaneMean;
             const L ptrs = ~small & ~beyond;
@@ -801,9 +808,8 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
                 appendBits(maskBits(beyond) & liveBits, kLanes, base0, retry.get(), retries);
             D kd = {}; // a mean of 0 (or below, or NaN) gives 0; the inversion fills in the small ones
             if (maskBits(ptrs)) {
-                const PtrsTryLanes<W> t =
-                    ptrsTryLanes<W>(ptrs ? lambda : D{} + 10.0, __builtin_convertvector(a, UL),
-                                    __builtin_convertvector(b, UL));
+                const PtrsTryLanes<W> t = ptrsTryOfWords<W>(ptrs ? lambda : D{} + 10.0, words + g * kLanes,
+                                                            words + kChunk + g * kLanes);
                 kd = ptrs ? t.kd : kd;
                 appendBits(maskBits(ptrs & ~t.accept & ~t.refuse) & liveBits, kLanes, base0, fullTest.get(),
                            fullTests);
@@ -886,7 +892,7 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
         for (int start = 0; start < open; start += kChunk) {
             const int live = std::min(kChunk, open - start);
             alignas(64) double lambdas[kChunk], kds[kChunk];
-            alignas(64) uint64_t firsts[kChunk], seconds[kChunk];
+            alignas(64) uint32_t firsts[kChunk], seconds[kChunk];
             int index[kChunk];
             for (int i = 0; i < kChunk; ++i) {
                 index[i] = i < live ? retry[static_cast<size_t>(start + i)] : -1;
@@ -897,11 +903,9 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
             int decidedBits = 0, refusedBits = 0;
             for (int g = 0; g < kGroups; ++g) {
                 D lambda;
-                UL w1, w2;
                 std::memcpy(&lambda, lambdas + g * kLanes, sizeof(lambda));
-                std::memcpy(&w1, firsts + g * kLanes, sizeof(w1));
-                std::memcpy(&w2, seconds + g * kLanes, sizeof(w2));
-                const PtrsTryLanes<W> t = ptrsTryLanes<W>(lambda, w1, w2);
+                const PtrsTryLanes<W> t =
+                    ptrsTryOfWords<W>(lambda, firsts + g * kLanes, seconds + g * kLanes);
                 std::memcpy(kds + g * kLanes, &t.kd, sizeof(t.kd));
                 decidedBits |= maskBits(t.accept | t.refuse) << (g * kLanes);
                 refusedBits |= maskBits(t.refuse) << (g * kLanes);
