@@ -100,7 +100,10 @@ SensorParams darkComponentSensorParams(Size size, double lambda, uint64 seed)
 
 double poissonChiSquare(const std::map<int64_t, int>& counts, double lambda, double n, int& dof, double* mass)
 {
-    double chi2 = 0, cellP = 0, cellObs = 0, covered = 0;
+    const auto term = [n](double p, double observed) {
+        return (observed - p * n) * (observed - p * n) / (p * n);
+    };
+    double chi2 = 0, cellP = 0, cellObs = 0, covered = 0, closedP = 0, closedObs = 0, lastP = 0, lastObs = 0;
     dof = -1;
     for (int64_t k = 0; k < 4 * lambda + 60; ++k) {
         const double pk = std::exp(-lambda + static_cast<double>(k) * std::log(lambda) -
@@ -110,10 +113,22 @@ double poissonChiSquare(const std::map<int64_t, int>& counts, double lambda, dou
         const auto it = counts.find(k);
         cellObs += it == counts.end() ? 0 : it->second;
         if (cellP * n >= 20) {
-            chi2 += (cellObs - cellP * n) * (cellObs - cellP * n) / (cellP * n);
+            chi2 += term(cellP, cellObs);
             ++dof;
+            closedP += cellP;
+            closedObs += cellObs;
+            lastP = cellP;
+            lastObs = cellObs;
             cellP = cellObs = 0;
         }
+    }
+    // The rest of the distribution, every count above the last cell (beyond 4 lambda + 59 too), joins
+    // that cell, so that an excess of large counts shows.
+    double total = 0;
+    for (const auto& c : counts)
+        total += c.second;
+    if (dof >= 0) {
+        chi2 += term(lastP + (1 - closedP), lastObs + (total - closedObs)) - term(lastP, lastObs);
     }
     if (mass)
         *mass = covered;

@@ -44,8 +44,8 @@ SensorParams referenceSensorParams();
 SensorParams darkComponentSensorParams(Size size, double lambda, uint64 seed);
 
 /** Pearson's chi-square of integer counts against Poisson(lambda): cells grown from 0 upwards until their
- * expected count in n draws reaches 20 (the remainder above, below 20, is left out). `dof` is set to the
- * cells less one, and `mass` to the Poisson probability of the counts looked at, 0 to 4 lambda + 59. A
+ * expected count in n draws reaches 20, the rest above (every larger count) joined to the last. `dof` is set
+ * to the cells less one, and `mass` to the Poisson probability of the counts looked at, 0 to 4 lambda + 59. A
  * correct sampler gives about dof, with standard deviation sqrt(2 dof). */
 double poissonChiSquare(const std::map<int64_t, int>& counts, double lambda, double n, int& dof,
                         double* mass = nullptr);
