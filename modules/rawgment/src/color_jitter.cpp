@@ -115,7 +115,7 @@ template <int W> struct PixelLanes<W, float>
 
 // t: the row's unit-variance heavy-tailed draws (NoiseModel::tukeyRead), or null. With them the read
 // part of the variance (the rest, never more than the total) takes t and the shot part z, as
-// detail::splitNoise() does; kLineBySite is never set then, since it does not split the two.
+// detail::splitNoise() does; with kLineBySite the read part is the line's offset.
 template <int W, typename T, NoiseAlignment A, bool kLocalMean, bool kLineBySite>
 RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* t, const float* prior,
                                  const float* extra, const JitterColumns& col, int c,
@@ -139,7 +139,16 @@ RAWGMENT_KERNEL void jitterBlock(const T* s, T* d, const float* z, const float* 
             std::memcpy(&offset, col.offset + c, sizeof(offset));
             const F total = slope * detail::maxLanes(xm, F{}) + offset;
             bright -= total < 0; // -1 per brightening lane
-            out += detail::sqrtLanes(detail::maxLanes(total, F{})) * zv;
+            if (t) {
+                // The line's offset is the read part of Eq. 13 (perSiteLine()), its slope term the shot part.
+                F tv;
+                std::memcpy(&tv, t + c, sizeof(tv));
+                const F all = detail::maxLanes(total, F{});
+                const F read = detail::minLanes(detail::maxLanes(offset, F{}), all);
+                out += detail::sqrtLanes(all - read) * zv + detail::sqrtLanes(read) * tv;
+            } else {
+                out += detail::sqrtLanes(detail::maxLanes(total, F{})) * zv;
+            }
         } else {
             const detail::AddedVarianceOf<F> v = jitterVariance<A>(xm, pcv, k);
             const F total = v.shot + v.rest;
@@ -211,7 +220,7 @@ RAWGMENT_KERNEL int jitterRowAnyAlignment(const T* s, T* d, const float* z, cons
 {
     switch (k.alignment) {
     case NoiseAlignment::ACCOUNT_PRIOR:
-        if (k.lineBySite && !t)
+        if (k.lineBySite)
             return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, true>(s, d, z, t, prior,
                                                                                         extra, col, k, cols);
         return jitterRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, kLocalMean, false>(s, d, z, t, prior, extra,
@@ -526,11 +535,8 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
         if (noise)
             detail::fillGaussian(keys.gaussian, static_cast<uint64_t>(r), z.data(), cols);
         if (tails) {
-            const int even = 2 * (r & 1);
-            const detail::TukeyUnitSampler &s0 = k.dark.tailSampler[even], &s1 = k.dark.tailSampler[even + 1];
-            detail::fillTukeyUnit(keys.tukey, static_cast<uint64_t>(r), static_cast<float>(s0.lambda),
-                                  static_cast<float>(s0.invSd), static_cast<float>(s1.lambda),
-                                  static_cast<float>(s1.invSd), t.data(), cols);
+            detail::fillTukeyUnit(keys.tukey, static_cast<uint64_t>(r), k.dark.tailTable[r & 1], t.data(),
+                                  cols);
         }
         if (dark && !detail::darkRowExtra(k.dark, model, keys.row, r, cols, extra.data()))
             nonFinite = true;
@@ -593,6 +599,14 @@ detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, Point se
                                               readOut - pc * pc * readIn)
                     : model.tukeyLambda);
     }
+    if (d.tails)
+        for (int parity = 0; parity < 2; ++parity) {
+            const detail::TukeyUnitSampler &s0 = d.tailSampler[2 * parity],
+                                           &s1 = d.tailSampler[2 * parity + 1];
+            d.tailTable[parity] =
+                detail::TukeyQuantileTable(static_cast<float>(s0.lambda), static_cast<float>(s0.invSd),
+                                           static_cast<float>(s1.lambda), static_cast<float>(s1.invSd));
+        }
     return d;
 }
 

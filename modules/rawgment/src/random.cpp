@@ -2,6 +2,7 @@
 #include "random.hpp"
 
 #include "cpu_dispatch.hpp"
+#include "noise_terms.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -65,6 +66,75 @@ int64_t CounterRng::poisson(double lambda)
         if (std::log(v) + std::log(invAlpha) - std::log(a / (us * us) + b) <=
             -lambda + kd * logLambda - logFactorial(k))
             return k;
+    }
+}
+
+/* The nodes of every table (TukeyQuantileTable): ln u and ln(1 - u) at the four Chebyshev nodes of each
+ * cell, which do not depend on the shape, computed once. */
+struct TukeyTableNodes
+{
+    std::vector<double> logU, log1mU, x;
+    TukeyTableNodes()
+    {
+        const int cells = TukeyQuantileTable::kCells - 1;
+        logU.resize(4 * static_cast<size_t>(cells));
+        log1mU.resize(logU.size());
+        for (int k = 0; k < 4; ++k)
+            x.push_back(-0.5 * std::cos((2 * k + 1) * CV_PI / 8));
+        for (int c = 0; c < cells; ++c) {
+            const int octave = c / TukeyQuantileTable::kCellsPerOctave,
+                      j = c % TukeyQuantileTable::kCellsPerOctave;
+            const double scale = std::ldexp(1.0, TukeyQuantileTable::kLowestExponent - 127 + octave);
+            const double width = scale / TukeyQuantileTable::kCellsPerOctave;
+            for (int k = 0; k < 4; ++k) {
+                const double u = scale + width * (j + 0.5 + x[static_cast<size_t>(k)]);
+                logU[4 * static_cast<size_t>(c) + k] = std::log(u);
+                log1mU[4 * static_cast<size_t>(c) + k] = std::log1p(-u);
+            }
+        }
+    }
+};
+
+TukeyQuantileTable::TukeyQuantileTable(float lambda0, float invSd0, float lambda1, float invSd1)
+    : lambda{lambda0, lambda1}, invSd{invSd0, invSd1}
+{
+    for (int s = 0; s < 2; ++s)
+        if (!(lambda[s] >= static_cast<float>(kTukeyLambdaMin) && lambda[s] <= 1) ||
+            !(invSd[s] > 0 && std::isfinite(invSd[s])))
+            CV_Error(Error::StsBadArg,
+                     format("a Tukey-lambda table needs lambda in [%g, 1] and a finite positive 1 / sd (got "
+                            "lambda %g, 1 / sd %g)",
+                            kTukeyLambdaMin, static_cast<double>(lambda[s]), static_cast<double>(invSd[s])));
+    static const TukeyTableNodes nodes;
+    coefficients_.assign(static_cast<size_t>(8 * kCells), 0.0f); // the cell of u = 1/2 stays 0
+    for (int s = 0; s < 2; ++s) {
+        float* const site = coefficients_.data() + 4 * static_cast<size_t>(s * kCells);
+        if (s == 1 && lambda[1] == lambda[0] && invSd[1] == invSd[0]) {
+            std::copy(coefficients_.begin(), coefficients_.begin() + 4 * kCells, site);
+            break;
+        }
+        const double l = lambda[s], scale = invSd[s];
+        for (int c = 0; c + 1 < kCells; ++c) {
+            // The quantile at the nodes, then Newton's divided differences, then the monomial coefficients.
+            double y[4], p[4] = {0, 0, 0, 0};
+            for (int k = 0; k < 4; ++k) {
+                const double a = nodes.logU[4 * static_cast<size_t>(c) + k],
+                             b = nodes.log1mU[4 * static_cast<size_t>(c) + k];
+                y[k] = scale * (l == 0 ? a - b : (std::expm1(l * a) - std::expm1(l * b)) / l);
+            }
+            const double* x = nodes.x.data();
+            for (int k = 1; k < 4; ++k)
+                for (int m = 3; m >= k; --m)
+                    y[m] = (y[m] - y[m - 1]) / (x[m] - x[m - k]);
+            p[0] = y[3];
+            for (int k = 2; k >= 0; --k) { // p = p (x - x_k) + y_k
+                for (int m = 3; m >= 1; --m)
+                    p[m] = p[m - 1] - x[k] * p[m];
+                p[0] = y[k] - x[k] * p[0];
+            }
+            for (int m = 0; m < 4; ++m)
+                site[4 * c + m] = static_cast<float>(p[m]);
+        }
     }
 }
 
@@ -226,29 +296,116 @@ RAWGMENT_KERNEL typename Lanes<W>::F tukeyValuesLanes(typename Lanes<W>::U w1, t
     return invSd * (negative ? -q : q);
 }
 
-/* n unit-variance Tukey-lambda values from the stream, one Philox word each (value h of a chunk of 32 takes
- * word h of its 8 blocks), as tukeyValuesLanes() makes them from two. Where m, the word's 31 bits of u, is
- * 2^24 or more (u >= 2^-8), float's 24 bits hold m alone and the second word's fraction cannot change u, so
- * none is drawn; below (a share 2^-7), the second word is the first of the value's own stream
- * (tukeyRefineKey(seed, stream), index), so u reaches 2^-57 and the tails are drawn as far as a double
- * uniform's would be. Even columns take lambda0, odd columns lambda1 (the two CFA sites of a row). */
+/* Lane i of c0..c3 from the four floats at table + offset[i]: 16-byte loads transposed in registers (a
+ * gather would load each float on its own). Target v3, so that the AVX2 and AVX-512 paths inline it; not
+ * always_inline, which GCC would also try in loadCells<8>'s baseline instance. */
+#if RAWGMENT_HAVE_CPU_PATHS
+__attribute__((target("arch=x86-64-v3"))) inline void
+loadCells8(const float* table, const int32_t* offset, __m256& c0, __m256& c1, __m256& c2, __m256& c3)
+{
+    // Cells i and i + 4 in the low and high halves, so that the transpose leaves lane i in place.
+    const __m256 a0 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(table + offset[0])),
+                                           _mm_loadu_ps(table + offset[4]), 1);
+    const __m256 a1 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(table + offset[1])),
+                                           _mm_loadu_ps(table + offset[5]), 1);
+    const __m256 a2 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(table + offset[2])),
+                                           _mm_loadu_ps(table + offset[6]), 1);
+    const __m256 a3 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(table + offset[3])),
+                                           _mm_loadu_ps(table + offset[7]), 1);
+    const __m256 lo01 = _mm256_unpacklo_ps(a0, a1), lo23 = _mm256_unpacklo_ps(a2, a3);
+    const __m256 hi01 = _mm256_unpackhi_ps(a0, a1), hi23 = _mm256_unpackhi_ps(a2, a3);
+    c0 = _mm256_shuffle_ps(lo01, lo23, 0x44);
+    c1 = _mm256_shuffle_ps(lo01, lo23, 0xee);
+    c2 = _mm256_shuffle_ps(hi01, hi23, 0x44);
+    c3 = _mm256_shuffle_ps(hi01, hi23, 0xee);
+}
+#endif
+
 template <int W>
-RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, float lambda0, float invSd0,
-                                         float lambda1, float invSd1, float* out, int n)
+RAWGMENT_KERNEL void loadCells(const float* table, typename Lanes<W>::I offsets, typename Lanes<W>::F& c0,
+                               typename Lanes<W>::F& c1, typename Lanes<W>::F& c2, typename Lanes<W>::F& c3)
 {
     typedef typename Lanes<W>::F F;
+    alignas(64) int32_t offset[W];
+    std::memcpy(offset, &offsets, sizeof(offsets));
+#if RAWGMENT_HAVE_CPU_PATHS
+    if constexpr (W == 4) {
+        __m128 r0 = _mm_loadu_ps(table + offset[0]), r1 = _mm_loadu_ps(table + offset[1]),
+               r2 = _mm_loadu_ps(table + offset[2]), r3 = _mm_loadu_ps(table + offset[3]);
+        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+        c0 = (F)r0;
+        c1 = (F)r1;
+        c2 = (F)r2;
+        c3 = (F)r3;
+        return;
+    }
+    if constexpr (W == 8) {
+        __m256 r0, r1, r2, r3;
+        loadCells8(table, offset, r0, r1, r2, r3);
+        c0 = (F)r0;
+        c1 = (F)r1;
+        c2 = (F)r2;
+        c3 = (F)r3;
+        return;
+    }
+#endif
+    for (int i = 0; i < W; ++i) {
+        c0[i] = table[offset[i]];
+        c1[i] = table[offset[i] + 1];
+        c2[i] = table[offset[i] + 2];
+        c3[i] = table[offset[i] + 3];
+    }
+}
+
+/* W unit-variance Tukey-lambda values from W words by the table's cubics (TukeyQuantileTable): u = m 2^-32
+ * from the word's 31 bits m, exact in float from m = 2^24 up (the float rounds m, as tukeyValuesLanes()
+ * does); float's exponent and top 5 mantissa bits of m pick the cell, its other 18 bits the position in
+ * it. A value below (m < 2^24) gets the lowest cell here, and its refinement later. */
+template <int W>
+RAWGMENT_KERNEL typename Lanes<W>::F tukeyTableLanes(typename Lanes<W>::U w, const float* table,
+                                                     typename Lanes<W>::I siteOffset)
+{
+    typedef typename Lanes<W>::F F;
+    typedef typename Lanes<W>::I I;
+    constexpr int kPositionBits = 23 - 5; // TukeyQuantileTable::kCellsPerOctave = 2^5
+    static_assert(TukeyQuantileTable::kCellsPerOctave == 1 << (23 - kPositionBits), "cells per octave");
+    // m 2^-32 has the exponent of m less 32: the cell of u from the bits of m as a float.
+    constexpr int kFirstCell = (TukeyQuantileTable::kLowestExponent + 32) << (23 - kPositionBits);
+    const F m = __builtin_convertvector((I)(w & 0x7fffffffu), F);
+    const I bits = (I)m;
+    const I cell = detail::maxLanes((bits >> kPositionBits) - kFirstCell, I{});
+    const F x =
+        __builtin_convertvector(bits & ((1 << kPositionBits) - 1), F) * (1.0f / (1 << kPositionBits)) - 0.5f;
+    F c0, c1, c2, c3;
+    loadCells<W>(table, cell * 4 + siteOffset, c0, c1, c2, c3);
+    const F q = c0 + x * (c1 + x * (c2 + x * c3));
+    const I negative = (I)(w >> 31) != 0;
+    return negative ? -q : q;
+}
+
+/* n unit-variance Tukey-lambda values from the stream, one Philox word each (value h of a chunk of 32 takes
+ * word h of its 8 blocks), by the table's cubics (tukeyTableLanes()). Where m, the word's 31 bits of u, is
+ * below 2^24 (u < 2^-8, a share 2^-7), the second word is the first of the value's own stream
+ * (tukeyRefineKey(seed, stream), index), so u reaches 2^-57 and the tails are drawn as far as a double
+ * uniform's would be; such a value is the quantile computed by tukeyValuesLanes(). Even columns take the
+ * table's first shape, odd columns its second (the two CFA sites of a row). */
+template <int W>
+RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, const TukeyQuantileTable& table,
+                                         float* out, int n)
+{
+    typedef typename Lanes<W>::F F;
+    typedef typename Lanes<W>::I I;
     typedef typename Lanes<W>::U U;
+    CV_Assert(!table.empty());
     const int kChunk = 32; // values per 8 Philox blocks
     const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
-    F lambda, invSd;
-    for (int i = 0; i < W; ++i) {
-        lambda[i] = (i & 1) ? lambda1 : lambda0;
-        invSd[i] = (i & 1) ? invSd1 : invSd0;
-    }
-    const F safeLambda = lambda == 0.0f ? F{} + 1.0f : lambda;
+    I siteOffset;
+    for (int i = 0; i < W; ++i)
+        siteOffset[i] = (i & 1) * 4 * TukeyQuantileTable::kCells;
+    const float* const coefficients = table.coefficients();
     const U fine = U{} + (1u << 24);
-    // Two chunks per step: their words first, then their values, so that the quantiles' chains of dependent
-    // operations overlap. The values to refine, and their words, are kept for the end.
+    // Two chunks per step: their words first, then their values. The values to refine, and their words,
+    // are kept for the end.
     const int kStep = 2 * kChunk;
     alignas(64) uint32_t stepWords[kStep];
     alignas(64) float stepValues[kStep];
@@ -263,7 +420,7 @@ RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, float l
         for (int h = 0; h < kStep; h += W) {
             U w1;
             std::memcpy(&w1, stepWords + h, sizeof(w1));
-            const F v = tukeyValuesLanes<W>(w1, U{}, lambda, invSd, safeLambda);
+            const F v = tukeyTableLanes<W>(w1, coefficients, siteOffset);
             std::memcpy(dst + h, &v, sizeof(v));
             if (int coarse = maskBits((w1 & 0x7fffffffu) < fine))
                 for (; coarse; coarse &= coarse - 1) {
@@ -279,7 +436,7 @@ RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, float l
     }
     if (refine.empty())
         return;
-    // The refined values, eight streams' first words at a time, recomputed in lanes as the others.
+    // The refined values, eight streams' first words at a time, in lanes.
     const uint64_t refineKey = tukeyRefineKey(seed, stream);
     const std::array<uint32_t, 2> refineWordsKey = {static_cast<uint32_t>(refineKey),
                                                     static_cast<uint32_t>(refineKey >> 32)};
@@ -294,8 +451,8 @@ RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, float l
             const int index = i < live ? refine[static_cast<size_t>(start + i)] : 0;
             if (i < 8)
                 streams[i] = static_cast<uint64_t>(index);
-            lambdas[i] = (index & 1) ? lambda1 : lambda0;
-            invSds[i] = (index & 1) ? invSd1 : invSd0;
+            lambdas[i] = table.lambda[index & 1];
+            invSds[i] = table.invSd[index & 1];
             if (i < live)
                 firsts[i] = refineWords[static_cast<size_t>(start + i)];
         }
@@ -936,9 +1093,9 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
 RAWGMENT_DISPATCHED_BY_WIDTH(void, fillGaussian, (uint64_t seed, uint64_t stream, float* out, int n),
                              (seed, stream, out, n))
 RAWGMENT_DISPATCHED_BY_WIDTH(void, fillTukeyUnit,
-                             (uint64_t seed, uint64_t stream, float lambda0, float invSd0, float lambda1,
-                              float invSd1, float* out, int n),
-                             (seed, stream, lambda0, invSd0, lambda1, invSd1, out, n))
+                             (uint64_t seed, uint64_t stream, const TukeyQuantileTable& table, float* out,
+                              int n),
+                             (seed, stream, table, out, n))
 RAWGMENT_DISPATCHED_BY_WIDTH(void, fillPoisson,
                              (uint64_t seed, uint64_t stream, const double* means, double* counts, int n),
                              (seed, stream, means, counts, n))

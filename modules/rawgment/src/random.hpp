@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 #if RAWGMENT_HAVE_CPU_PATHS
 #include <immintrin.h>
@@ -508,18 +509,52 @@ double logFactorial(int64_t k);
  * model; the uniforms have 24 bits, so |z| <= 5.8 (probability of a larger |z| for a true normal: 7e-9). */
 void fillGaussian(uint64_t seed, uint64_t stream, float* out, int n);
 
+/** The Tukey-lambda quantiles fillTukeyUnit() draws with, for the two CFA sites of a row (even columns:
+ * shape lambda[0] scaled by invSd[0], 1 / the shape's standard deviation; odd columns: lambda[1], invSd[1]).
+ * For u in [2^-8, 1/2), where all but a share 2^-7 of the uniforms lie, invSd Q(u) is a cubic in each of 32
+ * cells per octave of u: the interpolant at the cell's four Chebyshev nodes, in double from the exact
+ * quantile, rounded to float coefficients of x = the position in the cell - 1/2 (in [-1/2, 1/2), so the
+ * terms do not cancel). Its truncation error is below 2e-9 of the quantile's scale (the fourth derivative
+ * of ln u over a cell of 1/32 of its octave), so the float rounding of the coefficients and of the four
+ * multiply-adds decide: 2e-7 relative at most, measured at lambda -0.2 to 1. Built once per step (two
+ * exponentials at each of 896 nodes and site, about 70 microseconds); a lookup and the cubic cost a
+ * fraction of the logarithms and exponentials the quantile needs otherwise. */
+class CV_RAWGMENT_EXPORTS TukeyQuantileTable
+{
+public:
+    static constexpr int kCellsPerOctave = 32;
+    static constexpr int kOctaves = 7;          //!< u in [2^-8, 2^-1)
+    static constexpr int kLowestExponent = 119; //!< float's biased exponent of 2^-8
+    //! The cells of one site: kOctaves * kCellsPerOctave, and one for u = 1/2 (whose quantile is 0).
+    static constexpr int kCells = kOctaves * kCellsPerOctave + 1;
+
+    TukeyQuantileTable() = default; //!< unusable: for arrays that are assigned later
+    //! Throws StsBadArg unless each lambda is in [kTukeyLambdaMin, 1] and each invSd finite and positive.
+    TukeyQuantileTable(float lambda0, float invSd0, float lambda1, float invSd1);
+    //! Both sites of the same shape (a plane row of a resampled mosaic is one site).
+    TukeyQuantileTable(float lambda_, float invSd_) : TukeyQuantileTable(lambda_, invSd_, lambda_, invSd_) {}
+
+    float lambda[2] = {0, 0}, invSd[2] = {1, 1};
+    //! Cell c of site s: the coefficients of x^0..x^3 at 4 (s kCells + c).
+    const float* coefficients() const { return coefficients_.data(); }
+    bool empty() const { return coefficients_.empty(); }
+
+private:
+    std::vector<float> coefficients_;
+};
+
 /** Fills out[0..n) with unit-variance Tukey-lambda float32 values from the stream (seed, stream): even
- * indices of shape lambda0 (scaled by invSd0, 1 / the shape's standard deviation), odd ones of lambda1
- * (the two CFA sites of a mosaic row). Vector lanes on every path, the same bits on each: the quantile's
- * logarithms and exponentials are polynomials (no library calls). Value i uses word i % 32 of its chunk
- * (32 values per 8 Philox blocks): its top bit the sign, the other 31 bits m the uniform u = m 2^-32 in
- * (0, 1/2), all float keeps of it from u = 2^-8 up. Below (m < 2^24, a share 2^-7), 24 bits of the first
- * word of the value's own stream (tukeyRefineKey(seed, stream), i) extend u, so the uniforms reach 2^-57
- * and the tails are drawn as far as a double uniform's would be. Accuracy: within 2e-6 relative (or 1e-6
- * absolute near 0) of the double quantile of the same uniform
+ * indices of the table's first shape, odd ones of its second (the two CFA sites of a mosaic row). Vector
+ * lanes on every path, the same bits on each. Value i uses word i % 32 of its chunk (32 values per 8 Philox
+ * blocks): its top bit the sign, the other 31 bits m the uniform u = m 2^-32 in (0, 1/2), all float keeps of
+ * it from u = 2^-8 up, where the table's cubics give the quantile. Below (m < 2^24, a share 2^-7), 24 bits
+ * of the first word of the value's own stream (tukeyRefineKey(seed, stream), i) extend u, so the uniforms
+ * reach 2^-57 and the tails are drawn as far as a double uniform's would be; those values are computed
+ * from the logarithms and exponentials as polynomials (no library calls). Accuracy: within 2e-6 relative
+ * (or 1e-6 absolute near 0) of the double quantile of the same uniform
  * (Simulate.fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath). */
-CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, float lambda0, float invSd0,
-                                       float lambda1, float invSd1, float* out, int n);
+CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, const TukeyQuantileTable& table,
+                                       float* out, int n);
 
 /** Fills counts[0..n) with exact Poisson variates of means[0..n) from the stream (seed, stream), the
  * vector version of CounterRng::poisson() that ShotNoiseSampling::POISSON draws with. Every mean must lie

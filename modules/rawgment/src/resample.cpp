@@ -271,10 +271,7 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
     }
     if (noise && k.dark.tails) {
         t.resize(static_cast<size_t>(n));
-        // A plane row is one CFA site: the same shape in every column.
-        const float lambda = static_cast<float>(k.dark.tailSampler[site].lambda),
-                    invSd = static_cast<float>(k.dark.tailSampler[site].invSd);
-        detail::fillTukeyUnit(k.tukeyKey, stream, lambda, invSd, lambda, invSd, t.data(), n);
+        detail::fillTukeyUnit(k.tukeyKey, stream, k.dark.tailTable[0], t.data(), n);
     }
     const float* extraRow = extra.empty() ? nullptr : extra.data();
     if (noise && (k.sampling == ShotNoiseSampling::POISSON || k.dark.tails)) {
@@ -336,6 +333,9 @@ void resampleDarkTerms(ResampleConstants& k, const NoiseModel& model, const RawF
                     : model.tukeyLambda;
         for (int s = 0; s < 4; ++s)
             d.tailSampler[s] = detail::TukeyUnitSampler(lambda);
+        // One shape for every site, so one table (a plane row is one site).
+        d.tailTable[0] = detail::TukeyQuantileTable(static_cast<float>(lambda),
+                                                    static_cast<float>(d.tailSampler[0].invSd));
     }
     if (d.shading) {
         k.shading = detail::ShadingRows(model, format.gain, format.sensorOrigin);

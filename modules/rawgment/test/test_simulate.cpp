@@ -593,6 +593,7 @@ TEST(Simulate, fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath)
     const int n = 32 * 4096 + 11; // a partial last chunk too
     for (const Vec2f& lambdas : {Vec2f(1.0f, 0.14f), Vec2f(0.0f, -0.05f), Vec2f(-0.2f, 0.5f)}) {
         const float invSd[2] = {0.7f, 1.3f};
+        const detail::TukeyQuantileTable table(lambdas[0], invSd[0], lambdas[1], invSd[1]);
         std::vector<double> reference(static_cast<size_t>(n));
         for (int i = 0; i < n; ++i) {
             double u, unrefined;
@@ -600,14 +601,16 @@ TEST(Simulate, fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath)
             const double q = quantile(u, lambdas[i & 1]) * invSd[i & 1];
             reference[static_cast<size_t>(i)] = negative ? -q : q;
         }
-        // The float quantile rounds in the two logarithms (each a few ulps of |ln u| <= 40), the
-        // exponential and the difference: 2e-6 of max(1, |value|) bounds it (5e-7 seen on every path); a
-        // wrong word, sign or branch of the series errs by order one.
+        // From u = 2^-8 up the table's cubics round in their float coefficients and four multiply-adds (their
+        // truncation is below 2e-9, random.hpp), and u rounds to float's 24 bits: a few ulps, 2.5e-7 of
+        // max(1, |value|) seen. The refined values below round in the two logarithms (each a few ulps of
+        // |ln u| <= 40), the exponential and the difference. 2e-6 bounds both; a wrong word, cell, sign or
+        // branch of the series errs by order one.
         std::vector<float> first;
         for (CpuPath path : availableCpuPaths()) {
             setCpuPath(path);
             std::vector<float> t(static_cast<size_t>(n));
-            detail::fillTukeyUnit(seed, stream, lambdas[0], invSd[0], lambdas[1], invSd[1], t.data(), n);
+            detail::fillTukeyUnit(seed, stream, table, t.data(), n);
             double worst = 0;
             for (int i = 0; i < n; ++i) {
                 const double ref = reference[static_cast<size_t>(i)];
@@ -629,7 +632,7 @@ TEST(Simulate, fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath)
     // one (|v| = ln((1 - u) / u) within 4e-5 here, so u within 5e-5 relative).
     const int many = 1 << 22;
     std::vector<float> t(static_cast<size_t>(many));
-    detail::fillTukeyUnit(seed, stream, 0.0f, 1.0f, 0.0f, 1.0f, t.data(), many);
+    detail::fillTukeyUnit(seed, stream, detail::TukeyQuantileTable(0.0f, 1.0f), t.data(), many);
     int refined = 0, telling = 0;
     for (int i = 0; i < many; ++i) {
         double u, unrefined;
