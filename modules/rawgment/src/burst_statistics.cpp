@@ -10,6 +10,7 @@
 #include <sys/mman.h>
 #endif
 #include <cstring>
+#include <type_traits>
 
 namespace cv {
 namespace rawgment {
@@ -17,18 +18,19 @@ namespace rawgment {
 namespace {
 
 // Sums of d = v_k - v_0 and d^2 over frames 1..m-1 of a group, and min/max of the raw values, for n
-// columns. Multi-versioned (see random.hpp): these loops are the whole cost of burst statistics.
+// columns from `offset` on. Multi-versioned (cpu_dispatch.hpp): these loops are the whole cost of burst
+// statistics.
 template <typename T>
 RAWGMENT_KERNEL void groupSumsBody(const T* const* rows, int m, int n, double* s1, double* s2, double* lo,
-                                   double* hi)
+                                   double* hi, int offset = 0)
 {
-    const T* first = rows[0];
+    const T* first = rows[0] + offset;
     for (int c = 0; c < n; ++c) {
         s1[c] = s2[c] = 0;
         lo[c] = hi[c] = static_cast<double>(first[c]);
     }
     for (int k = 1; k < m; ++k) {
-        const T* v = rows[k];
+        const T* v = rows[k] + offset;
         for (int c = 0; c < n; ++c) {
             const double x = static_cast<double>(v[c]);
             const double d = x - static_cast<double>(first[c]);
@@ -39,15 +41,6 @@ RAWGMENT_KERNEL void groupSumsBody(const T* const* rows, int m, int n, double* s
         }
     }
 }
-
-RAWGMENT_KERNEL void groupSumsKernel(const ushort* const* rows, int m, int n, double* s1, double* s2,
-                                     double* lo, double* hi)
-{
-    groupSumsBody(rows, m, n, s1, s2, lo, hi);
-}
-RAWGMENT_DISPATCHED(void, groupSums,
-                    (const ushort* const* rows, int m, int n, double* s1, double* s2, double* lo, double* hi),
-                    (rows, m, n, s1, s2, lo, hi))
 
 RAWGMENT_KERNEL void groupSumsKernel(const float* const* rows, int m, int n, double* s1, double* s2,
                                      double* lo, double* hi)
@@ -96,6 +89,141 @@ RAWGMENT_DISPATCHED(void, mergeGroupColumns,
                      int m, double wGroup, double wCross, float* mu, float* acc, int n),
                     (first, s1, s2, blackOfColumn, m, wGroup, wCross, mu, acc, n))
 
+// Half the lanes of a kernel of width W: int32, double and float.
+template <int W> struct HalfLanes
+{
+    typedef int32_t I __attribute__((vector_size(2 * W)));
+    typedef double D __attribute__((vector_size(4 * W)));
+    typedef float F __attribute__((vector_size(2 * W)));
+};
+
+//! Half h of a vector of W lanes.
+template <typename Half, typename V> RAWGMENT_KERNEL Half halfOf(const V& v, int h)
+{
+    Half part;
+    std::memcpy(&part, reinterpret_cast<const char*>(&v) + h * sizeof(Half), sizeof(Half));
+    return part;
+}
+
+//! W / 2 lanes of a float64 or float32 state, in double lanes, and back.
+template <int W> RAWGMENT_KERNEL typename HalfLanes<W>::D loadState(const double* p)
+{
+    typename HalfLanes<W>::D d;
+    std::memcpy(&d, p, sizeof(d));
+    return d;
+}
+template <int W> RAWGMENT_KERNEL typename HalfLanes<W>::D loadState(const float* p)
+{
+    typename HalfLanes<W>::F f;
+    std::memcpy(&f, p, sizeof(f));
+    return __builtin_convertvector(f, typename HalfLanes<W>::D);
+}
+template <int W> RAWGMENT_KERNEL void storeState(double* p, typename HalfLanes<W>::D d)
+{
+    std::memcpy(p, &d, sizeof(d));
+}
+template <int W> RAWGMENT_KERNEL void storeState(float* p, typename HalfLanes<W>::D d)
+{
+    const typename HalfLanes<W>::F f = __builtin_convertvector(d, typename HalfLanes<W>::F);
+    std::memcpy(p, &f, sizeof(f));
+}
+
+/* A group of 16-bit frames folded into one row's running statistics, W columns at a time: the sums of
+ * groupSumsBody() in integer lanes with the frames as the inner loop, so that they stay in registers
+ * (d = v_k - v_0 in int32; d^2 < 2^32 in uint32, split into its low and high 16 bits, whose sums over at most
+ * 256 frames stay below 2^31), then mergeGroupColumnsBody()'s operations in double lanes, in its order, and
+ * the clipped flags (a value of 0 or at least `whiteFloor`, the smallest integer >= the white level). The
+ * sums are the exact integers the double loop gives and the merge rounds as it does, so the results are
+ * the same bits. Before, the double loop cost about four operations per value and frame and loaded and
+ * stored its sums for each frame, and the merge read them back from arrays. */
+template <int W, typename S>
+RAWGMENT_KERNEL void mergeGroup16Body(const ushort* const* rows, int m, int n, double black0, double black1,
+                                      double wGroup, double wCross, int whiteFloor, S* mu, S* acc,
+                                      uchar* clip)
+{
+    typedef typename detail::Lanes<W>::I I;
+    typedef typename detail::Lanes<W>::U U;
+    typedef typename detail::Lanes<W>::U16 U16;
+    typedef typename HalfLanes<W>::I HalfI;
+    typedef typename HalfLanes<W>::D D;
+    D black; // columns start even in each half, so the CFA phase is the lane's
+    for (int i = 0; i < W / 2; ++i)
+        black[i] = (i & 1) ? black1 : black0;
+    const D md = D{} + static_cast<double>(m);
+    int c = 0;
+    for (; c + W <= n; c += W) {
+        U16 raw;
+        std::memcpy(&raw, rows[0] + c, sizeof(raw));
+        const I first = __builtin_convertvector(raw, I);
+        I sum = {}, low = first, high = first;
+        U squareLow = {}, squareHigh = {};
+        for (int k = 1; k < m; ++k) {
+            std::memcpy(&raw, rows[k] + c, sizeof(raw));
+            const I v = __builtin_convertvector(raw, I);
+            const I d = v - first;
+            sum += d;
+            const U square = (U)d * (U)d; // |d| <= 65535: exact modulo 2^32, so exact
+            squareLow += square & 0xffffu;
+            squareHigh += square >> 16;
+            low = detail::minLanes(low, v);
+            high = detail::maxLanes(high, v);
+        }
+        for (int h = 0; h < 2; ++h) {
+            const D s1 = __builtin_convertvector(halfOf<HalfI>(sum, h), D);
+            const D s2 = __builtin_convertvector(halfOf<HalfI>((I)squareHigh, h), D) * 65536.0 +
+                         __builtin_convertvector(halfOf<HalfI>((I)squareLow, h), D);
+            const D groupMean = __builtin_convertvector(halfOf<HalfI>(first, h), D) - black + s1 / md;
+            const D groupM2 = (md * s2 - s1 * s1) / md;
+            S* const muAt = mu + c + h * W / 2;
+            S* const accAt = acc + c + h * W / 2;
+            const D oldMean = loadState<W>(muAt);
+            const D delta = groupMean - oldMean;
+            storeState<W>(muAt, oldMean + delta * wGroup);
+            storeState<W>(accAt, loadState<W>(accAt) + groupM2 + delta * delta * wCross);
+        }
+        for (int bits = detail::maskBits((low <= 0) | (high >= whiteFloor)); bits; bits &= bits - 1)
+            clip[c + __builtin_ctz(static_cast<unsigned>(bits))] = 255;
+    }
+    if (c == n)
+        return;
+    // The last columns (fewer than W) by the scalar loops, which give the same bits.
+    double s1[W], s2[W], lo[W], hi[W], first[W], blackOfColumn[W];
+    groupSumsBody(rows, m, n - c, s1, s2, lo, hi, c);
+    for (int i = 0; i < n - c; ++i) {
+        first[i] = rows[0][c + i];
+        blackOfColumn[i] = ((c + i) & 1) ? black1 : black0;
+    }
+    mergeGroupColumnsBody(first, s1, s2, blackOfColumn, m, wGroup, wCross, mu + c, acc + c, n - c);
+    for (int i = 0; i < n - c; ++i)
+        if (lo[i] <= 0 || hi[i] >= whiteFloor)
+            clip[c + i] = 255;
+}
+
+template <int W>
+RAWGMENT_KERNEL void mergeGroup16Kernel(const ushort* const* rows, int m, int n, double black0, double black1,
+                                        double wGroup, double wCross, int whiteFloor, double* mu, double* acc,
+                                        uchar* clip)
+{
+    mergeGroup16Body<W>(rows, m, n, black0, black1, wGroup, wCross, whiteFloor, mu, acc, clip);
+}
+template <int W>
+RAWGMENT_KERNEL void mergeGroup16Kernel(const ushort* const* rows, int m, int n, double black0, double black1,
+                                        double wGroup, double wCross, int whiteFloor, float* mu, float* acc,
+                                        uchar* clip)
+{
+    mergeGroup16Body<W>(rows, m, n, black0, black1, wGroup, wCross, whiteFloor, mu, acc, clip);
+}
+RAWGMENT_DISPATCHED_BY_WIDTH(void, mergeGroup16,
+                             (const ushort* const* rows, int m, int n, double black0, double black1,
+                              double wGroup, double wCross, int whiteFloor, double* mu, double* acc,
+                              uchar* clip),
+                             (rows, m, n, black0, black1, wGroup, wCross, whiteFloor, mu, acc, clip))
+RAWGMENT_DISPATCHED_BY_WIDTH(void, mergeGroup16,
+                             (const ushort* const* rows, int m, int n, double black0, double black1,
+                              double wGroup, double wCross, int whiteFloor, float* mu, float* acc,
+                              uchar* clip),
+                             (rows, m, n, black0, black1, wGroup, wCross, whiteFloor, mu, acc, clip))
+
 /** Folds a group of frames into the running mean and M2 of each pixel of rows [r0, r1).
  *
  * Row by row, in column blocks whose sums stay in L1 while the group's rows stream past: sums of
@@ -113,6 +241,8 @@ void mergeGroupRows(const std::vector<Mat>& group, int merged, const Vec4d& blac
     std::vector<const T*> rows(static_cast<size_t>(m));
     const double total = static_cast<double>(merged + m);
     const double wGroup = m / total, wCross = static_cast<double>(merged) * m / total;
+    // For 16-bit values, hi >= white is hi >= ceil(white) (0 and 65536 bound every value).
+    const int whiteFloor = static_cast<int>(std::min(std::max(std::ceil(white), 0.0), 65536.0));
     for (int r = r0; r < r1; ++r) {
         const double b0 = black[2 * (r & 1)], b1 = black[2 * (r & 1) + 1];
         for (int c = 0; c < kBlock; ++c)
@@ -127,17 +257,23 @@ void mergeGroupRows(const std::vector<Mat>& group, int merged, const Vec4d& blac
             std::memset(acc, 0, sizeof(S) * static_cast<size_t>(cols));
             std::memset(clip, 0, static_cast<size_t>(cols));
         }
-        for (int c0 = 0; c0 < cols; c0 += kBlock) {
-            const int n = std::min(kBlock, cols - c0);
+        if constexpr (std::is_same<T, ushort>::value) {
             for (int k = 0; k < m; ++k)
-                rows[static_cast<size_t>(k)] = group[static_cast<size_t>(k)].ptr<T>(r) + c0;
-            groupSums(rows.data(), m, n, s1, s2, lo, hi);
-            for (int c = 0; c < n; ++c)
-                first[c] = static_cast<double>(rows[0][c]);
-            mergeGroupColumns(first, s1, s2, blackOfColumn, m, wGroup, wCross, mu + c0, acc + c0, n);
-            for (int c = 0; c < n; ++c)
-                if (lo[c] <= 0 || hi[c] >= white)
-                    clip[c0 + c] = 255;
+                rows[static_cast<size_t>(k)] = group[static_cast<size_t>(k)].ptr<T>(r);
+            mergeGroup16(rows.data(), m, cols, b0, b1, wGroup, wCross, whiteFloor, mu, acc, clip);
+        } else {
+            for (int c0 = 0; c0 < cols; c0 += kBlock) {
+                const int n = std::min(kBlock, cols - c0);
+                for (int k = 0; k < m; ++k)
+                    rows[static_cast<size_t>(k)] = group[static_cast<size_t>(k)].ptr<T>(r) + c0;
+                groupSums(rows.data(), m, n, s1, s2, lo, hi);
+                for (int c = 0; c < n; ++c)
+                    first[c] = static_cast<double>(rows[0][c]);
+                mergeGroupColumns(first, s1, s2, blackOfColumn, m, wGroup, wCross, mu + c0, acc + c0, n);
+                for (int c = 0; c < n; ++c)
+                    if (lo[c] <= 0 || hi[c] >= white)
+                        clip[c0 + c] = 255;
+            }
         }
     }
 }

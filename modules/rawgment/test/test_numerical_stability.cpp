@@ -7,6 +7,7 @@
 
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/calibration.hpp>
+#include <opencv2/rawgment/cpu.hpp>
 #include <opencv2/rawgment/isp.hpp>
 #include <opencv2/rawgment/normality.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
@@ -226,6 +227,111 @@ TEST(NumericalStability, burstStatisticsAreExactForLargeMeansAndAnyFrameCount)
     RawFormat badWhite = fmt;
     badWhite.whiteLevel = std::numeric_limits<double>::infinity();
     EXPECT_CV_ERROR_CONTAINS(BurstStatistics stats(badWhite), "whiteLevel"); // and leaks nothing (ASan build)
+}
+
+TEST(NumericalStability, burstStatisticsOf16BitFramesAreExactAndTheSameOnEveryPath)
+{
+    // 16-bit frames take integer lanes (exact sums) and a merge in double lanes; float frames of the same
+    // values take the double loops. Both must give the same bits on every path, for both state depths and
+    // for groups of 256 frames (the largest: the split sums of d^2 are at their limit) and of 8, on values
+    // at the extremes: columns that alternate 0 and 65535 (|d| = 65535 in every frame), stay at 65535, are
+    // uniform over the whole range, or are near the white level (4000.5: 4001 is clipped, 4000 is not).
+    // Width 45 leaves a partial vector on every path, and 4 rows cover both CFA phases.
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d(100, 90, 80, 70);
+    fmt.whiteLevel = 4000.5;
+    const int frames = 300, rows = 4, cols = 45;
+    RNG rng(20261126);
+    std::vector<Mat> burst16, burst32;
+    for (int t = 0; t < frames; ++t) {
+        Mat f(rows, cols, CV_16UC1);
+        for (int r = 0; r < rows; ++r)
+            for (int c = 0; c < cols; ++c) {
+                int v;
+                switch (c % 5) {
+                case 0:
+                    v = (t + r) % 2 ? 65535 : 0;
+                    break;
+                case 1:
+                    v = 65535;
+                    break;
+                case 2:
+                    v = rng.uniform(0, 65536);
+                    break;
+                case 3:
+                    v = 3995 + rng.uniform(0, 6) * (c > 20 ? 1 : 0);
+                    break; // reaches 4000 at most
+                default:
+                    v = 3996 + rng.uniform(0, 6);
+                    break; // reaches 4001
+                }
+                f.at<ushort>(r, c) = static_cast<ushort>(v);
+            }
+        burst16.push_back(f);
+        Mat g;
+        f.convertTo(g, CV_32F);
+        burst32.push_back(g);
+    }
+    for (int depth : {CV_64F, CV_32F})
+        for (int group : {256, 8}) {
+            SCOPED_TRACE(testing::Message() << "depth " << depth << ", group " << group);
+            Mat firstMean, firstVar, firstMask;
+            for (CpuPath path : availableCpuPaths()) {
+                setCpuPath(path);
+                for (const std::vector<Mat>* burst : {&burst16, &burst32}) {
+                    BurstStatistics stats(fmt, group, depth);
+                    for (const Mat& f : *burst)
+                        stats.add(f);
+                    Mat mean, var, mask;
+                    stats.mean(mean);
+                    stats.variance(var);
+                    stats.clippedMask(mask);
+                    if (firstMean.empty()) {
+                        firstMean = mean;
+                        firstVar = var;
+                        firstMask = mask;
+                        continue;
+                    }
+                    const std::string what =
+                        std::string(cpuPathName(path)) + (burst == &burst16 ? ", 16-bit" : ", float");
+                    EXPECT_EQ(0, cv::norm(mean, firstMean, NORM_INF)) << what;
+                    EXPECT_EQ(0, cv::norm(var, firstVar, NORM_INF)) << what;
+                    EXPECT_EQ(0, cv::norm(mask, firstMask, NORM_INF)) << what;
+                }
+            }
+            setCpuPath(CpuPath::AUTO);
+            // Against exact integer sums: N S2 - S1^2 is exact in 128 bits, so with the float64 state the
+            // variance is exact up to the two merges' double rounding (1e-16 relative, 1e-13 allowed). The
+            // float32 state's rounding (burstStatisticsAreExactForLargeMeansAndAnyFrameCount) is the float
+            // input's too, which it matched bit for bit above.
+            if (depth != CV_64F)
+                continue;
+            const double tolerance = 1e-13;
+            for (int r = 0; r < rows; ++r)
+                for (int c = 0; c < cols; ++c) {
+                    int64_t s1 = 0;
+                    __int128 s2 = 0;
+                    int lowest = 65535, highest = 0;
+                    for (const Mat& f : burst16) {
+                        const int v = f.at<ushort>(r, c);
+                        s1 += v;
+                        s2 += static_cast<__int128>(v) * v;
+                        lowest = std::min(lowest, v);
+                        highest = std::max(highest, v);
+                    }
+                    const double black = fmt.blackLevel[2 * (r & 1) + (c & 1)];
+                    const double mean = static_cast<double>(s1) / frames - black;
+                    const double variance = static_cast<double>(static_cast<__int128>(frames) * s2 -
+                                                                static_cast<__int128>(s1) * s1) /
+                                            (static_cast<double>(frames) * (frames - 1));
+                    EXPECT_NEAR(firstMean.at<double>(r, c), mean, tolerance * std::max(1.0, std::abs(mean)))
+                        << r << ", " << c;
+                    EXPECT_NEAR(firstVar.at<double>(r, c), variance, tolerance * std::max(1.0, variance))
+                        << r << ", " << c;
+                    EXPECT_EQ(firstMask.at<uchar>(r, c), lowest <= 0 || highest >= 4001 ? 255 : 0)
+                        << r << ", " << c;
+                }
+        }
 }
 
 // ---------------------------------------------------------------------------------------------------
