@@ -559,109 +559,122 @@ template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D uniform32LanesD(type
     return (((D)(w | 0x4330000000000000ull) - kTwo52) + 0.5) * (1.0 / 4294967296.0);
 }
 
-// The largest mean fillPoisson() draws in lanes, 2^40: PTRS's floor then stays below 2^52. Larger means go
-// to CounterRng::poisson() (which takes up to kMaxPoissonMean).
+// The largest mean fillPoisson() draws in lanes, 2^40: mu + sqrt(mu) T and its floor then stay far below
+// 2^52. Larger means go to CounterRng::poisson() (which takes up to kMaxPoissonMean).
 constexpr double kMaxLaneMean = 1099511627776.0;
 
-/* One PTRS try (Hormann 1993; CounterRng::poisson() has the same constants) per lane, for means lambda in
- * [10, 2^40], from 32-bit words for u and v: its count kd, the lanes that the fast test accepts, and those
- * the try refuses outright (a negative count, or the tail the hat cuts). Lanes in neither take
- * ptrsFullTestLanes(). */
-template <int W> struct PtrsTryLanes
-{
-    typename DoubleLanes<W>::D kd;
-    typename DoubleLanes<W>::L accept, refuse;
-};
-
-template <int W> struct PtrsShape
-{
-    typedef typename DoubleLanes<W>::D D;
-    D a, b, u, v, us;
-    PtrsShape(D lambda, typename DoubleLanes<W>::UL w1, typename DoubleLanes<W>::UL w2)
-    {
-        b = 0.931 + 2.53 * sqrtLanes(lambda);
-        a = -0.059 + 0.02483 * b;
-        u = uniform32LanesD<W>(w1) - 0.5;
-        v = uniform32LanesD<W>(w2);
-        us = 0.5 - (u < 0.0 ? -u : u); // at least 2^-33
-    }
-};
-
-template <int W>
-RAWGMENT_KERNEL PtrsTryLanes<W> ptrsTryLanes(typename DoubleLanes<W>::D lambda,
-                                             typename DoubleLanes<W>::UL w1, typename DoubleLanes<W>::UL w2)
-{
-    typedef typename DoubleLanes<W>::D D;
-    const PtrsShape<W> h(lambda, w1, w2);
-    const D vr = 0.9277 - 3.6224 / (h.b - 2.0);
-    const D x = (2.0 * h.a / h.us + h.b) * h.u + lambda + 0.43;
-    PtrsTryLanes<W> t;
-    const D largest = D{} + 4503599627370495.0; // 2^52 - 1: a count that large is refused by the full test
-    t.kd = floorNonNegativeLanesD<W>(x < 0.0 ? D{} : (x < largest ? x : largest));
-    t.accept = (h.us >= 0.07) & (h.v <= vr) & (x >= 0.0);
-    t.refuse = (x < 0.0) | ((h.us < 0.013) & (h.v > h.us));
-    return t;
-}
-
-//! ptrsTryLanes() on the 32-bit words firsts[0..) (u) and seconds[0..) (v) of the lanes' values.
-template <int W>
-RAWGMENT_KERNEL PtrsTryLanes<W> ptrsTryOfWords(typename DoubleLanes<W>::D lambda, const uint32_t* firsts,
-                                               const uint32_t* seconds)
-{
-    typedef typename DoubleLanes<W>::UL UL;
-    typename DoubleLanes<W>::U32 a, b;
-    std::memcpy(&a, firsts, sizeof(a));
-    std::memcpy(&b, seconds, sizeof(b));
-    return ptrsTryLanes<W>(lambda, __builtin_convertvector(a, UL), __builtin_convertvector(b, UL));
-}
+/* The mean from which fillPoisson() takes Ahrens and Dieter's PD (1982), which needs 10 or more; below, it
+ * inverts the CDF (on host H2, inversion in lanes cost 6.5 ns per value at a mean of 0.5 and 10 at 10, PD
+ * about 6 from 10 up). CounterRng::poisson() switches from inversion to PTRS at 10 too. */
+constexpr double kInversionBelow = 10.0;
 
 /* log k! - (k ln k - k + ln(2 pi k) / 2), the remainder of Stirling's formula, for k >= 1: exact below 32
  * (from the table of logFactorial()), its series 1/(12k) - 1/(360k^3) + 1/(1260k^5) above, as
  * logFactorial() (error below 1e-13 relative to log k!). */
-const std::array<double, 32>& stirlingRemainderTable()
+double stirlingRemainder(double k)
 {
     static const std::array<double, 32> table = [] {
         std::array<double, 32> t{};
-        for (int k = 1; k < 32; ++k) {
-            const double x = k;
-            t[static_cast<size_t>(k)] =
-                logFactorial(k) - (x * std::log(x) - x + 0.5 * std::log(2.0 * CV_PI * x));
+        for (int i = 1; i < 32; ++i) {
+            const double x = i;
+            t[static_cast<size_t>(i)] =
+                logFactorial(i) - (x * std::log(x) - x + 0.5 * std::log(2.0 * CV_PI * x));
         }
         return t;
     }();
-    return table;
+    if (k < 32)
+        return table[static_cast<size_t>(k)];
+    const double inv = 1.0 / k, inv2 = inv * inv;
+    return inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260)));
 }
 
-/* PTRS's full test for the lanes of a try that ptrsTryLanes() left undecided: log(v / alpha / (a / us^2 +
- * b)) <= -lambda + kd ln lambda - log kd!, with log kd! as Stirling's formula plus its remainder, so that
- * ln sqrt(2 pi kd) joins the left side's logarithm and kd ln(lambda / kd) + kd - lambda stays accurate
- * where kd is near lambda. Five divisions (two inside the logarithms): the divider bounds this test, so
- * a / us^2 + b is taken as (a + b us^2) / us^2 into the one quotient, and lambda / kd as lambda (1 / kd). */
+/* The log of the Poisson probability of k at mean mu >= 10, to about 1e-13 absolute: directly below k = 10
+ * (the terms are small there), else as k (ln(1 + v) - v) - ln(2 pi k) / 2 - Stirling's remainder with
+ * v = (mu - k) / k, which keeps k ln(mu / k) + k - mu free of cancellation where k is near mu. */
+double logPoissonProbability(double k, double mu)
+{
+    if (k < 10)
+        return k * std::log(mu) - mu - logFactorial(static_cast<int64_t>(k));
+    const double v = (mu - k) / k;
+    return k * (std::log1p(v) - v) - 0.5 * std::log(2.0 * CV_PI * k) - stirlingRemainder(k);
+}
+
+/* Steps P, Q and E of Ahrens and Dieter's PD ("Computer generation of Poisson deviates from modified normal
+ * distributions", ACM TOMS 8, 1982) for a value that its steps N, I and S (in lanes, fillPoissonKernel())
+ * left undecided: g = mu + sqrt(mu) T from its normal T, u its uniform. Step Q takes the same g and u; step
+ * E draws from `rng` until its hat accepts. The Poisson probabilities are exact (logPoissonProbability());
+ * the algorithm's own approximations of them (Stirling's series to two terms, a polynomial of 7 digits
+ * for ln(1 + v)) would leave errors of 1e-8 relative. */
+double poissonPdRest(double mu, double g, double u, CounterRng& rng)
+{
+    const double s = std::sqrt(mu), omega = 0.3989422804014327 / s;
+    // The Hermite corrections of the discrete normal probabilities, and the hat's constant (A & D's c).
+    const double b1 = 1.0 / (24.0 * mu), b2 = 0.3 * b1 * b1;
+    const double c3 = b1 * b2 / 7.0, c2 = b2 - 15.0 * c3, c1 = b1 - 6.0 * b2 + 45.0 * c3;
+    const double c0 = 1.0 - b1 + 3.0 * b2 - 15.0 * c3, c = 0.1069 / mu;
+    double fx = 0, fy = 0;
+    const auto modifiedNormal = [&](double k) { // A & D's procedure F, less the Poisson part
+        const double x = (0.5 - (mu - k)) / s, xx = x * x;
+        fx = -0.5 * xx;
+        fy = omega * (((c3 * xx + c2) * xx + c1) * xx + c0);
+    };
+    if (g >= 0) { // step Q: quotient acceptance
+        const double k = std::floor(g);
+        modifiedNormal(k);
+        if (fy - u * fy <= std::exp(logPoissonProbability(k, mu) - fx))
+            return k;
+    }
+    for (;;) { // step E: a double exponential sample t, accepted under the hat by step H
+        const double e = -std::log(rng.uniform());
+        const double signedUniform = 2.0 * rng.uniform() - 1.0;
+        const double t = 1.8 + (signedUniform < 0 ? -e : e);
+        if (t <= -0.6744) // where the Poisson probabilities lie below the discrete normal's
+            continue;
+        const double k = std::floor(mu + s * t);
+        modifiedNormal(k);
+        if (c * std::abs(signedUniform) <= std::exp(logPoissonProbability(k, mu) + e) - fy * std::exp(fx + e))
+            return k;
+    }
+}
+
+/* Box-Muller in double lanes: the normals of kCount pairs from their 32-bit words, the radius from
+ * u = (w + 1/2) 2^-32 (so |T| <= 6.7: a true normal lies beyond with probability 3e-11), the angle's
+ * quadrant from the top 2 bits of the angle word and phi in (-pi/4, pi/4) from the other 30 (plus 1/2).
+ * sin and cos of phi by their Taylor series to phi^17 and phi^16 (next terms below 2^-55 relative), the
+ * quadrant by swapping and negating, so the normals are Box-Muller's to about 2 ulps on every path. */
 template <int W>
-RAWGMENT_KERNEL typename DoubleLanes<W>::L
-ptrsFullTestLanes(typename DoubleLanes<W>::D lambda, typename DoubleLanes<W>::UL w1,
-                  typename DoubleLanes<W>::UL w2, typename DoubleLanes<W>::D kd)
+RAWGMENT_KERNEL void normalPairsLanesD(const uint32_t* radiusWords, const uint32_t* angleWords,
+                                       typename DoubleLanes<W>::D& cosNormal,
+                                       typename DoubleLanes<W>::D& sinNormal)
 {
     typedef typename DoubleLanes<W>::D D;
     typedef typename DoubleLanes<W>::L L;
-    const PtrsShape<W> h(lambda, w1, w2);
-    const D invAlpha = 1.1239 + 1.1328 / (h.b - 3.4);
-    const D one = D{} + 1.0;
-    const L positive = kd >= 1.0;
-    const D k = positive ? kd : one;
-    const D inv = one / k, inv2 = inv * inv;
-    D remainder = inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260)));
-    if (maskBits(k < 32.0)) {
-        const std::array<double, 32>& table = stirlingRemainderTable();
-        for (int i = 0; i < DoubleLanes<W>::kCount; ++i)
-            if (k[i] < 32)
-                remainder[i] = table[static_cast<size_t>(k[i])];
-    }
-    const D root = positive ? sqrtLanes(2.0 * CV_PI * k) : one;
-    const D us2 = h.us * h.us;
-    const D lhs = logLanesD<W>(h.v * invAlpha * root * us2 / (h.a + h.b * us2));
-    const D rhs = (positive ? k * logLanesD<W>(lambda * inv) + k - remainder : D{}) - lambda;
-    return lhs <= rhs;
+    typedef typename DoubleLanes<W>::UL UL;
+    typename DoubleLanes<W>::U32 a, b;
+    std::memcpy(&a, radiusWords, sizeof(a));
+    std::memcpy(&b, angleWords, sizeof(b));
+    const UL w1 = __builtin_convertvector(a, UL), w2 = __builtin_convertvector(b, UL);
+    const D radius = sqrtLanes(-2.0 * logLanesD<W>(uniform32LanesD<W>(w1)));
+    const D fraction =
+        (((D)((w2 & 0x3fffffffull) | 0x4330000000000000ull) - kTwo52) + 0.5) * (1.0 / 1073741824.0);
+    const D phi = (fraction - 0.5) * 1.5707963267948966;
+    const D p2 = phi * phi, p4 = p2 * p2, p8 = p4 * p4;
+    const D sinPhi = phi * (((1.0 - p2 * (1.0 / 6)) + p4 * (1.0 / 120 - p2 * (1.0 / 5040))) +
+                            p8 * ((1.0 / 362880 - p2 * (1.0 / 39916800)) +
+                                  p4 * (1.0 / 6227020800.0 - p2 * (1.0 / 1307674368000.0)) +
+                                  p8 * (1.0 / 355687428096000.0)));
+    const D cosPhi =
+        ((1.0 - p2 * 0.5) + p4 * (1.0 / 24 - p2 * (1.0 / 720))) +
+        p8 * ((1.0 / 40320 - p2 * (1.0 / 3628800)) + p4 * (1.0 / 479001600 - p2 * (1.0 / 87178291200.0)) +
+              p8 * (1.0 / 20922789888000.0));
+    // Rotate (cos, sin) by q quarter turns, as boxMullerLanes() does in float.
+    const L q = (L)(w2 >> 30);
+    const L odd = (q & 1) != 0;
+    D c = odd ? sinPhi : cosPhi, s = odd ? cosPhi : sinPhi;
+    c = ((q == 1) | (q == 2)) ? -c : c;
+    s = q >= 2 ? -s : s;
+    cosNormal = radius * c;
+    sinNormal = radius * s;
 }
 
 //! 1 / k for k = 1..200 (index 0 unused): the steps of the inversion's search.
@@ -676,20 +689,13 @@ const std::array<double, 201>& inverseIntegers()
     return table;
 }
 
-/* The mean below which fillPoisson() inverts the CDF, and from which it takes PTRS: on host H2 (AVX2) the
- * search in lanes cost less than PTRS's tries and tests up to a mean of about 35 (10 ns against 20 at a
- * mean of 10, 16 against 18 at 30, 19 against 16 at 40, per value on one core). CounterRng::poisson(),
- * one value at a time, keeps Hormann's switch at 10. */
-constexpr double kInversionBelow = 30.0;
-
 /* Inversion by sequential search for the means below kInversionBelow among a chunk's G groups of lanes,
  * the groups' chains interleaved (one multiply-add chain each, so together they hide each other's
- * latency): u of 53 bits from both words, as CounterRng::uniform(), and p_k = p_(k-1) lambda (1 / k)
- * (CounterRng::poisson() divides: the two differ by an ulp at times, which moves a count only when u falls
- * within about 1e-13 of the CDF's boundary; e^-30 and the sums of up to 200 terms stay far inside double's
- * range and precision). Lanes of larger means run with mean 0 and give 0. */
+ * latency): u = (w + 1/2) 2^-32 from the value's own word, and p_k = p_(k-1) lambda (1 / k). e^-10 and the
+ * sums of up to 200 terms stay far inside double's range and precision. Lanes of larger means run with
+ * mean 0 and give 0. */
 template <int W, int G>
-RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint32_t* words,
+RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint32_t* ownWords,
                                            double* chunkCounts)
 {
     typedef typename DoubleLanes<W>::D D;
@@ -701,17 +707,12 @@ RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint3
     L small[G];
     for (int g = 0; g < G; ++g) {
         D m;
-        U32 a, b;
+        U32 a;
         std::memcpy(&m, chunkMeans + g * kLanes, sizeof(m));
-        std::memcpy(&a, words + g * kLanes, sizeof(a));
-        std::memcpy(&b, words + 16 + g * kLanes, sizeof(b));
+        std::memcpy(&a, ownWords + g * kLanes, sizeof(a));
         small[g] = m < kInversionBelow;
         lambda[g] = small[g] ? m : D{};
-        // bits = w1 2^21 + (w2 >> 11) < 2^53 as a double, exactly, from two exact conversions.
-        const UL w1 = __builtin_convertvector(a, UL), w2 = __builtin_convertvector(b, UL);
-        const D high = ((D)(w1 | 0x4330000000000000ull) - kTwo52) * 2097152.0;
-        const D bits53 = high + ((D)((w2 >> 11) | 0x4330000000000000ull) - kTwo52);
-        u[g] = (bits53 + 0.5) * (1.0 / 9007199254740992.0);
+        u[g] = uniform32LanesD<W>(__builtin_convertvector(a, UL));
         p[g] = expLanesD<W>(-lambda[g]);
         cdf[g] = p[g];
         k[g] = D{};
@@ -750,191 +751,34 @@ inline void appendBits(int bits, int lanes, int base, int* list, int& size)
     }
 }
 
-/* The largest mean and count the float pre-test takes: counts stay exact in float (below 2^24), and the
- * margin below holds (its analysis assumes them). Others take the double test only. */
-constexpr double kMaxFloatTestMean = 4194304.0, kMaxFloatTestCount = 8388608.0;
-
-/* PTRS's full test of ptrsFullTestLanes() in float lanes, for 16 values given as the double quantities
- * the double test starts from (us, v, lambda, k; q = lambda / k, s = 1 - q and Stirling's remainder, from
- * the same double division 1 / k), rounded to float. Both sides are written so that no cancellation is
- * left to float: k ln(lambda / k) + k - lambda = -k psi(s) with psi(s) = -ln(1 - s) - s = s^2 (1/2 + s/3 +
- * ... + s^11/13) below |s| = 1/4 (the series' next term is below 1e-8 relative), -ln q - s above (psi >=
- * 0.026 there, so the roundings of q and s, about 1e-7 absolute, are below 4e-6 of it). Every float
- * operation errs by at most half an ulp (logPositiveLanes(): about one ulp, plus ln 2 in float times the
- * exponent, below 3e-7), so each side is within 5e-6 absolute plus 2e-5 of its own size of the double test's
- * value, and the double test within 1e-9 of the exact one. A value is decided where the two sides differ by
- * more than the margin 2^-10 + 2^-14 (|lhs| + k psi + |rhs|): 190 times the absolute bound, and since |rhs|
- * >= k psi, 6 times the relative one. The rest (0.3-0.8% of the values tested, at means 15 to 5000) and the
- * values beyond the float range take the double test, so the counts are the double test's. Bit i of
- * `decided` and `accepted` is value i. */
-template <int W>
-RAWGMENT_KERNEL void ptrsFullTestFloatLanes(const float* lambdas, const float* ks, const float* qs,
-                                            const float* ss, const float* remainders, const float* uss,
-                                            const float* vs, int& decided, int& accepted)
-{
-    typedef typename Lanes<W>::F F;
-    typedef typename Lanes<W>::I I;
-    decided = accepted = 0;
-    for (int h = 0; h < 16; h += W) {
-        F lambda, k, q, s, remainder, us, v;
-        std::memcpy(&lambda, lambdas + h, sizeof(F));
-        std::memcpy(&remainder, remainders + h, sizeof(F));
-        std::memcpy(&k, ks + h, sizeof(F));
-        std::memcpy(&q, qs + h, sizeof(F));
-        std::memcpy(&s, ss + h, sizeof(F));
-        std::memcpy(&us, uss + h, sizeof(F));
-        std::memcpy(&v, vs + h, sizeof(F));
-        const F one = F{} + 1.0f;
-        const I positive = k >= 1.0f;
-        const F kk = positive ? k : one;
-        const F b = 0.931f + 2.53f * sqrtLanes(lambda);
-        const F a = -0.059f + 0.02483f * b;
-        const F invAlpha = 1.1239f + 1.1328f / (b - 3.4f);
-        const F us2 = us * us;
-        const F root = positive ? sqrtLanes(6.283185307f * kk) : one;
-        const F lhs = logPositiveLanes<W>(v * invAlpha * root * us2 / (a + b * us2));
-        // psi(s): the series by Estrin's scheme where |s| < 1/4, else from ln q.
-        const F s2 = s * s, s4 = s2 * s2, s8 = s4 * s4;
-        const F p01 = 0.5f + s * (1.0f / 3), p23 = 0.25f + s * 0.2f, p45 = (1.0f / 6) + s * (1.0f / 7),
-                p67 = 0.125f + s * (1.0f / 9), p89 = 0.1f + s * (1.0f / 11),
-                p1011 = (1.0f / 12) + s * (1.0f / 13);
-        const F series = s2 * ((p01 + s2 * p23) + s4 * (p45 + s2 * p67) + s8 * (p89 + s2 * p1011));
-        const I small = maxLanes(s, -s) < 0.25f;
-        const F direct = -logPositiveLanes<W>(positive ? q : one) - s;
-        const F kPsi = positive ? kk * (small ? series : direct) : F{};
-        const F rhs = positive ? -kPsi - remainder : -lambda;
-        const F gap = lhs - rhs;
-        const F margin = 9.765625e-4f + 6.103515625e-5f * (maxLanes(lhs, -lhs) + kPsi + maxLanes(rhs, -rhs));
-        decided |= maskBits(maxLanes(gap, -gap) > margin) << h;
-        accepted |= maskBits(gap < 0.0f) << h;
-    }
-}
-
-//! The double lanes at `at` of a gathered chunk: means, tries' counts and both words of each value.
-template <int W>
-RAWGMENT_KERNEL void loadGatheredLanes(const double* lambdas, const double* kds, const uint64_t* firsts,
-                                       const uint64_t* seconds, int at, typename DoubleLanes<W>::D& lambda,
-                                       typename DoubleLanes<W>::D& kd, typename DoubleLanes<W>::UL& w1,
-                                       typename DoubleLanes<W>::UL& w2)
-{
-    std::memcpy(&lambda, lambdas + at, sizeof(lambda));
-    std::memcpy(&kd, kds + at, sizeof(kd));
-    std::memcpy(&w1, firsts + at, sizeof(w1));
-    std::memcpy(&w2, seconds + at, sizeof(w2));
-}
-
-/* PTRS's full test for the values of list[0..size), whose try's count is in counts and whose words are in
- * firstWords and secondWords, gathered a chunk's worth at a time: in float lanes with a margin
- * (ptrsFullTestFloatLanes()), then in double lanes for the groups with a value the float test left
- * undecided. The values it rejects go to out[outSize..). (A kernel, not a lambda: a lambda would not take
- * the target of the kernel it is in.) */
-template <int W>
-RAWGMENT_KERNEL void ptrsFullTestPass(const double* means, const double* counts, const uint32_t* firstWords,
-                                      const uint32_t* secondWords, const int* list, int size, int* out,
-                                      int& outSize)
-{
-    typedef typename DoubleLanes<W>::D D;
-    typedef typename DoubleLanes<W>::L L;
-    typedef typename DoubleLanes<W>::UL UL;
-    typedef float F4 __attribute__((vector_size(2 * W))); // the floats of one double vector's lanes
-    const int kLanes = DoubleLanes<W>::kCount, kChunk = 16, kGroups = kChunk / kLanes;
-    for (int start = 0; start < size; start += kChunk) {
-        const int live = std::min(kChunk, size - start);
-        alignas(64) double lambdas[kChunk], kds[kChunk];
-        alignas(64) uint64_t firsts[kChunk], seconds[kChunk];
-        for (int i = 0; i < kChunk; ++i) {
-            const int index = i < live ? list[start + i] : -1; // padding lanes test a valid try
-            lambdas[i] = index >= 0 ? means[index] : 10.0;
-            kds[i] = index >= 0 ? counts[index] : 10.0;
-            firsts[i] = index >= 0 ? firstWords[index] : 0u;
-            seconds[i] = index >= 0 ? secondWords[index] : 0u;
-        }
-        // The float test's inputs, from the double quantities of the double test.
-        alignas(64) float lambdaF[kChunk], kF[kChunk], qF[kChunk], sF[kChunk], remainderF[kChunk],
-            usF[kChunk], vF[kChunk];
-        alignas(64) double remainders[kChunk];
-        int eligible = 0;
-        for (int g = 0; g < kGroups; ++g) {
-            D lambda, kd;
-            UL w1, w2;
-            loadGatheredLanes<W>(lambdas, kds, firsts, seconds, g * kLanes, lambda, kd, w1, w2);
-            const D u = uniform32LanesD<W>(w1) - 0.5;
-            const D us = 0.5 - (u < 0.0 ? -u : u);
-            const D v = uniform32LanesD<W>(w2);
-            const L positive = kd >= 1.0;
-            const D inv = 1.0 / (positive ? kd : D{} + 1.0), inv2 = inv * inv;
-            const D q = positive ? lambda * inv : D{} + 1.0;
-            const D s = 1.0 - q;
-            // Stirling's remainder as ptrsFullTestLanes() has it (the table below 32, filled in below).
-            const D remainder = inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260)));
-            std::memcpy(remainders + g * kLanes, &remainder, sizeof(remainder));
-            eligible |= maskBits((lambda <= kMaxFloatTestMean) & (kd <= kMaxFloatTestCount)) << (g * kLanes);
-            const F4 lf = __builtin_convertvector(lambda, F4), kf = __builtin_convertvector(kd, F4),
-                     qf = __builtin_convertvector(q, F4), sf = __builtin_convertvector(s, F4),
-                     usf = __builtin_convertvector(us, F4), vf = __builtin_convertvector(v, F4);
-            std::memcpy(lambdaF + g * kLanes, &lf, sizeof(lf));
-            std::memcpy(kF + g * kLanes, &kf, sizeof(kf));
-            std::memcpy(qF + g * kLanes, &qf, sizeof(qf));
-            std::memcpy(sF + g * kLanes, &sf, sizeof(sf));
-            std::memcpy(usF + g * kLanes, &usf, sizeof(usf));
-            std::memcpy(vF + g * kLanes, &vf, sizeof(vf));
-        }
-        const std::array<double, 32>& table = stirlingRemainderTable();
-        for (int i = 0; i < kChunk; ++i) {
-            const double k = kds[i];
-            remainderF[i] =
-                static_cast<float>(k < 32 ? table[static_cast<size_t>(k < 1 ? 1 : k)] : remainders[i]);
-        }
-        // Lanes beyond the float range hold values float cannot represent well; they are never decided.
-        for (int i = 0; i < kChunk; ++i)
-            if (!(eligible & (1 << i))) {
-                lambdaF[i] = kF[i] = qF[i] = usF[i] = vF[i] = 1.0f;
-                sF[i] = 0.0f;
-            }
-        int decided = 0, accepted = 0;
-        ptrsFullTestFloatLanes<W>(lambdaF, kF, qF, sF, remainderF, usF, vF, decided, accepted);
-        decided &= eligible;
-        accepted &= decided;
-        for (int g = 0; g < kGroups; ++g) {
-            const int groupBits = ((1 << kLanes) - 1) << (g * kLanes);
-            if ((decided & groupBits) == groupBits)
-                continue;
-            D lambda, kd;
-            UL w1, w2;
-            loadGatheredLanes<W>(lambdas, kds, firsts, seconds, g * kLanes, lambda, kd, w1, w2);
-            const int exact = maskBits(ptrsFullTestLanes<W>(lambda, w1, w2, kd)) << (g * kLanes);
-            accepted |= exact & groupBits & ~decided;
-        }
-        // Without branches (out has room for one more): which values are rejected is a coin flip.
-        for (int i = 0; i < live; ++i) {
-            out[outSize] = list[start + i];
-            outSize += ((accepted >> i) & 1) ^ 1;
-        }
-    }
-}
-
+/* The words of a chunk of 16 values (8 Philox blocks, word j of block b at 8 j + b): pair p < 8 of
+ * Box-Muller takes its radius from word p and its angle from word 8 + p, its cosine going to value p and its
+ * sine to value 8 + p; value i's own uniform is word 16 + i. A value of mean 10 or more (PD) uses its normal
+ * and its uniform; a smaller one (inversion) only its uniform. So each value's count depends on its own
+ * words and mean alone, whatever its pair's mean, and the two normals of a pair are independent. */
 template <int W>
 RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const double* means, double* counts,
                                        int n)
 {
     typedef typename DoubleLanes<W>::D D;
     typedef typename DoubleLanes<W>::L L;
+    typedef typename DoubleLanes<W>::UL UL;
     const int kLanes = DoubleLanes<W>::kCount, kChunk = 16; // 16 values per 8 Philox blocks
     const int kGroups = kChunk / kLanes;
     alignas(64) uint32_t words[32];
-    alignas(64) double chunkMeans[kChunk], chunkCounts[kChunk];
+    alignas(64) double chunkMeans[kChunk], chunkCounts[kChunk], normals[kChunk];
     const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
-    // Every value's two words, kept for the inversion and the full tests; the values to invert, those whose
-    // first try needs the full test, and those to retry.
-    // Left uninitialised: zeroing them cost about 0.5 ns per value, and only written entries are read.
+    // Every value's own word, kept for the gathered inversion; the values to invert, those PD's fast steps
+    // left (with their g and u), and those beyond the lanes' range. Left uninitialised: only written
+    // entries are read.
     const size_t room = static_cast<size_t>(n) + kChunk;
-    const std::unique_ptr<uint32_t[]> firstWords(new uint32_t[room]), secondWords(new uint32_t[room]);
-    const std::unique_ptr<int[]> fullTest(new int[room]), retry(new int[room]), invert(new int[room]);
-    int fullTests = 0, retries = 0, inverts = 0;
+    const std::unique_ptr<uint32_t[]> ownWords(new uint32_t[room]);
+    const std::unique_ptr<int[]> rest(new int[room]), invert(new int[room]), beyond(new int[room]);
+    const std::unique_ptr<double[]> restG(new double[room]), restU(new double[room]);
+    int rests = 0, inverts = 0, beyonds = 0;
     for (int base = 0; base < n; base += kChunk) {
         philox8BlocksFor<W>(static_cast<uint32_t>(base / 2), stream, key, words);
-        std::memcpy(firstWords.get() + base, words, sizeof(uint32_t) * kChunk);
-        std::memcpy(secondWords.get() + base, words + kChunk, sizeof(uint32_t) * kChunk);
+        std::memcpy(ownWords.get() + base, words + kChunk, sizeof(uint32_t) * kChunk);
         const int count = std::min(kChunk, n - base);
         if (count == kChunk) {
             for (int g = 0; g < kGroups; ++g) { // as the loop below, in lanes (NaN and negatives give 0)
@@ -949,141 +793,104 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
                 chunkMeans[i] = m > 0 ? m : 0.0;
             }
         }
-        int invertBits = 0, smallBits = 0;
+        int invertBits = 0, smallBits = 0, pdBits = 0, beyondBits = 0;
         for (int g = 0; g < kGroups; ++g) {
             D lambda;
             std::memcpy(&lambda, chunkMeans + g * kLanes, sizeof(lambda));
             const L small = lambda < kInversionBelow;
-            const L beyond = lambda > kMaxLaneMean;
-            const L ptrs = ~small & ~beyond;
+            const L far = lambda > kMaxLaneMean;
             const int live = std::max(0, std::min(kLanes, count - g * kLanes));
             const int liveBits = (1 << live) - 1;
             invertBits |= (maskBits(small & (lambda > 0.0)) & liveBits) << (g * kLanes);
             smallBits |= (maskBits(small) & liveBits) << (g * kLanes);
-            const int base0 = base + g * kLanes;
-            if (maskBits(beyond))
-                appendBits(maskBits(beyond) & liveBits, kLanes, base0, retry.get(), retries);
-            D kd = {}; // a mean of 0 (or below, or NaN) gives 0; the inversion fills in the small ones
-            if (maskBits(ptrs)) {
-                const PtrsTryLanes<W> t = ptrsTryOfWords<W>(ptrs ? lambda : D{} + 10.0, words + g * kLanes,
-                                                            words + kChunk + g * kLanes);
-                kd = ptrs ? t.kd : kd;
-                appendBits(maskBits(ptrs & ~t.accept & ~t.refuse) & liveBits, kLanes, base0, fullTest.get(),
-                           fullTests);
-                appendBits(maskBits(ptrs & t.refuse) & liveBits, kLanes, base0, retry.get(), retries);
-            }
-            std::memcpy(chunkCounts + g * kLanes, &kd, sizeof(kd));
+            pdBits |= (maskBits(~small & ~far) & liveBits) << (g * kLanes);
+            beyondBits |= (maskBits(far) & liveBits) << (g * kLanes);
         }
+        if (!pdBits) // a mean of 0 (or below, or NaN) gives 0
+            for (int g = 0; g < kGroups; ++g) {
+                const D zero = {};
+                std::memcpy(chunkCounts + g * kLanes, &zero, sizeof(zero));
+            }
+        if (pdBits) {
+            // Steps N, I and S of PD: g = mu + sqrt(mu) T, K = floor(g), taken at once when K >= floor(mu -
+            // 1.1484) (there the Poisson probabilities exceed the discrete normal's) or when 6 mu^2 u >= (mu
+            // - K)^3 (the squeeze); the rest (about 1% from a mean of 30 up, 2% at 10) go to poissonPdRest().
+            for (int g = 0; g < kGroups / 2; ++g) {
+                D c, s;
+                normalPairsLanesD<W>(words + g * kLanes, words + 8 + g * kLanes, c, s);
+                std::memcpy(normals + g * kLanes, &c, sizeof(c));
+                std::memcpy(normals + 8 + g * kLanes, &s, sizeof(s));
+            }
+            for (int g = 0; g < kGroups; ++g) {
+                const int bits = (pdBits >> (g * kLanes)) & ((1 << kLanes) - 1);
+                if (!bits) {
+                    const D zero = {};
+                    std::memcpy(chunkCounts + g * kLanes, &zero, sizeof(zero));
+                    continue;
+                }
+                D m, t;
+                typename DoubleLanes<W>::U32 w;
+                std::memcpy(&m, chunkMeans + g * kLanes, sizeof(m));
+                std::memcpy(&t, normals + g * kLanes, sizeof(t));
+                std::memcpy(&w, words + kChunk + g * kLanes, sizeof(w));
+                const L pd = (m >= kInversionBelow) & (m <= kMaxLaneMean);
+                const D mu = pd ? m : D{} + kInversionBelow; // other lanes compute on a valid mean, unused
+                const D gv = mu + sqrtLanes(mu) * t;
+                const D k = floorNonNegativeLanesD<W>(gv > 0.0 ? gv : D{});
+                const D u = uniform32LanesD<W>(__builtin_convertvector(w, UL));
+                const D dif = mu - k;
+                const L taken = (gv >= 0.0) & ((k >= floorNonNegativeLanesD<W>(mu - 1.1484)) |
+                                               (6.0 * mu * mu * u >= dif * dif * dif));
+                const D kept = pd ? k : D{}; // other lanes: 0, or their inversion's count later
+                std::memcpy(chunkCounts + g * kLanes, &kept, sizeof(kept));
+                // The rest (1-5%) rarely appear, so a branch costs less than appending every lane.
+                for (int open = maskBits(~taken) & bits; open; open &= open - 1) {
+                    const int i = __builtin_ctz(static_cast<unsigned>(open));
+                    rest[rests] = base + g * kLanes + i;
+                    restG[rests] = gv[i];
+                    restU[rests] = u[i];
+                    ++rests;
+                }
+            }
+        }
+        if (beyondBits)
+            appendBits(beyondBits, kChunk, base, beyond.get(), beyonds);
         // A chunk of small means only (a dark region) is inverted in place; the small means of a mixed chunk
         // are gathered, so that one value's search does not hold up fifteen others of large means.
         if (smallBits == (1 << count) - 1)
-            poissonInversionLanes<W, kGroups>(chunkMeans, words, chunkCounts);
+            poissonInversionLanes<W, kGroups>(chunkMeans, words + kChunk, chunkCounts);
         else
             appendBits(invertBits, kChunk, base, invert.get(), inverts);
-        std::memcpy(counts + base, chunkCounts, sizeof(double) * static_cast<size_t>(count));
+        if (count == kChunk)
+            std::memcpy(counts + base, chunkCounts, sizeof(chunkCounts));
+        else
+            std::memcpy(counts + base, chunkCounts, sizeof(double) * static_cast<size_t>(count));
     }
     // The small means of mixed chunks, gathered into whole chunks (in a row of means spread from 0 to 750,
     // half the chunks have one).
     for (int start = 0; start < inverts; start += kChunk) {
         const int live = std::min(kChunk, inverts - start);
-        alignas(64) uint32_t gatheredWords[2 * kChunk];
+        alignas(64) uint32_t gatheredWords[kChunk];
         for (int i = 0; i < kChunk; ++i) {
             const int index = i < live ? invert[start + i] : -1; // padding lanes: mean 0, no count
             chunkMeans[i] = index >= 0 ? means[index] : 0.0;
-            gatheredWords[i] = index >= 0 ? firstWords[index] : 0u;
-            gatheredWords[kChunk + i] = index >= 0 ? secondWords[index] : 0u;
+            gatheredWords[i] = index >= 0 ? ownWords[static_cast<size_t>(index)] : 0u;
         }
         poissonInversionLanes<W, kGroups>(chunkMeans, gatheredWords, chunkCounts);
         for (int i = 0; i < live; ++i)
             counts[invert[start + i]] = chunkCounts[i];
     }
-    // The full tests of the first tries; the values they reject join the retries.
-    ptrsFullTestPass<W>(means, counts, firstWords.get(), secondWords.get(), fullTest.get(), fullTests,
-                        retry.get(), retries);
-    if (retries == 0)
-        return;
-    // A retried value draws from its own CounterRng (poissonRetryKey(seed, stream), index): two more tries
-    // on its first four words (the stream's first Philox block), in lanes, then the scalar sampler on the
-    // rest. A mean beyond the lanes' range goes straight to the scalar sampler.
-    const uint64_t retryKey = poissonRetryKey(seed, stream);
-    const std::array<uint32_t, 2> retryWordsKey = {static_cast<uint32_t>(retryKey),
-                                                   static_cast<uint32_t>(retryKey >> 32)};
-    int open = 0;
-    for (int r = 0; r < retries; ++r) {
-        const int index = retry[static_cast<size_t>(r)];
-        if (means[index] > kMaxLaneMean) {
-            CounterRng rng(retryKey, static_cast<uint64_t>(index));
-            counts[index] = static_cast<double>(rng.poisson(means[index]));
-            continue;
-        }
-        retry[static_cast<size_t>(open++)] = index;
+    // PD's steps Q and E, and the means beyond the lanes' range, from each value's own CounterRng
+    // (poissonRetryKey(seed, stream), index).
+    const uint64_t restKey = poissonRetryKey(seed, stream);
+    for (int r = 0; r < rests; ++r) {
+        const int index = rest[r];
+        CounterRng rng(restKey, static_cast<uint64_t>(index));
+        counts[index] = poissonPdRest(means[index], restG[r], restU[r], rng);
     }
-    // The first blocks of eight values' streams at a time, in lanes (one block of a scalar Philox per value
-    // cost more than all the tries). The first try's words are spent, so the second try's take their
-    // place; the third try's wait in the lists' place (fullTest is free now, and retry has its own).
-    const std::unique_ptr<uint32_t[]> thirdWords(new uint32_t[room]), fourthWords(new uint32_t[room]);
-    for (int start = 0; start < open; start += 8) {
-        alignas(64) uint64_t streams[8];
-        alignas(64) uint32_t blockWords[32];
-        for (int b = 0; b < 8; ++b)
-            streams[b] = start + b < open ? static_cast<uint64_t>(retry[static_cast<size_t>(start + b)]) : 0u;
-        philox8StreamsFor<W>(0, streams, retryWordsKey, blockWords);
-        for (int b = 0; b < 8 && start + b < open; ++b) {
-            const size_t index = static_cast<size_t>(retry[static_cast<size_t>(start + b)]);
-            firstWords[index] = blockWords[b];
-            secondWords[index] = blockWords[8 + b];
-            thirdWords[index] = blockWords[16 + b];
-            fourthWords[index] = blockWords[24 + b];
-        }
-    }
-    for (int attempt = 0; attempt < 2 && open > 0; ++attempt) {
-        if (attempt == 1)
-            for (int r = 0; r < open; ++r) {
-                const size_t index = static_cast<size_t>(retry[static_cast<size_t>(r)]);
-                firstWords[index] = thirdWords[index];
-                secondWords[index] = fourthWords[index];
-            }
-        // The tries, gathered a chunk at a time as the first ones; the values they refuse are compacted in
-        // place (a chunk is read whole before any is written back), those the full test rejects join them.
-        int still = 0, undecided = 0;
-        for (int start = 0; start < open; start += kChunk) {
-            const int live = std::min(kChunk, open - start);
-            alignas(64) double lambdas[kChunk], kds[kChunk];
-            alignas(64) uint32_t firsts[kChunk], seconds[kChunk];
-            int index[kChunk];
-            for (int i = 0; i < kChunk; ++i) {
-                index[i] = i < live ? retry[static_cast<size_t>(start + i)] : -1;
-                lambdas[i] = index[i] >= 0 ? means[index[i]] : 10.0;
-                firsts[i] = index[i] >= 0 ? firstWords[static_cast<size_t>(index[i])] : 0u;
-                seconds[i] = index[i] >= 0 ? secondWords[static_cast<size_t>(index[i])] : 0u;
-            }
-            int decidedBits = 0, refusedBits = 0;
-            for (int g = 0; g < kGroups; ++g) {
-                D lambda;
-                std::memcpy(&lambda, lambdas + g * kLanes, sizeof(lambda));
-                const PtrsTryLanes<W> t =
-                    ptrsTryOfWords<W>(lambda, firsts + g * kLanes, seconds + g * kLanes);
-                std::memcpy(kds + g * kLanes, &t.kd, sizeof(t.kd));
-                decidedBits |= maskBits(t.accept | t.refuse) << (g * kLanes);
-                refusedBits |= maskBits(t.refuse) << (g * kLanes);
-            }
-            for (int i = 0; i < live; ++i) { // without branches, as in ptrsFullTestPass()
-                counts[index[i]] = kds[i];
-                retry[static_cast<size_t>(still)] = index[i];
-                still += (refusedBits >> i) & 1;
-                fullTest[static_cast<size_t>(undecided)] = index[i];
-                undecided += ((decidedBits >> i) & 1) ^ 1;
-            }
-        }
-        ptrsFullTestPass<W>(means, counts, firstWords.get(), secondWords.get(), fullTest.get(), undecided,
-                            retry.get(), still);
-        open = still;
-    }
-    for (int r = 0; r < open; ++r) {
-        const int index = retry[static_cast<size_t>(r)];
-        CounterRng rng(retryKey, static_cast<uint64_t>(index));
-        for (int used = 0; used < 4; ++used) // the words of the two tries above
-            rng.nextU32();
+    for (int r = 0; r < beyonds; ++r) {
+        const int index = beyond[r];
+        CounterRng rng(restKey, static_cast<uint64_t>(index));
         counts[index] = static_cast<double>(rng.poisson(means[index]));
     }
 }

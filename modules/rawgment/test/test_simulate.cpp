@@ -388,9 +388,14 @@ TEST(Simulate, derivedSeedsAreStableAndDistinctPerPurposeAndIndex)
     EXPECT_CV_ERROR_CONTAINS(deriveSeed(1, static_cast<SeedPurpose>(3), 0), "unknown purpose 3");
 }
 
-//! The words of fillPoisson()'s value i in the stream (seed, stream): words i % 16 and 16 + i % 16 of its
-//! chunk of 8 Philox blocks (word j of block b at 8 j + b % 8), as random.hpp documents.
-std::pair<uint32_t, uint32_t> poissonWords(uint64_t seed, uint64_t stream, int i)
+/* The words of fillPoisson()'s value i in the stream (seed, stream), as random.hpp documents (word j of
+ * block b of a chunk's 8 at 8 j + b): value h of its chunk of 16 owns word 16 + h; its Box-Muller pair
+ * h % 8 takes the radius from word h % 8 and the angle from word 8 + h % 8. */
+struct PoissonWords
+{
+    uint32_t own, radius, angle;
+};
+PoissonWords poissonWords(uint64_t seed, uint64_t stream, int i)
 {
     const std::array<uint32_t, 2> key = {static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
     auto word = [&](int chunk, int w) {
@@ -399,38 +404,56 @@ std::pair<uint32_t, uint32_t> poissonWords(uint64_t seed, uint64_t stream, int i
                                                  static_cast<uint32_t>(stream >> 32)};
         return detail::philox4x32(counter, key)[static_cast<size_t>(w / 8)];
     };
-    return {word(i / 16, i % 16), word(i / 16, 16 + i % 16)};
+    const int chunk = i / 16, h = i % 16;
+    return {word(chunk, 16 + h), word(chunk, h % 8), word(chunk, 8 + h % 8)};
 }
 
-//! One PTRS try (Hormann 1993) at mean lambda >= 10 from 32-bit words for u and v, with the C library's
-//! log and lgamma; false when the try is rejected.
-bool ptrsTry(double lambda, uint32_t wu, uint32_t wv, double& k)
+/* Steps P, Q and E of Ahrens and Dieter's PD (ACM TOMS 8, 1982), written out from the paper with the C
+ * library's lgamma for the Poisson probabilities (the library's own takes Stirling's formula with its
+ * remainder), for a value whose steps N, I and S left it: g = mu + sqrt(mu) T, u its uniform. */
+double referencePdRest(double mu, double g, double u, detail::CounterRng& rng)
 {
-    const double b = 0.931 + 2.53 * std::sqrt(lambda), a = -0.059 + 0.02483 * b;
-    const double invAlpha = 1.1239 + 1.1328 / (b - 3.4), vr = 0.9277 - 3.6224 / (b - 2);
-    const double u = (wu + 0.5) / 4294967296.0 - 0.5, v = (wv + 0.5) / 4294967296.0;
-    const double us = 0.5 - std::abs(u), x = (2 * a / us + b) * u + lambda + 0.43;
-    k = std::floor(x);
-    if (x < 0)
-        return false;
-    if (us >= 0.07 && v <= vr)
-        return true;
-    return !(us < 0.013 && v > us) && std::log(v * invAlpha / (a / (us * us) + b)) <=
-                                          -lambda + k * std::log(lambda) - std::lgamma(k + 1);
+    const double s = std::sqrt(mu), omega = 1 / std::sqrt(2 * CV_PI) / s;
+    const double b1 = 1 / (24 * mu), b2 = 0.3 * b1 * b1, c3 = b1 * b2 / 7, c2 = b2 - 15 * c3;
+    const double c1 = b1 - 6 * b2 + 45 * c3, c0 = 1 - b1 + 3 * b2 - 15 * c3, c = 0.1069 / mu;
+    const auto logP = [mu](double k) { return k * std::log(mu) - mu - std::lgamma(k + 1); };
+    const auto fxy = [&](double k, double& fx, double& fy) {
+        const double x2 = std::pow((0.5 - (mu - k)) / s, 2);
+        fx = -0.5 * x2;
+        fy = omega * (((c3 * x2 + c2) * x2 + c1) * x2 + c0);
+    };
+    double fx, fy;
+    if (g >= 0) {
+        const double k = std::floor(g);
+        fxy(k, fx, fy);
+        if (fy * (1 - u) <= std::exp(logP(k) - fx))
+            return k;
+    }
+    for (;;) {
+        const double e = -std::log(rng.uniform()), signedU = 2 * rng.uniform() - 1;
+        const double t = 1.8 + (signedU < 0 ? -e : e);
+        if (t <= -0.6744)
+            continue;
+        const double k = std::floor(mu + s * t);
+        fxy(k, fx, fy);
+        if (c * std::abs(signedU) <= std::exp(logP(k) + e) - fy * std::exp(fx + e))
+            return k;
+    }
 }
 
-/* fillPoisson()'s value i written out with the C library's exp and log: inversion from the 53-bit u of
- * both words below a mean of 30; else a PTRS try on the two words, two more on the first four words of
- * the value's retry stream, and the scalar sampler on the rest of that stream (on all of it beyond 2^40).
- * `tries` counts the tries beyond the first (3 for the scalar sampler). */
-double referencePoisson(uint64_t seed, uint64_t stream, int i, double lambda, int* tries = nullptr)
+/* fillPoisson()'s value i written out with the C library's exp, log, sqrt, sin and cos: below a mean of 10,
+ * inversion from the uniform of its own word; up to 2^40, PD's steps N, I and S on its normal (Box-Muller of
+ * its pair's words) and its uniform, and referencePdRest() on its retry stream for the rest (`rest` tells);
+ * beyond 2^40, the scalar sampler on that stream. */
+double referencePoisson(uint64_t seed, uint64_t stream, int i, double lambda, bool* rest = nullptr)
 {
+    if (rest)
+        *rest = false;
     if (!(lambda > 0))
         return 0;
-    const std::pair<uint32_t, uint32_t> w = poissonWords(seed, stream, i);
-    if (lambda < 30) { // fillPoisson's switch (CounterRng::poisson()'s is at 10)
-        const uint64_t bits = (static_cast<uint64_t>(w.first) << 21) ^ (w.second >> 11);
-        const double u = (static_cast<double>(bits) + 0.5) / 9007199254740992.0;
+    const PoissonWords w = poissonWords(seed, stream, i);
+    const double u = (w.own + 0.5) / 4294967296.0;
+    if (lambda < 10) {
         double p = std::exp(-lambda), cdf = p;
         int k = 0;
         while (u > cdf && k < 200) {
@@ -440,35 +463,44 @@ double referencePoisson(uint64_t seed, uint64_t stream, int i, double lambda, in
         }
         return k;
     }
-    double k = 0;
     detail::CounterRng retry(detail::poissonRetryKey(seed, stream), static_cast<uint64_t>(i));
-    if (lambda > 1099511627776.0) { // beyond 2^40: the scalar sampler alone
-        if (tries)
-            *tries = 3;
+    if (lambda > 1099511627776.0) // beyond 2^40: the scalar sampler alone
         return static_cast<double>(retry.poisson(lambda));
-    }
-    if (ptrsTry(lambda, w.first, w.second, k))
+    // The angle: quadrant q from the top 2 bits, phi in (-pi/4, pi/4) from the other 30.
+    const double radius = std::sqrt(-2 * std::log((w.radius + 0.5) / 4294967296.0));
+    const double phi = (((w.angle & 0x3fffffffu) + 0.5) / 1073741824.0 - 0.5) * (CV_PI / 2);
+    const int q = static_cast<int>(w.angle >> 30);
+    const double angle = q * (CV_PI / 2) + phi;
+    const double t = radius * ((i % 16) < 8 ? std::cos(angle) : std::sin(angle));
+    const double g = lambda + std::sqrt(lambda) * t;
+    const double k = std::floor(std::max(g, 0.0)), dif = lambda - k;
+    if (g >= 0 && (k >= std::floor(lambda - 1.1484) || 6 * lambda * lambda * u >= dif * dif * dif))
         return k;
-    for (int attempt = 1; attempt <= 2; ++attempt) {
-        const uint32_t wu = retry.nextU32(), wv = retry.nextU32();
-        if (tries)
-            *tries = attempt;
-        if (ptrsTry(lambda, wu, wv, k))
-            return k;
-    }
-    if (tries)
-        *tries = 3;
-    return static_cast<double>(retry.poisson(lambda));
+    if (rest)
+        *rest = true;
+    return referencePdRest(lambda, g, u, retry);
+}
+
+/* The share of values that PD's steps N, I and S leave to steps Q and E at mean mu: K = floor(mu + sqrt(mu)
+ * T) below floor(mu - 1.1484) and not squeezed (u < (mu - K)^3 / (6 mu^2)), or mu + sqrt(mu) T < 0. */
+double pdRestShare(double mu)
+{
+    const double s = std::sqrt(mu), l = std::floor(mu - 1.1484);
+    const auto below = [&](double x) { return 0.5 * std::erfc(-(x - mu) / (s * std::sqrt(2.0))); };
+    double share = below(0);
+    for (double k = 0; k < l; ++k)
+        share += (below(k + 1) - below(k)) * std::min(1.0, std::pow(mu - k, 3) / (6 * mu * mu));
+    return share;
 }
 
 TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
 {
     const uint64_t seed = 0x1234abcd5678ef01ull, stream = 7;
-    // Means on both sides of the switch from inversion to PTRS at 30 (and of CounterRng::poisson()'s at 10),
-    // inside (2e6) and beyond (5e6) the range of the full test's float pre-test, the retry beyond 2^40, and
-    // 0, interleaved, so that the small means are gathered from mixed chunks.
-    const std::vector<double> lambdas = {0.05, 0.7,    3.0, 9.99, 10.0, 29.99, 30.0,
-                                         37.5, 1000.0, 2e6, 0.0,  3e12, 5e6};
+    // Means on both sides of the switch from inversion to PD at 10, PD's range up to 2^40 and the scalar
+    // sampler beyond, and 0, interleaved, so that the small means are gathered from mixed chunks and the
+    // pairs of Box-Muller mix both kinds.
+    const std::vector<double> lambdas = {0.05, 0.7,    3.0, 9.99, 10.0, 10.5, 30.0,
+                                         37.5, 1000.0, 2e6, 0.0,  3e12, 5e9};
     const int perMean = 40000;
     const int n = static_cast<int>(lambdas.size()) * perMean + 5; // a partial last chunk too
     std::vector<double> means(static_cast<size_t>(n));
@@ -486,36 +518,30 @@ TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
                 << cpuPathName(path);
     }
     setCpuPath(CpuPath::AUTO);
-    // Value by value against the reference: the polynomial exp and log differ from the C library's by an
-    // ulp or two, which moves a count only when a uniform falls within about 1e-15 of a boundary of the
-    // CDF or of the acceptance test (chance about 1e-14 per value): none of these 520,005 may differ. The
-    // float pre-test of PTRS's full test decides only outside a margin of 1e-3 or more, so it never moves
-    // one.
-    std::map<double, std::array<int, 4>> tries;
+    // Value by value against the reference: the polynomial exp, log, sin and cos differ from the C library's
+    // by an ulp or two, and the library's Poisson probabilities from lgamma's by about 1e-13, which moves a
+    // count only when a uniform or g falls within about 1e-13 of a boundary of the CDF or of a test (chance
+    // below 1e-12 per value): none of these 520,005 may differ.
+    std::map<double, int> rests;
     for (int i = 0; i < n; ++i) {
         const double lambda = means[static_cast<size_t>(i)];
-        int extra = 0;
-        ASSERT_EQ(first[static_cast<size_t>(i)], referencePoisson(seed, stream, i, lambda, &extra))
+        bool rest = false;
+        ASSERT_EQ(first[static_cast<size_t>(i)], referencePoisson(seed, stream, i, lambda, &rest))
             << "value " << i << ", mean " << lambda;
-        ++tries[lambda][static_cast<size_t>(extra)];
+        rests[lambda] += rest;
     }
-    // A PTRS try is accepted with probability at most alpha = 1 / (1.1239 + 1.1328 / (b - 3.4)), the area
-    // under its hat (the (u, v) square maps onto the hat with Jacobian a / us^2 + b), less only the far
-    // tails it cuts (below 1e-3 here): 1 - alpha of first tries are retried. 5 binomial standard errors.
-    // A share far from that would mean the vector try drops or keeps lanes it should not.
-    for (double lambda : {30.0, 37.5, 1000.0, 2e6}) {
-        const std::array<int, 4>& t = tries[lambda];
-        const double b = 0.931 + 2.53 * std::sqrt(lambda), alpha = 1 / (1.1239 + 1.1328 / (b - 3.4));
-        const double share = (perMean - t[0]) / static_cast<double>(perMean);
-        std::cout << "fillPoisson at mean " << lambda << ": retried " << share << " (1 - alpha " << 1 - alpha
-                  << "), after a third try " << t[3] / static_cast<double>(perMean) << "\n";
-        EXPECT_NEAR(share, 1 - alpha, 5 * std::sqrt(alpha * (1 - alpha) / perMean)) << lambda;
+    // The share that steps N, I and S leave (1-2%) against its value from the normal CDF, 5 binomial standard
+    // errors: a share far from it would mean the lanes take or leave values they should not.
+    for (double lambda : {10.0, 10.5, 30.0, 37.5, 1000.0, 2e6}) {
+        const double expected = pdRestShare(lambda), share = rests[lambda] / static_cast<double>(perMean);
+        std::cout << "fillPoisson at mean " << lambda << ": steps Q and E for " << share << " (expected "
+                  << expected << ")\n";
+        EXPECT_NEAR(share, expected, 5 * std::sqrt(expected * (1 - expected) / perMean)) << lambda;
     }
-    EXPECT_EQ(tries[3e12][3], perMean); // beyond 2^40: always the scalar sampler
     // A chunk of small means only is inverted in place, not gathered: the same values as the reference.
     std::vector<double> dark(4096 + 7), darkCounts(dark.size());
     for (size_t i = 0; i < dark.size(); ++i)
-        dark[i] = 0.05 + 29.9 * static_cast<double>((i * 37) % 101) / 100.0; // 0.05 to 29.95
+        dark[i] = 0.05 + 9.9 * static_cast<double>((i * 37) % 101) / 100.0; // 0.05 to 9.95
     detail::fillPoisson(seed, stream, dark.data(), darkCounts.data(), static_cast<int>(dark.size()));
     for (size_t i = 0; i < dark.size(); ++i)
         ASSERT_EQ(darkCounts[i], referencePoisson(seed, stream, static_cast<int>(i), dark[i]))
