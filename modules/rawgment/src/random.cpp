@@ -563,10 +563,11 @@ template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D uniform32LanesD(type
 // 2^52. Larger means go to CounterRng::poisson() (which takes up to kMaxPoissonMean).
 constexpr double kMaxLaneMean = 1099511627776.0;
 
-/* The mean from which fillPoisson() takes Ahrens and Dieter's PD (1982), which needs 10 or more; below, it
- * inverts the CDF (on host H2, inversion in lanes cost 6.5 ns per value at a mean of 0.5 and 10 at 10, PD
- * about 6 from 10 up). CounterRng::poisson() switches from inversion to PTRS at 10 too. */
-constexpr double kInversionBelow = 10.0;
+/* The mean from which fillPoisson() takes Ahrens and Dieter's PD (which needs 10 or more); below, it inverts
+ * the CDF. On host H2 (AVX2), per value on one core, inversion took 9.1 ns at a mean of 10 and 13.3 at 24.9,
+ * PD 16.5 at 10 (where 5% of values need its scalar steps Q and E), 13.5 at 25 and 12.9 at 30.
+ * CounterRng::poisson() switches from inversion to PTRS at 10. */
+constexpr double kInversionBelow = 25.0;
 
 /* log k! - (k ln k - k + ln(2 pi k) / 2), the remainder of Stirling's formula, for k >= 1: exact below 32
  * (from the table of logFactorial()), its series 1/(12k) - 1/(360k^3) + 1/(1260k^5) above, as

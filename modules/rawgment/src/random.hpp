@@ -346,8 +346,8 @@ RAWGMENT_KERNEL void philox8StreamsFor(uint32_t block, const uint64_t* streams,
  *
  * - augmentation steps (RandomStream below): key stepKey(user seed, family); stream: the row (jitter),
  *   planeRowStream(site, plane row) (blur, scale), 0 (policy draw). A Poisson draw that fillPoisson()
- *   retries: key poissonRetryKey(family key, row stream) = stepKey(family key, row stream); stream: the
- *   value's index in its row. A Tukey-lambda value that fillTukeyUnit() refines: key tukeyRefineKey(family
+ *   finishes in scalar code (PD's steps Q and E, or a mean beyond 2^40): key poissonRetryKey(family key,
+ *   row stream) = stepKey(family key, row stream); stream: the value's index in its row. A Tukey-lambda value that fillTukeyUnit() refines: key tukeyRefineKey(family
  *   key, row stream), the same derivation under the Tukey family's key; stream: the value's index.
  * - simulator captures: key the capture's seed; stream captureStream(frame, row).
  * - simulator fixed pattern (PRNU, DSNU, defects): key SensorParams::fixedPatternSeed; stream
@@ -557,31 +557,29 @@ CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, const Tuk
                                        float* out, int n);
 
 /** Fills counts[0..n) with exact Poisson variates of means[0..n) from the stream (seed, stream), the
- * vector version of CounterRng::poisson() that ShotNoiseSampling::POISSON draws with. Every mean must lie
- * in [0, kMaxPoissonMean] (0 gives 0).
+ * vector sampler that ShotNoiseSampling::POISSON draws with. Every mean must lie in [0, kMaxPoissonMean]
+ * (0 gives 0).
  *
- * Value i uses words i and 16 + i of its chunk (16 values per 8 Philox blocks) and depends only on
- * (seed, stream, i, means[i]), on every path, whatever its neighbours' means. Below a mean of 30 (in lanes
- * the search costs less than PTRS there; CounterRng::poisson() switches at 10), inversion by sequential
- * search with u of 53 bits from both words, in place for a chunk of small means only and gathered into
- * whole chunks from mixed ones; from 30 up, one try of
- * Hormann's PTRS with u and v of 32 bits each, all in vector lanes: the fast test for every value, then the
- * full test for the values it left undecided (20-65% of them), gathered into whole vectors: first in float
- * lanes, which decide a value only where the two sides differ by more than a margin that bounds float's
- * rounding 6 to 190 times over, then in double lanes for the rest (0.3-0.8%), so the counts are the double
- * test's. A value whose
- * try is rejected (a share 1 - alpha, PTRS's acceptance constant: 25% at a mean of 10, 12% at 1000) tries
- * again in lanes with the first four words of its own CounterRng (poissonRetryKey(seed, stream), i),
- * twice, then calls CounterRng::poisson() on the rest of that stream; a mean beyond 2^40 calls it at once.
- * Retrying with fresh numbers is what a rejection sampler does anyway, so the draw stays exact. The
- * logarithms and the exponential are double polynomials (no library calls), so every path gives the same bits
- * (Simulate.fillPoissonIsExactAndTheSameOnEveryPath). Exactness: up to double rounding, and the 32-bit u and
- * v of the PTRS try: each count's probability is exact to about 2^-31 absolute. counts must not overlap
- * means. */
+ * Value h of a chunk of 16 (8 Philox blocks) owns word 16 + h; Box-Muller pair h % 8 takes its radius from
+ * word h % 8 and its angle from word 8 + h % 8, its cosine going to value h % 8 and its sine to value
+ * 8 + h % 8. A value depends only on (seed, stream, i, means[i]), on every path, whatever its neighbours'
+ * means. Below a mean of 25, inversion by sequential search with u = (own word + 1/2) 2^-32 (in place for a
+ * chunk of small means only, gathered into whole chunks from mixed ones). From 25 up to 2^40, Ahrens and
+ * Dieter's PD (ACM TOMS 8, 1982): steps N, I and S in double lanes, g = mu + sqrt(mu) T with T the normal of
+ * its pair (Box-Muller in double with polynomial logarithm, sine and cosine), taken when floor(g) >=
+ * floor(mu - 1.1484) or when the squeeze 6 mu^2 u >= (mu - floor(g))^3 holds for its own uniform u; the rest
+ * (5% at a mean of 10, 3% at 25, 0.4% at 1000) take steps Q and E in scalar code with exact Poisson
+ * probabilities (Stirling's formula with its remainder, not PD's own 7-digit approximations), step E
+ * drawing from the value's CounterRng (poissonRetryKey(seed, stream), i). A mean beyond 2^40 calls
+ * CounterRng::poisson() on that stream. CounterRng::poisson(), the simulator's sampler, is inversion below
+ * 10 and PTRS above. Exactness: up to double rounding and the 32-bit words: the uniforms and the normal's
+ * radius and angle are on grids of 2^-32 (|T| <= 6.7), so each count's probability is exact to about 2^-31
+ * absolute. Same bits on every path (Simulate.fillPoissonIsExactAndTheSameOnEveryPath, which also checks
+ * each value against a reference written with the C library). counts must not overlap means. */
 CV_RAWGMENT_EXPORTS void fillPoisson(uint64_t seed, uint64_t stream, const double* means, double* counts,
                                      int n);
 
-//! The key of fillPoisson()'s retries for the stream (seed, stream); a retried value i draws from (key, i).
+//! The key of fillPoisson()'s scalar steps for the stream (seed, stream); such a value i draws from (key, i).
 inline uint64_t poissonRetryKey(uint64_t seed, uint64_t stream)
 {
     return stepKey(seed, stream);

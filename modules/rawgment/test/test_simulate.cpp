@@ -441,7 +441,7 @@ double referencePdRest(double mu, double g, double u, detail::CounterRng& rng)
     }
 }
 
-/* fillPoisson()'s value i written out with the C library's exp, log, sqrt, sin and cos: below a mean of 10,
+/* fillPoisson()'s value i written out with the C library's exp, log, sqrt, sin and cos: below a mean of 25,
  * inversion from the uniform of its own word; up to 2^40, PD's steps N, I and S on its normal (Box-Muller of
  * its pair's words) and its uniform, and referencePdRest() on its retry stream for the rest (`rest` tells);
  * beyond 2^40, the scalar sampler on that stream. */
@@ -453,7 +453,7 @@ double referencePoisson(uint64_t seed, uint64_t stream, int i, double lambda, bo
         return 0;
     const PoissonWords w = poissonWords(seed, stream, i);
     const double u = (w.own + 0.5) / 4294967296.0;
-    if (lambda < 10) {
+    if (lambda < 25) { // fillPoisson's switch (CounterRng::poisson()'s is at 10)
         double p = std::exp(-lambda), cdf = p;
         int k = 0;
         while (u > cdf && k < 200) {
@@ -496,11 +496,11 @@ double pdRestShare(double mu)
 TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
 {
     const uint64_t seed = 0x1234abcd5678ef01ull, stream = 7;
-    // Means on both sides of the switch from inversion to PD at 10, PD's range up to 2^40 and the scalar
+    // Means on both sides of the switch from inversion to PD at 25, PD's range up to 2^40 and the scalar
     // sampler beyond, and 0, interleaved, so that the small means are gathered from mixed chunks and the
     // pairs of Box-Muller mix both kinds.
-    const std::vector<double> lambdas = {0.05, 0.7,    3.0, 9.99, 10.0, 10.5, 30.0,
-                                         37.5, 1000.0, 2e6, 0.0,  3e12, 5e9};
+    const std::vector<double> lambdas = {0.05, 0.7,    3.0, 12.0, 24.99, 25.0, 30.0,
+                                         37.5, 1000.0, 2e6, 0.0,  3e12,  5e9};
     const int perMean = 40000;
     const int n = static_cast<int>(lambdas.size()) * perMean + 5; // a partial last chunk too
     std::vector<double> means(static_cast<size_t>(n));
@@ -532,7 +532,7 @@ TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
     }
     // The share that steps N, I and S leave (1-2%) against its value from the normal CDF, 5 binomial standard
     // errors: a share far from it would mean the lanes take or leave values they should not.
-    for (double lambda : {10.0, 10.5, 30.0, 37.5, 1000.0, 2e6}) {
+    for (double lambda : {25.0, 30.0, 37.5, 1000.0, 2e6}) {
         const double expected = pdRestShare(lambda), share = rests[lambda] / static_cast<double>(perMean);
         std::cout << "fillPoisson at mean " << lambda << ": steps Q and E for " << share << " (expected "
                   << expected << ")\n";
@@ -541,7 +541,7 @@ TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
     // A chunk of small means only is inverted in place, not gathered: the same values as the reference.
     std::vector<double> dark(4096 + 7), darkCounts(dark.size());
     for (size_t i = 0; i < dark.size(); ++i)
-        dark[i] = 0.05 + 9.9 * static_cast<double>((i * 37) % 101) / 100.0; // 0.05 to 9.95
+        dark[i] = 0.05 + 24.9 * static_cast<double>((i * 37) % 101) / 100.0; // 0.05 to 24.95
     detail::fillPoisson(seed, stream, dark.data(), darkCounts.data(), static_cast<int>(dark.size()));
     for (size_t i = 0; i < dark.size(); ++i)
         ASSERT_EQ(darkCounts[i], referencePoisson(seed, stream, static_cast<int>(i), dark[i]))

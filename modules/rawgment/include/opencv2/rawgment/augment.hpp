@@ -34,9 +34,9 @@ enum class ShotNoiseSampling
      * output's DN per electron (\f$ g\alpha \f$ at the output gain) and \f$ m = v_{shot} / q^2 \f$, so
      * the variance is the same as with GAUSSIAN and only the shape changes; the read-noise part stays
      * Gaussian. Exact for the darkening that matters (p_u << 1, where the scaled prior noise is
-     * negligible). The counts are drawn exactly (inversion below 30 electrons, Hormann's PTRS above) in
-     * vector lanes, the same bits on every CPU path: about 8x the time of GAUSSIAN for colour jitter
-     * (rawgment_tradeoffs; docs/performance.md). */
+     * negligible). The counts are drawn exactly (inversion below 25 electrons, Ahrens and Dieter's PD
+     * above) in vector lanes, the same bits on every CPU path: about 6x the time of GAUSSIAN for colour
+     * jitter (rawgment_tradeoffs; docs/performance.md). */
     POISSON = 1
 };
 
