@@ -589,7 +589,8 @@ double stirlingRemainder(double k)
     return inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260)));
 }
 
-/* The log of the Poisson probability of k at mean mu >= 10, to about 1e-13 absolute: directly below k = 10
+/* The log of the Poisson probability of k at mean mu >= 10, to about 1e-13 + 1e-16 |mu - k| absolute (the
+ * rounding of ln(1 + v), times k): directly below k = 10
  * (the terms are small there), else as k (ln(1 + v) - v) - ln(2 pi k) / 2 - Stirling's remainder with
  * v = (mu - k) / k, which keeps k ln(mu / k) + k - mu free of cancellation where k is near mu. */
 double logPoissonProbability(double k, double mu)
@@ -692,7 +693,7 @@ const std::array<double, 201>& inverseIntegers()
 
 /* Inversion by sequential search for the means below kInversionBelow among a chunk's G groups of lanes,
  * the groups' chains interleaved (one multiply-add chain each, so together they hide each other's
- * latency): u = (w + 1/2) 2^-32 from the value's own word, and p_k = p_(k-1) lambda (1 / k). e^-10 and the
+ * latency): u = (w + 1/2) 2^-32 from the value's own word, and p_k = p_(k-1) lambda (1 / k). e^-25 and the
  * sums of up to 200 terms stay far inside double's range and precision. Lanes of larger means run with
  * mean 0 and give 0. */
 template <int W, int G>
@@ -754,7 +755,7 @@ inline void appendBits(int bits, int lanes, int base, int* list, int& size)
 
 /* The words of a chunk of 16 values (8 Philox blocks, word j of block b at 8 j + b): pair p < 8 of
  * Box-Muller takes its radius from word p and its angle from word 8 + p, its cosine going to value p and its
- * sine to value 8 + p; value i's own uniform is word 16 + i. A value of mean 10 or more (PD) uses its normal
+ * sine to value 8 + p; value i's own uniform is word 16 + i. A value of mean 25 or more (PD) uses its normal
  * and its uniform; a smaller one (inversion) only its uniform. So each value's count depends on its own
  * words and mean alone, whatever its pair's mean, and the two normals of a pair are independent. */
 template <int W>
@@ -815,7 +816,7 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
         if (pdBits) {
             // Steps N, I and S of PD: g = mu + sqrt(mu) T, K = floor(g), taken at once when K >= floor(mu -
             // 1.1484) (there the Poisson probabilities exceed the discrete normal's) or when 6 mu^2 u >= (mu
-            // - K)^3 (the squeeze); the rest (about 1% from a mean of 30 up, 2% at 10) go to poissonPdRest().
+            // - K)^3 (the squeeze); the rest (3% at a mean of 25, 0.4% at 1000) go to poissonPdRest().
             for (int g = 0; g < kGroups / 2; ++g) {
                 D c, s;
                 normalPairsLanesD<W>(words + g * kLanes, words + 8 + g * kLanes, c, s);
