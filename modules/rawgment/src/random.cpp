@@ -602,11 +602,11 @@ double logPoissonProbability(double k, double mu)
 }
 
 /* Steps P, Q and E of Ahrens and Dieter's PD ("Computer generation of Poisson deviates from modified normal
- * distributions", ACM TOMS 8, 1982) for a value that its steps N, I and S (in lanes, fillPoissonKernel())
- * left undecided: g = mu + sqrt(mu) T from its normal T, u its uniform. Step Q takes the same g and u; step
- * E draws from `rng` until its hat accepts. The Poisson probabilities are exact (logPoissonProbability());
- * the algorithm's own approximations of them (Stirling's series to two terms, a polynomial of 7 digits
- * for ln(1 + v)) would leave errors of 1e-8 relative. */
+ * distributions", ACM TOMS 8, 1982) in scalar code, for a value that poissonPdRestLanes() has tried 64 times
+ * (g < 0 skips step Q): g = mu + sqrt(mu) T from its normal T, u its uniform. Step Q takes the same g and u;
+ * step E draws from `rng` until its hat accepts. The Poisson probabilities are exact
+ * (logPoissonProbability()); the algorithm's own approximations of them (Stirling's series to two terms, a
+ * polynomial of 7 digits for ln(1 + v)) would leave errors of 1e-8 relative. */
 double poissonPdRest(double mu, double g, double u, CounterRng& rng)
 {
     const double s = std::sqrt(mu), omega = 0.3989422804014327 / s;
@@ -753,6 +753,165 @@ inline void appendBits(int bits, int lanes, int base, int* list, int& size)
     }
 }
 
+/* log(1 + v) - v for v > -1, to about 2 ulps of v^2 / 2 and without cancellation: below |v| = 1/4 as
+ * -s v + 2 s^3 (1/3 + s^2/5 + ... + s^18/21) with s = v / (2 + v) (log(1 + v) = 2 atanh(s), and v - 2 s =
+ * s v exactly in real numbers; |s| <= 1/7, so the series' next term is below 2^-56 of the sum), else from
+ * the logarithm, where v is large enough. */
+template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D log1pMinusLanesD(typename DoubleLanes<W>::D v)
+{
+    typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::L L;
+    const L small = (v < 0.25) & (v > -0.25);
+    const D vs = small ? v : D{};
+    const D s = vs / (2.0 + vs), s2 = s * s, s4 = s2 * s2, s8 = s4 * s4;
+    const D p01 = 1.0 / 3 + s2 * (1.0 / 5), p23 = 1.0 / 7 + s2 * (1.0 / 9), p45 = 1.0 / 11 + s2 * (1.0 / 13),
+            p67 = 1.0 / 15 + s2 * (1.0 / 17), p89 = 1.0 / 19 + s2 * (1.0 / 21);
+    const D series = -s * vs + 2.0 * s * s2 * (((p01 + s4 * p23) + s8 * (p45 + s4 * p67)) + s8 * s8 * p89);
+    if (maskBits(~small) == 0)
+        return series;
+    const D direct = logLanesD<W>(small ? D{} + 1.0 : 1.0 + v) - v;
+    return small ? series : direct;
+}
+
+/* logPoissonProbability() in lanes, for k >= 0: -mu at k = 0, else k (log(1 + v) - v) - ln(2 pi k) / 2 -
+ * Stirling's remainder (the table below 32, its series above) with v = (mu - k) / k. */
+template <int W>
+RAWGMENT_KERNEL typename DoubleLanes<W>::D logPoissonProbabilityLanesD(typename DoubleLanes<W>::D k,
+                                                                       typename DoubleLanes<W>::D mu)
+{
+    typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::L L;
+    const L zero = k < 1.0;
+    const D kk = zero ? D{} + 1.0 : k;
+    const D inv = 1.0 / kk, inv2 = inv * inv;
+    D remainder = inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260)));
+    if (maskBits(kk < 32.0))
+        for (int i = 0; i < DoubleLanes<W>::kCount; ++i)
+            if (kk[i] < 32)
+                remainder[i] = stirlingRemainder(kk[i]);
+    const D v = (mu - kk) * inv;
+    const D lp = kk * log1pMinusLanesD<W>(v) - 0.5 * logLanesD<W>(2.0 * CV_PI * kk) - remainder;
+    return zero ? -mu : lp;
+}
+
+//! e^x for x <= 40 in lanes, with x below -700 taken as -700 (e^-700 is 1e-304: every comparison PD makes
+//! with it has the same outcome as with 0).
+template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D expClampedLanesD(typename DoubleLanes<W>::D x)
+{
+    return expLanesD<W>(x < -700.0 ? typename DoubleLanes<W>::D{} - 700.0 : x);
+}
+
+/* PD's steps Q and E (poissonPdRest()) in lanes, for the `count` values fillPoissonKernel()'s fast steps
+ * left, eight at a time: step Q on their g and u, then step E's tries, try j of value i on block j of its
+ * stream (key, i): its first two words the 53-bit uniform of the exponential, its last two the signed
+ * uniform, as two calls of CounterRng::uniform() take them. After 64 tries (a chance below 1e-30) a value
+ * finishes in scalar code from block 64 on. Log and exp are the double polynomials, the same bits on every
+ * path. */
+template <int W>
+RAWGMENT_KERNEL void poissonPdRestLanes(uint64_t key, const double* means, const int* list, const double* gs,
+                                        const double* us, int count, double* counts)
+{
+    typedef typename DoubleLanes<W>::D D;
+    typedef typename DoubleLanes<W>::L L;
+    typedef typename DoubleLanes<W>::UL UL;
+    typedef typename DoubleLanes<W>::U32 U32;
+    const int kLanes = DoubleLanes<W>::kCount, kGroups = 8 / kLanes, kTries = 64;
+    const std::array<uint32_t, 2> streamKey = {static_cast<uint32_t>(key), static_cast<uint32_t>(key >> 32)};
+    for (int start = 0; start < count; start += 8) {
+        const int live = std::min(8, count - start);
+        alignas(64) uint64_t streams[8];
+        alignas(64) double mus[8], g8[8], u8[8], k8[8] = {};
+        for (int i = 0; i < 8; ++i) {
+            const int index = i < live ? list[start + i] : 0;
+            streams[i] = static_cast<uint64_t>(index);
+            mus[i] = i < live ? means[index] : kInversionBelow; // padding lanes: a valid mean, unused
+            g8[i] = i < live ? gs[start + i] : 0.0;
+            u8[i] = i < live ? us[start + i] : 0.5;
+        }
+        int pending = (1 << live) - 1;
+        // The constants of each value's hat and its step Q.
+        D mu[kGroups], s[kGroups], invS[kGroups], omega[kGroups], c0[kGroups], c1[kGroups], c2[kGroups],
+            c3[kGroups], c[kGroups];
+        for (int gr = 0; gr < kGroups; ++gr) {
+            std::memcpy(&mu[gr], mus + gr * kLanes, sizeof(D));
+            s[gr] = sqrtLanes(mu[gr]);
+            invS[gr] = 1.0 / s[gr];
+            omega[gr] = 0.3989422804014327 * invS[gr];
+            const D b1 = 1.0 / (24.0 * mu[gr]), b2 = 0.3 * b1 * b1;
+            c3[gr] = b1 * b2 * (1.0 / 7);
+            c2[gr] = b2 - 15.0 * c3[gr];
+            c1[gr] = b1 - 6.0 * b2 + 45.0 * c3[gr];
+            c0[gr] = 1.0 - b1 + 3.0 * b2 - 15.0 * c3[gr];
+            c[gr] = 0.1069 / mu[gr];
+            D g, u;
+            std::memcpy(&g, g8 + gr * kLanes, sizeof(D));
+            std::memcpy(&u, u8 + gr * kLanes, sizeof(D));
+            const L quotient = g >= 0.0;
+            const D k = floorNonNegativeLanesD<W>(quotient ? g : D{});
+            const D x = (0.5 - (mu[gr] - k)) * invS[gr], xx = x * x;
+            const D fx = -0.5 * xx, fy = omega[gr] * (((c3[gr] * xx + c2[gr]) * xx + c1[gr]) * xx + c0[gr]);
+            const L accept = quotient & (fy - u * fy <=
+                                         expClampedLanesD<W>(logPoissonProbabilityLanesD<W>(k, mu[gr]) - fx));
+            std::memcpy(k8 + gr * kLanes, &k, sizeof(D));
+            pending &= ~(maskBits(accept) << (gr * kLanes));
+        }
+        for (int j = 0; j < kTries && pending; ++j) {
+            alignas(64) uint32_t words[32];
+            philox8StreamsFor<W>(static_cast<uint32_t>(j), streams, streamKey, words);
+            for (int gr = 0; gr < kGroups; ++gr) {
+                const int groupBits = (pending >> (gr * kLanes)) & ((1 << kLanes) - 1);
+                if (!groupBits)
+                    continue;
+                U32 a0, a1, a2, a3;
+                std::memcpy(&a0, words + gr * kLanes, sizeof(U32));
+                std::memcpy(&a1, words + 8 + gr * kLanes, sizeof(U32));
+                std::memcpy(&a2, words + 16 + gr * kLanes, sizeof(U32));
+                std::memcpy(&a3, words + 24 + gr * kLanes, sizeof(U32));
+                // CounterRng::uniform(): (first << 21) ^ (second >> 11), 53 bits, exact as a double sum.
+                const UL w0 = __builtin_convertvector(a0, UL), w1 = __builtin_convertvector(a1, UL),
+                         w2 = __builtin_convertvector(a2, UL), w3 = __builtin_convertvector(a3, UL);
+                const D ue = ((((D)(w0 | 0x4330000000000000ull) - kTwo52) * 2097152.0 +
+                               ((D)((w1 >> 11) | 0x4330000000000000ull) - kTwo52)) +
+                              0.5) *
+                             (1.0 / 9007199254740992.0);
+                const D us2 = ((((D)(w2 | 0x4330000000000000ull) - kTwo52) * 2097152.0 +
+                                ((D)((w3 >> 11) | 0x4330000000000000ull) - kTwo52)) +
+                               0.5) *
+                              (1.0 / 9007199254740992.0);
+                const D e = -logLanesD<W>(ue);
+                const D signedUniform = 2.0 * us2 - 1.0;
+                const D t = 1.8 + (signedUniform < 0.0 ? -e : e);
+                const L valid = t > -0.6744;
+                const D k = floorNonNegativeLanesD<W>(valid ? mu[gr] + s[gr] * t : D{});
+                const D x = (0.5 - (mu[gr] - k)) * invS[gr], xx = x * x;
+                const D fx = -0.5 * xx,
+                        fy = omega[gr] * (((c3[gr] * xx + c2[gr]) * xx + c1[gr]) * xx + c0[gr]);
+                const D lp = logPoissonProbabilityLanesD<W>(k, mu[gr]);
+                const D absU = signedUniform < 0.0 ? -signedUniform : signedUniform;
+                const L accept =
+                    valid & (c[gr] * absU <= expClampedLanesD<W>(lp + e) - fy * expClampedLanesD<W>(fx + e));
+                const int taken = maskBits(accept) & groupBits;
+                for (int bits = taken; bits; bits &= bits - 1) {
+                    const int i = __builtin_ctz(static_cast<unsigned>(bits));
+                    k8[gr * kLanes + i] = k[i];
+                }
+                pending &= ~(taken << (gr * kLanes));
+            }
+        }
+        for (int i = 0; i < live; ++i) {
+            const int index = list[start + i];
+            if ((pending >> i) & 1) {
+                CounterRng rng(key, static_cast<uint64_t>(index));
+                for (int used = 0; used < 4 * kTries; ++used)
+                    rng.nextU32();
+                counts[index] = poissonPdRest(mus[i], -1.0, 0.0, rng);
+            } else {
+                counts[index] = k8[i];
+            }
+        }
+    }
+}
+
 /* The words of a chunk of 16 values (8 Philox blocks, word j of block b at 8 j + b): pair p < 8 of
  * Box-Muller takes its radius from word p and its angle from word 8 + p, its cosine going to value p and its
  * sine to value 8 + p; value i's own uniform is word 16 + i. A value of mean 25 or more (PD) uses its normal
@@ -816,7 +975,7 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
         if (pdBits) {
             // Steps N, I and S of PD: g = mu + sqrt(mu) T, K = floor(g), taken at once when K >= floor(mu -
             // 1.1484) (there the Poisson probabilities exceed the discrete normal's) or when 6 mu^2 u >= (mu
-            // - K)^3 (the squeeze); the rest (3% at a mean of 25, 0.4% at 1000) go to poissonPdRest().
+            // - K)^3 (the squeeze); the rest (3% at a mean of 25, 0.4% at 1000) go to poissonPdRestLanes().
             for (int g = 0; g < kGroups / 2; ++g) {
                 D c, s;
                 normalPairsLanesD<W>(words + g * kLanes, words + 8 + g * kLanes, c, s);
@@ -882,18 +1041,37 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
         for (int i = 0; i < live; ++i)
             counts[invert[start + i]] = chunkCounts[i];
     }
-    // PD's steps Q and E, and the means beyond the lanes' range, from each value's own CounterRng
+    // PD's steps Q and E, and the means beyond the lanes' range, from each value's own stream
     // (poissonRetryKey(seed, stream), index).
     const uint64_t restKey = poissonRetryKey(seed, stream);
-    for (int r = 0; r < rests; ++r) {
-        const int index = rest[r];
-        CounterRng rng(restKey, static_cast<uint64_t>(index));
-        counts[index] = poissonPdRest(means[index], restG[r], restU[r], rng);
-    }
+    poissonPdRestLanes<W>(restKey, means, rest.get(), restG.get(), restU.get(), rests, counts);
     for (int r = 0; r < beyonds; ++r) {
         const int index = beyond[r];
         CounterRng rng(restKey, static_cast<uint64_t>(index));
         counts[index] = static_cast<double>(rng.poisson(means[index]));
+    }
+}
+
+/* logPoissonProbabilityLanesD() over arrays, for the test of its accuracy; the last partial vector on
+ * padded copies. */
+template <int W>
+RAWGMENT_KERNEL void logPoissonProbabilitiesKernel(const double* ks, const double* mus, double* out, int n)
+{
+    typedef typename DoubleLanes<W>::D D;
+    const int kLanes = DoubleLanes<W>::kCount;
+    for (int i = 0; i < n; i += kLanes) {
+        alignas(64) double k[kLanes], mu[kLanes], lp[kLanes];
+        for (int j = 0; j < kLanes; ++j) {
+            k[j] = i + j < n ? ks[i + j] : 1.0;
+            mu[j] = i + j < n ? mus[i + j] : kInversionBelow;
+        }
+        D kv, muv;
+        std::memcpy(&kv, k, sizeof(kv));
+        std::memcpy(&muv, mu, sizeof(muv));
+        const D r = logPoissonProbabilityLanesD<W>(kv, muv);
+        std::memcpy(lp, &r, sizeof(r));
+        for (int j = 0; j < kLanes && i + j < n; ++j)
+            out[i + j] = lp[j];
     }
 }
 
@@ -905,6 +1083,8 @@ RAWGMENT_DISPATCHED_BY_WIDTH(void, fillTukeyUnit,
                              (uint64_t seed, uint64_t stream, const TukeyQuantileTable& table, float* out,
                               int n),
                              (seed, stream, table, out, n))
+RAWGMENT_DISPATCHED_BY_WIDTH(void, logPoissonProbabilities,
+                             (const double* ks, const double* mus, double* out, int n), (ks, mus, out, n))
 RAWGMENT_DISPATCHED_BY_WIDTH(void, fillPoisson,
                              (uint64_t seed, uint64_t stream, const double* means, double* counts, int n),
                              (seed, stream, means, counts, n))

@@ -568,9 +568,11 @@ CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, const Tuk
  * Dieter's PD (ACM TOMS 8, 1982): steps N, I and S in double lanes, g = mu + sqrt(mu) T with T the normal of
  * its pair (Box-Muller in double with polynomial logarithm, sine and cosine), taken when floor(g) >=
  * floor(mu - 1.1484) or when the squeeze 6 mu^2 u >= (mu - floor(g))^3 holds for its own uniform u; the rest
- * (5% at a mean of 10, 3% at 25, 0.4% at 1000) take steps Q and E in scalar code with exact Poisson
- * probabilities (Stirling's formula with its remainder, not PD's own 7-digit approximations), step E
- * drawing from the value's CounterRng (poissonRetryKey(seed, stream), i). A mean beyond 2^40 calls
+ * (3% at a mean of 25, 0.4% at 1000) take steps Q and E, gathered eight at a time into double lanes, with
+ * exact Poisson probabilities (Stirling's formula with its remainder, not PD's own 7-digit approximations;
+ * logPoissonProbabilities()), step E's try j drawing from block j of the value's stream
+ * (poissonRetryKey(seed, stream), i) as CounterRng::uniform() would (after 64 tries, a chance below 1e-30,
+ * scalar code goes on from block 64). A mean beyond 2^40 calls
  * CounterRng::poisson() on that stream. CounterRng::poisson(), the simulator's sampler, is inversion below
  * 10 and PTRS above. Exactness: up to double rounding and the 32-bit words: the uniforms and the normal's
  * radius and angle are on grids of 2^-32 (|T| <= 6.7), so each count's probability is exact to about 2^-31
@@ -578,6 +580,11 @@ CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, const Tuk
  * each value against a reference written with the C library). counts must not overlap means. */
 CV_RAWGMENT_EXPORTS void fillPoisson(uint64_t seed, uint64_t stream, const double* means, double* counts,
                                      int n);
+
+/** out[i] = ln P(K = ks[i]) for K ~ Poisson(mus[i]), as fillPoisson()'s steps Q and E compute it in lanes
+ * (k (ln(1 + v) - v) - ln(2 pi k) / 2 - Stirling's remainder, v = (mu - k) / k; -mu at k = 0), for ks[i] >= 0
+ * and mus[i] >= 1: exposed for the test of its accuracy (Simulate.poissonProbabilitiesOfTheLanesAreExact). */
+CV_RAWGMENT_EXPORTS void logPoissonProbabilities(const double* ks, const double* mus, double* out, int n);
 
 //! The key of fillPoisson()'s scalar steps for the stream (seed, stream); such a value i draws from (key, i).
 inline uint64_t poissonRetryKey(uint64_t seed, uint64_t stream)

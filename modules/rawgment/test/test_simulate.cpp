@@ -586,6 +586,44 @@ TEST(Simulate, fillPoissonIsExactAndTheSameOnEveryPath)
     }
 }
 
+TEST(Simulate, poissonProbabilitiesOfTheLanesAreExact)
+{
+    // PD's quotient test and hat compare against the Poisson probabilities. The reference, k ln mu - mu -
+    // lgamma(k + 1) in long double, errs by a few long-double ulps (4e-19) of its largest term, k ln mu + mu
+    // (2e10 at a mean of 1e9). The lanes round v = (mu - k) / k (2e-16 |mu - k| after the factor k), the
+    // sum (2e-15 of |ln P|, four double ulps) and the rest (1e-13). Checked on every path: near k = mu (the
+    // series of ln(1 + v) - v), far from it (the logarithm), at k = 0, below and above the remainder's table
+    // (32) and at means up to 1e9.
+    std::vector<double> ks, mus;
+    for (double mu : {25.0, 30.5, 1000.0, 123456.7, 1e9})
+        for (double f : {0.0, 0.3, 0.7, 0.9, 0.99, 1.0, 1.01, 1.1, 1.3, 2.0, 4.0})
+            for (double shift : {0.0, 1.0, 7.0}) {
+                ks.push_back(std::floor(f * mu) + shift);
+                mus.push_back(mu);
+            }
+    for (double k : {1.0, 2.0, 9.0, 10.0, 31.0, 32.0, 33.0}) {
+        ks.push_back(k);
+        mus.push_back(27.25);
+    }
+    const int n = static_cast<int>(ks.size());
+    for (CpuPath path : availableCpuPaths()) {
+        setCpuPath(path);
+        std::vector<double> lp(static_cast<size_t>(n));
+        detail::logPoissonProbabilities(ks.data(), mus.data(), lp.data(), n);
+        for (int i = 0; i < n; ++i) {
+            const long double k = ks[static_cast<size_t>(i)], mu = mus[static_cast<size_t>(i)];
+            const long double reference = k * std::log(mu) - mu - std::lgamma(k + 1);
+            const double referenceError = 4e-19 * static_cast<double>(k * std::log(mu) + mu);
+            EXPECT_NEAR(lp[static_cast<size_t>(i)], static_cast<double>(reference),
+                        1e-13 + 2e-16 * static_cast<double>(std::abs(mu - k)) +
+                            2e-15 * std::abs(static_cast<double>(reference)) + referenceError)
+                << cpuPathName(path) << ": k " << ks[static_cast<size_t>(i)] << ", mu "
+                << mus[static_cast<size_t>(i)];
+        }
+    }
+    setCpuPath(CpuPath::AUTO);
+}
+
 TEST(Simulate, fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath)
 {
     // Each value against the Tukey-lambda quantile in double precision of the uniform its words give, in the
