@@ -1020,7 +1020,7 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
         // are gathered, so that one value's search does not hold up fifteen others of large means.
         if (smallBits == (1 << count) - 1)
             poissonInversionLanes<W, kGroups>(chunkMeans, words + kChunk, chunkCounts);
-        else
+        else if (invertBits) // appendBits() writes every lane: skipped for the chunks without one
             appendBits(invertBits, kChunk, base, invert.get(), inverts);
         if (count == kChunk)
             std::memcpy(counts + base, chunkCounts, sizeof(chunkCounts));
