@@ -589,56 +589,6 @@ double stirlingRemainder(double k)
     return inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260)));
 }
 
-/* The log of the Poisson probability of k at mean mu >= 10, to about 1e-13 + 1e-16 |mu - k| absolute (the
- * rounding of ln(1 + v), times k): directly below k = 10
- * (the terms are small there), else as k (ln(1 + v) - v) - ln(2 pi k) / 2 - Stirling's remainder with
- * v = (mu - k) / k, which keeps k ln(mu / k) + k - mu free of cancellation where k is near mu. */
-double logPoissonProbability(double k, double mu)
-{
-    if (k < 10)
-        return k * std::log(mu) - mu - logFactorial(static_cast<int64_t>(k));
-    const double v = (mu - k) / k;
-    return k * (std::log1p(v) - v) - 0.5 * std::log(2.0 * CV_PI * k) - stirlingRemainder(k);
-}
-
-/* Steps P, Q and E of Ahrens and Dieter's PD ("Computer generation of Poisson deviates from modified normal
- * distributions", ACM TOMS 8, 1982) in scalar code, for a value that poissonPdRestLanes() has tried 64 times
- * (g < 0 skips step Q): g = mu + sqrt(mu) T from its normal T, u its uniform. Step Q takes the same g and u;
- * step E draws from `rng` until its hat accepts. The Poisson probabilities are exact
- * (logPoissonProbability()); the algorithm's own approximations of them (Stirling's series to two terms, a
- * polynomial of 7 digits for ln(1 + v)) would leave errors of 1e-8 relative. */
-double poissonPdRest(double mu, double g, double u, CounterRng& rng)
-{
-    const double s = std::sqrt(mu), omega = 0.3989422804014327 / s;
-    // The Hermite corrections of the discrete normal probabilities, and the hat's constant (A & D's c).
-    const double b1 = 1.0 / (24.0 * mu), b2 = 0.3 * b1 * b1;
-    const double c3 = b1 * b2 / 7.0, c2 = b2 - 15.0 * c3, c1 = b1 - 6.0 * b2 + 45.0 * c3;
-    const double c0 = 1.0 - b1 + 3.0 * b2 - 15.0 * c3, c = 0.1069 / mu;
-    double fx = 0, fy = 0;
-    const auto modifiedNormal = [&](double k) { // A & D's procedure F, less the Poisson part
-        const double x = (0.5 - (mu - k)) / s, xx = x * x;
-        fx = -0.5 * xx;
-        fy = omega * (((c3 * xx + c2) * xx + c1) * xx + c0);
-    };
-    if (g >= 0) { // step Q: quotient acceptance
-        const double k = std::floor(g);
-        modifiedNormal(k);
-        if (fy - u * fy <= std::exp(logPoissonProbability(k, mu) - fx))
-            return k;
-    }
-    for (;;) { // step E: a double exponential sample t, accepted under the hat by step H
-        const double e = -std::log(rng.uniform());
-        const double signedUniform = 2.0 * rng.uniform() - 1.0;
-        const double t = 1.8 + (signedUniform < 0 ? -e : e);
-        if (t <= -0.6744) // where the Poisson probabilities lie below the discrete normal's
-            continue;
-        const double k = std::floor(mu + s * t);
-        modifiedNormal(k);
-        if (c * std::abs(signedUniform) <= std::exp(logPoissonProbability(k, mu) + e) - fy * std::exp(fx + e))
-            return k;
-    }
-}
-
 /* Box-Muller in double lanes: the normals of kCount pairs from their 32-bit words, the radius from
  * u = (w + 1/2) 2^-32 (so |T| <= 6.7: a true normal lies beyond with probability 3e-11), the angle's
  * quadrant from the top 2 bits of the angle word and phi in (-pi/4, pi/4) from the other 30 (plus 1/2).
@@ -773,7 +723,8 @@ template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D log1pMinusLanesD(typ
     return small ? series : direct;
 }
 
-/* logPoissonProbability() in lanes, for k >= 0: -mu at k = 0, else k (log(1 + v) - v) - ln(2 pi k) / 2 -
+/* The log of the Poisson probability of k >= 0 at mean mu in lanes, to about 1e-13 + 1e-16 |mu - k| absolute
+ * (the rounding of ln(1 + v), times k): -mu at k = 0, else k (log(1 + v) - v) - ln(2 pi k) / 2 -
  * Stirling's remainder (the table below 32, its series above) with v = (mu - k) / k. */
 template <int W>
 RAWGMENT_KERNEL typename DoubleLanes<W>::D logPoissonProbabilityLanesD(typename DoubleLanes<W>::D k,
@@ -801,12 +752,15 @@ template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D expClampedLanesD(typ
     return expLanesD<W>(x < -700.0 ? typename DoubleLanes<W>::D{} - 700.0 : x);
 }
 
-/* PD's steps Q and E (poissonPdRest()) in lanes, for the `count` values fillPoissonKernel()'s fast steps
- * left, eight at a time: step Q on their g and u, then step E's tries, try j of value i on block j of its
- * stream (key, i): its first two words the 53-bit uniform of the exponential, its last two the signed
- * uniform, as two calls of CounterRng::uniform() take them. After 64 tries (a chance below 1e-30) a value
- * finishes in scalar code from block 64 on. Log and exp are the double polynomials, the same bits on every
- * path. */
+/* Steps P, Q and E of Ahrens and Dieter's PD ("Computer generation of Poisson deviates from modified normal
+ * distributions", ACM TOMS 8, 1982) in lanes, for the `count` values that fillPoissonKernel()'s steps N, I
+ * and S left, eight at a time: step Q on their g = mu + sqrt(mu) T and u, then step E's tries until each is
+ * accepted (0.64 of tries are at means 10 and 100, measured), try j of value i on block j of its stream (key,
+ * i): its first two words the 53-bit uniform of the exponential, its last two the signed uniform, as two
+ * calls of CounterRng::uniform() take them. The Poisson probabilities are exact
+ * (logPoissonProbabilityLanesD()); the algorithm's own approximations of them (Stirling's series to two
+ * terms, a polynomial of 7 digits for ln(1 + v)) would leave errors of 1e-8 relative. Log and exp are the
+ * double polynomials, the same bits on every path. */
 template <int W>
 RAWGMENT_KERNEL void poissonPdRestLanes(uint64_t key, const double* means, const int* list, const double* gs,
                                         const double* us, int count, double* counts)
@@ -815,7 +769,7 @@ RAWGMENT_KERNEL void poissonPdRestLanes(uint64_t key, const double* means, const
     typedef typename DoubleLanes<W>::L L;
     typedef typename DoubleLanes<W>::UL UL;
     typedef typename DoubleLanes<W>::U32 U32;
-    const int kLanes = DoubleLanes<W>::kCount, kGroups = 8 / kLanes, kTries = 64;
+    const int kLanes = DoubleLanes<W>::kCount, kGroups = 8 / kLanes;
     const std::array<uint32_t, 2> streamKey = {static_cast<uint32_t>(key), static_cast<uint32_t>(key >> 32)};
     for (int start = 0; start < count; start += 8) {
         const int live = std::min(8, count - start);
@@ -855,9 +809,9 @@ RAWGMENT_KERNEL void poissonPdRestLanes(uint64_t key, const double* means, const
             std::memcpy(k8 + gr * kLanes, &k, sizeof(D));
             pending &= ~(maskBits(accept) << (gr * kLanes));
         }
-        for (int j = 0; j < kTries && pending; ++j) {
+        for (uint32_t j = 0; pending; ++j) {
             alignas(64) uint32_t words[32];
-            philox8StreamsFor<W>(static_cast<uint32_t>(j), streams, streamKey, words);
+            philox8StreamsFor<W>(j, streams, streamKey, words);
             for (int gr = 0; gr < kGroups; ++gr) {
                 const int groupBits = (pending >> (gr * kLanes)) & ((1 << kLanes) - 1);
                 if (!groupBits)
@@ -898,17 +852,8 @@ RAWGMENT_KERNEL void poissonPdRestLanes(uint64_t key, const double* means, const
                 pending &= ~(taken << (gr * kLanes));
             }
         }
-        for (int i = 0; i < live; ++i) {
-            const int index = list[start + i];
-            if ((pending >> i) & 1) {
-                CounterRng rng(key, static_cast<uint64_t>(index));
-                for (int used = 0; used < 4 * kTries; ++used)
-                    rng.nextU32();
-                counts[index] = poissonPdRest(mus[i], -1.0, 0.0, rng);
-            } else {
-                counts[index] = k8[i];
-            }
-        }
+        for (int i = 0; i < live; ++i)
+            counts[list[start + i]] = k8[i];
     }
 }
 

@@ -571,8 +571,8 @@ CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, const Tuk
  * (3% at a mean of 25, 0.4% at 1000) take steps Q and E, gathered eight at a time into double lanes, with
  * exact Poisson probabilities (Stirling's formula with its remainder, not PD's own 7-digit approximations;
  * logPoissonProbabilities()), step E's try j drawing from block j of the value's stream
- * (poissonRetryKey(seed, stream), i) as CounterRng::uniform() would (after 64 tries, a chance below 1e-30,
- * scalar code goes on from block 64). A mean beyond 2^40 calls
+ * (poissonRetryKey(seed, stream), i) as CounterRng::uniform() would, until the hat accepts. A mean beyond
+ * 2^40 calls
  * CounterRng::poisson() on that stream. CounterRng::poisson(), the simulator's sampler, is inversion below
  * 10 and PTRS above. Exactness: up to double rounding and the 32-bit words: the uniforms and the normal's
  * radius and angle are on grids of 2^-32 (|T| <= 6.7), so each count's probability is exact to about 2^-31
