@@ -105,9 +105,9 @@ struct DarkTerms
     float rowSigma[4] = {0, 0, 0, 0};
     float shadingPerGain[4] = {0, 0, 0, 0}, shadingOffset[4] = {0, 0, 0, 0};
     Point origin; // where the mosaic lies on the sensor (RawFormat::sensorOrigin): the maps are read there
-    TukeyUnitSampler tailSampler[4]; // the added read part's heavy-tailed shape per site, when `tails`
-    // The quantiles of tailSampler's shapes for fillTukeyUnit(): a mosaic row of parity p reads
-    // tailTable[p] (sites 2p and 2p + 1); a resampling step, whose sites share one shape, tailTable[0].
+    // The quantiles of the added read part's heavy-tailed shapes, when `tails`, for fillTukeyUnit(): a mosaic
+    // row of parity p reads tailTable[p] (sites 2p and 2p + 1); a resampling step, whose sites share one
+    // shape, tailTable[0].
     TukeyQuantileTable tailTable[2];
     bool any() const { return row || shading; }
 };

@@ -245,8 +245,6 @@ void mergeGroupRows(const std::vector<Mat>& group, int merged, const Vec4d& blac
     const int whiteFloor = static_cast<int>(std::min(std::max(std::ceil(white), 0.0), 65536.0));
     for (int r = r0; r < r1; ++r) {
         const double b0 = black[2 * (r & 1)], b1 = black[2 * (r & 1) + 1];
-        for (int c = 0; c < kBlock; ++c)
-            blackOfColumn[c] = (c & 1) ? b1 : b0; // kBlock is even: the phase holds in every block
         S* mu = mean.ptr<S>(r);
         S* acc = m2.ptr<S>(r);
         uchar* clip = clipped.ptr<uchar>(r);
@@ -262,6 +260,8 @@ void mergeGroupRows(const std::vector<Mat>& group, int merged, const Vec4d& blac
                 rows[static_cast<size_t>(k)] = group[static_cast<size_t>(k)].ptr<T>(r);
             mergeGroup16(rows.data(), m, cols, b0, b1, wGroup, wCross, whiteFloor, mu, acc, clip);
         } else {
+            for (int c = 0; c < kBlock; ++c)
+                blackOfColumn[c] = (c & 1) ? b1 : b0; // kBlock is even: the phase holds in every block
             for (int c0 = 0; c0 < cols; c0 += kBlock) {
                 const int n = std::min(kBlock, cols - c0);
                 for (int k = 0; k < m; ++k)

@@ -584,6 +584,7 @@ detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, Point se
     const double readIn = g * g * model.sigmaD2 + model.sigmaR2;
     const double readOut = pg * pg * g * g * model.sigmaD2 + model.sigmaR2;
     const bool account = alignment == NoiseAlignment::ACCOUNT_PRIOR;
+    detail::TukeyUnitSampler shapes[4]; // the added read part's heavy-tailed shape per site, when `tails`
     for (int s = 0; s < 4; ++s) {
         const double pc = jitter.contrast[s], pu = pc / pg;
         const double rowAdded =
@@ -594,15 +595,14 @@ detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, Point se
         d.shadingOffset[s] = static_cast<float>(account ? 0.0 : 1.0);
         if (!d.tails)
             continue;
-        d.tailSampler[s] = detail::TukeyUnitSampler(
+        shapes[s] = detail::TukeyUnitSampler(
             account ? detail::addedReadLambda(model.tukeyLambda, readOut, std::pow(pc, 4) * readIn * readIn,
                                               readOut - pc * pc * readIn)
                     : model.tukeyLambda);
     }
     if (d.tails)
         for (int parity = 0; parity < 2; ++parity) {
-            const detail::TukeyUnitSampler &s0 = d.tailSampler[2 * parity],
-                                           &s1 = d.tailSampler[2 * parity + 1];
+            const detail::TukeyUnitSampler &s0 = shapes[2 * parity], &s1 = shapes[2 * parity + 1];
             d.tailTable[parity] =
                 detail::TukeyQuantileTable(static_cast<float>(s0.lambda), static_cast<float>(s0.invSd),
                                            static_cast<float>(s1.lambda), static_cast<float>(s1.invSd));

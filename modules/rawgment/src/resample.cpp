@@ -331,11 +331,9 @@ void resampleDarkTerms(ResampleConstants& k, const NoiseModel& model, const RawF
         const double lambda =
             account ? detail::addedReadLambda(model.tukeyLambda, b, sumW4 * b * b, (1 - sumW2) * b)
                     : model.tukeyLambda;
-        for (int s = 0; s < 4; ++s)
-            d.tailSampler[s] = detail::TukeyUnitSampler(lambda);
         // One shape for every site, so one table (a plane row is one site).
-        d.tailTable[0] = detail::TukeyQuantileTable(static_cast<float>(lambda),
-                                                    static_cast<float>(d.tailSampler[0].invSd));
+        d.tailTable[0] = detail::TukeyQuantileTable(
+            static_cast<float>(lambda), static_cast<float>(detail::TukeyUnitSampler(lambda).invSd));
     }
     if (d.shading) {
         k.shading = detail::ShadingRows(model, format.gain, format.sensorOrigin);
