@@ -41,8 +41,21 @@ bool exists(const std::string& path)
     return std::ifstream(path).good();
 }
 
+/** How the sanitizer build's apps record where memory was allocated. FAST follows frame pointers, which
+ * stop at the first frame of Debian's OpenCV (built without them). FULL unwinds every frame from the
+ * debugging information, which more than doubled the time of this file's calibrations (36 s to 89 s for
+ * one test on host H2), so only the runs that detect a chart with cv::mcc ask for it: OpenCV's
+ * colour-conversion tables, which it keeps for the process's life, are allocated deep inside
+ * libopencv_imgproc, and test/lsan_suppressions.txt can match them only on a complete stack. */
+enum class AllocationStacks
+{
+    FAST,
+    FULL
+};
+
 //! Runs an app of this build with arguments (shell-quoted by the caller), capturing stdout and stderr.
-AppRun runApp(const std::string& app, const std::string& args)
+AppRun runApp(const std::string& app, const std::string& args,
+              AllocationStacks stacks = AllocationStacks::FAST)
 {
     static int counter = 0;
     const std::string log = ::testing::TempDir() + "/rawgment_app_" + std::to_string(::getpid()) + "_" +
@@ -53,6 +66,13 @@ AppRun runApp(const std::string& app, const std::string& args)
     // ctest runs here directly rather than through scripts/test.sh (whose LSAN_OPTIONS, if set, wins).
     if (!std::getenv("LSAN_OPTIONS"))
         command = "LSAN_OPTIONS='suppressions=" + std::string(RAWGMENT_LSAN_SUPPRESSIONS) + "' " + command;
+    if (stacks == AllocationStacks::FULL) {
+        const char* asan = std::getenv("ASAN_OPTIONS");
+        command = "ASAN_OPTIONS='" + std::string(asan != nullptr ? asan : "") + ":fast_unwind_on_malloc=0' " +
+                  command;
+    }
+#else
+    (void)stacks;
 #endif
     const int raw = std::system(command.c_str());
     AppRun r;
@@ -469,8 +489,9 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
         std::ofstream f(dir + "/sim/manifest_detect.yml");
         f << manifest;
     }
-    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest_detect.yml' --side=12 --plots=false --out='" +
-                                         dir + "/cal_detect'");
+    r = runApp("rawgment_calibrate",
+               "'" + dir + "/sim/manifest_detect.yml' --side=12 --plots=false --out='" + dir + "/cal_detect'",
+               AllocationStacks::FULL);
     ASSERT_EQ(0, r.status) << r.output << manifest;
     EXPECT_NE(std::string::npos, r.output.find("patches detected with cv::mcc")) << r.output;
     // A quarter of the pixels of the given squares: alpha still within 2% (about 5 of its spreads).
@@ -1006,7 +1027,8 @@ TEST(Apps, calibrateTheRealColourChartInSingleFrameModeSaysWhatItCannotDetermine
     const std::string dir = freshDir("calibrate_colorchart");
     std::ofstream(dir + "/m.yml") << "%YAML:1.0\ncalibration_manifest:\n  patches: detect\n  bursts:\n"
                                   << "    - { files: ['" << chart << "'] }\n";
-    const AppRun r = runApp("rawgment_calibrate", "'" + dir + "/m.yml' --out='" + dir + "/cal'");
+    const AppRun r =
+        runApp("rawgment_calibrate", "'" + dir + "/m.yml' --out='" + dir + "/cal'", AllocationStacks::FULL);
     ASSERT_EQ(0, r.status) << r.output;
     const std::string report = readText(dir + "/cal/report.md");
     // One frame at one unknown gain: the line of this capture, and a verdict that says why it is no more.
