@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <emmintrin.h>
 
 namespace cv {
 namespace rawgment {
@@ -70,6 +71,75 @@ struct ResampleConstants
     std::atomic<bool>* nonFiniteShading = nullptr; // set when a shading row held NaN or Inf
 };
 
+// The columns of one site (column 0 or 1 of the CFA) of a mosaic row, less black, into out[0..width).
+// SSE2, which every x86-64 has, takes four at a time with the scalar tail's own conversion and
+// subtraction, so every path gives the same bits.
+void siteColumns(const ushort* row, int column, int width, float black, float* out)
+{
+    const __m128 b = _mm_set1_ps(black);
+    const __m128i low = _mm_set1_epi32(0xFFFF);
+    int j = 0;
+    for (; j + 4 <= width; j += 4) {
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 2 * j));
+        const __m128i site = column == 0 ? _mm_and_si128(v, low) : _mm_srli_epi32(v, 16);
+        _mm_storeu_ps(out + j, _mm_sub_ps(_mm_cvtepi32_ps(site), b));
+    }
+    for (; j < width; ++j)
+        out[j] = static_cast<float>(row[2 * j + column]) - black;
+}
+
+void siteColumns(const float* row, int column, int width, float black, float* out)
+{
+    const __m128 b = _mm_set1_ps(black);
+    int j = 0;
+    for (; j + 4 <= width; j += 4) {
+        const __m128 a = _mm_loadu_ps(row + 2 * j), c = _mm_loadu_ps(row + 2 * j + 4);
+        const __m128 site = column == 0 ? _mm_shuffle_ps(a, c, _MM_SHUFFLE(2, 0, 2, 0))
+                                        : _mm_shuffle_ps(a, c, _MM_SHUFFLE(3, 1, 3, 1));
+        _mm_storeu_ps(out + j, _mm_sub_ps(site, b));
+    }
+    for (; j < width; ++j)
+        out[j] = row[2 * j + column] - black;
+}
+
+// Both sites of a mosaic row (plane rows `even` and `odd`, CFA columns 0 and 1) interleaved into it with
+// whole-vector stores. One task writes a whole row, so no two threads write into one cache line: when
+// each site was stored on its own, the two threads took every line of the output from each other.
+// 16-bit values are rounded half to even like detail::roundHalfToEven(): _mm_cvtps_epi32 rounds in the
+// default mode, to nearest even. Values lie in [0, white]; above 65535 (a white level no 16-bit
+// file holds) they saturate there.
+void storeMosaicRow(const float* even, const float* odd, ushort* d, int width)
+{
+    const __m128i bias = _mm_set1_epi32(32768), flip = _mm_set1_epi16(static_cast<short>(0x8000));
+    int j = 0;
+    for (; j + 4 <= width; j += 4) {
+        const __m128i a = _mm_cvtps_epi32(_mm_loadu_ps(even + j)), b = _mm_cvtps_epi32(_mm_loadu_ps(odd + j));
+        // Signed saturation is exact on v - 32768 for v in [0, 65535]; the flip of the top bit adds it back.
+        const __m128i lo = _mm_sub_epi32(_mm_unpacklo_epi32(a, b), bias);
+        const __m128i hi = _mm_sub_epi32(_mm_unpackhi_epi32(a, b), bias);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(d + 2 * j), _mm_xor_si128(_mm_packs_epi32(lo, hi), flip));
+    }
+    for (; j < width; ++j) {
+        d[2 * j] = static_cast<ushort>(std::min(static_cast<int>(detail::roundHalfToEven(even[j])), 65535));
+        d[2 * j + 1] =
+            static_cast<ushort>(std::min(static_cast<int>(detail::roundHalfToEven(odd[j])), 65535));
+    }
+}
+
+void storeMosaicRow(const float* even, const float* odd, float* d, int width)
+{
+    int j = 0;
+    for (; j + 4 <= width; j += 4) {
+        const __m128 a = _mm_loadu_ps(even + j), b = _mm_loadu_ps(odd + j);
+        _mm_storeu_ps(d + 2 * j, _mm_unpacklo_ps(a, b));
+        _mm_storeu_ps(d + 2 * j + 4, _mm_unpackhi_ps(a, b));
+    }
+    for (; j < width; ++j) {
+        d[2 * j] = even[j];
+        d[2 * j + 1] = odd[j];
+    }
+}
+
 // Plane row `planeRow` of site `site`, black-subtracted (and without the input's dark shading when
 // `shading` is not empty), into out[0..pad + width + pad) with the plane's edge replicated `pad` columns
 // on each side.
@@ -77,10 +147,8 @@ template <typename T>
 void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, float* out,
                   const detail::ShadingRows& shading = detail::ShadingRows())
 {
-    const T* s = src.ptr<T>(2 * planeRow + site / 2) + site % 2;
     const int width = src.cols / 2;
-    for (int j = 0; j < width; ++j)
-        out[pad + j] = static_cast<float>(s[2 * j]) - black;
+    siteColumns(src.ptr<T>(2 * planeRow + site / 2), site % 2, width, black, out + pad);
     if (!shading.empty()) {
         const int r = 2 * planeRow + site / 2;
         const float *bd = shading.perGainRow(r) + site % 2, *br = shading.offsetRow(r) + site % 2;
@@ -183,16 +251,6 @@ RAWGMENT_DISPATCHED_BY_WIDTH(void, finishResampledRow,
                               const float* extra, const ResampleConstants& k, float black, int n),
                              (mean, shotSum, readFactor, z, extra, k, black, n))
 
-template <typename T> void storePlaneRow(const float* v, Mat& dst, int site, int planeRow)
-{
-    T* d = dst.ptr<T>(2 * planeRow + site / 2) + site % 2;
-    const int width = dst.cols / 2;
-    for (int j = 0; j < width; ++j)
-        d[2 * j] = std::is_same<T, ushort>::value
-                       ? static_cast<T>(static_cast<int>(detail::roundHalfToEven(v[j])))
-                       : static_cast<T>(v[j]);
-}
-
 // The scalar rows: ShotNoiseSampling::POISSON for a resampled row (the shot part of Eq. 15, or of the
 // model for IGNORE_PRIOR, as an electron count at the input gain, see detail::splitNoise()) and Tukey-lambda
 // read noise (t: the row's unit-variance draws, the read part's shape), with the dark terms' `extra`.
@@ -252,13 +310,11 @@ bool resampledDarkRow(const ResampleConstants& k, int site, int planeRow, float 
 }
 
 // The end of every resampled row: its noise streams (site, row), the noise, the dark terms, the black
-// level, the store.
-template <typename T>
+// level, in `mean`; storeMosaicRow() stores it with the row's other site.
 void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float* readFactor,
-                    std::vector<float>& z, const ResampleConstants& k, Mat& dst, int site, int planeRow,
+                    std::vector<float>& z, const ResampleConstants& k, int n, int site, int planeRow,
                     float rowKeep = 1)
 {
-    const int n = dst.cols / 2;
     const uint64_t stream = detail::planeRowStream(site, planeRow);
     const bool noise = k.alignment != NoiseAlignment::NONE;
     if (noise)
@@ -280,7 +336,6 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
     } else {
         finishResampledRow(mean.data(), shotSum, readFactor, z.data(), extraRow, k, k.black[site], n);
     }
-    storePlaneRow<T>(mean.data(), dst, site, planeRow);
 }
 
 ResampleConstants resampleConstants(const RawFormat& format, const NoiseModel& model,
@@ -395,10 +450,15 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
     // A ring row holds the plane row with rx columns of edge on each side, and one widest block more,
     // which addTapRow's last block reads past the row (detail::wholeBlocks()).
     const int stride = pw + 2 * rx + detail::kWidestLanes;
-    std::vector<float> ring(static_cast<size_t>(ksize.height) * stride);
-    std::vector<int> ringRow(static_cast<size_t>(ksize.height), -1);
-    std::vector<float> mean(detail::wholeBlocks(pw)), shotSum(detail::wholeBlocks(pw)),
-        z(detail::wholeBlocks(pw)), readFactors(detail::wholeBlocks(pw));
+    // A ring per site: a task makes whole plane rows i, the four sites in turn, so that it writes both
+    // mosaic rows 2 i and 2 i + 1 whole (storeMosaicRow()).
+    const size_t ringRows = static_cast<size_t>(ksize.height);
+    std::vector<float> ring(4 * ringRows * stride);
+    std::vector<int> ringRow(4 * ringRows, -1);
+    std::vector<float> means[2] = {std::vector<float>(detail::wholeBlocks(pw)),
+                                   std::vector<float>(detail::wholeBlocks(pw))};
+    std::vector<float> shotSum(detail::wholeBlocks(pw)), z(detail::wholeBlocks(pw)),
+        readFactors(detail::wholeBlocks(pw));
     const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
     const bool exactShot = account && !shotFromMean;
     struct EdgeColumn
@@ -418,13 +478,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
     std::vector<float> rowWeights; // the kernel's weight per source row (after clamping)
     std::vector<const float*> tapRows;
     std::vector<float> tapWeights, tapShotWeights;
-    int ringSite = -1;
-    for (int idx = range.start; idx < range.end; ++idx) {
-        const int site = idx / ph, i = idx % ph;
-        if (site != ringSite) {
-            std::fill(ringRow.begin(), ringRow.end(), -1);
-            ringSite = site;
-        }
+    for (int i = range.start; i < range.end; ++i) {
         const bool edgeRow = i < ry || i >= ph - ry;
         float rowKeep = 1;
         if (k.dark.row) {
@@ -437,50 +491,56 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
         }
         const float rowReadFactor =
             edgeRow ? mergeClampedTaps(taps, i, 0, plane, radius, true, false, rowTaps) : readFactor;
-        std::fill(readFactors.begin(), readFactors.end(), rowReadFactor);
-        // The rows of one output row are distinct ring slots, so every tap's row stays loaded.
-        tapRows.clear();
-        tapWeights.clear();
-        tapShotWeights.clear();
-        for (const KernelTap& t : edgeRow ? rowTaps : taps) {
-            const int si = std::min(std::max(i + t.dy - ry, 0), ph - 1);
-            const size_t slot = static_cast<size_t>(si % ksize.height);
-            float* row = ring.data() + slot * stride;
-            if (ringRow[slot] != si) {
-                loadPlaneRow<T>(src, site, si, rx, k.black[site], row, k.inputShading);
-                ringRow[slot] = si;
+        for (int site = 0; site < 4; ++site) {
+            std::vector<float>& mean = means[site % 2];
+            float* const siteRing = ring.data() + static_cast<size_t>(site) * ringRows * stride;
+            int* const siteRingRow = ringRow.data() + static_cast<size_t>(site) * ringRows;
+            std::fill(readFactors.begin(), readFactors.end(), rowReadFactor);
+            // The rows of one output row are distinct ring slots, so every tap's row stays loaded.
+            tapRows.clear();
+            tapWeights.clear();
+            tapShotWeights.clear();
+            for (const KernelTap& t : edgeRow ? rowTaps : taps) {
+                const int si = std::min(std::max(i + t.dy - ry, 0), ph - 1);
+                const size_t slot = static_cast<size_t>(si) % ringRows;
+                float* row = siteRing + slot * stride;
+                if (siteRingRow[slot] != si) {
+                    loadPlaneRow<T>(src, site, si, rx, k.black[site], row, k.inputShading);
+                    siteRingRow[slot] = si;
+                }
+                tapRows.push_back(row + t.dx);
+                tapWeights.push_back(t.w);
+                tapShotWeights.push_back(t.shotWeight);
             }
-            tapRows.push_back(row + t.dx);
-            tapWeights.push_back(t.w);
-            tapShotWeights.push_back(t.shotWeight);
-        }
-        addTapsRow(mean.data(), shotSum.data(), tapRows.data(), tapWeights.data(), tapShotWeights.data(),
-                   static_cast<int>(tapRows.size()), exactShot, pw);
-        if (!account) {
-            finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i, rowKeep);
-            continue;
-        }
-        for (const EdgeColumn& e : edgeColumns) {
-            const std::vector<KernelTap>* merged = &e.taps;
-            readFactors[static_cast<size_t>(e.j)] = e.readFactor;
-            if (edgeRow) {
-                readFactors[static_cast<size_t>(e.j)] =
-                    mergeClampedTaps(taps, i, e.j, plane, radius, true, true, pixelTaps);
-                merged = &pixelTaps;
+            addTapsRow(mean.data(), shotSum.data(), tapRows.data(), tapWeights.data(), tapShotWeights.data(),
+                       static_cast<int>(tapRows.size()), exactShot, pw);
+            if (account) {
+                for (const EdgeColumn& e : edgeColumns) {
+                    const std::vector<KernelTap>* merged = &e.taps;
+                    readFactors[static_cast<size_t>(e.j)] = e.readFactor;
+                    if (edgeRow) {
+                        readFactors[static_cast<size_t>(e.j)] =
+                            mergeClampedTaps(taps, i, e.j, plane, radius, true, true, pixelTaps);
+                        merged = &pixelTaps;
+                    }
+                    float shot = 0;
+                    for (const KernelTap& t : *merged)
+                        shot +=
+                            t.shotWeight *
+                            std::max(
+                                siteRing[static_cast<size_t>(i + t.dy - ry) % ringRows * stride + e.j + t.dx],
+                                0.0f);
+                    shotSum[static_cast<size_t>(e.j)] = shot;
+                }
+                if (shotFromMean) // sum w (1 - w) = 1 - sum w^2, the read-noise factor
+                    for (int j = 0; j < pw; ++j)
+                        shotSum[static_cast<size_t>(j)] = readFactors[static_cast<size_t>(j)] *
+                                                          std::max(mean[static_cast<size_t>(j)], 0.0f);
             }
-            float shot = 0;
-            for (const KernelTap& t : *merged)
-                shot +=
-                    t.shotWeight *
-                    std::max(ring[static_cast<size_t>((i + t.dy - ry) % ksize.height) * stride + e.j + t.dx],
-                             0.0f);
-            shotSum[static_cast<size_t>(e.j)] = shot;
+            finishPlaneRow(mean, shotSum.data(), readFactors.data(), z, k, pw, site, i, rowKeep);
+            if (site % 2 == 1)
+                storeMosaicRow(means[0].data(), means[1].data(), dst.ptr<T>(2 * i + site / 2), pw);
         }
-        if (shotFromMean) // sum w (1 - w) = 1 - sum w^2, the read-noise factor
-            for (int j = 0; j < pw; ++j)
-                shotSum[static_cast<size_t>(j)] =
-                    readFactors[static_cast<size_t>(j)] * std::max(mean[static_cast<size_t>(j)], 0.0f);
-        finishPlaneRow<T>(mean, shotSum.data(), readFactors.data(), z, k, dst, site, i, rowKeep);
     }
 }
 
@@ -560,24 +620,31 @@ template <typename T>
 void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const BilinearAxis* rows,
                     const ResampleConstants& k, const Range& range)
 {
-    const int pw = src.cols / 2, ph = src.rows / 2;
+    const int pw = src.cols / 2;
     std::vector<float> row0(static_cast<size_t>(pw)), row1(static_cast<size_t>(pw));
-    std::vector<float> mean(detail::wholeBlocks(pw)), shot(detail::wholeBlocks(pw)),
-        readFactor(detail::wholeBlocks(pw)), z(detail::wholeBlocks(pw));
-    for (int idx = range.start; idx < range.end; ++idx) {
-        const int site = idx / ph, i = idx % ph;
-        const BilinearAxis& ax = cols[site % 2];
-        const BilinearAxis& ay = rows[site / 2];
-        loadPlaneRow<T>(src, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site], row0.data(),
-                        k.inputShading);
-        loadPlaneRow<T>(src, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data(),
-                        k.inputShading);
-        bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
-                    ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
-        const float fy = ay.f[static_cast<size_t>(i)];
-        finishPlaneRow<T>(mean, shot.data(), readFactor.data(), z, k, dst, site, i,
-                          (1 - fy) * (1 - fy) + fy * fy);
-    }
+    std::vector<float> means[2] = {std::vector<float>(detail::wholeBlocks(pw)),
+                                   std::vector<float>(detail::wholeBlocks(pw))};
+    std::vector<float> shot(detail::wholeBlocks(pw)), readFactor(detail::wholeBlocks(pw)),
+        z(detail::wholeBlocks(pw));
+    // Whole plane rows i, the four sites in turn, so that a task writes mosaic rows 2 i and 2 i + 1
+    // whole (storeMosaicRow()).
+    for (int i = range.start; i < range.end; ++i)
+        for (int site = 0; site < 4; ++site) {
+            std::vector<float>& mean = means[site % 2];
+            const BilinearAxis& ax = cols[site % 2];
+            const BilinearAxis& ay = rows[site / 2];
+            loadPlaneRow<T>(src, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site], row0.data(),
+                            k.inputShading);
+            loadPlaneRow<T>(src, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data(),
+                            k.inputShading);
+            bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
+                        ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
+            const float fy = ay.f[static_cast<size_t>(i)];
+            finishPlaneRow(mean, shot.data(), readFactor.data(), z, k, pw, site, i,
+                           (1 - fy) * (1 - fy) + fy * fy);
+            if (site % 2 == 1)
+                storeMosaicRow(means[0].data(), means[1].data(), dst.ptr<T>(2 * i + site / 2), pw);
+        }
 }
 
 } // namespace
@@ -617,7 +684,7 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
                           detail::RandomStream::SCALE_ROW, detail::RandomStream::SCALE_TUKEY);
     }
     Mat dst = detail::stepOutput(src, _dst);
-    parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
+    parallel_for_(Range(0, src.rows / 2), [&](const Range& range) {
         if (src.depth() == CV_16U)
             scalePlaneRows<ushort>(src, dst, cols, rows, k, range);
         else
@@ -673,7 +740,7 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
     }
     const bool shotFromMean = noise.blurNoiseSum == BlurNoiseSum::FROM_BLURRED_MEAN;
     Mat dst = detail::stepOutput(src, _dst);
-    parallel_for_(Range(0, 2 * src.rows), [&](const Range& range) {
+    parallel_for_(Range(0, src.rows / 2), [&](const Range& range) {
         if (src.depth() == CV_16U)
             blurPlaneRows<ushort>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
         else
