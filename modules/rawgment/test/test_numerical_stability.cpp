@@ -158,6 +158,27 @@ TEST(NumericalStability, augmentationHardCasesGiveFiniteCorrectOutput)
                 out, outFmt);
     minMaxLoc(out.row(1), &lo, &hi);
     EXPECT_EQ(lo, 65535);
+    // A white level above what 16 bits hold (a format that claims never to saturate): every 16-bit step
+    // clips at 65535. The jitter once wrapped 1.2 x 60000 round to 4464. 34 columns: whole vectors and
+    // the scalar tail of every store.
+    RawFormat beyond = wide;
+    beyond.whiteLevel = 70000;
+    const Mat high(8, 34, CV_16UC1, Scalar(60000));
+    for (NoiseAlignment mode : kAlignments) {
+        SCOPED_TRACE(static_cast<int>(mode));
+        colorJitter(high, beyond, model, ColorJitter::exposureChange(1.2, 1), mode, 6, out, outFmt);
+        minMaxLoc(out, &lo, &hi);
+        EXPECT_EQ(lo, 65535) << "colorJitter";
+        const Mat higher = Mat(high.size(), CV_16UC1, Scalar(65535));
+        motionBlur(higher, beyond, model, linearMotionKernel(9, 10), mode, 6, out);
+        minMaxLoc(out, &lo, &hi);
+        EXPECT_GT(lo, 65535 - 6 * std::sqrt(model.variance(65535, beyond.gain))) << "motionBlur";
+        EXPECT_EQ(hi, 65535) << "motionBlur";
+        scaleMosaic(higher, beyond, model, 1.1, mode, 6, out);
+        minMaxLoc(out, &lo, &hi);
+        EXPECT_GT(lo, 65535 - 6 * std::sqrt(model.variance(65535, beyond.gain))) << "scaleMosaic";
+        EXPECT_EQ(hi, 65535) << "scaleMosaic";
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------
