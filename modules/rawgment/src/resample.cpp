@@ -106,8 +106,7 @@ void siteColumns(const float* row, int column, int width, float black, float* ou
 // whole-vector stores. One task writes a whole row, so no two threads write into one cache line: when
 // each site was stored on its own, the two threads took every line of the output from each other.
 // 16-bit values are rounded half to even like detail::roundHalfToEven(): _mm_cvtps_epi32 rounds in the
-// default mode, to nearest even. Values lie in [0, white]; above 65535 (a white level no 16-bit
-// file holds) they saturate there.
+// default mode, to nearest even. Values lie in [0, white], white at most 65535 (resampleConstants()).
 void storeMosaicRow(const float* even, const float* odd, ushort* d, int width)
 {
     const __m128i bias = _mm_set1_epi32(32768), flip = _mm_set1_epi16(static_cast<short>(0x8000));
@@ -120,9 +119,8 @@ void storeMosaicRow(const float* even, const float* odd, ushort* d, int width)
         _mm_storeu_si128(reinterpret_cast<__m128i*>(d + 2 * j), _mm_xor_si128(_mm_packs_epi32(lo, hi), flip));
     }
     for (; j < width; ++j) {
-        d[2 * j] = static_cast<ushort>(std::min(static_cast<int>(detail::roundHalfToEven(even[j])), 65535));
-        d[2 * j + 1] =
-            static_cast<ushort>(std::min(static_cast<int>(detail::roundHalfToEven(odd[j])), 65535));
+        d[2 * j] = static_cast<ushort>(static_cast<int>(detail::roundHalfToEven(even[j])));
+        d[2 * j + 1] = static_cast<ushort>(static_cast<int>(detail::roundHalfToEven(odd[j])));
     }
 }
 
@@ -338,7 +336,7 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
     }
 }
 
-ResampleConstants resampleConstants(const RawFormat& format, const NoiseModel& model,
+ResampleConstants resampleConstants(int depth, const RawFormat& format, const NoiseModel& model,
                                     const NoiseOptions& noise, uint64 seed, detail::RandomStream gaussian,
                                     detail::RandomStream poisson)
 {
@@ -346,7 +344,9 @@ ResampleConstants resampleConstants(const RawFormat& format, const NoiseModel& m
     ResampleConstants k;
     for (int s = 0; s < 4; ++s)
         k.black[s] = static_cast<float>(format.blackLevel[s]);
-    k.white = static_cast<float>(format.whiteLevel);
+    // A 16-bit output holds no more than 65535, whatever white level the format claims (storeMosaicRow()
+    // converts through int32, which would not hold a white level of 1e12).
+    k.white = static_cast<float>(depth == CV_16U ? std::min(format.whiteLevel, 65535.0) : format.whiteLevel);
     k.shot = static_cast<float>(terms.shot);
     k.floorVar = static_cast<float>(terms.read());
     k.alignment = noise.alignment;
@@ -663,8 +663,9 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
     const BilinearAxis cols[2] = {bilinearAxis(src.cols / 2, 0, scale), bilinearAxis(src.cols / 2, 1, scale)};
     const BilinearAxis rows[2] = {bilinearAxis(src.rows / 2, 0, scale), bilinearAxis(src.rows / 2, 1, scale)};
     std::atomic<bool> nonFinite{false};
-    ResampleConstants k = resampleConstants(format, model, noise, seed, detail::RandomStream::SCALE_GAUSSIAN,
-                                            detail::RandomStream::SCALE_POISSON);
+    ResampleConstants k =
+        resampleConstants(src.depth(), format, model, noise, seed, detail::RandomStream::SCALE_GAUSSIAN,
+                          detail::RandomStream::SCALE_POISSON);
     k.nonFiniteShading = &nonFinite;
     if (model.hasDarkComponents()) {
         // The typical weights: sum w^2 and sum w^4 of the bilinear taps averaged over the output pixels
@@ -729,8 +730,9 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
                 taps.push_back({y, x, static_cast<float>(wk), static_cast<float>(wk * (1 - wk))});
         }
     std::atomic<bool> nonFinite{false};
-    ResampleConstants k = resampleConstants(format, model, noise, seed, detail::RandomStream::BLUR_GAUSSIAN,
-                                            detail::RandomStream::BLUR_POISSON);
+    ResampleConstants k =
+        resampleConstants(src.depth(), format, model, noise, seed, detail::RandomStream::BLUR_GAUSSIAN,
+                          detail::RandomStream::BLUR_POISSON);
     const float readFactor = static_cast<float>(1 - w.dot(w));
     k.nonFiniteShading = &nonFinite;
     if (model.hasDarkComponents()) {

@@ -158,11 +158,11 @@ TEST(NumericalStability, augmentationHardCasesGiveFiniteCorrectOutput)
                 out, outFmt);
     minMaxLoc(out.row(1), &lo, &hi);
     EXPECT_EQ(lo, 65535);
-    // A white level above what 16 bits hold (a format that claims never to saturate): every 16-bit step
-    // clips at 65535. The jitter once wrapped 1.2 x 60000 round to 4464. 34 columns: whole vectors and
-    // the scalar tail of every store.
+    // A white level far above what 16 bits hold (a format that claims never to saturate): every 16-bit
+    // step clips at 65535. With a white level of 70000 the jitter once wrapped 1.2 x 60000 round to 4464.
+    // 34 columns: whole vectors and the scalar tail of every store.
     RawFormat beyond = wide;
-    beyond.whiteLevel = 70000;
+    beyond.whiteLevel = 1e12;
     const Mat high(8, 34, CV_16UC1, Scalar(60000));
     for (NoiseAlignment mode : kAlignments) {
         SCOPED_TRACE(static_cast<int>(mode));
