@@ -638,31 +638,33 @@ def summarize(results):
 def _plotScript(rows, arms):
     """A gnuplot script (data inline) against the photon ratio, one line per arm: PSNR on top and, below,
     the gain over the noisy input (where the arms' differences of tenths of a dB are visible); one column
-    at the bright gain, one with the gain change, one for the blur condition."""
+    at the bright gain, one with the gain change, one for the blur condition. Without the NOISY arm there is
+    no gain to draw: the PSNR row alone."""
     styles = {"NONE": 1, "IGNORE_PRIOR": 2, "ACCOUNT_PRIOR": 3, "ORACLE": 4, "NOISY": 5}
     panels = [("at the bright gain", lambda r: r["gainRatio"] == 1 and r["blurLength"] == 0),
               ("gain raised by 1/ratio (at most +12 dB)", lambda r: r["gainRatio"] > 1 and r["blurLength"] == 0),
               ("with motion blur", lambda r: r["blurLength"] > 0)]
     panels = [(title, test) for title, test in panels if any(test(r) for r in rows)]
     noisy = {r["condition"]: r["psnr"] for r in rows if r["arm"] == "NOISY"}
-    lines = ["set terminal pngcairo size %d,1000 enhanced font 'DejaVu Sans,11'" % (520 * len(panels)),
-             "set multiplot layout 2,%d title 'Denoiser on captures simulated at the target "
-             "(mean and s.d. over seeds)'" % len(panels),
+    measures = [("PSNR (dB)", lambda r: r["psnr"])]
+    if noisy:
+        measures.append(("PSNR gain over the noisy input (dB)", lambda r: r["psnr"] - noisy.get(r["condition"], math.nan)))
+    lines = ["set terminal pngcairo size %d,%d enhanced font 'DejaVu Sans,11'" % (520 * len(panels), 500 * len(measures)),
+             "set multiplot layout %d,%d title 'Denoiser on captures simulated at the target "
+             "(mean and s.d. over seeds)'" % (len(measures), len(panels)),
              "set grid", "set logscale x", "set xrange [*:*] reverse",
              "set xlabel 'photon ratio of the target (darker to the right)'",
              "set offsets graph 0.08, graph 0.08, graph 0.05, graph 0.05"]
     for arm in arms:
         lines.append("set style line %d lw 2 pt %d ps 1.2" % (styles[arm], styles[arm] + 4))
-    for row, (ylabel, value) in enumerate([("PSNR (dB)", lambda r: r["psnr"]),
-                                           ("PSNR gain over the noisy input (dB)",
-                                            lambda r: r["psnr"] - noisy.get(r["condition"], math.nan))]):
+    for row, (ylabel, value) in enumerate(measures):
         lines.append("set ylabel '%s'" % ylabel)
         lines.append("set key bottom left" if row == 0 else "set key right center")
         for title, test in panels:
             lines.append("set title '%s'" % title)
             plots = []
             for arm in arms:
-                if row == 1 and (arm == "NOISY" or not noisy):
+                if row == 1 and arm == "NOISY":
                     continue
                 data = sorted((r for r in rows if r["arm"] == arm and test(r)), key=lambda r: -r["photonRatio"])
                 if not data:

@@ -57,6 +57,21 @@ def test_quick_run_writes_the_report_and_the_oracle_beats_the_noisy_input(tmp_pa
     assert "![PSNR against darkening, blind](blind/psnr.png)" in both
 
 
+def test_the_plot_is_drawn_for_any_choice_of_arms():
+    # Without the NOISY arm there is no gain over the noisy input to draw: that row of panels once became an
+    # empty "plot" command, and gnuplot failed (a run with --arms IGNORE_PRIOR,ACCOUNT_PRIOR had no plot).
+    # One condition per panel (a single photon ratio each) must draw too.
+    config = tiny_config(conditions=[ab.Condition("x0.2", 0.2), ab.Condition("x0.2 +6dB", 0.2, 2.0),
+                                     ab.Condition("x0.5 blur3", 0.5, 1.0, 3.0, 0.0)])
+    rows = ab.summarize(ab.runAblation(dataclasses.replace(config, arms=("IGNORE_PRIOR", "ACCOUNT_PRIOR"))))
+    for arms in (["IGNORE_PRIOR", "ACCOUNT_PRIOR"], ["ACCOUNT_PRIOR"]):
+        script = ab._plotScript([r for r in rows if r["arm"] in arms], arms)
+        assert all(line.strip() != "plot" for line in script.splitlines()), script
+        assert "layout 1,3" in script
+        png, why = ab._plotPng([r for r in rows if r["arm"] in arms], arms)
+        assert why is None and png.startswith(b"\x89PNG"), why
+
+
 def test_the_networks_report_sets_each_networks_differences_side_by_side(tmp_path):
     # The side-by-side table takes each cell from its own network's summary: a cell is that network's
     # ACCOUNT_PRIOR minus the arm, interval and verdict, as summarize() gives it.
