@@ -249,16 +249,32 @@ RAWGMENT_DISPATCHED_BY_WIDTH(void, finishResampledRow,
                               const float* extra, const ResampleConstants& k, float black, int n),
                              (mean, shotSum, readFactor, z, extra, k, black, n))
 
+// The buffers of a task's rows, sized once per task for plane rows of n pixels (whole blocks where a
+// vector kernel reads them): a row allocates nothing.
+struct RowScratch
+{
+    std::vector<float> z, extra, t;
+    std::vector<detail::NoiseSplit> splits;
+    std::vector<double> means, counts;
+    explicit RowScratch(int n)
+        : z(detail::wholeBlocks(n)), extra(detail::wholeBlocks(n)), t(static_cast<size_t>(n)),
+          splits(static_cast<size_t>(n)), means(static_cast<size_t>(n)), counts(static_cast<size_t>(n))
+    {
+    }
+};
+
 // The scalar rows: ShotNoiseSampling::POISSON for a resampled row (the shot part of Eq. 15, or of the
 // model for IGNORE_PRIOR, as an electron count at the input gain, see detail::splitNoise()) and Tukey-lambda
 // read noise (t: the row's unit-variance draws, the read part's shape), with the dark terms' `extra`.
 void finishResampledRowScalar(float* mean, const float* shotSum, const float* readFactor, const float* z,
                               const float* t, const float* extra, const ResampleConstants& k, float black,
-                              uint64_t stream, int n)
+                              uint64_t stream, int n, RowScratch& scratch)
 {
     const bool poisson = k.sampling == ShotNoiseSampling::POISSON;
-    std::vector<detail::NoiseSplit> splits(static_cast<size_t>(n));
-    std::vector<double> means(poisson ? n : 0), counts(static_cast<size_t>(n), 0.0);
+    std::vector<detail::NoiseSplit>& splits = scratch.splits;
+    std::vector<double>&means = scratch.means, &counts = scratch.counts;
+    if (!poisson)
+        std::fill(counts.begin(), counts.begin() + n, 0.0);
     const detail::PoissonScale scale(k.shot);
     for (int j = 0; j < n; ++j) {
         const AddedVariance v = k.alignment == NoiseAlignment::ACCOUNT_PRIOR
@@ -310,29 +326,25 @@ bool resampledDarkRow(const ResampleConstants& k, int site, int planeRow, float 
 // The end of every resampled row: its noise streams (site, row), the noise, the dark terms, the black
 // level, in `mean`; storeMosaicRow() stores it with the row's other site.
 void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float* readFactor,
-                    std::vector<float>& z, const ResampleConstants& k, int n, int site, int planeRow,
+                    RowScratch& scratch, const ResampleConstants& k, int n, int site, int planeRow,
                     float rowKeep = 1)
 {
     const uint64_t stream = detail::planeRowStream(site, planeRow);
     const bool noise = k.alignment != NoiseAlignment::NONE;
     if (noise)
-        detail::fillGaussian(k.key, stream, z.data(), n);
-    std::vector<float> extra, t;
-    if (noise && k.dark.any()) {
-        extra.resize(detail::wholeBlocks(n));
-        if (!resampledDarkRow(k, site, planeRow, rowKeep, extra.data(), n))
-            *k.nonFiniteShading = true;
-    }
-    if (noise && k.dark.tails) {
-        t.resize(static_cast<size_t>(n));
-        detail::fillTukeyUnit(k.tukeyKey, stream, k.dark.tailTable[0], t.data(), n);
-    }
-    const float* extraRow = extra.empty() ? nullptr : extra.data();
-    if (noise && (k.sampling == ShotNoiseSampling::POISSON || k.dark.tails)) {
-        finishResampledRowScalar(mean.data(), shotSum, readFactor, z.data(), t.empty() ? nullptr : t.data(),
-                                 extraRow, k, k.black[site], stream, n);
+        detail::fillGaussian(k.key, stream, scratch.z.data(), n);
+    const bool dark = noise && k.dark.any(), tails = noise && k.dark.tails;
+    if (dark && !resampledDarkRow(k, site, planeRow, rowKeep, scratch.extra.data(), n))
+        *k.nonFiniteShading = true;
+    if (tails)
+        detail::fillTukeyUnit(k.tukeyKey, stream, k.dark.tailTable[0], scratch.t.data(), n);
+    const float* extraRow = dark ? scratch.extra.data() : nullptr;
+    if (noise && (k.sampling == ShotNoiseSampling::POISSON || tails)) {
+        finishResampledRowScalar(mean.data(), shotSum, readFactor, scratch.z.data(),
+                                 tails ? scratch.t.data() : nullptr, extraRow, k, k.black[site], stream, n,
+                                 scratch);
     } else {
-        finishResampledRow(mean.data(), shotSum, readFactor, z.data(), extraRow, k, k.black[site], n);
+        finishResampledRow(mean.data(), shotSum, readFactor, scratch.z.data(), extraRow, k, k.black[site], n);
     }
 }
 
@@ -457,8 +469,8 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
     std::vector<int> ringRow(4 * ringRows, -1);
     std::vector<float> means[2] = {std::vector<float>(detail::wholeBlocks(pw)),
                                    std::vector<float>(detail::wholeBlocks(pw))};
-    std::vector<float> shotSum(detail::wholeBlocks(pw)), z(detail::wholeBlocks(pw)),
-        readFactors(detail::wholeBlocks(pw));
+    std::vector<float> shotSum(detail::wholeBlocks(pw)), readFactors(detail::wholeBlocks(pw));
+    RowScratch scratch(pw);
     const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
     const bool exactShot = account && !shotFromMean;
     struct EdgeColumn
@@ -537,7 +549,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
                         shotSum[static_cast<size_t>(j)] = readFactors[static_cast<size_t>(j)] *
                                                           std::max(mean[static_cast<size_t>(j)], 0.0f);
             }
-            finishPlaneRow(mean, shotSum.data(), readFactors.data(), z, k, pw, site, i, rowKeep);
+            finishPlaneRow(mean, shotSum.data(), readFactors.data(), scratch, k, pw, site, i, rowKeep);
             if (site % 2 == 1)
                 storeMosaicRow(means[0].data(), means[1].data(), dst.ptr<T>(2 * i + site / 2), pw);
         }
@@ -624,8 +636,8 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
     std::vector<float> row0(static_cast<size_t>(pw)), row1(static_cast<size_t>(pw));
     std::vector<float> means[2] = {std::vector<float>(detail::wholeBlocks(pw)),
                                    std::vector<float>(detail::wholeBlocks(pw))};
-    std::vector<float> shot(detail::wholeBlocks(pw)), readFactor(detail::wholeBlocks(pw)),
-        z(detail::wholeBlocks(pw));
+    std::vector<float> shot(detail::wholeBlocks(pw)), readFactor(detail::wholeBlocks(pw));
+    RowScratch scratch(pw);
     // Whole plane rows i, the four sites in turn, so that a task writes mosaic rows 2 i and 2 i + 1
     // whole (storeMosaicRow()).
     for (int i = range.start; i < range.end; ++i)
@@ -640,7 +652,7 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
             bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
                         ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
             const float fy = ay.f[static_cast<size_t>(i)];
-            finishPlaneRow(mean, shot.data(), readFactor.data(), z, k, pw, site, i,
+            finishPlaneRow(mean, shot.data(), readFactor.data(), scratch, k, pw, site, i,
                            (1 - fy) * (1 - fy) + fy * fy);
             if (site % 2 == 1)
                 storeMosaicRow(means[0].data(), means[1].data(), dst.ptr<T>(2 * i + site / 2), pw);
