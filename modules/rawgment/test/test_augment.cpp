@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <map>
+#include <random>
 
 #include "../src/random.hpp"
 #include <opencv2/core/utility.hpp>
@@ -626,6 +627,53 @@ TEST(Augment, stepsWriteIntoTheCallersBufferButNeverIntoTheirInput)
         Mat wrongType(src.size(), CV_32FC1);
         step.second(src, wrongType);
         EXPECT_EQ(wrongType.type(), CV_16UC1) << step.first;
+    }
+}
+
+TEST(Augment, exposureChangeThirdCumulantIsWhatTheMathematicsDerives)
+{
+    // docs/mathematics.md: with pure shot noise (q = 1 DN per electron) an input of Poisson(lambda / p_u)
+    // electrons darkened by p_u with PIXEL_VALUE has third cumulant (3 p_u - 2 p_u^2) lambda with Gaussian
+    // added noise and (1 + 2 p_u (1 - p_u)) lambda with POISSON counts; the capture has lambda. These pin
+    // the documented departure from the capture (POISSON overshoots a mild darkening's skewness by half),
+    // so that a change of either sampling shows here. 2 M pixels: the standard error of k3 / lambda is
+    // sqrt(6 / (n lambda)) = 0.017 at lambda = 100; the bound is 4 of them, and the two samplings differ
+    // by 0.5 lambda at p_u = 1/2.
+    const double lambda = 100;
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d::all(100);
+    fmt.whiteLevel = 1e6;
+    fmt.gain = 1;
+    const NoiseModel model(1.0, 0.0, 1e-6);
+    std::mt19937_64 engine(7);
+    for (double pu : {0.5, 0.2, 0.05}) {
+        Mat bright(1000, 2000, CV_32FC1);
+        std::poisson_distribution<int> electrons(lambda / pu);
+        for (int r = 0; r < bright.rows; ++r)
+            for (int c = 0; c < bright.cols; ++c)
+                bright.at<float>(r, c) = static_cast<float>(100 + electrons(engine));
+        for (ShotNoiseSampling sampling : {ShotNoiseSampling::GAUSSIAN, ShotNoiseSampling::POISSON}) {
+            NoiseOptions noise;
+            noise.shotSampling = sampling;
+            Mat out;
+            RawFormat outFmt;
+            colorJitter(bright, fmt, model, ColorJitter::exposureChange(pu, 1), noise, 3, out, outFmt);
+            double s1 = 0, s2 = 0, s3 = 0;
+            for (int r = 0; r < out.rows; ++r)
+                for (int c = 0; c < out.cols; ++c) {
+                    const double v = out.at<float>(r, c) - 100 - lambda;
+                    s1 += v;
+                    s2 += v * v;
+                    s3 += v * v * v;
+                }
+            const double n = static_cast<double>(out.total()), m = s1 / n;
+            const double k3 = s3 / n - 3 * m * s2 / n + 2 * m * m * m;
+            const double predicted =
+                sampling == ShotNoiseSampling::GAUSSIAN ? 3 * pu - 2 * pu * pu : 1 + 2 * pu * (1 - pu);
+            EXPECT_NEAR(k3 / lambda, predicted, 4 * 0.017)
+                << "p_u " << pu << (sampling == ShotNoiseSampling::GAUSSIAN ? " GAUSSIAN" : " POISSON");
+            EXPECT_NEAR((s2 / n - m * m) / lambda, 1.0, 4 * std::sqrt(2.0 / n)) << "p_u " << pu;
+        }
     }
 }
 
