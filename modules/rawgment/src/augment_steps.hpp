@@ -154,6 +154,13 @@ template <typename V> inline __attribute__((always_inline)) V roundHalfToEven(V 
     return (v + spacingOne) - spacingOne;
 }
 
+//! The level a step clips its output at: the format's white level, and for 16-bit output no more than
+//! 65535, whatever white level the format claims (clipped there, never wrapped round).
+inline float outputWhite(const RawFormat& format, int depth)
+{
+    return static_cast<float>(depth == CV_16U ? std::min(format.whiteLevel, 65535.0) : format.whiteLevel);
+}
+
 // Clipped to [0, white]; 16-bit output is rounded half to even.
 template <typename T> inline __attribute__((always_inline)) T storeValue(float out, float white)
 {

@@ -690,10 +690,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     }
     k.pb = static_cast<float>(jitter.brightness);
     k.pg = static_cast<float>(jitter.gainRatio);
-    // A 16-bit output holds no more than 65535, whatever white level the format claims: clipped there,
-    // not wrapped.
-    k.white =
-        static_cast<float>(src.depth() == CV_16U ? std::min(format.whiteLevel, 65535.0) : format.whiteLevel);
+    k.white = detail::outputWhite(format, src.depth());
     k.in = {static_cast<float>(terms.shot), static_cast<float>(terms.readBeforeGain),
             static_cast<float>(terms.readAfterGain)};
     k.alignment = noise.alignment;

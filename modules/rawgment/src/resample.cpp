@@ -106,7 +106,7 @@ void siteColumns(const float* row, int column, int width, float black, float* ou
 // whole-vector stores. One task writes a whole row, so no two threads write into one cache line: when
 // each site was stored on its own, the two threads took every line of the output from each other.
 // 16-bit values are rounded half to even like detail::roundHalfToEven(): _mm_cvtps_epi32 rounds in the
-// default mode, to nearest even. Values lie in [0, white], white at most 65535 (resampleConstants()).
+// default mode, to nearest even. Values lie in [0, white], white at most 65535 (detail::outputWhite()).
 void storeMosaicRow(const float* even, const float* odd, ushort* d, int width)
 {
     const __m128i bias = _mm_set1_epi32(32768), flip = _mm_set1_epi16(static_cast<short>(0x8000));
@@ -356,9 +356,7 @@ ResampleConstants resampleConstants(int depth, const RawFormat& format, const No
     ResampleConstants k;
     for (int s = 0; s < 4; ++s)
         k.black[s] = static_cast<float>(format.blackLevel[s]);
-    // A 16-bit output holds no more than 65535, whatever white level the format claims (storeMosaicRow()
-    // converts through int32, which would not hold a white level of 1e12).
-    k.white = static_cast<float>(depth == CV_16U ? std::min(format.whiteLevel, 65535.0) : format.whiteLevel);
+    k.white = detail::outputWhite(format, depth); // storeMosaicRow() converts through int32
     k.shot = static_cast<float>(terms.shot);
     k.floorVar = static_cast<float>(terms.read());
     k.alignment = noise.alignment;
