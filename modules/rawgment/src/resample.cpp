@@ -265,11 +265,13 @@ struct RowScratch
 
 // The scalar rows: ShotNoiseSampling::POISSON for a resampled row (the shot part of Eq. 15, or of the
 // model for IGNORE_PRIOR, as an electron count at the input gain, see detail::splitNoise()) and Tukey-lambda
-// read noise (t: the row's unit-variance draws, the read part's shape), with the dark terms' `extra`.
-void finishResampledRowScalar(float* mean, const float* shotSum, const float* readFactor, const float* z,
-                              const float* t, const float* extra, const ResampleConstants& k, float black,
-                              uint64_t stream, int n, RowScratch& scratch)
+// read noise (`tails`: scratch.t holds the row's unit-variance draws, the read part's shape), with the dark
+// terms' `extra`.
+void finishResampledRowScalar(float* mean, const float* shotSum, const float* readFactor, const float* extra,
+                              bool tails, const ResampleConstants& k, float black, uint64_t stream, int n,
+                              RowScratch& scratch)
 {
+    const float *z = scratch.z.data(), *t = tails ? scratch.t.data() : nullptr;
     const bool poisson = k.sampling == ShotNoiseSampling::POISSON;
     std::vector<detail::NoiseSplit>& splits = scratch.splits;
     std::vector<double>&means = scratch.means, &counts = scratch.counts;
@@ -340,9 +342,8 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
         detail::fillTukeyUnit(k.tukeyKey, stream, k.dark.tailTable[0], scratch.t.data(), n);
     const float* extraRow = dark ? scratch.extra.data() : nullptr;
     if (noise && (k.sampling == ShotNoiseSampling::POISSON || tails)) {
-        finishResampledRowScalar(mean.data(), shotSum, readFactor, scratch.z.data(),
-                                 tails ? scratch.t.data() : nullptr, extraRow, k, k.black[site], stream, n,
-                                 scratch);
+        finishResampledRowScalar(mean.data(), shotSum, readFactor, extraRow, tails, k, k.black[site], stream,
+                                 n, scratch);
     } else {
         finishResampledRow(mean.data(), shotSum, readFactor, scratch.z.data(), extraRow, k, k.black[site], n);
     }
