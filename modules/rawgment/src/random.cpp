@@ -752,6 +752,53 @@ template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D expClampedLanesD(typ
     return expLanesD<W>(x < -700.0 ? typename DoubleLanes<W>::D{} - 700.0 : x);
 }
 
+//! CounterRng::uniform() from its two words in lanes: (first << 21) ^ (second >> 11), 53 bits, plus 1/2,
+//! times 2^-53, exact as a double sum.
+template <int W>
+RAWGMENT_KERNEL typename DoubleLanes<W>::D uniform53LanesD(typename DoubleLanes<W>::UL first,
+                                                           typename DoubleLanes<W>::UL second)
+{
+    typedef typename DoubleLanes<W>::D D;
+    return ((((D)(first | 0x4330000000000000ull) - kTwo52) * 2097152.0 +
+             ((D)((second >> 11) | 0x4330000000000000ull) - kTwo52)) +
+            0.5) *
+           (1.0 / 9007199254740992.0);
+}
+
+//! The constants of PD's hat and of its discrete normal for means mu, in lanes: sqrt(mu), 1 / sqrt(mu),
+//! omega = 1 / sqrt(2 pi mu), the Hermite corrections c0..c3 and the hat's constant c (A & D's names).
+template <int W> struct PdHatLanes
+{
+    typename DoubleLanes<W>::D mu, s, invS, omega, c0, c1, c2, c3, c;
+};
+
+template <int W> RAWGMENT_KERNEL PdHatLanes<W> pdHatLanes(typename DoubleLanes<W>::D mu)
+{
+    PdHatLanes<W> h;
+    h.mu = mu;
+    h.s = sqrtLanes(mu);
+    h.invS = 1.0 / h.s;
+    h.omega = 0.3989422804014327 * h.invS;
+    const typename DoubleLanes<W>::D b1 = 1.0 / (24.0 * mu), b2 = 0.3 * b1 * b1;
+    h.c3 = b1 * b2 * (1.0 / 7);
+    h.c2 = b2 - 15.0 * h.c3;
+    h.c1 = b1 - 6.0 * b2 + 45.0 * h.c3;
+    h.c0 = 1.0 - b1 + 3.0 * b2 - 15.0 * h.c3;
+    h.c = 0.1069 / mu;
+    return h;
+}
+
+//! A & D's procedure F less its Poisson part, at counts k: fx = -x^2 / 2 and fy = omega (c3 x^6 + c2 x^4 + c1
+//! x^2 + c0) with x = (k + 1/2 - mu) / sqrt(mu).
+template <int W>
+RAWGMENT_KERNEL void pdModifiedNormalLanes(const PdHatLanes<W>& h, typename DoubleLanes<W>::D k,
+                                           typename DoubleLanes<W>::D& fx, typename DoubleLanes<W>::D& fy)
+{
+    const typename DoubleLanes<W>::D x = (0.5 - (h.mu - k)) * h.invS, xx = x * x;
+    fx = -0.5 * xx;
+    fy = h.omega * (((h.c3 * xx + h.c2) * xx + h.c1) * xx + h.c0);
+}
+
 /* Steps P, Q and E of Ahrens and Dieter's PD ("Computer generation of Poisson deviates from modified normal
  * distributions", ACM TOMS 8, 1982) in lanes, for the `count` values that fillPoissonKernel()'s steps N, I
  * and S left, eight at a time: step Q on their g = mu + sqrt(mu) T and u, then step E's tries until each is
@@ -783,29 +830,19 @@ RAWGMENT_KERNEL void poissonPdRestLanes(uint64_t key, const double* means, const
             u8[i] = i < live ? us[start + i] : 0.5;
         }
         int pending = (1 << live) - 1;
-        // The constants of each value's hat and its step Q.
-        D mu[kGroups], s[kGroups], invS[kGroups], omega[kGroups], c0[kGroups], c1[kGroups], c2[kGroups],
-            c3[kGroups], c[kGroups];
+        // Each value's hat, and its step Q.
+        PdHatLanes<W> hat[kGroups];
         for (int gr = 0; gr < kGroups; ++gr) {
-            std::memcpy(&mu[gr], mus + gr * kLanes, sizeof(D));
-            s[gr] = sqrtLanes(mu[gr]);
-            invS[gr] = 1.0 / s[gr];
-            omega[gr] = 0.3989422804014327 * invS[gr];
-            const D b1 = 1.0 / (24.0 * mu[gr]), b2 = 0.3 * b1 * b1;
-            c3[gr] = b1 * b2 * (1.0 / 7);
-            c2[gr] = b2 - 15.0 * c3[gr];
-            c1[gr] = b1 - 6.0 * b2 + 45.0 * c3[gr];
-            c0[gr] = 1.0 - b1 + 3.0 * b2 - 15.0 * c3[gr];
-            c[gr] = 0.1069 / mu[gr];
-            D g, u;
+            D mu, g, u, fx, fy;
+            std::memcpy(&mu, mus + gr * kLanes, sizeof(D));
+            hat[gr] = pdHatLanes<W>(mu);
             std::memcpy(&g, g8 + gr * kLanes, sizeof(D));
             std::memcpy(&u, u8 + gr * kLanes, sizeof(D));
             const L quotient = g >= 0.0;
             const D k = floorNonNegativeLanesD<W>(quotient ? g : D{});
-            const D x = (0.5 - (mu[gr] - k)) * invS[gr], xx = x * x;
-            const D fx = -0.5 * xx, fy = omega[gr] * (((c3[gr] * xx + c2[gr]) * xx + c1[gr]) * xx + c0[gr]);
-            const L accept = quotient & (fy - u * fy <=
-                                         expClampedLanesD<W>(logPoissonProbabilityLanesD<W>(k, mu[gr]) - fx));
+            pdModifiedNormalLanes<W>(hat[gr], k, fx, fy);
+            const L accept =
+                quotient & (fy - u * fy <= expClampedLanesD<W>(logPoissonProbabilityLanesD<W>(k, mu) - fx));
             std::memcpy(k8 + gr * kLanes, &k, sizeof(D));
             pending &= ~(maskBits(accept) << (gr * kLanes));
         }
@@ -821,29 +858,21 @@ RAWGMENT_KERNEL void poissonPdRestLanes(uint64_t key, const double* means, const
                 std::memcpy(&a1, words + 8 + gr * kLanes, sizeof(U32));
                 std::memcpy(&a2, words + 16 + gr * kLanes, sizeof(U32));
                 std::memcpy(&a3, words + 24 + gr * kLanes, sizeof(U32));
-                // CounterRng::uniform(): (first << 21) ^ (second >> 11), 53 bits, exact as a double sum.
-                const UL w0 = __builtin_convertvector(a0, UL), w1 = __builtin_convertvector(a1, UL),
-                         w2 = __builtin_convertvector(a2, UL), w3 = __builtin_convertvector(a3, UL);
-                const D ue = ((((D)(w0 | 0x4330000000000000ull) - kTwo52) * 2097152.0 +
-                               ((D)((w1 >> 11) | 0x4330000000000000ull) - kTwo52)) +
-                              0.5) *
-                             (1.0 / 9007199254740992.0);
-                const D us2 = ((((D)(w2 | 0x4330000000000000ull) - kTwo52) * 2097152.0 +
-                                ((D)((w3 >> 11) | 0x4330000000000000ull) - kTwo52)) +
-                               0.5) *
-                              (1.0 / 9007199254740992.0);
-                const D e = -logLanesD<W>(ue);
-                const D signedUniform = 2.0 * us2 - 1.0;
+                const PdHatLanes<W>& h = hat[gr];
+                const D e = -logLanesD<W>(
+                    uniform53LanesD<W>(__builtin_convertvector(a0, UL), __builtin_convertvector(a1, UL)));
+                const D signedUniform = 2.0 * uniform53LanesD<W>(__builtin_convertvector(a2, UL),
+                                                                 __builtin_convertvector(a3, UL)) -
+                                        1.0;
                 const D t = 1.8 + (signedUniform < 0.0 ? -e : e);
                 const L valid = t > -0.6744;
-                const D k = floorNonNegativeLanesD<W>(valid ? mu[gr] + s[gr] * t : D{});
-                const D x = (0.5 - (mu[gr] - k)) * invS[gr], xx = x * x;
-                const D fx = -0.5 * xx,
-                        fy = omega[gr] * (((c3[gr] * xx + c2[gr]) * xx + c1[gr]) * xx + c0[gr]);
-                const D lp = logPoissonProbabilityLanesD<W>(k, mu[gr]);
+                const D k = floorNonNegativeLanesD<W>(valid ? h.mu + h.s * t : D{});
+                D fx, fy;
+                pdModifiedNormalLanes<W>(h, k, fx, fy);
+                const D lp = logPoissonProbabilityLanesD<W>(k, h.mu);
                 const D absU = signedUniform < 0.0 ? -signedUniform : signedUniform;
                 const L accept =
-                    valid & (c[gr] * absU <= expClampedLanesD<W>(lp + e) - fy * expClampedLanesD<W>(fx + e));
+                    valid & (h.c * absU <= expClampedLanesD<W>(lp + e) - fy * expClampedLanesD<W>(fx + e));
                 const int taken = maskBits(accept) & groupBits;
                 for (int bits = taken; bits; bits &= bits - 1) {
                     const int i = __builtin_ctz(static_cast<unsigned>(bits));
