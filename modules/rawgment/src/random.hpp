@@ -572,12 +572,11 @@ CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, const Tuk
  * exact Poisson probabilities (Stirling's formula with its remainder, not PD's own 7-digit approximations;
  * logPoissonProbabilities()), step E's try j drawing from block j of the value's stream
  * (poissonRetryKey(seed, stream), i) as CounterRng::uniform() would, until the hat accepts. A mean beyond
- * 2^40 calls
- * CounterRng::poisson() on that stream. CounterRng::poisson(), the simulator's sampler, is inversion below
- * 10 and PTRS above. Exactness: up to double rounding and the 32-bit words: the uniforms and the normal's
- * radius and angle are on grids of 2^-32 (|T| <= 6.7), so each count's probability is exact to about 2^-31
- * absolute. Same bits on every path (Simulate.fillPoissonIsExactAndTheSameOnEveryPath, which also checks
- * each value against a reference written with the C library). counts must not overlap means. */
+ * 2^40 calls CounterRng::poisson() on that stream. CounterRng::poisson(), the simulator's sampler, is
+ * inversion below 10 and PTRS above. Exactness: up to double rounding and the 32-bit words: the uniforms and
+ * the normal's radius and angle are on grids of 2^-32 (|T| <= 6.7), so each count's probability is exact to
+ * about 2^-31 absolute. Same bits on every path (Simulate.fillPoissonIsExactAndTheSameOnEveryPath, which also
+ * checks each value against a reference written with the C library). counts must not overlap means. */
 CV_RAWGMENT_EXPORTS void fillPoisson(uint64_t seed, uint64_t stream, const double* means, double* counts,
                                      int n);
 

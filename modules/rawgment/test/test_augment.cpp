@@ -637,8 +637,8 @@ TEST(Augment, exposureChangeThirdCumulantIsWhatTheMathematicsDerives)
     // added noise and (1 + 2 p_u (1 - p_u)) lambda with POISSON counts; the capture has lambda. These pin
     // the documented departure from the capture (POISSON overshoots a mild darkening's skewness by half),
     // so that a change of either sampling shows here. 2 M pixels: the standard error of k3 / lambda is
-    // sqrt(6 / (n lambda)) = 0.017 at lambda = 100; the bound is 4 of them, and the two samplings differ
-    // by 0.5 lambda at p_u = 1/2.
+    // sqrt(6 lambda / n) (a near-normal sample of variance lambda), 0.017 at lambda = 100; the bound is 4
+    // of them, and the two samplings differ by 0.5 lambda at p_u = 1/2.
     const double lambda = 100;
     RawFormat fmt;
     fmt.blackLevel = Vec4d::all(100);
@@ -670,7 +670,7 @@ TEST(Augment, exposureChangeThirdCumulantIsWhatTheMathematicsDerives)
             const double k3 = s3 / n - 3 * m * s2 / n + 2 * m * m * m;
             const double predicted =
                 sampling == ShotNoiseSampling::GAUSSIAN ? 3 * pu - 2 * pu * pu : 1 + 2 * pu * (1 - pu);
-            EXPECT_NEAR(k3 / lambda, predicted, 4 * 0.017)
+            EXPECT_NEAR(k3 / lambda, predicted, 4 * std::sqrt(6 * lambda / n))
                 << "p_u " << pu << (sampling == ShotNoiseSampling::GAUSSIAN ? " GAUSSIAN" : " POISSON");
             EXPECT_NEAR((s2 / n - m * m) / lambda, 1.0, 4 * std::sqrt(2.0 / n)) << "p_u " << pu;
         }
