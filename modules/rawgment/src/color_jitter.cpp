@@ -269,11 +269,6 @@ RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
  * three passes: every pixel's split (detail::splitNoise(), here in vector lanes: the same operations),
  * the row's counts (detail::fillPoisson()), every pixel's noise and output. Like jitterRowBody(), the
  * last partial block runs through the vector code on padded copies. */
-template <int W> struct PoissonLanes
-{
-    typedef double D __attribute__((vector_size(8 * W))); // one double per float lane (arithmetic only)
-};
-
 template <int W, typename T, NoiseAlignment A, bool kLocalMean>
 RAWGMENT_KERNEL void poissonSplitBlock(const T* s, const float* prior, const JitterColumns& col, int c,
                                        const JitterConstants& k, const detail::PoissonScale& scale,
@@ -282,7 +277,6 @@ RAWGMENT_KERNEL void poissonSplitBlock(const T* s, const float* prior, const Jit
 {
     typedef typename detail::Lanes<W>::F F;
     typedef typename detail::Lanes<W>::I I;
-    typedef typename PoissonLanes<W>::D D;
     typedef PixelLanes<W, T> P;
     F pcv, blackv;
     std::memcpy(&pcv, col.pc + c, sizeof(pcv));
@@ -301,8 +295,7 @@ RAWGMENT_KERNEL void poissonSplitBlock(const T* s, const float* prior, const Jit
     const I drawn = (shot > 0.0f) & (shot <= scale.maxShot);
     const F shotDrawn = drawn ? shot : zero;
     const F z = (total - read) - shotDrawn;
-    const D mean = __builtin_convertvector(shotDrawn, D) * scale.invQ2;
-    std::memcpy(means + c, &mean, sizeof(mean));
+    detail::storeScaledAsDoubles(shotDrawn, scale.invQ2, means + c);
     std::memcpy(zVar + c, &z, sizeof(z));
     std::memcpy(tVar + c, &read, sizeof(read));
 }
@@ -314,10 +307,8 @@ RAWGMENT_KERNEL void poissonNoiseBlock(const T* s, T* d, const float* z, const f
                                        const float* tVar)
 {
     typedef typename detail::Lanes<W>::F F;
-    typedef typename PoissonLanes<W>::D D;
     typedef PixelLanes<W, T> P;
     F pcv, blackv, zv, tv = {}, zVarv, tVarv;
-    D mean, count;
     std::memcpy(&pcv, col.pc + c, sizeof(pcv));
     std::memcpy(&blackv, col.black + c, sizeof(blackv));
     std::memcpy(&zv, z + c, sizeof(zv));
@@ -325,9 +316,7 @@ RAWGMENT_KERNEL void poissonNoiseBlock(const T* s, T* d, const float* z, const f
         std::memcpy(&tv, t + c, sizeof(tv));
     std::memcpy(&zVarv, zVar + c, sizeof(zVarv));
     std::memcpy(&tVarv, tVar + c, sizeof(tVarv));
-    std::memcpy(&mean, means + c, sizeof(mean));
-    std::memcpy(&count, counts + c, sizeof(count));
-    const F noise = q * __builtin_convertvector(count - mean, F) + detail::sqrtLanes(zVarv) * zv +
+    const F noise = q * detail::differenceAsFloats<F>(counts + c, means + c) + detail::sqrtLanes(zVarv) * zv +
                     detail::sqrtLanes(tVarv) * tv;
     const F x = P::load(s + c) - blackv;
     F out = pcv * x + k.pb + noise;

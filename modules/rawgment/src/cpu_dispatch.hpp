@@ -157,7 +157,68 @@ __attribute__((target("arch=x86-64-v3"))) inline int signBits4x64(__m256d m)
 {
     return _mm256_movemask_pd(m);
 }
+// The 8-lane bodies of storeScaledAsDoubles() and differenceAsFloats() below, target v3 for the same reason.
+__attribute__((target("arch=x86-64-v3"))) inline void storeScaledAsDoubles8(__m256 v, double scale,
+                                                                            double* out)
+{
+    const __m256d s = _mm256_set1_pd(scale);
+    _mm256_storeu_pd(out, _mm256_mul_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(v)), s));
+    _mm256_storeu_pd(out + 4, _mm256_mul_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(v, 1)), s));
+}
+__attribute__((target("arch=x86-64-v3"))) inline __m256 differenceAsFloats8(const double* a, const double* b)
+{
+    const __m128 lo = _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd(a), _mm256_loadu_pd(b)));
+    const __m128 hi = _mm256_cvtpd_ps(_mm256_sub_pd(_mm256_loadu_pd(a + 4), _mm256_loadu_pd(b + 4)));
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(lo), hi, 1);
+}
 #endif
+
+/** out[i] = double(v[i]) * scale for the W float lanes of v: the exact conversion, then the product rounded
+ * to double, as __builtin_convertvector and a multiply give. GCC 12 lowers that conversion of a whole
+ * kernel vector (8 doubles, two AVX registers) through the stack and general registers: the POISSON
+ * jitter's split and noise passes took 3.5 ms more of its 77 on host H2's AVX2 path. So the x86 paths
+ * convert half registers with cvtps2pd. */
+template <typename F>
+inline __attribute__((always_inline)) void storeScaledAsDoubles(F v, double scale, double* out)
+{
+    constexpr int lanes = static_cast<int>(sizeof(F) / sizeof(v[0]));
+#if RAWGMENT_HAVE_CPU_PATHS
+    if constexpr (lanes == 8) {
+        storeScaledAsDoubles8((__m256)v, scale, out);
+        return;
+    }
+    if constexpr (lanes == 4) {
+        const __m128d s = _mm_set1_pd(scale);
+        _mm_storeu_pd(out, _mm_mul_pd(_mm_cvtps_pd((__m128)v), s));
+        _mm_storeu_pd(out + 2, _mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps((__m128)v, (__m128)v)), s));
+        return;
+    }
+#endif
+    for (int i = 0; i < lanes; ++i)
+        out[i] = static_cast<double>(v[i]) * scale;
+}
+
+/** The W floats float(a[i] - b[i]): the difference rounded to double, then to float (to nearest), as
+ * __builtin_convertvector of a double vector gives; with cvtpd2ps on half registers on x86, for the reason
+ * storeScaledAsDoubles() gives. */
+template <typename F>
+inline __attribute__((always_inline)) F differenceAsFloats(const double* a, const double* b)
+{
+    constexpr int lanes = static_cast<int>(sizeof(F) / sizeof(float));
+#if RAWGMENT_HAVE_CPU_PATHS
+    if constexpr (lanes == 8)
+        return (F)differenceAsFloats8(a, b);
+    if constexpr (lanes == 4) {
+        const __m128 lo = _mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(a), _mm_loadu_pd(b)));
+        const __m128 hi = _mm_cvtpd_ps(_mm_sub_pd(_mm_loadu_pd(a + 2), _mm_loadu_pd(b + 2)));
+        return (F)_mm_movelh_ps(lo, hi);
+    }
+#endif
+    F r;
+    for (int i = 0; i < lanes; ++i)
+        r[i] = static_cast<float>(a[i] - b[i]);
+    return r;
+}
 
 /** Bit i set where lane i of a comparison mask (lanes of 0 or -1, 4 or 8 bytes each) is set: a kernel
  * tests "any lane" or walks the set lanes with this. One movemask on x86 (reading a mask lane by lane
