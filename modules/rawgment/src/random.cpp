@@ -669,9 +669,10 @@ RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint3
         cdf[g] = p[g];
         k[g] = D{};
     }
-    // An active lane has taken every step so far (its cdf grew each time; an inactive one never changes
-    // again), so its count is the step number. lambda / k as lambda (1 / k), 1 / k from a table: a division
-    // per group and step cost more than the rest of the search.
+    // An active lane has taken every step so far, so its count is the step number. An inactive one stays
+    // so: its cdf, which already reached u, only grows (it adds p >= 0), so its p and cdf need no select.
+    // lambda / k as lambda (1 / k), 1 / k from a table: a division per group and step cost more than the
+    // rest of the search.
     const std::array<double, 201>& inverse = inverseIntegers();
     for (int step = 1; step <= 200; ++step) {
         L any = {};
@@ -679,18 +680,19 @@ RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint3
         for (int g = 0; g < G; ++g) {
             const L active = u[g] > cdf[g];
             any |= active;
-            const D pNext = p[g] * (lambda[g] * invNext);
-            p[g] = active ? pNext : p[g];
-            cdf[g] = active ? cdf[g] + pNext : cdf[g];
+            p[g] = p[g] * (lambda[g] * invNext);
+            cdf[g] = cdf[g] + p[g];
             k[g] = active ? D{} + next : k[g];
         }
         if (!maskBits(any))
             break;
     }
-    for (int g = 0; g < G; ++g)
-        for (int i = 0; i < kLanes; ++i)
-            if (small[g][i])
-                chunkCounts[g * kLanes + i] = k[g][i];
+    for (int g = 0; g < G; ++g) {
+        D counts;
+        std::memcpy(&counts, chunkCounts + g * kLanes, sizeof(counts));
+        counts = small[g] ? k[g] : counts;
+        std::memcpy(chunkCounts + g * kLanes, &counts, sizeof(counts));
+    }
 }
 
 //! Appends base + i to list[size..] for every bit i of `bits` (of `lanes`), without branches: each lane is
