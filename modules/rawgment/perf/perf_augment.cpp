@@ -5,9 +5,10 @@
 //   the same colour jitter composed naively with OpenCV calls (convertTo, RNG::fill NORMAL, Mat
 //   arithmetic, sqrt), and a memcpy of the frame (the floor); and standard normals alone
 //   (fillStandardNormal); and exact Poisson draws alone, in vector lanes (detail::fillPoisson) against the
-//   scalar sampler they replaced (CounterRng::poisson, a loop per value). Every benchmark of the library runs
-//   once per CpuPath this CPU has (name suffix /baseline, /sse4.2, /avx2, /avx512), so the paths are compared
-//   in one run.
+//   scalar sampler they replaced (CounterRng::poisson, a loop per value); and the Philox words alone, the
+//   generator's ceiling for the normals, by each version of the generator this CPU runs (/sse2, /avx2,
+//   /avx512_at_512_bits). Every benchmark of the library runs once per CpuPath this CPU has (name suffix
+//   /baseline, /sse4.2, /avx2, /avx512), so the paths are compared in one run.
 #include "../src/random.hpp"
 #include "perf_common.hpp"
 
@@ -196,6 +197,66 @@ void BM_Augment_poissonDrawsScalar(benchmark::State& state)
     });
 }
 
+#if RAWGMENT_HAVE_CPU_PATHS
+/* A row of Philox4x32-10 words, eight blocks at a time, by each version of the eight-block generator, in a
+ * function of its target, so that the generator is inlined into the row's loop as into the noise kernels
+ * (called once per eight blocks instead, the AVX2 version took 0.91 ns per word against 0.56 inlined). */
+void philoxRowSse2(const std::array<uint32_t, 2>& key, uint64_t stream, uint32_t* words, int n)
+{
+    for (int base = 0; base < n; base += 32)
+        rawgment::detail::philox8BlocksSse2(static_cast<uint32_t>(base / 4), stream, key, words + base);
+}
+__attribute__((target("arch=x86-64-v3"))) void philoxRowAvx2(const std::array<uint32_t, 2>& key,
+                                                             uint64_t stream, uint32_t* words, int n)
+{
+    for (int base = 0; base < n; base += 32)
+        rawgment::detail::philox8BlocksAvx2(static_cast<uint32_t>(base / 4), stream, key, words + base);
+}
+__attribute__((target("arch=x86-64-v4"))) void philoxRowAvx512(const std::array<uint32_t, 2>& key,
+                                                               uint64_t stream, uint32_t* words, int n)
+{
+    for (int base = 0; base < n; base += 32)
+        rawgment::detail::philox8BlocksAvx512(static_cast<uint32_t>(base / 4), stream, key, words + base);
+}
+
+/** Philox4x32-10 words alone, 12 M as 3000 rows of 4000 (each row its own stream, rows split among threads
+ * as the noise steps split them) into a row buffer per task that stays in cache, as the normals' kernel
+ * takes them: the generator's ceiling for every transform on its words. One benchmark per version of the
+ * eight-block generator this CPU runs (SSE2, AVX2, and AVX-512 at 512 bits, which no path's kernels call:
+ * cpu_dispatch.hpp), so that the share of a path's normals that is the generator's shows in the same run. */
+void timePhiloxWords(benchmark::State& state,
+                     void (*philoxRow)(const std::array<uint32_t, 2>&, uint64_t, uint32_t*, int))
+{
+    const int rows = frame().rows, cols = frame().cols; // a multiple of 32 words
+    uint64 seed = 0;
+    for (auto _ : state) {
+        const std::array<uint32_t, 2> key = {static_cast<uint32_t>(++seed), 0u};
+        parallel_for_(Range(0, rows), [&](const Range& range) {
+            std::vector<uint32_t> words(static_cast<size_t>(cols));
+            for (int r = range.start; r < range.end; ++r) {
+                philoxRow(key, static_cast<uint64_t>(r), words.data(), cols);
+                benchmark::DoNotOptimize(words.data());
+                benchmark::ClobberMemory();
+            }
+        });
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+}
+
+void BM_Augment_philoxWordsSse2(benchmark::State& state)
+{
+    timePhiloxWords(state, philoxRowSse2);
+}
+void BM_Augment_philoxWordsAvx2(benchmark::State& state)
+{
+    timePhiloxWords(state, philoxRowAvx2);
+}
+void BM_Augment_philoxWordsAvx512(benchmark::State& state)
+{
+    timePhiloxWords(state, philoxRowAvx512);
+}
+#endif
+
 void BM_Augment_memcpy(benchmark::State& state)
 {
     Mat out(frame().size(), frame().type());
@@ -215,6 +276,13 @@ int main(int argc, char** argv)
     perf::registerTimed("BM_Augment_memcpy", BM_Augment_memcpy);
     perf::registerTimed("BM_Augment_colorJitterNaiveOpenCV", BM_Augment_colorJitterNaiveOpenCV);
     perf::registerTimed("BM_Augment_poissonDrawsScalar", BM_Augment_poissonDrawsScalar);
+#if RAWGMENT_HAVE_CPU_PATHS
+    perf::registerTimed("BM_Augment_philoxWords/sse2", BM_Augment_philoxWordsSse2);
+    if (isCpuPathAvailable(CpuPath::AVX2))
+        perf::registerTimed("BM_Augment_philoxWords/avx2", BM_Augment_philoxWordsAvx2);
+    if (isCpuPathAvailable(CpuPath::AVX512))
+        perf::registerTimed("BM_Augment_philoxWords/avx512_at_512_bits", BM_Augment_philoxWordsAvx512);
+#endif
     const std::pair<const char*, void (*)(benchmark::State&)> library[] = {
         {"BM_Augment_standardNormals", BM_Augment_standardNormals},
         {"BM_Augment_colorJitter", BM_Augment_colorJitter},
