@@ -132,7 +132,7 @@ def study(campaigns):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0], allow_abbrev=False)
     parser.add_argument("--study", type=int, default=0, help="campaigns of the import check (0: none)")
     args = parser.parse_args()
     rng = np.random.default_rng(1)
