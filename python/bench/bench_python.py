@@ -180,18 +180,39 @@ def cpu_name():
     return platform.processor()
 
 
+def jitter_frame():
+    """The benchmark's 12 MP mosaic of a simulated sensor, its format and model, and the jitter timed on it."""
+    sensor = rg.SensorSimulator(rg.SensorParams(), SIZE)
+    y, x = np.mgrid[0:SIZE[1], 0:SIZE[0]].astype(np.float32)
+    scene = (200 + 2000 * (x / SIZE[0]) * (y / SIZE[1])).astype(np.float32)
+    raw = sensor.capture(scene, 1.0, 1.0, seed=1)
+    return raw, sensor.rawFormat(1.0), sensor.effectiveModel(), rg.ColorJitter.exposureChange(0.1, 2.0)
+
+
+def efficient_minima(raw, fmt, model, jitter, rounds):
+    """Minima in seconds over `rounds` interleaved rounds of rawgment's colorJitter into a reused dst and of
+    the efficient numpy and torch jitters, each on as many threads as rawgment uses: (rawgment, numpy,
+    torch, threads)."""
+    threads = rg.getNumThreads()
+    torch.set_num_threads(threads)
+    efficient_np = EfficientNumpyJitter(raw, fmt, model, 0.1, 2.0, threads)
+    efficient_torch = EfficientTorchJitter(raw, fmt, model, 0.1, 2.0)
+    noise = rg.NoiseOptions()
+    # The baselines reuse their buffers; so does rawgment here, through dst.
+    reused = np.empty_like(raw)
+    ours, best_np, best_torch = interleaved_minima(
+        [lambda: rg.colorJitter(raw, fmt, model, jitter, noise, seed=1, dst=reused), efficient_np, efficient_torch],
+        rounds)
+    return ours, best_np, best_torch, threads
+
+
 def main():
     parser = argparse.ArgumentParser(description="Benchmark of the Python module", allow_abbrev=False)
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
     torch.set_num_threads(os.cpu_count())
 
-    sensor = rg.SensorSimulator(rg.SensorParams(), SIZE)
-    y, x = np.mgrid[0:SIZE[1], 0:SIZE[0]].astype(np.float32)
-    scene = (200 + 2000 * (x / SIZE[0]) * (y / SIZE[1])).astype(np.float32)
-    raw = sensor.capture(scene, 1.0, 1.0, seed=1)
-    fmt, model = sensor.rawFormat(1.0), sensor.effectiveModel()
-    jitter = rg.ColorJitter.exposureChange(0.1, 2.0)
+    raw, fmt, model, jitter = jitter_frame()
     noise = rg.NoiseOptions()
 
     cxx = statistics.median(rg._benchmark.colorJitterSeconds(raw, fmt, model, jitter, noise, 1, args.repeats))
@@ -201,15 +222,7 @@ def main():
     generator = torch.Generator().manual_seed(1)
     naive_torch = median_seconds(lambda: torch_jitter(raw, fmt, model, 0.1, 2.0, generator), max(3, args.repeats // 2))
 
-    threads = rg.getNumThreads()
-    torch.set_num_threads(threads)
-    efficient_np = EfficientNumpyJitter(raw, fmt, model, 0.1, 2.0, threads)
-    efficient_torch = EfficientTorchJitter(raw, fmt, model, 0.1, 2.0)
-    # The baselines reuse their buffers; so does rawgment here, through dst.
-    reused = np.empty_like(raw)
-    ours, best_np, best_torch = interleaved_minima(
-        [lambda: rg.colorJitter(raw, fmt, model, jitter, noise, seed=1, dst=reused), efficient_np, efficient_torch],
-        max(5, args.repeats))
+    ours, best_np, best_torch, threads = efficient_minima(raw, fmt, model, jitter, max(5, args.repeats))
 
     rows = [
         ("colorJitter, C++ call timed in C++", "%.1f ms" % (cxx * 1e3), ""),
