@@ -191,12 +191,14 @@ def jitter_frame():
 
 def efficient_minima(raw, fmt, model, jitter, rounds):
     """Minima in seconds over `rounds` interleaved rounds of rawgment's colorJitter into a reused dst and of
-    the efficient numpy and torch jitters, each on as many threads as rawgment uses: (rawgment, numpy,
-    torch, threads)."""
+    the efficient numpy and torch jitters of the same exposure change (`jitter`, without brightness), each
+    on as many threads as rawgment uses: (rawgment, numpy, torch, threads)."""
     threads = rg.getNumThreads()
     torch.set_num_threads(threads)
-    efficient_np = EfficientNumpyJitter(raw, fmt, model, 0.1, 2.0, threads)
-    efficient_torch = EfficientTorchJitter(raw, fmt, model, 0.1, 2.0)
+    gain_ratio = jitter.gainRatio
+    photon_ratio = jitter.contrast[0] / gain_ratio  # exposureChange(p_u, p_g) has contrast p_u p_g
+    efficient_np = EfficientNumpyJitter(raw, fmt, model, photon_ratio, gain_ratio, threads)
+    efficient_torch = EfficientTorchJitter(raw, fmt, model, photon_ratio, gain_ratio)
     noise = rg.NoiseOptions()
     # The baselines reuse their buffers; so does rawgment here, through dst.
     reused = np.empty_like(raw)
