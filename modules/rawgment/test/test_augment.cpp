@@ -630,6 +630,19 @@ TEST(Augment, stepsWriteIntoTheCallersBufferButNeverIntoTheirInput)
     }
 }
 
+//! colorJitter's exposure change by photonRatio (the gain unchanged) with the shot noise drawn by `sampling`
+//! and the other noise options at their defaults (ACCOUNT_PRIOR, PIXEL_VALUE).
+Mat exposureChangeSampledBy(ShotNoiseSampling sampling, const Mat& src, const RawFormat& fmt,
+                            const NoiseModel& model, double photonRatio, uint64 seed)
+{
+    NoiseOptions noise;
+    noise.shotSampling = sampling;
+    Mat out;
+    RawFormat outFmt;
+    colorJitter(src, fmt, model, ColorJitter::exposureChange(photonRatio, 1.0), noise, seed, out, outFmt);
+    return out;
+}
+
 TEST(Augment, exposureChangeThirdCumulantIsWhatTheMathematicsDerives)
 {
     // docs/mathematics.md: with pure shot noise (q = 1 DN per electron) an input of Poisson(lambda / p_u)
@@ -653,11 +666,7 @@ TEST(Augment, exposureChangeThirdCumulantIsWhatTheMathematicsDerives)
             for (int c = 0; c < bright.cols; ++c)
                 bright.at<float>(r, c) = static_cast<float>(100 + electrons(engine));
         for (ShotNoiseSampling sampling : {ShotNoiseSampling::GAUSSIAN, ShotNoiseSampling::POISSON}) {
-            NoiseOptions noise;
-            noise.shotSampling = sampling;
-            Mat out;
-            RawFormat outFmt;
-            colorJitter(bright, fmt, model, ColorJitter::exposureChange(pu, 1), noise, 3, out, outFmt);
+            const Mat out = exposureChangeSampledBy(sampling, bright, fmt, model, pu, 3);
             double s1 = 0, s2 = 0, s3 = 0;
             for (int r = 0; r < out.rows; ++r)
                 for (int c = 0; c < out.cols; ++c) {
@@ -1080,11 +1089,7 @@ TEST(Augment, poissonShotNoiseGivesTheElectronLatticeOfARealDarkCapture)
     spatialStats(truth, fmt, truthMean, truthVar);
     double kl[2] = {0, 0};
     for (ShotNoiseSampling sampling : {ShotNoiseSampling::GAUSSIAN, ShotNoiseSampling::POISSON}) {
-        NoiseOptions noise;
-        noise.shotSampling = sampling;
-        Mat out;
-        RawFormat outFmt;
-        colorJitter(bright, fmt, model, ColorJitter::exposureChange(photonRatio, 1.0), noise, 7, out, outFmt);
+        const Mat out = exposureChangeSampledBy(sampling, bright, fmt, model, photonRatio, 7);
         const int i = static_cast<int>(sampling);
         kl[i] = klDivergence(truthCounts, valueHistogram(out, fmt.blackLevel[0], lo, hi));
         double mean = 0, var = 0;
@@ -1234,11 +1239,7 @@ TEST(Augment, poissonJitterAddsExactPoissonCountsAtEveryMean)
     fmt.blackLevel = Vec4d::all(0);
     fmt.whiteLevel = 1e9;
     fmt.gain = 1;
-    NoiseOptions noise;
-    noise.shotSampling = ShotNoiseSampling::POISSON;
-    Mat out;
-    RawFormat outFmt;
-    colorJitter(src, fmt, model, ColorJitter::exposureChange(0.2, 1.0), noise, 11, out, outFmt);
+    const Mat out = exposureChangeSampledBy(ShotNoiseSampling::POISSON, src, fmt, model, 0.2, 11);
     for (size_t m = 0; m < means.size(); ++m) {
         const double lambda = means[m];
         std::map<int64_t, int> hist;
