@@ -163,13 +163,12 @@ TEST(NumericalStability, augmentationHardCasesGiveFiniteCorrectOutput)
     // 34 columns: whole vectors and the scalar tail of every store.
     RawFormat beyond = wide;
     beyond.whiteLevel = 1e12;
-    const Mat high(8, 34, CV_16UC1, Scalar(60000));
+    const Mat high(8, 34, CV_16UC1, Scalar(60000)), higher(high.size(), CV_16UC1, Scalar(65535));
     for (NoiseAlignment mode : kAlignments) {
         SCOPED_TRACE(static_cast<int>(mode));
         colorJitter(high, beyond, model, ColorJitter::exposureChange(1.2, 1), mode, 6, out, outFmt);
         minMaxLoc(out, &lo, &hi);
         EXPECT_EQ(lo, 65535) << "colorJitter";
-        const Mat higher = Mat(high.size(), CV_16UC1, Scalar(65535));
         motionBlur(higher, beyond, model, linearMotionKernel(9, 10), mode, 6, out);
         minMaxLoc(out, &lo, &hi);
         EXPECT_GT(lo, 65535 - 6 * std::sqrt(model.variance(65535, beyond.gain))) << "motionBlur";
