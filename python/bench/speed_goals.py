@@ -108,7 +108,8 @@ def run_benchmarks(binary, pattern, repetitions):
             return median_times(json.load(f))
 
 
-def host_line():
+def host_line(best_path):
+    """lscpu's model name, CPU family and model, the cores, the best path the benchmarks ran on, the date."""
     fields = {}
     try:
         lscpu = subprocess.run(["lscpu"], check=True, capture_output=True, text=True).stdout
@@ -117,12 +118,9 @@ def host_line():
             fields[key.strip()] = value.strip()
     except (OSError, subprocess.CalledProcessError):
         pass
-    flags = fields.get("Flags", "").split()
-    best = "avx512" if "avx512f" in flags else "avx2" if "avx2" in flags else "sse4.2" if "sse4_2" in flags \
-        else "baseline"
     return "%s (family %s, model %s), %d cores, best path %s, %s" % (
         fields.get("Model name", "unknown CPU"), fields.get("CPU family", "?"), fields.get("Model", "?"),
-        os.cpu_count(), best, datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"))
+        os.cpu_count(), best_path, datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"))
 
 
 def python_row(repeats):
@@ -186,7 +184,8 @@ def main(argv=None):
     cores = os.cpu_count()
     paths, rows = goal_rows(times, cores)
     python = python_row(args.python_rounds) if args.python else None
-    text = markdown(host_line(), paths, rows, philox_row(times, cores), python)
+    # The benchmarks ran on every path the library found on this CPU, in PATHS' order: the last is the best.
+    text = markdown(host_line(paths[-1]), paths, rows, philox_row(times, cores), python)
     sys.stdout.write(text)
     if args.out:
         write_atomically(args.out, text)
