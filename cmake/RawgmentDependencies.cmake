@@ -17,6 +17,16 @@ rawgment_require(Ceres_FOUND "Ceres Solver 2.1" "libceres-dev")
 find_package(LibRaw 0.20 QUIET)
 rawgment_require(LibRaw_FOUND "LibRaw 0.20" "libraw-dev")
 
+# The file reader's parsers (src/files.cpp): libyaml for YAML and nlohmann-json for JSON, both iterative,
+# so that a deeply nested file is an error, not a stack overflow in OpenCV's recursive readers.
+find_package(PkgConfig QUIET)
+if(PKG_CONFIG_FOUND)
+  pkg_check_modules(yaml QUIET IMPORTED_TARGET yaml-0.1>=0.2.5)
+endif()
+rawgment_require(yaml_FOUND "libyaml 0.2.5" "libyaml-dev")
+find_package(nlohmann_json 3.11 QUIET CONFIG)
+rawgment_require(nlohmann_json_FOUND "nlohmann-json 3.11" "nlohmann-json3-dev")
+
 if(RAWGMENT_BUILD_TESTS)
   find_package(GTest QUIET CONFIG)
   rawgment_require(GTest_FOUND "GoogleTest" "libgtest-dev")

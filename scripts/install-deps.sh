@@ -12,6 +12,8 @@ packages=(
   libopencv-contrib-dev  # contrib modules: mcc (colour-checker detection)
   libceres-dev      # Ceres 2.1: cross-gain noise fits
   libraw-dev        # LibRaw 0.20: camera RAW input
+  libyaml-dev       # libyaml 0.2.5: the file reader's YAML parser (iterative, depth-limited)
+  nlohmann-json3-dev  # nlohmann-json 3.11: the file reader's JSON parser (iterative, reads \u escapes)
   libgtest-dev      # GoogleTest
   libbenchmark-dev  # Google Benchmark
   gnuplot-nox       # PNG plots in apps and the demo

@@ -96,8 +96,10 @@ class _ModelSource:
             if camera is None:
                 raise ValueError("'%s' is a darktable noise-profile file of many cameras: choose with camera= (a "
                                  "name, a list of names, 'good' or 'usable')" % path)
-            selection = camera if isinstance(camera, str) else ",".join(camera)
-            self.cameras = _rg.selectCameraProfiles(_rg.readCameraProfiles(path), selection)
+            catalogue = _rg.readCameraProfiles(path)
+            # Each name of a list on its own: a camera's name may hold a comma.
+            selections = [camera] if isinstance(camera, str) else list(camera)
+            self.cameras = [c for one in selections for c in _rg.selectCameraProfiles(catalogue, one)]
         elif camera is not None:
             raise ValueError("camera chooses among the cameras of a darktable profile file, and '%s' is not one" % path)
         elif kind == _rg.ANDROID_PROFILE_FILE:

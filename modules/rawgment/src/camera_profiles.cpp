@@ -80,6 +80,9 @@ double median(std::vector<double> v)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+//! The smallest shot slope (of the white level) a measured profile may have: a full well of 1e12 electrons.
+constexpr double MIN_SHOT_SLOPE = 1e-12;
+
 struct MeasuredProfile
 {
     double iso = 0;
@@ -114,6 +117,14 @@ std::vector<MeasuredProfile> readProfiles(const FileNode& modelNode, const Strin
                 m.b[c] = b[size_t(c)];
                 if (!std::isfinite(m.a[c]) || !std::isfinite(m.b[c]))
                     CV_Error(Error::StsParseError, format("colour %d has a non-finite a or b", c));
+                // A shot slope is one over the electrons of the full scale: below MIN_SHOT_SLOPE it would
+                // take a trillion electrons (darktable's measured slopes are above 2e-7), and a denormal
+                // one overflows the fit's sums to NaN or zero.
+                if (m.a[c] > 0 && m.a[c] < MIN_SHOT_SLOPE)
+                    CV_Error(Error::StsParseError,
+                             format("colour %d has a shot slope a = %g, below %g: no sensor has a full well "
+                                    "of 1e12 electrons",
+                                    c, m.a[c], MIN_SHOT_SLOPE));
             }
             if (!(std::isfinite(m.iso) && m.iso > 0))
                 CV_Error(Error::StsParseError, format("ISO %g must be finite and > 0", m.iso));
@@ -161,13 +172,13 @@ Vec2d fitOffsets(const std::vector<double>& g2, const std::vector<double>& b, co
 void judge(CameraNoiseProfile& cam, const DarktableImportParams& params)
 {
     std::vector<String> rough;
-    if (cam.medianSlopeResidual > params.goodMedianSlopeResidual)
+    if (!(cam.medianSlopeResidual <= params.goodMedianSlopeResidual))
         rough.push_back(format("median shot-slope residual %.0f%% > %.0f%%", 100 * cam.medianSlopeResidual,
                                100 * params.goodMedianSlopeResidual));
-    if (cam.worstSlopeResidual > params.goodWorstSlopeResidual)
+    if (!(cam.worstSlopeResidual <= params.goodWorstSlopeResidual))
         rough.push_back(format("shot slope %.0f%% off at ISO %g (> %.0f%%)", 100 * cam.worstSlopeResidual,
                                cam.worstSlopeIso, 100 * params.goodWorstSlopeResidual));
-    if (cam.worstOffsetResidual > params.goodWorstOffsetResidual)
+    if (!(cam.worstOffsetResidual <= params.goodWorstOffsetResidual))
         rough.push_back(format("offset %.0f%% off at ISO %g (> %.0f%%)", 100 * cam.worstOffsetResidual,
                                cam.worstOffsetIso, 100 * params.goodWorstOffsetResidual));
     std::set<double> distinct;
@@ -243,6 +254,14 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
     const Vec2d offsets = fitOffsets(g2, b, w);
     cam.sigmaD2 = offsets[0];
     cam.sigmaR2 = offsets[1];
+    // NaN passes every '>' bound of the verdict: a fit that is not finite is refused here.
+    if (!(std::isfinite(cam.alpha) && cam.alpha > 0 && std::isfinite(cam.sigmaD2) &&
+          std::isfinite(cam.sigmaR2))) {
+        cam.verdict = CAMERA_PROFILE_REFUSED;
+        cam.reason = format("the fit is not finite and positive (alpha %g, sigma_d^2 %g, sigma_r^2 %g)",
+                            cam.alpha, cam.sigmaD2, cam.sigmaR2);
+        return;
+    }
 
     std::vector<double> slopeResiduals, spreads;
     for (size_t k = 0; k < cam.isos.size(); ++k) {
@@ -277,6 +296,26 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
         return;
     }
     judge(cam, params);
+}
+
+/** The name with each control character written as an escape ("\\n", "\\x01"), so that a catalogue line or a
+ * CSV row never breaks where the file put a newline; counts them in `controls`. */
+String printableName(const String& name, int& controls)
+{
+    String out;
+    for (char ch : name) {
+        const unsigned char u = static_cast<unsigned char>(ch);
+        if (u >= 0x20 && u != 0x7F) {
+            out += ch;
+            continue;
+        }
+        ++controls;
+        out += u == '\n'   ? String("\\n")
+               : u == '\r' ? String("\\r")
+               : u == '\t' ? String("\\t")
+                           : format("\\x%02x", u);
+    }
+    return out;
 }
 
 String normalisedName(const String& name)
@@ -365,6 +404,15 @@ std::vector<CameraNoiseProfile> readCameraProfiles(const String& path, const Dar
                     "malformed: " +
                     (e.err.compare(0, cam.place.size(), cam.place) == 0 ? e.err : cam.place + ": " + e.err);
             }
+            int controls = 0;
+            cam.maker = printableName(cam.maker, controls);
+            cam.model = printableName(cam.model, controls);
+            if (controls > 0) {
+                cam.verdict = CAMERA_PROFILE_REFUSED;
+                cam.reason = format("its name holds %d control character%s (shown escaped): a name that "
+                                    "cannot be typed or printed on one line cannot be selected",
+                                    controls, controls == 1 ? "" : "s");
+            }
             cameras.push_back(cam);
         }
     }
@@ -410,15 +458,37 @@ std::vector<CameraNoiseProfile> selectCameraProfiles(const std::vector<CameraNoi
             CV_Error(Error::StsBadArg, "camera selection '" + selection + "': no camera has that verdict");
         return chosen;
     }
-    size_t start = 0;
-    while (start <= selection.size()) {
+    // Names are split at commas, but a camera's own name may hold one ("Foo, Inc. X"): at each place
+    // the longest run of comma-separated pieces that names a camera is taken, and a piece that starts
+    // no name is looked up alone (for the error with the closest names).
+    std::vector<String> pieces;
+    for (size_t start = 0; start <= selection.size();) {
         const size_t comma = std::min(selection.find(',', start), selection.size());
-        String one = selection.substr(start, comma - start);
+        pieces.push_back(selection.substr(start, comma - start));
+        start = comma + 1;
+    }
+    std::set<String> names;
+    for (const CameraNoiseProfile& cam : cameras)
+        names.insert(normalisedName(cam.name()));
+    for (size_t i = 0; i < pieces.size();) {
+        size_t end = i + 1;
+        for (size_t j = pieces.size(); j > i + 1; --j) {
+            String joined = pieces[i];
+            for (size_t k = i + 1; k < j; ++k)
+                joined += "," + pieces[k];
+            if (names.count(normalisedName(joined))) {
+                end = j;
+                break;
+            }
+        }
+        String one = pieces[i];
+        for (size_t k = i + 1; k < end; ++k)
+            one += "," + pieces[k];
         one.erase(0, one.find_first_not_of(" \t"));
         one.erase(one.find_last_not_of(" \t") + 1);
         if (!one.empty())
             chosen.push_back(findCameraProfile(cameras, one));
-        start = comma + 1;
+        i = end;
     }
     if (chosen.empty())
         CV_Error(Error::StsBadArg, "camera selection '" + selection + "' names no camera");
@@ -472,6 +542,9 @@ NoiseModel noiseModelFromAndroidFile(const String& path, const RawFormat& format
     AndroidNoiseProfile profile;
     double baseIso = 0;
     try {
+        // A model beside the profile (a failed calibration's noise_model, say) would be ignored, and with
+        // it its failed_calibration mark: the file holds the profile alone.
+        rejectUnknownKeys(fs.root(), {"android_noise_profile"});
         if (!node.isMap())
             CV_Error(Error::StsParseError, "expected a map 'android_noise_profile'");
         rejectUnknownKeys(node, {"comment", "base_iso", "A", "B", "C", "D"});

@@ -7,19 +7,16 @@
 #include <atomic>
 #include <cctype>
 #include <cerrno>
-#include <chrono>
 #include <climits>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
-#include <poll.h>
 #include <sstream>
 #include <sys/stat.h>
-#include <sys/syscall.h>
-#include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
+
+#include <nlohmann/json.hpp>
+#include <yaml.h>
 
 namespace cv {
 namespace rawgment {
@@ -45,32 +42,16 @@ bool fileExists(const String& path)
 
 namespace {
 
-bool isBlank(char c)
+//! Whether a plain scalar is an integer literal, [+-]?[0-9]+, as OpenCV's readers would take it.
+bool isIntegerLiteral(const char* s, size_t n)
 {
-    return c == ' ' || c == '\t' || c == '\r';
-}
-
-/** The integer literal that starts at `line[i]` (after blanks, an optional sign and digits) when it is
- * a whole scalar: followed by blanks and then the end of the line, a comma, a closing bracket or a
- * comment. Empty otherwise. */
-std::string scalarIntegerAt(const std::string& line, size_t i)
-{
-    while (i < line.size() && isBlank(line[i]))
-        ++i;
-    const size_t start = i;
-    if (i < line.size() && (line[i] == '-' || line[i] == '+'))
-        ++i;
-    const size_t digits = i;
-    while (i < line.size() && line[i] >= '0' && line[i] <= '9')
-        ++i;
-    if (i == digits)
-        return std::string();
-    const size_t stop = i;
-    while (i < line.size() && isBlank(line[i]))
-        ++i;
-    if (i < line.size() && line[i] != ',' && line[i] != ']' && line[i] != '}' && line[i] != '#')
-        return std::string();
-    return line.substr(start, stop - start);
+    size_t i = n > 0 && (s[0] == '-' || s[0] == '+') ? 1 : 0;
+    if (i == n)
+        return false;
+    for (; i < n; ++i)
+        if (s[i] < '0' || s[i] > '9')
+            return false;
+    return true;
 }
 
 bool fitsInt(const std::string& literal)
@@ -86,46 +67,172 @@ bool fitsInt(const std::string& literal)
     return value >= INT_MIN && value <= INT_MAX;
 }
 
-} // namespace
-
-void rejectWrappingIntegers(const String& path, const std::string& text)
+[[noreturn]] void refuseWrappingInteger(const String& path, int line, const std::string& literal)
 {
-    // A plain integer scalar follows the start of a line, a block list's dash, a key's colon, or a flow
-    // list's or map's bracket or comma. Quoted text is skipped. A hand-written scan, not std::regex,
-    // whose recursion overflows the stack on a long line.
-    std::istringstream lines(text);
-    std::string line;
-    for (int number = 1; std::getline(lines, line); ++number) {
-        std::string unquoted;
-        char quote = 0;
-        for (char c : line) {
-            if (quote) {
-                quote = c == quote ? 0 : quote;
-                continue;
-            }
-            if (c == '"' || c == '\'') {
-                quote = c;
-                continue;
-            }
-            unquoted += c;
-        }
-        std::vector<size_t> starts = {0};
-        const size_t firstNonBlank = unquoted.find_first_not_of(" \t");
-        if (firstNonBlank != std::string::npos && unquoted[firstNonBlank] == '-')
-            starts.push_back(firstNonBlank + 1);
-        for (size_t i = 0; i < unquoted.size(); ++i)
-            if (unquoted[i] == ':' || unquoted[i] == '[' || unquoted[i] == ',' || unquoted[i] == '{')
-                starts.push_back(i + 1);
-        for (size_t start : starts) {
-            const std::string literal = scalarIntegerAt(unquoted, start);
-            if (!literal.empty() && !fitsInt(literal))
-                CV_Error(Error::StsParseError,
-                         format("'%s' line %d: the integer %s does not fit 32 bits (OpenCV's reader would "
-                                "wrap it); write it as a real (%s.0) if that is the value meant",
-                                path.c_str(), number, literal.c_str(), literal.c_str()));
+    CV_Error(
+        Error::StsParseError,
+        format("'%s' line %d: the integer %s does not fit 32 bits (OpenCV's reader would wrap it); write "
+               "it as a real (%s.0) if that is the value meant",
+               path.c_str(), line, literal.c_str(), literal.c_str()));
+}
+
+[[noreturn]] void refuseDepth(const String& path, int line)
+{
+    CV_Error(Error::StsParseError,
+             format("'%s' line %d: collections nested more than %d levels deep; no file of this module nests "
+                    "so deep (OpenCV's recursive reader would overflow the stack)",
+                    path.c_str(), line, MAX_NESTING_DEPTH));
+}
+
+//! The libyaml parser of one text, freed on every path out.
+struct YamlParser
+{
+    yaml_parser_t parser;
+    YamlParser(const char* text, size_t size)
+    {
+        if (!yaml_parser_initialize(&parser))
+            CV_Error(Error::StsNoMem, "cannot initialise the YAML parser");
+        yaml_parser_set_input_string(&parser, reinterpret_cast<const unsigned char*>(text), size);
+    }
+    ~YamlParser() { yaml_parser_delete(&parser); }
+    YamlParser(const YamlParser&) = delete;
+    YamlParser& operator=(const YamlParser&) = delete;
+};
+
+struct YamlEvent
+{
+    yaml_event_t event;
+    bool held = false;
+    ~YamlEvent()
+    {
+        if (held)
+            yaml_event_delete(&event);
+    }
+};
+
+//! The line (1-based) of byte `offset` of `text`.
+int lineAt(const std::string& text, size_t offset)
+{
+    offset = std::min(offset, text.size());
+    return 1 + static_cast<int>(
+                   std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(offset), '\n'));
+}
+
+/** A JSON validator's events (nlohmann's SAX interface): the depth and 32-bit integers checked as the
+ * text streams by, nothing stored. nlohmann's parser keeps its own state on the heap, not the stack. */
+class JsonChecks : public nlohmann::json_sax<nlohmann::json>
+{
+public:
+    enum class Stop
+    {
+        NONE,
+        SYNTAX,
+        DEPTH,
+        INTEGER
+    };
+    Stop stop = Stop::NONE;
+    std::string message;
+    std::string literal;
+    bool null() override { return true; }
+    bool boolean(bool) override { return true; }
+    bool number_integer(number_integer_t value) override
+    {
+        return value >= INT_MIN && value <= INT_MAX ? true : wraps(std::to_string(value));
+    }
+    bool number_unsigned(number_unsigned_t value) override
+    {
+        return value <= static_cast<number_unsigned_t>(INT_MAX) ? true : wraps(std::to_string(value));
+    }
+    bool number_float(number_float_t, const string_t&) override { return true; }
+    bool string(string_t&) override { return true; }
+    bool binary(binary_t&) override { return true; }
+    bool key(string_t&) override { return true; }
+    bool start_object(std::size_t) override { return enter(); }
+    bool start_array(std::size_t) override { return enter(); }
+    bool end_object() override { return leave(); }
+    bool end_array() override { return leave(); }
+    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override
+    {
+        stop = Stop::SYNTAX;
+        message = e.what();
+        // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." without the class.
+        const size_t bracket = message.find("] ");
+        if (message.compare(0, 1, "[") == 0 && bracket != std::string::npos)
+            message.erase(0, bracket + 2);
+        return false;
+    }
+
+private:
+    int depth_ = 0;
+    bool enter()
+    {
+        if (++depth_ <= MAX_NESTING_DEPTH)
+            return true;
+        stop = Stop::DEPTH;
+        return false;
+    }
+    bool leave()
+    {
+        --depth_;
+        return true;
+    }
+    bool wraps(std::string value)
+    {
+        stop = Stop::INTEGER;
+        literal = std::move(value);
+        return false;
+    }
+};
+
+//! Where the JSON text first opens a collection deeper than MAX_NESTING_DEPTH (strings skipped).
+size_t offsetBeyondDepth(const std::string& text)
+{
+    int depth = 0;
+    bool inString = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > MAX_NESTING_DEPTH)
+                return i;
+        } else if (c == ']' || c == '}') {
+            --depth;
         }
     }
+    return text.size();
 }
+
+void appendUtf8(std::string& out, unsigned codePoint)
+{
+    if (codePoint < 0x80) {
+        out += static_cast<char>(codePoint);
+    } else if (codePoint < 0x800) {
+        out += static_cast<char>(0xC0 | (codePoint >> 6));
+        out += static_cast<char>(0x80 | (codePoint & 0x3F));
+    } else if (codePoint < 0x10000) {
+        out += static_cast<char>(0xE0 | (codePoint >> 12));
+        out += static_cast<char>(0x80 | ((codePoint >> 6) & 0x3F));
+        out += static_cast<char>(0x80 | (codePoint & 0x3F));
+    } else {
+        out += static_cast<char>(0xF0 | (codePoint >> 18));
+        out += static_cast<char>(0x80 | ((codePoint >> 12) & 0x3F));
+        out += static_cast<char>(0x80 | ((codePoint >> 6) & 0x3F));
+        out += static_cast<char>(0x80 | (codePoint & 0x3F));
+    }
+}
+
+unsigned hex4(const std::string& text, size_t at)
+{
+    return static_cast<unsigned>(std::stoul(text.substr(at, 4), nullptr, 16));
+}
+
+} // namespace
 
 void rejectUnsupportedStructure(const String& path, const std::string& text)
 {
@@ -182,125 +289,152 @@ void rejectUnsupportedStructure(const String& path, const std::string& text)
     }
 }
 
-double parseCpuBound(size_t bytes)
+void validateYaml(const String& path, const std::string& text)
 {
-    // 44 MB of numbers parse in 0.42 s (0.01 s/MB on a 2-core AMD EPYC Zen 4, Release, 2026-11-24): 2 s
-    // plus 0.25 s per MB is 25 times that. Sanitizer builds are slower, and AddressSanitizer's
-    // strict_string_checks (the test command sets it) makes OpenCV's parse of a long line quadratic:
-    // 300 kB on one line took 4.2 s of CPU time there against 7 ms without it; so 30 times as long.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-    const double factor = 30;
-#else
-    const double factor = 1;
-#endif
-    return factor * (2 + static_cast<double>(bytes) / (4 << 20));
+    // OpenCV's own header line ("%YAML:1.0") is no YAML directive: libyaml reads from the next line.
+    size_t from = 0;
+    int lineOffset = 0;
+    if (text.compare(0, 5, "%YAML") == 0) {
+        const size_t newline = text.find('\n');
+        from = newline == std::string::npos ? text.size() : newline + 1;
+        lineOffset = 1;
+    }
+    YamlParser yaml(text.data() + from, text.size() - from);
+    const auto lineOf = [&](const yaml_mark_t& mark) { return static_cast<int>(mark.line) + 1 + lineOffset; };
+    const auto refuse = [&](int line, const std::string& why) {
+        CV_Error(Error::StsParseError, format("'%s' line %d: %s", path.c_str(), line, why.c_str()));
+    };
+    int depth = 0, documents = 0;
+    bool root = false;
+    for (;;) {
+        YamlEvent e;
+        if (!yaml_parser_parse(&yaml.parser, &e.event)) {
+            const yaml_parser_t& p = yaml.parser;
+            std::string why = p.problem ? p.problem : "malformed YAML";
+            if (p.context)
+                why += std::string(" ") + p.context + format(" (from line %d)", lineOf(p.context_mark));
+            refuse(lineOf(p.problem_mark), "not valid YAML: " + why);
+        }
+        e.held = true;
+        const yaml_event_t& ev = e.event;
+        const int line = lineOf(ev.start_mark);
+        switch (ev.type) {
+        case YAML_STREAM_END_EVENT:
+            if (!root)
+                CV_Error(Error::StsParseError, "'" + path + "' holds no map (only comments or directives)");
+            return;
+        case YAML_DOCUMENT_START_EVENT:
+            if (++documents > 1)
+                refuse(line, "a second document (this module reads single-document YAML files)");
+            break;
+        case YAML_ALIAS_EVENT:
+            refuse(line, "an alias (*name): OpenCV's reader has no anchors or aliases");
+            break;
+        case YAML_SCALAR_EVENT:
+            if (ev.data.scalar.anchor)
+                refuse(line, "an anchor (&name): OpenCV's reader has no anchors or aliases");
+            if (depth == 0)
+                refuse(line, "the root is a single value, not a map (this module reads single-document YAML "
+                             "files whose root is a block map or list at column 0)");
+            if (ev.data.scalar.style == YAML_PLAIN_SCALAR_STYLE) {
+                const char* value = reinterpret_cast<const char*>(ev.data.scalar.value);
+                const size_t length = ev.data.scalar.length;
+                if (isIntegerLiteral(value, length) && !fitsInt(std::string(value, length)))
+                    refuseWrappingInteger(path, line, std::string(value, length));
+            }
+            break;
+        case YAML_SEQUENCE_START_EVENT:
+        case YAML_MAPPING_START_EVENT: {
+            const bool mapping = ev.type == YAML_MAPPING_START_EVENT;
+            const yaml_char_t* anchor =
+                mapping ? ev.data.mapping_start.anchor : ev.data.sequence_start.anchor;
+            if (anchor)
+                refuse(line, "an anchor (&name): OpenCV's reader has no anchors or aliases");
+            if (depth == 0) {
+                const bool flow = mapping ? ev.data.mapping_start.style == YAML_FLOW_MAPPING_STYLE
+                                          : ev.data.sequence_start.style == YAML_FLOW_SEQUENCE_STYLE;
+                if (flow)
+                    refuse(line, "the root is a flow collection (this module reads single-document YAML "
+                                 "files whose root is a block map or list at column 0)");
+                if (ev.start_mark.column != 0)
+                    refuse(line, "the root collection does not start at column 0 (this module reads "
+                                 "single-document YAML files whose root is a block map or list at column 0)");
+                root = true;
+            }
+            if (++depth > MAX_NESTING_DEPTH)
+                refuseDepth(path, line);
+            break;
+        }
+        case YAML_SEQUENCE_END_EVENT:
+        case YAML_MAPPING_END_EVENT:
+            --depth;
+            break;
+        default:
+            break;
+        }
+    }
 }
 
-ChildWait waitForChild(int child, double cpuBound, double wallCap, double stallSeconds)
+std::string validateJson(const String& path, const std::string& text)
 {
-    const auto start = std::chrono::steady_clock::now();
-    const auto wallSeconds = [&] {
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    };
-    clockid_t childClock;
-    const bool haveChildClock = ::clock_getcpuclockid(child, &childClock) == 0;
-    // Without the child's clock nothing tells spinning from blocked: wall time stands in for CPU time
-    // (so a blocked child counts as spinning) and the stall rule is off.
-    const auto cpuSeconds = [&] {
-        timespec t;
-        if (!haveChildClock)
-            return wallSeconds();
-        if (::clock_gettime(childClock, &t) != 0)
-            return -1.0; // the child has just ended: the next wait sees it
-        return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-    };
-    // A pidfd becomes readable the moment the child ends, even where SIGCHLD is ignored and waitpid()
-    // cannot see it; without one (kernels before 5.3), waitpid() and short naps.
-    const int pidfd = static_cast<int>(::syscall(SYS_pidfd_open, child, 0));
-    long sleepNs = 20000;
-    // A runnable child gets its share of a core within milliseconds, even behind a few busy processes
-    // (the scheduler is fair): one that gains less than a millisecond of CPU time in stallSeconds of
-    // wall time is asleep, waiting for something that will not come.
-    const double progressStep = 1e-3;
-    double lastCpu = 0, lastProgress = 0;
-    ChildWait outcome = ChildWait::OVERTIME;
-    while (wallSeconds() <= wallCap) {
-        bool finished = false;
-        if (pidfd >= 0) {
-            pollfd ready = {pidfd, POLLIN, 0};
-            finished = ::poll(&ready, 1, 50) > 0;
-        } else {
-            int status = 0;
-            const pid_t done = ::waitpid(child, &status, WNOHANG);
-            // ECHILD: SIGCHLD is ignored and the child reaped itself, so it has ended.
-            finished = done == child || (done < 0 && errno == ECHILD);
-            const timespec pause = {0, sleepNs};
-            if (!finished)
-                ::nanosleep(&pause, nullptr);
-            sleepNs = std::min(sleepNs * 2, 10000000L);
-        }
-        if (finished) {
-            outcome = ChildWait::FINISHED;
-            break;
-        }
-        const double cpu = cpuSeconds(), now = wallSeconds();
-        if (cpu > cpuBound) {
-            outcome = ChildWait::SPINNING;
-            break;
-        }
-        if (cpu >= lastCpu + progressStep) {
-            lastCpu = cpu;
-            lastProgress = now;
-        } else if (haveChildClock && cpu >= 0 && now - lastProgress > stallSeconds) {
-            outcome = ChildWait::STALLED;
-            break;
-        }
+    JsonChecks checks;
+    nlohmann::json::sax_parse(text, &checks);
+    switch (checks.stop) {
+    case JsonChecks::Stop::SYNTAX:
+        CV_Error(Error::StsParseError, "'" + path + "' is not valid JSON: " + checks.message);
+    case JsonChecks::Stop::DEPTH:
+        refuseDepth(path, lineAt(text, offsetBeyondDepth(text)));
+    case JsonChecks::Stop::INTEGER:
+        refuseWrappingInteger(path, lineAt(text, text.find(checks.literal)), checks.literal);
+    case JsonChecks::Stop::NONE:
+        break;
     }
-    if (outcome != ChildWait::FINISHED)
-        ::kill(child, SIGKILL);
-    int status = 0;
-    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
-    }
-    if (pidfd >= 0)
-        ::close(pidfd);
-    return outcome;
-}
-
-void requireParseFinishes(const String& path, const std::string& text, double cpuBound)
-{
-    // OpenCV 4.6's YAML reader never returns when its root collection ends before the text does and
-    // what follows starts with a '-' that is not '---' (its document loop then spins, neither advancing
-    // nor failing). rejectUnsupportedStructure() refuses the shapes seen so far, but where the root ends
-    // depends on the whole parser; so the text is parsed once in a child process, which is killed when
-    // it has spun for longer than an honest file needs (parseCpuBound()). CPU time, not wall time: under
-    // `ctest -j2` a sanitizer build's child took more than 2 s of wall time for 300 kB while waiting for
-    // a core. The child of a multi-threaded caller can block for good on a lock that another thread
-    // held at the fork (an AddressSanitizer build's allocator did, in an app whose workers read sidecars
-    // in parallel, and the caller waited out the whole wall-time cap): such a child says nothing about
-    // the text, so it is killed as soon as it is seen asleep and the caller parses. The child only
-    // parses and leaves with _exit(): it runs no atexit handler and touches no file.
-    if (!(cpuBound > 0))
-        cpuBound = parseCpuBound(text.size());
-    const double wallCap = 30 + 10 * cpuBound;
-    const pid_t child = ::fork();
-    if (child < 0)
-        return; // no process to spare (a limit on processes): the text checks alone must do
-    if (child == 0) {
-        // The caller's SIGALRM handler (if any) is inherited: the default action ends the child.
-        ::signal(SIGALRM, SIG_DFL);
-        ::alarm(static_cast<unsigned>(wallCap) + 1);
-        try {
-            FileStorage fs(text, FileStorage::READ | FileStorage::MEMORY);
-        } catch (...) {
+    // OpenCV's JSON reader knows the escapes \" \\ \' \n \r \t \b \f but not \u or \/, which JSON allows
+    // and common writers use (Python's json.dump writes every non-ASCII letter as \u00f8): those are
+    // written out as UTF-8. The text is valid JSON here, so every backslash is an escape in a string.
+    if (text.find("\\u") == std::string::npos && text.find("\\/") == std::string::npos)
+        return text;
+    std::string out;
+    out.reserve(text.size());
+    for (size_t i = 0; i < text.size(); ++i) {
+        if (text[i] != '\\') {
+            out += text[i];
+            continue;
         }
-        ::_exit(0);
+        const char kind = text[i + 1];
+        if (kind == '/') {
+            out += '/';
+            ++i;
+            continue;
+        }
+        if (kind != 'u') {
+            out.append(text, i, 2);
+            ++i;
+            continue;
+        }
+        unsigned codePoint = hex4(text, i + 2);
+        size_t length = 6;
+        // A high surrogate is followed by its low one (the validator has checked the pair).
+        if (codePoint >= 0xD800 && codePoint <= 0xDBFF) {
+            codePoint = 0x10000 + ((codePoint - 0xD800) << 10) + (hex4(text, i + 8) - 0xDC00);
+            length = 12;
+        }
+        if (codePoint == 0)
+            CV_Error(Error::StsParseError,
+                     format("'%s' line %d: a \\u0000 (NUL) in a string; OpenCV's strings "
+                            "end at a NUL",
+                            path.c_str(), lineAt(text, i)));
+        if (codePoint == '"' || codePoint == '\\')
+            out += '\\';
+        if (codePoint == '\n')
+            out += "\\n";
+        else if (codePoint == '\r')
+            out += "\\r";
+        else
+            appendUtf8(out, codePoint);
+        i += length - 1;
     }
-    if (waitForChild(child, cpuBound, wallCap, CHILD_STALL_SECONDS) == ChildWait::SPINNING)
-        CV_Error(Error::StsParseError,
-                 format("'%s': OpenCV's YAML reader spun for %.3g s of CPU time without finishing; the text "
-                        "is not a single YAML document of the shape this module reads (a line that ends the "
-                        "root collection early, followed by a '-'?)",
-                        path.c_str(), cpuBound));
+    return out;
 }
 
 std::string readTextFile(const String& path)
@@ -418,14 +552,19 @@ FileStorage openFileStorageForReading(const String& path, const String& what)
     if (text.compare(0, 3, "\xEF\xBB\xBF") == 0)
         text.erase(0, 3);
     detail::rejectUnsupportedStructure(path, text);
-    detail::rejectWrappingIntegers(path, text);
+    // A maintained parser reads the text first, iteratively and with a depth limit: OpenCV's readers
+    // recurse once per level (60,000 nested brackets overflow the stack) and loop forever on some
+    // malformed YAML streams, so they only ever see text that is valid, shallow and of one document.
     // OpenCV tells YAML from JSON by the first bytes only: JSON must start with its brace, and YAML
     // with a %YAML line, which hand-written files often lack.
     const size_t first = text.find_first_not_of(" \t\r\n");
-    const std::string parsed = text[first] == '{'                 ? text.substr(first)
-                               : text.compare(0, 5, "%YAML") == 0 ? text
-                                                                  : "%YAML:1.0\n" + text;
-    detail::requireParseFinishes(path, parsed);
+    std::string parsed;
+    if (text[first] == '{') {
+        parsed = detail::validateJson(path, text.substr(first));
+    } else {
+        detail::validateYaml(path, text);
+        parsed = text.compare(0, 5, "%YAML") == 0 ? std::move(text) : "%YAML:1.0\n" + text;
+    }
     FileStorage fs;
     try {
         fs.open(parsed, FileStorage::READ | FileStorage::MEMORY);

@@ -391,6 +391,21 @@ String jsonNumber(double v)
 
 } // namespace
 
+namespace {
+
+/** Neither darktable's nor Android's format has a place for the failed_calibration mark: an export
+ * would turn a model that NoiseModel::load() refuses into one every reader takes. */
+void refuseFailedCalibrationExport(const NoiseModel& model, const char* who)
+{
+    if (!model.failedCalibration.empty())
+        CV_Error(Error::StsBadArg,
+                 cv::format("%s: the model is marked failed_calibration (%s); the exported profile could not "
+                            "carry the mark, so it is not exported",
+                            who, model.failedCalibration.c_str()));
+}
+
+} // namespace
+
 String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format, double baseIso,
                               const std::vector<double>& isos, const String& maker, const String& cameraModel,
                               double haarVarianceRatio)
@@ -398,6 +413,7 @@ String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format, 
     const char* who = "darktableNoiseProfiles";
     checkBaseIso(baseIso, who);
     checkHaarVarianceRatio(haarVarianceRatio, who);
+    refuseFailedCalibrationExport(model, who);
     const double c = haarVarianceRatio;
     if (isos.empty())
         CV_Error(Error::StsBadArg, "darktableNoiseProfiles: no ISO given");
@@ -564,6 +580,7 @@ AndroidNoiseProfile androidNoiseProfile(const NoiseModel& model, const RawFormat
 {
     checkBaseIso(baseIso, "androidNoiseProfile");
     model.validate();
+    refuseFailedCalibrationExport(model, "androidNoiseProfile");
     format.validate();
     AndroidNoiseProfile p;
     for (int site = 0; site < 4; ++site) {

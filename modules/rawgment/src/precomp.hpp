@@ -69,34 +69,23 @@ std::string readTextFile(const String& path);
 void checkRegularFile(const String& path, const String& what);
 //! Why a file of this st_mode is not read ("it is a FIFO ...").
 const char* notRegularReason(unsigned mode);
-/** Throws StsParseError naming the file (`path`) and line of an integer literal of `text` beyond 32 bits:
- * OpenCV's YAML and JSON readers keep integers in an int and silently wrap them (4294967297 reads as 1). */
-void rejectWrappingIntegers(const String& path, const std::string& text);
 /** Throws StsParseError naming the file (`path`) unless `text` is JSON or a single-document YAML stream
  * whose root collection starts a line at column 0 (empty text and XML are refused too): OpenCV 4.6's
  * YAML parser loops forever on some streams with more than one document. */
 void rejectUnsupportedStructure(const String& path, const std::string& text);
-//! How waitForChild() saw a child process end.
-enum class ChildWait
-{
-    FINISHED, //!< it ended by itself
-    SPINNING, //!< it used more than its bound of CPU time and was killed
-    STALLED,  //!< it gained no CPU time for a while (blocked, as on a lock held at the fork) and was killed
-    OVERTIME  //!< the wall-time cap passed and it was killed
-};
-//! Seconds without CPU progress after which requireParseFinishes() takes its child as blocked.
-constexpr double CHILD_STALL_SECONDS = 3.0;
-/** Waits for the forked `child` until it ends, spins beyond `cpuBound` seconds of its CPU time, gains
- * less than a millisecond of CPU time in `stallSeconds` of wall time, or `wallCap` seconds of wall time
- * pass; kills it unless it ended, and reaps it (also where SIGCHLD is ignored). */
-CV_RAWGMENT_EXPORTS ChildWait waitForChild(int child, double cpuBound, double wallCap, double stallSeconds);
-/** Throws StsParseError naming the file (`path`) when OpenCV's parser spins on `text` (as
- * FileStorage::MEMORY would be given it) beyond `cpuBound` seconds of CPU time (0: parseCpuBound() of
- * the text): the parse runs first in a child process. */
-CV_RAWGMENT_EXPORTS void requireParseFinishes(const String& path, const std::string& text,
-                                              double cpuBound = 0);
-//! The CPU time an honest parse of `bytes` of YAML/JSON never needs (requireParseFinishes()'s default).
-CV_RAWGMENT_EXPORTS double parseCpuBound(size_t bytes);
+//! The deepest nesting of maps and lists openFileStorageForReading() accepts; this module's files nest
+//! at most five levels, and OpenCV's readers recurse once per level.
+constexpr int MAX_NESTING_DEPTH = 64;
+/** Parses `text` (a file's whole content, OpenCV's "%YAML:1.0" line allowed) with libyaml, iteratively,
+ * and throws StsParseError naming the file (`path`), the line and what is wrong unless it is one YAML
+ * document whose root is a block map or list at column 0, nested at most MAX_NESTING_DEPTH levels, with
+ * no anchor or alias and no integer literal beyond 32 bits (OpenCV's reader would wrap it). */
+CV_RAWGMENT_EXPORTS void validateYaml(const String& path, const std::string& text);
+/** Parses `text` with nlohmann's JSON parser, iteratively, and throws StsParseError naming the file
+ * (`path`), the line and what is wrong unless it is valid JSON nested at most MAX_NESTING_DEPTH levels
+ * with no integer beyond 32 bits. Returns the text OpenCV's reader is given: the same, with the escapes it
+ * lacks (\uXXXX, \/) written out as UTF-8. */
+CV_RAWGMENT_EXPORTS std::string validateJson(const String& path, const std::string& text);
 
 //! The text that writeFileStorageAtomically() would write to `path`.
 template <typename Writer> std::string fileStorageText(const String& path, Writer&& writeBody)

@@ -245,6 +245,92 @@ TEST(CameraProfiles, camerasAreFoundByNameAndAMissingOneListsTheClosest)
     EXPECT_CV_ERROR_CONTAINS(selectCameraProfiles(cams, "Nikon D3, Canon X"), "no camera named 'Canon X'");
 }
 
+TEST(CameraProfiles, tinyAndDenormalShotSlopesAreRefusedNotFittedToNanOrZero)
+{
+    // A denormal green slope once made alpha NaN (judged GOOD: NaN passes every '>' bound), and a slope
+    // of 1e-300 overflowed the fit's sums to alpha = 0 (a usable camera with no shot noise).
+    const double c = DARKTABLE_HAAR_VARIANCE_RATIO;
+    const std::string dir = makeTempDir("camera_profiles_tiny_slopes");
+    std::vector<std::string> entries;
+    const double tiny[] = {5e-324, 1e-310, 1e-300, 1e-13};
+    for (int k = 0; k < 4; ++k)
+        entries.push_back(cameraEntry(
+            "T" + std::to_string(k),
+            {Vec3d(100, tiny[k], c * 4e-8), Vec3d(200, c * 2e-4, c * 5e-8), Vec3d(400, c * 4e-4, c * 8e-8)}));
+    entries.push_back(cameraEntry("Fine", {Vec3d(100, c * 1e-4, c * 4e-8), Vec3d(200, c * 2e-4, c * 5e-8),
+                                           Vec3d(400, c * 4e-4, c * 8e-8)}));
+    const std::vector<CameraNoiseProfile> cams =
+        readCameraProfiles(writeText(dir, "tiny.json", profileFile("Tiny", entries)));
+    for (int k = 0; k < 4; ++k) {
+        const CameraNoiseProfile& cam = byModel(cams, "T" + std::to_string(k));
+        EXPECT_EQ(CAMERA_PROFILE_REFUSED, cam.verdict) << cam.name() << ": " << cam.reason;
+        EXPECT_NE(cam.reason.find("below 1e-12"), std::string::npos) << cam.reason;
+    }
+    EXPECT_EQ(CAMERA_PROFILE_GOOD, byModel(cams, "Fine").verdict) << byModel(cams, "Fine").reason;
+    const std::vector<CameraNoiseProfile> good = selectCameraProfiles(cams, "good");
+    ASSERT_EQ(1u, good.size());
+    EXPECT_EQ("Fine", good[0].model);
+}
+
+TEST(CameraProfiles, aNameWithACommaIsSelectedAndControlCharactersAreRefusedShownEscaped)
+{
+    const double c = DARKTABLE_HAAR_VARIANCE_RATIO;
+    const std::vector<Vec3d> good = {Vec3d(100, c * 1e-4, c * 4e-8), Vec3d(200, c * 2e-4, c * 5e-8),
+                                     Vec3d(400, c * 4e-4, c * 8e-8)};
+    const std::string dir = makeTempDir("camera_profiles_odd_names");
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(writeText(
+        dir, "names.json",
+        profileFile("Foo", {cameraEntry("X, Mark II", good), cameraEntry("X", good), cameraEntry("Y", good),
+                            cameraEntry("Evil\\nInjected line", good), cameraEntry("Bell\\u0007", good)})));
+    ASSERT_EQ(5u, cams.size());
+    // Alone, in a list, and beside a camera whose name is its first piece.
+    ASSERT_EQ(1u, selectCameraProfiles(cams, "Foo X, Mark II").size());
+    EXPECT_EQ("X, Mark II", selectCameraProfiles(cams, "Foo X, Mark II")[0].model);
+    const std::vector<CameraNoiseProfile> listed = selectCameraProfiles(cams, "Foo Y, Foo X, Mark II, Foo X");
+    ASSERT_EQ(3u, listed.size());
+    EXPECT_EQ("Y", listed[0].model);
+    EXPECT_EQ("X, Mark II", listed[1].model);
+    EXPECT_EQ("X", listed[2].model);
+    EXPECT_EQ("X, Mark II", findCameraProfile(cams, "foo x, mark ii").model);
+    // A newline or a bell in a name: kept escaped (one line in any listing), and the camera refused.
+    for (const CameraNoiseProfile& cam : cams) {
+        EXPECT_EQ(std::string::npos, cam.name().find_first_of("\n\a")) << cam.name();
+    }
+    EXPECT_EQ("Evil\\nInjected line", cams[3].model);
+    EXPECT_EQ(CAMERA_PROFILE_REFUSED, cams[3].verdict);
+    EXPECT_NE(cams[3].reason.find("1 control character"), std::string::npos) << cams[3].reason;
+    EXPECT_EQ("Bell\\x07", cams[4].model);
+    EXPECT_EQ(CAMERA_PROFILE_REFUSED, cams[4].verdict);
+}
+
+TEST(CameraProfiles, anAndroidProfileFileHoldsTheProfileAloneAndExportsKeepTheFailedMark)
+{
+    const std::string dir = makeTempDir("camera_profiles_android_root");
+    const RawFormat format = fourteenBitFormat();
+    NoiseModel model(0.42, 1.7, 3.1);
+    const AndroidNoiseProfile android = androidNoiseProfile(model, format, 100);
+    const std::string profile = cv::format(
+        "android_noise_profile:\n   base_iso: 100\n   A: [%.17g, %.17g, %.17g, %.17g]\n   B: [0, 0, 0, 0]\n"
+        "   C: [%.17g, %.17g, %.17g, %.17g]\n   D: [%.17g, %.17g, %.17g, %.17g]\n",
+        android.A[0], android.A[1], android.A[2], android.A[3], android.C[0], android.C[1], android.C[2],
+        android.C[3], android.D[0], android.D[1], android.D[2], android.D[3]);
+    EXPECT_NO_THROW(loadAnyNoiseModel(writeText(dir, "alone.yml", profile), "", format));
+    // A failed calibration's model beside it, or any other root key: an error naming the key.
+    const std::string beside = writeText(dir, "beside.yml",
+                                         "noise_model:\n   format_version: 1\n   alpha: 1\n   sigma_d2: 1\n"
+                                         "   sigma_r2: 1\n   failed_calibration: \"fit\"\n" +
+                                             profile);
+    EXPECT_CV_ERROR_CONTAINS(loadAnyNoiseModel(beside, "", format), "unknown key 'noise_model'");
+    EXPECT_CV_ERROR_CONTAINS(
+        loadAnyNoiseModel(writeText(dir, "extra.yml", profile + "extra: 1\n"), "", format),
+        "unknown key 'extra'");
+    // Neither export has a place for the failed_calibration mark: a marked model is not exported.
+    model.failedCalibration = "read noise: chi-square p = 1e-9";
+    EXPECT_CV_ERROR_CONTAINS(androidNoiseProfile(model, format, 100), "marked failed_calibration");
+    EXPECT_CV_ERROR_CONTAINS(darktableNoiseProfiles(model, format, 100, {100, 200}, "M", "C"),
+                             "marked failed_calibration (read noise: chi-square p = 1e-9)");
+}
+
 TEST(CameraProfiles, cameraDrawsAreUniformAndAFunctionOfTheSeed)
 {
     const int count = 7, draws = 70000;

@@ -2,16 +2,38 @@
 #include "test_common.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <dirent.h>
+#include <dlfcn.h>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <unistd.h>
+
+namespace {
+std::atomic<long> forkCount{0};
+} // namespace
+
+// The test program's own fork(): the library's calls resolve to it before libc's, so a test can tell
+// whether a reader started a child (Files.readersStartNoChildProcess).
+extern "C" pid_t fork() noexcept
+{
+    ++forkCount;
+    using Fork = pid_t (*)();
+    static const Fork next = reinterpret_cast<Fork>(::dlsym(RTLD_NEXT, "fork"));
+    return next ? next() : -1;
+}
 
 namespace cv {
 namespace rawgment {
 namespace test {
+
+long forkCalls()
+{
+    return forkCount.load();
+}
 
 std::string findDataFile(const std::string& name)
 {

@@ -29,6 +29,8 @@ int countNonFinite(const Mat& m);
 std::vector<char> readBytes(const std::string& path);
 //! Writes bytes to a file, failing the test when it cannot.
 void writeBytes(const std::string& path, const std::vector<char>& bytes);
+//! How many times this test program has called fork() (interposed by test_common.cpp) since it began.
+long forkCalls();
 //! The names in a folder, sorted, without the ones starting with '.'.
 std::vector<std::string> filesIn(const std::string& dir);
 
