@@ -1086,6 +1086,49 @@ TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
     EXPECT_NE(std::string::npos, r.output.find("needs dark bursts")) << r.output;
 }
 
+TEST(Apps, calibrateDarkComponentsRefusesDarkFramesOfAnotherFormatNamingBoth)
+{
+    // Dark frames of another camera (BGGR for RGGB, black 64 for 256, white 1023 for 4095, same size)
+    // were taken without a word: sigma_r^2 came out about 15 instead of 0.87.
+    const std::string dir = freshDir("dark_other_format");
+    AppRun r = runApp("rawgment_simulate", "--frames=3 --levels=0.5 --format=png --validation=false "
+                                           "--gains=6,18 --dark=true --out='" +
+                                               dir + "/sim'");
+    ASSERT_EQ(0, r.status) << r.output;
+    std::ostringstream manifest;
+    manifest << "calibration_manifest:\n  patches: none\n  bursts:\n";
+    for (const char* burst : {"g06dB_level0.50", "g18dB_level0.50", "dark_g06dB", "dark_g18dB"}) {
+        const bool dark = std::string(burst).rfind("dark", 0) == 0;
+        manifest << "    - { gain_db: " << (std::string(burst).find("18dB") != std::string::npos ? 18 : 6)
+                 << ", dark: " << (dark ? "true" : "false") << ", files: [";
+        for (int t = 0; t < 3; ++t) {
+            std::string file = cv::format("%s/sim/%s/frame_%03d.png", dir.c_str(), burst, t);
+            if (dark) {
+                cv::Mat mosaic;
+                cv::rawgment::MosaicMetadata meta = cv::rawgment::readMosaic(file, mosaic);
+                meta.format.pattern = cv::rawgment::CFA_BGGR;
+                meta.format.blackLevel = cv::Vec4d::all(64);
+                meta.format.whiteLevel = 1023;
+                meta.hasScene = false;
+                cv::Mat clipped = cv::min(mosaic, 1023);
+                file = cv::format("%s/%s_%03d.png", dir.c_str(), burst, t);
+                cv::rawgment::writeMosaic(file, clipped, meta);
+            }
+            manifest << (t ? ", " : "") << "'" << file << "'";
+        }
+        manifest << "] }\n";
+    }
+    std::ofstream(dir + "/m.yml") << manifest.str();
+    r = runApp("rawgment_calibrate",
+               "'" + dir + "/m.yml' --plots=false --dark_components=true --out='" + dir + "/cal'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos,
+              r.output.find("(BGGR, black 64/64/64/64, white 1023) has another format than"))
+        << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("(RGGB, black 256/256/256/256, white 4095)")) << r.output;
+    EXPECT_FALSE(exists(dir + "/cal/noise_model.yml"));
+}
+
 TEST(Apps, calibrateReadsBurstsOfDifferentFrameSizesEachInsideItsOwnFrame)
 {
     // patches: none with a light burst and the dark bursts cropped: the sampling read beyond the smaller

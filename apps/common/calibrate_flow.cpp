@@ -154,6 +154,25 @@ void requireSameCapture(const LoadedMosaic& first, const std::string& firstPath,
                                  ": the frames of a burst must share ISO, exposure, size and levels");
 }
 
+std::string formatDescription(const RawFormat& f)
+{
+    return cv::format("%s, black %g/%g/%g/%g, white %g", cfaPatternName(f.pattern).c_str(), f.blackLevel[0],
+                      f.blackLevel[1], f.blackLevel[2], f.blackLevel[3], f.whiteLevel);
+}
+
+/* --dark_components fits the dark frames' rows, tails and shading with the first burst's format: dark
+ * frames of another camera mode (another pattern or levels) would be fitted as if they were this one's. */
+void requireOneFormatForDarkComponents(const RawFormat& first, const std::string& firstPath,
+                                       const RawFormat& f, const std::string& path)
+{
+    if (f.pattern == first.pattern && f.blackLevel == first.blackLevel && f.whiteLevel == first.whiteLevel)
+        return;
+    throw std::runtime_error("'" + path + "' (" + formatDescription(f) + ") has another format than '" +
+                             firstPath + "' (" + formatDescription(first) +
+                             "): --dark_components fits every burst with one format, so dark frames must "
+                             "come from the same camera and mode as the light bursts");
+}
+
 //! report.md: the verdict first, with its checks, then the model, the per-gain lines, the plots, the notes.
 std::string calibrationReportMarkdown(const CalibrateResult& r, const std::string& outDir)
 {
@@ -535,6 +554,9 @@ BurstInputs readBursts(const CalibrateOptions& o, const std::vector<CalibrationM
             } else {
                 requireSameCapture(first, spec.files.front(), m, spec.files[t]);
             }
+            if (o.darkComponents && t == 0 && i > 0)
+                requireOneFormatForDarkComponents(in.firstFormat, specs.front().files.front(), m.format,
+                                                  spec.files.front());
             stats->add(m.mosaic);
             if (spec.dark && o.darkComponents) {
                 if (t == 0) {
