@@ -154,7 +154,9 @@ def markdown(host, paths, rows, philox, python):
     return "\n".join(lines) + "\n"
 
 
-def write_atomically(path, text):
+def write_atomically(path, text, replace=False):
+    """Writes text to path through a synced temporary beside it; an existing path is kept (FileExistsError)
+    unless replace, and is never left half-written either way."""
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(dir=folder, prefix=".speed_goals.")
     try:
@@ -162,9 +164,14 @@ def write_atomically(path, text):
             f.write(text)
             f.flush()
             os.fsync(f.fileno())
-        os.replace(tmp, path)
+        if replace:
+            os.replace(tmp, path)
+        else:
+            os.link(tmp, path)  # fails when path exists: "never replaced" without a race
+            os.unlink(tmp)
     except BaseException:
-        os.unlink(tmp)
+        if os.path.lexists(tmp):
+            os.unlink(tmp)
         raise
 
 
@@ -174,10 +181,21 @@ def main(argv=None):
     parser.add_argument("--repetitions", type=int, default=3, help="runs of each benchmark; their median counts")
     parser.add_argument("--python", action="store_true", help="also goal 6 (needs the module on PYTHONPATH)")
     parser.add_argument("--python-rounds", type=int, default=5, help="interleaved rounds of goal 6")
-    parser.add_argument("--out", help="also write the table to this file (atomically)")
+    parser.add_argument("--out", help="also write the table to this file (atomically; an existing file is an "
+                                      "error unless --replace)")
+    parser.add_argument("--replace", action="store_true", help="let --out replace an existing file")
     args = parser.parse_args(argv)
     if args.repetitions < 1 or args.python_rounds < 1:
         parser.error("--repetitions and --python-rounds must be at least 1")
+    # Checked before the benchmarks, which take minutes: a table that cannot be written is said at once.
+    if args.out:
+        folder = os.path.dirname(os.path.abspath(args.out))
+        if not os.path.isdir(folder):
+            parser.error("--out '%s': the folder '%s' does not exist" % (args.out, folder))
+        if os.path.isdir(args.out):
+            parser.error("--out '%s' is a folder" % args.out)
+        if os.path.lexists(args.out) and not args.replace:
+            parser.error("--out '%s' exists; it is not replaced without --replace" % args.out)
     binaries = os.path.join(args.build, "bin")
     times = run_benchmarks(os.path.join(binaries, "perf_augment"), AUGMENT_FILTER, args.repetitions)
     times.update(run_benchmarks(os.path.join(binaries, "perf_calibration"), CALIBRATION_FILTER, args.repetitions))
@@ -188,7 +206,7 @@ def main(argv=None):
     text = markdown(host_line(paths[-1]), paths, rows, philox_row(times, cores), python)
     sys.stdout.write(text)
     if args.out:
-        write_atomically(args.out, text)
+        write_atomically(args.out, text, replace=args.replace)
 
 
 if __name__ == "__main__":

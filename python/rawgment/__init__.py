@@ -11,6 +11,7 @@ Optional parts: ``rawgment.torch`` (PyTorch transform and dataset; needs torch) 
 (folder augmentation on one machine or a Dask cluster; needs dask.distributed for a cluster).
 """
 import functools as _functools
+import os as _os
 import numbers as _numbers
 
 import numpy as _np
@@ -125,6 +126,10 @@ def _misfit(pname, ptype, value):
             return "must be an int, not %s" % type(value).__name__
         if "seed" in pname.lower() and not 0 <= int(value) < _SEED_LIMIT:
             return "must be a seed, an integer from 0 to %d (got %d)" % (_SEED_LIMIT - 1, value)
+        # pybind11 shows C++'s int and its 64-bit integers alike as "int"; a value it refused that does not
+        # fit 32 bits was refused for its size.
+        if "seed" not in pname.lower() and not -2 ** 31 <= int(value) < 2 ** 31:
+            return "must fit a 32-bit int, from %d to %d (got %d)" % (-2 ** 31, 2 ** 31 - 1, value)
     elif ptype == "float":
         if not isinstance(value, _numbers.Real):
             return "must be a number, not %s" % type(value).__name__
@@ -164,6 +169,9 @@ def _explained(fn):
 
     @_functools.wraps(fn)
     def call(*args, **kwargs):
+        # A pathlib.Path is as good a path as a str.
+        args = tuple(_os.fspath(a) if isinstance(a, _os.PathLike) else a for a in args)
+        kwargs = {k: _os.fspath(v) if isinstance(v, _os.PathLike) else v for k, v in kwargs.items()}
         try:
             return fn(*args, **kwargs)
         except TypeError as e:
@@ -177,8 +185,28 @@ def _explained(fn):
     return call
 
 
+def _explainedProperty(cls, name, prop):
+    """The property with a setter whose refusal names the field and why, not pybind11's generic message."""
+    def fset(obj, value):
+        try:
+            prop.fset(obj, value)
+        except TypeError as e:
+            if "incompatible function arguments" not in str(e):
+                raise
+            ptype = "int" if isinstance(prop.fget(obj), int) and not isinstance(prop.fget(obj), bool) else ""
+            why = _misfit(name, ptype, value) if ptype else None
+            raise TypeError("%s.%s %s" % (cls.__name__, name, why or "cannot be set to %r (a %s)" % (
+                value, type(value).__name__))) from None
+
+    return property(prop.fget, fset, prop.fdel, prop.__doc__)
+
+
 for _name in __all__:
     _fn = getattr(_rawgment, _name)
     if type(_fn).__name__ == "builtin_function_or_method":
         globals()[_name] = _explained(_fn)
+    elif isinstance(_fn, type):
+        for _field, _prop in list(vars(_fn).items()):
+            if isinstance(_prop, property) and _prop.fset is not None:
+                setattr(_fn, _field, _explainedProperty(_fn, _field, _prop))
 del _name, _fn

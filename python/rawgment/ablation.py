@@ -929,8 +929,64 @@ def _parser():
     return parser
 
 
+#: What writeOutputs() writes into its folder.
+OUTPUT_FILES = ("results.json", "results.csv", "psnr.png", "report.md")
+
+
+def _outputConflicts(outDir, networks):
+    """Why the outputs could not be written into outDir (None when they can), checked before any training:
+    the files are never replaced, so a previous run's would make the whole run fail at its end."""
+    if os.path.lexists(outDir) and not os.path.isdir(outDir):
+        return "--out '%s' exists and is not a folder" % outDir
+    folders = [outDir] if len(networks) == 1 else [os.path.join(outDir, n) for n in networks]
+    paths = [os.path.join(f, name) for f in folders for name in OUTPUT_FILES]
+    if len(networks) > 1:
+        paths += [os.path.join(outDir, "report.md")]
+        paths = [p for p in paths if not os.path.isdir(p)]
+        for f in folders:
+            if os.path.lexists(f) and not os.path.isdir(f):
+                return "'%s' exists and is not a folder" % f
+    existing = [p for p in paths if os.path.lexists(p)]
+    if existing:
+        return ("--out '%s' holds a previous run's %s; outputs are never replaced: choose another --out or "
+                "remove them" % (outDir, ", ".join("'%s'" % p for p in existing)))
+    parent = os.path.dirname(os.path.abspath(outDir))
+    while not os.path.exists(parent):
+        parent = os.path.dirname(parent)
+    if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
+        return "--out '%s' cannot be created: '%s' is not a writable folder" % (outDir, parent)
+    return None
+
+
+def _argumentErrors(args):
+    """The numeric options' errors, each naming its option (argparse checks only that they are numbers)."""
+    errors = []
+    if not 0 <= args.seed < 2 ** 64:
+        errors.append("--seed must be in [0, 2^64), got %d" % args.seed)
+    if args.threads < 0:
+        errors.append("--threads must be >= 0 (0: all cores), got %d" % args.threads)
+    if not math.isfinite(args.base_gain_db):
+        errors.append("--base-gain-db must be finite, got %r" % args.base_gain_db)
+    if not 1 <= args.bit_depth <= 16:
+        errors.append("--bit-depth must be in [1, 16], got %d" % args.bit_depth)
+    if not math.isfinite(args.black_level) or args.black_level < 0:
+        errors.append("--black-level must be finite and >= 0, got %r" % args.black_level)
+    if not math.isfinite(args.blind_step):
+        errors.append("--blind-step must be finite, got %r" % args.blind_step)
+    for name in ("seeds", "iterations"):
+        value = getattr(args, name)
+        if value is not None and value < 1:
+            errors.append("--%s must be >= 1, got %d" % (name, value))
+    return errors
+
+
 def main(argv=None):
     args = _parser().parse_args(argv)
+    errors = _argumentErrors(args)
+    if errors:
+        for e in errors:
+            print("rawgment.ablation: %s" % e, file=sys.stderr)
+        return 2
     config = AblationConfig()
     if args.quick:
         config.conditions = quickConditions()
@@ -979,6 +1035,10 @@ def main(argv=None):
         config.validate()
     except (ValueError, _rg.error) as e:
         print("rawgment.ablation: %s" % e, file=sys.stderr)
+        return 2
+    conflict = _outputConflicts(args.out, networks)
+    if conflict is not None:
+        print("rawgment.ablation: %s" % conflict, file=sys.stderr)
         return 2
 
     def log(line):

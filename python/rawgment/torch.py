@@ -273,8 +273,8 @@ class RawFolderDataset(torch.utils.data.Dataset):
     def set_epoch(self, epoch):
         """Sets the epoch whose seeds the next iteration uses, in this process and in a DataLoader's
         workers, persistent or not (call it before iterating over the loader for that epoch)."""
-        if int(epoch) < 0:
-            raise ValueError("epoch must be >= 0, got %r" % epoch)
+        if not 0 <= int(epoch) < 2 ** 63:
+            raise ValueError("epoch must be in [0, 2^63), got %r" % epoch)
         self._epoch[0] = int(epoch)
 
     def __len__(self):

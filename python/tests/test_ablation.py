@@ -278,6 +278,11 @@ def test_a_real_camera_from_darktables_profiles_is_the_one_simulated(tmp_path):
     (["--networks", "told,deaf"], "--networks must be told, blind or told,blind, got 'told,deaf'"),
     (["--blind-step", "0"], "blindStep in (0, 1]"),
     (["--shot-sampling", "binomial"], "shotSampling must be GAUSSIAN or POISSON"),
+    # Once tracebacks: each option's range is checked before anything runs.
+    (["--seed=-1"], "--seed must be in [0, 2^64), got -1"),
+    (["--seed=%d" % 2 ** 64], "--seed must be in [0, 2^64)"),
+    (["--threads=-1"], "--threads must be >= 0"),
+    (["--base-gain-db=nan"], "--base-gain-db must be finite, got nan"),
 ])
 def test_the_command_refuses_what_it_does_not_understand(argv, message, tmp_path):
     run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--out", str(tmp_path / "x"), *argv],
@@ -285,6 +290,31 @@ def test_the_command_refuses_what_it_does_not_understand(argv, message, tmp_path
     assert run.returncode == 2
     assert message in run.stderr
     assert not (tmp_path / "x").exists()
+
+
+def test_an_out_that_cannot_take_the_outputs_is_refused_before_any_training(tmp_path):
+    # A previous run's folder or a file at --out once failed after all the training, with a traceback.
+    quick = ["--quick", "--seeds", "1", "--iterations", "1", "--arms", "ORACLE,NOISY", "--networks", "told"]
+    afile = tmp_path / "afile"
+    afile.write_text("mine")
+    previous = tmp_path / "previous"
+    previous.mkdir()
+    (previous / "report.md").write_text("an earlier report")
+    both = tmp_path / "both"
+    (both / "blind").mkdir(parents=True)
+    (both / "blind" / "results.json").write_text("{}")
+    for out, extra, message in ((afile, [], "exists and is not a folder"),
+                                (previous, [], "holds a previous run's '%s'" % (previous / "report.md")),
+                                (both, ["--networks", "told,blind"], str(both / "blind" / "results.json")),
+                                (tmp_path / "afile" / "sub", [], "is not a writable folder")):
+        run = subprocess.run([sys.executable, "-m", "rawgment.ablation", *quick, *extra, "--out", str(out)],
+                             capture_output=True, text=True)
+        assert run.returncode == 2, run.stderr
+        assert message in run.stderr
+        assert "Traceback" not in run.stderr
+        assert "training" not in run.stderr.lower()
+    assert afile.read_text() == "mine"
+    assert (previous / "report.md").read_text() == "an earlier report"
 
 
 def test_help_names_the_options():

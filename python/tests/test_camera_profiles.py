@@ -96,6 +96,38 @@ def test_every_camera_of_darktables_file_matches_an_independent_fit():
     assert checked >= 300
 
 
+def test_darktables_file_saved_again_with_json_escapes_reads_the_same(tmp_path):
+    # Python's json.dump writes every non-ASCII letter as \u00f8 (and may write '/' as \/); JSON allows
+    # both and OpenCV's reader knows neither: the file was refused whole with "parseValue".
+    with open(_profiles_path()) as f:
+        data = json.load(f)
+    data["noiseprofiles"][0]["maker"] += " Sj\u00f8str\u00f8m"  # a non-ASCII letter, escaped by dump
+    escaped = tmp_path / "escaped.json"
+    escaped.write_text(json.dumps(data).replace("/", "\\/"))
+    assert "\\u00f8" in escaped.read_text() and "\\/" in escaped.read_text()
+    plain = tmp_path / "plain.json"
+    plain.write_text(json.dumps(data, ensure_ascii=False), encoding="utf-8")
+    a, b = rg.readCameraProfiles(escaped), rg.readCameraProfiles(str(plain))
+    assert len(a) == len(b) == len(data["noiseprofiles"][0]["models"]) + sum(
+        len(m["models"]) for m in data["noiseprofiles"][1:])
+    assert a[0].maker.endswith("Sj\u00f8str\u00f8m")
+    for x, y in zip(a, b):
+        assert (x.name(), x.verdict, x.alpha, x.reason) == (y.name(), y.verdict, y.alpha, y.reason)
+
+
+def test_the_smaller_refusals_name_the_argument(tmp_path):
+    with pytest.raises(TypeError, match=r"drawCameraIndex\(\): argument 'count' must fit a 32-bit int"):
+        rg.drawCameraIndex(2 ** 31, 1)
+    params = rg.DarktableImportParams()
+    with pytest.raises(TypeError, match=r"DarktableImportParams.goodMinIsos must fit a 32-bit int .*1000000000000"):
+        params.goodMinIsos = 10 ** 12
+    params.goodMinIsos = 4
+    assert params.goodMinIsos == 4
+    # A pathlib.Path is a path like any other.
+    with pytest.raises(rg.error, match="no such file"):
+        rg.readCameraProfiles(tmp_path / "none.json")
+
+
 @pytest.fixture(scope="module")
 def two_cameras(tmp_path_factory):
     """A darktable file of two cameras of very different read noise (the project's own exports)."""
@@ -135,6 +167,21 @@ def test_the_transform_draws_a_camera_per_sample_from_its_seed(two_cameras, sens
         torch_module.RandomNoiseScene(path, camera="Maker Lod")
     with pytest.raises(ValueError, match="camera chooses among"):
         torch_module.RandomNoiseScene(rg.NoiseModel(0.3, 1, 1), camera="Maker Loud")
+
+
+def test_a_camera_whose_name_holds_a_comma_is_selected_alone_and_in_a_list(tmp_path):
+    torch_module = pytest.importorskip("rawgment.torch")
+    fmt = rg.RawFormat(blackLevel=(64, 64, 64, 64), whiteLevel=4095)
+    models = []
+    for name in ("X, Mark II", "X"):
+        text = rg.darktableNoiseProfiles(rg.NoiseModel(0.3, 0.5, 2.0), fmt, 100, [100, 400, 1600], "Foo", name)
+        models += json.loads(text)["noiseprofiles"][0]["models"]
+    path = tmp_path / "noiseprofiles.json"
+    path.write_text(json.dumps({"version": 0, "noiseprofiles": [{"maker": "Foo", "models": models}]}))
+    assert [c.model for c in torch_module.RandomNoiseScene(str(path), camera="Foo X, Mark II").cameras] == [
+        "X, Mark II"]
+    assert [c.model for c in torch_module.RandomNoiseScene(str(path), camera=["Foo X, Mark II", "Foo X"]).cameras] \
+        == ["X, Mark II", "X"]
 
 
 def test_the_dataset_records_each_samples_camera(two_cameras, sensor, tmp_path):

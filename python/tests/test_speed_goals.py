@@ -95,12 +95,29 @@ def test_a_failed_run_leaves_the_previous_table_and_unknown_flags_are_refused(go
     out = tmp_path / "goals.md"
     out.write_text("the previous table\n")
     with pytest.raises(FileNotFoundError, match="perf_augment"):
-        goals.main(["--build", str(tmp_path / "no_build"), "--out", str(out)])
+        goals.main(["--build", str(tmp_path / "no_build"), "--out", str(out), "--replace"])
     assert out.read_text() == "the previous table\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["goals.md"]  # no temporary left
     with pytest.raises(SystemExit):
         goals.main(["--repetition", "3"])
     assert "--repetition" in capsys.readouterr().err
-    goals.write_atomically(str(out), "a new table\n")
+    with pytest.raises(FileExistsError):
+        goals.write_atomically(str(out), "a new table\n")
+    assert out.read_text() == "the previous table\n"
+    goals.write_atomically(str(out), "a new table\n", replace=True)
     assert out.read_text() == "a new table\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["goals.md"]
+
+
+def test_an_out_that_exists_or_has_no_folder_is_refused_before_the_benchmarks(goals, tmp_path, capsys):
+    # The build folder does not exist either: an error about --out proves it came first.
+    out = tmp_path / "goals.md"
+    out.write_text("the previous table\n")
+    for argv, message in (([], "exists; it is not replaced without --replace"),
+                          (["--out", str(tmp_path / "missing" / "goals.md")], "does not exist"),
+                          (["--out", str(tmp_path)], "is a folder")):
+        with pytest.raises(SystemExit) as stop:
+            goals.main(["--build", str(tmp_path / "no_build"), "--out", str(out), *argv])
+        assert stop.value.code == 2
+        assert message in capsys.readouterr().err
+    assert out.read_text() == "the previous table\n"

@@ -78,6 +78,11 @@ def test_dataloader_gives_the_same_samples_with_0_and_2_workers(folder, sensor):
     dataset.set_epoch(0)
     again = batches(torch.utils.data.DataLoader(dataset, batch_size=2, num_workers=2))
     assert all(torch.equal(a[1], b[1]) for a, b in zip(results[0], again))
+    # The epoch is a 64-bit signed tensor: beyond it, an error that says the range (once "Overflow when
+    # unpacking long").
+    for bad in (2 ** 63, -1):
+        with pytest.raises(ValueError, match=r"epoch must be in \[0, 2\^63\)"):
+            dataset.set_epoch(bad)
 
 
 def test_persistent_workers_see_every_epoch(folder, sensor):
