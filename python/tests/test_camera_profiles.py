@@ -119,7 +119,7 @@ def test_the_smaller_refusals_name_the_argument(tmp_path):
     with pytest.raises(TypeError, match=r"drawCameraIndex\(\): argument 'count' must fit a 32-bit int"):
         rg.drawCameraIndex(2 ** 31, 1)
     params = rg.DarktableImportParams()
-    with pytest.raises(TypeError, match=r"DarktableImportParams.goodMinIsos must fit a 32-bit int .*1000000000000"):
+    with pytest.raises(TypeError, match=r"DarktableImportParams.goodMinIsos must fit a 32-bit int, .*got 1000000000000"):
         params.goodMinIsos = 10 ** 12
     params.goodMinIsos = 4
     assert params.goodMinIsos == 4
