@@ -289,6 +289,29 @@ void rejectUnsupportedStructure(const String& path, const std::string& text)
     }
 }
 
+namespace {
+
+//! The byte offset of a libyaml mark (its line and column count characters) in `text`.
+size_t byteOffsetOf(const std::string& text, size_t from, const yaml_mark_t& mark)
+{
+    size_t at = from;
+    for (size_t line = 0; line < mark.line && at < text.size(); ++line) {
+        const size_t newline = text.find('\n', at);
+        at = newline == std::string::npos ? text.size() : newline + 1;
+    }
+    // UTF-8 continuation bytes (10xxxxxx) are no characters of their own.
+    for (size_t column = 0; at < text.size() && (column < mark.column || (text[at] & 0xC0) == 0x80); ++at)
+        if ((text[at] & 0xC0) != 0x80)
+            ++column;
+    return at;
+}
+
+/** Parses `text` from byte `from` once; returns the offset of a backslash where libyaml found an unknown
+ * escape and the text has OpenCV's \' there (std::string::npos when it parsed or failed otherwise). */
+size_t validateYamlOnce(const String& path, const std::string& text, size_t from, int lineOffset);
+
+} // namespace
+
 void validateYaml(const String& path, const std::string& text)
 {
     // OpenCV's own header line ("%YAML:1.0") is no YAML directive: libyaml reads from the next line.
@@ -299,6 +322,40 @@ void validateYaml(const String& path, const std::string& text)
         from = newline == std::string::npos ? text.size() : newline + 1;
         lineOffset = 1;
     }
+    // OpenCV's writer escapes an apostrophe in a double-quoted string as \', which YAML does not have
+    // (a calibration report's notes hold them). libyaml says exactly where it meets one, always in a
+    // double-quoted scalar: that scalar's \' become \" (the same length, so lines and columns stay) and
+    // the text is parsed again. A budget of bytes re-parsed keeps a file full of them from costing
+    // more than a second.
+    std::string patched;
+    const std::string* parsed = &text;
+    long long budget = 64LL << 20;
+    for (;;) {
+        const size_t escape = validateYamlOnce(path, *parsed, from, lineOffset);
+        if (escape == std::string::npos)
+            return;
+        budget -= static_cast<long long>(parsed->size() - from);
+        if (budget < 0)
+            CV_Error(Error::StsParseError,
+                     format("'%s' line %d: too many double-quoted strings with OpenCV's \\' escape to check",
+                            path.c_str(), lineAt(*parsed, escape)));
+        if (parsed == &text) {
+            patched = text;
+            parsed = &patched;
+        }
+        for (size_t i = escape; i + 1 < patched.size() && patched[i] != '"'; ++i)
+            if (patched[i] == '\\') {
+                if (patched[i + 1] == '\'')
+                    patched[i + 1] = '"';
+                ++i;
+            }
+    }
+}
+
+namespace {
+
+size_t validateYamlOnce(const String& path, const std::string& text, size_t from, int lineOffset)
+{
     YamlParser yaml(text.data() + from, text.size() - from);
     const auto lineOf = [&](const yaml_mark_t& mark) { return static_cast<int>(mark.line) + 1 + lineOffset; };
     const auto refuse = [&](int line, const std::string& why) {
@@ -310,6 +367,11 @@ void validateYaml(const String& path, const std::string& text)
         YamlEvent e;
         if (!yaml_parser_parse(&yaml.parser, &e.event)) {
             const yaml_parser_t& p = yaml.parser;
+            if (p.problem && std::strcmp(p.problem, "found unknown escape character") == 0) {
+                const size_t at = byteOffsetOf(text, from, p.problem_mark);
+                if (text.compare(at, 2, "\\'") == 0)
+                    return at;
+            }
             std::string why = p.problem ? p.problem : "malformed YAML";
             if (p.context)
                 why += std::string(" ") + p.context + format(" (from line %d)", lineOf(p.context_mark));
@@ -322,7 +384,7 @@ void validateYaml(const String& path, const std::string& text)
         case YAML_STREAM_END_EVENT:
             if (!root)
                 CV_Error(Error::StsParseError, "'" + path + "' holds no map (only comments or directives)");
-            return;
+            return std::string::npos;
         case YAML_DOCUMENT_START_EVENT:
             if (++documents > 1)
                 refuse(line, "a second document (this module reads single-document YAML files)");
@@ -375,10 +437,25 @@ void validateYaml(const String& path, const std::string& text)
     }
 }
 
+} // namespace
+
 std::string validateJson(const String& path, const std::string& text)
 {
+    // OpenCV's JSON writer escapes an apostrophe as \', which JSON does not have (its reader takes it).
+    // In JSON every backslash belongs to a string, so each \' is such an escape: the validator is given
+    // \" in its place (the same length and string), and OpenCV the text as it is.
+    std::string forValidator;
+    if (text.find("\\'") != std::string::npos) {
+        forValidator = text;
+        for (size_t i = 0; i + 1 < forValidator.size(); ++i)
+            if (forValidator[i] == '\\') {
+                if (forValidator[i + 1] == '\'')
+                    forValidator[i + 1] = '"';
+                ++i;
+            }
+    }
     JsonChecks checks;
-    nlohmann::json::sax_parse(text, &checks);
+    nlohmann::json::sax_parse(forValidator.empty() ? text : forValidator, &checks);
     switch (checks.stop) {
     case JsonChecks::Stop::SYNTAX:
         CV_Error(Error::StsParseError, "'" + path + "' is not valid JSON: " + checks.message);
