@@ -1086,6 +1086,66 @@ TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
     EXPECT_NE(std::string::npos, r.output.find("needs dark bursts")) << r.output;
 }
 
+TEST(Apps, everyFileAnAppReadsNested100000DeepIsAnErrorNotACrash)
+{
+    // 60,000 nested brackets overflowed the stack in OpenCV's recursive reader: rawgment_cameras,
+    // rawgment_augment --model and the manifests died with exit 139. Each is now an error naming the file.
+    const std::string dir = freshDir("deep_files");
+    const std::string deep = std::string(100000, '[') + "1" + std::string(100000, ']');
+    const auto write = [&](const std::string& name, const std::string& text) {
+        std::ofstream(dir + "/" + name) << text;
+        return dir + "/" + name;
+    };
+    const std::string json = write("deep.json", "{\"noiseprofiles\": " + deep + "}\n");
+    const std::string model =
+        write("model.yml", "noise_model:\n   format_version: 1\n   alpha: " + deep + "\n");
+    const std::string good = dir + "/good.yml";
+    cv::rawgment::NoiseModel(0.4, 0.5, 2.0).save(good);
+    const std::string scene = write("scene.yml", "scene:\n   shift: " + deep + "\n");
+    const std::string policy =
+        write("policy.yml", "random_scene_policy:\n   format_version: 1\n   noise: " + deep + "\n");
+    const std::string manifest = write("manifest.yml", "calibration_manifest:\n   bursts: " + deep + "\n");
+    const std::string validation = write("validation.yml", "validation_manifest:\n   pairs: " + deep + "\n");
+    const std::string patches = write("patches.yml", "chart_patches:\n   squares: " + deep + "\n");
+    const std::string patchesManifest =
+        write("patches_manifest.yml",
+              "calibration_manifest:\n   patches: '" + patches +
+                  "'\n   bursts:\n      - { gain_db: 6, files: [ in0.png, in1.png, in2.png ] }\n");
+    const std::string input = dir + "/in.png";
+    cv::rawgment::writeMosaic(input, cv::Mat(8, 8, CV_16UC1, cv::Scalar(300)),
+                              cv::rawgment::MosaicMetadata());
+    for (int k = 0; k < 3; ++k)
+        cv::rawgment::writeMosaic(dir + "/in" + std::to_string(k) + ".png",
+                                  cv::Mat(8, 8, CV_16UC1, cv::Scalar(300)), cv::rawgment::MosaicMetadata());
+    const struct
+    {
+        const char* app;
+        std::string args, file;
+    } runs[] = {
+        {"rawgment_cameras", "--profiles='" + json + "'", json},
+        {"rawgment_augment",
+         "--model='" + model + "' --policy='" + policy + "' --out='" + dir + "/o1' '" + input + "'", model},
+        {"rawgment_augment",
+         "--model='" + json + "' --camera=x --policy='" + policy + "' --out='" + dir + "/o2' '" + input + "'",
+         json},
+        {"rawgment_augment",
+         "--model='" + good + "' --scene='" + scene + "' --out='" + dir + "/o3' '" + input + "'", scene},
+        {"rawgment_augment",
+         "--model='" + good + "' --policy='" + policy + "' --out='" + dir + "/o4' '" + input + "'", policy},
+        {"rawgment_calibrate", "'" + manifest + "' --out='" + dir + "/c1'", manifest},
+        {"rawgment_calibrate", "'" + patchesManifest + "' --out='" + dir + "/c2'", patches},
+        {"rawgment_validate", "'" + validation + "' --model='" + good + "' --out='" + dir + "/v1'",
+         validation},
+    };
+    for (const auto& run : runs) {
+        const AppRun r = runApp(run.app, run.args);
+        EXPECT_EQ(1, r.status) << run.app << " " << run.args << "\n" << r.output;
+        EXPECT_NE(std::string::npos, r.output.find("nested more than 64 levels")) << run.app << "\n"
+                                                                                  << r.output;
+        EXPECT_NE(std::string::npos, r.output.find(run.file)) << run.app << "\n" << r.output;
+    }
+}
+
 TEST(Apps, calibrateDarkComponentsRefusesDarkFramesOfAnotherFormatNamingBoth)
 {
     // Dark frames of another camera (BGGR for RGGB, black 64 for 256, white 1023 for 4095, same size)

@@ -208,6 +208,22 @@ size_t offsetBeyondDepth(const std::string& text)
     return text.size();
 }
 
+/** Where the number `literal` stands alone in the JSON text (not inside a longer number); the text's end if
+ * nowhere. Only for the line of an error: a string that holds the same digits may be taken for it. */
+size_t offsetOfNumber(const std::string& text, const std::string& literal)
+{
+    const auto partOfNumber = [](char c) {
+        return (c >= '0' && c <= '9') || c == '.' || c == 'e' || c == 'E';
+    };
+    for (size_t at = text.find(literal); at != std::string::npos; at = text.find(literal, at + 1)) {
+        const size_t end = at + literal.size();
+        if ((at == 0 || (!partOfNumber(text[at - 1]) && text[at - 1] != '-')) &&
+            (end == text.size() || !partOfNumber(text[end])))
+            return at;
+    }
+    return text.size();
+}
+
 void appendUtf8(std::string& out, unsigned codePoint)
 {
     if (codePoint < 0x80) {
@@ -398,7 +414,8 @@ size_t validateYamlOnce(const String& path, const std::string& text, size_t from
             if (depth == 0)
                 refuse(line, "the root is a single value, not a map (this module reads single-document YAML "
                              "files whose root is a block map or list at column 0)");
-            if (ev.data.scalar.style == YAML_PLAIN_SCALAR_STYLE) {
+            // An untagged plain scalar; "!!str 4294967297" is a string to OpenCV too.
+            if (ev.data.scalar.style == YAML_PLAIN_SCALAR_STYLE && ev.data.scalar.plain_implicit) {
                 const char* value = reinterpret_cast<const char*>(ev.data.scalar.value);
                 const size_t length = ev.data.scalar.length;
                 if (isIntegerLiteral(value, length) && !fitsInt(std::string(value, length)))
@@ -462,7 +479,7 @@ std::string validateJson(const String& path, const std::string& text)
     case JsonChecks::Stop::DEPTH:
         refuseDepth(path, lineAt(text, offsetBeyondDepth(text)));
     case JsonChecks::Stop::INTEGER:
-        refuseWrappingInteger(path, lineAt(text, text.find(checks.literal)), checks.literal);
+        refuseWrappingInteger(path, lineAt(text, offsetOfNumber(text, checks.literal)), checks.literal);
     case JsonChecks::Stop::NONE:
         break;
     }

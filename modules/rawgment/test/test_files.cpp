@@ -270,6 +270,7 @@ TEST(Files, theYamlValidatorNamesTheLineAndWhatIsWrong)
                              "'a.yml' line 2: the integer 4294967297 does not fit 32 bits");
     // Quoted, it is a string, and a real is a real.
     EXPECT_NO_THROW(detail::validateYaml("a.yml", "m: \"4294967297\"\nn: 4294967297.0\nk: -2147483648\n"));
+    EXPECT_NO_THROW(detail::validateYaml("a.yml", "m: !!str 4294967297\n"));
     // Invalid UTF-8 (a Latin-1 byte) is named, not taken for something else.
     EXPECT_CV_ERROR_CONTAINS(detail::validateYaml("a.yml", "m: caf\xe9\n"), "not valid YAML");
 }
@@ -330,7 +331,7 @@ TEST(Files, theJsonValidatorReadsEveryEscapeAndNamesTheLine)
     EXPECT_CV_ERROR_CONTAINS(detail::validateJson("a.json", "{\n\"a\": \"x\\u0000\"}"), "line 2: a \\u0000");
     EXPECT_CV_ERROR_CONTAINS(detail::validateJson("a.json", "{\n \"a\": [ 1, 2 }\n"),
                              "'a.json' is not valid JSON: parse error at line 2");
-    EXPECT_CV_ERROR_CONTAINS(detail::validateJson("a.json", "{\n \"a\": [ 1,\n 4294967297 ]\n}"),
+    EXPECT_CV_ERROR_CONTAINS(detail::validateJson("a.json", "{\n \"a\": [ 14294967297.5,\n 4294967297 ]\n}"),
                              "'a.json' line 3: the integer 4294967297 does not fit 32 bits");
     EXPECT_CV_ERROR_CONTAINS(detail::validateJson("a.json", "{\n \"a\": -9999999999 }"),
                              "line 2: the integer -9999999999");

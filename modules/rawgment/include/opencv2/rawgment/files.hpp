@@ -62,18 +62,24 @@ CV_RAWGMENT_EXPORTS std::string readFileBounded(const String& path, long long ma
 /** @brief Opens a YAML or JSON file for reading the way every reader of this module does.
  *
  * What it adds to cv::FileStorage, which readers of your own files (manifests, job files) can use too:
- * the file is at most MAX_TEXT_FILE_BYTES; an integer literal beyond 32 bits is an error naming the line
- * (OpenCV's reader would wrap 4294967297 to 1); whatever OpenCV's parser throws, including the
- * std::length_error of some malformed files, becomes a cv::Exception; and every error names the file.
+ * the file is a regular file of at most MAX_TEXT_FILE_BYTES; before OpenCV's recursive parser sees the
+ * text, libyaml (YAML) or nlohmann-json (JSON: text that starts with a brace) parses it in the calling
+ * thread, iteratively, and it must be one document whose root is a map (a block map or list at column 0
+ * for YAML), nested at most 64 levels, without YAML anchors or aliases, and without integer literals
+ * beyond 32 bits (OpenCV's reader would wrap 4294967297 to 1). JSON's \\uXXXX and \\/ escapes and OpenCV's
+ * own \\' are read. No child process or thread is started and no time limit applies: a malformed file is
+ * refused by the parse itself. Whatever OpenCV's parser throws, including the std::length_error of some
+ * malformed files, becomes a cv::Exception, and every error names the file (and the line where there is
+ * one).
  *
  * @param path the file (.yml, .yaml or .json; the content decides how it is parsed)
  * @param what what the file is, for the messages ("scene", "calibration manifest")
  * @return an opened storage
  * @throws cv::Exception StsError for a missing, unreadable or oversized file, or anything but a regular
  * file (a directory, a FIFO, a device: see readFileBounded());
- * StsParseError for an empty file, XML, text that is not YAML or JSON, or a YAML stream that is not one
- * document whose root collection starts a line at column 0 (OpenCV 4.6's parser never returns on some
- * multi-document streams).
+ * StsParseError for an empty file, XML, text that is not valid YAML or JSON, nesting deeper than 64
+ * levels, or a YAML stream that is not one document whose root collection starts a line at column 0
+ * (OpenCV 4.6's parser never returns on some such streams), each with the line where it is known.
  */
 CV_RAWGMENT_EXPORTS FileStorage openFileStorageForReading(const String& path, const String& what);
 
