@@ -254,10 +254,11 @@ std::vector<CameraNoiseProfile> contrastingCameras(const std::vector<CameraNoise
     for (const CameraNoiseProfile& cam : cameras) {
         if (cam.verdict != CAMERA_PROFILE_GOOD || cam.isos.back().gain < 8)
             continue;
-        const double read = cam.sigmaD2 + cam.sigmaR2;
-        if (!quiet || read < quiet->sigmaD2 + quiet->sigmaR2)
+        // The read variance at the base ISO (gain 1) orders them.
+        const double read = cam.noise.lineAtGain(1).b;
+        if (!quiet || read < quiet->noise.lineAtGain(1).b)
             quiet = &cam;
-        if (!loud || read > loud->sigmaD2 + loud->sigmaR2)
+        if (!loud || read > loud->noise.lineAtGain(1).b)
             loud = &cam;
     }
     if (!quiet || quiet == loud)
@@ -313,9 +314,9 @@ std::string realCamerasSection(const DemoOptions& o, const SensorParams& sensorP
         tiles.push_back(
             labelled(rawgment_apps::previewOf(augmented, augmentedFormat, brightening), cam.name()));
         md += cv::format("| %s | %s | %.0f | %.2f | %.2f |\n", cam.name().c_str(),
-                         cameraProfileVerdictName(cam.verdict).c_str(), 1 / cam.alpha,
-                         std::sqrt(cam.sigmaD2 + cam.sigmaR2) / cam.alpha,
-                         std::sqrt(model.sigmaD2 + model.sigmaR2));
+                         cameraProfileVerdictName(cam.verdict).c_str(), 1 / cam.noise.alpha,
+                         std::sqrt(cam.noise.lineAtGain(1).b) / cam.noise.alpha,
+                         std::sqrt(model.lineAtGain(1).b));
     }
     cv::Mat side;
     cv::hconcat(tiles, side);

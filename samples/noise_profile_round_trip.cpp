@@ -46,7 +46,7 @@ int main(int argc, char** argv)
         std::ofstream(json) << darktableNoiseProfiles(model, format, model.baseIso, {100, 200, 400, 800},
                                                       "Sample", "Camera");
         const NoiseModel fromDarktable =
-            noiseModelFromDarktable(json, format, model.baseIso, "Sample", "Camera");
+            noiseModelFromDarktableExport(json, format, model.baseIso, "Sample", "Camera");
         std::printf("darktable: alpha %.6f, sigma_d^2 %.6f, sigma_r^2 %.6f (model %.1f, %.1f, %.1f)\n",
                     fromDarktable.alpha, fromDarktable.sigmaD2, fromDarktable.sigmaR2, model.alpha,
                     model.sigmaD2, model.sigmaR2);

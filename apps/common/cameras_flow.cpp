@@ -32,14 +32,15 @@ double quantile(std::vector<double> v, double q)
 double preGainShare(const CameraNoiseProfile& cam, bool highest = true)
 {
     const double g = highest ? cam.isos.back().gain : 1.0;
-    const double before = g * g * cam.sigmaD2, total = before + cam.sigmaR2;
+    // The line's offset less the part after the gain.
+    const double total = cam.noise.lineAtGain(g).b, before = total - cam.noise.sigmaR2;
     return total > 0 ? before / total : std::nan("");
 }
 
 //! Read noise at the base ISO in electrons: sqrt(sigma_d^2 + sigma_r^2) / alpha.
 double readElectrons(const CameraNoiseProfile& cam)
 {
-    return std::sqrt(cam.sigmaD2 + cam.sigmaR2) / cam.alpha;
+    return std::sqrt(cam.noise.lineAtGain(1).b) / cam.noise.alpha;
 }
 
 std::string catalogueLine(const CameraNoiseProfile& cam)
@@ -48,7 +49,7 @@ std::string catalogueLine(const CameraNoiseProfile& cam)
         return cv::format("%-34s %-8s %s", cam.name().c_str(), "REFUSED", cam.reason.c_str());
     return cv::format("%-34s %-8s %4zu %6g %9.0f %7.2f %6.2f %6.1f%% %6.1f%% %6.1f%% %5.2f  %s",
                       cam.name().c_str(), cameraProfileVerdictName(cam.verdict).c_str(), cam.isos.size(),
-                      cam.baseIso, 1 / cam.alpha, readElectrons(cam), preGainShare(cam),
+                      cam.noise.baseIso, 1 / cam.noise.alpha, readElectrons(cam), preGainShare(cam),
                       100 * cam.medianSlopeResidual, 100 * cam.worstSlopeResidual,
                       100 * cam.worstOffsetResidual, cam.medianColourSpread, cam.reason.c_str());
 }
@@ -69,13 +70,14 @@ std::string isoTable(const CameraNoiseProfile& cam)
     out << cv::format(
         "fit over a range of 1: alpha %.4g (full well %.0f e-), sigma_d^2 %.4g, sigma_r^2 %.4g, base "
         "ISO %g\n",
-        cam.alpha, 1 / cam.alpha, cam.sigmaD2, cam.sigmaR2, cam.baseIso);
+        cam.noise.alpha, 1 / cam.noise.alpha, cam.noise.sigmaD2, cam.noise.sigmaR2, cam.noise.baseIso);
     out << "     ISO    gain   slope (a/c)  fitted       resid   offset (b/c)  fitted       resid  colours\n";
-    for (const CameraIsoFit& f : cam.isos)
+    for (const CameraIsoFit& f : cam.isos) {
+        const NoiseLine fitted = cam.noise.lineAtGain(f.gain);
         out << cv::format("%8g %7.3f  %11.4g  %11.4g %6.1f%%  %11.4g  %11.4g %6.1f%%  %5.2f\n", f.iso, f.gain,
-                          f.slope, f.gain * cam.alpha, 100 * f.slopeResidual, f.offset,
-                          f.gain * f.gain * cam.sigmaD2 + cam.sigmaR2, 100 * f.offsetResidual,
-                          f.colourSpread);
+                          f.slope, fitted.a, 100 * f.slopeResidual, f.offset, fitted.b,
+                          100 * f.offsetResidual, f.colourSpread);
+    }
     return out.str();
 }
 
@@ -117,7 +119,7 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
         for (const CameraIsoFit& f : cam.isos)
             offsets.push_back(std::abs(f.offsetResidual));
         medianOffset.push_back(quantile(offsets, 0.5));
-        fullWell.push_back(1 / cam.alpha);
+        fullWell.push_back(1 / cam.noise.alpha);
         read.push_back(readElectrons(cam));
         share.push_back(preGainShare(cam));
         baseShare.push_back(preGainShare(cam, false));
@@ -198,18 +200,19 @@ void writeReportTables(const std::string& dir, const std::vector<CameraNoiseProf
     for (const CameraNoiseProfile& cam : cams) {
         if (cam.usable())
             for (const CameraIsoFit& f : cam.isos)
-                points.addRow(std::vector<double>{f.iso, f.slope / (f.gain * cam.alpha), f.offsetResidual});
+                points.addRow(
+                    std::vector<double>{f.iso, f.slope / cam.noise.lineAtGain(f.gain).a, f.offsetResidual});
         std::string name = cam.name(), reason = cam.reason;
         for (std::string* s : {&name, &reason})
             std::replace(s->begin(), s->end(), ',', ';');
         cameras.addRow(std::vector<std::string>{name,
                                                 cameraProfileVerdictName(cam.verdict),
                                                 std::to_string(cam.isos.size()),
-                                                formatNumber(cam.baseIso),
-                                                formatNumber(cam.alpha),
-                                                formatNumber(cam.sigmaD2),
-                                                formatNumber(cam.sigmaR2),
-                                                cam.usable() ? formatNumber(1 / cam.alpha) : "",
+                                                formatNumber(cam.noise.baseIso),
+                                                formatNumber(cam.noise.alpha),
+                                                formatNumber(cam.noise.sigmaD2),
+                                                formatNumber(cam.noise.sigmaR2),
+                                                cam.usable() ? formatNumber(1 / cam.noise.alpha) : "",
                                                 cam.usable() ? formatNumber(readElectrons(cam)) : "",
                                                 cam.usable() ? formatNumber(preGainShare(cam)) : "",
                                                 cam.usable() ? formatNumber(preGainShare(cam, false)) : "",

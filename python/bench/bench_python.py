@@ -41,15 +41,22 @@ def median_seconds(fn, repeats):
     return statistics.median(times)
 
 
+def added_line(model, gain, photon_ratio, gain_ratio):
+    """The slope and offset of the variance Eq. 11 adds, from the model's own lines: the target gain's line
+    less the prior's scaled by (p_u p_g)^2, the slope at the prior's mean."""
+    scale = photon_ratio * gain_ratio
+    prior, target = model.lineAtGain(gain), model.lineAtGain(gain * gain_ratio)
+    return scale * target.a - scale * scale * prior.a, target.b - scale * scale * prior.b
+
+
 def numpy_jitter(raw, fmt, model, photon_ratio, gain_ratio, rng):
     """Eq. 11 with the paper's prior-mean estimate, as a numpy user writes it."""
     black = np.float32(fmt.blackLevel[0])
     x = raw.astype(np.float32) - black
-    g = fmt.gain
     mu = np.maximum(x, 0)
     pu, pg = photon_ratio, gain_ratio
-    v = (pu * (1 - pu) * pg * pg * g * model.alpha) * mu + np.float32(
-        (1 - pu * pu) * pg * pg * g * g * model.sigmaD2 + (1 - pu * pu * pg * pg) * model.sigmaR2)
+    slope, offset = added_line(model, fmt.gain, pu, pg)
+    v = np.float32(slope) * mu + np.float32(offset)
     out = np.float32(pu * pg) * x + np.sqrt(np.maximum(v, 0)) * rng.standard_normal(x.shape, dtype=np.float32)
     return np.clip(np.rint(out + black), 0, fmt.whiteLevel).astype(np.uint16)
 
@@ -57,10 +64,9 @@ def numpy_jitter(raw, fmt, model, photon_ratio, gain_ratio, rng):
 def torch_jitter(raw, fmt, model, photon_ratio, gain_ratio, generator):
     black = fmt.blackLevel[0]
     x = torch.from_numpy(raw.astype(np.float32)) - black
-    g = fmt.gain
     pu, pg = photon_ratio, gain_ratio
-    v = (pu * (1 - pu) * pg * pg * g * model.alpha) * x.clamp(min=0) + (
-        (1 - pu * pu) * pg * pg * g * g * model.sigmaD2 + (1 - pu * pu * pg * pg) * model.sigmaR2)
+    slope, offset = added_line(model, fmt.gain, pu, pg)
+    v = slope * x.clamp(min=0) + offset
     out = (pu * pg) * x + v.clamp(min=0).sqrt() * torch.randn(x.shape, generator=generator)
     return torch.clamp(torch.round(out + black), 0, fmt.whiteLevel).to(torch.int32).numpy().astype(np.uint16)
 
@@ -72,9 +78,9 @@ class EfficientNumpyJitter:
         from concurrent.futures import ThreadPoolExecutor
 
         self.raw, self.black, self.white = raw, np.float32(fmt.blackLevel[0]), fmt.whiteLevel
-        g, pu, pg = fmt.gain, photon_ratio, gain_ratio
-        self.slope = np.float32(pu * (1 - pu) * pg * pg * g * model.alpha)
-        self.offset = np.float32((1 - pu * pu) * pg * pg * g * g * model.sigmaD2 + (1 - pu * pu * pg * pg) * model.sigmaR2)
+        pu, pg = photon_ratio, gain_ratio
+        slope, offset = added_line(model, fmt.gain, pu, pg)
+        self.slope, self.offset = np.float32(slope), np.float32(offset)
         self.scale = np.float32(pu * pg)
         rows = raw.shape[0]
         self.bands = [slice(rows * k // threads, rows * (k + 1) // threads) for k in range(threads)]
@@ -114,9 +120,8 @@ class EfficientTorchJitter:
     def __init__(self, raw, fmt, model, photon_ratio, gain_ratio):
         self.raw = torch.from_numpy(raw.astype(np.int32))  # torch has no uint16 arithmetic
         self.black, self.white = float(fmt.blackLevel[0]), float(fmt.whiteLevel)
-        g, pu, pg = fmt.gain, photon_ratio, gain_ratio
-        self.slope = pu * (1 - pu) * pg * pg * g * model.alpha
-        self.offset = (1 - pu * pu) * pg * pg * g * g * model.sigmaD2 + (1 - pu * pu * pg * pg) * model.sigmaR2
+        pu, pg = photon_ratio, gain_ratio
+        self.slope, self.offset = added_line(model, fmt.gain, pu, pg)
         self.scale = pu * pg
         self.x = torch.empty(raw.shape, dtype=torch.float32)
         self.v = torch.empty(raw.shape, dtype=torch.float32)

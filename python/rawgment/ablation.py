@@ -402,9 +402,11 @@ class _Study:
         planes = packCfaPlanes(signal / np.float32(condition.photonRatio * condition.gainRatio), fmt)
         if not self.config.noiseMaps:
             return planes
-        m = self.model
         meanDn = planes.clamp(min=0.0).double() * scale
-        sigma = torch.sqrt(gain * m.alpha * meanDn + gain * gain * m.sigmaD2 + m.sigmaR2) / scale
+        # The model's own variance of each mean (NoiseModel.variance on the float64 array).
+        flat = meanDn.reshape(meanDn.shape[0] * meanDn.shape[1], -1).numpy()
+        variance = torch.from_numpy(self.model.variance(flat, gain)).reshape(meanDn.shape)
+        sigma = torch.sqrt(variance) / scale
         return torch.cat([planes, sigma.float()])
 
     def trainingInputs(self, mean, condition, arms, seed):
@@ -424,23 +426,22 @@ class _Study:
         """The target capture's noise variance at mid-grey green on the network's scale (normalised and
         brightened back): the training loss divides each crop's squared error by it, so that every
         condition weighs the same in the pooled training instead of the darkest dominating by 1/ratio."""
-        m, gain = self.model, self.config.baseGain * condition.gainRatio
+        gain = self.config.baseGain * condition.gainRatio
         p, g = condition.photonRatio, condition.gainRatio
         meanDn = _MID_GREY * self.level * self.config.baseGain * p * g
         scale = self.range * p * g
-        return (gain * m.alpha * meanDn + gain * gain * m.sigmaD2 + m.sigmaR2) / (scale * scale)
+        return self.model.variance(meanDn, gain) / (scale * scale)
 
     def priorShare(self, condition):
         """The share of the target's noise variance already present in the darkened prior (mid-grey
         green, model variance): IGNORE_PRIOR's inputs carry (1 + share) times the target variance."""
-        m, g0 = self.model, self.config.baseGain
+        g0 = self.config.baseGain
         mean = _MID_GREY * self.level * g0  # DN above black of the bright capture
-        brightVar = g0 * m.alpha * mean + g0 * g0 * m.sigmaD2 + m.sigmaR2
+        brightVar = self.model.variance(mean, g0)
         if condition.blurLength > 0:
             brightVar *= float(np.sum(self.kernel(condition).astype(np.float64) ** 2))
         p, g = condition.photonRatio, condition.gainRatio
-        gt = g0 * g
-        targetVar = gt * m.alpha * (p * g * mean) + gt * gt * m.sigmaD2 + m.sigmaR2
+        targetVar = self.model.variance(p * g * mean, g0 * g)
         return (p * g) ** 2 * brightVar / targetVar
 
 

@@ -263,9 +263,9 @@ void bindAugment(py::module_& m)
     m.def("darktableNoiseProfiles", &darktableNoiseProfiles, py::arg("model"), py::arg("format"),
           py::arg("baseIso"), py::arg("isos"), py::arg("maker"), py::arg("cameraModel"),
           py::arg("haarVarianceRatio") = DARKTABLE_HAAR_VARIANCE_RATIO, doc("darktableNoiseProfiles"));
-    m.def("noiseModelFromDarktable", &noiseModelFromDarktable, py::arg("path"), py::arg("format"),
+    m.def("noiseModelFromDarktableExport", &noiseModelFromDarktableExport, py::arg("path"), py::arg("format"),
           py::arg("baseIso"), py::arg("maker"), py::arg("cameraModel"),
-          py::arg("haarVarianceRatio") = DARKTABLE_HAAR_VARIANCE_RATIO, doc("noiseModelFromDarktable"));
+          py::arg("haarVarianceRatio") = DARKTABLE_HAAR_VARIANCE_RATIO, doc("noiseModelFromDarktableExport"));
     // ---- real cameras (camera_profiles.hpp) -------------------------------------------------------
     py::enum_<CameraProfileVerdict>(m, "CameraProfileVerdict", doc("CameraProfileVerdict"))
         .value("CAMERA_PROFILE_GOOD", CAMERA_PROFILE_GOOD, doc("CameraProfileVerdict::CAMERA_PROFILE_GOOD"))
@@ -308,10 +308,7 @@ void bindAugment(py::module_& m)
         .def_readwrite("place", &CameraNoiseProfile::place, doc("CameraNoiseProfile::place"))
         .def_readwrite("verdict", &CameraNoiseProfile::verdict, doc("CameraNoiseProfile::verdict"))
         .def_readwrite("reason", &CameraNoiseProfile::reason, doc("CameraNoiseProfile::reason"))
-        .def_readwrite("baseIso", &CameraNoiseProfile::baseIso, doc("CameraNoiseProfile::baseIso"))
-        .def_readwrite("alpha", &CameraNoiseProfile::alpha, doc("CameraNoiseProfile::alpha"))
-        .def_readwrite("sigmaD2", &CameraNoiseProfile::sigmaD2, doc("CameraNoiseProfile::sigmaD2"))
-        .def_readwrite("sigmaR2", &CameraNoiseProfile::sigmaR2, doc("CameraNoiseProfile::sigmaR2"))
+        .def_readwrite("noise", &CameraNoiseProfile::noise, doc("CameraNoiseProfile::noise"))
         .def_readwrite("isos", &CameraNoiseProfile::isos, doc("CameraNoiseProfile::isos"))
         .def_readwrite("skippedProfiles", &CameraNoiseProfile::skippedProfiles,
                        doc("CameraNoiseProfile::skippedProfiles"))

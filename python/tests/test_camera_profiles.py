@@ -30,7 +30,7 @@ def test_a_sensor_measured_the_way_darktable_measures_is_imported_with_its_noise
         camera = rg.readCameraProfiles(str(path))[0]
         assert camera.verdict == rg.CAMERA_PROFILE_GOOD, camera.reason
         alpha, sd, sr = tool.STUDY_SENSOR
-        got.append((camera.alpha / alpha, camera.sigmaD2 / sd, camera.sigmaR2 / sr))
+        got.append((camera.noise.alpha / alpha, camera.noise.sigmaD2 / sd, camera.noise.sigmaR2 / sr))
     ratio = np.mean(got, axis=0)
     # Eight campaigns of this sensor (seeds 1-8, the same steps) gave alpha 1.000 +- 0.001 (mean +- standard
     # error): the shot slope comes back exact, so 1.5% is ~15 standard errors of a two-campaign mean. The
@@ -88,9 +88,9 @@ def test_every_camera_of_darktables_file_matches_an_independent_fit():
                 continue
             alpha, sd, sr, worst = _numpy_fit(model["profiles"])
             # The same arithmetic in another order: agreement to rounding, relative to each term's scale.
-            assert camera.alpha == pytest.approx(alpha, rel=1e-9)
-            assert camera.sigmaD2 == pytest.approx(sd, rel=1e-6, abs=1e-9 * (sd + sr))
-            assert camera.sigmaR2 == pytest.approx(sr, rel=1e-6, abs=1e-9 * (sd + sr))
+            assert camera.noise.alpha == pytest.approx(alpha, rel=1e-9)
+            assert camera.noise.sigmaD2 == pytest.approx(sd, rel=1e-6, abs=1e-9 * (sd + sr))
+            assert camera.noise.sigmaR2 == pytest.approx(sr, rel=1e-6, abs=1e-9 * (sd + sr))
             assert camera.worstSlopeResidual == pytest.approx(worst, rel=1e-9)
             checked += 1
     assert checked >= 300
@@ -112,7 +112,7 @@ def test_darktables_file_saved_again_with_json_escapes_reads_the_same(tmp_path):
         len(m["models"]) for m in data["noiseprofiles"][1:])
     assert a[0].maker.endswith("Sj\u00f8str\u00f8m")
     for x, y in zip(a, b):
-        assert (x.name(), x.verdict, x.alpha, x.reason) == (y.name(), y.verdict, y.alpha, y.reason)
+        assert (x.name(), x.verdict, x.noise.alpha, x.reason) == (y.name(), y.verdict, y.noise.alpha, y.reason)
 
 
 def test_the_smaller_refusals_name_the_argument(tmp_path):

@@ -81,7 +81,7 @@ def test_darktable_file_is_json_with_the_layout_darktable_reads(tmp_path):
         assert list(zip(p["a"], p["b"])) == [(c * s, c * o) for s, o in rg.dngNoiseProfile(model, fmt)]
     path = tmp_path / "noiseprofiles.json"
     path.write_text(text)
-    back = rg.noiseModelFromDarktable(str(path), fmt, 100, "Maker", "Model")
+    back = rg.noiseModelFromDarktableExport(str(path), fmt, 100, "Maker", "Model")
     assert (back.alpha, back.sigmaD2, back.sigmaR2) == pytest.approx((0.4, 1.5, 3.0), rel=1e-9)
 
 

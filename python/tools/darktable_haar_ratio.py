@@ -123,8 +123,8 @@ def study(campaigns):
             with open(path, "w") as f:
                 json.dump(measured_sensor_profiles(seed), f)
             camera = rawgment.readCameraProfiles(path)[0]
-            ratios.append((camera.alpha / STUDY_SENSOR[0], camera.sigmaD2 / STUDY_SENSOR[1],
-                           camera.sigmaR2 / STUDY_SENSOR[2]))
+            ratios.append((camera.noise.alpha / STUDY_SENSOR[0], camera.noise.sigmaD2 / STUDY_SENSOR[1],
+                           camera.noise.sigmaR2 / STUDY_SENSOR[2]))
     ratios = np.array(ratios)
     mean, se = ratios.mean(0), ratios.std(0, ddof=1) / np.sqrt(len(ratios))
     print("imported over truth: alpha %.4f +- %.4f   sigma_d^2 %.3f +- %.3f   sigma_r^2 %.3f +- %.3f" %

@@ -77,17 +77,16 @@ void BM_Augment_colorJitterPoisson(benchmark::State& state)
 void BM_Augment_colorJitterNaiveOpenCV(benchmark::State& state)
 {
     // Eq. 11 with whole-frame OpenCV operations and temporaries.
+    // The added line is the target gain's line less the prior's, scaled by (p_u p_g)^2 (the model's lines).
     const RawFormat fmt = frameFormat();
-    const NoiseLine line = kModel.lineAtGain(fmt.gain);
-    const double pu = 0.2, pg = 2.0;
+    const double pu = 0.2, pg = 2.0, scale = pu * pg;
+    const NoiseLine prior = kModel.lineAtGain(fmt.gain), target = kModel.lineAtGain(fmt.gain * pg);
     RNG rng(1);
     for (auto _ : state) {
         Mat x, mu, v, noise, out;
         frame().convertTo(x, CV_32F, 1.0, -256.0);
         mu = max(x, 0.0);
-        v = mu * (pu * (1 - pu) * pg * pg * line.a) +
-            ((1 - pu * pu) * pg * pg * fmt.gain * fmt.gain * kModel.sigmaD2 +
-             (1 - pu * pu * pg * pg) * kModel.sigmaR2);
+        v = mu * (scale * target.a - scale * scale * prior.a) + (target.b - scale * scale * prior.b);
         v = max(v, 0.0);
         sqrt(v, v);
         noise.create(x.size(), CV_32F);

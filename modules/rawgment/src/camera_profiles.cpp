@@ -63,8 +63,8 @@ NoiseModel CameraNoiseProfile::modelFor(const RawFormat& format) const
     const double black =
         (format.blackLevel[0] + format.blackLevel[1] + format.blackLevel[2] + format.blackLevel[3]) / 4;
     const double r = format.whiteLevel - black;
-    NoiseModel m(alpha * r, sigmaD2 * r * r, sigmaR2 * r * r);
-    m.baseIso = baseIso;
+    NoiseModel m(noise.alpha * r, noise.sigmaD2 * r * r, noise.sigmaR2 * r * r);
+    m.baseIso = noise.baseIso;
     m.validate();
     return m;
 }
@@ -221,12 +221,12 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
                                              usable[0]->iso);
         return;
     }
-    cam.baseIso = usable.front()->iso;
+    const double baseIso = usable.front()->iso;
     std::vector<double> g, a, b, g2, w;
     for (const MeasuredProfile* p : usable) {
         CameraIsoFit f;
         f.iso = p->iso;
-        f.gain = p->iso / cam.baseIso;
+        f.gain = p->iso / baseIso;
         f.slope = p->a[1] / c;
         f.offset = p->b[1] / c;
         double lo = HUGE_VAL, hi = 0;
@@ -250,24 +250,24 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
         num += g[k] / a[k];
         den += g[k] * g[k] / (a[k] * a[k]);
     }
-    cam.alpha = num / den;
+    const double alpha = num / den;
     const Vec2d offsets = fitOffsets(g2, b, w);
-    cam.sigmaD2 = offsets[0];
-    cam.sigmaR2 = offsets[1];
     // NaN passes every '>' bound of the verdict: a fit that is not finite is refused here.
-    if (!(std::isfinite(cam.alpha) && cam.alpha > 0 && std::isfinite(cam.sigmaD2) &&
-          std::isfinite(cam.sigmaR2))) {
+    if (!(std::isfinite(alpha) && alpha > 0 && std::isfinite(offsets[0]) && std::isfinite(offsets[1]))) {
         cam.verdict = CAMERA_PROFILE_REFUSED;
         cam.reason = format("the fit is not finite and positive (alpha %g, sigma_d^2 %g, sigma_r^2 %g)",
-                            cam.alpha, cam.sigmaD2, cam.sigmaR2);
+                            alpha, offsets[0], offsets[1]);
         return;
     }
+    cam.noise = NoiseModel(alpha, offsets[0], offsets[1]);
+    cam.noise.baseIso = baseIso;
 
     std::vector<double> slopeResiduals, spreads;
     for (size_t k = 0; k < cam.isos.size(); ++k) {
         CameraIsoFit& f = cam.isos[k];
-        f.slopeResidual = (f.gain * cam.alpha - f.slope) / f.slope;
-        f.offsetResidual = (g2[k] * cam.sigmaD2 + cam.sigmaR2 - f.offset) / (1 / std::sqrt(w[k]));
+        const NoiseLine fitted = cam.noise.lineAtGain(f.gain);
+        f.slopeResidual = (fitted.a - f.slope) / f.slope;
+        f.offsetResidual = (fitted.b - f.offset) / (1 / std::sqrt(w[k]));
         slopeResiduals.push_back(std::abs(f.slopeResidual));
         spreads.push_back(f.colourSpread);
         if (std::abs(f.slopeResidual) > cam.worstSlopeResidual) {
@@ -290,7 +290,7 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
                             int(cam.isos.size()));
         return;
     }
-    if (cam.sigmaD2 == 0 && cam.sigmaR2 == 0) {
+    if (cam.noise.sigmaD2 == 0 && cam.noise.sigmaR2 == 0) {
         cam.verdict = CAMERA_PROFILE_REFUSED;
         cam.reason = "the offsets fit no read noise at all (sigma_d^2 and sigma_r^2 both zero)";
         return;

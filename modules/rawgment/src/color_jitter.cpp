@@ -570,8 +570,7 @@ detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, Point se
     d.shading = model.hasDarkShading();
     d.tails = model.tukeyRead;
     const double pg = jitter.gainRatio, g = gain;
-    const double readIn = g * g * model.sigmaD2 + model.sigmaR2;
-    const double readOut = pg * pg * g * g * model.sigmaD2 + model.sigmaR2;
+    const double readIn = model.lineAtGain(g).b, readOut = model.lineAtGain(pg * g).b;
     const bool account = alignment == NoiseAlignment::ACCOUNT_PRIOR;
     detail::TukeyUnitSampler shapes[4]; // the added read part's heavy-tailed shape per site, when `tails`
     for (int s = 0; s < 4; ++s) {

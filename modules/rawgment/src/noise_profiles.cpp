@@ -318,11 +318,11 @@ std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, const RawFormat& for
 {
     format.validate();
     model.validate();
-    const double g = format.gain;
+    const NoiseLine line = model.lineAtGain(format.gain);
     std::vector<Vec2d> profile(3);
     for (int plane = 0; plane < 3; ++plane) {
         const double r = detail::rangeOfColourPlane(format, plane);
-        profile[plane] = Vec2d(g * model.alpha / r, (g * g * model.sigmaD2 + model.sigmaR2) / (r * r));
+        profile[plane] = Vec2d(line.a / r, line.b / (r * r));
     }
     detail::checkDngNoiseProfile(profile, "dngNoiseProfile");
     return profile;
@@ -450,14 +450,14 @@ String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format, 
     return out.str();
 }
 
-NoiseModel noiseModelFromDarktable(const String& path, const RawFormat& format, double baseIso,
+NoiseModel noiseModelFromDarktableExport(const String& path, const RawFormat& format, double baseIso,
                                    const String& maker, const String& cameraModel, double haarVarianceRatio)
 {
-    checkBaseIso(baseIso, "noiseModelFromDarktable");
-    checkHaarVarianceRatio(haarVarianceRatio, "noiseModelFromDarktable");
+    checkBaseIso(baseIso, "noiseModelFromDarktableExport");
+    checkHaarVarianceRatio(haarVarianceRatio, "noiseModelFromDarktableExport");
     const double c = haarVarianceRatio;
     format.validate();
-    const String where = "noiseModelFromDarktable: '" + path + "'";
+    const String where = "noiseModelFromDarktableExport: '" + path + "'";
     FileStorage fs = openFileStorageForReading(path, "darktable noise profiles");
     struct Profile
     {

@@ -76,7 +76,7 @@ TEST(CameraProfiles, theProjectsOwnExportComesBackGoodWithItsModel)
     EXPECT_EQ(cam.verdict, CAMERA_PROFILE_GOOD) << cam.reason;
     EXPECT_EQ(cam.place, "noiseprofiles[0].models[0]");
     ASSERT_EQ(cam.isos.size(), 4u);
-    EXPECT_EQ(cam.baseIso, 100);
+    EXPECT_EQ(cam.noise.baseIso, 100);
     // An exact model: every residual is rounding (17-digit text and one division by c).
     EXPECT_LT(cam.worstSlopeResidual, 1e-12);
     EXPECT_LT(cam.worstOffsetResidual, 1e-9);
@@ -95,7 +95,7 @@ TEST(CameraProfiles, theProjectsOwnExportComesBackGoodWithItsModel)
     EXPECT_NEAR(cam.modelFor(twelve).alpha, model.alpha * ratio, 1e-12);
     EXPECT_NEAR(cam.modelFor(twelve).sigmaR2, model.sigmaR2 * ratio * ratio, 1e-9);
     // And the exact loader of the same file agrees.
-    const NoiseModel exact = noiseModelFromDarktable(path, format, 100, "Rawgment", "Sim");
+    const NoiseModel exact = noiseModelFromDarktableExport(path, format, 100, "Rawgment", "Sim");
     EXPECT_NEAR(exact.alpha, back.alpha, 1e-12 * model.alpha);
 }
 
@@ -123,13 +123,13 @@ TEST(CameraProfiles, aFitOfNoisyProfilesRecoversTheModelAndMeasuresItsResiduals)
         num += 1 / e;
         den += 1 / (e * e);
     }
-    EXPECT_NEAR(cam.alpha, alpha * num / den, 1e-15);
+    EXPECT_NEAR(cam.noise.alpha, alpha * num / den, 1e-15);
     for (int k = 0; k < 5; ++k)
         EXPECT_NEAR(cam.isos[size_t(k)].slopeResidual, (num / den) / slopeError[k] - 1, 1e-12) << isos[k];
     EXPECT_EQ(cam.worstSlopeIso, 200);
     // Exact offsets are fitted exactly.
-    EXPECT_NEAR(cam.sigmaD2, sd, 1e-6 * sd);
-    EXPECT_NEAR(cam.sigmaR2, sr, 1e-6 * sr);
+    EXPECT_NEAR(cam.noise.sigmaD2, sd, 1e-6 * sd);
+    EXPECT_NEAR(cam.noise.sigmaR2, sr, 1e-6 * sr);
     EXPECT_LT(cam.worstOffsetResidual, 1e-6);
     EXPECT_TRUE(cam.monotoneSlope);
 }
@@ -153,8 +153,8 @@ TEST(CameraProfiles, negativeOffsetsAreFittedWithNonNegativeTerms)
     const std::vector<CameraNoiseProfile> cams = readCameraProfiles(path);
     const CameraNoiseProfile& dip = byModel(cams, "Dipping");
     EXPECT_TRUE(dip.usable()) << dip.reason;
-    EXPECT_GE(dip.sigmaR2, 0);
-    EXPECT_GT(dip.sigmaD2, 0);
+    EXPECT_GE(dip.noise.sigmaR2, 0);
+    EXPECT_GT(dip.noise.sigmaD2, 0);
     EXPECT_EQ(dip.negativeOffsets, 1); // ISO 100: 1e-8 - 2e-8
     const CameraNoiseProfile& neg = byModel(cams, "Negative");
     EXPECT_EQ(neg.verdict, CAMERA_PROFILE_REFUSED);
@@ -421,12 +421,12 @@ TEST(CameraProfiles, everyCameraOfDarktablesFileImportsOrIsRefusedWithAReason)
             continue;
         }
         EXPECT_GE(cam.isos.size(), 2u);
-        for (double v : {cam.alpha, cam.sigmaD2, cam.sigmaR2, cam.worstSlopeResidual, cam.worstOffsetResidual,
-                         cam.medianColourSpread})
+        for (double v : {cam.noise.alpha, cam.noise.sigmaD2, cam.noise.sigmaR2, cam.worstSlopeResidual,
+                         cam.worstOffsetResidual, cam.medianColourSpread})
             EXPECT_TRUE(std::isfinite(v));
-        EXPECT_GT(cam.alpha, 0);
-        EXPECT_GE(cam.sigmaD2, 0);
-        EXPECT_GE(cam.sigmaR2, 0);
+        EXPECT_GT(cam.noise.alpha, 0);
+        EXPECT_GE(cam.noise.sigmaD2, 0);
+        EXPECT_GE(cam.noise.sigmaR2, 0);
         const NoiseModel m = cam.modelFor(format);
         EXPECT_NO_THROW(m.validate());
         // Every ISO's modelled variance at mid-grey is finite and positive.

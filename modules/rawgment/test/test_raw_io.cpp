@@ -273,18 +273,18 @@ TEST(RawIo, darktableNoiseProfilesAreTheDngProfilesPerIsoAndGiveTheModelBack)
         }
     }
 
-    const NoiseModel back = noiseModelFromDarktable(path, format, 100, "Rawgment", "Test \"Cam\"");
+    const NoiseModel back = noiseModelFromDarktableExport(path, format, 100, "Rawgment", "Test \"Cam\"");
     // Exact up to the rounding of a 12-value least-squares line: a few ulps of the largest term.
     EXPECT_NEAR(back.alpha, model.alpha, 1e-13 * model.alpha);
     EXPECT_NEAR(back.sigmaD2, model.sigmaD2, 1e-11 * model.sigmaD2);
     EXPECT_NEAR(back.sigmaR2, model.sigmaR2, 1e-9 * model.sigmaR2);
     EXPECT_EQ(100.0, back.baseIso);
     // Another base ISO scales the gain: the model at base ISO 200 has twice the per-gain terms.
-    const NoiseModel at200 = noiseModelFromDarktable(path, format, 200, "Rawgment", "Test \"Cam\"");
+    const NoiseModel at200 = noiseModelFromDarktableExport(path, format, 200, "Rawgment", "Test \"Cam\"");
     EXPECT_NEAR(at200.alpha, 2 * model.alpha, 1e-12);
     EXPECT_NEAR(at200.sigmaD2, 4 * model.sigmaD2, 1e-9);
 
-    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(path, format, 100, "Rawgment", "Other"),
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktableExport(path, format, 100, "Rawgment", "Other"),
                              "no profile of 'Rawgment / Other' (it has: Rawgment / Test \"Cam\")");
     EXPECT_CV_ERROR_CONTAINS(darktableNoiseProfiles(model, format, 100, {100, 100}, "A", "B"), "given twice");
     EXPECT_CV_ERROR_CONTAINS(darktableNoiseProfiles(model, format, 0, {100}, "A", "B"), "baseIso");
@@ -323,7 +323,7 @@ TEST(RawIo, darktableFilesThatNoModelMatchesAreRefusedNamingWhy)
             "1]},\n"
             "  {\"name\": \"M iso 200\", \"iso\": 200, \"a\": " +
             list(p2, 0) + ", \"b\": " + list(p2, 1) + "}]}]}]}\n");
-    const NoiseModel back = noiseModelFromDarktable(good, format, 100, "Maker", "M");
+    const NoiseModel back = noiseModelFromDarktableExport(good, format, 100, "Maker", "M");
     EXPECT_NEAR(back.alpha, 0.5, 1e-13);
     EXPECT_NEAR(back.sigmaD2, 2, 1e-11);
     EXPECT_NEAR(back.sigmaR2, 4, 1e-10);
@@ -337,22 +337,22 @@ TEST(RawIo, darktableFilesThatNoModelMatchesAreRefusedNamingWhy)
               "3e-09, 4.7e-09]},\n"
               "  {\"name\": \"b\", \"iso\": 200, \"a\": [1.5e-05, 3e-06, 4.6e-06], \"b\": [8e-09, "
               "1.2e-08, 1.9e-08]}]}]}]}\n");
-    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(measured, format, 100, "Maker", "M"),
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktableExport(measured, format, 100, "Maker", "M"),
                              "measured.json': ISO 100 colour 1 gives alpha");
     const std::string oneIso =
         write("one_iso.json",
               "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", \"models\": [{\"model\": "
               "\"M\", \"profiles\": [{\"name\": \"a\", \"iso\": 100, \"a\": " +
                   list(p1, 0) + ", \"b\": " + list(p1, 1) + "}]}]}]}\n");
-    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(oneIso, format, 100, "Maker", "M"), "one ISO only");
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktableExport(oneIso, format, 100, "Maker", "M"), "one ISO only");
     const std::string typo = write("typo.json", "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", "
                                                 "\"modles\": []}]}\n");
-    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(typo, format, 100, "Maker", "M"), "modles");
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktableExport(typo, format, 100, "Maker", "M"), "modles");
     const std::string shortList =
         write("short.json", "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", "
                             "\"models\": [{\"model\": \"M\", \"profiles\": [{\"iso\": 100, "
                             "\"a\": [1, 2], \"b\": [1, 2, 3]}]}]}]}\n");
-    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(shortList, format, 100, "Maker", "M"),
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktableExport(shortList, format, 100, "Maker", "M"),
                              "short.json': field 'a' must be a list of 3 numbers");
     // a = 0 at one ISO: 0 once meant "alpha not yet seen", so the profile was taken. A zero slope where
     // another ISO has one is no exact model.
@@ -362,16 +362,16 @@ TEST(RawIo, darktableFilesThatNoModelMatchesAreRefusedNamingWhy)
               "\"M\", \"profiles\": [{\"name\": \"a\", \"iso\": 100, \"a\": [0, 0, 0], \"b\": " +
                   list(p1, 1) + "},\n  {\"name\": \"b\", \"iso\": 200, \"a\": " + list(p2, 0) +
                   ", \"b\": " + list(p2, 1) + "}]}]}]}\n");
-    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(zeroSlope, format, 100, "Maker", "M"),
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktableExport(zeroSlope, format, 100, "Maker", "M"),
                              "zero_slope.json': ISO 200 colour 0 gives alpha");
     const std::string negative =
         write("negative.json",
               "{\"version\": 0, \"noiseprofiles\": [{\"maker\": \"Maker\", \"models\": [{\"model\": "
               "\"M\", \"profiles\": [{\"name\": \"a\", \"iso\": 100, \"a\": [-1e-6, 1e-6, 1e-6], \"b\": " +
                   list(p1, 1) + "}]}]}]}\n");
-    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(negative, format, 100, "Maker", "M"),
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktableExport(negative, format, 100, "Maker", "M"),
                              "ISO 100 colour 0 has a = -1e-06");
-    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktable(good, format, 1e300, "Maker", "M"),
+    EXPECT_CV_ERROR_CONTAINS(noiseModelFromDarktableExport(good, format, 1e300, "Maker", "M"),
                              "baseIso must lie in [1, 1e+07]");
 }
 

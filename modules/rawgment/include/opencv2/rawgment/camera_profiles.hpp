@@ -80,8 +80,9 @@ struct CV_RAWGMENT_EXPORTS CameraIsoFit
 
 /** @brief A real camera's noise, fitted to Eq. 5 from its measured profiles, in units of a raw range of 1.
  *
- * Per-pixel variance of a signal x in [0, 1] at gain g = ISO / baseIso:
- * \f$ g\alpha x + g^2\sigma_d^2 + \sigma_r^2 \f$. modelFor() scales it to a RawFormat's range. */
+ * `noise` is the fitted model: the per-pixel variance of a signal x in [0, 1] at gain
+ * g = ISO / noise.baseIso is noise.variance(x, g), \f$ g\alpha x + g^2\sigma_d^2 + \sigma_r^2 \f$.
+ * modelFor() scales it to a RawFormat's range. */
 struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
 {
     String maker; //!< maker as the file names it
@@ -89,10 +90,11 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
     String place; //!< where the entry is in the file, e.g. "noiseprofiles[5].models[12]"
     int verdict = CAMERA_PROFILE_REFUSED; //!< a CameraProfileVerdict
     String reason;                        //!< why the verdict is not GOOD (empty when GOOD)
-    double baseIso = 0;                   //!< the lowest usable ISO: gain 1
-    double alpha = 0;               //!< shot slope at gain 1 over the range (1 / full well in electrons)
-    double sigmaD2 = 0;             //!< read variance before the gain, over the range squared
-    double sigmaR2 = 0;             //!< read variance after the gain, over the range squared
+    /** The fitted model over a raw range of 1: alpha is the shot slope at gain 1 (1 / full well in
+     * electrons), sigmaD2 and sigmaR2 the read variances before and after the gain over the range
+     * squared, and baseIso the lowest usable ISO (gain 1). All zero while the camera is REFUSED before
+     * its fit. */
+    NoiseModel noise;
     std::vector<CameraIsoFit> isos; //!< the usable profiles, by ascending ISO (an ISO measured twice twice)
     int skippedProfiles = 0;        //!< profiles marked "skip" or without a positive green slope
     double medianSlopeResidual = 0; //!< median over ISOs of |slope residual|
@@ -108,8 +110,8 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
     String name() const;
     //! Whether the camera is imported (GOOD or ROUGH).
     bool usable() const { return verdict != CAMERA_PROFILE_REFUSED; }
-    /** @brief The camera's noise model in DN for mosaics of `format`: alpha times r, the variances times
-     * r^2, with r = white - mean black, and NoiseModel::baseIso = baseIso.
+    /** @brief The camera's noise model in DN for mosaics of `format`: `noise` with alpha times r and the
+     * variances times r^2, with r = white - mean black (its baseIso kept).
      * @throws cv::Exception when the camera is REFUSED (naming the reason) or the format is invalid. */
     NoiseModel modelFor(const RawFormat& format) const;
 };

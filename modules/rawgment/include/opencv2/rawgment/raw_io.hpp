@@ -109,7 +109,7 @@ constexpr double DARKTABLE_HAAR_VARIANCE_RATIO = 0.0794;
  * @param cameraModel camera model as darktable names it (e.g. "EOS 5D Mark II"); not empty
  * @param haarVarianceRatio c, in (0, 1]
  * @return the JSON text of a complete noise-profile file with one maker and one model entry; numbers are
- *         written with 17 significant digits, so noiseModelFromDarktable() (with the same c) gives the
+ *         written with 17 significant digits, so noiseModelFromDarktableExport() (with the same c) gives the
  *         model back, and readCameraProfiles() finds it GOOD.
  * @throws cv::Exception on an invalid argument or a model without shot noise (alpha = 0).
  */
@@ -118,15 +118,18 @@ CV_RAWGMENT_EXPORTS String darktableNoiseProfiles(const NoiseModel& model, const
                                                   const String& maker, const String& cameraModel,
                                                   double haarVarianceRatio = DARKTABLE_HAAR_VARIANCE_RATIO);
 
-/** @brief The noise model whose darktable noise profiles a file holds, where the mapping is exact.
+/** @brief The noise model of a darktable profile file that darktableNoiseProfiles() wrote: the strict
+ * inverse of the project's own export, for round trips and checks of it.
  *
+ * A real camera's profiles, as darktable measured them, are read by readCameraProfiles() and
+ * CameraNoiseProfile::modelFor() (what loadAnyNoiseModel() and the apps use); this function refuses them.
  * Reads the profiles of one maker and model (profiles with `"skip": true` are ignored) and inverts
  * darktableNoiseProfiles(): \f$ \alpha = a r / (c g) \f$ from every colour and ISO, and \f$ \sigma_d^2 \f$,
  * \f$ \sigma_r^2 \f$ from the line \f$ b r^2 / c = g^2\sigma_d^2 + \sigma_r^2 \f$ across ISOs (least
  * squares).
  * The model has one alpha for all colours and no other terms, so the file's values must agree with one
  * model to 1e-9 relative; a profile measured by darktable's own tool generally does not, and is refused
- * with the spread it has rather than averaged silently: readCameraProfiles() fits those.
+ * with the spread it has rather than averaged silently.
  * @param path a darktable noise-profile JSON file (read with openFileStorageForReading(); every key is
  *        checked)
  * @param format black and white levels of the camera's raw files
@@ -137,9 +140,9 @@ CV_RAWGMENT_EXPORTS String darktableNoiseProfiles(const NoiseModel& model, const
  *         fewer than two distinct ISOs (sigma_d^2 and sigma_r^2 cannot be told apart), or is not of the
  *         model's form.
  */
-CV_RAWGMENT_EXPORTS NoiseModel
-noiseModelFromDarktable(const String& path, const RawFormat& format, double baseIso, const String& maker,
-                        const String& cameraModel, double haarVarianceRatio = DARKTABLE_HAAR_VARIANCE_RATIO);
+CV_RAWGMENT_EXPORTS NoiseModel noiseModelFromDarktableExport(
+    const String& path, const RawFormat& format, double baseIso, const String& maker,
+    const String& cameraModel, double haarVarianceRatio = DARKTABLE_HAAR_VARIANCE_RATIO);
 
 /** @brief The noise model in the form of Android's camera tests (the CTS/ITS `dng_noise_model` output
  * behind `android.sensor.noiseProfile`): for sensitivity s (ISO), the DNG NoiseProfile of each CFA
