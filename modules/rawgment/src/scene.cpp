@@ -3,7 +3,7 @@
 #include "augment_steps.hpp"
 
 #include <opencv2/imgproc.hpp>
-#include <opencv2/rawgment/simulate.hpp>
+#include <opencv2/rawgment/seeds.hpp>
 
 #include <atomic>
 #include <cmath>

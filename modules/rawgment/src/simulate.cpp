@@ -250,13 +250,6 @@ void fillStandardNormal(InputOutputArray _dst, Size size, uint64 seed)
     });
 }
 
-uint64 deriveSeed(uint64 seed, SeedPurpose purpose, uint64 index)
-{
-    if (purpose < SEED_SIMULATED_BURST || purpose > SEED_ABLATION)
-        CV_Error(Error::StsBadArg, format("deriveSeed: unknown purpose %d", static_cast<int>(purpose)));
-    return detail::stepKey(detail::stepKey(seed, static_cast<uint64_t>(purpose)), index);
-}
-
 std::vector<Vec3d> colorCheckerReflectances()
 {
     // Published sRGB (8-bit) values of the classic chart, row by row.

@@ -374,20 +374,6 @@ TEST(Simulate, colorCheckerLayoutAndValues)
                              "patchSize must be even");
 }
 
-TEST(Simulate, derivedSeedsAreStableAndDistinctPerPurposeAndIndex)
-{
-    // A pure function of (seed, purpose, index): the same on every call, and no two of 9 purposes x
-    // 1000 indices x 3 seeds collide (a 64-bit hash collides among 27,000 values with odds ~1e-11).
-    EXPECT_EQ(deriveSeed(1, SEED_SIMULATED_BURST, 3), deriveSeed(1, SEED_SIMULATED_BURST, 3));
-    std::set<uint64> seen;
-    for (uint64 seed : {0ull, 1ull, 2ull})
-        for (int p = SEED_SIMULATED_BURST; p <= SEED_ABLATION; ++p)
-            for (uint64 index = 0; index < 1000; ++index)
-                seen.insert(deriveSeed(seed, static_cast<SeedPurpose>(p), index));
-    EXPECT_EQ(seen.size(), 3u * 9u * 1000u);
-    EXPECT_CV_ERROR_CONTAINS(deriveSeed(1, static_cast<SeedPurpose>(3), 0), "unknown purpose 3");
-}
-
 /* The words of fillPoisson()'s value i in the stream (seed, stream), as random.hpp documents (word j of
  * block b of a chunk's 8 at 8 j + b): value h of its chunk of 16 owns word 16 + h; its Box-Muller pair
  * h % 8 takes the radius from word h % 8 and the angle from word 8 + h % 8. */

@@ -12,6 +12,7 @@
 #include <opencv2/rawgment/noise_model.hpp>
 #include <opencv2/rawgment/normality.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
+#include <opencv2/rawgment/seeds.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
 /** @defgroup rawgment Noise-accounted RAW augmentation
@@ -31,6 +32,7 @@ subtraction; gains are linear (0 dB = 1).
     @defgroup rawgment_calibration Noise calibration from bursts: statistics, line fits, cross-gain fits
     @defgroup rawgment_cpu Instruction-set paths of the hot loops: one binary, the same bits on every CPU
     @defgroup rawgment_simulate A physical sensor simulator and a ColorChecker scene: the ground truth
+    @defgroup rawgment_seeds Seeds: one user seed, an independent stream for every use of it
 @}
 */
 
