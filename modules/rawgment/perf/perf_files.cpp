@@ -8,6 +8,7 @@
 #include <benchmark/benchmark.h>
 #include <opencv2/rawgment/camera_profiles.hpp>
 #include <opencv2/rawgment/files.hpp>
+#include <opencv2/rawgment/mosaic_files.hpp>
 #include <opencv2/rawgment/noise_model.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
 

@@ -9,6 +9,7 @@
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/camera_profiles.hpp>
 #include <opencv2/rawgment/files.hpp>
+#include <opencv2/rawgment/mosaic_files.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
 
 #include <algorithm>

@@ -9,6 +9,7 @@
 #include <opencv2/rawgment/cpu.hpp>
 #include <opencv2/rawgment/files.hpp>
 #include <opencv2/rawgment/isp.hpp>
+#include <opencv2/rawgment/mosaic_files.hpp>
 #include <opencv2/rawgment/noise_model.hpp>
 #include <opencv2/rawgment/normality.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
@@ -27,7 +28,10 @@ subtraction; gains are linear (0 dB = 1).
     @defgroup rawgment_noise_model The heteroscedastic Gaussian noise model
     @defgroup rawgment_normality Shapiro-Wilk tests of the Gaussian noise assumption
     @defgroup rawgment_isp The paper's simple ISPs: tone curves, white balance, demosaicing for previews
-    @defgroup rawgment_raw_io Camera RAW files in (LibRaw) and augmented mosaics out (PNG, TIFF, DNG)
+    @defgroup rawgment_raw_io Camera RAW files in (LibRaw) and out (DNG), and the noise profiles of other
+tools
+    @defgroup rawgment_mosaic_files Mosaics with YAML sidecars (PNG, TIFF, DNG): what augmentation writes and
+reads
     @defgroup rawgment_files Files of every topic: atomic writes, bounded reads, guarded YAML/JSON
     @defgroup rawgment_calibration Noise calibration from bursts: statistics, line fits, cross-gain fits
     @defgroup rawgment_cpu Instruction-set paths of the hot loops: one binary, the same bits on every CPU

@@ -3,7 +3,6 @@
 #define OPENCV_RAWGMENT_RAW_IO_HPP
 
 #include <opencv2/core.hpp>
-#include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/bayer.hpp>
 #include <opencv2/rawgment/export.hpp>
 #include <opencv2/rawgment/files.hpp>
@@ -231,59 +230,6 @@ struct CV_RAWGMENT_EXPORTS CameraTags
     //! Reads tags written by write(). @throws cv::Exception naming an invalid or unknown field.
     static CameraTags read(const FileNode& node);
 };
-
-/** @brief What a sidecar file says about a mosaic written by writeMosaic(). */
-struct CV_RAWGMENT_EXPORTS MosaicMetadata
-{
-    /** Version written to files; versions 1 (no camera tags), 2 (no noise camera) and 3 are read. */
-    static constexpr int FORMAT_VERSION = 3;
-    RawFormat format;       //!< the mosaic's format, with the gain after augmentation
-    bool hasScene = false;  //!< whether `scene` and `seed` describe how the mosaic was made
-    Scene scene;            //!< the scene applied to the source
-    uint64 seed = 0;        //!< the noise seed of that scene
-    String source;          //!< the file the mosaic was made from (informative)
-    bool hasCamera = false; //!< whether `camera` describes the mosaic (a DNG then carries the tags)
-    CameraTags camera;      //!< the camera and capture, when hasCamera
-    /** The real camera whose measured noise the scene simulated (a darktable profile's "maker model",
-     * CameraNoiseProfile::name()); empty when the noise model came from elsewhere. */
-    String noiseCamera;
-    Size size;           //!< the mosaic's size; set by writeMosaic(), checked by readMosaic()
-    int type = CV_16UC1; //!< the mosaic's type; set by writeMosaic(), checked by readMosaic()
-
-    //! Writes the metadata as a map under `name`.
-    void write(FileStorage& fs, const String& name) const;
-    //! Reads metadata written by write(). @throws cv::Exception naming an invalid field.
-    static MosaicMetadata read(const FileNode& node);
-};
-
-/** @brief The sidecar of a mosaic file: `path` + ".yml". */
-CV_RAWGMENT_EXPORTS String sidecarPathOf(const String& path);
-
-/** @brief Writes a mosaic and its sidecar YAML (top-level map `mosaic_metadata`).
- *
- * The container follows the extension: `.png` (16-bit), `.tif`/`.tiff` (16-bit or 32-bit float) or
- * `.dng` (16-bit, see writeDng()). The sidecar is written first and the image last, each atomically,
- * and neither replaces an existing file: an existing image marks a finished output, and an input can
- * never be overwritten. An existing sidecar without its image is kept when it holds exactly the text
- * this call would write (an interrupted run of the same job) and is an error otherwise. When the image
- * cannot be written, the sidecar this call wrote is removed: no sidecar is left without its image.
- * @param path destination image, which must not exist
- * @param mosaic CV_16UC1 (any container) or CV_32FC1 (TIFF only)
- * @param metadata the format, and optionally the scene and seed that made the mosaic and the camera tags
- *        (validated); a DNG carries the camera tags when `hasCamera`
- * @throws cv::Exception when `path` exists, the type does not fit the container, the camera tags do not
- *         fit a DNG (see writeDng()), or a write fails.
- */
-CV_RAWGMENT_EXPORTS void writeMosaic(const String& path, InputArray mosaic, const MosaicMetadata& metadata);
-
-/** @brief Reads a mosaic written by writeMosaic() and its sidecar.
- * @param path the image; its sidecar must be beside it
- * @param mosaic output, the stored type
- * @return the sidecar's metadata
- * @throws cv::Exception naming the file when either is missing or invalid, or when the image's size or
- *         type contradicts the sidecar.
- */
-CV_RAWGMENT_EXPORTS MosaicMetadata readMosaic(const String& path, OutputArray mosaic);
 
 //! @}
 

@@ -1,0 +1,200 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The mosaic_files topic (mosaic_files.hpp): mosaics written with a YAML sidecar of their format, scene,
+// seed and camera tags, and read back with every field checked against the image.
+#include "raw_io_detail.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/rawgment/mosaic_files.hpp>
+
+#include <cstdio>
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+
+void MosaicMetadata::write(FileStorage& fs, const String& name) const
+{
+    format.validate();
+    fs << name << "{";
+    fs << "format_version" << FORMAT_VERSION;
+    format.write(fs, "raw_format");
+    fs << "size" << size;
+    fs << "type" << typeToString(type);
+    fs << "source" << source;
+    fs << "has_scene" << int(hasScene);
+    if (hasScene) {
+        scene.write(fs, "scene");
+        // FileStorage has no 64-bit integer: the seed travels as a decimal string.
+        fs << "seed" << cv::format("%llu", static_cast<unsigned long long>(seed));
+    }
+    if (hasCamera)
+        camera.write(fs, "camera");
+    if (!noiseCamera.empty())
+        fs << "noise_camera" << noiseCamera;
+    fs << "}";
+}
+
+MosaicMetadata MosaicMetadata::read(const FileNode& node)
+{
+    if (node.empty() || !node.isMap())
+        CV_Error(Error::StsParseError, "mosaic metadata: expected a map with format_version and raw_format");
+    const FileNode version = node["format_version"];
+    if (version.empty() || !version.isInt() || int(version) < 1 || int(version) > FORMAT_VERSION)
+        CV_Error(
+            Error::StsParseError,
+            cv::format("mosaic metadata: format_version is missing or not one of 1..%d", FORMAT_VERSION));
+    try {
+        rejectUnknownKeys(node, {"format_version", "raw_format", "size", "type", "source", "has_scene",
+                                 "scene", "seed", "camera", "noise_camera"});
+    } catch (const Exception& e) {
+        CV_Error(e.code, "mosaic metadata: " + e.err);
+    }
+    MosaicMetadata m;
+    m.format = RawFormat::read(node["raw_format"]);
+    node["size"] >> m.size;
+    const String typeName = node["type"].empty() ? String() : String(node["type"]);
+    if (typeName == "CV_16UC1")
+        m.type = CV_16UC1;
+    else if (typeName == "CV_32FC1")
+        m.type = CV_32FC1;
+    else
+        CV_Error(Error::StsParseError,
+                 "mosaic metadata: field 'type' must be CV_16UC1 or CV_32FC1 (got '" + typeName + "')");
+    if (m.size.width <= 0 || m.size.height <= 0)
+        CV_Error(Error::StsParseError, "mosaic metadata: field 'size' is missing or not positive");
+    m.source = node["source"].empty() ? String() : String(node["source"]);
+    m.hasScene = !node["has_scene"].empty() && int(node["has_scene"]) != 0;
+    if (m.hasScene) {
+        m.scene = Scene::read(node["scene"]);
+        const String seed = node["seed"].empty() ? String() : String(node["seed"]);
+        char* end = nullptr;
+        errno = 0;
+        const unsigned long long v = std::strtoull(seed.c_str(), &end, 10);
+        if (seed.empty() || *end != '\0' || errno != 0)
+            CV_Error(Error::StsParseError,
+                     "mosaic metadata: field 'seed' is missing or not a decimal integer");
+        m.seed = static_cast<uint64>(v);
+    }
+    const FileNode noiseCamera = node["noise_camera"];
+    if (!noiseCamera.empty() && !noiseCamera.isString())
+        CV_Error(Error::StsParseError, "mosaic metadata: field 'noise_camera' must be a string");
+    m.noiseCamera = noiseCamera.empty() ? String() : String(noiseCamera);
+    m.hasCamera = !node["camera"].empty();
+    if (m.hasCamera)
+        m.camera = CameraTags::read(node["camera"]);
+    return m;
+}
+
+String sidecarPathOf(const String& path)
+{
+    return path + ".yml";
+}
+using detail::lowerExtensionOf;
+
+void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& metadata)
+{
+    const Mat mosaic = _mosaic.getMat();
+    const String ext = lowerExtensionOf(path);
+    const bool tiff = ext == ".tif" || ext == ".tiff";
+    if (ext != ".png" && ext != ".dng" && !tiff)
+        CV_Error(Error::StsBadArg, "writeMosaic: '" + path +
+                                       "': unsupported extension; expected .png, .tif, "
+                                       ".tiff or .dng");
+    if (mosaic.empty() || (mosaic.type() != CV_16UC1 && !(tiff && mosaic.type() == CV_32FC1)))
+        CV_Error(Error::StsBadArg,
+                 cv::format("writeMosaic: '%s': a %s mosaic cannot be stored as %s; expected CV_16UC1%s",
+                            path.c_str(), mosaic.empty() ? "empty" : typeToString(mosaic.type()).c_str(),
+                            ext.c_str(), tiff ? " or CV_32FC1" : " (TIFF also takes CV_32FC1)"));
+    if (detail::fileExists(path))
+        CV_Error(Error::StsError, "writeMosaic: '" + path + "' already exists; it is never overwritten");
+    MosaicMetadata meta = metadata;
+    meta.size = mosaic.size();
+    meta.type = mosaic.type();
+    const String sidecar = sidecarPathOf(path);
+    const std::string text =
+        detail::fileStorageText(sidecar, [&](FileStorage& fs) { meta.write(fs, "mosaic_metadata"); });
+    // The sidecar is never replaced either. One left by an interrupted run of the same job (the image
+    // missing, the same text) is kept; any other is another mosaic's and stops the write.
+    bool createdSidecar = false;
+    if (detail::fileExists(sidecar)) {
+        if (detail::readTextFile(sidecar) != text)
+            CV_Error(Error::StsError, "writeMosaic: '" + sidecar +
+                                          "' exists and describes another mosaic; it is never overwritten "
+                                          "(remove it if an interrupted run left it)");
+    } else {
+        writeFileAtomically(sidecar, text.data(), text.size(), false);
+        createdSidecar = true;
+    }
+    try {
+        if (ext == ".dng") {
+            RawImage image;
+            image.mosaic = mosaic;
+            image.format = meta.format;
+            if (meta.hasCamera)
+                meta.camera.applyTo(image);
+            writeDng(path, image);
+            return;
+        }
+        std::vector<uchar> bytes;
+        const std::vector<int> params =
+            tiff ? std::vector<int>{IMWRITE_TIFF_COMPRESSION, 1} : std::vector<int>{};
+        bool encoded = false;
+        try {
+            encoded = imencode(ext, mosaic, bytes, params);
+        } catch (const Exception& e) {
+            CV_Error(Error::StsError, "writeMosaic: '" + path + "': encoding failed: " + e.err);
+        }
+        if (!encoded)
+            CV_Error(Error::StsError,
+                     "writeMosaic: '" + path + "': OpenCV could not encode the mosaic as " + ext);
+        writeFileAtomically(path, bytes.data(), bytes.size(), false);
+    } catch (...) {
+        // No sidecar without its image: a sidecar this call made goes with the failed image.
+        if (createdSidecar)
+            std::remove(sidecar.c_str());
+        throw;
+    }
+}
+
+MosaicMetadata readMosaic(const String& path, OutputArray _mosaic)
+{
+    const String sidecar = sidecarPathOf(path);
+    if (!detail::fileExists(path))
+        CV_Error(Error::StsError, "readMosaic: '" + path + "': no such file");
+    detail::checkRegularFile(path, "mosaic");
+    const MosaicMetadata meta =
+        detail::loadFileStorage(sidecar, "mosaic_metadata", "mosaic sidecar",
+                                [](const FileNode& n) { return MosaicMetadata::read(n); });
+    Mat mosaic;
+    if (lowerExtensionOf(path) == ".dng") {
+        // A DNG states its own levels and pattern: a sidecar that contradicts them describes another file.
+        const RawImage raw = readRaw(path);
+        const RawFormat& f = raw.format;
+        if (f.pattern != meta.format.pattern || f.blackLevel != meta.format.blackLevel ||
+            f.whiteLevel != meta.format.whiteLevel)
+            CV_Error(
+                Error::StsError,
+                cv::format("readMosaic: '%s' is %s with black %g %g %g %g and white %g, but its sidecar says "
+                           "%s with black %g %g %g %g and white %g",
+                           path.c_str(), cfaPatternName(f.pattern).c_str(), f.blackLevel[0], f.blackLevel[1],
+                           f.blackLevel[2], f.blackLevel[3], f.whiteLevel,
+                           cfaPatternName(meta.format.pattern).c_str(), meta.format.blackLevel[0],
+                           meta.format.blackLevel[1], meta.format.blackLevel[2], meta.format.blackLevel[3],
+                           meta.format.whiteLevel));
+        mosaic = raw.mosaic;
+    } else {
+        mosaic = imread(path, IMREAD_UNCHANGED);
+    }
+    if (mosaic.empty())
+        CV_Error(Error::StsError, "readMosaic: '" + path + "': OpenCV cannot decode it");
+    if (mosaic.size() != meta.size || mosaic.type() != meta.type)
+        CV_Error(Error::StsError,
+                 cv::format("readMosaic: '%s' is %dx%d %s but its sidecar says %dx%d %s", path.c_str(),
+                            mosaic.cols, mosaic.rows, typeToString(mosaic.type()).c_str(), meta.size.width,
+                            meta.size.height, typeToString(meta.type).c_str()));
+    _mosaic.assign(mosaic);
+    return meta;
+}
+
+} // namespace rawgment
+} // namespace cv

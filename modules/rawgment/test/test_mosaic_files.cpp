@@ -1,0 +1,237 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The mosaic_files topic: mosaics with their sidecars in every container, camera tags that travel with
+// them, sidecars never replaced or left without their image, and sidecars checked against the image.
+#include "test_common.hpp"
+
+#include "../src/precomp.hpp"
+
+#include <opencv2/rawgment/augment.hpp>
+#include <opencv2/rawgment/mosaic_files.hpp>
+#include <opencv2/rawgment/raw_io.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+namespace {
+
+using test::filesIn;
+using test::makeTempDir;
+using test::readBytes;
+using test::writeBytes;
+
+TEST(MosaicFiles, cameraTagsTravelInTheSidecarAndTheDngAndFirstVersionSidecarsStillLoad)
+{
+    const std::string dir = makeTempDir("raw_io_camera_tags");
+    Mat m16(48, 64, CV_16UC1, Scalar(900));
+    MosaicMetadata meta;
+    meta.format.whiteLevel = 4095;
+    meta.format.blackLevel = Vec4d::all(64);
+    meta.hasCamera = true;
+    meta.camera.make = "Maker";
+    meta.camera.model = "Model";
+    meta.camera.iso = 1234.4;
+    meta.camera.exposureTime = 1.0 / 32000 * 0.3;
+    meta.camera.whiteBalance = Vec3d(2.1, 1, 1.6);
+    meta.camera.cameraToSrgb = Matx33d(1.6, -0.4, -0.2, -0.2, 1.5, -0.3, 0.1, -0.5, 1.4);
+    meta.camera.noiseProfile = {Vec2d(1e-4, 2e-7)};
+    writeMosaic(dir + "/tagged.dng", m16, meta);
+    Mat back;
+    const CameraTags side = readMosaic(dir + "/tagged.dng", back).camera;
+    EXPECT_EQ(side.make, "Maker");
+    EXPECT_EQ(side.iso, 1234.4) << "the sidecar keeps what the DNG rounds";
+    EXPECT_EQ(side.exposureTime, meta.camera.exposureTime);
+    EXPECT_EQ(side.whiteBalance, meta.camera.whiteBalance);
+    EXPECT_EQ(side.cameraToSrgb, meta.camera.cameraToSrgb);
+    EXPECT_EQ(side.noiseProfile, meta.camera.noiseProfile);
+    const RawImage dng = readRaw(dir + "/tagged.dng");
+    EXPECT_EQ(dng.make, "Maker");
+    EXPECT_EQ(dng.model, "Model");
+    EXPECT_EQ(dng.iso, 1234) << "ISOSpeedRatings is an integer";
+    // Nine decimals of the DNG rational, then LibRaw's float: 1e-7 relative.
+    EXPECT_NEAR(dng.exposureTime, meta.camera.exposureTime, 1e-6 * meta.camera.exposureTime);
+    EXPECT_NEAR(norm(Vec3d(dng.whiteBalance) - meta.camera.whiteBalance), 0, 1e-5);
+    EXPECT_EQ(dng.noiseProfile, meta.camera.noiseProfile);
+
+    // Colour tags travel verbatim through the sidecar and the DNG: a big-endian source's numerators,
+    // an unsigned rational beyond int32, a CalibrationIlluminant2 that writeDng would never make.
+    DngTag colorMatrix, neutral, illuminant2;
+    colorMatrix.tag = 50721;
+    colorMatrix.type = 10;
+    colorMatrix.count = 9;
+    colorMatrix.values = {6461,  10000, -1164, 10000, -857,  10000, -3825, 10000, 11597,
+                          10000, 2534,  10000, -416,  10000, 1540,  10000, 6039,  10000};
+    neutral.tag = 50728;
+    neutral.type = 5;
+    neutral.count = 3;
+    neutral.values = {3000000000.0, 3000000000.0, 2477, 1000, 1462, 1000};
+    illuminant2.tag = 50779;
+    illuminant2.type = 3;
+    illuminant2.count = 1;
+    illuminant2.values = {17};
+    meta.camera.colorTags = {colorMatrix, neutral, illuminant2};
+    writeMosaic(dir + "/colour.dng", m16, meta);
+    const CameraTags colourSide = readMosaic(dir + "/colour.dng", back).camera;
+    const RawImage colourDng = readRaw(dir + "/colour.dng");
+    for (const std::vector<DngTag>* tags : {&colourSide.colorTags, &colourDng.colorTags}) {
+        ASSERT_EQ(3u, tags->size());
+        for (size_t k = 0; k < 3; ++k) {
+            EXPECT_EQ((*tags)[k].tag, meta.camera.colorTags[k].tag);
+            EXPECT_EQ((*tags)[k].type, meta.camera.colorTags[k].type);
+            EXPECT_EQ((*tags)[k].values, meta.camera.colorTags[k].values);
+        }
+    }
+    // What no TIFF value holds is refused, naming the tag.
+    DngTag bad = neutral;
+    bad.values[1] = 0;
+    EXPECT_CV_ERROR_CONTAINS(bad.validate("x"),
+                             "x 50728: value 1 (0) does not fit TIFF type 5 (a denominator");
+    bad = colorMatrix;
+    bad.tag = 271;
+    EXPECT_CV_ERROR_CONTAINS(bad.validate("x"), "tag 271 is not one of the DNG colour tags");
+    meta.camera.colorTags.clear();
+
+    // The same sidecar as format version 1 wrote it (no camera key) still loads.
+    meta.hasCamera = false;
+    writeMosaic(dir + "/plain.png", m16, meta);
+    std::string text;
+    {
+        const std::vector<char> bytes = readBytes(dir + "/plain.png.yml");
+        text.assign(bytes.begin(), bytes.end());
+    }
+    const size_t at = text.find("format_version: 3");
+    ASSERT_NE(at, std::string::npos) << text;
+    text.replace(at, 17, "format_version: 1");
+    std::remove((dir + "/plain.png.yml").c_str());
+    writeBytes(dir + "/plain.png.yml", std::vector<char>(text.begin(), text.end()));
+    EXPECT_FALSE(readMosaic(dir + "/plain.png", back).hasCamera);
+    // A misspelled camera key is named.
+    text.replace(at, 17, "format_version: 2");
+    text +=
+        "   camera: { make: x, iso: 1, white_balance: [1, 1, 1], camera_to_srgb: [1, 0, 0, 0, 1, 0, 0, 0, 1],"
+        " exposure: 1 }\n";
+    std::remove((dir + "/plain.png.yml").c_str());
+    writeBytes(dir + "/plain.png.yml", std::vector<char>(text.begin(), text.end()));
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/plain.png", back), "exposure");
+
+    // The real camera whose noise a scene simulated travels in the sidecar (format version 3).
+    meta.noiseCamera = "Nikon D3";
+    writeMosaic(dir + "/camera.png", m16, meta);
+    EXPECT_EQ(readMosaic(dir + "/camera.png", back).noiseCamera, "Nikon D3");
+}
+
+TEST(MosaicFiles, mosaicRoundTripsWithItsSidecarInEveryContainer)
+{
+    const std::string dir = makeTempDir("raw_io_mosaic");
+    Mat m16(32, 48, CV_16UC1);
+    randu(m16, 0, 65536);
+    MosaicMetadata meta;
+    meta.format.pattern = CFA_GBRG;
+    meta.format.blackLevel = Vec4d(64, 64, 64, 64);
+    meta.format.whiteLevel = 65535;
+    meta.format.gain = 3.98;
+    meta.hasScene = true;
+    meta.scene.jitter.brightness = -2.5;
+    meta.scene.jitter.gainRatio = 2.0;
+    meta.seed = 18446744073709551557ull; // the largest 64-bit prime: the seed needs all 64 bits
+    meta.source = "input.dng";
+    for (const char* ext : {".png", ".tif", ".dng"}) {
+        const std::string path = dir + "/out" + ext;
+        writeMosaic(path, m16, meta);
+        Mat back;
+        const MosaicMetadata r = readMosaic(path, back);
+        SCOPED_TRACE(ext);
+        EXPECT_EQ(0, norm(m16, back, NORM_INF));
+        EXPECT_EQ(cfaPatternName(CFA_GBRG), cfaPatternName(r.format.pattern));
+        EXPECT_EQ(3.98, r.format.gain) << "the new gain travels in the sidecar";
+        EXPECT_TRUE(r.hasScene);
+        EXPECT_EQ(-2.5, r.scene.jitter.brightness);
+        EXPECT_EQ(2.0, r.scene.jitter.gainRatio);
+        EXPECT_EQ(meta.seed, r.seed);
+        EXPECT_EQ("input.dng", r.source);
+        EXPECT_CV_ERROR_CONTAINS(writeMosaic(path, m16, meta), "never overwritten");
+    }
+    Mat f32(32, 48, CV_32FC1);
+    randu(f32, -5.0, 1000.0);
+    writeMosaic(dir + "/float.tiff", f32, meta);
+    Mat back;
+    readMosaic(dir + "/float.tiff", back);
+    EXPECT_EQ(0, norm(f32, back, NORM_INF)) << "float TIFF is lossless";
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/float.png", f32, meta), "cannot be stored as .png");
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/x.jpg", m16, meta), "unsupported extension");
+    const std::vector<std::string> expected = {"float.tiff", "float.tiff.yml", "out.dng", "out.dng.yml",
+                                               "out.png",    "out.png.yml",    "out.tif", "out.tif.yml"};
+    EXPECT_EQ(expected, filesIn(dir)) << "no temporary files are left behind";
+}
+
+TEST(MosaicFiles, writeMosaicNeverReplacesASidecarAndLeavesNoneWithoutItsImage)
+{
+    const std::string dir = makeTempDir("raw_io_sidecar_safety");
+    Mat m16(32, 48, CV_16UC1, Scalar(500));
+    MosaicMetadata meta;
+    meta.format.whiteLevel = 65535;
+    meta.source = "a/frame_000.dng";
+    // Another mosaic's sidecar whose image is missing: kept as it is, and the write refused.
+    const std::string other = dir + "/other.png";
+    writeBytes(sidecarPathOf(other), {'x', '\n'});
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(other, m16, meta), "describes another mosaic");
+    EXPECT_EQ(readBytes(sidecarPathOf(other)), (std::vector<char>{'x', '\n'}));
+    EXPECT_FALSE(std::ifstream(other).good());
+    // The sidecar an interrupted run of the same job left: the write completes.
+    const std::string same = dir + "/same.png";
+    writeMosaic(same, m16, meta);
+    std::remove(same.c_str());
+    writeMosaic(same, m16, meta);
+    Mat back;
+    EXPECT_EQ(readMosaic(same, back).source, "a/frame_000.dng");
+    // An image that cannot be written takes its new sidecar with it (odd sides do not fit a DNG).
+    const std::string odd = dir + "/odd.dng";
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(odd, Mat(31, 48, CV_16UC1, Scalar(1)), meta), "even");
+    EXPECT_FALSE(std::ifstream(sidecarPathOf(odd)).good()) << "no sidecar without its image";
+}
+
+TEST(MosaicFiles, readMosaicChecksTheSidecar)
+{
+    const std::string dir = makeTempDir("raw_io_sidecar");
+    Mat m(8, 8, CV_16UC1, Scalar(7));
+    MosaicMetadata meta;
+    writeMosaic(dir + "/a.png", m, meta);
+    Mat back;
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/b.png", back), "no such file");
+    ASSERT_EQ(0, std::remove((dir + "/a.png.yml").c_str()));
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/a.png", back), "cannot open mosaic sidecar");
+    // A sidecar that describes another image.
+    Mat other(4, 4, CV_16UC1, Scalar(1));
+    writeMosaic(dir + "/c.png", other, meta);
+    ASSERT_EQ(0, std::rename((dir + "/c.png.yml").c_str(), (dir + "/a.png.yml").c_str()));
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/a.png", back), "but its sidecar says 4x4");
+}
+
+TEST(MosaicFiles, readMosaicRefusesASidecarThatContradictsItsDng)
+{
+    const std::string dir = makeTempDir("raw_io_sidecar_dng");
+    MosaicMetadata meta;
+    meta.format.blackLevel = Vec4d::all(64);
+    meta.format.whiteLevel = 4095;
+    writeMosaic(dir + "/m.dng", Mat(64, 64, CV_16UC1, Scalar(500)), meta);
+    std::vector<char> text = readBytes(dir + "/m.dng.yml");
+    std::string s(text.begin(), text.end());
+    const size_t at = s.find("white_level: 4095.");
+    ASSERT_NE(at, std::string::npos) << s;
+    s.replace(at, 18, "white_level: 1023.");
+    writeBytes(dir + "/m.dng.yml", std::vector<char>(s.begin(), s.end()));
+    Mat back;
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/m.dng", back),
+                             "but its sidecar says RGGB with black 64 64 64 64 and white 1023");
+}
+
+} // namespace
+} // namespace rawgment
+} // namespace cv
