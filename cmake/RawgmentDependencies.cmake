@@ -38,11 +38,11 @@ if(RAWGMENT_BUILD_PERF)
 endif()
 
 # The Python module needs Debian's interpreter (its numpy, torch and dask are Debian packages), its
-# headers, pybind11, NumPy, the apps (rawgment.batch runs their jobs) and Doxygen (its docstrings are the
-# C++ documentation). A sanitizer build has no Python module: an instrumented extension needs the
+# headers, pybind11, NumPy and Doxygen (its docstrings are the C++ documentation); rawgment.batch runs the
+# pipeline layer's jobs (pipeline/), not the apps. A sanitizer build has no Python module: an instrumented extension needs the
 # sanitizer runtime preloaded into the interpreter.
 set(RAWGMENT_WITH_PYTHON OFF)
-if(NOT RAWGMENT_BUILD_PYTHON STREQUAL "OFF" AND NOT RAWGMENT_SANITIZE AND RAWGMENT_BUILD_APPS)
+if(NOT RAWGMENT_BUILD_PYTHON STREQUAL "OFF" AND NOT RAWGMENT_SANITIZE)
   if(NOT DEFINED Python3_EXECUTABLE AND EXISTS /usr/bin/python3)
     set(Python3_EXECUTABLE /usr/bin/python3)
   endif()

@@ -1,8 +1,11 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // What the apps share and the library must not hold (docs/architecture.md): progress, command-line
-// lists, CSV and plots; files go through the library's writeFileAtomically().
+// lists, CSV and plots; files go through the pipeline layer (output_files.hpp) and so through the
+// library's writeFileAtomically().
 #ifndef RAWGMENT_APPS_APP_TOOLS_HPP
 #define RAWGMENT_APPS_APP_TOOLS_HPP
+
+#include "output_files.hpp"
 
 #include <opencv2/core.hpp>
 
@@ -15,12 +18,9 @@
 
 namespace rawgment_apps {
 
-//! Whether a file or directory exists.
-bool pathExists(const std::string& path);
-//! Whether `path` is a regular file (or a link to one).
-bool isRegularFile(const std::string& path);
-//! `path` with '.', '..' and links resolved (as far as it exists): two names of one file compare equal.
-std::string canonicalPath(const std::string& path);
+// The pipeline layer's files (paths, output folders, writes that never replace) are the apps' too.
+using namespace rawgment_pipeline;
+
 /** The seed of a --seed option: decimal digits of a value in [0, 2^64 - 1], the one rule of every app
  * and of rawgment.batch (a negative seed used to wrap to 2^64 - 1 here and raise in Python). Throws
  * std::runtime_error naming the value. */
@@ -44,34 +44,9 @@ private:
     bool existed_, kept_ = false;
 };
 
-/** Makes `dir` (and its parents), removes the temporaries that interrupted runs left in it (files
- * `*.tmp-<pid>-<n>` and `*.gp.<pid>.run` of processes that are gone, saying how many), and checks that a
- * file can be written there: before any computation, not after it. Throws std::runtime_error. */
-void prepareOutputDirectory(const std::string& dir);
-
 /** On SIGINT, SIGTERM or SIGHUP, removes the temporaries of the writes in progress, then ends the
  * process as the signal would have. */
 void installInterruptCleanup();
-
-//! Creates a directory and its parents (like mkdir -p); throws std::runtime_error naming the path.
-void makeDirectories(const std::string& path);
-//! The directory part of a path ("." when there is none).
-std::string directoryOf(const std::string& path);
-//! The file name without directory and without its last extension.
-std::string stemOf(const std::string& path);
-//! `path` resolved against `base` when it is relative.
-std::string resolvePath(const std::string& base, const std::string& path);
-
-/** Writes `text` to `path` atomically: a temporary file beside it, checked writes, then rename.
- * Throws std::runtime_error naming the file and the reason. */
-void writeTextAtomically(const std::string& path, const std::string& text);
-/** Encodes an image by the extension of `path` and writes it atomically (see writeTextAtomically). */
-void writeImageAtomically(const std::string& path, const cv::Mat& image);
-/** Like writeImageAtomically(), but never replaces a file: an existing file with exactly these bytes
- * (an interrupted run of the same job) is kept, any other is an error. */
-void writeNewImage(const std::string& path, const cv::Mat& image);
-//! writeNewImage() for text.
-void writeNewText(const std::string& path, const std::string& text);
 
 /** What cv::CommandLineParser lets through: an option that `keys` does not name, a valued option
  * without `=<value>` (`--model m.yml` would read "true"), a number option whose value is not a number.

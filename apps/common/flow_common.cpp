@@ -86,35 +86,6 @@ std::vector<cv::Rect> manifestSquares(const std::string& patches, const std::str
     return found.squares;
 }
 
-LoadedMosaic loadMosaicFile(const std::string& path)
-{
-    LoadedMosaic out;
-    if (pathExists(sidecarPathOf(path))) {
-        const MosaicMetadata meta = readMosaic(path, out.mosaic);
-        out.format = meta.format;
-        out.hasCamera = meta.hasCamera;
-        out.camera = meta.camera;
-    } else {
-        RawImage image = readRaw(path);
-        out.mosaic = image.mosaic;
-        out.format = image.format;
-        out.hasCamera = true;
-        out.camera = CameraTags::of(image);
-        out.fromCameraFile = true;
-    }
-    return out;
-}
-
-cv::Mat previewOf(const cv::Mat& mosaic, const RawFormat& format, double exposure)
-{
-    IspParams isp;
-    isp.tone = ToneCurve::srgb();
-    isp.exposure = exposure;
-    cv::Mat bgr;
-    renderSimpleIsp(mosaic, format, bgr, isp);
-    return bgr;
-}
-
 void addDarkShadingPattern(cv::Size size, double amplitude, uint64_t seed, cv::rawgment::NoiseModel& model)
 {
     cv::Mat perGain(size, CV_32FC1), offset(size, CV_32FC1);

@@ -1,7 +1,10 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// The work of each app as a function, so that the demo runs exactly what the apps run.
+// The work of each app as a function, so that the demo runs exactly what the apps run; the augmentation
+// jobs they share with the Python module are the pipeline layer's (pipeline/augment_jobs.hpp).
 #ifndef RAWGMENT_APPS_PIPELINE_HPP
 #define RAWGMENT_APPS_PIPELINE_HPP
+
+#include "augment_jobs.hpp"
 
 #include <opencv2/rawgment.hpp>
 
@@ -10,16 +13,8 @@
 
 namespace rawgment_apps {
 
-//! A mosaic from any file the apps read: our mosaics with a sidecar, or camera RAW files.
-struct LoadedMosaic
-{
-    cv::Mat mosaic;
-    cv::rawgment::RawFormat format;
-    bool hasCamera = false;      //!< a camera RAW file, or a mosaic whose sidecar has camera tags
-    bool fromCameraFile = false; //!< read by LibRaw (no sidecar): format.gain is 1, whatever the ISO
-    cv::rawgment::CameraTags camera;
-};
-LoadedMosaic loadMosaicFile(const std::string& path);
+// The pipeline layer's inputs and augmentation jobs (augment_jobs.hpp) are the apps' too.
+using namespace rawgment_pipeline;
 
 // ---------------------------------------------------------------------------------------------------
 //! The ISO that rawgment_simulate writes for unit gain (frames at gain g say ISO 100 g).
@@ -162,24 +157,6 @@ ValidationManifest readValidationManifest(const std::string& path);
 ValidateResult validateConversion(const ValidateOptions& options);
 
 // ---------------------------------------------------------------------------------------------------
-struct AugmentOptions
-{
-    std::vector<std::string> inputs;
-    std::string model; //!< a NoiseModel file, an Android profile YAML, or a darktable profile file
-    /** With a darktable profile file: a camera name, a comma-separated list of names or "good" /
-     * "usable" (selectCameraProfiles()); with several cameras each output draws one
-     * (drawCameraIndex() of its seed). Must be empty for the other model files. */
-    std::string camera;
-    std::string scene;  //!< a Scene file (map `scene`), or
-    std::string policy; //!< a RandomScenePolicy file
-    std::string outDir;
-    int variants = 1;
-    uint64_t seed = 1;
-    std::string extension; //!< output container; empty: .dng for RAW inputs, else the input's
-    bool previews = false;
-    bool acceptFailedCalibration = false; //!< also a model whose calibration failed (NoiseModel::load())
-};
-
 struct AugmentResult
 {
     int written = 0, skipped = 0;
@@ -187,50 +164,6 @@ struct AugmentResult
 };
 
 AugmentResult augmentFiles(const AugmentOptions& options);
-
-/** One output of an augmentation run. Every front end (the app, Python, Dask workers) makes an output
- * with runAugmentJob(), so the same job gives the same bytes wherever it runs. */
-struct AugmentJob
-{
-    std::string input;   //!< the input file as given
-    std::string name;    //!< the input's output name: its stem, plus a hash of its path if stems collide
-    int variant = 0;     //!< variant number
-    uint64_t seed = 0;   //!< augmentedOutputSeed(options seed, name, variant)
-    std::string out;     //!< the output mosaic (its sidecar beside it)
-    std::string preview; //!< the preview PNG, empty for none
-};
-
-/** The outputs of a run: the jobs still to do, and the outputs that a previous run finished (a finished
- * output is one whose sidecar says it was made from the same input with the same seed; anything else
- * at an output's path is an error). Checks the options and the inputs, and creates the output folder. */
-struct AugmentPlan
-{
-    std::vector<AugmentJob> jobs;
-    std::vector<std::string> outputs; //!< every output, finished or not, in input and variant order
-    int skipped = 0;                  //!< outputs already finished
-};
-AugmentPlan planAugmentJobs(const AugmentOptions& options);
-
-//! What every job of a run applies: the model and either one scene or a random policy.
-struct AugmentRecipe
-{
-    cv::rawgment::NoiseModel model; //!< from a NoiseModel file (when cameras and android are empty)
-    std::vector<cv::rawgment::CameraNoiseProfile> cameras; //!< real cameras: each output takes one
-    std::string android; //!< an Android profile YAML, whose model depends on each input's format
-    bool randomScenes = false;
-    cv::rawgment::Scene scene;              //!< when !randomScenes
-    cv::rawgment::RandomScenePolicy policy; //!< when randomScenes
-};
-//! Loads the model and the scene or policy files of the options; errors name the file.
-AugmentRecipe loadAugmentRecipe(const AugmentOptions& options);
-/** The model of one job and, for a real camera, its name: a fixed model, the Android profile at the
- * input's format, or the job's camera (the only one, or drawCameraIndex() of the seed) at that format. */
-cv::rawgment::NoiseModel modelOfJob(const AugmentRecipe& recipe, const cv::rawgment::RawFormat& format,
-                                    uint64_t seed, std::string& cameraName);
-//! Makes one output (and its preview); throws on any error. Atomic: a failed job leaves no output.
-void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe);
-//! The scene of a scene file (a map `scene`, as Scene::write() writes it); errors name the file.
-cv::rawgment::Scene readSceneFile(const std::string& path);
 
 // ---------------------------------------------------------------------------------------------------
 //! rawgment_cameras: what a darktable noise-profile file holds and what its cameras say about Eq. 5.
@@ -249,9 +182,6 @@ struct CamerasResult
 };
 
 CamerasResult runCameras(const CamerasOptions& options);
-
-//! An sRGB-like 8-bit preview of a mosaic (tone curve gamma 2.2 with the sRGB toe, white balance 1).
-cv::Mat previewOf(const cv::Mat& mosaic, const cv::rawgment::RawFormat& format, double exposure = 1.0);
 
 } // namespace rawgment_apps
 

@@ -3,7 +3,7 @@
 // and jobs, so its files are the app's, byte for byte), and the timing hook of the Python benchmark.
 #include "binding_tools.hpp"
 
-#include "pipeline.hpp"
+#include "augment_jobs.hpp"
 
 #include <chrono>
 
@@ -13,13 +13,14 @@ using namespace cv::rawgment;
 
 namespace {
 
-rawgment_apps::AugmentOptions optionsFrom(const std::vector<std::string>& inputs, const std::string& model,
-                                          const std::string& scene, const std::string& policy,
-                                          const std::string& outDir, int variants, uint64 seed,
-                                          const std::string& extension, bool previews,
-                                          bool acceptFailedCalibration, const std::string& camera)
+rawgment_pipeline::AugmentOptions optionsFrom(const std::vector<std::string>& inputs,
+                                              const std::string& model, const std::string& scene,
+                                              const std::string& policy, const std::string& outDir,
+                                              int variants, uint64 seed, const std::string& extension,
+                                              bool previews, bool acceptFailedCalibration,
+                                              const std::string& camera)
 {
-    rawgment_apps::AugmentOptions o;
+    rawgment_pipeline::AugmentOptions o;
     o.inputs = inputs;
     o.model = model;
     o.camera = camera;
@@ -34,7 +35,7 @@ rawgment_apps::AugmentOptions optionsFrom(const std::vector<std::string>& inputs
     return o;
 }
 
-py::dict jobToDict(const rawgment_apps::AugmentJob& job)
+py::dict jobToDict(const rawgment_pipeline::AugmentJob& job)
 {
     py::dict d;
     d["input"] = job.input;
@@ -46,9 +47,9 @@ py::dict jobToDict(const rawgment_apps::AugmentJob& job)
     return d;
 }
 
-rawgment_apps::AugmentJob jobFromDict(const py::dict& d)
+rawgment_pipeline::AugmentJob jobFromDict(const py::dict& d)
 {
-    rawgment_apps::AugmentJob job;
+    rawgment_pipeline::AugmentJob job;
     job.input = d["input"].cast<std::string>();
     job.name = d["name"].cast<std::string>();
     job.variant = d["variant"].cast<int>();
@@ -71,9 +72,9 @@ void bindBatch(py::module_& m)
            const std::string& camera) {
             const auto options = optionsFrom(inputs, model, scene, policy, outDir, variants, seed, extension,
                                              previews, acceptFailedCalibration, camera);
-            rawgment_apps::loadAugmentRecipe(options); // the files are checked before any job is planned
-            const rawgment_apps::AugmentPlan plan =
-                withoutGil("planAugmentJobs", [&] { return rawgment_apps::planAugmentJobs(options); });
+            rawgment_pipeline::loadAugmentRecipe(options); // the files are checked before any job is planned
+            const rawgment_pipeline::AugmentPlan plan =
+                withoutGil("planAugmentJobs", [&] { return rawgment_pipeline::planAugmentJobs(options); });
             py::list jobs;
             for (const auto& job : plan.jobs)
                 jobs.append(jobToDict(job));
@@ -93,12 +94,12 @@ void bindBatch(py::module_& m)
         "runAugmentJob",
         [](const py::dict& job, const std::string& model, const std::string& scene, const std::string& policy,
            bool acceptFailedCalibration, const std::string& camera) {
-            const rawgment_apps::AugmentJob j = jobFromDict(job);
+            const rawgment_pipeline::AugmentJob j = jobFromDict(job);
             const auto options = optionsFrom({j.input}, model, scene, policy, "", 1, 0, "", false,
                                              acceptFailedCalibration, camera);
             withoutGil("runAugmentJob", [&] {
-                const rawgment_apps::AugmentRecipe recipe = rawgment_apps::loadAugmentRecipe(options);
-                rawgment_apps::runAugmentJob(j, recipe);
+                const rawgment_pipeline::AugmentRecipe recipe = rawgment_pipeline::loadAugmentRecipe(options);
+                rawgment_pipeline::runAugmentJob(j, recipe);
             });
         },
         py::arg("job"), py::arg("model"), py::arg("scene"), py::arg("policy"),

@@ -1,0 +1,219 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The pipeline layer's augmentation jobs (augment_jobs.hpp): a run planned as jobs, each made by
+// runAugmentJob() from the run's recipe, by the app, rawgment.batch or a Dask worker alike.
+#include "augment_jobs.hpp"
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+namespace rawgment_pipeline {
+
+using namespace cv::rawgment;
+
+namespace {
+
+/** The name of each input's outputs: its stem, unique per input. Inputs that share a stem (a/x.dng and
+ * b/x.dng) each add 8 hex digits of a hash of their path, so that no output or sidecar of one can be
+ * taken for the other's. The same file given twice is an error. */
+std::vector<std::string> outputNames(const std::vector<std::string>& inputs)
+{
+    std::map<std::string, int> stems;
+    std::map<std::string, std::string> seen; // canonical path -> the name it was given as first
+    for (const std::string& in : inputs) {
+        const auto given = seen.emplace(canonicalPath(in), in);
+        if (!given.second)
+            throw std::runtime_error(
+                "input '" + in + "' is given twice" +
+                (given.first->second == in ? std::string() : " (also as '" + given.first->second + "')"));
+        ++stems[stemOf(in)];
+    }
+    std::vector<std::string> names;
+    for (const std::string& in : inputs) {
+        const std::string stem = stemOf(in);
+        names.push_back(stems[stem] == 1
+                            ? stem
+                            : stem + cv::format("-%08llx", static_cast<unsigned long long>(
+                                                               augmentedOutputSeed(0, in, 0) >> 32)));
+    }
+    return names;
+}
+
+//! Throws unless `out`'s sidecar says it was made from `input` with `seed`: only then is it skipped.
+void requireFinishedBy(const std::string& out, const std::string& input, uint64_t seed)
+{
+    const std::string sidecar = sidecarPathOf(out);
+    if (!pathExists(sidecar))
+        throw std::runtime_error("'" + out +
+                                 "' exists without its sidecar; it is never overwritten (choose "
+                                 "another --out)");
+    cv::FileStorage fs = openFileStorageForReading(sidecar, "sidecar");
+    MosaicMetadata meta;
+    try {
+        meta = MosaicMetadata::read(fs["mosaic_metadata"]);
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error("'" + sidecar + "': " + e.err);
+    }
+    if (meta.source != input || !meta.hasScene || meta.seed != seed)
+        throw std::runtime_error("'" + out + "' exists but was made from '" + meta.source + "', not from '" +
+                                 input +
+                                 "' with this seed; it is never overwritten (choose "
+                                 "another --out)");
+}
+
+} // namespace
+
+Scene readSceneFile(const std::string& path)
+{
+    cv::FileStorage fs = openFileStorageForReading(path, "scene");
+    try {
+        return Scene::read(fs["scene"]);
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error("'" + path + "': " + e.err);
+    }
+}
+
+AugmentRecipe loadAugmentRecipe(const AugmentOptions& o)
+{
+    if (o.scene.empty() == o.policy.empty())
+        throw std::runtime_error("give exactly one of a scene file and a policy file");
+    AugmentRecipe recipe;
+    const int kind = noiseModelFileKind(o.model);
+    if (kind == DARKTABLE_PROFILE_FILE) {
+        if (o.camera.empty())
+            throw std::runtime_error("'" + o.model +
+                                     "' is a darktable noise-profile file of many cameras: choose with "
+                                     "--camera (a name, a comma-separated list, good or usable; "
+                                     "rawgment_cameras lists them)");
+        recipe.cameras = selectCameraProfiles(readCameraProfiles(o.model), o.camera);
+    } else if (!o.camera.empty()) {
+        throw std::runtime_error(
+            "--camera chooses among the cameras of a darktable noise-profile file, and '" + o.model +
+            "' is not one");
+    } else if (kind == ANDROID_PROFILE_FILE) {
+        recipe.android = o.model;
+        // Checked now, at a format of full range, so that a malformed file fails before any job.
+        noiseModelFromAndroidFile(o.model, RawFormat());
+    } else {
+        recipe.model = NoiseModel::load(o.model, o.acceptFailedCalibration);
+    }
+    recipe.randomScenes = o.scene.empty();
+    if (recipe.randomScenes)
+        recipe.policy = RandomScenePolicy::load(o.policy);
+    else
+        recipe.scene = readSceneFile(o.scene);
+    return recipe;
+}
+
+//! The most variants of one input, and outputs of one run (each job is a few hundred bytes in the plan).
+const int kMaxVariants = 100000;
+const size_t kMaxJobs = 1000000;
+
+AugmentPlan planAugmentJobs(const AugmentOptions& o)
+{
+    if (o.inputs.empty())
+        throw std::runtime_error("no input files");
+    if (o.variants < 1 || o.variants > kMaxVariants)
+        throw std::runtime_error(
+            cv::format("variants must lie in [1, %d] (got %d)", kMaxVariants, o.variants));
+    // Every job is planned before the first runs: a bound keeps the plan in memory.
+    if (o.inputs.size() * static_cast<size_t>(o.variants) > kMaxJobs)
+        throw std::runtime_error(
+            cv::format("%zu inputs x %d variants is more than the %zu outputs one run makes; "
+                       "split the inputs over several runs",
+                       o.inputs.size(), o.variants, kMaxJobs));
+    for (const std::string& in : o.inputs) {
+        if (!pathExists(in))
+            throw std::runtime_error("input '" + in + "': no such file");
+        if (!isRegularFile(in))
+            throw std::runtime_error("input '" + in + "' is not a file (a directory?)");
+    }
+    prepareOutputDirectory(o.outDir);
+
+    AugmentPlan plan;
+    const std::vector<std::string> names = outputNames(o.inputs);
+    for (size_t i = 0; i < o.inputs.size(); ++i) {
+        const size_t dot = o.inputs[i].find_last_of('.');
+        const std::string inExt = dot == std::string::npos ? std::string() : o.inputs[i].substr(dot);
+        const bool ours = pathExists(sidecarPathOf(o.inputs[i]));
+        const std::string ext = !o.extension.empty() ? o.extension : (ours ? inExt : std::string(".dng"));
+        for (int v = 0; v < o.variants; ++v) {
+            const std::string stem = o.outDir + "/" + names[i] + cv::format("_v%02d", v);
+            AugmentJob job;
+            job.input = o.inputs[i];
+            job.name = names[i];
+            job.variant = v;
+            // The seed depends on the file name and the variant, not on the order of the inputs.
+            job.seed = augmentedOutputSeed(o.seed, names[i], v);
+            job.out = stem + ext;
+            job.preview = o.previews ? stem + "_preview.png" : std::string();
+            for (const std::string& in : o.inputs)
+                if (in == job.out)
+                    throw std::runtime_error("output '" + job.out +
+                                             "' would replace an input; choose another --out");
+            plan.outputs.push_back(job.out);
+            if (pathExists(job.out)) {
+                // Resumable: a finished output of this very job stays; anything else there is refused.
+                requireFinishedBy(job.out, job.input, job.seed);
+                ++plan.skipped;
+                continue;
+            }
+            plan.jobs.push_back(job);
+        }
+    }
+    return plan;
+}
+
+NoiseModel modelOfJob(const AugmentRecipe& recipe, const RawFormat& format, uint64_t seed,
+                      std::string& cameraName)
+{
+    cameraName.clear();
+    if (!recipe.android.empty())
+        return noiseModelFromAndroidFile(recipe.android, format);
+    if (recipe.cameras.empty())
+        return recipe.model;
+    const CameraNoiseProfile& camera =
+        recipe.cameras[size_t(drawCameraIndex(int(recipe.cameras.size()), seed))];
+    cameraName = camera.name();
+    return camera.modelFor(format);
+}
+
+void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe)
+{
+    LoadedMosaic m = loadMosaicFile(job.input);
+    std::string cameraName;
+    const NoiseModel model = modelOfJob(recipe, m.format, job.seed, cameraName);
+    // A camera file read without a sidecar is at the gain its ISO says, relative to the ISO of the
+    // model's gain 1 (a model calibrated from the camera's files knows it). A file that does not say its
+    // ISO, or a model without a base ISO, leaves gain 1: the capture is taken to be at the base ISO.
+    if (m.fromCameraFile && m.camera.iso > 0 && model.baseIso > 0)
+        m.format.gain = m.camera.iso / model.baseIso;
+    const Scene scene = recipe.randomScenes ? recipe.policy.draw(m.mosaic, m.format, job.seed) : recipe.scene;
+    cv::Mat out;
+    RawFormat outFormat;
+    AugmentReport report;
+    applyScene(m.mosaic, m.format, model, scene, job.seed, out, outFormat, &report);
+    MosaicMetadata meta;
+    meta.format = outFormat;
+    meta.hasScene = true;
+    meta.scene = scene;
+    meta.seed = job.seed;
+    meta.source = job.input;
+    meta.noiseCamera = cameraName;
+    // The output is the camera's capture of the darker or brighter scene: the input's camera tags, with
+    // the ISO scaled by the gain ratio, the exposure time by the photon ratio (of green, which hue leaves
+    // alone) and the noise profile of the model at the output's gain.
+    const double signalRatio = scene.jitter.contrast[cfaSiteOfChannel(m.format.pattern, CFA_G1)];
+    meta.hasCamera = true;
+    meta.camera = m.camera;
+    meta.camera.iso = m.camera.iso * outFormat.gain / m.format.gain;
+    meta.camera.exposureTime = m.camera.exposureTime * signalRatio / scene.jitter.gainRatio;
+    meta.camera.noiseProfile = model.alpha > 0 ? dngNoiseProfile(model, outFormat) : std::vector<cv::Vec2d>();
+    // A preview brightened back to the input's level shows the noise the scene added, not a dark frame.
+    if (!job.preview.empty())
+        writeNewImage(job.preview, previewOf(out, outFormat, 1.0 / signalRatio));
+    writeMosaic(job.out, out, meta);
+}
+
+} // namespace rawgment_pipeline

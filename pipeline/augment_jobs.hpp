@@ -1,0 +1,96 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The pipeline layer: what the apps and the Python module (rawgment.batch, Dask workers) share to read
+// inputs and make augmented outputs, so that a job gives the same bytes wherever it runs. Above the
+// library, below the apps; errors are std::runtime_error or cv::Exception naming the file.
+#ifndef RAWGMENT_PIPELINE_AUGMENT_JOBS_HPP
+#define RAWGMENT_PIPELINE_AUGMENT_JOBS_HPP
+
+#include "output_files.hpp"
+
+#include <opencv2/rawgment.hpp>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rawgment_pipeline {
+
+//! A mosaic from any file the apps read: our mosaics with a sidecar, or camera RAW files.
+struct LoadedMosaic
+{
+    cv::Mat mosaic;
+    cv::rawgment::RawFormat format;
+    bool hasCamera = false;      //!< a camera RAW file, or a mosaic whose sidecar has camera tags
+    bool fromCameraFile = false; //!< read by LibRaw (no sidecar): format.gain is 1, whatever the ISO
+    cv::rawgment::CameraTags camera;
+};
+LoadedMosaic loadMosaicFile(const std::string& path);
+
+//! An sRGB-like 8-bit preview of a mosaic (tone curve gamma 2.2 with the sRGB toe, white balance 1).
+cv::Mat previewOf(const cv::Mat& mosaic, const cv::rawgment::RawFormat& format, double exposure = 1.0);
+
+struct AugmentOptions
+{
+    std::vector<std::string> inputs;
+    std::string model; //!< a NoiseModel file, an Android profile YAML, or a darktable profile file
+    /** With a darktable profile file: a camera name, a comma-separated list of names or "good" /
+     * "usable" (selectCameraProfiles()); with several cameras each output draws one
+     * (drawCameraIndex() of its seed). Must be empty for the other model files. */
+    std::string camera;
+    std::string scene;  //!< a Scene file (map `scene`), or
+    std::string policy; //!< a RandomScenePolicy file
+    std::string outDir;
+    int variants = 1;
+    uint64_t seed = 1;
+    std::string extension; //!< output container; empty: .dng for RAW inputs, else the input's
+    bool previews = false;
+    bool acceptFailedCalibration = false; //!< also a model whose calibration failed (NoiseModel::load())
+};
+
+/** One output of an augmentation run. Every front end (the app, Python, Dask workers) makes an output
+ * with runAugmentJob(), so the same job gives the same bytes wherever it runs. */
+struct AugmentJob
+{
+    std::string input;   //!< the input file as given
+    std::string name;    //!< the input's output name: its stem, plus a hash of its path if stems collide
+    int variant = 0;     //!< variant number
+    uint64_t seed = 0;   //!< augmentedOutputSeed(options seed, name, variant)
+    std::string out;     //!< the output mosaic (its sidecar beside it)
+    std::string preview; //!< the preview PNG, empty for none
+};
+
+/** The outputs of a run: the jobs still to do, and the outputs that a previous run finished (a finished
+ * output is one whose sidecar says it was made from the same input with the same seed; anything else
+ * at an output's path is an error). Checks the options and the inputs, and creates the output folder. */
+struct AugmentPlan
+{
+    std::vector<AugmentJob> jobs;
+    std::vector<std::string> outputs; //!< every output, finished or not, in input and variant order
+    int skipped = 0;                  //!< outputs already finished
+};
+AugmentPlan planAugmentJobs(const AugmentOptions& options);
+
+//! What every job of a run applies: the model and either one scene or a random policy.
+struct AugmentRecipe
+{
+    cv::rawgment::NoiseModel model; //!< from a NoiseModel file (when cameras and android are empty)
+    std::vector<cv::rawgment::CameraNoiseProfile> cameras; //!< real cameras: each output takes one
+    std::string android; //!< an Android profile YAML, whose model depends on each input's format
+    bool randomScenes = false;
+    cv::rawgment::Scene scene;              //!< when !randomScenes
+    cv::rawgment::RandomScenePolicy policy; //!< when randomScenes
+};
+//! Loads the model and the scene or policy files of the options; errors name the file.
+AugmentRecipe loadAugmentRecipe(const AugmentOptions& options);
+/** The model of one job and, for a real camera, its name: a fixed model, the Android profile at the
+ * input's format, or the job's camera (the only one, or drawCameraIndex() of the seed) at that format. */
+cv::rawgment::NoiseModel modelOfJob(const AugmentRecipe& recipe, const cv::rawgment::RawFormat& format,
+                                    uint64_t seed, std::string& cameraName);
+//! Makes one output (and its preview); throws on any error. Atomic: a failed job leaves no output.
+void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe);
+//! The scene of a scene file (a map `scene`, as Scene::write() writes it); errors name the file.
+cv::rawgment::Scene readSceneFile(const std::string& path);
+
+} // namespace rawgment_pipeline
+
+#endif // RAWGMENT_PIPELINE_AUGMENT_JOBS_HPP

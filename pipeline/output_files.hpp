@@ -1,0 +1,49 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The pipeline layer's files: paths, output folders, and writes that are atomic and never replace a
+// file, shared by the apps and the Python module. Errors are std::runtime_error naming the path.
+#ifndef RAWGMENT_PIPELINE_OUTPUT_FILES_HPP
+#define RAWGMENT_PIPELINE_OUTPUT_FILES_HPP
+
+#include <opencv2/core.hpp>
+
+#include <string>
+
+namespace rawgment_pipeline {
+
+//! Whether a file or directory exists.
+bool pathExists(const std::string& path);
+//! Whether `path` is a regular file (or a link to one).
+bool isRegularFile(const std::string& path);
+//! `path` with '.', '..' and links resolved (as far as it exists): two names of one file compare equal.
+std::string canonicalPath(const std::string& path);
+/** Makes `dir` (and its parents), removes the temporaries that interrupted runs left in it (files
+ * `*.tmp-<pid>-<n>` and `*.gp.<pid>.run` of processes that are gone, saying how many), and checks that a
+ * file can be written there: before any computation, not after it. Throws std::runtime_error. */
+void prepareOutputDirectory(const std::string& dir);
+
+//! Creates a directory and its parents (like mkdir -p); throws std::runtime_error naming the path.
+void makeDirectories(const std::string& path);
+//! The directory part of a path ("." when there is none).
+std::string directoryOf(const std::string& path);
+//! The file name without directory and without its last extension.
+std::string stemOf(const std::string& path);
+//! `path` resolved against `base` when it is relative.
+std::string resolvePath(const std::string& base, const std::string& path);
+
+/** Writes bytes to `path` through the library's writer (checked, synced, atomic), replacing a file there;
+ * its errors become std::runtime_error with the library's message. */
+void writeBytesAtomically(const std::string& path, const void* data, size_t size);
+/** Writes `text` to `path` atomically: a temporary file beside it, checked writes, then rename.
+ * Throws std::runtime_error naming the file and the reason. */
+void writeTextAtomically(const std::string& path, const std::string& text);
+/** Encodes an image by the extension of `path` and writes it atomically (see writeTextAtomically). */
+void writeImageAtomically(const std::string& path, const cv::Mat& image);
+/** Like writeImageAtomically(), but never replaces a file: an existing file with exactly these bytes
+ * (an interrupted run of the same job) is kept, any other is an error. */
+void writeNewImage(const std::string& path, const cv::Mat& image);
+//! writeNewImage() for text.
+void writeNewText(const std::string& path, const std::string& text);
+
+} // namespace rawgment_pipeline
+
+#endif // RAWGMENT_PIPELINE_OUTPUT_FILES_HPP
