@@ -99,6 +99,8 @@ class _ModelSource:
             catalogue = _rg.readCameraProfiles(path)
             # Each name of a list on its own: a camera's name may hold a comma.
             selections = [camera] if isinstance(camera, str) else list(camera)
+            if not selections:
+                raise ValueError("camera= is an empty list: name at least one camera, 'good' or 'usable'")
             self.cameras = [c for one in selections for c in _rg.selectCameraProfiles(catalogue, one)]
         elif camera is not None:
             raise ValueError("camera chooses among the cameras of a darktable profile file, and '%s' is not one" % path)

@@ -182,6 +182,8 @@ def test_a_camera_whose_name_holds_a_comma_is_selected_alone_and_in_a_list(tmp_p
         "X, Mark II"]
     assert [c.model for c in torch_module.RandomNoiseScene(str(path), camera=["Foo X, Mark II", "Foo X"]).cameras] \
         == ["X, Mark II", "X"]
+    with pytest.raises(ValueError, match="camera= is an empty list"):
+        torch_module.RandomNoiseScene(str(path), camera=[])
 
 
 def test_the_dataset_records_each_samples_camera(two_cameras, sensor, tmp_path):
