@@ -55,11 +55,9 @@ std::vector<cv::Rect> boxesFrom(const py::object& boxes)
     }
 }
 
-} // namespace
-
-void bindAugment(py::module_& m)
+//! How the noise steps draw and account for noise, and what they report.
+void bindNoiseOptions(py::module_& m)
 {
-    // ---- options -----------------------------------------------------------------------------------
     py::enum_<NoiseAlignment>(m, "NoiseAlignment", doc("NoiseAlignment"))
         .value("NONE", NoiseAlignment::NONE, doc("NoiseAlignment::NONE"))
         .value("IGNORE_PRIOR", NoiseAlignment::IGNORE_PRIOR, doc("NoiseAlignment::IGNORE_PRIOR"))
@@ -94,8 +92,11 @@ void bindAugment(py::module_& m)
         .def_readwrite("saturatedPixels", &AugmentReport::saturatedPixels,
                        doc("AugmentReport::saturatedPixels"))
         .def_readwrite("steps", &AugmentReport::steps, doc("AugmentReport::steps"));
+}
 
-    // ---- noise steps -------------------------------------------------------------------------------
+//! Colour jitter, motion blur and scaling.
+void bindNoiseSteps(py::module_& m)
+{
     py::class_<ColorJitter>(m, "ColorJitter", doc("ColorJitter"))
         .def(keywordInit<ColorJitter>())
         .def_readwrite("contrast", &ColorJitter::contrast, doc("ColorJitter::contrast"))
@@ -168,7 +169,11 @@ void bindAugment(py::module_& m)
         py::arg("noise") = NoiseOptions(), py::kw_only(), py::arg("seed"),
         doc("scaleMosaic", "Python: returns (dst, report)."));
     m.def("scaleBox", &scaleBox, py::arg("box"), py::arg("size"), py::arg("scale"), doc("scaleBox"));
+}
 
+//! Scenes, their seeds, and the random policy.
+void bindScenes(py::module_& m)
+{
     py::class_<Scene> scene(m, "Scene", doc("Scene"));
     scene.def(keywordInit<Scene>())
         .def_readwrite("shift", &Scene::shift, doc("Scene::shift"))
@@ -232,8 +237,11 @@ void bindAugment(py::module_& m)
             py::arg("src"), py::arg("format"), py::arg("seed"), doc("RandomScenePolicy::draw"))
         .def("save", &RandomScenePolicy::save, py::arg("path"), doc("RandomScenePolicy::save"))
         .def_static("load", &RandomScenePolicy::load, py::arg("path"), doc("RandomScenePolicy::load"));
+}
 
-    // ---- raw_io ------------------------------------------------------------------------------------
+//! Camera RAW files, DNGs and the noise profiles of darktable.
+void bindRawIo(py::module_& m)
+{
     py::class_<DngTag>(m, "DngTag", doc("DngTag"))
         .def(keywordInit<DngTag>())
         .def_readwrite("tag", &DngTag::tag, doc("DngTag::tag"))
@@ -266,7 +274,11 @@ void bindAugment(py::module_& m)
     m.def("noiseModelFromDarktableExport", &noiseModelFromDarktableExport, py::arg("path"), py::arg("format"),
           py::arg("baseIso"), py::arg("maker"), py::arg("cameraModel"),
           py::arg("haarVarianceRatio") = DARKTABLE_HAAR_VARIANCE_RATIO, doc("noiseModelFromDarktableExport"));
-    // ---- real cameras (camera_profiles.hpp) -------------------------------------------------------
+}
+
+//! Real cameras from darktable's measured profiles: the catalogue, lookup and draws.
+void bindCameraCatalogue(py::module_& m)
+{
     py::enum_<CameraProfileVerdict>(m, "CameraProfileVerdict", doc("CameraProfileVerdict"))
         .value("CAMERA_PROFILE_GOOD", CAMERA_PROFILE_GOOD, doc("CameraProfileVerdict::CAMERA_PROFILE_GOOD"))
         .value("CAMERA_PROFILE_ROUGH", CAMERA_PROFILE_ROUGH,
@@ -344,6 +356,11 @@ void bindAugment(py::module_& m)
           doc("selectCameraProfiles"));
     m.def("drawCameraIndex", &drawCameraIndex, py::arg("count"), py::arg("seed"), doc("drawCameraIndex"));
     m.def("darktableProfilesPath", &darktableProfilesPath, doc("darktableProfilesPath"));
+}
+
+//! Every model file through one call, and Android's camera-test form.
+void bindModelFiles(py::module_& m)
+{
     py::enum_<NoiseModelFileKind>(m, "NoiseModelFileKind", doc("NoiseModelFileKind"))
         .value("NOISE_MODEL_FILE", NOISE_MODEL_FILE, doc("NoiseModelFileKind::NOISE_MODEL_FILE"))
         .value("ANDROID_PROFILE_FILE", ANDROID_PROFILE_FILE, doc("NoiseModelFileKind::ANDROID_PROFILE_FILE"))
@@ -382,6 +399,11 @@ void bindAugment(py::module_& m)
         py::arg("path"), py::arg("data"), py::arg("replace") = false,
         doc("writeFileAtomically", "Python: `data` is a bytes object."));
     m.attr("MAX_TEXT_FILE_BYTES") = MAX_TEXT_FILE_BYTES;
+}
+
+//! Camera tags and mosaics with their sidecars.
+void bindMosaicFiles(py::module_& m)
+{
     py::class_<CameraTags>(m, "CameraTags", doc("CameraTags"))
         .def(keywordInit<CameraTags>())
         .def_readwrite("make", &CameraTags::make, doc("CameraTags::make"))
@@ -424,8 +446,11 @@ void bindAugment(py::module_& m)
             return py::make_tuple(arrayFromMat(mosaic), meta);
         },
         py::arg("path"), doc("readMosaic", "Python: returns (mosaic, metadata)."));
+}
 
-    // ---- isp ---------------------------------------------------------------------------------------
+//! The simple ISPs: tone curves, demosaicing, previews.
+void bindIsp(py::module_& m)
+{
     py::class_<ToneCurve>(m, "ToneCurve", doc("ToneCurve"))
         .def(keywordInit<ToneCurve>())
         .def_readwrite("gamma", &ToneCurve::gamma, doc("ToneCurve::gamma"))
@@ -471,6 +496,20 @@ void bindAugment(py::module_& m)
         },
         py::arg("mosaic"), py::arg("format"), py::arg("params") = IspParams(),
         doc("renderSimpleIsp", "Python: returns the HxWx3 BGR array (as cv2 images are)."));
+}
+
+} // namespace
+
+void bindAugment(py::module_& m)
+{
+    bindNoiseOptions(m);
+    bindNoiseSteps(m);
+    bindScenes(m);
+    bindRawIo(m);
+    bindCameraCatalogue(m);
+    bindModelFiles(m);
+    bindMosaicFiles(m);
+    bindIsp(m);
 }
 
 } // namespace rawgment_python

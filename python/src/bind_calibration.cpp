@@ -10,11 +10,9 @@ namespace {
 
 const std::vector<int> kNumericDepths{CV_8U, CV_8S, CV_16U, CV_16S, CV_32S, CV_32F, CV_64F};
 
-} // namespace
-
-void bindCalibration(py::module_& m)
+//! Burst statistics and the noise samples of bursts, squares and single frames.
+void bindBurstSampling(py::module_& m)
 {
-    // ---- calibration -------------------------------------------------------------------------------
     py::class_<BurstStatistics>(m, "BurstStatistics", doc("BurstStatistics"))
         .def(py::init<const RawFormat&, int, int>(), py::arg("format"), py::arg("groupFrames") = 8,
              py::arg("stateDepth") = int(CV_64F), doc("BurstStatistics::BurstStatistics"))
@@ -88,7 +86,11 @@ void bindCalibration(py::module_& m)
         },
         py::arg("raw"), py::arg("format"), py::arg("squares"), py::arg("gain"),
         doc("sampleSingleFramePatches"));
+}
 
+//! Per-gain line fits and the calibration parameters.
+void bindLineFits(py::module_& m)
+{
     py::class_<LineFitParams>(m, "LineFitParams", doc("LineFitParams"))
         .def(keywordInit<LineFitParams>())
         .def_readwrite("robust", &LineFitParams::robust, doc("LineFitParams::robust"))
@@ -134,6 +136,11 @@ void bindCalibration(py::module_& m)
                        doc("CalibrationParams::readExcessKurtosis"))
         .def_readwrite("bootstrapReplicates", &CalibrationParams::bootstrapReplicates,
                        doc("CalibrationParams::bootstrapReplicates"));
+}
+
+//! The calibration, its uncertainty, its report and what more data would buy.
+void bindCalibrationReport(py::module_& m)
+{
     py::enum_<NoiseModelParameter>(m, "NoiseModelParameter", doc("NoiseModelParameter"))
         .value("NOISE_PARAM_ALPHA", NOISE_PARAM_ALPHA, doc("NoiseModelParameter::NOISE_PARAM_ALPHA"))
         .value("NOISE_PARAM_SIGMA_D2", NOISE_PARAM_SIGMA_D2, doc("NoiseModelParameter::NOISE_PARAM_SIGMA_D2"))
@@ -202,8 +209,11 @@ void bindCalibration(py::module_& m)
             return withoutGil("calibrateNoiseModel", [&] { return calibrateNoiseModel(samples, params); });
         },
         py::arg("samples"), py::arg("params") = CalibrationParams(), doc("calibrateNoiseModel"));
+}
 
-    // ---- normality ---------------------------------------------------------------------------------
+//! Shapiro-Wilk results and the dark-frame components from dark bursts.
+void bindDarkCalibration(py::module_& m)
+{
     py::class_<ShapiroWilkResult>(m, "ShapiroWilkResult", doc("ShapiroWilkResult"))
         .def(keywordInit<ShapiroWilkResult>())
         .def_readwrite("W", &ShapiroWilkResult::W, doc("ShapiroWilkResult::W"))
@@ -267,6 +277,11 @@ void bindCalibration(py::module_& m)
         doc("calibrateDarkNoise",
             "Python: `bursts` is a list (one per gain) of lists of uint16 or float32 HxW "
             "arrays."));
+}
+
+//! The verdict of a calibration, and light and dark samples calibrated in one call.
+void bindVerdictAndDarkFrames(py::module_& m)
+{
     py::class_<CalibrationBurstFacts>(m, "CalibrationBurstFacts", doc("CalibrationBurstFacts"))
         .def(keywordInit<CalibrationBurstFacts>())
         .def_readwrite("name", &CalibrationBurstFacts::name, doc("CalibrationBurstFacts::name"))
@@ -348,6 +363,11 @@ void bindCalibration(py::module_& m)
         py::arg("samples"),
         doc("shapiroWilk", "Python: `samples` is a numeric numpy array of any shape (C-contiguous) or a "
                            "sequence of numbers."));
+}
+
+//! Shapiro-Wilk of samples, batches and bursts, and its summary by mean.
+void bindNormality(py::module_& m)
+{
     py::enum_<ShapiroWilkLayout>(m, "ShapiroWilkLayout", doc("ShapiroWilkLayout"))
         .value("SW_SERIES_IN_COLUMNS", SW_SERIES_IN_COLUMNS, doc("ShapiroWilkLayout::SW_SERIES_IN_COLUMNS"))
         .value("SW_SERIES_IN_ROWS", SW_SERIES_IN_ROWS, doc("ShapiroWilkLayout::SW_SERIES_IN_ROWS"))
@@ -388,6 +408,18 @@ void bindCalibration(py::module_& m)
                        doc("NormalityBin::meanDistinctValues"));
     m.def("summarizeNormality", &summarizeNormality, py::arg("burst"), py::arg("bins"),
           py::arg("alpha") = 0.05, doc("summarizeNormality"));
+}
+
+} // namespace
+
+void bindCalibration(py::module_& m)
+{
+    bindBurstSampling(m);
+    bindLineFits(m);
+    bindCalibrationReport(m);
+    bindDarkCalibration(m);
+    bindVerdictAndDarkFrames(m);
+    bindNormality(m);
 }
 
 } // namespace rawgment_python

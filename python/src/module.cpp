@@ -241,9 +241,11 @@ bool isDataProperty(const py::handle& type, const std::string& name)
     return false;
 }
 
-void bindCore(py::module_& m)
+namespace {
+
+//! CFA patterns, formats, planes and black levels.
+void bindBayer(py::module_& m)
 {
-    // ---- bayer -------------------------------------------------------------------------------------
     py::enum_<CfaPattern>(m, "CfaPattern", doc("CfaPattern"))
         .value("CFA_RGGB", CFA_RGGB, doc("CfaPattern::CFA_RGGB"))
         .value("CFA_BGGR", CFA_BGGR, doc("CfaPattern::CFA_BGGR"))
@@ -320,8 +322,11 @@ void bindCore(py::module_& m)
         },
         py::arg("src"), py::arg("format"), py::arg("ddepth") = int(CV_16U), py::arg("normalized") = false,
         doc("addBlackLevel", "Python: returns dst; ddepth is rawgment.CV_16U or rawgment.CV_32F."));
+}
 
-    // ---- noise model -------------------------------------------------------------------------------
+//! The noise model, its lines and files.
+void bindNoiseModel(py::module_& m)
+{
     m.def("dbToLinearGain", &dbToLinearGain, py::arg("db"), doc("dbToLinearGain"));
     m.def("linearGainToDb", &linearGainToDb, py::arg("gain"), doc("linearGainToDb"));
     py::class_<NoiseLine>(m, "NoiseLine", doc("NoiseLine"))
@@ -398,8 +403,11 @@ void bindCore(py::module_& m)
         .def("save", &NoiseModel::save, py::arg("path"), doc("NoiseModel::save"))
         .def_static("load", &NoiseModel::load, py::arg("path"), py::arg("acceptFailedCalibration") = false,
                     doc("NoiseModel::load"));
+}
 
-    // ---- cpu ---------------------------------------------------------------------------------------
+//! The instruction-set paths of the hot loops.
+void bindCpu(py::module_& m)
+{
     py::enum_<CpuPath>(m, "CpuPath", doc("CpuPath"))
         .value("AUTO", CpuPath::AUTO, doc("CpuPath::AUTO"))
         .value("BASELINE", CpuPath::BASELINE, doc("CpuPath::BASELINE"))
@@ -418,8 +426,11 @@ void bindCore(py::module_& m)
           "(0 or 1: none; negative: OpenCV's default). Results do not depend on it.");
     m.def("getNumThreads", &cv::getNumThreads,
           "OpenCV's cv::getNumThreads: the threads a parallel loop uses.");
+}
 
-    // ---- simulate ----------------------------------------------------------------------------------
+//! The sensor simulator.
+void bindSimulator(py::module_& m)
+{
     py::class_<SensorParams>(m, "SensorParams", doc("SensorParams"))
         .def(keywordInit<SensorParams>())
         .def_readwrite("noise", &SensorParams::noise, doc("SensorParams::noise"))
@@ -493,7 +504,11 @@ void bindCore(py::module_& m)
                 return py::make_tuple(arrayFromMat(gainFactor), arrayFromMat(offset), arrayFromMat(defects));
             },
             doc("SensorSimulator::fixedPattern", "Python: returns (gainFactor, offset, defects)."));
+}
 
+//! The ColorChecker scene.
+void bindColorChecker(py::module_& m)
+{
     py::class_<ColorCheckerOptions>(m, "ColorCheckerOptions", doc("ColorCheckerOptions"))
         .def(keywordInit<ColorCheckerOptions>())
         .def_readwrite("pattern", &ColorCheckerOptions::pattern, doc("ColorCheckerOptions::pattern"))
@@ -513,7 +528,11 @@ void bindCore(py::module_& m)
     m.def("colorCheckerReflectances", &colorCheckerReflectances, doc("colorCheckerReflectances"));
     m.def("makeColorCheckerScene", &makeColorCheckerScene, py::arg("options") = ColorCheckerOptions(),
           doc("makeColorCheckerScene"));
+}
 
+//! Seeds derived from a user's seed, and the generator's normal numbers.
+void bindSeeds(py::module_& m)
+{
     py::enum_<SeedPurpose>(m, "SeedPurpose", doc("SeedPurpose"))
         .value("SEED_SIMULATED_BURST", SEED_SIMULATED_BURST, doc("SeedPurpose::SEED_SIMULATED_BURST"))
         .value("SEED_SIMULATED_VALIDATION_BURST", SEED_SIMULATED_VALIDATION_BURST,
@@ -538,6 +557,18 @@ void bindCore(py::module_& m)
         py::arg("size"), py::arg("seed"),
         doc("fillStandardNormal",
             "Python: fillStandardNormal(size=(width, height), seed) returns the float32 array."));
+}
+
+} // namespace
+
+void bindCore(py::module_& m)
+{
+    bindBayer(m);
+    bindNoiseModel(m);
+    bindCpu(m);
+    bindSimulator(m);
+    bindColorChecker(m);
+    bindSeeds(m);
 }
 
 } // namespace rawgment_python
