@@ -872,9 +872,9 @@ TEST(Apps, calibrateTakesTheGainsFromTheFilesIsoWithOrWithoutAChart)
         // The profile for darktable gives the same model back.
         cv::rawgment::RawFormat format =
             cv::rawgment::readRaw(dir + "/sim/g6.02dB_level0.20/frame_000.dng").format;
-        const cv::rawgment::NoiseModel viaDarktable =
-            cv::rawgment::noiseModelFromDarktableExport(dir + "/cal_" + mode + "/darktable_noiseprofiles.json",
-                                                  format, 100, "cv::rawgment", "simulated sensor");
+        const cv::rawgment::NoiseModel viaDarktable = cv::rawgment::noiseModelFromDarktableExport(
+            dir + "/cal_" + mode + "/darktable_noiseprofiles.json", format, 100, "cv::rawgment",
+            "simulated sensor");
         EXPECT_NEAR(viaDarktable.alpha, fitted.alpha, 1e-9 * fitted.alpha);
         EXPECT_TRUE(exists(dir + "/cal_" + mode + "/android_noise_profile.yml"));
     }

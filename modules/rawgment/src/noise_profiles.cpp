@@ -451,7 +451,8 @@ String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format, 
 }
 
 NoiseModel noiseModelFromDarktableExport(const String& path, const RawFormat& format, double baseIso,
-                                   const String& maker, const String& cameraModel, double haarVarianceRatio)
+                                         const String& maker, const String& cameraModel,
+                                         double haarVarianceRatio)
 {
     checkBaseIso(baseIso, "noiseModelFromDarktableExport");
     checkHaarVarianceRatio(haarVarianceRatio, "noiseModelFromDarktableExport");
