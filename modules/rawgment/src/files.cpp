@@ -157,7 +157,8 @@ FileStorage openFileStorageForReading(const String& path, const String& what)
     const size_t first = text.find_first_not_of(" \t\r\n");
     std::string parsed;
     if (text[first] == '{') {
-        parsed = detail::validateJson(path, text.substr(first));
+        text.erase(0, first);
+        parsed = detail::validateJson(path, std::move(text));
     } else {
         detail::validateYaml(path, text);
         parsed = text.compare(0, 5, "%YAML") == 0 ? std::move(text) : "%YAML:1.0\n" + text;

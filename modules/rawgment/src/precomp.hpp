@@ -85,7 +85,7 @@ CV_RAWGMENT_EXPORTS void validateYaml(const String& path, const std::string& tex
  * (`path`), the line and what is wrong unless it is valid JSON nested at most MAX_NESTING_DEPTH levels
  * with no integer beyond 32 bits. Returns the text OpenCV's reader is given: the same, with the escapes it
  * lacks (\uXXXX, \/) written out as UTF-8. */
-CV_RAWGMENT_EXPORTS std::string validateJson(const String& path, const std::string& text);
+CV_RAWGMENT_EXPORTS std::string validateJson(const String& path, std::string text);
 
 //! The text that writeFileStorageAtomically() would write to `path`.
 template <typename Writer> std::string fileStorageText(const String& path, Writer&& writeBody)

@@ -284,6 +284,19 @@ void rejectUnsupportedStructure(const String& path, const std::string& text)
 
 namespace {
 
+/** OpenCV's \\' escapes in `text` from byte `from` written as \\" (the same length, and a quote inside the
+ * string for a parser that knows only YAML's or JSON's escapes); with `oneString`, only up to the end of the
+ * double-quoted string `from` is in. Every backslash is taken as an escape of the next byte. */
+void apostropheEscapesAsQuotes(std::string& text, size_t from, bool oneString)
+{
+    for (size_t i = from; i + 1 < text.size() && !(oneString && text[i] == '"'); ++i)
+        if (text[i] == '\\') {
+            if (text[i + 1] == '\'')
+                text[i + 1] = '"';
+            ++i;
+        }
+}
+
 //! The byte offset of a libyaml mark (its line and column count characters) in `text`.
 size_t byteOffsetOf(const std::string& text, size_t from, const yaml_mark_t& mark)
 {
@@ -336,12 +349,7 @@ void validateYaml(const String& path, const std::string& text)
             patched = text;
             parsed = &patched;
         }
-        for (size_t i = escape; i + 1 < patched.size() && patched[i] != '"'; ++i)
-            if (patched[i] == '\\') {
-                if (patched[i + 1] == '\'')
-                    patched[i + 1] = '"';
-                ++i;
-            }
+        apostropheEscapesAsQuotes(patched, escape, true);
     }
 }
 
@@ -433,7 +441,7 @@ size_t validateYamlOnce(const String& path, const std::string& text, size_t from
 
 } // namespace
 
-std::string validateJson(const String& path, const std::string& text)
+std::string validateJson(const String& path, std::string text)
 {
     // OpenCV's JSON writer escapes an apostrophe as \', which JSON does not have (its reader takes it).
     // In JSON every backslash belongs to a string, so each \' is such an escape: the validator is given
@@ -441,12 +449,7 @@ std::string validateJson(const String& path, const std::string& text)
     std::string forValidator;
     if (text.find("\\'") != std::string::npos) {
         forValidator = text;
-        for (size_t i = 0; i + 1 < forValidator.size(); ++i)
-            if (forValidator[i] == '\\') {
-                if (forValidator[i + 1] == '\'')
-                    forValidator[i + 1] = '"';
-                ++i;
-            }
+        apostropheEscapesAsQuotes(forValidator, 0, false);
     }
     JsonChecks checks;
     nlohmann::json::sax_parse(forValidator.empty() ? text : forValidator, &checks);
