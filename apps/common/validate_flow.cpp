@@ -54,6 +54,100 @@ ValidationManifest readValidationManifest(const std::string& path)
     return m;
 }
 
+namespace {
+
+struct BurstMoments
+{
+    cv::Mat mean, variance, clipped;
+};
+
+BurstMoments momentsOf(const RawFormat& format, const std::function<cv::Mat(size_t)>& frameAt, size_t frames)
+{
+    BurstStatistics stats(format);
+    for (size_t t = 0; t < frames; ++t)
+        stats.add(frameAt(t));
+    BurstMoments m;
+    stats.mean(m.mean);
+    stats.variance(m.variance);
+    stats.clippedMask(m.clipped);
+    return m;
+}
+
+/** One target's rows: bins of the real burst's mean (BurstStatistics subtracts the black) over the masked
+ * pixels unclipped in both bursts, each holding the mean variance of the real burst and of the three
+ * conversions; empty bins are left out. */
+std::vector<ValidationRow> binByRealMean(double factor, int bins, const cv::Mat& mask,
+                                         const BurstMoments& bright, const BurstMoments& real,
+                                         const cv::Mat (&convVar)[3], CsvTable& csv)
+{
+    const auto counted = [&](int y, int x) {
+        return mask.at<uchar>(y, x) && !real.clipped.at<uchar>(y, x) && !bright.clipped.at<uchar>(y, x);
+    };
+    double lo = 1e300, hi = -1e300;
+    for (int y = 0; y < mask.rows; ++y)
+        for (int x = 0; x < mask.cols; ++x)
+            if (counted(y, x)) {
+                lo = std::min(lo, real.mean.at<double>(y, x));
+                hi = std::max(hi, real.mean.at<double>(y, x));
+            }
+    if (!(hi > lo))
+        throw std::runtime_error("the target burst has no unclipped pixels with distinct means");
+    std::vector<ValidationRow> rows(static_cast<size_t>(bins));
+    std::vector<double> meanSum(size_t(bins), 0), brightMeanSum(size_t(bins), 0),
+        brightVarSum(size_t(bins), 0);
+    for (int b = 0; b < bins; ++b) {
+        rows[size_t(b)].factor = factor;
+        rows[size_t(b)].meanLow = lo + (hi - lo) * b / bins;
+        rows[size_t(b)].meanHigh = lo + (hi - lo) * (b + 1) / bins;
+    }
+    for (int y = 0; y < mask.rows; ++y)
+        for (int x = 0; x < mask.cols; ++x) {
+            if (!counted(y, x))
+                continue;
+            const double mu = real.mean.at<double>(y, x);
+            const int b = std::min(bins - 1, static_cast<int>((mu - lo) / (hi - lo) * bins));
+            ValidationRow& r = rows[size_t(b)];
+            ++r.pixels;
+            meanSum[size_t(b)] += mu;
+            r.realVariance += real.variance.at<double>(y, x);
+            r.noneVariance += convVar[0].at<double>(y, x);
+            r.ignoreVariance += convVar[1].at<double>(y, x);
+            r.accountVariance += convVar[2].at<double>(y, x);
+            brightMeanSum[size_t(b)] += bright.mean.at<double>(y, x);
+            brightVarSum[size_t(b)] += bright.variance.at<double>(y, x);
+        }
+    std::vector<ValidationRow> kept;
+    for (int b = 0; b < bins; ++b) {
+        ValidationRow r = rows[size_t(b)];
+        if (r.pixels == 0)
+            continue;
+        const double n = r.pixels;
+        r.realVariance /= n;
+        r.noneVariance /= n;
+        r.ignoreVariance /= n;
+        r.accountVariance /= n;
+        csv.addRow(std::vector<double>{factor, r.meanLow, r.meanHigh, meanSum[size_t(b)] / n, n,
+                                       r.realVariance, r.noneVariance, r.ignoreVariance, r.accountVariance,
+                                       brightMeanSum[size_t(b)] / n, brightVarSum[size_t(b)] / n});
+        kept.push_back(r);
+    }
+    return kept;
+}
+
+std::string validationTable(const std::vector<ValidationRow>& rows)
+{
+    std::string md =
+        "| factor | mean bin (DN) | pixels | real variance | NONE | IGNORE_PRIOR | ACCOUNT_PRIOR | "
+        "ACCOUNT_PRIOR / real |\n|---|---|---|---|---|---|---|---|\n";
+    for (const ValidationRow& r : rows)
+        md += cv::format("| x%.2f | %.1f-%.1f | %d | %.3f | %.3f | %.3f | %.3f | %.3f |\n", r.factor,
+                         r.meanLow, r.meanHigh, r.pixels, r.realVariance, r.noneVariance, r.ignoreVariance,
+                         r.accountVariance, r.accountVariance / r.realVariance);
+    return md;
+}
+
+} // namespace
+
 ValidateResult validateConversion(const ValidateOptions& o)
 {
     const ValidationManifest manifest = readValidationManifest(o.manifest);
@@ -93,25 +187,11 @@ ValidateResult validateConversion(const ValidateOptions& o)
         for (const cv::Rect& s : rawgment_helpers::readChartPatches(manifest.patches).squares)
             mask(s & cv::Rect(cv::Point(), mask.size())).setTo(255);
 
-    const auto statsOf = [&](const std::function<cv::Mat(size_t)>& frameAt, size_t frames, cv::Mat& mean,
-                             cv::Mat& variance, cv::Mat& clipped) {
-        BurstStatistics stats(format);
-        for (size_t t = 0; t < frames; ++t)
-            stats.add(frameAt(t));
-        stats.mean(mean);
-        stats.variance(variance);
-        stats.clippedMask(clipped);
-    };
-    cv::Mat brightMean, brightVar, brightClip;
-    statsOf([&](size_t t) { return bright[t].mosaic; }, bright.size(), brightMean, brightVar, brightClip);
+    const BurstMoments brightMoments = momentsOf(
+        format, [&](size_t t) { return bright[t].mosaic; }, bright.size());
 
     ValidateResult result;
-    struct Target
-    {
-        double factor;
-        std::vector<ValidationRow> rows;
-    };
-    std::vector<Target> targets;
+    std::vector<ValidationPanel> panels;
     const NoiseAlignment alignments[3] = {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR,
                                           NoiseAlignment::ACCOUNT_PRIOR};
     ProgressBar progress("validate", manifest.targets.size() * (3 + 1) * bright.size());
@@ -119,102 +199,40 @@ ValidateResult validateConversion(const ValidateOptions& o)
                   "ignore_prior_variance", "account_prior_variance", "bright_mean", "bright_variance"});
     for (const ValidationManifest::Target& t : manifest.targets) {
         const double factor = t.factor;
-        const std::vector<std::string>& files = t.files;
-        cv::Mat realMean, realVar, realClip;
-        statsOf(
+        const BurstMoments real = momentsOf(
+            format,
             [&](size_t k) {
                 progress.advance();
-                return loadMatching(files[k]).mosaic;
+                return loadMatching(t.files[k]).mosaic;
             },
-            files.size(), realMean, realVar, realClip);
+            t.files.size());
         cv::Mat convVar[3];
-        for (int a = 0; a < 3; ++a) {
-            cv::Mat m, c;
-            statsOf(
-                [&](size_t k) {
-                    cv::Mat out;
-                    RawFormat outFormat;
-                    colorJitter(bright[k].mosaic, format, model, ColorJitter::exposureChange(factor, 1.0),
-                                alignments[a], deriveSeed(o.seed, SEED_VALIDATION_CONVERSION, k), out,
-                                outFormat);
-                    progress.advance();
-                    return out;
-                },
-                bright.size(), m, convVar[a], c);
-        }
-        // Bins of the real burst's mean (BurstStatistics subtracts the black) over the unclipped masked
-        // pixels.
-        double lo = 1e300, hi = -1e300;
-        for (int y = 0; y < mask.rows; ++y)
-            for (int x = 0; x < mask.cols; ++x)
-                if (mask.at<uchar>(y, x) && !realClip.at<uchar>(y, x) && !brightClip.at<uchar>(y, x)) {
-                    lo = std::min(lo, realMean.at<double>(y, x));
-                    hi = std::max(hi, realMean.at<double>(y, x));
-                }
-        if (!(hi > lo))
-            throw std::runtime_error("the target burst has no unclipped pixels with distinct means");
-        std::vector<ValidationRow> rows(size_t(o.bins));
-        std::vector<double> meanSum(size_t(o.bins), 0), brightMeanSum(size_t(o.bins), 0),
-            brightVarSum(size_t(o.bins), 0);
-        for (int b = 0; b < o.bins; ++b) {
-            rows[size_t(b)].factor = factor;
-            rows[size_t(b)].meanLow = lo + (hi - lo) * b / o.bins;
-            rows[size_t(b)].meanHigh = lo + (hi - lo) * (b + 1) / o.bins;
-        }
-        for (int y = 0; y < mask.rows; ++y)
-            for (int x = 0; x < mask.cols; ++x) {
-                if (!mask.at<uchar>(y, x) || realClip.at<uchar>(y, x) || brightClip.at<uchar>(y, x))
-                    continue;
-                const double mu = realMean.at<double>(y, x);
-                const int b = std::min(o.bins - 1, static_cast<int>((mu - lo) / (hi - lo) * o.bins));
-                ValidationRow& r = rows[size_t(b)];
-                ++r.pixels;
-                meanSum[size_t(b)] += mu;
-                r.realVariance += realVar.at<double>(y, x);
-                r.noneVariance += convVar[0].at<double>(y, x);
-                r.ignoreVariance += convVar[1].at<double>(y, x);
-                r.accountVariance += convVar[2].at<double>(y, x);
-                brightMeanSum[size_t(b)] += brightMean.at<double>(y, x);
-                brightVarSum[size_t(b)] += brightVar.at<double>(y, x);
-            }
-        Target target{factor, {}};
-        for (int b = 0; b < o.bins; ++b) {
-            ValidationRow r = rows[size_t(b)];
-            if (r.pixels == 0)
-                continue;
-            const double n = r.pixels;
-            r.realVariance /= n;
-            r.noneVariance /= n;
-            r.ignoreVariance /= n;
-            r.accountVariance /= n;
-            csv.addRow(std::vector<double>{factor, r.meanLow, r.meanHigh, meanSum[size_t(b)] / n, n,
-                                           r.realVariance, r.noneVariance, r.ignoreVariance,
-                                           r.accountVariance, brightMeanSum[size_t(b)] / n,
-                                           brightVarSum[size_t(b)] / n});
-            target.rows.push_back(r);
-            result.rows.push_back(r);
-        }
-        targets.push_back(target);
+        for (int a = 0; a < 3; ++a)
+            convVar[a] =
+                momentsOf(
+                    format,
+                    [&](size_t k) {
+                        cv::Mat out;
+                        RawFormat outFormat;
+                        colorJitter(bright[k].mosaic, format, model, ColorJitter::exposureChange(factor, 1.0),
+                                    alignments[a], deriveSeed(o.seed, SEED_VALIDATION_CONVERSION, k), out,
+                                    outFormat);
+                        progress.advance();
+                        return out;
+                    },
+                    bright.size())
+                    .variance;
+        const std::vector<ValidationRow> rows =
+            binByRealMean(factor, o.bins, mask, brightMoments, real, convVar, csv);
+        result.rows.insert(result.rows.end(), rows.begin(), rows.end());
+        panels.push_back({factor, rows.empty() ? 1.0 : rows.back().meanHigh});
     }
     progress.finish();
     csv.write(csvPath);
-
-    std::string md =
-        "| factor | mean bin (DN) | pixels | real variance | NONE | IGNORE_PRIOR | ACCOUNT_PRIOR | "
-        "ACCOUNT_PRIOR / real |\n|---|---|---|---|---|---|---|---|\n";
-    for (const ValidationRow& r : result.rows)
-        md += cv::format("| x%.2f | %.1f-%.1f | %d | %.3f | %.3f | %.3f | %.3f | %.3f |\n", r.factor,
-                         r.meanLow, r.meanHigh, r.pixels, r.realVariance, r.noneVariance, r.ignoreVariance,
-                         r.accountVariance, r.accountVariance / r.realVariance);
-    result.table = md;
-    writeTextAtomically(mdPath, md);
-
-    if (!o.plots)
-        return result;
-    std::vector<ValidationPanel> panels;
-    for (const Target& t : targets)
-        panels.push_back({t.factor, t.rows.empty() ? 1.0 : t.rows.back().meanHigh});
-    plotValidation(o.outDir, csvPath, panels, result.pngs, result.notes);
+    result.table = validationTable(result.rows);
+    writeTextAtomically(mdPath, result.table);
+    if (o.plots)
+        plotValidation(o.outDir, csvPath, panels, result.pngs, result.notes);
     return result;
 }
 

@@ -197,10 +197,7 @@ bool estimateReadKurtosis(const std::map<double, std::vector<NoiseSample>>& byGa
     return true;
 }
 
-} // namespace
-
-CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
-                                      const CalibrationParams& params)
+void checkCalibrationParams(const std::vector<NoiseSample>& samples, const CalibrationParams& params)
 {
     if (samples.empty())
         CV_Error(Error::StsBadArg, "calibrateNoiseModel: no samples (all pixels clipped, or no patches?)");
@@ -212,27 +209,27 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
         params.bootstrapReplicates < 0 || params.bootstrapReplicates == 1)
         CV_Error(Error::StsBadArg, "calibrateNoiseModel: lossScale must be >= 0, reweightIterations >= 1, "
                                    "minGainRatio >= 1, bootstrapReplicates 0 or >= 2");
-    const bool kurtosisGiven = !std::isnan(params.readExcessKurtosis);
-    if (kurtosisGiven &&
+    if (!std::isnan(params.readExcessKurtosis) &&
         !(params.readExcessKurtosis >= kMinExcessKurtosis && params.readExcessKurtosis <= kMaxExcessKurtosis))
         CV_Error(
             Error::StsBadArg,
             format("calibrateNoiseModel: readExcessKurtosis must be NaN (estimate it) or lie in [%g, %g] "
                    "(got %g)",
                    kMinExcessKurtosis, kMaxExcessKurtosis, params.readExcessKurtosis));
-    CalibrationReport report;
-    report.method = params.method;
-    report.samples = static_cast<int>(samples.size());
+}
 
+//! The per-gain lines and what the cross-gain fit takes from them: the inlier samples, grouped by gain.
+struct PerGainLines
+{
     std::map<double, std::vector<NoiseSample>> byGain;
-    for (const NoiseSample& s : samples)
-        byGain[s.gain].push_back(s);
     std::vector<NoiseSample> inlierSamples;
     std::vector<detail::GainGroup> groups;
     std::set<int64> outlierPixels; // pixels outside the band of their gain's line in some burst
-    LineFitParams lineParams = params.line;
-    lineParams.readExcessKurtosis = kurtosisGiven ? params.readExcessKurtosis : 0.0;
-    const auto fitEachGain = [&]() {
+    LineFitParams lineParams;
+
+    //! Fits each gain's line anew into report.perGain and collects its inliers and outlier pixels.
+    void fit(const CalibrationParams& params, CalibrationReport& report)
+    {
         report.perGain.clear();
         inlierSamples.clear();
         groups.clear();
@@ -264,79 +261,79 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
             group.end = static_cast<int>(inlierSamples.size());
             groups.push_back(group);
         }
-    };
-    fitEachGain();
-    /* Without a given kurtosis, it is estimated from the lines' residuals and the lines are fitted again
-     * with bands of that spread (twice: the first lines were cut with Gaussian bands). */
-    if (!kurtosisGiven) {
-        std::string why;
-        for (int round = 0; round < 2; ++round) {
-            double kappa = 0;
-            if (!estimateReadKurtosis(byGain, report.perGain, kappa, why))
-                break;
-            report.readExcessKurtosisEstimated = true;
-            if (std::abs(kappa - lineParams.readExcessKurtosis) < 1e-3)
-                break;
-            lineParams.readExcessKurtosis = kappa;
-            outlierPixels.clear();
-            fitEachGain();
-        }
-        if (!report.readExcessKurtosisEstimated)
-            report.notes.push_back("the read noise's excess kurtosis could not be estimated, " + why +
-                                   ": the fit takes it as 0 (Gaussian); give CalibrationParams::"
-                                   "readExcessKurtosis (for example from dark frames) if the read noise has "
-                                   "heavier tails");
     }
-    report.readExcessKurtosis = lineParams.readExcessKurtosis;
-    /* A noisy pixel (random telegraph noise) or a stuck one is the same pixel in every burst, but it stands
-     * out of the noise band only where the normal noise is small (dark patches, dark frames, low gains);
-     * in bright patches its extra variance hides inside the band, and kept there it biases the lines
-     * where it hides and not where it was cut (5% such pixels moved alpha by 2-3 standard errors). So a
-     * pixel outside the band in any burst is left out of every burst, as a defect map would, unless so
-     * many are that the lines themselves must be wrong. Normal pixels leave the band by chance in
-     * 2 Phi(-k) of bursts; that only costs samples, since their bursts are independent. */
-    if (!outlierPixels.empty()) {
-        std::set<int64> pixels;
-        for (const NoiseSample& s : samples)
-            if (s.pixel >= 0)
-                pixels.insert(s.pixel);
-        // The count before the refit: the refit's own outliers are not left out again.
-        const int leftOut = static_cast<int>(outlierPixels.size());
-        if (outlierPixels.size() <= pixels.size() / 5) {
-            for (auto& entry : byGain) {
-                std::vector<NoiseSample>& v = entry.second;
-                v.erase(
-                    std::remove_if(v.begin(), v.end(),
-                                   [&](const NoiseSample& x) { return outlierPixels.count(x.pixel) > 0; }),
-                    v.end());
-                if (v.size() < 2)
-                    CV_Error(Error::StsBadArg,
-                             format("calibrateNoiseModel: gain %g: fewer than 2 samples are left once the "
-                                    "pixels outside the noise band in any burst are left out",
-                                    entry.first));
-            }
-            fitEachGain();
-            report.notes.push_back(
-                format("%d of %d pixels lay outside the noise band in at least one burst "
-                       "(a band as wide as read noise of excess kurtosis %.3g makes it) "
-                       "and were left out of every burst, as noisy, hot or stuck pixels "
-                       "would be; normal pixels leave it by chance in %.2g of their bursts",
-                       leftOut, static_cast<int>(pixels.size()), report.readExcessKurtosis,
-                       std::erfc(params.line.inlierThreshold / std::sqrt(2.0))));
-        } else {
-            report.notes.push_back(
-                format("%d of %d pixels lay outside the noise band in at least one burst: too "
-                       "many to be defects, so each was left out only where it was outside",
-                       leftOut, static_cast<int>(pixels.size())));
-        }
-    }
-    for (const NoiseLineFit& fit : report.perGain)
-        if (fit.line.a < 0 || fit.line.b < 0)
-            report.notes.push_back(
-                format("gain %g: the line has a negative %s (a = %g, b = %g); the data do not "
-                       "follow the model there",
-                       fit.gain, fit.line.a < 0 ? "slope" : "offset", fit.line.a, fit.line.b));
+};
 
+/* Without a given kurtosis, it is estimated from the lines' residuals and the lines are fitted again
+ * with bands of that spread (twice: the first lines were cut with Gaussian bands). */
+void estimateKurtosisAndRefit(PerGainLines& lines, const CalibrationParams& params, CalibrationReport& report)
+{
+    std::string why;
+    for (int round = 0; round < 2; ++round) {
+        double kappa = 0;
+        if (!estimateReadKurtosis(lines.byGain, report.perGain, kappa, why))
+            break;
+        report.readExcessKurtosisEstimated = true;
+        if (std::abs(kappa - lines.lineParams.readExcessKurtosis) < 1e-3)
+            break;
+        lines.lineParams.readExcessKurtosis = kappa;
+        lines.outlierPixels.clear();
+        lines.fit(params, report);
+    }
+    if (!report.readExcessKurtosisEstimated)
+        report.notes.push_back("the read noise's excess kurtosis could not be estimated, " + why +
+                               ": the fit takes it as 0 (Gaussian); give CalibrationParams::"
+                               "readExcessKurtosis (for example from dark frames) if the read noise has "
+                               "heavier tails");
+}
+
+/* A noisy pixel (random telegraph noise) or a stuck one is the same pixel in every burst, but it stands
+ * out of the noise band only where the normal noise is small (dark patches, dark frames, low gains);
+ * in bright patches its extra variance hides inside the band, and kept there it biases the lines
+ * where it hides and not where it was cut (5% such pixels moved alpha by 2-3 standard errors). So a
+ * pixel outside the band in any burst is left out of every burst, as a defect map would, unless so
+ * many are that the lines themselves must be wrong. Normal pixels leave the band by chance in
+ * 2 Phi(-k) of bursts; that only costs samples, since their bursts are independent. */
+void leaveOutOutlierPixels(const std::vector<NoiseSample>& samples, PerGainLines& lines,
+                           const CalibrationParams& params, CalibrationReport& report)
+{
+    if (lines.outlierPixels.empty())
+        return;
+    std::set<int64> pixels;
+    for (const NoiseSample& s : samples)
+        if (s.pixel >= 0)
+            pixels.insert(s.pixel);
+    // The count before the refit: the refit's own outliers are not left out again.
+    const int leftOut = static_cast<int>(lines.outlierPixels.size());
+    if (lines.outlierPixels.size() > pixels.size() / 5) {
+        report.notes.push_back(format("%d of %d pixels lay outside the noise band in at least one burst: too "
+                                      "many to be defects, so each was left out only where it was outside",
+                                      leftOut, static_cast<int>(pixels.size())));
+        return;
+    }
+    for (auto& entry : lines.byGain) {
+        std::vector<NoiseSample>& v = entry.second;
+        v.erase(std::remove_if(v.begin(), v.end(),
+                               [&](const NoiseSample& x) { return lines.outlierPixels.count(x.pixel) > 0; }),
+                v.end());
+        if (v.size() < 2)
+            CV_Error(Error::StsBadArg,
+                     format("calibrateNoiseModel: gain %g: fewer than 2 samples are left once the "
+                            "pixels outside the noise band in any burst are left out",
+                            entry.first));
+    }
+    lines.fit(params, report);
+    report.notes.push_back(format("%d of %d pixels lay outside the noise band in at least one burst "
+                                  "(a band as wide as read noise of excess kurtosis %.3g makes it) "
+                                  "and were left out of every burst, as noisy, hot or stuck pixels "
+                                  "would be; normal pixels leave it by chance in %.2g of their bursts",
+                                  leftOut, static_cast<int>(pixels.size()), report.readExcessKurtosis,
+                                  std::erfc(params.line.inlierThreshold / std::sqrt(2.0))));
+}
+
+//! alpha, sigma_d^2 and sigma_r^2 across the gains' lines, with their notes, R^2 and uncertainty.
+void fitAcrossGains(const PerGainLines& lines, const CalibrationParams& params, CalibrationReport& report)
+{
     // alpha from a_g = g alpha (least squares through the origin, non-negative).
     double sga = 0, sgg = 0;
     for (const NoiseLineFit& f : report.perGain) {
@@ -346,6 +343,7 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
     double alpha = std::max(0.0, sga / sgg);
     const double gainRatio = report.perGain.back().gain / report.perGain.front().gain;
     report.separable = report.perGain.size() >= 2 && gainRatio >= params.minGainRatio;
+    report.samplesUsed = static_cast<int>(lines.inlierSamples.size());
     if (!report.separable) {
         report.notes.push_back(format("sigma_d^2 and sigma_r^2 are not separable: %s; only alpha is reported "
                                       "(the offset of each gain is in its line)",
@@ -353,24 +351,23 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
                                           ? "a single gain was calibrated"
                                           : "the gains differ by less than minGainRatio"));
         report.model = NoiseModel(alpha, 0.0, 0.0);
-        report.samplesUsed = static_cast<int>(inlierSamples.size());
-        report.uncertainty = detail::modelUncertainty(inlierSamples, groups, report, params, report.notes);
-        return report;
+        report.uncertainty =
+            detail::modelUncertainty(lines.inlierSamples, lines.groups, report, params, report.notes);
+        return;
     }
     double sigmaD2 = 0, sigmaR2 = 0;
     fitOffsets(report.perGain, sigmaD2, sigmaR2);
 
     if (params.method == NOISE_FIT_JOINT) {
-        const Vec3d p =
-            detail::refineJointFit(inlierSamples.data(), nullptr, static_cast<int>(inlierSamples.size()),
-                                   Vec3d(alpha, sigmaD2, sigmaR2), params.lossScale, params.line.robust,
-                                   params.reweightIterations, report.readExcessKurtosis);
+        const Vec3d p = detail::refineJointFit(
+            lines.inlierSamples.data(), nullptr, static_cast<int>(lines.inlierSamples.size()),
+            Vec3d(alpha, sigmaD2, sigmaR2), params.lossScale, params.line.robust, params.reweightIterations,
+            report.readExcessKurtosis);
         alpha = p[0];
         sigmaD2 = p[1];
         sigmaR2 = p[2];
     }
     report.model = NoiseModel(alpha, sigmaD2, sigmaR2);
-    report.samplesUsed = static_cast<int>(inlierSamples.size());
     const char* names[3] = {"alpha", "sigma_d^2", "sigma_r^2"};
     const double values[3] = {alpha, sigmaD2, sigmaR2};
     for (int k = 0; k < 3; ++k)
@@ -388,7 +385,38 @@ CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
     }
     report.rSquaredSlope = rSquared(a, aFit);
     report.rSquaredOffset = rSquared(b, bFit);
-    report.uncertainty = detail::modelUncertainty(inlierSamples, groups, report, params, report.notes);
+    report.uncertainty =
+        detail::modelUncertainty(lines.inlierSamples, lines.groups, report, params, report.notes);
+}
+
+} // namespace
+
+CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
+                                      const CalibrationParams& params)
+{
+    checkCalibrationParams(samples, params);
+    const bool kurtosisGiven = !std::isnan(params.readExcessKurtosis);
+    CalibrationReport report;
+    report.method = params.method;
+    report.samples = static_cast<int>(samples.size());
+
+    PerGainLines lines;
+    for (const NoiseSample& s : samples)
+        lines.byGain[s.gain].push_back(s);
+    lines.lineParams = params.line;
+    lines.lineParams.readExcessKurtosis = kurtosisGiven ? params.readExcessKurtosis : 0.0;
+    lines.fit(params, report);
+    if (!kurtosisGiven)
+        estimateKurtosisAndRefit(lines, params, report);
+    report.readExcessKurtosis = lines.lineParams.readExcessKurtosis;
+    leaveOutOutlierPixels(samples, lines, params, report);
+    for (const NoiseLineFit& fit : report.perGain)
+        if (fit.line.a < 0 || fit.line.b < 0)
+            report.notes.push_back(
+                format("gain %g: the line has a negative %s (a = %g, b = %g); the data do not "
+                       "follow the model there",
+                       fit.gain, fit.line.a < 0 ? "slope" : "offset", fit.line.a, fit.line.b));
+    fitAcrossGains(lines, params, report);
     return report;
 }
 

@@ -109,15 +109,18 @@ double fittedVariance(const CalibrationReport& report, double mean, double gain)
     return nearest->line.a * std::max(0.0, mean) + nearest->line.b;
 }
 
-CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, const CalibrationReport& report,
-                                    const std::vector<CalibrationBurstFacts>& bursts, double signalRange)
-{
-    CalibrationVerdict verdict;
-    const auto add = [&](const VerdictCheck& c) {
-        verdict.checks.push_back(c);
-        verdict.pass = verdict.pass && c.pass;
-    };
+namespace {
 
+//! What the per-gain checks found worst so far, over the gains.
+struct PerGainFindings
+{
+    std::string fewMeans, badBin, curved;
+    double worstBin = 0, worstCurvature = 0;
+    int worstDistinct = INT_MAX;
+};
+
+std::vector<VerdictCheck> burstChecks(const std::vector<CalibrationBurstFacts>& bursts)
+{
     int fewest = INT_MAX;
     std::string fewestName;
     double mostClipped = 0;
@@ -132,22 +135,26 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
             mostClippedName = b.name;
         }
     }
-    add(check("frames per burst", fewest >= kMinFrames,
+    return {
+        check("frames per burst", fewest >= kMinFrames,
               format("fewest %d (%s); threshold %d%s", fewest, fewestName.c_str(), kMinFrames,
-                     fewest >= kMinFrames ? "" : ": shoot more frames per burst")));
-    add(check("clipped fraction", mostClipped <= kMaxClippedFraction,
+                     fewest >= kMinFrames ? "" : ": shoot more frames per burst")),
+        check("clipped fraction", mostClipped <= kMaxClippedFraction,
               format("largest %.1f%% (%s); threshold %.0f%%%s", 100 * mostClipped,
                      mostClippedName.empty() ? "none" : mostClippedName.c_str(), 100 * kMaxClippedFraction,
-                     mostClipped <= kMaxClippedFraction ? "" : ": lower the exposure of that burst")));
+                     mostClipped <= kMaxClippedFraction ? "" : ": lower the exposure of that burst"))};
+}
 
-    // Separability: the spread of the gains.
+//! Separability: the spread of the gains and whether the read terms' intervals stay clear of 0.
+VerdictCheck separabilityCheck(const CalibrationReport& report)
+{
     double gMin = INFINITY, gMax = 0;
     for (const NoiseLineFit& f : report.perGain) {
         gMin = std::min(gMin, f.gain);
         gMax = std::max(gMax, f.gain);
     }
     const double ratio = report.perGain.empty() ? 1.0 : gMax / gMin;
-    // And the intervals: a read term whose 95% interval reaches 0 is not told apart from 0 by the data.
+    // A read term whose 95% interval reaches 0 is not told apart from 0 by the data.
     bool intervalsClear = report.separable && report.uncertainty.source != UNCERTAINTY_NONE;
     std::string intervals;
     if (intervalsClear) {
@@ -157,7 +164,7 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
             format("; 95%% intervals sigma_d^2 [%.4g, %.4g], sigma_r^2 [%.4g, %.4g]", d[0], d[1], r[0], r[1]);
     }
     const bool separated = report.separable && ratio >= kMinGainRatio && intervalsClear;
-    add(check(
+    return check(
         "separability of sigma_d^2 and sigma_r^2", separated,
         format("gain ratio %.2f (%.1f dB) over %zu gains%s; threshold %.1f (%.1f dB) and both intervals "
                "above 0%s",
@@ -165,115 +172,143 @@ CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, con
                linearGainToDb(kMinGainRatio),
                separated ? ""
                          : ": add a burst at an ISO at least twice the lowest, and dark frames at "
-                           "each ISO")));
+                           "each ISO"));
+}
 
-    add(gainsAgreeWithSlopes(report, bursts));
+//! One gain's residuals per mean bin and the spread of its means, from lo to hi.
+void judgeMeanBins(double g, const std::vector<const NoiseSample*>& gs, const CalibrationReport& report,
+                   double lo, double hi, double signalRange, PerGainFindings& found)
+{
+    const double width = std::max(hi - lo, 1e-9) / kMeanBins;
+    std::vector<std::vector<double>> ratios(kMeanBins);
+    std::vector<double> dofs(kMeanBins, 0), binMeans(kMeanBins, 0);
+    for (const NoiseSample* s : gs) {
+        const int bin = std::min(kMeanBins - 1, std::max(0, int((std::max(0.0, s->mean) - lo) / width)));
+        const double predicted = fittedVariance(report, s->mean, g);
+        if (predicted > 0) {
+            ratios[size_t(bin)].push_back(s->variance / predicted);
+            dofs[size_t(bin)] += s->dof;
+            binMeans[size_t(bin)] += s->mean;
+        }
+    }
+    int distinct = 0;
+    double lowest = INFINITY, highest = -INFINITY;
+    for (int b = 0; b < kMeanBins; ++b) {
+        const std::vector<double>& r = ratios[size_t(b)];
+        if (int(r.size()) < kMinBinSamples)
+            continue;
+        ++distinct;
+        const double meanOfBin = binMeans[size_t(b)] / double(r.size());
+        lowest = std::min(lowest, meanOfBin);
+        highest = std::max(highest, meanOfBin);
+        // The median ratio over the median a correct model gives; its standard error is about
+        // 1.25 sqrt(2 / dof) / sqrt(n) (the median's efficiency against the mean is 2 / pi).
+        const double dof = dofs[size_t(b)] / double(r.size());
+        const double deviation = median(r) / medianVarianceRatio(dof) - 1;
+        const double standardError = 1.2533 * std::sqrt(2 / dof) / std::sqrt(double(r.size()));
+        const double excess = std::abs(deviation) - 4 * standardError;
+        if (excess > kMaxBinDeviation && std::abs(deviation) > std::abs(found.worstBin)) {
+            found.worstBin = deviation;
+            found.badBin =
+                format("%.2f dB, mean %.0f DN: %+.1f%%", linearGainToDb(g), meanOfBin, 100 * deviation);
+        }
+    }
+    const bool spread = distinct >= kMinDistinctMeans && highest - lowest >= kMinMeanSpread * signalRange;
+    if (!spread && distinct < found.worstDistinct) {
+        found.worstDistinct = distinct;
+        found.fewMeans =
+            format("%.2f dB: %d mean bins of %d samples, spanning %.1f%% of the range", linearGainToDb(g),
+                   distinct, kMinBinSamples, distinct ? 100 * (highest - lowest) / signalRange : 0.0);
+    }
+}
 
-    // Per gain: distinct means, residuals per mean bin, curvature.
+//! Curvature: weighted least squares of v = b + a mu + c mu^2 with weights dof / (2 model^2).
+void judgeCurvature(double g, const std::vector<const NoiseSample*>& gs, const CalibrationReport& report,
+                    double hi, PerGainFindings& found)
+{
+    Matx33d A = Matx33d::zeros();
+    Vec3d rhs(0, 0, 0);
+    for (const NoiseSample* s : gs) {
+        const double m = std::max(0.0, s->mean), predicted = fittedVariance(report, s->mean, g);
+        if (!(predicted > 0))
+            continue;
+        const double w = s->dof / (2 * predicted * predicted);
+        const Vec3d x(1, m, m * m);
+        A += w * x * x.t();
+        rhs += w * s->variance * x;
+    }
+    Matx33d cov;
+    if (invert(A, cov, DECOMP_SVD) == 0 || !(hi > 0))
+        return;
+    const Vec3d p = cov * rhs;
+    const double top = fittedVariance(report, hi, g);
+    const double share = p[2] * hi * hi / top, shareSe = std::sqrt(cov(2, 2)) * hi * hi / top;
+    if (std::abs(share) - 4 * shareSe > kMaxCurvatureShare &&
+        std::abs(share) > std::abs(found.worstCurvature)) {
+        found.worstCurvature = share;
+        found.curved = format("%.2f dB: %+.1f%% of the variance at the highest mean (%.0f DN) is curvature",
+                              linearGainToDb(g), 100 * share, hi);
+    }
+}
+
+std::vector<VerdictCheck> perGainChecks(const std::vector<NoiseSample>& samples,
+                                        const CalibrationReport& report, double signalRange)
+{
     std::map<double, std::vector<const NoiseSample*>> byGain;
     for (const NoiseSample& s : samples)
         byGain[s.gain].push_back(&s);
-    std::string fewMeans, badBin, curved;
-    double worstBin = 0, worstCurvature = 0;
-    int worstDistinct = INT_MAX;
+    PerGainFindings found;
     for (const auto& kv : byGain) {
-        const double g = kv.first;
-        const std::vector<const NoiseSample*>& gs = kv.second;
         double lo = INFINITY, hi = -INFINITY;
-        for (const NoiseSample* s : gs) {
+        for (const NoiseSample* s : kv.second) {
             lo = std::min(lo, std::max(0.0, s->mean));
             hi = std::max(hi, s->mean);
         }
-        const double width = std::max(hi - lo, 1e-9) / kMeanBins;
-        std::vector<std::vector<double>> ratios(kMeanBins);
-        std::vector<double> dofs(kMeanBins, 0), binMeans(kMeanBins, 0);
-        for (const NoiseSample* s : gs) {
-            const int bin = std::min(kMeanBins - 1, std::max(0, int((std::max(0.0, s->mean) - lo) / width)));
-            const double predicted = fittedVariance(report, s->mean, g);
-            if (predicted > 0) {
-                ratios[size_t(bin)].push_back(s->variance / predicted);
-                dofs[size_t(bin)] += s->dof;
-                binMeans[size_t(bin)] += s->mean;
-            }
-        }
-        int distinct = 0;
-        double lowest = INFINITY, highest = -INFINITY;
-        for (int b = 0; b < kMeanBins; ++b) {
-            const std::vector<double>& r = ratios[size_t(b)];
-            if (int(r.size()) < kMinBinSamples)
-                continue;
-            ++distinct;
-            const double meanOfBin = binMeans[size_t(b)] / double(r.size());
-            lowest = std::min(lowest, meanOfBin);
-            highest = std::max(highest, meanOfBin);
-            // The median ratio over the median a correct model gives; its standard error is about
-            // 1.25 sqrt(2 / dof) / sqrt(n) (the median's efficiency against the mean is 2 / pi).
-            const double dof = dofs[size_t(b)] / double(r.size());
-            const double deviation = median(r) / medianVarianceRatio(dof) - 1;
-            const double standardError = 1.2533 * std::sqrt(2 / dof) / std::sqrt(double(r.size()));
-            const double excess = std::abs(deviation) - 4 * standardError;
-            if (excess > kMaxBinDeviation && std::abs(deviation) > std::abs(worstBin)) {
-                worstBin = deviation;
-                badBin =
-                    format("%.2f dB, mean %.0f DN: %+.1f%%", linearGainToDb(g), meanOfBin, 100 * deviation);
-            }
-        }
-        const bool spread = distinct >= kMinDistinctMeans && highest - lowest >= kMinMeanSpread * signalRange;
-        if (!spread && distinct < worstDistinct) {
-            worstDistinct = distinct;
-            fewMeans =
-                format("%.2f dB: %d mean bins of %d samples, spanning %.1f%% of the range", linearGainToDb(g),
-                       distinct, kMinBinSamples, distinct ? 100 * (highest - lowest) / signalRange : 0.0);
-        }
-
-        // Curvature: weighted least squares of v = b + a mu + c mu^2 with weights dof / (2 model^2).
-        Matx33d A = Matx33d::zeros();
-        Vec3d rhs(0, 0, 0);
-        for (const NoiseSample* s : gs) {
-            const double m = std::max(0.0, s->mean), predicted = fittedVariance(report, s->mean, g);
-            if (!(predicted > 0))
-                continue;
-            const double w = s->dof / (2 * predicted * predicted);
-            const Vec3d x(1, m, m * m);
-            A += w * x * x.t();
-            rhs += w * s->variance * x;
-        }
-        Matx33d cov;
-        if (invert(A, cov, DECOMP_SVD) == 0 || !(hi > 0))
-            continue;
-        const Vec3d p = cov * rhs;
-        const double top = fittedVariance(report, hi, g);
-        const double share = p[2] * hi * hi / top, shareSe = std::sqrt(cov(2, 2)) * hi * hi / top;
-        if (std::abs(share) - 4 * shareSe > kMaxCurvatureShare &&
-            std::abs(share) > std::abs(worstCurvature)) {
-            worstCurvature = share;
-            curved = format("%.2f dB: %+.1f%% of the variance at the highest mean (%.0f DN) is curvature",
-                            linearGainToDb(g), 100 * share, hi);
-        }
+        judgeMeanBins(kv.first, kv.second, report, lo, hi, signalRange, found);
+        judgeCurvature(kv.first, kv.second, report, hi, found);
     }
-    add(check("residuals per gain and mean bin", badBin.empty(),
-              badBin.empty() ? format("every bin of >= %d samples within %.0f%% (+4 standard errors) of the "
-                                      "model",
-                                      kMinBinSamples, 100 * kMaxBinDeviation)
-                             : "worst " + badBin +
-                                   format("; threshold %.0f%% beyond 4 standard errors: the model does not "
-                                          "describe these data (see the mean-variance plot)",
-                                          100 * kMaxBinDeviation)));
-    add(check("distinct means per gain", fewMeans.empty(),
-              fewMeans.empty()
+    return {
+        check("residuals per gain and mean bin", found.badBin.empty(),
+              found.badBin.empty()
+                  ? format("every bin of >= %d samples within %.0f%% (+4 standard errors) of the "
+                           "model",
+                           kMinBinSamples, 100 * kMaxBinDeviation)
+                  : "worst " + found.badBin +
+                        format("; threshold %.0f%% beyond 4 standard errors: the model does not "
+                               "describe these data (see the mean-variance plot)",
+                               100 * kMaxBinDeviation)),
+        check("distinct means per gain", found.fewMeans.empty(),
+              found.fewMeans.empty()
                   ? format("every gain has >= %d mean bins spanning >= %.0f%% of the range",
                            kMinDistinctMeans, 100 * kMinMeanSpread)
-                  : fewMeans + format("; threshold %d bins spanning %.0f%%: use a chart or scene with darker "
-                                      "and brighter parts, or a second exposure",
-                                      kMinDistinctMeans, 100 * kMinMeanSpread)));
-    add(check(
-        "linearity (curvature of variance against mean)", curved.empty(),
-        curved.empty()
-            ? format("no gain has curvature beyond %.0f%% (+4 standard errors)", 100 * kMaxCurvatureShare)
-            : "worst " + curved +
-                  format("; threshold %.0f%%: the raw values are not linear in light (a tone curve, "
-                         "compression or a processed file?)",
-                         100 * kMaxCurvatureShare)));
+                  : found.fewMeans + format("; threshold %d bins spanning %.0f%%: use a chart or scene with "
+                                            "darker and brighter parts, or a second exposure",
+                                            kMinDistinctMeans, 100 * kMinMeanSpread)),
+        check(
+            "linearity (curvature of variance against mean)", found.curved.empty(),
+            found.curved.empty()
+                ? format("no gain has curvature beyond %.0f%% (+4 standard errors)", 100 * kMaxCurvatureShare)
+                : "worst " + found.curved +
+                      format("; threshold %.0f%%: the raw values are not linear in light (a tone curve, "
+                             "compression or a processed file?)",
+                             100 * kMaxCurvatureShare))};
+}
+
+} // namespace
+
+CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, const CalibrationReport& report,
+                                    const std::vector<CalibrationBurstFacts>& bursts, double signalRange)
+{
+    CalibrationVerdict verdict;
+    std::vector<VerdictCheck> checks = burstChecks(bursts);
+    checks.push_back(separabilityCheck(report));
+    checks.push_back(gainsAgreeWithSlopes(report, bursts));
+    for (const VerdictCheck& c : perGainChecks(samples, report, signalRange))
+        checks.push_back(c);
+    for (const VerdictCheck& c : checks) {
+        verdict.checks.push_back(c);
+        verdict.pass = verdict.pass && c.pass;
+    }
     return verdict;
 }
 

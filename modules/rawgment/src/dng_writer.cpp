@@ -208,9 +208,9 @@ uint8_t dngColourOf(CfaChannel ch)
     return ch == CFA_R ? 0 : (ch == CFA_B ? 2 : 1);
 }
 
-} // namespace
-
-void writeDng(const String& path, const RawImage& image)
+/** Every field writeDng stores, checked against what its tag can hold; returns the black levels as the
+ * integers DNG stores for 16-bit data. */
+std::vector<uint32_t> checkDngImage(const String& path, const RawImage& image)
 {
     image.format.validate();
     const Mat& m = image.mosaic;
@@ -239,48 +239,12 @@ void writeDng(const String& path, const RawImage& image)
                                           path.c_str(), image.exposureTime));
     if (!image.noiseProfile.empty())
         detail::checkDngNoiseProfile(image.noiseProfile, ("writeDng: '" + path + "': noiseProfile").c_str());
-    if (detail::fileExists(path))
-        CV_Error(Error::StsError, "writeDng: '" + path + "' already exists; it is never overwritten");
 
-    TiffBuilder t;
-    t.longs(254, {0});
-    t.longs(256, {uint32_t(m.cols)});
-    t.longs(257, {uint32_t(m.rows)});
-    t.shorts(258, {16});
-    t.shorts(259, {1});
-    t.shorts(262, {32803}); // CFA
-    if (!image.make.empty())
-        t.ascii(271, image.make);
-    if (!image.model.empty())
-        t.ascii(272, image.model);
-    t.shorts(274, {1});
-    t.shorts(277, {1});
-    t.longs(278, {uint32_t(m.rows)});
-    t.shorts(284, {1});
-    t.ascii(305, "cv::rawgment");
-    t.shorts(33421, {2, 2});
-    const CfaPattern p = image.format.pattern;
-    t.bytes(33422, {dngColourOf(cfaChannelAt(p, 0, 0)), dngColourOf(cfaChannelAt(p, 0, 1)),
-                    dngColourOf(cfaChannelAt(p, 1, 0)), dngColourOf(cfaChannelAt(p, 1, 1))});
-    if (image.exposureTime > 0)
-        t.rationals(33434, {image.exposureTime}, false);
-    if (image.iso > 0)
-        t.shorts(34855, {static_cast<uint16_t>(std::min(65535.0, std::round(image.iso)))});
-    t.bytes(50706, {1, 4, 0, 0});
-    t.bytes(50707, {1, 1, 0, 0});
-    t.ascii(50708, image.make.empty() && image.model.empty() ? String("cv::rawgment")
-                                                             : image.make + " " + image.model);
-    t.bytes(50710, {0, 1, 2}); // CFAPlaneColor
-    t.shorts(50711, {1});      // CFALayout: rectangular
-    t.shorts(50713, {2, 2});
-    {
-        std::vector<uint8_t> b;
-        for (uint32_t v : blacks)
-            for (int k = 0; k < 4; ++k)
-                b.push_back(uint8_t(v >> (8 * k)));
-        t.add(50714, TIFF_LONG, 4, b);
-    }
-    t.longs(50717, {static_cast<uint32_t>(std::llround(image.format.whiteLevel))});
+    return blacks;
+}
+
+void addColourTags(TiffBuilder& t, const RawImage& image)
+{
     // The colour tags as the source stated them (RawImage::colorTags): rebuilt from LibRaw's normalised
     // matrix, ColorMatrix1's rows came out rescaled and a reader derived another white point.
     const auto has = [&](int tag) {
@@ -332,6 +296,57 @@ void writeDng(const String& path, const RawImage& image)
         }
         t.rationals(50728, neutral, false);
     }
+}
+
+} // namespace
+
+void writeDng(const String& path, const RawImage& image)
+{
+    const std::vector<uint32_t> blacks = checkDngImage(path, image);
+    const Mat& m = image.mosaic;
+    if (detail::fileExists(path))
+        CV_Error(Error::StsError, "writeDng: '" + path + "' already exists; it is never overwritten");
+
+    TiffBuilder t;
+    t.longs(254, {0});
+    t.longs(256, {uint32_t(m.cols)});
+    t.longs(257, {uint32_t(m.rows)});
+    t.shorts(258, {16});
+    t.shorts(259, {1});
+    t.shorts(262, {32803}); // CFA
+    if (!image.make.empty())
+        t.ascii(271, image.make);
+    if (!image.model.empty())
+        t.ascii(272, image.model);
+    t.shorts(274, {1});
+    t.shorts(277, {1});
+    t.longs(278, {uint32_t(m.rows)});
+    t.shorts(284, {1});
+    t.ascii(305, "cv::rawgment");
+    t.shorts(33421, {2, 2});
+    const CfaPattern p = image.format.pattern;
+    t.bytes(33422, {dngColourOf(cfaChannelAt(p, 0, 0)), dngColourOf(cfaChannelAt(p, 0, 1)),
+                    dngColourOf(cfaChannelAt(p, 1, 0)), dngColourOf(cfaChannelAt(p, 1, 1))});
+    if (image.exposureTime > 0)
+        t.rationals(33434, {image.exposureTime}, false);
+    if (image.iso > 0)
+        t.shorts(34855, {static_cast<uint16_t>(std::min(65535.0, std::round(image.iso)))});
+    t.bytes(50706, {1, 4, 0, 0});
+    t.bytes(50707, {1, 1, 0, 0});
+    t.ascii(50708, image.make.empty() && image.model.empty() ? String("cv::rawgment")
+                                                             : image.make + " " + image.model);
+    t.bytes(50710, {0, 1, 2}); // CFAPlaneColor
+    t.shorts(50711, {1});      // CFALayout: rectangular
+    t.shorts(50713, {2, 2});
+    {
+        std::vector<uint8_t> b;
+        for (uint32_t v : blacks)
+            for (int k = 0; k < 4; ++k)
+                b.push_back(uint8_t(v >> (8 * k)));
+        t.add(50714, TIFF_LONG, 4, b);
+    }
+    t.longs(50717, {static_cast<uint32_t>(std::llround(image.format.whiteLevel))});
+    addColourTags(t, image);
     if (!image.noiseProfile.empty()) {
         std::vector<double> pairs;
         for (const Vec2d& so : image.noiseProfile) {
