@@ -8,6 +8,72 @@
 #include <cstdio>
 #include <iostream>
 
+namespace {
+
+//! The verdict, the lines, the model with its errors, Shapiro-Wilk, the dark frames' findings and the notes.
+void printCalibration(const rawgment_apps::CalibrateResult& r, const std::string& method)
+{
+    const cv::rawgment::CalibrationReport& rep = r.report;
+    std::printf("verdict: %s\n", r.verdict.pass ? "PASS" : "FAIL");
+    for (const cv::rawgment::VerdictCheck& c : r.verdict.checks)
+        std::printf("  %s %s: %s\n", c.pass ? "pass" : "FAIL", c.name.c_str(), c.figure.c_str());
+    std::printf("method %s, %d of %d samples used\n", method.c_str(), rep.samplesUsed, rep.samples);
+    for (const cv::rawgment::NoiseLineFit& l : rep.perGain)
+        std::printf(
+            "  gain %6.2f dB: variance = (%.5f +- %.2g) mean + (%.4f +- %.2g)  (R^2 %.4f, %d inliers)\n",
+            cv::rawgment::linearGainToDb(l.gain), l.line.a, l.slopeStdError, l.line.b, l.offsetStdError,
+            l.rSquared, l.inliers);
+    // Standard errors, and 95% intervals for the read terms, whose relative errors are the larger.
+    const cv::Vec2d d = rep.interval(cv::rawgment::NOISE_PARAM_SIGMA_D2),
+                    r2 = rep.interval(cv::rawgment::NOISE_PARAM_SIGMA_R2);
+    if (rep.separable)
+        std::printf("model: alpha %.6f +- %.2g  sigma_d^2 %.5f +- %.2g [%.5g, %.5g]  sigma_r^2 %.5f +- %.2g "
+                    "[%.5g, %.5g]  (+- one standard error, [95%% interval]; R^2 slope %.4f, offset %.4f)\n",
+                    rep.model.alpha, rep.uncertainty.stdError[0], rep.model.sigmaD2,
+                    rep.uncertainty.stdError[1], d[0], d[1], rep.model.sigmaR2, rep.uncertainty.stdError[2],
+                    r2[0], r2[1], rep.rSquaredSlope, rep.rSquaredOffset);
+    else
+        std::printf("model: alpha %.6f +- %.2g (sigma_d^2 and sigma_r^2 not separable)\n", rep.model.alpha,
+                    rep.uncertainty.stdError[0]);
+    const std::string correlation =
+        rep.separable ? cv::format("; sigma_d^2 and sigma_r^2 correlate %+.2f",
+                                   rep.uncertainty.correlation(cv::rawgment::NOISE_PARAM_SIGMA_D2,
+                                                               cv::rawgment::NOISE_PARAM_SIGMA_R2))
+                      : std::string();
+    std::printf("errors: from the %s%s\n",
+                rep.uncertainty.source == cv::rawgment::UNCERTAINTY_BOOTSTRAP ? "bootstrap"
+                                                                              : "fit's covariance",
+                correlation.c_str());
+    if (r.shapiroTested > 0)
+        std::printf("Shapiro-Wilk: %.1f%% of %d pixels have p > 0.05\n", 100 * r.gaussianFraction,
+                    r.shapiroTested);
+    else
+        std::printf("Shapiro-Wilk: no pixel tested (it needs bursts of 3 or more frames)\n");
+    if (r.haveDark) {
+        const cv::rawgment::NoiseModel& m = rep.model;
+        std::printf(
+            "dark frames: row noise %.4g g^2 + %.4g DN^2, read-noise lambda %.3f (PPCC %.5f, Gaussian "
+            "%.5f)%s\n",
+            m.rowSigmaD2, m.rowSigmaR2, m.tukeyLambda, r.dark.ppccBest, r.dark.ppccGaussian,
+            m.hasDarkShading() ? ", dark shading maps beside noise_model.yml" : "");
+        for (const cv::rawgment::DarkGainStatistics& g : r.dark.gains)
+            std::printf("  gain %6.2f dB: row variance %.4g +- %.2g, pixel variance %.4g, excess kurtosis "
+                        "%.3f, Shapiro-Wilk p %.3g with the rows, %.3g without\n",
+                        cv::rawgment::linearGainToDb(g.gain), g.rowVariance, g.rowVarianceSE, g.pixelVariance,
+                        g.excessKurtosis, g.before.pValue, g.after.pValue);
+        for (const std::string& n : r.dark.notes)
+            std::printf("note: %s\n", n.c_str());
+    }
+    for (const std::string& n : rep.notes)
+        std::printf("note: %s\n", n.c_str());
+    for (const std::string& n : r.notes)
+        std::printf("note: %s\n", n.c_str());
+    for (const std::string& p : r.pngs)
+        std::printf("plot: %s\n", p.c_str());
+}
+
+} // namespace
+
 int main(int argc, char** argv)
 {
     const char* keys =
@@ -70,65 +136,7 @@ int main(int argc, char** argv)
     try {
         rawgment_apps::OutputDirectory outputDirectory(o.outDir);
         const rawgment_apps::CalibrateResult r = rawgment_apps::calibrateFromManifest(o);
-        const cv::rawgment::CalibrationReport& rep = r.report;
-        std::printf("verdict: %s\n", r.verdict.pass ? "PASS" : "FAIL");
-        for (const cv::rawgment::VerdictCheck& c : r.verdict.checks)
-            std::printf("  %s %s: %s\n", c.pass ? "pass" : "FAIL", c.name.c_str(), c.figure.c_str());
-        std::printf("method %s, %d of %d samples used\n", method.c_str(), rep.samplesUsed, rep.samples);
-        for (const cv::rawgment::NoiseLineFit& l : rep.perGain)
-            std::printf(
-                "  gain %6.2f dB: variance = (%.5f +- %.2g) mean + (%.4f +- %.2g)  (R^2 %.4f, %d inliers)\n",
-                cv::rawgment::linearGainToDb(l.gain), l.line.a, l.slopeStdError, l.line.b, l.offsetStdError,
-                l.rSquared, l.inliers);
-        // Standard errors, and 95% intervals for the read terms, whose relative errors are the larger.
-        const cv::Vec2d d = rep.interval(cv::rawgment::NOISE_PARAM_SIGMA_D2),
-                        r2 = rep.interval(cv::rawgment::NOISE_PARAM_SIGMA_R2);
-        if (rep.separable)
-            std::printf(
-                "model: alpha %.6f +- %.2g  sigma_d^2 %.5f +- %.2g [%.5g, %.5g]  sigma_r^2 %.5f +- %.2g "
-                "[%.5g, %.5g]  (+- one standard error, [95%% interval]; R^2 slope %.4f, offset %.4f)\n",
-                rep.model.alpha, rep.uncertainty.stdError[0], rep.model.sigmaD2, rep.uncertainty.stdError[1],
-                d[0], d[1], rep.model.sigmaR2, rep.uncertainty.stdError[2], r2[0], r2[1], rep.rSquaredSlope,
-                rep.rSquaredOffset);
-        else
-            std::printf("model: alpha %.6f +- %.2g (sigma_d^2 and sigma_r^2 not separable)\n",
-                        rep.model.alpha, rep.uncertainty.stdError[0]);
-        const std::string correlation =
-            rep.separable ? cv::format("; sigma_d^2 and sigma_r^2 correlate %+.2f",
-                                       rep.uncertainty.correlation(cv::rawgment::NOISE_PARAM_SIGMA_D2,
-                                                                   cv::rawgment::NOISE_PARAM_SIGMA_R2))
-                          : std::string();
-        std::printf("errors: from the %s%s\n",
-                    rep.uncertainty.source == cv::rawgment::UNCERTAINTY_BOOTSTRAP ? "bootstrap"
-                                                                                  : "fit's covariance",
-                    correlation.c_str());
-        if (r.shapiroTested > 0)
-            std::printf("Shapiro-Wilk: %.1f%% of %d pixels have p > 0.05\n", 100 * r.gaussianFraction,
-                        r.shapiroTested);
-        else
-            std::printf("Shapiro-Wilk: no pixel tested (it needs bursts of 3 or more frames)\n");
-        if (r.haveDark) {
-            const cv::rawgment::NoiseModel& m = rep.model;
-            std::printf(
-                "dark frames: row noise %.4g g^2 + %.4g DN^2, read-noise lambda %.3f (PPCC %.5f, Gaussian "
-                "%.5f)%s\n",
-                m.rowSigmaD2, m.rowSigmaR2, m.tukeyLambda, r.dark.ppccBest, r.dark.ppccGaussian,
-                m.hasDarkShading() ? ", dark shading maps beside noise_model.yml" : "");
-            for (const cv::rawgment::DarkGainStatistics& g : r.dark.gains)
-                std::printf(
-                    "  gain %6.2f dB: row variance %.4g +- %.2g, pixel variance %.4g, excess kurtosis "
-                    "%.3f, Shapiro-Wilk p %.3g with the rows, %.3g without\n",
-                    cv::rawgment::linearGainToDb(g.gain), g.rowVariance, g.rowVarianceSE, g.pixelVariance,
-                    g.excessKurtosis, g.before.pValue, g.after.pValue);
-            for (const std::string& n : r.dark.notes)
-                std::printf("note: %s\n", n.c_str());
-        }
-        for (const std::string& n : rep.notes)
-            std::printf("note: %s\n", n.c_str());
-        for (const std::string& n : r.notes)
-            std::printf("note: %s\n", n.c_str());
-        for (const std::string& p : r.pngs)
-            std::printf("plot: %s\n", p.c_str());
+        printCalibration(r, method);
         outputDirectory.keep();
         return 0;
     } catch (const std::exception& e) {

@@ -194,6 +194,71 @@ std::string tradeoffPlotScript(const std::vector<rawgment_apps::TradeoffRow>& ro
     return script + "unset multiplot\n";
 }
 
+//! The table's rows as CSV cells, one time column per CPU path.
+rawgment_apps::CsvTable tradeoffTable(const std::vector<rawgment_apps::TradeoffRow>& rows)
+{
+    std::vector<std::string> header = {"knob", "setting", "measure", "error", "ms_per_mp"};
+    for (CpuPath p : availableCpuPaths())
+        header.push_back("ms_per_mp_" + cpuPathName(p));
+    rawgment_apps::CsvTable table(header);
+    // CsvTable does not quote: text cells keep their commas out of the way as semicolons.
+    const auto cell = [](std::string text) {
+        std::replace(text.begin(), text.end(), ',', ';');
+        return text;
+    };
+    for (const rawgment_apps::TradeoffRow& r : rows) {
+        std::vector<std::string> cells = {cell(r.knob), cell(r.setting), cell(r.measure),
+                                          formatNumber(r.error), formatNumber(r.msPerMp)};
+        // Knobs whose loops are not dispatched have one time: the other cells stay empty.
+        for (size_t k = 0; k < availableCpuPaths().size(); ++k)
+            cells.push_back(k < r.msPerMpByPath.size() ? formatNumber(r.msPerMpByPath[k]) : std::string());
+        table.addRow(cells);
+    }
+    return table;
+}
+
+//! tradeoffs.md: the table, what each setting means, and what more calibration data buys.
+std::string tradeoffMarkdown(const std::vector<rawgment_apps::TradeoffRow>& rows,
+                             const std::vector<rawgment_apps::PrecisionRow>& precision,
+                             const rawgment_apps::TradeoffSettings& set, bool quick)
+{
+    std::ostringstream text;
+    text << "# What accuracy costs in time\n\n"
+         << "Measured by `rawgment_tradeoffs" << (quick ? " --quick" : "") << "` on " << getNumThreads()
+         << " threads; times per megapixel of a " << set.timingSize.width << "x" << set.timingSize.height
+         << " CV_16UC1 mosaic (fastest of " << set.repeats
+         << "), per MP of burst input for calibration, per million values for Shapiro-Wilk; the "
+            "augmentation and burst-statistics knobs are timed on every CPU path this machine has "
+            "(the same bits on each). Errors "
+            "against "
+            "the sensor simulator's truth; calibration errors are RMS over "
+         << set.seeds << " simulated campaigns.\n\n"
+         << markdownTable(rows) << "\n## What each setting means\n\n";
+    for (const rawgment_apps::TradeoffRow& r : rows)
+        text << "- " << r.knob << ", " << r.setting << ": " << r.meaning << ".\n";
+    text << "\n## Calibration precision: what more data buys\n\n"
+            "Relative standard errors the calibration states (mean over "
+         << set.seeds
+         << " campaigns), the relative errors it makes (RMS over the same campaigns, against the "
+            "simulator's truth: with few campaigns a noisy figure of the same size), and for more of the "
+            "same data the formula se0 sqrt((T0 - 1) N0 / ((T - 1) N)) from the reference row (T frames, "
+            "N "
+            "pixels). Fewer gains and dark frames change the design; their rows are measured only "
+            "(`projectedStdError` and the calibrate app's report project them for a user's own data).\n\n"
+            "| set-up | alpha stated | made | formula | sigma_d^2 stated | made | formula | sigma_r^2 "
+            "stated | "
+            "made | formula |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    const auto percent = [](double v) { return v > 0 ? cv::format("%.3g%%", 100 * v) : std::string("-"); };
+    for (const rawgment_apps::PrecisionRow& p : precision) {
+        text << "| " << p.setting;
+        for (int k = 0; k < 3; ++k)
+            text << " | " << percent(p.stated[k]) << " | " << percent(p.made[k]) << " | "
+                 << percent(p.formula[k]);
+        text << " |\n";
+    }
+    return text.str();
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -253,64 +318,12 @@ int main(int argc, char** argv)
         rawgment_apps::measureTradeoffs(set, progress, rows, precision);
         progress.finish();
 
-        std::vector<std::string> header = {"knob", "setting", "measure", "error", "ms_per_mp"};
-        for (CpuPath p : availableCpuPaths())
-            header.push_back("ms_per_mp_" + cpuPathName(p));
-        rawgment_apps::CsvTable table(header);
-        // CsvTable does not quote: text cells keep their commas out of the way as semicolons.
-        const auto cell = [](std::string text) {
-            std::replace(text.begin(), text.end(), ',', ';');
-            return text;
-        };
-        for (const rawgment_apps::TradeoffRow& r : rows) {
-            std::vector<std::string> cells = {cell(r.knob), cell(r.setting), cell(r.measure),
-                                              formatNumber(r.error), formatNumber(r.msPerMp)};
-            // Knobs whose loops are not dispatched have one time: the other cells stay empty.
-            for (size_t k = 0; k < availableCpuPaths().size(); ++k)
-                cells.push_back(k < r.msPerMpByPath.size() ? formatNumber(r.msPerMpByPath[k])
-                                                           : std::string());
-            table.addRow(cells);
-        }
-        std::ostringstream text;
-        text << "# What accuracy costs in time\n\n"
-             << "Measured by `rawgment_tradeoffs" << (parser.get<bool>("quick") ? " --quick" : "") << "` on "
-             << getNumThreads() << " threads; times per megapixel of a " << set.timingSize.width << "x"
-             << set.timingSize.height << " CV_16UC1 mosaic (fastest of " << set.repeats
-             << "), per MP of burst input for calibration, per million values for Shapiro-Wilk; the "
-                "augmentation and burst-statistics knobs are timed on every CPU path this machine has "
-                "(the same bits on each). Errors "
-                "against "
-                "the sensor simulator's truth; calibration errors are RMS over "
-             << set.seeds << " simulated campaigns.\n\n"
-             << markdownTable(rows) << "\n## What each setting means\n\n";
-        for (const rawgment_apps::TradeoffRow& r : rows)
-            text << "- " << r.knob << ", " << r.setting << ": " << r.meaning << ".\n";
-        text << "\n## Calibration precision: what more data buys\n\n"
-                "Relative standard errors the calibration states (mean over "
-             << set.seeds
-             << " campaigns), the relative errors it makes (RMS over the same campaigns, against the "
-                "simulator's truth: with few campaigns a noisy figure of the same size), and for more of the "
-                "same data the formula se0 sqrt((T0 - 1) N0 / ((T - 1) N)) from the reference row (T frames, "
-                "N "
-                "pixels). Fewer gains and dark frames change the design; their rows are measured only "
-                "(`projectedStdError` and the calibrate app's report project them for a user's own data).\n\n"
-                "| set-up | alpha stated | made | formula | sigma_d^2 stated | made | formula | sigma_r^2 "
-                "stated | "
-                "made | formula |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-        const auto percent = [](double v) {
-            return v > 0 ? cv::format("%.3g%%", 100 * v) : std::string("-");
-        };
-        for (const rawgment_apps::PrecisionRow& p : precision) {
-            text << "| " << p.setting;
-            for (int k = 0; k < 3; ++k)
-                text << " | " << percent(p.stated[k]) << " | " << percent(p.made[k]) << " | "
-                     << percent(p.formula[k]);
-            text << " |\n";
-        }
-        rawgment_apps::writeTextAtomically(md, text.str());
+        const rawgment_apps::CsvTable table = tradeoffTable(rows);
+        const std::string text = tradeoffMarkdown(rows, precision, set, parser.get<bool>("quick"));
+        rawgment_apps::writeTextAtomically(md, text);
         table.write(csv);
         const std::string script = tradeoffPlotScript(rows);
-        std::cout << text.str();
+        std::cout << text;
         if (plots) {
             std::string message;
             if (rawgment_apps::plotWithGnuplot(png, script, message, 1800, 1700))

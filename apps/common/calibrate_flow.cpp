@@ -296,26 +296,59 @@ struct BurstInputs
     std::vector<double> darkGains;
 };
 
+/* Shapiro-Wilk positions: every k-th pixel of the squares (of each burst's own frame without a chart), at
+ * most shapiroPixels of them. Bursts may differ in size (dark frames of a crop, say): each is read only
+ * inside its own frame. */
+std::vector<cv::Point> testedPositions(const std::vector<cv::Rect>& rects, int shapiroPixels)
+{
+    std::vector<cv::Point> positions;
+    for (const cv::Rect& s : rects)
+        for (int y = s.y; y < s.br().y; ++y)
+            for (int x = s.x; x < s.br().x; ++x)
+                positions.emplace_back(x, y);
+    const size_t step = std::max<size_t>(1, positions.size() / size_t(std::max(1, shapiroPixels)));
+    std::vector<cv::Point> tested;
+    for (size_t k = 0; k < positions.size(); k += step)
+        tested.push_back(positions[k]);
+    return tested;
+}
+
+/* A burst's facts for the verdict (its clipped share of the sampled area) and its Shapiro-Wilk rows (the
+ * unclipped, non-constant tested pixels); returns how many of them look Gaussian at 5%. */
+int addBurstFactsAndShapiro(const BurstStatistics& stats, const std::string& name, double gainDb, bool dark,
+                            const std::vector<cv::Rect>& sampledRects, const cv::Mat& series,
+                            const std::vector<cv::Point>& tested, BurstInputs& in, CalibrateResult& result)
+{
+    // Shapiro-Wilk needs 3 values per pixel.
+    std::vector<ShapiroWilkResult> sw;
+    if (series.rows >= 3)
+        shapiroWilkBatch(series, sw, SW_SERIES_IN_COLUMNS);
+    cv::Mat mean, clipped;
+    stats.mean(mean);
+    stats.clippedMask(clipped);
+    CalibrationBurstFacts burstFacts{name, gainDb, stats.frames(), 0.0, dark};
+    double area = 0, clippedArea = 0;
+    for (const cv::Rect& r : sampledRects) {
+        area += r.area();
+        clippedArea += cv::countNonZero(clipped(r));
+    }
+    burstFacts.clippedFraction = area > 0 ? clippedArea / area : 0.0;
+    in.facts.push_back(burstFacts);
+    int gaussian = 0;
+    for (size_t k = 0; k < sw.size(); ++k) {
+        if (clipped.at<uchar>(tested[k]) || sw[k].constant)
+            continue;
+        in.shapiro.addRow(std::vector<double>{gainDb, mean.at<double>(tested[k]), sw[k].pValue, sw[k].W});
+        ++result.shapiroTested;
+        gaussian += sw[k].pValue > 0.05;
+    }
+    return gaussian;
+}
+
 BurstInputs readBursts(const CalibrateOptions& o, const std::vector<CalibrationManifest::Burst>& specs,
                        const std::vector<double>& gainsDb, const std::vector<cv::Rect>& squares,
                        bool chartless, cv::Size frameSize, size_t totalFrames, CalibrateResult& result)
 {
-    // Shapiro-Wilk positions: every k-th pixel of the squares (of each burst's own frame without a
-    // chart), at most shapiroPixels of them. Bursts may differ in size (dark frames of a crop, say): each
-    // is read only inside its own frame.
-    const auto testedPositions = [&](const std::vector<cv::Rect>& rects) {
-        std::vector<cv::Point> positions;
-        for (const cv::Rect& s : rects)
-            for (int y = s.y; y < s.br().y; ++y)
-                for (int x = s.x; x < s.br().x; ++x)
-                    positions.emplace_back(x, y);
-        const size_t step = std::max<size_t>(1, positions.size() / size_t(std::max(1, o.shapiroPixels)));
-        std::vector<cv::Point> tested;
-        for (size_t k = 0; k < positions.size(); k += step)
-            tested.push_back(positions[k]);
-        return tested;
-    };
-
     BurstInputs in;
     int gaussian = 0;
     ProgressBar progress("calibrate", totalFrames);
@@ -358,7 +391,8 @@ BurstInputs readBursts(const CalibrateOptions& o, const std::vector<CalibrationM
                             s.x, s.y, s.width, s.height, stats->size().width, stats->size().height,
                             spec.files.front().c_str(), specs.front().files.front().c_str(), frameSize.width,
                             frameSize.height));
-                tested = testedPositions(chartless ? frameGridSquares(stats->size()) : squares);
+                tested =
+                    testedPositions(chartless ? frameGridSquares(stats->size()) : squares, o.shapiroPixels);
                 series.create(int(spec.files.size()), int(tested.size()), CV_64F);
             }
             // stats->add() has checked the size and the type (CV_16UC1 or CV_32FC1).
@@ -394,35 +428,69 @@ BurstInputs readBursts(const CalibrateOptions& o, const std::vector<CalibrationM
         in.samples.insert(in.samples.end(), burstSamples.begin(), burstSamples.end());
         in.lightSample.insert(in.lightSample.end(), burstSamples.size(), !spec.dark);
         in.sampleFrame.insert(in.sampleFrame.end(), burstSamples.size(), stats->size());
-        // Shapiro-Wilk needs 3 values per pixel.
-        std::vector<ShapiroWilkResult> sw;
-        if (series.rows >= 3)
-            shapiroWilkBatch(series, sw, SW_SERIES_IN_COLUMNS);
-        cv::Mat mean, clipped;
-        stats->mean(mean);
-        stats->clippedMask(clipped);
-        CalibrationBurstFacts burstFacts{spec.files.front(), gainsDb[i], stats->frames(), 0.0, spec.dark};
-        {
-            double area = 0, clippedArea = 0;
-            for (const cv::Rect& r : chartless || spec.dark ? frameGridSquares(stats->size()) : squares) {
-                area += r.area();
-                clippedArea += cv::countNonZero(clipped(r));
-            }
-            burstFacts.clippedFraction = area > 0 ? clippedArea / area : 0.0;
-        }
-        in.facts.push_back(burstFacts);
-        for (size_t k = 0; k < sw.size(); ++k) {
-            if (clipped.at<uchar>(tested[k]) || sw[k].constant)
-                continue;
-            in.shapiro.addRow(
-                std::vector<double>{gainsDb[i], mean.at<double>(tested[k]), sw[k].pValue, sw[k].W});
-            ++result.shapiroTested;
-            gaussian += sw[k].pValue > 0.05;
-        }
+        gaussian += addBurstFactsAndShapiro(
+            *stats, spec.files.front(), gainsDb[i], spec.dark,
+            chartless || spec.dark ? frameGridSquares(stats->size()) : squares, series, tested, in, result);
     }
     progress.finish();
     result.gaussianFraction = result.shapiroTested ? double(gaussian) / result.shapiroTested : 0.0;
     return in;
+}
+
+//! How the standard errors would shrink with more frames, pixels, dark frames or one more gain.
+void addProjections(const std::vector<NoiseSample>& samples, const std::vector<CalibrationBurstFacts>& facts,
+                    CalibrateResult& result)
+{
+    const CalibrationReport& report = result.report;
+    const double highest = report.perGain.back().gain;
+    const auto plan = [&](const std::string& name, double frames, double pixels, bool dark, double gain) {
+        CalibrationPlan p;
+        p.frameFactor = frames;
+        p.pixelFactor = pixels;
+        p.addDarkFrames = dark;
+        p.addGain = gain;
+        result.projections.emplace_back(name, projectedStdError(samples, report, p));
+    };
+    plan("as shot", 1, 1, false, 0);
+    plan("2x the frames per burst", 2, 1, false, 0);
+    plan("4x the frames per burst", 4, 1, false, 0);
+    plan("2x the pixels (patches)", 1, 2, false, 0);
+    if (std::none_of(facts.begin(), facts.end(), [](const CalibrationBurstFacts& b) { return b.dark; }))
+        plan("dark frames at each gain", 1, 1, true, 0);
+    plan(cv::format("one more gain, %.1f dB", linearGainToDb(2 * highest)), 1, 1, false, 2 * highest);
+}
+
+/* The model with its dark-shading images (when the gains separate its terms), and the darktable and
+ * Android exports when the gains come from ISO and the verdict passed. */
+void writeModelAndExports(const CalibrateOptions& o, const std::vector<CalibrationManifest::Burst>& specs,
+                          const BurstGains& gains, const RawFormat& firstFormat, CalibrateResult& result)
+{
+    const CalibrationReport& report = result.report;
+    if (!report.separable) {
+        result.notes.push_back(
+            "sigma_d^2 and sigma_r^2 are not separable with these gains: no noise_model.yml "
+            "written (see the report's notes)");
+        return;
+    }
+    // Dark shading goes into two float TIFFs next to the model, which names them with their checksums.
+    std::vector<std::string> shadingImages;
+    if (report.model.hasDarkShading()) {
+        shadingImages = {"noise_model.dark_shading_per_gain.tiff", "noise_model.dark_shading_offset.tiff"};
+        writeNewImage(o.outDir + "/" + shadingImages[0], report.model.darkShadingPerGain);
+        writeNewImage(o.outDir + "/" + shadingImages[1], report.model.darkShadingOffset);
+    }
+    writeNewText(o.outDir + "/noise_model.yml", yamlToString([&](cv::FileStorage& fs) {
+                     report.model.write(fs, "noise_model",
+                                        std::vector<cv::String>(shadingImages.begin(), shadingImages.end()));
+                 }));
+    // With gains from ISO the model carries over to the tools that index noise by ISO.
+    if (result.baseIso > 0 && report.model.alpha > 0 && result.verdict.pass)
+        writeProfileExports(o.outDir, specs, gains.gainsDb, gains.isos, firstFormat, result);
+    else if (result.baseIso > 0 && report.model.alpha > 0)
+        result.notes.push_back("the verdict is FAIL: darktable_noiseprofiles.json and "
+                               "android_noise_profile.yml are not written, and noise_model.yml is marked "
+                               "failed_calibration, so the apps and NoiseModel::load() refuse it unless "
+                               "asked (--accept_failed_calibration)");
 }
 
 } // namespace
@@ -431,8 +499,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
 {
     const CalibrationManifest manifest = readCalibrationManifest(o.manifest);
     prepareOutputDirectory(o.outDir);
-    const std::string modelPath = o.outDir + "/noise_model.yml",
-                      reportPath = o.outDir + "/calibration_report.yml",
+    const std::string reportPath = o.outDir + "/calibration_report.yml",
                       samplesCsv = o.outDir + "/samples.csv", linesCsv = o.outDir + "/lines.csv",
                       shapiroCsv = o.outDir + "/shapiro.csv",
                       histCsv = o.outDir + "/variance_ratio_histogram.csv";
@@ -455,7 +522,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
         totalFrames += spec.files.size();
 
     const BurstGains gains = burstGains(manifest, result);
-    const std::vector<double>&isos = gains.isos, &gainsDb = gains.gainsDb;
+    const std::vector<double>& gainsDb = gains.gainsDb;
     const cv::Size frameSize = gains.frameSize;
 
     const bool chartless = manifest.patches == "none";
@@ -481,25 +548,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     // The ISO of gain 1 travels with the model, so a camera file's ISO gives its gain when augmenting.
     result.report.model.baseIso = result.baseIso;
     const CalibrationReport& report = result.report;
-    {
-        const double highest = report.perGain.back().gain;
-        const auto plan = [&](const std::string& name, double frames, double pixels, bool dark, double gain) {
-            CalibrationPlan p;
-            p.frameFactor = frames;
-            p.pixelFactor = pixels;
-            p.addDarkFrames = dark;
-            p.addGain = gain;
-            result.projections.emplace_back(name, projectedStdError(samples, report, p));
-        };
-        plan("as shot", 1, 1, false, 0);
-        plan("2x the frames per burst", 2, 1, false, 0);
-        plan("4x the frames per burst", 4, 1, false, 0);
-        plan("2x the pixels (patches)", 1, 2, false, 0);
-        if (std::none_of(in.facts.begin(), in.facts.end(),
-                         [](const CalibrationBurstFacts& b) { return b.dark; }))
-            plan("dark frames at each gain", 1, 1, true, 0);
-        plan(cv::format("one more gain, %.1f dB", linearGainToDb(2 * highest)), 1, 1, false, 2 * highest);
-    }
+    addProjections(samples, in.facts, result);
     result.verdict =
         judgeCalibration(samples, report, in.facts,
                          firstFormat.whiteLevel - (firstFormat.blackLevel[0] + firstFormat.blackLevel[1] +
@@ -517,32 +566,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     }
     writeNewText(reportPath,
                  yamlToString([&](cv::FileStorage& fs) { report.write(fs, "calibration_report"); }));
-    if (report.separable) {
-        // Dark shading goes into two float TIFFs next to the model, which names them with their checksums.
-        std::vector<std::string> shadingImages;
-        if (report.model.hasDarkShading()) {
-            shadingImages = {"noise_model.dark_shading_per_gain.tiff",
-                             "noise_model.dark_shading_offset.tiff"};
-            writeNewImage(o.outDir + "/" + shadingImages[0], report.model.darkShadingPerGain);
-            writeNewImage(o.outDir + "/" + shadingImages[1], report.model.darkShadingOffset);
-        }
-        writeNewText(modelPath, yamlToString([&](cv::FileStorage& fs) {
-                         report.model.write(
-                             fs, "noise_model",
-                             std::vector<cv::String>(shadingImages.begin(), shadingImages.end()));
-                     }));
-        // With gains from ISO the model carries over to the tools that index noise by ISO.
-        if (result.baseIso > 0 && report.model.alpha > 0 && result.verdict.pass)
-            writeProfileExports(o.outDir, specs, gainsDb, isos, firstFormat, result);
-        else if (result.baseIso > 0 && report.model.alpha > 0)
-            result.notes.push_back("the verdict is FAIL: darktable_noiseprofiles.json and "
-                                   "android_noise_profile.yml are not written, and noise_model.yml is marked "
-                                   "failed_calibration, so the apps and NoiseModel::load() refuse it unless "
-                                   "asked (--accept_failed_calibration)");
-    } else
-        result.notes.push_back(
-            "sigma_d^2 and sigma_r^2 are not separable with these gains: no noise_model.yml "
-            "written (see the report's notes)");
+    writeModelAndExports(o, specs, gains, firstFormat, result);
 
     const size_t histogramGains =
         writeSampleTables(samples, report, in.shapiro, samplesCsv, linesCsv, shapiroCsv, histCsv);

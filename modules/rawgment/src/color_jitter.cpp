@@ -1,8 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Colour jitter: noise-accounted exposure, gain, contrast, brightness and hue (paper Eq. 11 and 13).
-#include "augment_steps.hpp"
-#include "cpu_dispatch.hpp"
-#include "noise_terms.hpp"
+#include "color_jitter_rows.hpp"
 
 #include <opencv2/imgproc.hpp>
 
@@ -15,28 +13,13 @@ namespace rawgment {
 namespace {
 
 using detail::AddedVariance;
+using detail::JitterColumns;
+using detail::JitterConstants;
+using detail::jitterRowPoisson;
+using detail::jitterVariance;
+using detail::PixelLanes;
+using detail::PoissonRowBuffers;
 using detail::storeValue;
-
-struct JitterConstants
-{
-    float pc[4], black[4];
-    float slope[4], offset[4]; // lineBySite: the added variance per site (perSiteLine())
-    float pb, pg, white;
-    detail::NoiseTerms<float> in; // the model's terms at the input gain
-    NoiseAlignment alignment;
-    ShotNoiseSampling sampling;
-    // ACCOUNT_PRIOR without brightness: the prior's share p_u = p_c / p_g is one number per CFA site, so
-    // Eq. 13 is a line in the mean per site, its slope and offset computed once (perSiteLine()).
-    bool lineBySite;
-    detail::DarkTerms dark; // the model's dark-frame components this jitter adds
-};
-
-// The column arrays of one row (the CFA site alternates along it): contrast, black level and, for
-// lineBySite, the slope and offset of the added variance.
-struct JitterColumns
-{
-    const float *pc, *black, *slope, *offset;
-};
 
 /* Eq. 13 with p_u = p_c / p_g (no brightness) as a line in the black-subtracted mean:
  * slope p_u (1 - p_u) p_g^2 g alpha, offset (1 - p_u^2) p_g^2 g^2 sigma_d^2 + (1 - p_c^2) sigma_r^2,
@@ -50,69 +33,12 @@ void perSiteLine(double pc, double pg, const detail::NoiseTerms<double>& in, flo
         static_cast<float>((1 - pu * pu) * pg * pg * in.readBeforeGain + (1 - pc * pc) * in.readAfterGain);
 }
 
-// The variance to add to a pixel, split into its shot part and the rest (read noise, and for
-// ACCOUNT_PRIOR the correction of the scaled prior), before any clipping. xm is the prior-mean estimate
-// (black-subtracted), pc the pixel's contrast. Eq. 13 for ACCOUNT_PRIOR; the model at the new mean and
-// gain for IGNORE_PRIOR.
-// V is float (one pixel) or a vector of lanes (cpu_dispatch.hpp): the same operations in the same order.
-template <NoiseAlignment A, typename V>
-RAWGMENT_KERNEL detail::AddedVarianceOf<V> jitterVariance(V xm, V pc, const JitterConstants& k)
-{
-    const V zero = V{} + 0.0f, one = zero + 1.0f;
-    const float pg = k.pg, pg2 = k.pg * k.pg;
-    if (A == NoiseAlignment::ACCOUNT_PRIOR) {
-        const V xf = detail::maxLanes(xm, one);
-        const V pu = detail::maxLanes((pc * xf + k.pb) / (xf * pg), zero);
-        const V mu = detail::maxLanes(xm, zero);
-        return {pu * (1 - pu) * (pg2 * k.in.shot) * mu,
-                (1 - pu * pu) * (pg2 * k.in.readBeforeGain) + (1 - pu * pu * pg2) * k.in.readAfterGain};
-    }
-    if (A == NoiseAlignment::IGNORE_PRIOR)
-        return {pg * k.in.shot * detail::maxLanes(pc * xm + k.pb, zero),
-                zero + (pg2 * k.in.readBeforeGain + k.in.readAfterGain)};
-    return {zero, zero};
-}
-
 // One row of Eq. 11/13 on explicit vectors of W lanes (cpu_dispatch.hpp). `prior` is the local-mean
 // row, or null to use the pixel's own value; per-column constants come in arrays (the CFA site
 // alternates along the row). The last partial block runs through the same vector code on padded
 // copies, so every pixel goes through the same operations on every path. 16-bit output is clipped to
 // [0, white] and rounded half to even (detail::roundHalfToEven). Returns the number of brightening pixels (a
 // negative added variance, which adds no noise).
-template <int W, typename T> struct PixelLanes;
-template <int W> struct PixelLanes<W, ushort>
-{
-    typedef typename detail::Lanes<W>::F F;
-    RAWGMENT_KERNEL F load(const ushort* p)
-    {
-        typename detail::Lanes<W>::U16 v;
-        std::memcpy(&v, p, sizeof(v));
-        return __builtin_convertvector(v, F);
-    }
-    RAWGMENT_KERNEL void store(ushort* p, F out, F white)
-    {
-        out = detail::roundHalfToEven(detail::minLanes(detail::maxLanes(out, F{}), white));
-        const typename detail::Lanes<W>::U16 v = __builtin_convertvector(
-            __builtin_convertvector(out, typename detail::Lanes<W>::I), typename detail::Lanes<W>::U16);
-        std::memcpy(p, &v, sizeof(v));
-    }
-};
-template <int W> struct PixelLanes<W, float>
-{
-    typedef typename detail::Lanes<W>::F F;
-    RAWGMENT_KERNEL F load(const float* p)
-    {
-        F v;
-        std::memcpy(&v, p, sizeof(v));
-        return v;
-    }
-    RAWGMENT_KERNEL void store(float* p, F out, F white)
-    {
-        out = detail::minLanes(detail::maxLanes(out, F{}), white);
-        std::memcpy(p, &out, sizeof(out));
-    }
-};
-
 // t: the row's unit-variance heavy-tailed draws (NoiseModel::tukeyRead), or null. With them the read
 // part of the variance (the rest, never more than the total) takes t and the shot part z, as
 // detail::splitNoise() does; with kLineBySite the read part is the line's offset.
@@ -263,208 +189,6 @@ RAWGMENT_DISPATCHED_BY_WIDTH(int, jitterRow,
                               const float* extra, const JitterColumns& col, const JitterConstants& k,
                               int cols),
                              (s, d, z, t, prior, extra, col, k, cols))
-
-/* The rows of ShotNoiseSampling::POISSON, with Tukey-lambda read noise (NoiseModel::tukeyRead: t holds
- * the row's unit-variance heavy-tailed draws) or without, and the dark terms' `extra` when present, in
- * three passes: every pixel's split (detail::splitNoise(), here in vector lanes: the same operations),
- * the row's counts (detail::fillPoisson()), every pixel's noise and output. Like jitterRowBody(), the
- * last partial block runs through the vector code on padded copies. */
-template <int W, typename T, NoiseAlignment A, bool kLocalMean>
-RAWGMENT_KERNEL void poissonSplitBlock(const T* s, const float* prior, const JitterColumns& col, int c,
-                                       const JitterConstants& k, const detail::PoissonScale& scale,
-                                       bool tails, double* means, float* zVar, float* tVar,
-                                       typename detail::Lanes<W>::I& bright)
-{
-    typedef typename detail::Lanes<W>::F F;
-    typedef typename detail::Lanes<W>::I I;
-    typedef PixelLanes<W, T> P;
-    F pcv, blackv;
-    std::memcpy(&pcv, col.pc + c, sizeof(pcv));
-    std::memcpy(&blackv, col.black + c, sizeof(blackv));
-    const F x = P::load(s + c) - blackv;
-    F xm = x;
-    if (kLocalMean)
-        std::memcpy(&xm, prior + c, sizeof(xm));
-    const detail::AddedVarianceOf<F> v = jitterVariance<A>(xm, pcv, k);
-    const F sum = v.shot + v.rest;
-    bright -= sum < 0;
-    const F zero = F{}, total = detail::maxLanes(sum, zero);
-    const F read = tails ? detail::minLanes(detail::maxLanes(v.rest, zero), total) : zero;
-    const F shot =
-        tails ? total - read : (scale.q > 0 ? detail::minLanes(detail::maxLanes(v.shot, zero), total) : zero);
-    const I drawn = (shot > 0.0f) & (shot <= scale.maxShot);
-    const F shotDrawn = drawn ? shot : zero;
-    const F z = (total - read) - shotDrawn;
-    detail::storeScaledAsDoubles(shotDrawn, scale.invQ2, means + c);
-    std::memcpy(zVar + c, &z, sizeof(z));
-    std::memcpy(tVar + c, &read, sizeof(read));
-}
-
-template <int W, typename T>
-RAWGMENT_KERNEL void poissonNoiseBlock(const T* s, T* d, const float* z, const float* t, const float* extra,
-                                       const JitterColumns& col, int c, const JitterConstants& k, float q,
-                                       const double* means, const double* counts, const float* zVar,
-                                       const float* tVar)
-{
-    typedef typename detail::Lanes<W>::F F;
-    typedef PixelLanes<W, T> P;
-    F pcv, blackv, zv, tv = {}, zVarv, tVarv;
-    std::memcpy(&pcv, col.pc + c, sizeof(pcv));
-    std::memcpy(&blackv, col.black + c, sizeof(blackv));
-    std::memcpy(&zv, z + c, sizeof(zv));
-    if (t)
-        std::memcpy(&tv, t + c, sizeof(tv));
-    std::memcpy(&zVarv, zVar + c, sizeof(zVarv));
-    std::memcpy(&tVarv, tVar + c, sizeof(tVarv));
-    const F noise = q * detail::differenceAsFloats<F>(counts + c, means + c) + detail::sqrtLanes(zVarv) * zv +
-                    detail::sqrtLanes(tVarv) * tv;
-    const F x = P::load(s + c) - blackv;
-    F out = pcv * x + k.pb + noise;
-    if (extra) {
-        F e;
-        std::memcpy(&e, extra + c, sizeof(e));
-        out += e;
-    }
-    P::store(d + c, out + blackv, F{} + k.white);
-}
-
-template <int W, typename T, NoiseAlignment A, bool kLocalMean>
-RAWGMENT_KERNEL int poissonSplitRowBody(const T* s, const float* prior, const JitterColumns& col,
-                                        const JitterConstants& k, const detail::PoissonScale& scale,
-                                        bool tails, double* means, float* zVar, float* tVar, int cols)
-{
-    typename detail::Lanes<W>::I bright = {};
-    int c = 0;
-    for (; c + W <= cols; c += W)
-        poissonSplitBlock<W, T, A, kLocalMean>(s, prior, col, c, k, scale, tails, means, zVar, tVar, bright);
-    int total = 0;
-    for (int i = 0; i < W; ++i)
-        total += bright[i];
-    const int rest = cols - c;
-    if (rest > 0) {
-        // Padded copies: the extra lanes compute on zeros and are neither kept nor counted.
-        T sPad[W] = {};
-        float priorPad[W] = {}, pcPad[W] = {}, blackPad[W] = {}, zPad[W], tPad[W];
-        double meanPad[W];
-        for (int i = 0; i < rest; ++i) {
-            sPad[i] = s[c + i];
-            priorPad[i] = kLocalMean ? prior[c + i] : 0.0f;
-            pcPad[i] = col.pc[c + i];
-            blackPad[i] = col.black[c + i];
-        }
-        const JitterColumns padded = {pcPad, blackPad, nullptr, nullptr};
-        typename detail::Lanes<W>::I tail = {};
-        poissonSplitBlock<W, T, A, kLocalMean>(sPad, priorPad, padded, 0, k, scale, tails, meanPad, zPad,
-                                               tPad, tail);
-        for (int i = 0; i < rest; ++i) {
-            means[c + i] = meanPad[i];
-            zVar[c + i] = zPad[i];
-            tVar[c + i] = tPad[i];
-            total += tail[i];
-        }
-    }
-    return total;
-}
-
-template <int W, typename T>
-RAWGMENT_KERNEL int poissonSplitRowKernel(const T* s, const float* prior, const JitterColumns& col,
-                                          const JitterConstants& k, const detail::PoissonScale& scale,
-                                          bool tails, double* means, float* zVar, float* tVar, int cols)
-{
-    if (k.alignment == NoiseAlignment::ACCOUNT_PRIOR)
-        return prior ? poissonSplitRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, true>(
-                           s, prior, col, k, scale, tails, means, zVar, tVar, cols)
-                     : poissonSplitRowBody<W, T, NoiseAlignment::ACCOUNT_PRIOR, false>(
-                           s, prior, col, k, scale, tails, means, zVar, tVar, cols);
-    return prior ? poissonSplitRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, true>(
-                       s, prior, col, k, scale, tails, means, zVar, tVar, cols)
-                 : poissonSplitRowBody<W, T, NoiseAlignment::IGNORE_PRIOR, false>(
-                       s, prior, col, k, scale, tails, means, zVar, tVar, cols);
-}
-
-template <int W, typename T>
-RAWGMENT_KERNEL void
-poissonNoiseRowKernel(const T* s, T* d, const float* z, const float* t, const float* extra,
-                      const JitterColumns& col, const JitterConstants& k, float q, const double* means,
-                      const double* counts, const float* zVar, const float* tVar, int cols)
-{
-    int c = 0;
-    for (; c + W <= cols; c += W)
-        poissonNoiseBlock<W, T>(s, d, z, t, extra, col, c, k, q, means, counts, zVar, tVar);
-    const int rest = cols - c;
-    if (rest <= 0)
-        return;
-    T sPad[W] = {}, dPad[W];
-    float zPad[W] = {}, tPad[W] = {}, extraPad[W] = {}, pcPad[W] = {}, blackPad[W] = {}, zVarPad[W] = {},
-          tVarPad[W] = {};
-    double meanPad[W] = {}, countPad[W] = {};
-    for (int i = 0; i < rest; ++i) {
-        sPad[i] = s[c + i];
-        zPad[i] = z[c + i];
-        tPad[i] = t ? t[c + i] : 0.0f;
-        extraPad[i] = extra ? extra[c + i] : 0.0f;
-        pcPad[i] = col.pc[c + i];
-        blackPad[i] = col.black[c + i];
-        zVarPad[i] = zVar[c + i];
-        tVarPad[i] = tVar[c + i];
-        meanPad[i] = means[c + i];
-        countPad[i] = counts[c + i];
-    }
-    const JitterColumns padded = {pcPad, blackPad, nullptr, nullptr};
-    poissonNoiseBlock<W, T>(sPad, dPad, zPad, t ? tPad : nullptr, extra ? extraPad : nullptr, padded, 0, k, q,
-                            meanPad, countPad, zVarPad, tVarPad);
-    for (int i = 0; i < rest; ++i)
-        d[c + i] = dPad[i];
-}
-
-RAWGMENT_DISPATCHED_BY_WIDTH(int, poissonSplitRow,
-                             (const ushort* s, const float* prior, const JitterColumns& col,
-                              const JitterConstants& k, const detail::PoissonScale& scale, bool tails,
-                              double* means, float* zVar, float* tVar, int cols),
-                             (s, prior, col, k, scale, tails, means, zVar, tVar, cols))
-RAWGMENT_DISPATCHED_BY_WIDTH(int, poissonSplitRow,
-                             (const float* s, const float* prior, const JitterColumns& col,
-                              const JitterConstants& k, const detail::PoissonScale& scale, bool tails,
-                              double* means, float* zVar, float* tVar, int cols),
-                             (s, prior, col, k, scale, tails, means, zVar, tVar, cols))
-RAWGMENT_DISPATCHED_BY_WIDTH(void, poissonNoiseRow,
-                             (const ushort* s, ushort* d, const float* z, const float* t, const float* extra,
-                              const JitterColumns& col, const JitterConstants& k, float q,
-                              const double* means, const double* counts, const float* zVar, const float* tVar,
-                              int cols),
-                             (s, d, z, t, extra, col, k, q, means, counts, zVar, tVar, cols))
-RAWGMENT_DISPATCHED_BY_WIDTH(void, poissonNoiseRow,
-                             (const float* s, float* d, const float* z, const float* t, const float* extra,
-                              const JitterColumns& col, const JitterConstants& k, float q,
-                              const double* means, const double* counts, const float* zVar, const float* tVar,
-                              int cols),
-                             (s, d, z, t, extra, col, k, q, means, counts, zVar, tVar, cols))
-
-// The passes' arrays of one thread, reused row after row.
-struct PoissonRowBuffers
-{
-    std::vector<double> means, counts;
-    std::vector<float> zVar, tVar;
-};
-
-template <typename T>
-int jitterRowPoisson(const T* s, T* d, const float* z, const float* t, const float* prior, const float* extra,
-                     const JitterColumns& col, const JitterConstants& k, uint64_t key, uint64_t stream,
-                     PoissonRowBuffers& rows, int cols)
-{
-    const detail::PoissonScale scale(k.pg * k.in.shot); // DN per electron at the output gain: g alpha p_g
-    const size_t n = static_cast<size_t>(cols);
-    rows.means.resize(n);
-    rows.counts.resize(n);
-    rows.zVar.resize(n);
-    rows.tVar.resize(n);
-    const int bright = poissonSplitRow(s, prior, col, k, scale, t != nullptr, rows.means.data(),
-                                       rows.zVar.data(), rows.tVar.data(), cols);
-    detail::fillPoisson(key, stream, rows.means.data(), rows.counts.data(), cols);
-    poissonNoiseRow(s, d, z, t, extra, col, k, scale.q, rows.means.data(), rows.counts.data(),
-                    rows.zVar.data(), rows.tVar.data(), cols);
-    return bright;
-}
 
 // The column arrays of even rows (sites 0, 1) and odd rows (sites 2, 3), made once per call: a
 // parallel_for_ stripe can be a single row, which would otherwise rebuild them for four times its work.

@@ -450,22 +450,21 @@ String darktableNoiseProfiles(const NoiseModel& model, const RawFormat& format, 
     return out.str();
 }
 
-NoiseModel noiseModelFromDarktableExport(const String& path, const RawFormat& format, double baseIso,
-                                         const String& maker, const String& cameraModel,
-                                         double haarVarianceRatio)
+namespace {
+
+//! One ISO's profile as darktable states it: a and b per colour plane.
+struct ExportedProfile
 {
-    checkBaseIso(baseIso, "noiseModelFromDarktableExport");
-    checkHaarVarianceRatio(haarVarianceRatio, "noiseModelFromDarktableExport");
-    const double c = haarVarianceRatio;
-    format.validate();
-    const String where = "noiseModelFromDarktableExport: '" + path + "'";
+    double iso;
+    std::vector<double> a, b;
+};
+
+//! Every profile of one camera in a darktable noise-profile file, read strictly (unknown keys refused).
+std::vector<ExportedProfile> readExportedProfiles(const String& path, const String& where,
+                                                  const String& maker, const String& cameraModel)
+{
     FileStorage fs = openFileStorageForReading(path, "darktable noise profiles");
-    struct Profile
-    {
-        double iso;
-        std::vector<double> a, b;
-    };
-    std::vector<Profile> profiles;
+    std::vector<ExportedProfile> profiles;
     std::vector<String> entries;
     try {
         const FileNode root = fs.root();
@@ -488,8 +487,8 @@ NoiseModel noiseModelFromDarktableExport(const String& path, const RawFormat& fo
                     rejectUnknownKeys(p, {"name", "iso", "a", "b", "skip", "comment"});
                     if (!p["skip"].empty() && p["skip"].isInt() && int(p["skip"]) != 0)
                         continue;
-                    Profile profile{detail::readRealField(p, "iso"), detail::readRealList(p, "a", 3),
-                                    detail::readRealList(p, "b", 3)};
+                    ExportedProfile profile{detail::readRealField(p, "iso"), detail::readRealList(p, "a", 3),
+                                            detail::readRealList(p, "b", 3)};
                     if (!(std::isfinite(profile.iso) && profile.iso > 0))
                         CV_Error(Error::StsParseError,
                                  cv::format("ISO %g must be finite and > 0", profile.iso));
@@ -508,12 +507,28 @@ NoiseModel noiseModelFromDarktableExport(const String& path, const RawFormat& fo
                                            "' (it has: " + (known.empty() ? String("none") : known) + ")");
     }
 
+    return profiles;
+}
+
+} // namespace
+
+NoiseModel noiseModelFromDarktableExport(const String& path, const RawFormat& format, double baseIso,
+                                         const String& maker, const String& cameraModel,
+                                         double haarVarianceRatio)
+{
+    checkBaseIso(baseIso, "noiseModelFromDarktableExport");
+    checkHaarVarianceRatio(haarVarianceRatio, "noiseModelFromDarktableExport");
+    const double c = haarVarianceRatio;
+    format.validate();
+    const String where = "noiseModelFromDarktableExport: '" + path + "'";
+    const std::vector<ExportedProfile> profiles = readExportedProfiles(path, where, maker, cameraModel);
+
     // alpha from every colour and ISO; sigma_d^2 and sigma_r^2 from b r^2 = g^2 sigma_d^2 + sigma_r^2.
     double alpha = 0;
     bool haveAlpha = false;
     std::vector<double> x, y;
     std::set<double> distinct;
-    for (const Profile& p : profiles) {
+    for (const ExportedProfile& p : profiles) {
         const double g = p.iso / baseIso;
         distinct.insert(g);
         for (int plane = 0; plane < 3; ++plane) {

@@ -1,0 +1,116 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// What the colour jitter's rows share (color_jitter.cpp, and the ShotNoiseSampling::POISSON rows in
+// color_jitter_poisson.cpp): the jitter's constants, the variance Eq. 13 adds, and pixels in lanes.
+#ifndef OPENCV_RAWGMENT_SRC_COLOR_JITTER_ROWS_HPP
+#define OPENCV_RAWGMENT_SRC_COLOR_JITTER_ROWS_HPP
+
+#include "augment_steps.hpp"
+#include "cpu_dispatch.hpp"
+#include "noise_terms.hpp"
+
+#include <cstring>
+
+namespace cv {
+namespace rawgment {
+namespace detail {
+
+struct JitterConstants
+{
+    float pc[4], black[4];
+    float slope[4], offset[4]; // lineBySite: the added variance per site (perSiteLine())
+    float pb, pg, white;
+    NoiseTerms<float> in; // the model's terms at the input gain
+    NoiseAlignment alignment;
+    ShotNoiseSampling sampling;
+    // ACCOUNT_PRIOR without brightness: the prior's share p_u = p_c / p_g is one number per CFA site, so
+    // Eq. 13 is a line in the mean per site, its slope and offset computed once (perSiteLine()).
+    bool lineBySite;
+    DarkTerms dark; // the model's dark-frame components this jitter adds
+};
+
+// The column arrays of one row (the CFA site alternates along it): contrast, black level and, for
+// lineBySite, the slope and offset of the added variance.
+struct JitterColumns
+{
+    const float *pc, *black, *slope, *offset;
+};
+
+// The variance to add to a pixel, split into its shot part and the rest (read noise, and for
+// ACCOUNT_PRIOR the correction of the scaled prior), before any clipping. xm is the prior-mean estimate
+// (black-subtracted), pc the pixel's contrast. Eq. 13 for ACCOUNT_PRIOR; the model at the new mean and
+// gain for IGNORE_PRIOR.
+// V is float (one pixel) or a vector of lanes (cpu_dispatch.hpp): the same operations in the same order.
+template <NoiseAlignment A, typename V>
+RAWGMENT_KERNEL AddedVarianceOf<V> jitterVariance(V xm, V pc, const JitterConstants& k)
+{
+    const V zero = V{} + 0.0f, one = zero + 1.0f;
+    const float pg = k.pg, pg2 = k.pg * k.pg;
+    if (A == NoiseAlignment::ACCOUNT_PRIOR) {
+        const V xf = maxLanes(xm, one);
+        const V pu = maxLanes((pc * xf + k.pb) / (xf * pg), zero);
+        const V mu = maxLanes(xm, zero);
+        return {pu * (1 - pu) * (pg2 * k.in.shot) * mu,
+                (1 - pu * pu) * (pg2 * k.in.readBeforeGain) + (1 - pu * pu * pg2) * k.in.readAfterGain};
+    }
+    if (A == NoiseAlignment::IGNORE_PRIOR)
+        return {pg * k.in.shot * maxLanes(pc * xm + k.pb, zero),
+                zero + (pg2 * k.in.readBeforeGain + k.in.readAfterGain)};
+    return {zero, zero};
+}
+
+// W pixels of type T as float lanes: loaded, and stored clipped to [0, white] (16-bit: rounded half to
+// even, roundHalfToEven).
+template <int W, typename T> struct PixelLanes;
+template <int W> struct PixelLanes<W, ushort>
+{
+    typedef typename Lanes<W>::F F;
+    RAWGMENT_KERNEL F load(const ushort* p)
+    {
+        typename Lanes<W>::U16 v;
+        std::memcpy(&v, p, sizeof(v));
+        return __builtin_convertvector(v, F);
+    }
+    RAWGMENT_KERNEL void store(ushort* p, F out, F white)
+    {
+        out = roundHalfToEven(minLanes(maxLanes(out, F{}), white));
+        const typename Lanes<W>::U16 v = __builtin_convertvector(
+            __builtin_convertvector(out, typename Lanes<W>::I), typename Lanes<W>::U16);
+        std::memcpy(p, &v, sizeof(v));
+    }
+};
+template <int W> struct PixelLanes<W, float>
+{
+    typedef typename Lanes<W>::F F;
+    RAWGMENT_KERNEL F load(const float* p)
+    {
+        F v;
+        std::memcpy(&v, p, sizeof(v));
+        return v;
+    }
+    RAWGMENT_KERNEL void store(float* p, F out, F white)
+    {
+        out = minLanes(maxLanes(out, F{}), white);
+        std::memcpy(p, &out, sizeof(out));
+    }
+};
+
+// The passes' arrays of one thread, reused row after row.
+struct PoissonRowBuffers
+{
+    std::vector<double> means, counts;
+    std::vector<float> zVar, tVar;
+};
+
+/* One row of ShotNoiseSampling::POISSON (color_jitter_poisson.cpp): z and t the row's Gaussian and
+ * Tukey-lambda draws (t null without tails), prior the local-mean row or null, extra the dark terms or
+ * null; key and stream name the row's Poisson counts. Returns the number of brightening pixels. */
+template <typename T>
+int jitterRowPoisson(const T* s, T* d, const float* z, const float* t, const float* prior, const float* extra,
+                     const JitterColumns& col, const JitterConstants& k, uint64_t key, uint64_t stream,
+                     PoissonRowBuffers& rows, int cols);
+
+} // namespace detail
+} // namespace rawgment
+} // namespace cv
+
+#endif

@@ -1,0 +1,107 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The rows both resampling steps share (motionBlur() in motion_blur.cpp, scaleMosaic() in resample.cpp):
+// the step's constants (paper Eq. 15 with the step's weights), plane rows in and out of the mosaic, and
+// the end of every resampled row (its noise, dark terms and black level).
+#ifndef OPENCV_RAWGMENT_SRC_RESAMPLE_ROWS_HPP
+#define OPENCV_RAWGMENT_SRC_RESAMPLE_ROWS_HPP
+
+#include "augment_steps.hpp"
+#include "noise_terms.hpp"
+
+#include <atomic>
+
+namespace cv {
+namespace rawgment {
+namespace detail {
+
+// Constants of a resampling step (blur or scale) on one mosaic: Eq. 15 with the step's weights.
+struct ResampleConstants
+{
+    float black[4];
+    float white;
+    float shot;     // g alpha
+    float floorVar; // g^2 sigma_d^2 + sigma_r^2: the read noise a weighted sum removes, (1 - sum w^2) of it
+    NoiseAlignment alignment;
+    ShotNoiseSampling sampling;
+    uint64_t key, poissonKey; // the step's Gaussian and Poisson streams
+    // The dark-frame components (resampleDarkTerms()): the rows' variance to restore, the shading to
+    // restore, the tails; their streams; the model that holds the maps.
+    DarkTerms dark;
+    double rowVariance = 0;   // the input's row variance at its gain
+    ShadingRows inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out before the step
+    ShadingRows shading;      // the target's dark shading, added after it
+    uint64_t rowKey = 0, tukeyKey = 0;
+    std::atomic<bool>* nonFiniteShading = nullptr; // set when a shading row held NaN or Inf
+};
+
+// The buffers of a task's rows, sized once per task for plane rows of n pixels (whole blocks where a
+// vector kernel reads them): a row allocates nothing.
+struct RowScratch
+{
+    std::vector<float> z, extra, t;
+    std::vector<NoiseSplit> splits;
+    std::vector<double> means, counts;
+    explicit RowScratch(int n)
+        : z(wholeBlocks(n)), extra(wholeBlocks(n)), t(static_cast<size_t>(n)), splits(static_cast<size_t>(n)),
+          means(static_cast<size_t>(n)), counts(static_cast<size_t>(n))
+    {
+    }
+};
+
+void siteColumns(const ushort* row, int column, int width, float black, float* out);
+void siteColumns(const float* row, int column, int width, float black, float* out);
+
+/* Both sites of a mosaic row (plane rows `even` and `odd`, CFA columns 0 and 1) interleaved into it;
+ * 16-bit values rounded half to even, in [0, white]. */
+void storeMosaicRow(const float* even, const float* odd, ushort* d, int width);
+void storeMosaicRow(const float* even, const float* odd, float* d, int width);
+
+// Plane row `planeRow` of site `site`, black-subtracted (and without the input's dark shading when
+// `shading` is not empty), into out[0..pad + width + pad) with the plane's edge replicated `pad` columns
+// on each side.
+template <typename T>
+void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, float* out,
+                  const ShadingRows& shading = ShadingRows())
+{
+    const int width = src.cols / 2;
+    siteColumns(src.ptr<T>(2 * planeRow + site / 2), site % 2, width, black, out + pad);
+    if (!shading.empty()) {
+        const int r = 2 * planeRow + site / 2;
+        const float *bd = shading.perGainRow(r) + site % 2, *br = shading.offsetRow(r) + site % 2;
+        for (int j = 0; j < width; ++j)
+            out[pad + j] -= shading.at(bd, br, 2 * j);
+    }
+    for (int j = 0; j < pad; ++j) {
+        out[j] = out[pad];
+        out[pad + width + j] = out[pad + width - 1];
+    }
+}
+
+// The end of every resampled row: its noise streams (site, row), the noise, the dark terms, the black
+// level, in `mean`; storeMosaicRow() stores it with the row's other site.
+void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float* readFactor,
+                    RowScratch& scratch, const ResampleConstants& k, int n, int site, int planeRow,
+                    float rowKeep = 1);
+
+ResampleConstants resampleConstants(int depth, const RawFormat& format, const NoiseModel& model,
+                                    const NoiseOptions& noise, uint64 seed, RandomStream gaussian,
+                                    RandomStream poisson);
+
+/* The dark-frame components a resampling step adds (docs/mathematics.md, "Dark-frame noise"). The step
+ * keeps the gain, so the target has the input's components in full. A weighted sum keeps sum W^2 of the
+ * input's row variance (W the weights per source row: resampledDarkRow()). ACCOUNT_PRIOR takes the
+ * input's dark shading S out of the values before the step (so that it is neither resampled nor taken
+ * for signal by the shot-noise estimate of Eq. 15) and adds S after it; IGNORE_PRIOR adds S on top.
+ * The read part keeps sum w^2 of its variance and sum w^4 of its fourth cumulant: the added part's
+ * lambda is addedReadLambda() with the step's typical weights (sumW2, sumW4; per pixel they vary near
+ * edges and, for scaling, along the row: the variance stays exact per pixel, the kurtosis is matched
+ * on average). */
+void resampleDarkTerms(ResampleConstants& k, const NoiseModel& model, const RawFormat& format, Size size,
+                       double sumW2, double sumW4, uint64 seed, RandomStream rowStream,
+                       RandomStream tukeyStream);
+
+} // namespace detail
+} // namespace rawgment
+} // namespace cv
+
+#endif
