@@ -59,7 +59,37 @@ for f in "${files[@]}"; do
   fi
 done
 [ "$copies" -eq 0 ] || status=1
+
+# The layers (docs/architecture.md): Python is built on the module and the pipeline library, never on the
+# apps; the RAW reader sits below the augmentation. And each file one idea: no source over 750 lines
+# outside the tests (opencv_contrib's xphoto tops out at 826).
+if [ "${#explicit[@]}" -eq 0 ]; then
+  for f in "${files[@]}"; do
+    [ -f "$f" ] || continue
+    case "$f" in
+      python/*.cpp|python/*.hpp|python/CMakeLists.txt)
+        if grep -nE '#include "[./]*apps/|rawgment_apptools|apps/common' "$f" >/dev/null; then
+          grep -nE '#include "[./]*apps/|rawgment_apptools|apps/common' "$f" | sed "s|^|$f: Python leans on the apps: |"
+          status=1
+        fi ;;
+      modules/rawgment/src/raw_io*|modules/rawgment/include/opencv2/rawgment/raw_io.hpp)
+        if grep -nE '#include .*augment' "$f" >/dev/null; then
+          grep -nE '#include .*augment' "$f" | sed "s|^|$f: the RAW reader includes the augmentation: |"
+          status=1
+        fi ;;
+    esac
+    case "$f" in
+      modules/rawgment/test/*|test/*|python/tests/*) ;;
+      *.cpp|*.hpp|*.h|*.py)
+        lines=$(wc -l < "$f")
+        if [ "$lines" -gt 750 ]; then
+          echo "$f: $lines lines; split it along its seams (at most 750 outside the tests)"
+          status=1
+        fi ;;
+    esac
+  done
+fi
 if [ "$status" -eq 0 ]; then
-  echo "check-sources: ${#files[@]} files, no control characters, no copy of Eq. 5"
+  echo "check-sources: ${#files[@]} files, no control characters, no copy of Eq. 5, layers kept, no file over 750 lines"
 fi
 exit "$status"

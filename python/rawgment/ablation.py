@@ -27,7 +27,6 @@ import time
 
 import numpy as np
 import torch
-import torch.nn.functional as F
 
 import rawgment as _rg
 from rawgment._ablation_common import (ARMS, BLIND_STEP, DEFAULT_ARMS, TRAINED_ARMS, _ROLE_BATCH, _ROLE_NETWORK,
@@ -35,6 +34,8 @@ from rawgment._ablation_common import (ARMS, BLIND_STEP, DEFAULT_ARMS, TRAINED_A
                                        _seed)
 from rawgment.ablation_report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, pairedSignificance,
                                       summarize, writeNetworksOutputs, writeOutputs)
+from rawgment.ablation_network import Denoiser, psnr, ssim
+from rawgment.ablation_scenes import mosaicOfScene, renderScene
 from rawgment.torch import packCfaPlanes
 
 __all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "defaultConditions",
@@ -45,9 +46,6 @@ __all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS"
 ALIGNMENTS = {"NONE": _rg.NoiseAlignment.NONE, "IGNORE_PRIOR": _rg.NoiseAlignment.IGNORE_PRIOR,
               "ACCOUNT_PRIOR": _rg.NoiseAlignment.ACCOUNT_PRIOR}
 
-# Relative illumination of the R, G, B sites: a daylight-like white balance, so the red and blue planes
-# are darker (and noisier) than green, as on real sensors.
-_ILLUMINANT = (0.55, 1.0, 0.75)
 # The brightest expected signal of a bright training capture, as a fraction of white - black: headroom
 # so that the bright captures (and the test's clean references) are not clipped.
 _FILL = 0.8
@@ -167,136 +165,6 @@ class AblationConfig:
                              "got %r and %r" % (self.shotSampling, self.priorMean))
         for size in (16, self.patch, self.trainSceneSize, self.testSceneSize):
             self.sensorParams(int(size)).validate()
-
-
-def _randomColour(rng):
-    """Linear RGB reflectance: a log-uniform lightness from 3% to 90% with a random tint."""
-    lightness = math.exp(rng.uniform(math.log(0.03), math.log(0.9)))
-    return np.clip(lightness * rng.uniform(0.5, 1.5, 3), 0.02, 0.95).astype(np.float32)
-
-
-def renderScene(rng, height, width):
-    """A synthetic scene (H x W x 3 linear reflectance in [0.02, 0.95]): a gradient background with
-    flat rectangles and discs (sharp edges), gratings of random frequency and orientation, and smooth
-    random textures, drawn from the numpy Generator `rng`."""
-    y, x = np.mgrid[0:height, 0:width].astype(np.float32)
-    angle = rng.uniform(0.0, 2.0 * math.pi)
-    t = math.cos(angle) * x + math.sin(angle) * y
-    t = (t - t.min()) / max(float(t.max() - t.min()), 1.0)
-    image = _randomColour(rng) * (1.0 - t)[..., None] + _randomColour(rng) * t[..., None]
-    for _ in range(int(rng.integers(8, 16))):
-        kind = int(rng.integers(0, 4))
-        colour = _randomColour(rng)
-        cx, cy = rng.uniform(0, width), rng.uniform(0, height)
-        size = rng.uniform(0.08, 0.4) * min(width, height)
-        if kind == 0:
-            mask = (np.abs(x - cx) < size / 2) & (np.abs(y - cy) < rng.uniform(0.3, 1.0) * size / 2)
-            image[mask] = colour
-        elif kind == 1:
-            mask = (x - cx) ** 2 + (y - cy) ** 2 < (size / 2) ** 2
-            image[mask] = colour
-        elif kind == 2:
-            period = rng.uniform(3.0, 24.0)  # mosaic pixels: from near the planes' Nyquist to coarse
-            theta = rng.uniform(0.0, math.pi)
-            phase = 2.0 * math.pi * (math.cos(theta) * x + math.sin(theta) * y) / period
-            wave = 0.5 + 0.5 * np.sin(phase)
-            mask = (np.abs(x - cx) < size / 2) & (np.abs(y - cy) < size / 2)
-            other = _randomColour(rng)
-            image[mask] = (colour * wave[..., None] + other * (1.0 - wave[..., None]))[mask]
-        else:
-            cells = int(rng.integers(3, 9))
-            coarse = rng.uniform(0.0, 1.0, (cells + 1, cells + 1)).astype(np.float32)
-            gy = np.clip((y - (cy - size / 2)) / size * cells, 0, cells - 1e-3)
-            gx = np.clip((x - (cx - size / 2)) / size * cells, 0, cells - 1e-3)
-            iy, ix = gy.astype(int), gx.astype(int)
-            fy, fx = gy - iy, gx - ix
-            fy, fx = fy * fy * (3 - 2 * fy), fx * fx * (3 - 2 * fx)  # smoothstep: no creases at cells
-            value = (coarse[iy, ix] * (1 - fx) * (1 - fy) + coarse[iy, ix + 1] * fx * (1 - fy) +
-                     coarse[iy + 1, ix] * (1 - fx) * fy + coarse[iy + 1, ix + 1] * fx * fy)
-            mask = (np.abs(x - cx) < size / 2) & (np.abs(y - cy) < size / 2)
-            other = _randomColour(rng)
-            image[mask] = (colour * value[..., None] + other * (1.0 - value[..., None]))[mask]
-    return np.clip(image, 0.02, 0.95).astype(np.float32)
-
-
-def mosaicOfScene(rgb, pattern, level):
-    """The expected signal at gain 1 (DN above black, float32 H x W) of a reflectance scene under the
-    study's illuminant: each CFA site sees its channel, `level` DN for reflectance 1 at white."""
-    h, w, _ = rgb.shape
-    mosaic = np.empty((h, w), np.float32)
-    for row in (0, 1):
-        for col in (0, 1):
-            channel = _rg.cfaChannelAt(pattern, row, col)
-            rgbIndex = {_rg.CFA_R: 0, _rg.CFA_G1: 1, _rg.CFA_G2: 1, _rg.CFA_B: 2}[channel]
-            mosaic[row::2, col::2] = rgb[row::2, col::2, rgbIndex] * (_ILLUMINANT[rgbIndex] * level)
-    return mosaic
-
-
-class Denoiser(torch.nn.Module):
-    """A compact two-level U-Net on the packed R, G1, G2, B planes. Told the noise (noiseMaps, the
-    default) it also takes each plane's noise-level map and predicts the residual in units of the noise:
-    input 8 x H x W (the planes, then each plane's noise standard deviation; H, W even). Blind
-    (noiseMaps=False) it takes the 4 planes alone and predicts the residual in units of a fixed step
-    `blindScale`, the same for every input (so it carries no noise information): it must infer the noise
-    level from the image. Output: the 4 denoised planes."""
-
-    #: The blind network's default fixed residual unit (BLIND_STEP).
-    blindScale = BLIND_STEP
-
-    def __init__(self, width=16, noiseMaps=True, blindScale=None):
-        super().__init__()
-        self.noiseMaps = bool(noiseMaps)
-        if blindScale is not None:
-            self.blindScale = float(blindScale)
-        conv = torch.nn.Conv2d
-        self.encode = torch.nn.Sequential(conv(8 if self.noiseMaps else 4, width, 3, padding=1), torch.nn.ReLU(),
-                                          conv(width, width, 3, padding=1), torch.nn.ReLU())
-        self.down = torch.nn.Sequential(conv(width, 2 * width, 3, stride=2, padding=1), torch.nn.ReLU(),
-                                        conv(2 * width, 2 * width, 3, padding=1), torch.nn.ReLU(),
-                                        conv(2 * width, 2 * width, 3, padding=1), torch.nn.ReLU())
-        self.up = torch.nn.ConvTranspose2d(2 * width, width, 2, stride=2)
-        self.decode = torch.nn.Sequential(conv(2 * width, width, 3, padding=1), torch.nn.ReLU(),
-                                          conv(width, 4, 3, padding=1))
-        # The residual starts at zero, so an untrained network passes its input through instead of
-        # adding noise of its own; training then departs from the noisy input, the study's floor.
-        torch.nn.init.zeros_(self.decode[-1].weight)
-        torch.nn.init.zeros_(self.decode[-1].bias)
-
-    def forward(self, x):
-        skip = self.encode(x)
-        residual = self.decode(torch.cat([skip, self.up(self.down(skip))], dim=1))
-        if not self.noiseMaps:
-            return x + self.blindScale * residual
-        # The correction is predicted in units of the noise standard deviation: the same network then
-        # serves a 40 dB and an 18 dB input equally well, which a plain residual does not learn in a
-        # short budget (its corrections for the darkest inputs spoil the brightest).
-        return x[:, :4] + x[:, 4:] * residual
-
-
-def psnr(output, clean):
-    """PSNR in dB of images in [0, 1] (peak 1): 10 log10(1 / MSE); inf for identical images."""
-    mse = float(torch.mean((output.double() - clean.double()) ** 2))
-    return math.inf if mse == 0 else 10.0 * math.log10(1.0 / mse)
-
-
-def ssim(output, clean):
-    """Mean SSIM of C x H x W images in [0, 1] (data range 1), per channel with the usual 11-tap
-    Gaussian window of sigma 1.5 and constants (0.01)^2, (0.03)^2, over the valid region."""
-    c = output.shape[0]
-    taps = torch.arange(11, dtype=torch.float64) - 5
-    g = torch.exp(-taps ** 2 / (2 * 1.5 ** 2))
-    g = g / g.sum()
-    window = (g[:, None] * g[None, :]).expand(c, 1, 11, 11).contiguous()
-    x, y = output.double()[None], clean.double()[None]
-
-    def blur(v):
-        return F.conv2d(v, window, groups=c)
-
-    mx, my = blur(x), blur(y)
-    vx, vy, cxy = blur(x * x) - mx * mx, blur(y * y) - my * my, blur(x * y) - mx * my
-    c1, c2 = 0.01 ** 2, 0.03 ** 2
-    value = ((2 * mx * my + c1) * (2 * cxy + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2))
-    return float(value.mean())
 
 
 class _Study:
