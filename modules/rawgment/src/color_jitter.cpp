@@ -33,6 +33,16 @@ void perSiteLine(double pc, double pg, const detail::NoiseTerms<double>& in, flo
         static_cast<float>((1 - pu * pu) * pg * pg * in.readBeforeGain + (1 - pc * pc) * in.readAfterGain);
 }
 
+/* The same line with measured lines, each gain's own: the output gain's line at the output mean p_c mu
+ * less the prior scaled by p_c^2, slope p_c a_out - p_c^2 a_in and offset b_out - p_c^2 b_in (perSiteLine()
+ * when a_out = p_g a_in and b_out = p_g^2 g^2 sigma_d^2 + sigma_r^2). */
+void measuredSiteLine(double pc, const detail::NoiseTerms<double>& in, const detail::NoiseTerms<double>& out,
+                      float& slope, float& offset)
+{
+    slope = static_cast<float>(pc * out.shot - pc * pc * in.shot);
+    offset = static_cast<float>(out.read() - pc * pc * in.read());
+}
+
 // One row of Eq. 11/13 on explicit vectors of W lanes (cpu_dispatch.hpp). `prior` is the local-mean
 // row, or null to use the pixel's own value; per-column constants come in arrays (the CFA site
 // alternates along the row). The last partial block runs through the same vector code on padded
@@ -377,7 +387,10 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
             largestContrast = std::max(largestContrast, jitter.contrast[s]);
         const double g2 = jitter.gainRatio * jitter.gainRatio;
         const double largestValue = largestContrast * format.whiteLevel + std::abs(jitter.brightness);
-        const double largestVariance = g2 * (t.shot * format.whiteLevel + t.readBeforeGain) + t.readAfterGain;
+        const detail::NoiseTerms<double> out = detail::checkedNoiseTerms(model, newGain);
+        const double largestVariance =
+            std::max(g2 * (t.shot * format.whiteLevel + t.readBeforeGain) + t.readAfterGain,
+                     out.shot * largestContrast * format.whiteLevel + out.read());
         if (!(largestValue < 1e30 && largestVariance < 1e30 && largestContrast * jitter.gainRatio < 1e30))
             CV_Error(Error::StsBadArg,
                      cv::format(
@@ -408,9 +421,26 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     k.alignment = noise.alignment;
     k.sampling = noise.shotSampling;
     k.lineBySite = noise.alignment == NoiseAlignment::ACCOUNT_PRIOR && jitter.brightness == 0;
+    // The output gain's line: the model's own there with measured lines, else Eq. 5's scaling of the
+    // input's (in float, as jitterVariance() had it).
+    k.measured = model.hasMeasuredLines();
+    const detail::NoiseTerms<double> outTerms = detail::checkedNoiseTerms(model, newGain);
+    const double pg2 = jitter.gainRatio * jitter.gainRatio;
+    if (k.measured) {
+        k.shotOut = static_cast<float>(outTerms.shot);
+        k.readOut = static_cast<float>(outTerms.read());
+    } else {
+        k.shotOut = k.pg * k.in.shot;
+        k.readOut = k.pg * k.pg * k.in.readBeforeGain + k.in.readAfterGain;
+    }
+    k.pgShotOut = static_cast<float>(jitter.gainRatio * outTerms.shot);
+    k.pg2ShotIn = static_cast<float>(pg2 * terms.shot);
+    k.pg2ReadIn = static_cast<float>(pg2 * terms.read());
     for (int s = 0; s < 4; ++s) {
         k.slope[s] = k.offset[s] = 0;
-        if (k.lineBySite)
+        if (k.lineBySite && k.measured)
+            measuredSiteLine(jitter.contrast[s], terms, outTerms, k.slope[s], k.offset[s]);
+        else if (k.lineBySite)
             perSiteLine(jitter.contrast[s], jitter.gainRatio, terms, k.slope[s], k.offset[s]);
     }
 

@@ -192,7 +192,7 @@ int jitterRowPoisson(const T* s, T* d, const float* z, const float* t, const flo
                      const JitterColumns& col, const JitterConstants& k, uint64_t key, uint64_t stream,
                      PoissonRowBuffers& rows, int cols)
 {
-    const PoissonScale scale(k.pg * k.in.shot); // DN per electron at the output gain: g alpha p_g
+    const PoissonScale scale(k.shotOut); // DN per electron at the output gain
     const size_t n = static_cast<size_t>(cols);
     rows.means.resize(n);
     rows.counts.resize(n);

@@ -20,6 +20,14 @@ struct JitterConstants
     float slope[4], offset[4]; // lineBySite: the added variance per site (perSiteLine())
     float pb, pg, white;
     NoiseTerms<float> in; // the model's terms at the input gain
+    // The output gain's shot slope (DN per electron there) and read variance: with measured lines the
+    // model's own line there, else Eq. 5's scaling of `in` (p_g in.shot, p_g^2 in.readBeforeGain +
+    // in.readAfterGain) in float, as the Eq. 5 formulas below had it, so no bit changes.
+    float shotOut, readOut;
+    // Measured lines: Eq. 13 with each gain's own line (jitterVariance()), from p_g shotOut and p_g^2
+    // times the input's terms.
+    bool measured;
+    float pgShotOut, pg2ShotIn, pg2ReadIn;
     NoiseAlignment alignment;
     ShotNoiseSampling sampling;
     // ACCOUNT_PRIOR without brightness: the prior's share p_u = p_c / p_g is one number per CFA site, so
@@ -44,17 +52,20 @@ template <NoiseAlignment A, typename V>
 RAWGMENT_KERNEL AddedVarianceOf<V> jitterVariance(V xm, V pc, const JitterConstants& k)
 {
     const V zero = V{} + 0.0f, one = zero + 1.0f;
-    const float pg = k.pg, pg2 = k.pg * k.pg;
+    const float pg2 = k.pg * k.pg;
     if (A == NoiseAlignment::ACCOUNT_PRIOR) {
         const V xf = maxLanes(xm, one);
-        const V pu = maxLanes((pc * xf + k.pb) / (xf * pg), zero);
+        const V pu = maxLanes((pc * xf + k.pb) / (xf * k.pg), zero);
         const V mu = maxLanes(xm, zero);
+        // The target's line at the output mean p_u p_g mu less the prior scaled by (p_u p_g)^2; with
+        // Eq. 5 (shotOut = p_g in.shot) the same as the expressions below.
+        if (k.measured)
+            return {pu * (k.pgShotOut - pu * k.pg2ShotIn) * mu, k.readOut - pu * pu * k.pg2ReadIn};
         return {pu * (1 - pu) * (pg2 * k.in.shot) * mu,
                 (1 - pu * pu) * (pg2 * k.in.readBeforeGain) + (1 - pu * pu * pg2) * k.in.readAfterGain};
     }
     if (A == NoiseAlignment::IGNORE_PRIOR)
-        return {pg * k.in.shot * maxLanes(pc * xm + k.pb, zero),
-                zero + (pg2 * k.in.readBeforeGain + k.in.readAfterGain)};
+        return {k.shotOut * maxLanes(pc * xm + k.pb, zero), zero + k.readOut};
     return {zero, zero};
 }
 

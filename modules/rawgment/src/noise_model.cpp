@@ -112,6 +112,7 @@ void NoiseModel::validate() const
         checkShadingMap(darkShadingPerGain, "darkShadingPerGain", darkShadingPerGain.size());
         checkShadingMap(darkShadingOffset, "darkShadingOffset", darkShadingPerGain.size());
     }
+    detail::checkMeasuredLines(measuredLines);
 }
 
 double NoiseModel::rowVariance(double gain) const
@@ -143,7 +144,9 @@ NoiseTerms<double> checkedNoiseTerms(const NoiseModel& model, double gain)
 {
     model.validate();
     checkFinitePositive(gain, "gain");
-    const NoiseTerms<double> t = noiseTermsAt(gain, model.alpha, model.sigmaD2, model.sigmaR2);
+    const NoiseTerms<double> t = model.hasMeasuredLines()
+                                     ? measuredTermsAt(model, gain)
+                                     : noiseTermsAt(gain, model.alpha, model.sigmaD2, model.sigmaR2);
     if (!std::isfinite(t.shot) || !std::isfinite(t.read()))
         CV_Error(Error::StsBadArg,
                  format("noise line at gain %g overflows (a = %g, b = %g)", gain, t.shot, t.read()));
@@ -219,7 +222,11 @@ void NoiseModel::write(FileStorage& fs, const String& name, const std::vector<St
     if (hasDarkShading() && shadingImages.size() != 2)
         CV_Error(Error::StsBadArg, "NoiseModel::write: a model with dark shading needs the names of its two "
                                    "images (save() writes them)");
-    const int version = !failedCalibration.empty() ? 4 : hasDarkComponents() ? 3 : baseIso > 0 ? 2 : 1;
+    const int version = hasMeasuredLines()           ? 5
+                        : !failedCalibration.empty() ? 4
+                        : hasDarkComponents()        ? 3
+                        : baseIso > 0                ? 2
+                                                     : 1;
     fs << name << "{";
     fs << "format_version" << version;
     fs << "alpha" << alpha;
@@ -244,6 +251,8 @@ void NoiseModel::write(FileStorage& fs, const String& name, const std::vector<St
     }
     if (!failedCalibration.empty())
         fs << "failed_calibration" << failedCalibration;
+    if (hasMeasuredLines())
+        detail::writeMeasuredLines(fs, measuredLines);
     fs << "}";
 }
 
@@ -335,6 +344,8 @@ NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
             keys.insert(keys.end(), {"row_sigma_d2", "row_sigma_r2", "tukey_lambda", "dark_shading"});
         if (version >= 4)
             keys.push_back("failed_calibration");
+        if (version >= 5)
+            keys.push_back("measured_lines");
         rejectUnknownKeys(node, keys);
     } catch (const Exception& e) {
         CV_Error(e.code, "noise model: " + e.err);
@@ -381,6 +392,8 @@ NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
                 "noise model: field 'failed_calibration' must be a non-empty string (the failed checks)");
         m.failedCalibration = failed.string();
     }
+    if (!node["measured_lines"].empty())
+        m.measuredLines = detail::readMeasuredLines(node["measured_lines"]);
     const FileNode shading = node["dark_shading"];
     if (!shading.empty()) {
         if (!shading.isMap())

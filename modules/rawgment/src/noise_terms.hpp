@@ -43,8 +43,23 @@ template <typename T> inline NoiseTerms<T> noiseTermsAt(T gain, T alpha, T sigma
 
 /** The terms of a model at linear gain g, after checking both: throws StsBadArg when the model is
  * invalid, the gain is not finite and positive, or a term overflows. NoiseModel::lineAtGain() is
- * built from it. */
-NoiseTerms<double> checkedNoiseTerms(const NoiseModel& model, double gain);
+ * built from it. With measured lines, measuredTermsAt(); else noiseTermsAt() of Eq. 5's parameters. */
+CV_RAWGMENT_EXPORTS NoiseTerms<double> checkedNoiseTerms(const NoiseModel& model, double gain);
+
+/** The terms of a model with measured lines (NoiseModel::measuredLines, which says how they are
+ * interpolated and extrapolated) at linear gain g > 0; the offset split before and after the gain as
+ * Eq. 5's at g. The model is taken as valid (noise_lines.cpp). */
+NoiseTerms<double> measuredTermsAt(const NoiseModel& model, double gain);
+
+//! Throws StsBadArg naming the entry when measured lines are not by increasing gain or hold a value
+//! that is negative or not finite (NoiseModel::validate()).
+void checkMeasuredLines(const std::vector<MeasuredNoiseLine>& lines);
+
+//! The measured lines as the list `measured_lines` of a model file (NoiseModel::write()).
+void writeMeasuredLines(FileStorage& fs, const std::vector<MeasuredNoiseLine>& lines);
+
+//! The list `measured_lines` of a model file, every entry's keys and values checked.
+std::vector<MeasuredNoiseLine> readMeasuredLines(const FileNode& list);
 
 /** @name The Tukey-lambda shape of the read noise (NoiseModel::tukeyRead)
  * X = (U^lambda - (1 - U)^lambda) / lambda for U uniform in (0, 1); lambda = 0 is the logistic

@@ -98,8 +98,11 @@ RawFormat SensorSimulator::rawFormat(double gain) const
 NoiseModel SensorSimulator::effectiveModel() const
 {
     NoiseModel m = params_.noise;
-    if (params_.quantize)
+    if (params_.quantize) {
         m.sigmaR2 += 1.0 / 12.0;
+        for (MeasuredNoiseLine& l : m.measuredLines)
+            l.line.b += 1.0 / 12.0;
+    }
     return m;
 }
 
@@ -126,12 +129,18 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
     double prnuMax = 0, meanMax = 0;
     minMaxLoc(prnu_, nullptr, &prnuMax);
     minMaxLoc(mean, nullptr, &meanMax);
-    if (p.noise.alpha > 0 && !(meanMax * exposure * prnuMax / p.noise.alpha <= detail::kMaxPoissonMean))
+    // With measured lines the terms at this gain are the lines' (NoiseModel::measuredLines): the shot
+    // slope is the DN per electron at the gain, and the signal is counted in those electrons.
+    const bool measured = p.noise.hasMeasuredLines();
+    const detail::NoiseTerms<double> atGain =
+        measured ? detail::checkedNoiseTerms(p.noise, gain) : detail::NoiseTerms<double>{0, 0, 0};
+    const double electronDn = measured ? atGain.shot / gain : p.noise.alpha; // DN at gain 1 per electron
+    if (electronDn > 0 && !(meanMax * exposure * prnuMax / electronDn <= detail::kMaxPoissonMean))
         CV_Error(
             Error::StsBadArg,
             format("SensorSimulator::capture: %g electrons per pixel (signal %g DN x exposure %g / alpha %g) "
                    "exceed the simulator's %g: alpha is too small for this signal",
-                   meanMax * exposure * prnuMax / p.noise.alpha, meanMax, exposure, p.noise.alpha,
+                   meanMax * exposure * prnuMax / electronDn, meanMax, exposure, electronDn,
                    detail::kMaxPoissonMean));
     const double white = std::ldexp(1.0, p.bitDepth) - 1;
     // Each term of the model drawn where it arises: photons (shot), read noise before the gain, noise
@@ -148,6 +157,9 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
     const detail::TukeyUnitSampler tukeyDraw =
         tukey ? detail::TukeyUnitSampler(p.noise.tukeyLambda) : detail::TukeyUnitSampler();
     const double readSigma = std::sqrt(gain * gain * unit.readBeforeGain + unit.readAfterGain);
+    const double measuredReadSigma = std::sqrt(atGain.read()),
+                 measuredSigmaD = std::sqrt(atGain.readBeforeGain),
+                 measuredSigmaR = std::sqrt(atGain.readAfterGain);
     const Mat shading = p.noise.darkShadingAt(gain);
     if (!shading.empty() && shading.size() != size_)
         CV_Error(Error::StsBadArg,
@@ -173,11 +185,22 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
                     x = black;
                 } else {
                     const double signal = m[c] * exposure * prnu[c];
-                    // alpha = 0 is a sensor without shot noise: the signal is then deterministic.
-                    const double photoSignal =
-                        alpha > 0 ? alpha * static_cast<double>(rng.poisson(signal / alpha)) : signal;
-                    x = tukey ? gain * photoSignal + readSigma * tukeyDraw(rng.uniform())
-                              : gain * (photoSignal + sigmaD * rng.gaussian()) + sigmaR * rng.gaussian();
+                    if (measured) {
+                        // The electrons at this gain's own DN per electron, then its read noise.
+                        const double photoSignal =
+                            electronDn > 0
+                                ? electronDn * static_cast<double>(rng.poisson(signal / electronDn))
+                                : signal;
+                        x = tukey ? gain * photoSignal + measuredReadSigma * tukeyDraw(rng.uniform())
+                                  : gain * photoSignal + measuredSigmaD * rng.gaussian() +
+                                        measuredSigmaR * rng.gaussian();
+                    } else {
+                        // alpha = 0 is a sensor without shot noise: the signal is then deterministic.
+                        const double photoSignal =
+                            alpha > 0 ? alpha * static_cast<double>(rng.poisson(signal / alpha)) : signal;
+                        x = tukey ? gain * photoSignal + readSigma * tukeyDraw(rng.uniform())
+                                  : gain * (photoSignal + sigmaD * rng.gaussian()) + sigmaR * rng.gaussian();
+                    }
                     x = x + dsnu[c] + black;
                     if (p.noise.hasRowNoise())
                         x += rowOffset;

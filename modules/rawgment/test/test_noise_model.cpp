@@ -163,8 +163,8 @@ TEST(NoiseModel, readingRejectsBadFilesNamingTheField)
     EXPECT_CV_ERROR_CONTAINS(
         readFromYaml("  format_version: 1\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: abc\n"),
         "'sigma_r2' is not a number");
-    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 5\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
-                             "format_version 5 is not supported");
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 6\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"),
+                             "format_version 6 is not supported");
     // base_iso came with version 2: a version 1 file that has it was not written by this project.
     EXPECT_CV_ERROR_CONTAINS(
         readFromYaml("  format_version: 1\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n  base_iso: 100\n"),
@@ -225,6 +225,126 @@ TEST(NoiseModel, aFailedCalibrationsModelIsMarkedAndRefusedUnlessAccepted)
     EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 4\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"
                                           "  failed_calibration: \"\"\n"),
                              "'failed_calibration' must be a non-empty string");
+}
+
+//! Eq. 5 (0.4, 0.5, 2.0) with lines at gains 1, 2 and 8 that leave it (0.68 is 0.85 of Eq. 5's 0.8).
+NoiseModel modelWithMeasuredLines()
+{
+    NoiseModel m(0.4, 0.5, 2.0);
+    const double lines[3][3] = {{1, 0.4, 2.6}, {2, 0.68, 4.5}, {8, 3.6, 34.0}};
+    for (const auto& l : lines) {
+        MeasuredNoiseLine entry;
+        entry.gain = l[0];
+        entry.line.a = l[1];
+        entry.line.b = l[2];
+        m.measuredLines.push_back(entry);
+    }
+    m.validate();
+    return m;
+}
+
+TEST(NoiseModel, measuredLinesAreFollowedAtBetweenAndBeyondTheirGains)
+{
+    const NoiseModel m = modelWithMeasuredLines();
+    // At a measured gain, the measured line itself (the same bits).
+    for (const MeasuredNoiseLine& l : m.measuredLines) {
+        EXPECT_EQ(l.line.a, m.lineAtGain(l.gain).a);
+        EXPECT_EQ(l.line.b, m.lineAtGain(l.gain).b);
+        EXPECT_EQ(l.line.a * 100 + l.line.b, m.variance(100, l.gain));
+    }
+    // Between: the slope linear in g, the offset linear in g^2 (written out here as the docs state it).
+    const double g = 4, t = (4.0 - 2) / (8 - 2), t2 = (16.0 - 4) / (64 - 4);
+    EXPECT_NEAR(0.68 + t * (3.6 - 0.68), m.lineAtGain(g).a, 1e-12);
+    EXPECT_NEAR(4.5 + t2 * (34.0 - 4.5), m.lineAtGain(g).b, 1e-12);
+    // Exact for neighbours that follow Eq. 5 with parameters of their own.
+    NoiseModel own(0.4, 0.5, 2.0);
+    const NoiseModel other(0.3, 1.7, 0.9);
+    for (double gain : {1.5, 6.0}) {
+        MeasuredNoiseLine l;
+        l.gain = gain;
+        l.line = other.lineAtGain(gain);
+        own.measuredLines.push_back(l);
+    }
+    for (double between : {1.6, 2.5, 4.0, 5.9}) {
+        EXPECT_NEAR(other.lineAtGain(between).a, own.lineAtGain(between).a,
+                    1e-12 * other.lineAtGain(between).a);
+        EXPECT_NEAR(other.lineAtGain(between).b, own.lineAtGain(between).b,
+                    1e-12 * other.lineAtGain(between).b);
+    }
+    // Beyond: the edge line carried on by Eq. 5's trend, with no jump at the edge.
+    const NoiseLine below = m.lineAtGain(0.5), above = m.lineAtGain(16);
+    EXPECT_NEAR(0.4 * 0.5, below.a, 1e-15);
+    EXPECT_NEAR(2.6 * (0.25 * 0.5 + 2.0) / (0.5 + 2.0), below.b, 1e-12);
+    EXPECT_NEAR(3.6 * 2, above.a, 1e-12);
+    EXPECT_NEAR(34.0 * (256 * 0.5 + 2.0) / (64 * 0.5 + 2.0), above.b, 1e-9);
+    EXPECT_NEAR(m.lineAtGain(8 * (1 + 1e-12)).b, 34.0, 1e-9);
+    EXPECT_NEAR(m.lineAtGain(1 * (1 - 1e-12)).b, 2.6, 1e-9);
+    // The offset's split before and after the gain is Eq. 5's at that gain, and adds up to the line.
+    const detail::NoiseTerms<double> terms = detail::checkedNoiseTerms(m, 2);
+    EXPECT_NEAR(4.5 * 2.0 / 4.0, terms.readBeforeGain, 1e-12);
+    EXPECT_EQ(4.5, terms.read());
+}
+
+TEST(NoiseModel, measuredLinesRoundTripAsVersion5AndAreValidated)
+{
+    const std::string dir = test::makeTempDir("noise_model_measured_lines");
+    NoiseModel m = modelWithMeasuredLines();
+    m.baseIso = 100;
+    m.measuredLines[1].slopeStdError = 0.0123456789012345678;
+    m.measuredLines[1].offsetStdError = 0.1;
+    m.measuredLines[2].iso = 800;
+    for (const char* name : {"/lines.yml", "/lines.json"}) {
+        SCOPED_TRACE(name);
+        m.save(dir + name);
+        EXPECT_EQ(5, int(FileStorage(dir + name, FileStorage::READ)["noise_model"]["format_version"]));
+        const NoiseModel r = NoiseModel::load(dir + name);
+        ASSERT_EQ(m.measuredLines.size(), r.measuredLines.size());
+        for (size_t i = 0; i < m.measuredLines.size(); ++i) {
+            const MeasuredNoiseLine &a = m.measuredLines[i], &b = r.measuredLines[i];
+            EXPECT_EQ(a.gain, b.gain);
+            EXPECT_EQ(a.line.a, b.line.a);
+            EXPECT_EQ(a.line.b, b.line.b);
+            EXPECT_EQ(a.slopeStdError, b.slopeStdError);
+            EXPECT_EQ(a.offsetStdError, b.offsetStdError);
+            EXPECT_EQ(a.iso, b.iso);
+        }
+        EXPECT_EQ(m.lineAtGain(3).b, r.lineAtGain(3).b);
+    }
+    // Without lines, the version of the model's other contents, as before.
+    NoiseModel plain = m;
+    plain.measuredLines.clear();
+    plain.save(dir + "/plain.yml");
+    EXPECT_EQ(2, int(FileStorage(dir + "/plain.yml", FileStorage::READ)["noise_model"]["format_version"]));
+
+    NoiseModel bad = modelWithMeasuredLines();
+    bad.measuredLines[2].gain = 2;
+    EXPECT_CV_ERROR_CONTAINS(bad.validate(), "measuredLines[2]: gain 2 does not follow 2");
+    bad = modelWithMeasuredLines();
+    bad.measuredLines[0].line.b = -1;
+    EXPECT_CV_ERROR_CONTAINS(bad.validate(), "measuredLines[0]: offset b must be finite and >= 0");
+    bad = modelWithMeasuredLines();
+    bad.measuredLines[1].line.a = kNaN;
+    EXPECT_CV_ERROR_CONTAINS(bad.lineAtGain(2), "measuredLines[1]: slope a must be finite");
+    bad = modelWithMeasuredLines();
+    bad.measuredLines[1].gain = kInf;
+    EXPECT_CV_ERROR_CONTAINS(bad.save(dir + "/bad.yml"), "measuredLines[1]: gain must be finite and > 0");
+
+    const std::string head = "  format_version: 5\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n";
+    EXPECT_NO_THROW(readFromYaml(head + "  measured_lines:\n    - { gain: 1, a: 1, b: 2 }\n"));
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml(head + "  measured_lines:\n    - { gain: 1, a: 1, b: 2, c: 3 }\n"),
+                             "measured_lines[0]: unknown key 'c'");
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml(head + "  measured_lines:\n    - { gain: 1, a: 1 }\n"),
+                             "measured_lines[0]: field 'b' is missing");
+    EXPECT_CV_ERROR_CONTAINS(
+        readFromYaml(head + "  measured_lines:\n    - { gain: 1, a: 1, b: 1, a_std_error: 0.1 }\n"),
+        "a_std_error and b_std_error come together");
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml(head + "  measured_lines:\n    - { gain: 2, a: 1, b: 1 }\n"
+                                                 "    - { gain: 1, a: 1, b: 1 }\n"),
+                             "gain 1 does not follow 2");
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml(head + "  measured_lines: []\n"), "non-empty list");
+    EXPECT_CV_ERROR_CONTAINS(readFromYaml("  format_version: 4\n  alpha: 1\n  sigma_d2: 1\n  sigma_r2: 1\n"
+                                          "  measured_lines:\n    - { gain: 1, a: 1, b: 2 }\n"),
+                             "unknown key 'measured_lines'");
 }
 
 TEST(NoiseModel, loadNamesTheFileOnBadContent)

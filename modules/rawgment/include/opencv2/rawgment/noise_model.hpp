@@ -46,6 +46,20 @@ struct CV_RAWGMENT_EXPORTS NoiseLine
     double b = 0; //!< offset, \f$ b = g^2\sigma_d^2 + \sigma_r^2 \f$
 };
 
+/** @brief A noise line measured at one gain: darktable's profile of one ISO, one gain's fit of a
+ * calibration, or a DNG's own NoiseProfile. Raw DN of the mosaic, black subtracted.
+ *
+ * NoiseModel::measuredLines holds them; the augmentation then follows the measurements at every gain
+ * (NoiseModel::lineAtGain()) instead of Eq. 5's three parameters. */
+struct CV_RAWGMENT_EXPORTS MeasuredNoiseLine
+{
+    double gain = 0;           //!< linear gain it was measured at, finite and > 0
+    NoiseLine line;            //!< slope a and offset b, finite and >= 0
+    double slopeStdError = 0;  //!< standard error of a (0: not stated)
+    double offsetStdError = 0; //!< standard error of b (0: not stated)
+    double iso = 0;            //!< the ISO it was measured at (0: not stated); informative only
+};
+
 /** @brief Heteroscedastic Gaussian sensor noise model (paper Eq. 5) @cite yoshimura2023rawgment.
  *
  * A pixel with expected black-subtracted value \f$ \mu \f$ (DN) captured at linear analog gain g is
@@ -60,7 +74,7 @@ struct CV_RAWGMENT_EXPORTS NoiseLine
 struct CV_RAWGMENT_EXPORTS NoiseModel
 {
     //! Newest version of the file format; read() rejects newer versions (see write()).
-    static constexpr int FORMAT_VERSION = 4;
+    static constexpr int FORMAT_VERSION = 5;
     /** The range of a known baseIso, with room on both sides of every camera's (ISO 25 to 3,280,000):
      * beyond it a gain ISO / baseIso under- or overflows the noise terms (a base ISO of 1e300 wrote a
      * model of zeros, 1e-300 stopped the solver). */
@@ -118,6 +132,23 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
     Mat darkShadingAt(double gain) const;
     //! @}
 
+    /** @brief Noise lines measured at some gains, by increasing gain (empty: Eq. 5 alone, the paper's
+     * model).
+     *
+     * When present, lineAtGain() and every noise-accounted step follow them: the measured line at a
+     * measured gain; between two, each term in the shape Eq. 5 gives it, through both neighbours: the
+     * slope linear in g, the offset linear in \f$ g^2 \f$ (exact whenever two neighbouring lines follow
+     * Eq. 5 with parameters of their own, and never outside the two; interpolating in log-log instead is
+     * off by up to 6% a stop apart where the offset turns from \f$ \sigma_r^2 \f$ to \f$ g^2\sigma_d^2 \f$);
+     * beyond the measured range, the nearest line carried on by Eq. 5's trend (a in proportion to g, b in
+     * proportion to Eq. 5's offset), so the line never jumps at the range's edge. alpha, sigmaD2 and
+     * sigmaR2 then hold Eq. 5 fitted to the lines: a summary, and the trend beyond them. The split of a
+     * measured offset into the parts before and after the gain (which a contrast change scales
+     * differently, Eq. 13) is Eq. 5's at that gain. validate() requires increasing gains and finite,
+     * non-negative values. */
+    std::vector<MeasuredNoiseLine> measuredLines;
+    bool hasMeasuredLines() const { return !measuredLines.empty(); } //!< whether measuredLines is present
+
     NoiseModel() = default;
     /** @brief A validated model. @throws cv::Exception when a parameter is negative or not finite. */
     NoiseModel(double alpha, double sigmaD2, double sigmaR2);
@@ -128,13 +159,15 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      * written or simulated, and by the steps in the rows they read. */
     void validate() const;
 
-    /** @brief The per-gain line: \f$ a = g\alpha,\; b = g^2\sigma_d^2 + \sigma_r^2 \f$.
+    /** @brief The per-gain line: \f$ a = g\alpha,\; b = g^2\sigma_d^2 + \sigma_r^2 \f$, or the
+     * measured lines' (measuredLines) when the model has them.
      * @param gain linear gain, finite and > 0
      */
     NoiseLine lineAtGain(double gain) const;
 
     /** @brief Variance of a pixel with mean `mean` at linear gain `gain`:
-     * \f$ g\alpha\max(\mu,0) + g^2\sigma_d^2 + \sigma_r^2 \f$.
+     * \f$ g\alpha\max(\mu,0) + g^2\sigma_d^2 + \sigma_r^2 \f$ (with measuredLines, \f$ a\max(\mu,0) + b
+     * \f$ of lineAtGain()).
      * @param mean black-subtracted expected value in DN (any finite value)
      * @param gain linear gain, finite and > 0
      */
@@ -150,10 +183,11 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
     /** @brief Writes the model as a map under `name`: format_version, alpha, sigma_d2, sigma_r2,
      * base_iso when it is known, the dark-frame components that are present (row_sigma_d2,
      * row_sigma_r2, tukey_lambda, and dark_shading: the names, size and FNV-1a checksums of two
-     * CV_32FC1 TIFF images), and failed_calibration when it is set. The version is the lowest that holds
+     * CV_32FC1 TIFF images), failed_calibration when it is set, and measured_lines (a list of maps gain,
+     * a, b, a_std_error, b_std_error, iso) when present. The version is the lowest that holds
      * what the model has (1 without a base ISO, 2 with one, 3 with a dark-frame component, 4 with
-     * failedCalibration), so a model without them stays readable by older builds, and an older build
-     * refuses a failed calibration's model instead of using it.
+     * failedCalibration, 5 with measured lines), so a model without them stays readable by older builds, and
+     * an older build refuses a failed calibration's model instead of using it.
      * @param fs the storage
      * @param name the map's name
      * @param shadingImages the file names of the dark-shading images (per gain, offset) as the file
