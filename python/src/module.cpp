@@ -333,6 +333,15 @@ void bindNoiseModel(py::module_& m)
         .def(keywordInit<NoiseLine>())
         .def_readwrite("a", &NoiseLine::a, doc("NoiseLine::a"))
         .def_readwrite("b", &NoiseLine::b, doc("NoiseLine::b"));
+    py::class_<MeasuredNoiseLine>(m, "MeasuredNoiseLine", doc("MeasuredNoiseLine"))
+        .def(keywordInit<MeasuredNoiseLine>())
+        .def_readwrite("gain", &MeasuredNoiseLine::gain, doc("MeasuredNoiseLine::gain"))
+        .def_readwrite("line", &MeasuredNoiseLine::line, doc("MeasuredNoiseLine::line"))
+        .def_readwrite("slopeStdError", &MeasuredNoiseLine::slopeStdError,
+                       doc("MeasuredNoiseLine::slopeStdError"))
+        .def_readwrite("offsetStdError", &MeasuredNoiseLine::offsetStdError,
+                       doc("MeasuredNoiseLine::offsetStdError"))
+        .def_readwrite("iso", &MeasuredNoiseLine::iso, doc("MeasuredNoiseLine::iso"));
     py::class_<NoiseModel>(
         m, "NoiseModel",
         doc("NoiseModel", "Python: NoiseModel(alpha, sigmaD2, sigmaR2), by position or keyword."))
@@ -350,6 +359,10 @@ void bindNoiseModel(py::module_& m)
         .def_readwrite("rowSigmaR2", &NoiseModel::rowSigmaR2, doc("NoiseModel::rowSigmaR2"))
         .def_readwrite("tukeyRead", &NoiseModel::tukeyRead, doc("NoiseModel::tukeyRead"))
         .def_readwrite("tukeyLambda", &NoiseModel::tukeyLambda, doc("NoiseModel::tukeyLambda"))
+        .def_readwrite(
+            "measuredLines", &NoiseModel::measuredLines,
+            doc("NoiseModel::measuredLines", "Python: a list (a copy); assign a new list to change it."))
+        .def("hasMeasuredLines", &NoiseModel::hasMeasuredLines, doc("NoiseModel::hasMeasuredLines"))
         .def_property(
             "darkShadingPerGain",
             [](const NoiseModel& self) -> py::object {

@@ -65,6 +65,25 @@ NoiseModel CameraNoiseProfile::modelFor(const RawFormat& format) const
     const double r = format.whiteLevel - black;
     NoiseModel m(noise.alpha * r, noise.sigmaD2 * r * r, noise.sigmaR2 * r * r);
     m.baseIso = noise.baseIso;
+    // The augmentation follows what darktable measured at each ISO (NoiseModel::measuredLines); Eq. 5
+    // stays the summary and the trend beyond the measured ISOs. An ISO measured twice takes the mean of its
+    // two lines; a negative measured offset (a fit's intercept below zero, never a variance) is taken as 0.
+    for (size_t i = 0; i < isos.size();) {
+        size_t j = i;
+        double slope = 0, offset = 0;
+        for (; j < isos.size() && isos[j].iso == isos[i].iso; ++j) {
+            slope += isos[j].slope;
+            offset += isos[j].offset;
+        }
+        const double n = static_cast<double>(j - i);
+        MeasuredNoiseLine line;
+        line.gain = isos[i].gain;
+        line.iso = isos[i].iso;
+        line.line.a = slope / n * r;
+        line.line.b = std::max(offset / n, 0.0) * r * r;
+        m.measuredLines.push_back(line);
+        i = j;
+    }
     m.validate();
     return m;
 }

@@ -3,9 +3,13 @@
 // loader of every model file.
 #include "test_common.hpp"
 
+#include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/camera_profiles.hpp>
 #include <opencv2/rawgment/files.hpp>
+#include <opencv2/rawgment/raw_io.hpp>
+#include <opencv2/rawgment/simulate.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <map>
@@ -393,6 +397,136 @@ TEST(CameraProfiles, everyModelFileLoadsThroughOneCall)
                   "%YAML:1.0\n---\nandroid_noise_profile:\n   base_iso: 100\n   A: [1, 2]\n");
     EXPECT_CV_ERROR_CONTAINS(loadAnyNoiseModel(broken, "", format),
                              "broken_android.yml': field 'A' must be a list");
+}
+
+//! One profile of darktable's file as the file states it: green's a and b, straight from the JSON.
+struct DarktableProfile
+{
+    std::string camera;
+    double iso, a, b;
+};
+
+//! Every profile of darktable's file not marked skip, read here without the catalogue (the truth).
+std::vector<DarktableProfile> darktableGreenProfiles(const std::string& path)
+{
+    std::vector<DarktableProfile> out;
+    FileStorage fs = openFileStorageForReading(path, "darktable noise profiles");
+    for (const FileNode& maker : fs["noiseprofiles"])
+        for (const FileNode& model : maker["models"])
+            for (const FileNode& p : model["profiles"]) {
+                if (!p["skip"].empty() && p["skip"].isInt() && int(p["skip"]) != 0)
+                    continue;
+                out.push_back({std::string(maker["maker"]) + " " + std::string(model["model"]),
+                               double(p["iso"]), double(p["a"][1]), double(p["b"][1])});
+            }
+    return out;
+}
+
+double quantile(std::vector<double> v, double q)
+{
+    std::sort(v.begin(), v.end());
+    return v[static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
+}
+
+TEST(CameraProfiles, everyUsableCameraIsAugmentedWithTheLinesDarktableMeasured)
+{
+    const std::string path = darktableProfilesPath();
+    if (path.empty())
+        GTEST_SKIP() << "darktable's noiseprofiles.json not found (run scripts/fetch-darktable-profiles.sh)";
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(path);
+    std::map<std::string, const CameraNoiseProfile*> byName;
+    for (const CameraNoiseProfile& c : cams)
+        byName[c.name()] = &c;
+    const RawFormat format = fourteenBitFormat();
+    const double r = format.whiteLevel - format.blackLevel[0], c = DARKTABLE_HAAR_VARIANCE_RATIO;
+    // The slope the augmentation uses at each measured ISO against darktable's a / c, and Eq. 5's.
+    std::vector<double> measured, eq5;
+    std::map<std::string, NoiseModel> models;
+    for (const DarktableProfile& p : darktableGreenProfiles(path)) {
+        const auto cam = byName.find(p.camera);
+        if (cam == byName.end() || !cam->second->usable() || !(p.a > 0))
+            continue;
+        if (!models.count(p.camera))
+            models[p.camera] = cam->second->modelFor(format);
+        const NoiseModel& m = models[p.camera];
+        NoiseModel summary = m;
+        summary.measuredLines.clear();
+        const double g = p.iso / m.baseIso, truth = p.a / c * r;
+        measured.push_back(std::abs(m.lineAtGain(g).a / truth - 1));
+        eq5.push_back(std::abs(summary.lineAtGain(g).a / truth - 1));
+    }
+    ASSERT_GT(measured.size(), 3000u);
+    std::cout << "[ info ] " << measured.size() << " measured ISOs of " << models.size()
+              << " usable cameras: the augmentation's slope against darktable's a / c, median "
+              << 100 * quantile(measured, 0.5) << "%, 90th percentile " << 100 * quantile(measured, 0.9)
+              << "% (Eq. 5 alone: " << 100 * quantile(eq5, 0.5) << "%, " << 100 * quantile(eq5, 0.9)
+              << "%)\n";
+    // The bounds; only an ISO that darktable measured twice with two lines leaves 0.
+    EXPECT_LE(quantile(measured, 0.5), 0.02);
+    EXPECT_LE(quantile(measured, 0.9), 0.05);
+    EXPECT_GT(quantile(eq5, 0.9), 0.05) << "Eq. 5 alone was 30% off at the 90th percentile";
+}
+
+/* Flat frames as a real camera: a capture at the base ISO (half of the range), taken to every measured
+ * ISO at 0.45 of the range by an exposure change with the prior accounted, has the variance darktable
+ * measured there, (a x + b) / c in DN at its mean. 256 x 256 pixels: the spatial variance's standard error is
+ * sqrt(2 / 65536) = 0.55%, 5 of them 2.8%. ISOs with a negative offset are left out: the model takes
+ * it as 0 (a variance), which differs from the line by |b| / c at any level. */
+TEST(CameraProfiles, flatFramesAugmentedAsARealCameraHaveTheVarianceDarktableMeasured)
+{
+    const std::string path = darktableProfilesPath();
+    if (path.empty())
+        GTEST_SKIP() << "darktable's noiseprofiles.json not found (run scripts/fetch-darktable-profiles.sh)";
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(path);
+    const RawFormat format = fourteenBitFormat();
+    const double r = format.whiteLevel - format.blackLevel[0];
+    const Size size(256, 256);
+    const double tolerance = 5 * std::sqrt(2.0 / (size.area() - 1));
+    int tested = 0, camera = 0, tooNoisy = 0;
+    for (const CameraNoiseProfile& cam : cams) {
+        // The example and every 25th usable camera.
+        if (!cam.usable() || (cam.name() != "Canon EOS 5D Mark III" && camera++ % 25 != 0))
+            continue;
+        SensorParams params;
+        params.noise = cam.modelFor(format);
+        params.pattern = format.pattern;
+        params.blackLevel = format.blackLevel;
+        params.bitDepth = 14;
+        params.quantize = false;
+        const SensorSimulator sensor(params, size);
+        Mat base;
+        sensor.capture(Mat(size, CV_32FC1, Scalar(0.5 * r)), 1.0, 1.0, 7, 0, base);
+        for (const CameraIsoFit& f : cam.isos) {
+            if (f.offset < 0)
+                continue;
+            SCOPED_TRACE(cam.name() + cv::format(" at ISO %g", f.iso));
+            // Every ISO's flat at 0.45 of the range, where it is at least 5 standard deviations from black
+            // and white (clipping would cut the variance); the noisiest settings that are not are skipped.
+            const double level = 0.45 * r, spread = std::sqrt(f.slope * r * level + f.offset * r * r);
+            if (level - 5 * spread < -format.blackLevel[0] || level + 5 * spread > r) {
+                ++tooNoisy;
+                continue;
+            }
+            const double factor = 0.9 / f.gain;
+            Mat out;
+            RawFormat outFormat;
+            colorJitter(base, sensor.rawFormat(1.0), params.noise,
+                        ColorJitter::exposureChange(factor, f.gain), NoiseAlignment::ACCOUNT_PRIOR,
+                        100 + tested, out, outFormat);
+            Mat x;
+            subtractBlackLevel(out, outFormat, x);
+            Scalar mean, sd;
+            meanStdDev(x, mean, sd);
+            const double variance = sd[0] * sd[0] * size.area() / (size.area() - 1.0);
+            // darktable's own line at this ISO (the catalogue keeps a / c and b / c of a range of 1).
+            const double expected = f.slope * r * mean[0] + f.offset * r * r;
+            EXPECT_NEAR(variance / expected, 1.0, tolerance) << "mean " << mean[0];
+            ++tested;
+        }
+    }
+    std::cout << "[ info ] " << tested << " measured ISOs of flat frames within 5 standard errors; "
+              << tooNoisy << " too noisy to stay clear of black and white\n";
+    EXPECT_GT(tested, 100);
 }
 
 TEST(CameraProfiles, everyCameraOfDarktablesFileImportsOrIsRefusedWithAReason)

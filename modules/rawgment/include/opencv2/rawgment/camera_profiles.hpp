@@ -111,7 +111,10 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
     //! Whether the camera is imported (GOOD or ROUGH).
     bool usable() const { return verdict != CAMERA_PROFILE_REFUSED; }
     /** @brief The camera's noise model in DN for mosaics of `format`: `noise` with alpha times r and the
-     * variances times r^2, with r = white - mean black (its baseIso kept).
+     * variances times r^2, with r = white - mean black (its baseIso kept), and every usable ISO's
+     * measured line (isos: slope times r, offset times r^2, at its gain) as NoiseModel::measuredLines,
+     * which the augmentation follows; an ISO measured twice takes the mean of its lines, a negative
+     * measured offset is taken as 0.
      * @throws cv::Exception when the camera is REFUSED (naming the reason) or the format is invalid. */
     NoiseModel modelFor(const RawFormat& format) const;
 };
