@@ -214,3 +214,37 @@ def test_a_noise_model_from_any_model_file(two_cameras, tmp_path):
     assert rg.loadAnyNoiseModel(str(tmp_path / "model.yml")).sigmaR2 == 30.0
     with pytest.raises(rg.error, match="of many cameras"):
         rg.loadAnyNoiseModel(path)
+
+
+def test_flat_frames_augmented_as_a_real_camera_have_the_variance_darktable_measured_at_every_iso():
+    # The C++ test of the same name, from Python, for the example camera: a flat capture at the base
+    # ISO taken to each measured ISO at 0.45 of the range (clear of black and white by 5 standard
+    # deviations there) has darktable's (a x + b) / c of that ISO, read from the JSON here. 256 x 256
+    # pixels: 5 standard errors of the spatial variance are 2.8%.
+    path = _profiles_path()
+    name = "Canon EOS 5D Mark III"
+    camera = rg.findCameraProfile(rg.readCameraProfiles(path), name)
+    with open(path) as f:
+        data = json.load(f)
+    profiles = [p for maker in data["noiseprofiles"] for model in maker["models"]
+                if maker["maker"] + " " + model["model"] == name for p in model["profiles"]
+                if not p.get("skip") and p["a"][1] > 0 and p["b"][1] >= 0]
+    fmt = rg.RawFormat(pattern=rg.CFA_RGGB, blackLevel=(512, 512, 512, 512), whiteLevel=16383)
+    r, c = 16383 - 512, rg.DARKTABLE_HAAR_VARIANCE_RATIO
+    model = camera.modelFor(fmt)
+    assert model.hasMeasuredLines() and len(model.measuredLines) >= 10
+    params = rg.SensorParams(noise=model, pattern=rg.CFA_RGGB, blackLevel=(512, 512, 512, 512), bitDepth=14,
+                             quantize=False)
+    sensor = rg.SensorSimulator(params, (256, 256))
+    base = sensor.capture(np.full((256, 256), 0.5 * r, np.float32), 1.0, 1.0, seed=7, frameIndex=0)
+    tested = 0
+    for k, p in enumerate(profiles):
+        gain = p["iso"] / model.baseIso
+        out = rg.colorJitter(base, sensor.rawFormat(1.0), model,
+                             rg.ColorJitter.exposureChange(0.9 / gain, gain),
+                             rg.NoiseOptions(alignment=rg.NoiseAlignment.ACCOUNT_PRIOR), seed=100 + k)[0]
+        x = out.astype(np.float64) - 512
+        expected = p["a"][1] / c * r * x.mean() + p["b"][1] / c * r * r
+        assert x.var(ddof=1) / expected == pytest.approx(1, abs=5 * np.sqrt(2 / (x.size - 1))), p["iso"]
+        tested += 1
+    assert tested >= 10
