@@ -869,13 +869,25 @@ TEST(Apps, calibrateTakesTheGainsFromTheFilesIsoWithOrWithoutAChart)
             cv::rawgment::NoiseModel::load(dir + "/cal_" + mode + "/noise_model.yml");
         expectTruth(fitted, 1.0, std::string(mode) == "chart" ? 0.47 : 0.16, mode);
         EXPECT_EQ(100.0, fitted.baseIso) << "the model knows the ISO of its gain 1";
-        // The profile for darktable gives the same model back.
+        // The model carries its per-gain fits as measured lines, and the profile for darktable gives them
+        // back through the catalogue, ISO by ISO.
+        ASSERT_EQ(3u, fitted.measuredLines.size()) << "one line per gain with light";
+        EXPECT_EQ(200.0, fitted.measuredLines[0].iso) << "the lowest light burst, 6.02 dB over ISO 100";
+        EXPECT_GT(fitted.measuredLines[0].slopeStdError, 0);
         cv::rawgment::RawFormat format =
             cv::rawgment::readRaw(dir + "/sim/g6.02dB_level0.20/frame_000.dng").format;
-        const cv::rawgment::NoiseModel viaDarktable = cv::rawgment::noiseModelFromDarktableExport(
-            dir + "/cal_" + mode + "/darktable_noiseprofiles.json", format, 100, "cv::rawgment",
-            "simulated sensor");
-        EXPECT_NEAR(viaDarktable.alpha, fitted.alpha, 1e-9 * fitted.alpha);
+        const cv::rawgment::NoiseModel viaDarktable =
+            cv::rawgment::findCameraProfile(
+                cv::rawgment::readCameraProfiles(dir + "/cal_" + mode + "/darktable_noiseprofiles.json"),
+                "cv::rawgment simulated sensor")
+                .modelFor(format);
+        ASSERT_EQ(fitted.measuredLines.size(), viaDarktable.measuredLines.size());
+        // The catalogue's gain 1 is its lowest ISO (200 here): the lines are compared ISO by ISO.
+        for (const cv::rawgment::MeasuredNoiseLine& l : fitted.measuredLines) {
+            const cv::rawgment::NoiseLine back = viaDarktable.lineAtGain(l.iso / viaDarktable.baseIso);
+            EXPECT_NEAR(back.a, l.line.a, 1e-9 * l.line.a) << l.iso;
+            EXPECT_NEAR(back.b, l.line.b, 1e-9 * l.line.b) << l.iso;
+        }
         EXPECT_TRUE(exists(dir + "/cal_" + mode + "/android_noise_profile.yml"));
     }
 

@@ -493,6 +493,35 @@ void writeModelAndExports(const CalibrateOptions& o, const std::vector<Calibrati
                                "asked (--accept_failed_calibration)");
 }
 
+/* The per-gain lines of the gains that had light (a gain of dark frames alone has no slope to measure),
+ * with their standard errors and the ISO their bursts say; a negative slope or offset (a fit's value, never
+ * a variance) is taken as 0. */
+std::vector<MeasuredNoiseLine> measuredLinesOf(const std::vector<NoiseLineFit>& perGain,
+                                               const std::vector<CalibrationManifest::Burst>& specs,
+                                               const BurstGains& gains)
+{
+    std::vector<MeasuredNoiseLine> lines;
+    for (const NoiseLineFit& f : perGain) {
+        MeasuredNoiseLine l;
+        bool light = false;
+        for (size_t i = 0; i < specs.size(); ++i)
+            if (std::abs(gains.gainsDb[i] - linearGainToDb(f.gain)) < 1e-9 && !specs[i].dark) {
+                light = true;
+                l.iso = gains.isos[i];
+            }
+        if (!light)
+            continue;
+        l.gain = f.gain;
+        l.line.a = std::max(f.line.a, 0.0);
+        l.line.b = std::max(f.line.b, 0.0);
+        // A standard error the fit could not state (too few samples) is written as 0, "not stated".
+        l.slopeStdError = std::isfinite(f.slopeStdError) ? f.slopeStdError : 0.0;
+        l.offsetStdError = std::isfinite(f.offsetStdError) ? f.offsetStdError : 0.0;
+        lines.push_back(l);
+    }
+    return lines;
+}
+
 } // namespace
 
 CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
@@ -564,6 +593,9 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                 failed += (failed.empty() ? "" : ", ") + c.name;
         result.report.model.failedCalibration = failed;
     }
+    // The per-gain fits travel with the model as its measured lines, which the augmentation follows; the
+    // verdict above judged Eq. 5, which stays the model's summary and its trend beyond the gains.
+    result.report.model.measuredLines = measuredLinesOf(report.perGain, specs, gains);
     writeNewText(reportPath,
                  yamlToString([&](cv::FileStorage& fs) { report.write(fs, "calibration_report"); }));
     writeModelAndExports(o, specs, gains, firstFormat, result);
