@@ -268,6 +268,8 @@ void bindRawIo(py::module_& m)
     m.def("dngNoiseProfile", &dngNoiseProfile, py::arg("model"), py::arg("format"), doc("dngNoiseProfile"));
     m.def("noiseLineFromDngProfile", &noiseLineFromDngProfile, py::arg("profile"), py::arg("format"),
           py::arg("channel"), doc("noiseLineFromDngProfile"));
+    m.def("withDngNoiseProfileLine", &withDngNoiseProfileLine, py::arg("model"), py::arg("image"),
+          doc("withDngNoiseProfileLine"));
     m.def("darktableNoiseProfiles", &darktableNoiseProfiles, py::arg("model"), py::arg("format"),
           py::arg("baseIso"), py::arg("isos"), py::arg("maker"), py::arg("cameraModel"),
           py::arg("haarVarianceRatio") = DARKTABLE_HAAR_VARIANCE_RATIO, doc("darktableNoiseProfiles"));

@@ -349,6 +349,33 @@ NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& profile, const RawFo
     return line;
 }
 
+NoiseModel withDngNoiseProfileLine(const NoiseModel& model, const RawImage& image)
+{
+    model.validate();
+    const char* what = "withDngNoiseProfileLine";
+    if (image.noiseProfile.empty())
+        CV_Error(Error::StsBadArg, cv::format("%s: the file has no NoiseProfile", what));
+    if (!(image.iso > 0) || !(model.baseIso > 0))
+        CV_Error(Error::StsBadArg,
+                 cv::format("%s: the line's gain is ISO / baseIso, and %s", what,
+                            image.iso > 0 ? "the model has no base ISO" : "the file states no ISO"));
+    MeasuredNoiseLine measured;
+    measured.gain = image.iso / model.baseIso;
+    measured.iso = image.iso;
+    // Green's line: the augmentation's one line per gain, as darktable's catalogue takes it.
+    measured.line = noiseLineFromDngProfile(image.noiseProfile, image.format, CFA_G1);
+    NoiseModel out = model;
+    std::vector<MeasuredNoiseLine>& lines = out.measuredLines;
+    const auto at = std::lower_bound(lines.begin(), lines.end(), measured.gain,
+                                     [](const MeasuredNoiseLine& l, double g) { return l.gain < g; });
+    if (at != lines.end() && at->gain == measured.gain)
+        *at = measured;
+    else
+        lines.insert(at, measured);
+    out.validate();
+    return out;
+}
+
 namespace {
 
 //! How far values that one exact model produced may disagree after a round trip through 17-digit text.

@@ -191,6 +191,51 @@ TEST(RawIo, dngNoiseProfileRoundTripsAndGivesBackTheModelsLines)
     EXPECT_TRUE(readRaw(dir + "/plain.dng").noiseProfile.empty());
 }
 
+TEST(RawIo, aFilesOwnNoiseProfileBecomesAMeasuredLineAtItsGain)
+{
+    const std::string dir = makeTempDir("raw_io_noise_profile_line");
+    // The file states the noise of another sensor than the model's (as a converter's database would).
+    const NoiseModel stated(0.5, 2.0, 3.0), model = [] {
+        NoiseModel m(0.3, 1.2, 2.5);
+        m.baseIso = 100;
+        return m;
+    }();
+    RawImage img;
+    img.mosaic = Mat(48, 64, CV_16UC1, Scalar(500));
+    img.format.pattern = CFA_GBRG;
+    img.format.blackLevel = Vec4d(101, 101, 102, 102);
+    img.format.whiteLevel = 4000;
+    img.format.gain = 4;
+    img.iso = 400;
+    img.noiseProfile = dngNoiseProfile(stated, img.format);
+    writeDng(dir + "/stated.dng", img);
+    const RawImage back = readRaw(dir + "/stated.dng");
+    const NoiseModel followed = withDngNoiseProfileLine(model, back);
+    ASSERT_EQ(1u, followed.measuredLines.size());
+    EXPECT_EQ(4.0, followed.measuredLines[0].gain);
+    EXPECT_EQ(400.0, followed.measuredLines[0].iso);
+    // At the file's gain the file's line (green's range, up to the rounding of S r and O r^2).
+    EXPECT_NEAR(stated.lineAtGain(4).a, followed.lineAtGain(4).a, 1e-13 * stated.lineAtGain(4).a);
+    EXPECT_NEAR(stated.lineAtGain(4).b, followed.lineAtGain(4).b, 1e-12 * stated.lineAtGain(4).b);
+    EXPECT_GT(std::abs(followed.lineAtGain(4).a / model.lineAtGain(4).a - 1), 0.5);
+    // A second file at the same ISO replaces the line, one at another ISO joins it in order.
+    RawImage other = back;
+    other.iso = 200;
+    const NoiseModel two = withDngNoiseProfileLine(withDngNoiseProfileLine(followed, back), other);
+    ASSERT_EQ(2u, two.measuredLines.size());
+    EXPECT_EQ(2.0, two.measuredLines[0].gain);
+    EXPECT_EQ(4.0, two.measuredLines[1].gain);
+    RawImage noIso = back;
+    noIso.iso = 0;
+    EXPECT_CV_ERROR_CONTAINS(withDngNoiseProfileLine(model, noIso), "the file states no ISO");
+    NoiseModel noBase = model;
+    noBase.baseIso = 0;
+    EXPECT_CV_ERROR_CONTAINS(withDngNoiseProfileLine(noBase, back), "the model has no base ISO");
+    RawImage unprofiled = back;
+    unprofiled.noiseProfile.clear();
+    EXPECT_CV_ERROR_CONTAINS(withDngNoiseProfileLine(model, unprofiled), "the file has no NoiseProfile");
+}
+
 TEST(RawIo, aNoiseProfileDngCannotHoldIsRefusedAndAMalformedTagNamesTheFile)
 {
     const std::string dir = makeTempDir("raw_io_noise_profile_bad");

@@ -85,6 +85,17 @@ CV_RAWGMENT_EXPORTS std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, 
 CV_RAWGMENT_EXPORTS NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& profile,
                                                       const RawFormat& format, CfaChannel channel);
 
+/** @brief A model that also follows a file's own DNG NoiseProfile: the profile's green line (
+ * noiseLineFromDngProfile() at CFA_G1) as a measured line (NoiseModel::measuredLines) at the file's gain,
+ * ISO / model.baseIso, replacing a line the model had at that gain. The augmentation of that file then
+ * takes its prior noise from what the file states (a camera maker's or a converter's measurement).
+ * @param model the model, with a base ISO
+ * @param image a file read by readRaw() with a NoiseProfile and an ISO
+ * @throws cv::Exception when the file has no NoiseProfile or no ISO, the model no base ISO, or the
+ *         profile is invalid for the file's format.
+ */
+CV_RAWGMENT_EXPORTS NoiseModel withDngNoiseProfileLine(const NoiseModel& model, const RawImage& image);
+
 /** @brief darktable's noise variance over the per-pixel raw variance (green channel), as its profiling
  * tool measures: the Haar-MAD variance of a PPG-demosaiced export (docs/real_cameras.md). */
 constexpr double DARKTABLE_HAAR_VARIANCE_RATIO = 0.0794;
