@@ -283,16 +283,17 @@ std::string realCamerasSection(const DemoOptions& o, const SensorParams& sensorP
     const cv::Mat bright = galleryCapture(o, sensorParams, format);
     Scene scene;
     scene.jitter = ColorJitter::exposureChange(0.01, 8.0);
-    md +=
-        "The gallery's bright capture taken to x0.01 light at 8x the ISO (+18 dB), with the measured noise "
-        "of two "
-        "cameras from darktable's profiles (`" +
-        path +
-        "`, fitted to Eq. 5; `rawgment_cameras` lists all). The quietest and the loudest read noise over the "
-        "range among the GOOD cameras whose profiles reach 8x their base ISO. Previews are brightened back "
-        "to the input's level.\n\n| camera | verdict | full well (e-) | read noise at base ISO (e-) | read "
-        "noise at base ISO "
-        "(DN of this 12-bit sensor) |\n|---|---|---|---|---|\n";
+    md += "The gallery's bright capture taken to x0.01 light at 8x the ISO (+18 dB), with the measured noise "
+          "of two "
+          "cameras from darktable's profiles (`" +
+          path +
+          "`: the line darktable measured at every ISO, which the augmentation follows, with Eq. 5 fitted to "
+          "them as the summary; `rawgment_cameras` lists all). The quietest and the loudest read noise over "
+          "the "
+          "range among the GOOD cameras whose profiles reach 8x their base ISO. Previews are brightened back "
+          "to the input's level.\n\n| camera | verdict | full well (e-) | read noise at base ISO (e-) | read "
+          "noise at base ISO (DN of this 12-bit sensor) | shot slope at 8x, measured | Eq. 5's |"
+          "\n|---|---|---|---|---|---|---|\n";
     std::vector<cv::Mat> tiles;
     for (size_t k = 0; k < chosen.size(); ++k) {
         const CameraNoiseProfile& cam = chosen[k];
@@ -313,10 +314,15 @@ std::string realCamerasSection(const DemoOptions& o, const SensorParams& sensorP
         const double brightening = 1.0 / scene.jitter.contrast[cfaSiteOfChannel(format.pattern, CFA_G1)];
         tiles.push_back(
             labelled(rawgment_apps::previewOf(augmented, augmentedFormat, brightening), cam.name()));
-        md += cv::format("| %s | %s | %.0f | %.2f | %.2f |\n", cam.name().c_str(),
+        NoiseModel eq5 = model;
+        eq5.measuredLines.clear();
+        const double targetGain = format.gain * scene.jitter.gainRatio;
+        md += cv::format("| %s | %s | %.0f | %.2f | %.2f | %.4g | %.4g (%+.1f%%) |\n", cam.name().c_str(),
                          cameraProfileVerdictName(cam.verdict).c_str(), 1 / cam.noise.alpha,
                          std::sqrt(cam.noise.lineAtGain(1).b) / cam.noise.alpha,
-                         std::sqrt(model.lineAtGain(1).b));
+                         std::sqrt(model.lineAtGain(1).b), model.lineAtGain(targetGain).a,
+                         eq5.lineAtGain(targetGain).a,
+                         100 * (eq5.lineAtGain(targetGain).a / model.lineAtGain(targetGain).a - 1));
     }
     cv::Mat side;
     cv::hconcat(tiles, side);
