@@ -173,7 +173,9 @@ struct CV_RAWGMENT_EXPORTS AndroidNoiseProfile
 
 /** @brief The Android form of a noise model:
  * \f$ A = \alpha / (r s_0) \f$, B = 0, \f$ C = \sigma_d^2 / (r s_0)^2 \f$, \f$ D = \sigma_r^2 / r^2 \f$, with
- * \f$ s_0 \f$ the base ISO (gain g = s / \f$ s_0 \f$) and r = white - black of each CFA site.
+ * \f$ s_0 \f$ the base ISO (gain g = s / \f$ s_0 \f$) and r = white - black of each CFA site. The form is
+ * Eq. 5's: a model's measured lines (NoiseModel::measuredLines) have no place in it, so the profile is the
+ * model's Eq. 5 summary (darktableNoiseProfiles() states each ISO's line instead).
  * @throws cv::Exception on an invalid model, format or base ISO.
  */
 CV_RAWGMENT_EXPORTS AndroidNoiseProfile androidNoiseProfile(const NoiseModel& model, const RawFormat& format,
