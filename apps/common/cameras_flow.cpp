@@ -71,12 +71,14 @@ std::string isoTable(const CameraNoiseProfile& cam)
         "fit over a range of 1: alpha %.4g (full well %.0f e-), sigma_d^2 %.4g, sigma_r^2 %.4g, base "
         "ISO %g\n",
         cam.noise.alpha, 1 / cam.noise.alpha, cam.noise.sigmaD2, cam.noise.sigmaR2, cam.noise.baseIso);
-    out << "     ISO    gain   slope (a/c)  fitted       resid   offset (b/c)  fitted       resid  colours\n";
+    out << "     ISO    gain   slope (a/c)  fitted       resid   offset (b/c)  fitted       resid  colours  "
+           "setting\n";
     for (const CameraIsoFit& f : cam.isos) {
         const NoiseLine fitted = cam.noise.lineAtGain(f.gain);
-        out << cv::format("%8g %7.3f  %11.4g  %11.4g %6.1f%%  %11.4g  %11.4g %6.1f%%  %5.2f\n", f.iso, f.gain,
-                          f.slope, fitted.a, 100 * f.slopeResidual, f.offset, fitted.b,
-                          100 * f.offsetResidual, f.colourSpread);
+        out << cv::format("%8g %7.3f  %11.4g  %11.4g %6.1f%%  %11.4g  %11.4g %6.1f%%  %5.2f    %s\n", f.iso,
+                          f.gain, f.slope, fitted.a, 100 * f.slopeResidual, f.offset, fitted.b,
+                          100 * f.offsetResidual, f.colourSpread,
+                          f.expanded ? "expanded (not fitted)" : "fitted");
     }
     return out.str();
 }
@@ -94,7 +96,7 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
     std::map<std::string, int> refusals;
     std::vector<double> medianSlope, worstSlope, worstOffset, medianOffset, fullWell, read, share, baseShare,
         spread;
-    int negative = 0, nonMonotone = 0, usable = 0, lowestWorst = 0;
+    int negative = 0, nonMonotone = 0, usable = 0, lowestWorst = 0, expanded = 0;
     for (const CameraNoiseProfile& cam : cams) {
         ++verdicts[cam.verdict];
         if (!cam.usable()) {
@@ -116,8 +118,12 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
         worstSlope.push_back(cam.worstSlopeResidual);
         worstOffset.push_back(cam.worstOffsetResidual);
         std::vector<double> offsets;
+        double lowestFitted = 0;
         for (const CameraIsoFit& f : cam.isos)
-            offsets.push_back(std::abs(f.offsetResidual));
+            if (!f.expanded) {
+                offsets.push_back(std::abs(f.offsetResidual));
+                lowestFitted = lowestFitted > 0 ? lowestFitted : f.iso;
+            }
         medianOffset.push_back(quantile(offsets, 0.5));
         fullWell.push_back(1 / cam.noise.alpha);
         read.push_back(readElectrons(cam));
@@ -126,7 +132,8 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
         spread.push_back(cam.medianColourSpread);
         negative += cam.negativeOffsets > 0;
         nonMonotone += !cam.monotoneSlope;
-        lowestWorst += cam.worstSlopeIso == cam.isos.front().iso;
+        lowestWorst += cam.worstSlopeIso == lowestFitted;
+        expanded += cam.expandedIsos > 0;
     }
     const auto row = [](const char* what, const std::vector<double>& v, double scale, const char* unit) {
         return cv::format("| %s | %.3g%s | %.3g%s | %.3g%s | %.3g%s | %.3g%s |\n", what,
@@ -155,8 +162,12 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
        << row("median over ISOs of the offset residual", medianOffset, 100, "%")
        << row("worst offset residual", worstOffset, 100, "%")
        << row("colours' slope spread (largest / smallest)", spread, 1, "") << "\n"
-       << "- The shot slope's worst ISO is the camera's lowest for " << formatShare(lowestWorst, usable)
-       << " of the cameras.\n"
+       << "- Cameras with expanded low ISOs (a slope that falls less than the ISO below the next ISO: left "
+          "out of the fit and of these figures, never the base ISO, followed by the augmentation as "
+          "measured): "
+       << formatShare(expanded, usable) << ".\n"
+       << "- The shot slope's worst fitted ISO is the camera's lowest for "
+       << formatShare(lowestWorst, usable) << " of the cameras.\n"
        << "- Cameras with a negative offset at some ISO: " << formatShare(negative, usable) << ".\n"
        << "- Cameras whose measured slope falls somewhere as the ISO rises: "
        << formatShare(nonMonotone, usable) << ".\n\n"

@@ -314,7 +314,8 @@ void bindCameraCatalogue(py::module_& m)
         .def_readwrite("offset", &CameraIsoFit::offset, doc("CameraIsoFit::offset"))
         .def_readwrite("slopeResidual", &CameraIsoFit::slopeResidual, doc("CameraIsoFit::slopeResidual"))
         .def_readwrite("offsetResidual", &CameraIsoFit::offsetResidual, doc("CameraIsoFit::offsetResidual"))
-        .def_readwrite("colourSpread", &CameraIsoFit::colourSpread, doc("CameraIsoFit::colourSpread"));
+        .def_readwrite("colourSpread", &CameraIsoFit::colourSpread, doc("CameraIsoFit::colourSpread"))
+        .def_readwrite("expanded", &CameraIsoFit::expanded, doc("CameraIsoFit::expanded"));
     py::class_<CameraNoiseProfile>(m, "CameraNoiseProfile", doc("CameraNoiseProfile"))
         .def(keywordInit<CameraNoiseProfile>())
         .def_readwrite("maker", &CameraNoiseProfile::maker, doc("CameraNoiseProfile::maker"))
@@ -340,6 +341,8 @@ void bindCameraCatalogue(py::module_& m)
                        doc("CameraNoiseProfile::medianColourSpread"))
         .def_readwrite("negativeOffsets", &CameraNoiseProfile::negativeOffsets,
                        doc("CameraNoiseProfile::negativeOffsets"))
+        .def_readwrite("expandedIsos", &CameraNoiseProfile::expandedIsos,
+                       doc("CameraNoiseProfile::expandedIsos"))
         .def_readwrite("monotoneSlope", &CameraNoiseProfile::monotoneSlope,
                        doc("CameraNoiseProfile::monotoneSlope"))
         .def("name", &CameraNoiseProfile::name, doc("CameraNoiseProfile::name"))

@@ -57,6 +57,17 @@ def _numpy_fit(profiles, c=rg.DARKTABLE_HAAR_VARIANCE_RATIO, x_ref=1e-3):
     the origin; (sigma_d^2, sigma_r^2) >= 0 by weighted least squares, the best feasible point of the
     interior and the boundary."""
     used = sorted((p for p in profiles if not p.get("skip") and p["a"][1] > 0), key=lambda p: p["iso"])
+    # Expanded low settings: from the lowest ISO up, a green slope that falls less than the ISO towards the
+    # next ISO down (ratio of slopes over ratio of ISOs above 1.15), two ISOs always kept; not fitted.
+    distinct = sorted({p["iso"] for p in used})
+    slope = {s: np.mean([p["a"][1] for p in used if p["iso"] == s]) for s in distinct}
+    expanded = set()
+    for k in range(len(distinct) - 2):
+        lo, hi = distinct[k], distinct[k + 1]
+        if not (slope[lo] / slope[hi]) / (lo / hi) > 1.15:
+            break
+        expanded.add(lo)
+    used = [p for p in used if p["iso"] not in expanded]
     iso = np.array([p["iso"] for p in used], float)
     a = np.array([p["a"][1] for p in used]) / c
     b = np.array([p["b"][1] for p in used]) / c
@@ -236,11 +247,14 @@ def test_flat_frames_augmented_as_a_real_camera_have_the_variance_darktable_meas
     params = rg.SensorParams(noise=model, pattern=rg.CFA_RGGB, blackLevel=(512, 512, 512, 512), bitDepth=14,
                              quantize=False)
     sensor = rg.SensorSimulator(params, (256, 256))
-    base = sensor.capture(np.full((256, 256), 0.5 * r, np.float32), 1.0, 1.0, seed=7, frameIndex=0)
+    # At the lowest ISO (its expanded ISO 50, below the base ISO 100): every other ISO then adds noise.
+    lowest = model.measuredLines[0].gain
+    assert lowest == 0.5 and model.baseIso == 100
+    base = sensor.capture(np.full((256, 256), 0.5 * r / lowest, np.float32), lowest, 1.0, seed=7, frameIndex=0)
     tested = 0
     for k, p in enumerate(profiles):
-        gain = p["iso"] / model.baseIso
-        out = rg.colorJitter(base, sensor.rawFormat(1.0), model,
+        gain = p["iso"] / model.baseIso / lowest
+        out = rg.colorJitter(base, sensor.rawFormat(lowest), model,
                              rg.ColorJitter.exposureChange(0.9 / gain, gain),
                              rg.NoiseOptions(alignment=rg.NoiseAlignment.ACCOUNT_PRIOR), seed=100 + k)[0]
         x = out.astype(np.float64) - 512

@@ -201,16 +201,47 @@ void judge(CameraNoiseProfile& cam, const DarktableImportParams& params)
         rough.push_back(format("offset %.0f%% off at ISO %g (> %.0f%%)", 100 * cam.worstOffsetResidual,
                                cam.worstOffsetIso, 100 * params.goodWorstOffsetResidual));
     std::set<double> distinct;
+    int fitted = 0;
     for (const CameraIsoFit& f : cam.isos)
-        distinct.insert(f.iso);
+        if (!f.expanded) {
+            distinct.insert(f.iso);
+            ++fitted;
+        }
     if (int(distinct.size()) < params.goodMinIsos)
         rough.push_back(format("%d ISOs (< %d)", int(distinct.size()), params.goodMinIsos));
-    if (2 * cam.negativeOffsets > int(cam.isos.size()))
-        rough.push_back(
-            format("negative offsets at %d of %d ISOs", cam.negativeOffsets, int(cam.isos.size())));
+    if (2 * cam.negativeOffsets > fitted)
+        rough.push_back(format("negative offsets at %d of %d ISOs", cam.negativeOffsets, fitted));
     cam.verdict = rough.empty() ? CAMERA_PROFILE_GOOD : CAMERA_PROFILE_ROUGH;
     for (const String& r : rough)
         cam.reason += (cam.reason.empty() ? "" : "; ") + r;
+}
+
+/* The expanded low settings among profiles by increasing ISO: from the lowest, each ISO whose green slope
+ * falls less than its ISO does towards the next ISO down, (a_k / a_k+1) / (s_k / s_k+1) > 1.15. An analog
+ * step gives 1; an expanded setting whose raw is the next ISO's (over-exposed and pulled in processing,
+ * the Canon EOS 5D Mark III's ISO 50, the Nikon D3's ISO 100 to 159) gives s_k+1 / s_k, 1.26 a third of a
+ * stop below and 2 a stop below. Two analog ISOs are always kept. An ISO measured twice is taken at its
+ * mean slope. Expanded or digital settings above the highest analog gain cannot be told from the lines:
+ * a digital push scales the slope and the offset as an analog gain with the read noise before it does. */
+std::set<double> expandedLowIsos(const std::vector<const MeasuredProfile*>& usable)
+{
+    std::vector<double> isos, slopes;
+    for (size_t i = 0; i < usable.size();) {
+        size_t j = i;
+        double sum = 0;
+        for (; j < usable.size() && usable[j]->iso == usable[i]->iso; ++j)
+            sum += usable[j]->a[1];
+        isos.push_back(usable[i]->iso);
+        slopes.push_back(sum / double(j - i));
+        i = j;
+    }
+    std::set<double> expanded;
+    for (size_t k = 0; k + 2 < isos.size(); ++k) {
+        if (!((slopes[k] / slopes[k + 1]) / (isos[k] / isos[k + 1]) > 1.15))
+            break;
+        expanded.insert(isos[k]);
+    }
+    return expanded;
 }
 
 //! Fits one camera from its measured profiles; sets REFUSED with the reason when it cannot.
@@ -240,7 +271,14 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
                                              usable[0]->iso);
         return;
     }
-    const double baseIso = usable.front()->iso;
+    const std::set<double> expanded = expandedLowIsos(usable);
+    cam.expandedIsos = static_cast<int>(expanded.size());
+    double baseIso = 0;
+    for (const MeasuredProfile* p : usable)
+        if (!expanded.count(p->iso)) {
+            baseIso = p->iso;
+            break;
+        }
     std::vector<double> g, a, b, g2, w;
     for (const MeasuredProfile* p : usable) {
         CameraIsoFit f;
@@ -248,6 +286,7 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
         f.gain = p->iso / baseIso;
         f.slope = p->a[1] / c;
         f.offset = p->b[1] / c;
+        f.expanded = expanded.count(p->iso) > 0;
         double lo = HUGE_VAL, hi = 0;
         for (int k = 0; k < 3; ++k)
             if (p->a[k] > 0) {
@@ -256,6 +295,9 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
             }
         f.colourSpread = hi / lo;
         cam.isos.push_back(f);
+        // Eq. 5 describes the analog settings: an expanded one is measured (and followed) but not fitted.
+        if (f.expanded)
+            continue;
         g.push_back(f.gain);
         a.push_back(f.slope);
         b.push_back(f.offset);
@@ -282,11 +324,16 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
     cam.noise.baseIso = baseIso;
 
     std::vector<double> slopeResiduals, spreads;
-    for (size_t k = 0; k < cam.isos.size(); ++k) {
+    for (size_t k = 0, fitted = 0; k < cam.isos.size(); ++k) {
         CameraIsoFit& f = cam.isos[k];
-        const NoiseLine fitted = cam.noise.lineAtGain(f.gain);
-        f.slopeResidual = (fitted.a - f.slope) / f.slope;
-        f.offsetResidual = (fitted.b - f.offset) / (1 / std::sqrt(w[k]));
+        const NoiseLine line = cam.noise.lineAtGain(f.gain);
+        f.slopeResidual = (line.a - f.slope) / f.slope;
+        const double scale = std::abs(f.offset) + f.slope * params.offsetReferenceLevel;
+        f.offsetResidual = (line.b - f.offset) / scale;
+        // The verdict's figures are over the fitted (analog) settings.
+        if (f.expanded)
+            continue;
+        ++fitted;
         slopeResiduals.push_back(std::abs(f.slopeResidual));
         spreads.push_back(f.colourSpread);
         if (std::abs(f.slopeResidual) > cam.worstSlopeResidual) {
@@ -298,15 +345,15 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
             cam.worstOffsetIso = f.iso;
         }
         cam.negativeOffsets += f.offset < 0;
-        if (k > 0 && f.iso > cam.isos[k - 1].iso && f.slope < cam.isos[k - 1].slope)
+        if (fitted > 1 && f.iso > cam.isos[k - 1].iso && f.slope < cam.isos[k - 1].slope)
             cam.monotoneSlope = false;
     }
     cam.medianSlopeResidual = median(slopeResiduals);
     cam.medianColourSpread = median(spreads);
-    if (cam.negativeOffsets == int(cam.isos.size())) {
+    if (cam.negativeOffsets == int(g.size())) {
         cam.verdict = CAMERA_PROFILE_REFUSED;
-        cam.reason = format("offsets below zero at all %d ISOs: the read noise was not measured",
-                            int(cam.isos.size()));
+        cam.reason =
+            format("offsets below zero at all %d ISOs: the read noise was not measured", int(g.size()));
         return;
     }
     if (cam.noise.sigmaD2 == 0 && cam.noise.sigmaR2 == 0) {

@@ -467,7 +467,55 @@ TEST(CameraProfiles, everyUsableCameraIsAugmentedWithTheLinesDarktableMeasured)
     EXPECT_GT(quantile(eq5, 0.9), 0.05) << "Eq. 5 alone was 30% off at the 90th percentile";
 }
 
-/* Flat frames as a real camera: a capture at the base ISO (half of the range), taken to every measured
+TEST(CameraProfiles, expandedLowIsosAreNamedAndNeverTheBaseIso)
+{
+    const std::string dir = makeTempDir("camera_profiles_expanded");
+    // Slopes of a full well of 40k electrons at ISO 100: an analog ladder, and the same with ISO 50 and 80
+    // reusing ISO 100's raw (its slope) as expanded settings do.
+    const double a100 = 1.0 / 40000 * DARKTABLE_HAAR_VARIANCE_RATIO, b = 1e-8;
+    const std::vector<Vec3d> analog = {
+        {100, a100, b}, {200, 2 * a100, b}, {400, 4 * a100, 2 * b}, {800, 8 * a100, 5 * b}};
+    std::vector<Vec3d> withExpanded = {{50, a100, b}, {80, a100, b}};
+    withExpanded.insert(withExpanded.end(), analog.begin(), analog.end());
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(writeText(
+        dir, "p.json",
+        profileFile("Test", {cameraEntry("analog", analog), cameraEntry("expanded", withExpanded)})));
+    const CameraNoiseProfile &plain = byModel(cams, "analog"), &expanded = byModel(cams, "expanded");
+    EXPECT_EQ(0, plain.expandedIsos);
+    EXPECT_EQ(100.0, plain.noise.baseIso);
+    EXPECT_EQ(2, expanded.expandedIsos);
+    EXPECT_EQ(100.0, expanded.noise.baseIso) << "an expanded setting is never the base ISO";
+    ASSERT_EQ(6u, expanded.isos.size());
+    EXPECT_TRUE(expanded.isos[0].expanded && expanded.isos[1].expanded && !expanded.isos[2].expanded);
+    EXPECT_EQ(0.5, expanded.isos[0].gain);
+    // Left out of the fit: the expanded camera is fitted exactly as the analog one, and judged on it.
+    EXPECT_EQ(plain.noise.alpha, expanded.noise.alpha);
+    EXPECT_EQ(plain.verdict, expanded.verdict);
+    EXPECT_EQ(plain.worstSlopeResidual, expanded.worstSlopeResidual);
+    // Measured all the same: the augmentation follows ISO 50's line.
+    const NoiseModel m = expanded.modelFor(fourteenBitFormat());
+    EXPECT_NEAR(m.lineAtGain(0.5).a, m.lineAtGain(1).a, 1e-12 * m.lineAtGain(1).a);
+
+    const std::string path = darktableProfilesPath();
+    if (path.empty())
+        GTEST_SKIP() << "darktable's noiseprofiles.json not found (run scripts/fetch-darktable-profiles.sh)";
+    const std::vector<CameraNoiseProfile> real = readCameraProfiles(path);
+    // Two cameras whose expanded settings are documented: the EOS 5D Mark III's L (ISO 50) and the Nikon
+    // D3's Lo 1 to Lo 0.3 (ISO 100 to 160, written 100, 126 and 159 in the file).
+    const CameraNoiseProfile& canon = findCameraProfile(real, "Canon EOS 5D Mark III");
+    EXPECT_EQ(100.0, canon.noise.baseIso);
+    EXPECT_EQ(1, canon.expandedIsos);
+    const CameraNoiseProfile& nikon = findCameraProfile(real, "Nikon D3");
+    EXPECT_EQ(200.0, nikon.noise.baseIso);
+    EXPECT_EQ(3, nikon.expandedIsos);
+    int camerasWithExpanded = 0;
+    for (const CameraNoiseProfile& cam : real)
+        camerasWithExpanded += cam.expandedIsos > 0;
+    std::cout << "[ info ] " << camerasWithExpanded << " of " << real.size()
+              << " cameras have expanded low ISOs\n";
+}
+
+/* Flat frames as a real camera: a capture at the lowest ISO (half of the range), taken to every measured
  * ISO at 0.45 of the range by an exposure change with the prior accounted, has the variance darktable
  * measured there, (a x + b) / c in DN at its mean. 256 x 256 pixels: the spatial variance's standard error is
  * sqrt(2 / 65536) = 0.55%, 5 of them 2.8%. ISOs with a negative offset are left out: the model takes
@@ -495,7 +543,10 @@ TEST(CameraProfiles, flatFramesAugmentedAsARealCameraHaveTheVarianceDarktableMea
         params.quantize = false;
         const SensorSimulator sensor(params, size);
         Mat base;
-        sensor.capture(Mat(size, CV_32FC1, Scalar(0.5 * r)), 1.0, 1.0, 7, 0, base);
+        // At the camera's lowest ISO, expanded or not: every other ISO then adds noise (below it, the
+        // target would have less noise than the prior, which an augmentation cannot remove).
+        const double lowest = cam.isos.front().gain;
+        sensor.capture(Mat(size, CV_32FC1, Scalar(0.5 * r / lowest)), lowest, 1.0, 7, 0, base);
         for (const CameraIsoFit& f : cam.isos) {
             if (f.offset < 0)
                 continue;
@@ -507,11 +558,11 @@ TEST(CameraProfiles, flatFramesAugmentedAsARealCameraHaveTheVarianceDarktableMea
                 ++tooNoisy;
                 continue;
             }
-            const double factor = 0.9 / f.gain;
+            const double gainRatio = f.gain / lowest, factor = 0.9 / gainRatio;
             Mat out;
             RawFormat outFormat;
-            colorJitter(base, sensor.rawFormat(1.0), params.noise,
-                        ColorJitter::exposureChange(factor, f.gain), NoiseAlignment::ACCOUNT_PRIOR,
+            colorJitter(base, sensor.rawFormat(lowest), params.noise,
+                        ColorJitter::exposureChange(factor, gainRatio), NoiseAlignment::ACCOUNT_PRIOR,
                         100 + tested, out, outFormat);
             Mat x;
             subtractBlackLevel(out, outFormat, x);

@@ -76,6 +76,10 @@ struct CV_RAWGMENT_EXPORTS CameraIsoFit
     /** Largest over smallest shot slope of the colours with a positive slope (1 when the colours agree,
      * as in profiles that copy green to every colour). */
     double colourSpread = 1;
+    /** An expanded low setting: its green slope falls less than its ISO below the next ISO (its raw is a
+     * higher ISO's). Measured and followed by the augmentation, but not the base ISO, not fitted to Eq. 5
+     * and not counted in the verdict's figures (readCameraProfiles() says how it is told). */
+    bool expanded = false;
 };
 
 /** @brief A real camera's noise, fitted to Eq. 5 from its measured profiles, in units of a raw range of 1.
@@ -92,8 +96,8 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
     String reason;                        //!< why the verdict is not GOOD (empty when GOOD)
     /** The fitted model over a raw range of 1: alpha is the shot slope at gain 1 (1 / full well in
      * electrons), sigmaD2 and sigmaR2 the read variances before and after the gain over the range
-     * squared, and baseIso the lowest usable ISO (gain 1). All zero while the camera is REFUSED before
-     * its fit. */
+     * squared, and baseIso the lowest usable ISO that is not expanded (gain 1). All zero while the camera is
+     * REFUSED before its fit. */
     NoiseModel noise;
     std::vector<CameraIsoFit> isos; //!< the usable profiles, by ascending ISO (an ISO measured twice twice)
     int skippedProfiles = 0;        //!< profiles marked "skip" or without a positive green slope
@@ -103,7 +107,8 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
     double worstOffsetResidual = 0; //!< largest |offset residual|
     double worstOffsetIso = 0;      //!< its ISO
     double medianColourSpread = 1;  //!< median over ISOs of CameraIsoFit::colourSpread
-    int negativeOffsets = 0;        //!< ISOs whose measured offset is below zero
+    int negativeOffsets = 0;        //!< fitted ISOs whose measured offset is below zero
+    int expandedIsos = 0;           //!< expanded low ISOs (CameraIsoFit::expanded), below the base ISO
     bool monotoneSlope = true;      //!< whether the measured slope never falls as the ISO rises
 
     //! "maker model", the name cameras are selected by.
@@ -124,7 +129,11 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
  *
  * For each maker and model: the green channel's profiles at every ISO (profiles with `"skip": true` and
  * those without a positive green slope are left out and counted), divided by
- * DarktableImportParams::haarVarianceRatio to per-pixel units; alpha by least squares on the relative
+ * DarktableImportParams::haarVarianceRatio to per-pixel units; expanded low settings found (from the
+ * lowest ISO up, each whose green slope falls less than its ISO towards the next ISO down: slope ratio over
+ * ISO ratio above 1.15, where an analog step gives 1 and an expanded setting that reuses the next ISO's raw
+ * gives 1.26 to 2) and left out of the fit and the verdict, but kept as measured lines; alpha by least
+ * squares on the relative
  * slope residuals through the origin; sigma_d^2 and sigma_r^2 >= 0 by weighted non-negative least
  * squares of the offsets, each weighted by 1 / (|b| + a x_ref)^2. An entry that is malformed (a value
  * that is not a number, a list of another length, an unknown key) is REFUSED with the reason naming its
