@@ -78,7 +78,9 @@ std::string isoTable(const CameraNoiseProfile& cam)
         out << cv::format("%8g %7.3f  %11.4g  %11.4g %6.1f%%  %11.4g  %11.4g %6.1f%%  %5.2f    %s\n", f.iso,
                           f.gain, f.slope, fitted.a, 100 * f.slopeResidual, f.offset, fitted.b,
                           100 * f.offsetResidual, f.colourSpread,
-                          f.expanded ? "expanded (not fitted)" : "fitted");
+                          f.expanded       ? "expanded (not fitted)"
+                          : f.inconsistent ? "inconsistent colours (not used)"
+                                           : "fitted");
     }
     return out.str();
 }
@@ -96,7 +98,7 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
     std::map<std::string, int> refusals;
     std::vector<double> medianSlope, worstSlope, worstOffset, medianOffset, fullWell, read, share, baseShare,
         spread;
-    int negative = 0, nonMonotone = 0, usable = 0, lowestWorst = 0, expanded = 0;
+    int negative = 0, nonMonotone = 0, usable = 0, lowestWorst = 0, expanded = 0, inconsistent = 0;
     for (const CameraNoiseProfile& cam : cams) {
         ++verdicts[cam.verdict];
         if (!cam.usable()) {
@@ -120,7 +122,7 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
         std::vector<double> offsets;
         double lowestFitted = 0;
         for (const CameraIsoFit& f : cam.isos)
-            if (!f.expanded) {
+            if (f.fitted()) {
                 offsets.push_back(std::abs(f.offsetResidual));
                 lowestFitted = lowestFitted > 0 ? lowestFitted : f.iso;
             }
@@ -134,6 +136,7 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
         nonMonotone += !cam.monotoneSlope;
         lowestWorst += cam.worstSlopeIso == lowestFitted;
         expanded += cam.expandedIsos > 0;
+        inconsistent += cam.inconsistentProfiles > 0;
     }
     const auto row = [](const char* what, const std::vector<double>& v, double scale, const char* unit) {
         return cv::format("| %s | %.3g%s | %.3g%s | %.3g%s | %.3g%s | %.3g%s |\n", what,
@@ -166,6 +169,9 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
           "out of the fit and of these figures, never the base ISO, followed by the augmentation as "
           "measured): "
        << formatShare(expanded, usable) << ".\n"
+       << "- Cameras with a profile whose red or blue shot slope is negative (a failed fit: left out of "
+          "the fit, these figures and the measured lines): "
+       << formatShare(inconsistent, usable) << ".\n"
        << "- The shot slope's worst fitted ISO is the camera's lowest for "
        << formatShare(lowestWorst, usable) << " of the cameras.\n"
        << "- Cameras with a negative offset at some ISO: " << formatShare(negative, usable) << ".\n"

@@ -315,7 +315,9 @@ void bindCameraCatalogue(py::module_& m)
         .def_readwrite("slopeResidual", &CameraIsoFit::slopeResidual, doc("CameraIsoFit::slopeResidual"))
         .def_readwrite("offsetResidual", &CameraIsoFit::offsetResidual, doc("CameraIsoFit::offsetResidual"))
         .def_readwrite("colourSpread", &CameraIsoFit::colourSpread, doc("CameraIsoFit::colourSpread"))
-        .def_readwrite("expanded", &CameraIsoFit::expanded, doc("CameraIsoFit::expanded"));
+        .def_readwrite("expanded", &CameraIsoFit::expanded, doc("CameraIsoFit::expanded"))
+        .def_readwrite("inconsistent", &CameraIsoFit::inconsistent, doc("CameraIsoFit::inconsistent"))
+        .def("fitted", &CameraIsoFit::fitted, doc("CameraIsoFit::fitted"));
     py::class_<CameraNoiseProfile>(m, "CameraNoiseProfile", doc("CameraNoiseProfile"))
         .def(keywordInit<CameraNoiseProfile>())
         .def_readwrite("maker", &CameraNoiseProfile::maker, doc("CameraNoiseProfile::maker"))

@@ -57,6 +57,8 @@ def _numpy_fit(profiles, c=rg.DARKTABLE_HAAR_VARIANCE_RATIO, x_ref=1e-3):
     the origin; (sigma_d^2, sigma_r^2) >= 0 by weighted least squares, the best feasible point of the
     interior and the boundary."""
     used = sorted((p for p in profiles if not p.get("skip") and p["a"][1] > 0), key=lambda p: p["iso"])
+    # A negative red or blue slope is a failed fit: not fitted.
+    used = [p for p in used if p["a"][0] >= 0 and p["a"][2] >= 0]
     # Expanded low settings: from the lowest ISO up, a green slope that falls less than the ISO towards the
     # next ISO down (ratio of slopes over ratio of ISOs above 1.15), two ISOs always kept; not fitted.
     distinct = sorted({p["iso"] for p in used})
@@ -239,7 +241,7 @@ def test_flat_frames_augmented_as_a_real_camera_have_the_variance_darktable_meas
         data = json.load(f)
     profiles = [p for maker in data["noiseprofiles"] for model in maker["models"]
                 if maker["maker"] + " " + model["model"] == name for p in model["profiles"]
-                if not p.get("skip") and p["a"][1] > 0 and p["b"][1] >= 0]
+                if not p.get("skip") and p["a"][1] > 0 and p["b"][1] >= 0 and min(p["a"]) >= 0]
     fmt = rg.RawFormat(pattern=rg.CFA_RGGB, blackLevel=(512, 512, 512, 512), whiteLevel=16383)
     r, c = 16383 - 512, rg.DARKTABLE_HAAR_VARIANCE_RATIO
     model = camera.modelFor(fmt)
@@ -247,9 +249,10 @@ def test_flat_frames_augmented_as_a_real_camera_have_the_variance_darktable_meas
     params = rg.SensorParams(noise=model, pattern=rg.CFA_RGGB, blackLevel=(512, 512, 512, 512), bitDepth=14,
                              quantize=False)
     sensor = rg.SensorSimulator(params, (256, 256))
-    # At the lowest ISO (its expanded ISO 50, below the base ISO 100): every other ISO then adds noise.
+    # At the lowest measured line (ISO 100: the file's ISO 50 has a negative blue slope, a failed fit the
+    # model leaves out): every other ISO then adds noise.
     lowest = model.measuredLines[0].gain
-    assert lowest == 0.5 and model.baseIso == 100
+    assert lowest == 1 and model.baseIso == 100
     base = sensor.capture(np.full((256, 256), 0.5 * r / lowest, np.float32), lowest, 1.0, seed=7, frameIndex=0)
     tested = 0
     for k, p in enumerate(profiles):
@@ -261,4 +264,4 @@ def test_flat_frames_augmented_as_a_real_camera_have_the_variance_darktable_meas
         expected = p["a"][1] / c * r * x.mean() + p["b"][1] / c * r * r
         assert x.var(ddof=1) / expected == pytest.approx(1, abs=5 * np.sqrt(2 / (x.size - 1))), p["iso"]
         tested += 1
-    assert tested >= 10
+    assert tested == len(profiles) >= 5

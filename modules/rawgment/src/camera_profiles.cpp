@@ -67,15 +67,21 @@ NoiseModel CameraNoiseProfile::modelFor(const RawFormat& format) const
     m.baseIso = noise.baseIso;
     // The augmentation follows what darktable measured at each ISO (NoiseModel::measuredLines); Eq. 5
     // stays the summary and the trend beyond the measured ISOs. An ISO measured twice takes the mean of its
-    // two lines; a negative measured offset (a fit's intercept below zero, never a variance) is taken as 0.
+    // two lines; a negative measured offset (a fit's intercept below zero, never a variance) is taken as 0;
+    // an inconsistent profile is left out.
     for (size_t i = 0; i < isos.size();) {
         size_t j = i;
-        double slope = 0, offset = 0;
-        for (; j < isos.size() && isos[j].iso == isos[i].iso; ++j) {
-            slope += isos[j].slope;
-            offset += isos[j].offset;
+        double slope = 0, offset = 0, n = 0;
+        for (; j < isos.size() && isos[j].iso == isos[i].iso; ++j)
+            if (!isos[j].inconsistent) {
+                slope += isos[j].slope;
+                offset += isos[j].offset;
+                ++n;
+            }
+        if (n == 0) { // only failed profiles at this ISO: its line comes from its neighbours
+            i = j;
+            continue;
         }
-        const double n = static_cast<double>(j - i);
         MeasuredNoiseLine line;
         line.gain = isos[i].gain;
         line.iso = isos[i].iso;
@@ -203,7 +209,7 @@ void judge(CameraNoiseProfile& cam, const DarktableImportParams& params)
     std::set<double> distinct;
     int fitted = 0;
     for (const CameraIsoFit& f : cam.isos)
-        if (!f.expanded) {
+        if (f.fitted()) {
             distinct.insert(f.iso);
             ++fitted;
         }
@@ -251,30 +257,39 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
     const double c = params.haarVarianceRatio;
     // Two profiles at one ISO (19 of darktable's 4.2.1 cameras have some) are two measurements of it:
     // both are fitted.
-    std::vector<const MeasuredProfile*> usable;
+    std::vector<const MeasuredProfile*> usable, consistent;
     std::set<double> distinct;
     for (const MeasuredProfile& p : profiles) {
         if (!(p.a[1] > 0)) {
             ++cam.skippedProfiles;
             continue;
         }
-        distinct.insert(p.iso);
         usable.push_back(&p);
     }
-    std::stable_sort(usable.begin(), usable.end(),
-                     [](const MeasuredProfile* x, const MeasuredProfile* y) { return x->iso < y->iso; });
+    const auto byIso = [](const MeasuredProfile* x, const MeasuredProfile* y) { return x->iso < y->iso; };
+    std::stable_sort(usable.begin(), usable.end(), byIso);
+    // A colour whose shot slope is negative is a failed fit, not a noise (CameraIsoFit::inconsistent); 0 is
+    // how some cameras' files leave a colour unmeasured.
+    for (const MeasuredProfile* p : usable)
+        if (p->a[0] >= 0 && p->a[2] >= 0) {
+            consistent.push_back(p);
+            distinct.insert(p->iso);
+        }
+    cam.inconsistentProfiles = static_cast<int>(usable.size() - consistent.size());
     if (distinct.size() < 2) {
         cam.verdict = CAMERA_PROFILE_REFUSED;
         cam.reason = usable.empty() ? String("no profile with a positive green shot slope")
-                                    : format("a single usable ISO (%g): the read noise before and after the "
-                                             "gain cannot be told apart",
-                                             usable[0]->iso);
+                     : consistent.empty()
+                         ? String("no profile without a negative colour shot slope")
+                         : format("a single usable ISO (%g): the read noise before and after the "
+                                  "gain cannot be told apart",
+                                  consistent[0]->iso);
         return;
     }
-    const std::set<double> expanded = expandedLowIsos(usable);
+    const std::set<double> expanded = expandedLowIsos(consistent);
     cam.expandedIsos = static_cast<int>(expanded.size());
     double baseIso = 0;
-    for (const MeasuredProfile* p : usable)
+    for (const MeasuredProfile* p : consistent)
         if (!expanded.count(p->iso)) {
             baseIso = p->iso;
             break;
@@ -287,6 +302,7 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
         f.slope = p->a[1] / c;
         f.offset = p->b[1] / c;
         f.expanded = expanded.count(p->iso) > 0;
+        f.inconsistent = !(p->a[0] >= 0 && p->a[2] >= 0);
         double lo = HUGE_VAL, hi = 0;
         for (int k = 0; k < 3; ++k)
             if (p->a[k] > 0) {
@@ -295,8 +311,9 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
             }
         f.colourSpread = hi / lo;
         cam.isos.push_back(f);
-        // Eq. 5 describes the analog settings: an expanded one is measured (and followed) but not fitted.
-        if (f.expanded)
+        // Eq. 5 describes the analog settings: an expanded one is measured (and followed) but not fitted,
+        // an inconsistent one neither.
+        if (!f.fitted())
             continue;
         g.push_back(f.gain);
         a.push_back(f.slope);
@@ -324,16 +341,16 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
     cam.noise.baseIso = baseIso;
 
     std::vector<double> slopeResiduals, spreads;
-    for (size_t k = 0, fitted = 0; k < cam.isos.size(); ++k) {
+    const CameraIsoFit* previous = nullptr; // the last fitted ISO
+    for (size_t k = 0; k < cam.isos.size(); ++k) {
         CameraIsoFit& f = cam.isos[k];
         const NoiseLine line = cam.noise.lineAtGain(f.gain);
         f.slopeResidual = (line.a - f.slope) / f.slope;
         const double scale = std::abs(f.offset) + f.slope * params.offsetReferenceLevel;
         f.offsetResidual = (line.b - f.offset) / scale;
-        // The verdict's figures are over the fitted (analog) settings.
-        if (f.expanded)
+        // The verdict's figures are over the fitted (analog, consistent) settings.
+        if (!f.fitted())
             continue;
-        ++fitted;
         slopeResiduals.push_back(std::abs(f.slopeResidual));
         spreads.push_back(f.colourSpread);
         if (std::abs(f.slopeResidual) > cam.worstSlopeResidual) {
@@ -345,8 +362,9 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
             cam.worstOffsetIso = f.iso;
         }
         cam.negativeOffsets += f.offset < 0;
-        if (fitted > 1 && f.iso > cam.isos[k - 1].iso && f.slope < cam.isos[k - 1].slope)
+        if (previous && f.iso > previous->iso && f.slope < previous->slope)
             cam.monotoneSlope = false;
+        previous = &f;
     }
     cam.medianSlopeResidual = median(slopeResiduals);
     cam.medianColourSpread = median(spreads);

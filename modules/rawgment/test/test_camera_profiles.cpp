@@ -500,11 +500,15 @@ TEST(CameraProfiles, expandedLowIsosAreNamedAndNeverTheBaseIso)
     if (path.empty())
         GTEST_SKIP() << "darktable's noiseprofiles.json not found (run scripts/fetch-darktable-profiles.sh)";
     const std::vector<CameraNoiseProfile> real = readCameraProfiles(path);
-    // Two cameras whose expanded settings are documented: the EOS 5D Mark III's L (ISO 50) and the Nikon
-    // D3's Lo 1 to Lo 0.3 (ISO 100 to 160, written 100, 126 and 159 in the file).
+    // Two cameras whose expanded settings are documented: the EOS 5D Mark III's L (ISO 50, whose profile in
+    // the file has a negative blue slope, as have its third stops: inconsistent, never the base ISO either)
+    // and the Nikon D3's Lo 1 to Lo 0.3 (ISO 100 to 160, written 100, 126 and 159 in the file).
     const CameraNoiseProfile& canon = findCameraProfile(real, "Canon EOS 5D Mark III");
     EXPECT_EQ(100.0, canon.noise.baseIso);
-    EXPECT_EQ(1, canon.expandedIsos);
+    EXPECT_EQ(7, canon.inconsistentProfiles) << "ISO 50, 160, 320, 640, 1250, 2500 and 5000";
+    EXPECT_TRUE(canon.isos.front().inconsistent && !canon.isos.front().fitted());
+    const NoiseModel canonModel = canon.modelFor(fourteenBitFormat());
+    EXPECT_EQ(100.0, canonModel.measuredLines.front().iso) << "an inconsistent profile is no measured line";
     const CameraNoiseProfile& nikon = findCameraProfile(real, "Nikon D3");
     EXPECT_EQ(200.0, nikon.noise.baseIso);
     EXPECT_EQ(3, nikon.expandedIsos);
@@ -519,7 +523,8 @@ TEST(CameraProfiles, expandedLowIsosAreNamedAndNeverTheBaseIso)
  * ISO at 0.45 of the range by an exposure change with the prior accounted, has the variance darktable
  * measured there, (a x + b) / c in DN at its mean. 256 x 256 pixels: the spatial variance's standard error is
  * sqrt(2 / 65536) = 0.55%, 5 of them 2.8%. ISOs with a negative offset are left out: the model takes
- * it as 0 (a variance), which differs from the line by |b| / c at any level. */
+ * it as 0 (a variance), which differs from the line by |b| / c at any level; so are inconsistent profiles,
+ * which the model does not follow. */
 TEST(CameraProfiles, flatFramesAugmentedAsARealCameraHaveTheVarianceDarktableMeasured)
 {
     const std::string path = darktableProfilesPath();
@@ -548,7 +553,7 @@ TEST(CameraProfiles, flatFramesAugmentedAsARealCameraHaveTheVarianceDarktableMea
         const double lowest = cam.isos.front().gain;
         sensor.capture(Mat(size, CV_32FC1, Scalar(0.5 * r / lowest)), lowest, 1.0, 7, 0, base);
         for (const CameraIsoFit& f : cam.isos) {
-            if (f.offset < 0)
+            if (f.offset < 0 || f.inconsistent)
                 continue;
             SCOPED_TRACE(cam.name() + cv::format(" at ISO %g", f.iso));
             // Every ISO's flat at 0.45 of the range, where it is at least 5 standard deviations from black

@@ -80,6 +80,13 @@ struct CV_RAWGMENT_EXPORTS CameraIsoFit
      * higher ISO's). Measured and followed by the augmentation, but not the base ISO, not fitted to Eq. 5
      * and not counted in the verdict's figures (readCameraProfiles() says how it is told). */
     bool expanded = false;
+    /** A colour's shot slope is negative (a variance cannot fall as the signal rises): darktable's fit of
+     * that profile failed (the Canon EOS 5D Mark III's ISO 160, 320, 640, ... have negative blue slopes).
+     * Named, but left out of the fit, the verdict's figures and the measured lines (the ISO's line then comes
+     * from its neighbours). */
+    bool inconsistent = false;
+    //! Whether the ISO is fitted to Eq. 5 and counted in the verdict: neither expanded nor inconsistent.
+    bool fitted() const { return !expanded && !inconsistent; }
 };
 
 /** @brief A real camera's noise, fitted to Eq. 5 from its measured profiles, in units of a raw range of 1.
@@ -109,7 +116,8 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
     double medianColourSpread = 1;  //!< median over ISOs of CameraIsoFit::colourSpread
     int negativeOffsets = 0;        //!< fitted ISOs whose measured offset is below zero
     int expandedIsos = 0;           //!< expanded low ISOs (CameraIsoFit::expanded), below the base ISO
-    bool monotoneSlope = true;      //!< whether the measured slope never falls as the ISO rises
+    int inconsistentProfiles = 0; //!< profiles with a negative colour shot slope (CameraIsoFit::inconsistent)
+    bool monotoneSlope = true;    //!< whether the measured slope never falls as the ISO rises
 
     //! "maker model", the name cameras are selected by.
     String name() const;
@@ -119,7 +127,7 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
      * variances times r^2, with r = white - mean black (its baseIso kept), and every usable ISO's
      * measured line (isos: slope times r, offset times r^2, at its gain) as NoiseModel::measuredLines,
      * which the augmentation follows; an ISO measured twice takes the mean of its lines, a negative
-     * measured offset is taken as 0.
+     * measured offset is taken as 0, an inconsistent profile is left out.
      * @throws cv::Exception when the camera is REFUSED (naming the reason) or the format is invalid. */
     NoiseModel modelFor(const RawFormat& format) const;
 };
