@@ -379,18 +379,20 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     detail::checkFinitePositive(jitter.gainRatio, "colorJitter: gainRatio");
     const double newGain = format.gain * jitter.gainRatio;
     detail::checkFinitePositive(newGain, "colorJitter: the new gain");
+    // The model's terms at the input gain and at the output gain (its own line there with measured lines).
+    const detail::NoiseTerms<double> terms = detail::checkedNoiseTerms(model, format.gain);
+    const detail::NoiseTerms<double> outTerms = detail::checkedNoiseTerms(model, newGain);
     {
         // The row loops run in float: the largest value and variance they can form must fit one.
-        const detail::NoiseTerms<double> t = detail::checkedNoiseTerms(model, format.gain);
+        const detail::NoiseTerms<double>& t = terms;
         double largestContrast = 0;
         for (int s = 0; s < 4; ++s)
             largestContrast = std::max(largestContrast, jitter.contrast[s]);
         const double g2 = jitter.gainRatio * jitter.gainRatio;
         const double largestValue = largestContrast * format.whiteLevel + std::abs(jitter.brightness);
-        const detail::NoiseTerms<double> out = detail::checkedNoiseTerms(model, newGain);
         const double largestVariance =
             std::max(g2 * (t.shot * format.whiteLevel + t.readBeforeGain) + t.readAfterGain,
-                     out.shot * largestContrast * format.whiteLevel + out.read());
+                     outTerms.shot * largestContrast * format.whiteLevel + outTerms.read());
         if (!(largestValue < 1e30 && largestVariance < 1e30 && largestContrast * jitter.gainRatio < 1e30))
             CV_Error(Error::StsBadArg,
                      cv::format(
@@ -407,7 +409,6 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
         dstFormat = format;
         return;
     }
-    const detail::NoiseTerms<double> terms = detail::checkedNoiseTerms(model, format.gain);
     JitterConstants k;
     for (int s = 0; s < 4; ++s) {
         k.pc[s] = static_cast<float>(jitter.contrast[s]);
@@ -424,7 +425,6 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     // The output gain's line: the model's own there with measured lines, else Eq. 5's scaling of the
     // input's (in float, as jitterVariance() had it).
     k.measured = model.hasMeasuredLines();
-    const detail::NoiseTerms<double> outTerms = detail::checkedNoiseTerms(model, newGain);
     const double pg2 = jitter.gainRatio * jitter.gainRatio;
     if (k.measured) {
         k.shotOut = static_cast<float>(outTerms.shot);
