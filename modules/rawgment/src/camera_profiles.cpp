@@ -250,6 +250,18 @@ std::set<double> expandedLowIsos(const std::vector<const MeasuredProfile*>& usab
     return expanded;
 }
 
+//! Whether no colour's shot slope is negative (CameraIsoFit::inconsistent); 0 is a colour left unmeasured.
+bool hasConsistentColours(const MeasuredProfile& p)
+{
+    return p.a[0] >= 0 && p.a[2] >= 0;
+}
+
+//! The scale an ISO's offset is weighted and its residual judged by: |b| + a x_ref.
+double offsetScale(const CameraIsoFit& f, const DarktableImportParams& params)
+{
+    return std::abs(f.offset) + f.slope * params.offsetReferenceLevel;
+}
+
 //! Fits one camera from its measured profiles; sets REFUSED with the reason when it cannot.
 void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& profiles,
                const DarktableImportParams& params)
@@ -268,10 +280,9 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
     }
     const auto byIso = [](const MeasuredProfile* x, const MeasuredProfile* y) { return x->iso < y->iso; };
     std::stable_sort(usable.begin(), usable.end(), byIso);
-    // A colour whose shot slope is negative is a failed fit, not a noise (CameraIsoFit::inconsistent); 0 is
-    // how some cameras' files leave a colour unmeasured.
+    // A colour whose shot slope is negative is a failed fit, not a noise.
     for (const MeasuredProfile* p : usable)
-        if (p->a[0] >= 0 && p->a[2] >= 0) {
+        if (hasConsistentColours(*p)) {
             consistent.push_back(p);
             distinct.insert(p->iso);
         }
@@ -302,7 +313,7 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
         f.slope = p->a[1] / c;
         f.offset = p->b[1] / c;
         f.expanded = expanded.count(p->iso) > 0;
-        f.inconsistent = !(p->a[0] >= 0 && p->a[2] >= 0);
+        f.inconsistent = !hasConsistentColours(*p);
         double lo = HUGE_VAL, hi = 0;
         for (int k = 0; k < 3; ++k)
             if (p->a[k] > 0) {
@@ -319,7 +330,7 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
         a.push_back(f.slope);
         b.push_back(f.offset);
         g2.push_back(f.gain * f.gain);
-        const double scale = std::abs(f.offset) + f.slope * params.offsetReferenceLevel;
+        const double scale = offsetScale(f, params);
         w.push_back(1 / (scale * scale));
     }
     // alpha minimises the relative slope residuals: sum ((g alpha - a) / a)^2.
@@ -346,8 +357,7 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
         CameraIsoFit& f = cam.isos[k];
         const NoiseLine line = cam.noise.lineAtGain(f.gain);
         f.slopeResidual = (line.a - f.slope) / f.slope;
-        const double scale = std::abs(f.offset) + f.slope * params.offsetReferenceLevel;
-        f.offsetResidual = (line.b - f.offset) / scale;
+        f.offsetResidual = (line.b - f.offset) / offsetScale(f, params);
         // The verdict's figures are over the fitted (analog, consistent) settings.
         if (!f.fitted())
             continue;
