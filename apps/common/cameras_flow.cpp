@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -43,21 +44,33 @@ double readElectrons(const CameraNoiseProfile& cam)
     return std::sqrt(cam.noise.lineAtGain(1).b) / cam.noise.alpha;
 }
 
+//! The measured lines the camera's model carries, which the augmentation follows: one per consistent ISO.
+int measuredLineCount(const CameraNoiseProfile& cam)
+{
+    std::set<double> isos;
+    for (const CameraIsoFit& f : cam.isos)
+        if (!f.inconsistent)
+            isos.insert(f.iso);
+    return int(isos.size());
+}
+
 std::string catalogueLine(const CameraNoiseProfile& cam)
 {
     if (!cam.usable())
         return cv::format("%-34s %-8s %s", cam.name().c_str(), "REFUSED", cam.reason.c_str());
-    return cv::format("%-34s %-8s %4zu %6g %9.0f %7.2f %6.2f %6.1f%% %6.1f%% %6.1f%% %5.2f  %s",
-                      cam.name().c_str(), cameraProfileVerdictName(cam.verdict).c_str(), cam.isos.size(),
-                      cam.noise.baseIso, 1 / cam.noise.alpha, readElectrons(cam), preGainShare(cam),
-                      100 * cam.medianSlopeResidual, 100 * cam.worstSlopeResidual,
-                      100 * cam.worstOffsetResidual, cam.medianColourSpread, cam.reason.c_str());
+    return cv::format(
+        "%-34s %-8s %4zu %5d %6g %9.0f %7.2f %6.2f %6.1f%% %6.1f%% %6.1f%% %5.2f  %-9s %6.4f  %s",
+        cam.name().c_str(), cameraProfileVerdictName(cam.verdict).c_str(), cam.isos.size(),
+        measuredLineCount(cam), cam.noise.baseIso, 1 / cam.noise.alpha, readElectrons(cam), preGainShare(cam),
+        100 * cam.medianSlopeResidual, 100 * cam.worstSlopeResidual, 100 * cam.worstOffsetResidual,
+        cam.medianColourSpread, profileDemosaicName(cam.demosaic).c_str(), cam.haarVarianceRatio,
+        cam.reason.c_str());
 }
 
 const char* kCatalogueHeader =
-    "camera                             verdict  ISOs   base  full-well   read  pre-g  "
-    "slope~  slope^  offs^ colour  reason\n"
-    "                                                        (e-)   (e-)  share  "
+    "camera                             verdict  ISOs lines   base  full-well   read  pre-g  "
+    "slope~  slope^  offs^ colour  demosaic       c  reason\n"
+    "                                                   (Eq. 5:)   (e-)   (e-)  share  "
     " med    worst  worst  spread\n";
 
 std::string isoTable(const CameraNoiseProfile& cam)
@@ -71,18 +84,43 @@ std::string isoTable(const CameraNoiseProfile& cam)
         "fit over a range of 1: alpha %.4g (full well %.0f e-), sigma_d^2 %.4g, sigma_r^2 %.4g, base "
         "ISO %g\n",
         cam.noise.alpha, 1 / cam.noise.alpha, cam.noise.sigmaD2, cam.noise.sigmaR2, cam.noise.baseIso);
-    out << "     ISO    gain   slope (a/c)  fitted       resid   offset (b/c)  fitted       resid  colours  "
-           "setting\n";
+    out << cv::format("demosaic of the profiles: %s (%s); c = %.4f\n",
+                      profileDemosaicName(cam.demosaic).c_str(), cam.demosaicReason.c_str(),
+                      cam.haarVarianceRatio);
+    out << "     ISO    gain   slope (a/c)  Eq. 5        resid   offset (b/c)  Eq. 5        resid  colours  "
+           "R/G   B/G   setting\n";
     for (const CameraIsoFit& f : cam.isos) {
         const NoiseLine fitted = cam.noise.lineAtGain(f.gain);
-        out << cv::format("%8g %7.3f  %11.4g  %11.4g %6.1f%%  %11.4g  %11.4g %6.1f%%  %5.2f    %s\n", f.iso,
-                          f.gain, f.slope, fitted.a, 100 * f.slopeResidual, f.offset, fitted.b,
-                          100 * f.offsetResidual, f.colourSpread,
-                          f.expanded       ? "expanded (not fitted)"
-                          : f.inconsistent ? "inconsistent colours (not used)"
-                                           : "fitted");
+        const std::string setting = f.inconsistent ? "inconsistent colours (not used)"
+                                    : f.expanded   ? "expanded (not fitted)"
+                                    : f.digital()
+                                        ? cv::format("digital, the raw of ISO %g (not fitted)", f.rawIso)
+                                        : "fitted";
+        out << cv::format(
+            "%8g %7.3f  %11.4g  %11.4g %6.1f%%  %11.4g  %11.4g %6.1f%%  %5.2f  %5.2f %5.2f  %s\n", f.iso,
+            f.gain, f.slope, fitted.a, 100 * f.slopeResidual, f.offset, fitted.b, 100 * f.offsetResidual,
+            f.colourSpread, f.colourSlopeRatios[0], f.colourSlopeRatios[1], setting.c_str());
     }
+    out << "The augmentation follows the measured slope and offset at each ISO that is not inconsistent; the "
+           "Eq. 5 columns are the fit's summary.\n";
     return out.str();
+}
+
+/* Each usable profile's shot slope in the camera's model (its measured lines) and in Eq. 5's fit alone, as
+ * |used / (a / c) - 1|: the model is taken in DN of a 16-bit range and scaled back. */
+void addSlopeErrors(const CameraNoiseProfile& cam, std::vector<double>& lines, std::vector<double>& eq5)
+{
+    RawFormat format;
+    format.whiteLevel = 65535;
+    const double r = format.whiteLevel - format.blackLevel[0];
+    const NoiseModel model = cam.modelFor(format);
+    NoiseModel summary = model;
+    summary.measuredLines.clear();
+    for (const CameraIsoFit& f : cam.isos) {
+        const double g = f.iso / model.baseIso;
+        lines.push_back(std::abs(model.lineAtGain(g).a / r / f.slope - 1));
+        eq5.push_back(std::abs(summary.lineAtGain(g).a / r / f.slope - 1));
+    }
 }
 
 std::string formatShare(int part, int whole)
@@ -98,7 +136,10 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
     std::map<std::string, int> refusals;
     std::vector<double> medianSlope, worstSlope, worstOffset, medianOffset, fullWell, read, share, baseShare,
         spread;
-    int negative = 0, nonMonotone = 0, usable = 0, lowestWorst = 0, expanded = 0, inconsistent = 0;
+    int negative = 0, nonMonotone = 0, usable = 0, lowestWorst = 0, expanded = 0, inconsistent = 0,
+        digital = 0;
+    std::map<int, int> demosaics;
+    std::vector<double> balancePpg, balanceRcd, linesError, eq5Error;
     for (const CameraNoiseProfile& cam : cams) {
         ++verdicts[cam.verdict];
         if (!cam.usable()) {
@@ -137,6 +178,15 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
         lowestWorst += cam.worstSlopeIso == lowestFitted;
         expanded += cam.expandedIsos > 0;
         inconsistent += cam.inconsistentProfiles > 0;
+        digital += cam.digitalIsos > 0;
+        ++demosaics[cam.demosaic];
+        if (cam.demosaic == PROFILE_DEMOSAIC_UNDECIDED && cam.balancePpg[0] > 0) {
+            balancePpg.push_back(cam.balancePpg[0]);
+            balancePpg.push_back(cam.balancePpg[1]);
+            balanceRcd.push_back(cam.balanceRcd[0]);
+            balanceRcd.push_back(cam.balanceRcd[1]);
+        }
+        addSlopeErrors(cam, linesError, eq5Error);
     }
     const auto row = [](const char* what, const std::vector<double>& v, double scale, const char* unit) {
         return cv::format("| %s | %.3g%s | %.3g%s | %.3g%s | %.3g%s | %.3g%s |\n", what,
@@ -169,6 +219,11 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
           "out of the fit and of these figures, never the base ISO, followed by the augmentation as "
           "measured): "
        << formatShare(expanded, usable) << ".\n"
+       << "- Cameras with digital settings (neighbouring ISOs a third of a stop or more apart with one "
+          "slope: "
+          "one raw, such as Canon's third stops 160, 320, 640; left out of the fit and of these figures, "
+          "followed as measured): "
+       << formatShare(digital, usable) << ".\n"
        << "- Cameras with a profile whose red or blue shot slope is negative (a failed fit: left out of "
           "the fit, these figures and the measured lines): "
        << formatShare(inconsistent, usable) << ".\n"
@@ -177,6 +232,24 @@ std::string reportText(const std::vector<CameraNoiseProfile>& cams, const std::s
        << "- Cameras with a negative offset at some ISO: " << formatShare(negative, usable) << ".\n"
        << "- Cameras whose measured slope falls somewhere as the ISO rises: "
        << formatShare(nonMonotone, usable) << ".\n\n"
+       << "## What the augmentation follows\n\n"
+       << "At every measured ISO of the " << usable << " imported cameras (" << linesError.size()
+       << " profiles), the shot slope of the camera's model against darktable's a / c:\n\n"
+       << "| slope used | median | 90th percentile |\n|---|---:|---:|\n"
+       << cv::format("| the measured lines (what the augmentation follows) | %.1f%% | %.1f%% |\n",
+                     100 * quantile(linesError, 0.5), 100 * quantile(linesError, 0.9))
+       << cv::format("| Eq. 5's fit alone (the summary above) | %.1f%% | %.1f%% |\n\n",
+                     100 * quantile(eq5Error, 0.5), 100 * quantile(eq5Error, 0.9))
+       << "## Which demosaic the profiles were made with\n\n"
+       << "| demosaic | cameras |\n|---|---|\n";
+    for (const auto& d : demosaics)
+        md << "| " << profileDemosaicName(d.first) << " | " << d.second << " |\n";
+    md << "\nWhere both fit, the colour balance (green over red and blue raw level of the profiling shot) "
+          "each "
+          "implies, over the colours of those cameras: PPG "
+       << cv::format("%.2f (median; 10%%-90%%: %.2f-%.2f), RCD %.2f (%.2f-%.2f).\n\n",
+                     quantile(balancePpg, 0.5), quantile(balancePpg, 0.1), quantile(balancePpg, 0.9),
+                     quantile(balanceRcd, 0.5), quantile(balanceRcd, 0.1), quantile(balanceRcd, 0.9))
        << "## The fitted parameters\n\n"
        << "| parameter | 10% | 25% | median | 75% | 90% |\n|---|---|---|---|---|---|\n"
        << row("full well at base ISO, 1 / alpha (e-)", fullWell, 1, "")

@@ -291,6 +291,15 @@ void bindCameraCatalogue(py::module_& m)
     m.def("cameraProfileVerdictName", &cameraProfileVerdictName, py::arg("verdict"),
           doc("cameraProfileVerdictName"));
     m.attr("DARKTABLE_HAAR_VARIANCE_RATIO") = DARKTABLE_HAAR_VARIANCE_RATIO;
+    m.attr("DARKTABLE_RCD_HAAR_VARIANCE_RATIO") = DARKTABLE_RCD_HAAR_VARIANCE_RATIO;
+    py::enum_<ProfileDemosaic>(m, "ProfileDemosaic", doc("ProfileDemosaic"))
+        .value("PROFILE_DEMOSAIC_UNDECIDED", PROFILE_DEMOSAIC_UNDECIDED,
+               doc("ProfileDemosaic::PROFILE_DEMOSAIC_UNDECIDED"))
+        .value("PROFILE_DEMOSAIC_PPG", PROFILE_DEMOSAIC_PPG, doc("ProfileDemosaic::PROFILE_DEMOSAIC_PPG"))
+        .value("PROFILE_DEMOSAIC_NEITHER", PROFILE_DEMOSAIC_NEITHER,
+               doc("ProfileDemosaic::PROFILE_DEMOSAIC_NEITHER"))
+        .export_values();
+    m.def("profileDemosaicName", &profileDemosaicName, py::arg("demosaic"), doc("profileDemosaicName"));
     py::class_<DarktableImportParams>(m, "DarktableImportParams", doc("DarktableImportParams"))
         .def(keywordInit<DarktableImportParams>())
         .def_readwrite("haarVarianceRatio", &DarktableImportParams::haarVarianceRatio,
@@ -317,6 +326,10 @@ void bindCameraCatalogue(py::module_& m)
         .def_readwrite("colourSpread", &CameraIsoFit::colourSpread, doc("CameraIsoFit::colourSpread"))
         .def_readwrite("expanded", &CameraIsoFit::expanded, doc("CameraIsoFit::expanded"))
         .def_readwrite("inconsistent", &CameraIsoFit::inconsistent, doc("CameraIsoFit::inconsistent"))
+        .def_readwrite("colourSlopeRatios", &CameraIsoFit::colourSlopeRatios,
+                       doc("CameraIsoFit::colourSlopeRatios"))
+        .def_readwrite("rawIso", &CameraIsoFit::rawIso, doc("CameraIsoFit::rawIso"))
+        .def("digital", &CameraIsoFit::digital, doc("CameraIsoFit::digital"))
         .def("fitted", &CameraIsoFit::fitted, doc("CameraIsoFit::fitted"));
     py::class_<CameraNoiseProfile>(m, "CameraNoiseProfile", doc("CameraNoiseProfile"))
         .def(keywordInit<CameraNoiseProfile>())
@@ -347,6 +360,19 @@ void bindCameraCatalogue(py::module_& m)
                        doc("CameraNoiseProfile::expandedIsos"))
         .def_readwrite("monotoneSlope", &CameraNoiseProfile::monotoneSlope,
                        doc("CameraNoiseProfile::monotoneSlope"))
+        .def_readwrite("digitalIsos", &CameraNoiseProfile::digitalIsos,
+                       doc("CameraNoiseProfile::digitalIsos"))
+        .def_readwrite("inconsistentProfiles", &CameraNoiseProfile::inconsistentProfiles,
+                       doc("CameraNoiseProfile::inconsistentProfiles"))
+        .def_readwrite("colourSlopeRatios", &CameraNoiseProfile::colourSlopeRatios,
+                       doc("CameraNoiseProfile::colourSlopeRatios"))
+        .def_readwrite("balancePpg", &CameraNoiseProfile::balancePpg, doc("CameraNoiseProfile::balancePpg"))
+        .def_readwrite("balanceRcd", &CameraNoiseProfile::balanceRcd, doc("CameraNoiseProfile::balanceRcd"))
+        .def_readwrite("demosaic", &CameraNoiseProfile::demosaic, doc("CameraNoiseProfile::demosaic"))
+        .def_readwrite("demosaicReason", &CameraNoiseProfile::demosaicReason,
+                       doc("CameraNoiseProfile::demosaicReason"))
+        .def_readwrite("haarVarianceRatio", &CameraNoiseProfile::haarVarianceRatio,
+                       doc("CameraNoiseProfile::haarVarianceRatio"))
         .def("name", &CameraNoiseProfile::name, doc("CameraNoiseProfile::name"))
         .def("usable", &CameraNoiseProfile::usable, doc("CameraNoiseProfile::usable"))
         .def("modelFor", &CameraNoiseProfile::modelFor, py::arg("format"),

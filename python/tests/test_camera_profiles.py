@@ -43,6 +43,41 @@ def test_a_sensor_measured_the_way_darktable_measures_is_imported_with_its_noise
     assert 0.8 < ratio[2] < 1.6, got
 
 
+def test_the_demosaics_c_and_colour_ratios_are_the_ones_the_library_states(source_dir):
+    """The constants of the catalogue's demosaic judgement against darktable's PPG and RCD written in numpy
+    (python/tools/darktable_demosaic.py): c of green per demosaic, and the red and blue over green slope
+    ratio at a colour balance of 2."""
+    tool = _darktable_tool(source_dir)
+    rng = np.random.default_rng(7)
+    grey = {name: np.mean([tool.flat_field_ratios(d, 1.0, rng) for _ in range(2)], 0)
+            for name, d in tool.DEMOSAICS.items()}
+    # Two 492 x 492 frames give 2 x 60k Haar coefficients; a MAD variance of n normal values has a relative
+    # standard error of about 1.6 / sqrt(n), 0.5% here: 5% is ten of them, and PPG's and RCD's c differ by 68%.
+    assert grey["PPG"][1] == pytest.approx(rg.DARKTABLE_HAAR_VARIANCE_RATIO, rel=0.05)
+    assert grey["RCD"][1] == pytest.approx(rg.DARKTABLE_RCD_HAAR_VARIANCE_RATIO, rel=0.05)
+    for name, (intercept, slope) in (("PPG", (0.284, 0.946)), ("RCD", (0.592, 0.962))):
+        ratios = tool.flat_field_ratios(tool.DEMOSAICS[name], 2.0, rng)
+        # The ratio of two such variances: about 0.7% each, so 0.1 (4% of a ratio near 2.5) is several
+        # of them and a third of the gap between the demosaics' lines (0.34 at a balance of 2).
+        for colour in (0, 2):
+            assert ratios[colour] / ratios[1] == pytest.approx(intercept + 2 * slope, abs=0.1), (name, ratios)
+
+
+def test_the_catalogue_names_digital_settings_and_the_demosaic_in_python():
+    cameras = rg.readCameraProfiles(_profiles_path())
+    m5 = rg.findCameraProfile(cameras, "Canon EOS M5")
+    raw_of = {f.iso: f.rawIso for f in m5.isos}
+    assert raw_of[160] == 200 and raw_of[320] == 400 and raw_of[200] == 0
+    assert m5.digitalIsos >= 3
+    assert not [f for f in m5.isos if f.digital() and f.fitted()]
+    assert m5.haarVarianceRatio == rg.DARKTABLE_HAAR_VARIANCE_RATIO
+    judged = {c.demosaic for c in cameras if c.usable()}
+    assert rg.PROFILE_DEMOSAIC_PPG in judged and rg.PROFILE_DEMOSAIC_UNDECIDED in judged
+    ppg = next(c for c in cameras if c.demosaic == rg.PROFILE_DEMOSAIC_PPG)
+    assert min(ppg.balanceRcd) < 1 <= min(ppg.balancePpg) + 0.11, (ppg.name(), ppg.demosaicReason)
+    assert rg.profileDemosaicName(ppg.demosaic) == "PPG"
+
+
 def _profiles_path():
     path = rg.darktableProfilesPath()
     if not path:
@@ -69,7 +104,27 @@ def _numpy_fit(profiles, c=rg.DARKTABLE_HAAR_VARIANCE_RATIO, x_ref=1e-3):
         if not (slope[lo] / slope[hi]) / (lo / hi) > 1.15:
             break
         expanded.add(lo)
-    used = [p for p in used if p["iso"] not in expanded]
+    # Digital settings: above those, neighbours at least 1.2 apart in ISO whose slopes differ by under 8% are
+    # one raw; in each such run the ISO whose slope / ISO is nearest the median over ISOs in no run is the
+    # analog one. Two analog ISOs are always kept.
+    rest = [s for s in distinct if s not in expanded]
+    runs, run = [], [rest[0]]
+    for lo, hi in zip(rest, rest[1:]):
+        if hi / lo >= 1.2 and abs(slope[hi] / slope[lo] - 1) < 0.08:
+            run.append(hi)
+        else:
+            runs.append(run)
+            run = [hi]
+    runs.append(run)
+    alone = [slope[r[0]] / r[0] for r in runs if len(r) == 1] or [slope[s] / s for s in rest]
+    trend = np.median(alone)
+    digital = set()
+    for r in (r for r in runs if len(r) > 1):
+        analog = min(r, key=lambda s: abs(np.log(slope[s] / s / trend)))
+        digital |= set(r) - {analog}
+    if len(rest) - len(digital) < 2:
+        digital = set()
+    used = [p for p in used if p["iso"] not in expanded | digital]
     iso = np.array([p["iso"] for p in used], float)
     a = np.array([p["a"][1] for p in used]) / c
     b = np.array([p["b"][1] for p in used]) / c

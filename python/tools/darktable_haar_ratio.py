@@ -26,34 +26,15 @@ imported over truth, mean +- standard error:
 import argparse
 import json
 import os
+import sys
 import tempfile
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from darktable_demosaic import BORDER, ppg, ppg_green, rcd  # noqa: E402
+
 SIZE = 1024
-
-
-def ppg_green(mosaic):
-    """Green of an RGGB mosaic: kept at green sites, interpolated at red and blue sites."""
-    rows_, cols_ = mosaic.shape
-    pad = np.pad(mosaic, 3, mode="reflect")
-
-    def at(dy, dx):
-        return pad[3 + dy:3 + dy + rows_, 3 + dx:3 + dx + cols_]
-
-    c = at(0, 0)
-    xm, xp, xm2, xp2, xm3, xp3 = at(0, -1), at(0, 1), at(0, -2), at(0, 2), at(0, -3), at(0, 3)
-    ym, yp, ym2, yp2, ym3, yp3 = at(-1, 0), at(1, 0), at(-2, 0), at(2, 0), at(-3, 0), at(3, 0)
-    grad_x = (abs(xm2 - c) + abs(xp2 - c) + abs(xm - xp)) * 3 + (abs(xp3 - xp) + abs(xm3 - xm)) * 2
-    grad_y = (abs(ym2 - c) + abs(yp2 - c) + abs(ym - yp)) * 3 + (abs(yp3 - yp) + abs(ym3 - ym)) * 2
-    guess_x = np.clip(((xm + c + xp) * 2 - xp2 - xm2) / 4, np.minimum(xm, xp), np.maximum(xm, xp))
-    guess_y = np.clip(((ym + c + yp) * 2 - yp2 - ym2) / 4, np.minimum(ym, yp), np.maximum(ym, yp))
-    interpolated = np.where(grad_x > grad_y, guess_y, guess_x)
-    rows, cols = np.mgrid[0:rows_, 0:cols_]
-    green = mosaic.copy()
-    red_or_blue = (rows + cols) % 2 == 0
-    green[red_or_blue] = interpolated[red_or_blue]
-    return green
 
 
 def haar_hh(channel):
@@ -113,6 +94,53 @@ def measured_sensor_profiles(seed, sensor=STUDY_SENSOR, isos=(100, 200, 400, 800
     return {"version": 0, "noiseprofiles": [{"maker": "Sim", "models": [{"model": "Sensor", "profiles": profiles}]}]}
 
 
+#: darktable's demosaics for Bayer sensors: PPG, the default until 3.4, and RCD, the default from 3.6 (2021).
+DEMOSAICS = {"PPG": ppg, "RCD": rcd}
+#: Green over red (and over blue) raw level of the flat fields the colour study runs: 1 is grey; an
+#: un-white-balanced raw of a grey scene has green brightest, about 2 for red and 1.5 for blue in daylight.
+BALANCES = (1.0, 1.5, 2.0, 2.5, 3.0)
+
+
+def flat_field_ratios(demosaic, balance, rng, size=512, level=0.3, slope=1e-5):
+    """c of each colour (the Haar-MAD variance of the demosaiced colour over the per-pixel shot variance of that
+    colour's raw sites) on a flat RGGB field with green at `level` and red and blue at level / balance, shot
+    noise of variance slope x at each site. The noise is small against the level, as in a profile's bright
+    bins, so the demosaic's clamps and ratios act as they do there."""
+    rows, cols = np.mgrid[0:size, 0:size]
+    red = (rows % 2 == 0) & (cols % 2 == 0)
+    blue = (rows % 2 == 1) & (cols % 2 == 1)
+    levels = np.where(red | blue, level / balance, level)
+    mosaic = levels + np.sqrt(slope * levels) * rng.standard_normal((size, size))
+    out = demosaic(mosaic)[BORDER:-BORDER, BORDER:-BORDER]
+    own = (level / balance, level, level / balance)
+    return np.array([haar_mad_variance(out[..., k]) / (slope * own[k]) for k in range(3)])
+
+
+def demosaic_study(frames=4, seed=1):
+    """c per demosaic and colour on grey, and the line the red or blue over green slope ratio follows in the
+    colour balance: ratio = intercept + slope * balance, least squares over BALANCES (red and blue pooled,
+    the two are symmetric)."""
+    rng = np.random.default_rng(seed)
+    result = {}
+    for name, demosaic in DEMOSAICS.items():
+        per_balance = {k: np.mean([flat_field_ratios(demosaic, k, rng) for _ in range(frames)], 0) for k in BALANCES}
+        grey = per_balance[1.0]
+        ks = np.array([k for k in BALANCES for _ in range(2)])
+        ratios = np.array([per_balance[k][j] / per_balance[k][1] for k in BALANCES for j in (0, 2)])
+        slope, intercept = np.polyfit(ks, ratios, 1)
+        result[name] = {"c": grey, "ratio_line": (intercept, slope),
+                        "ratios": {k: (v[0] / v[1], v[2] / v[1]) for k, v in per_balance.items()}}
+    return result
+
+
+def print_demosaic_study(frames):
+    for name, r in demosaic_study(frames).items():
+        print("%s on grey:  c red %.4f  green %.4f  blue %.4f" % ((name,) + tuple(r["c"])))
+        for k, (red, blue) in r["ratios"].items():
+            print("    green/red = green/blue = %.1f: slope ratio red/green %.3f  blue/green %.3f" % (k, red, blue))
+        print("    ratio = %.3f + %.3f * balance" % r["ratio_line"])
+
+
 def study(campaigns):
     import rawgment
 
@@ -134,11 +162,15 @@ def study(campaigns):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0], allow_abbrev=False)
     parser.add_argument("--study", type=int, default=0, help="campaigns of the import check (0: none)")
+    parser.add_argument("--demosaics", type=int, default=0, metavar="FRAMES",
+                        help="c of PPG and RCD per colour and the slope ratios' line, FRAMES per balance (0: none)")
     args = parser.parse_args()
     rng = np.random.default_rng(1)
     for name, demosaic in [("no demosaicing", lambda m: m), ("darktable PPG green", ppg_green)]:
         ratios = [haar_mad_variance(demosaic(rng.standard_normal((SIZE, SIZE)))) for _ in range(16)]
         print(f"{name + ':':21s} c = {np.mean(ratios):.4f} +- {np.std(ratios) / np.sqrt(len(ratios)):.4f}")
+    if args.demosaics:
+        print_demosaic_study(args.demosaics)
     if args.study:
         study(args.study)
 

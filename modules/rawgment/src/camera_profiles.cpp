@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Real cameras (camera_profiles topic): darktable's measured noise profiles fitted to Eq. 5, the camera
 // catalogue, camera draws, and the one loader that takes a model from any file the project reads.
+#include "camera_profiles_detail.hpp"
 #include "precomp.hpp"
 #include "random.hpp"
 #include "raw_io_detail.hpp"
@@ -222,32 +223,20 @@ void judge(CameraNoiseProfile& cam, const DarktableImportParams& params)
         cam.reason += (cam.reason.empty() ? "" : "; ") + r;
 }
 
-/* The expanded low settings among profiles by increasing ISO: from the lowest, each ISO whose green slope
- * falls less than its ISO does towards the next ISO down, (a_k / a_k+1) / (s_k / s_k+1) > 1.15. An analog
- * step gives 1; an expanded setting whose raw is the next ISO's (over-exposed and pulled in processing,
- * the Canon EOS 5D Mark III's ISO 50, the Nikon D3's ISO 100 to 159) gives s_k+1 / s_k, 1.26 a third of a
- * stop below and 2 a stop below. Two analog ISOs are always kept. An ISO measured twice is taken at its
- * mean slope. Expanded or digital settings above the highest analog gain cannot be told from the lines:
- * a digital push scales the slope and the offset as an analog gain with the read noise before it does. */
-std::set<double> expandedLowIsos(const std::vector<const MeasuredProfile*>& usable)
+//! The settings of the ISOs of profiles by increasing ISO; an ISO measured twice is taken at its mean slope.
+IsoSettings isoSettingsOf(const std::vector<const MeasuredProfile*>& profiles)
 {
     std::vector<double> isos, slopes;
-    for (size_t i = 0; i < usable.size();) {
+    for (size_t i = 0; i < profiles.size();) {
         size_t j = i;
         double sum = 0;
-        for (; j < usable.size() && usable[j]->iso == usable[i]->iso; ++j)
-            sum += usable[j]->a[1];
-        isos.push_back(usable[i]->iso);
+        for (; j < profiles.size() && profiles[j]->iso == profiles[i]->iso; ++j)
+            sum += profiles[j]->a[1];
+        isos.push_back(profiles[i]->iso);
         slopes.push_back(sum / double(j - i));
         i = j;
     }
-    std::set<double> expanded;
-    for (size_t k = 0; k + 2 < isos.size(); ++k) {
-        if (!((slopes[k] / slopes[k + 1]) / (isos[k] / isos[k + 1]) > 1.15))
-            break;
-        expanded.insert(isos[k]);
-    }
-    return expanded;
+    return classifyIsoSettings(isos, slopes);
 }
 
 //! Whether no colour's shot slope is negative (CameraIsoFit::inconsistent); 0 is a colour left unmeasured.
@@ -267,6 +256,7 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
                const DarktableImportParams& params)
 {
     const double c = params.haarVarianceRatio;
+    cam.haarVarianceRatio = c;
     // Two profiles at one ISO (19 of darktable's 4.2.1 cameras have some) are two measurements of it:
     // both are fitted.
     std::vector<const MeasuredProfile*> usable, consistent;
@@ -297,11 +287,13 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
                                   consistent[0]->iso);
         return;
     }
-    const std::set<double> expanded = expandedLowIsos(consistent);
+    const IsoSettings settings = isoSettingsOf(consistent);
+    const std::set<double>& expanded = settings.expanded;
     cam.expandedIsos = static_cast<int>(expanded.size());
+    cam.digitalIsos = static_cast<int>(settings.digital.size());
     double baseIso = 0;
     for (const MeasuredProfile* p : consistent)
-        if (!expanded.count(p->iso)) {
+        if (!expanded.count(p->iso) && !settings.digital.count(p->iso)) {
             baseIso = p->iso;
             break;
         }
@@ -313,6 +305,8 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
         f.slope = p->a[1] / c;
         f.offset = p->b[1] / c;
         f.expanded = expanded.count(p->iso) > 0;
+        const auto digital = settings.digital.find(p->iso);
+        f.rawIso = digital == settings.digital.end() ? 0 : digital->second;
         f.inconsistent = !hasConsistentColours(*p);
         double lo = HUGE_VAL, hi = 0;
         for (int k = 0; k < 3; ++k)
@@ -321,9 +315,11 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
                 hi = std::max(hi, p->a[k]);
             }
         f.colourSpread = hi / lo;
+        for (int k = 0; k < 2; ++k)
+            f.colourSlopeRatios[k] = p->a[2 * k] > 0 ? p->a[2 * k] / p->a[1] : 0;
         cam.isos.push_back(f);
-        // Eq. 5 describes the analog settings: an expanded one is measured (and followed) but not fitted,
-        // an inconsistent one neither.
+        // Eq. 5 describes the analog settings: an expanded or digital one is measured (and followed) but not
+        // fitted, an inconsistent one neither.
         if (!f.fitted())
             continue;
         g.push_back(f.gain);
@@ -378,6 +374,7 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
     }
     cam.medianSlopeResidual = median(slopeResiduals);
     cam.medianColourSpread = median(spreads);
+    judgeProfileDemosaic(cam);
     if (cam.negativeOffsets == int(g.size())) {
         cam.verdict = CAMERA_PROFILE_REFUSED;
         cam.reason =

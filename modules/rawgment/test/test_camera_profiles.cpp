@@ -222,7 +222,7 @@ TEST(CameraProfiles, camerasAreFoundByNameAndAMissingOneListsTheClosest)
     const double c = DARKTABLE_HAAR_VARIANCE_RATIO;
     const std::vector<Vec3d> good = {Vec3d(100, c * 1e-4, c * 4e-8), Vec3d(200, c * 2e-4, c * 5e-8),
                                      Vec3d(400, c * 4e-4, c * 8e-8)};
-    const std::vector<Vec3d> rough = {Vec3d(100, c * 1e-4, c * 4e-8), Vec3d(200, c * 4e-4, c * 5e-8),
+    const std::vector<Vec3d> rough = {Vec3d(100, c * 1e-4, c * 4e-8), Vec3d(200, c * 3.6e-4, c * 5e-8),
                                       Vec3d(400, c * 4e-4, c * 8e-8)};
     const std::string dir = makeTempDir("camera_profiles_names");
     const std::string path =
@@ -518,6 +518,133 @@ TEST(CameraProfiles, expandedLowIsosAreNamedAndNeverTheBaseIso)
         camerasWithExpanded += cam.expandedIsos > 0;
     std::cout << "[ info ] " << camerasWithExpanded << " of " << real.size()
               << " cameras have expanded low ISOs\n";
+}
+
+TEST(CameraProfiles, digitalSettingsAreNamedWithTheirRawIsoAndNotFitted)
+{
+    const std::string dir = makeTempDir("camera_profiles_digital");
+    // A full well of 40k electrons at ISO 100 in third stops; in "pulled", ISO 160 and 320 have the slope of
+    // 200 and 400 (their raw scaled with its white level, as Canon's third stops), in "pushed" ISO 4000 and
+    // 5000 keep the raw of 3200 (as Fujifilm's high settings).
+    const double a100 = 1.0 / 40000 * DARKTABLE_HAAR_VARIANCE_RATIO, b = 1e-8;
+    std::vector<Vec3d> analog, pulled, pushed;
+    for (double iso : {100.0, 125.0, 160.0, 200.0, 250.0, 320.0, 400.0, 500.0}) {
+        analog.push_back(Vec3d(iso, a100 * iso / 100, b));
+        const double raw = iso == 160 ? 200 : iso == 320 ? 400 : iso;
+        pulled.push_back(Vec3d(iso, a100 * raw / 100, b));
+    }
+    for (double iso : {800.0, 1600.0, 3200.0, 4000.0, 5000.0})
+        pushed.push_back(Vec3d(iso, a100 * std::min(iso, 3200.0) / 100, b * iso / 800));
+    const std::vector<CameraNoiseProfile> cams = readCameraProfiles(
+        writeText(dir, "p.json",
+                  profileFile("Test", {cameraEntry("analog", analog), cameraEntry("pulled", pulled),
+                                       cameraEntry("pushed", pushed)})));
+    const CameraNoiseProfile &plain = byModel(cams, "analog"), &pull = byModel(cams, "pulled"),
+                             &push = byModel(cams, "pushed");
+    EXPECT_EQ(0, plain.digitalIsos) << "an analog ladder in thirds has no digital setting";
+    ASSERT_EQ(2, pull.digitalIsos);
+    for (const CameraIsoFit& f : pull.isos) {
+        SCOPED_TRACE(cv::format("ISO %g", f.iso));
+        EXPECT_EQ(f.rawIso, f.iso == 160 ? 200.0 : f.iso == 320 ? 400.0 : 0.0);
+        EXPECT_EQ(f.fitted(), !f.digital());
+    }
+    // Left out, the digital settings leave Eq. 5 the analog ladder's alpha, exactly.
+    EXPECT_NEAR(pull.noise.alpha, plain.noise.alpha, 1e-12 * plain.noise.alpha);
+    EXPECT_EQ(pull.verdict, CAMERA_PROFILE_GOOD) << pull.reason;
+    // Followed as measured all the same: ISO 160's line is ISO 200's slope.
+    const NoiseModel m = pull.modelFor(fourteenBitFormat());
+    EXPECT_NEAR(m.lineAtGain(1.6).a, m.lineAtGain(2).a, 1e-12 * m.lineAtGain(2).a);
+    ASSERT_EQ(2, push.digitalIsos);
+    EXPECT_EQ(3200.0, push.isos[3].rawIso);
+    EXPECT_EQ(3200.0, push.isos[4].rawIso);
+    EXPECT_EQ(800.0, push.noise.baseIso);
+
+    const std::string path = darktableProfilesPath();
+    if (path.empty())
+        GTEST_SKIP() << "darktable's noiseprofiles.json not found (run scripts/fetch-darktable-profiles.sh)";
+    const std::vector<CameraNoiseProfile> real = readCameraProfiles(path);
+    // The Canon EOS M5's third stops 160, 320 and 640 are 200, 400 and 800 with the white level lowered
+    // (their slopes differ by 3%, 0.2% and 1.9% from those ISOs' in the file).
+    const CameraNoiseProfile& m5 = findCameraProfile(real, "Canon EOS M5");
+    std::map<double, double> rawOf;
+    for (const CameraIsoFit& f : m5.isos)
+        rawOf[f.iso] = f.rawIso;
+    EXPECT_EQ(200.0, rawOf[160]);
+    EXPECT_EQ(400.0, rawOf[320]);
+    EXPECT_EQ(800.0, rawOf[640]);
+    EXPECT_EQ(0.0, rawOf[200]);
+    EXPECT_EQ(0.0, rawOf[125]);
+    EXPECT_EQ(100.0, m5.noise.baseIso);
+    int camerasWithDigital = 0;
+    for (const CameraNoiseProfile& cam : real)
+        camerasWithDigital += cam.digitalIsos > 0;
+    std::cout << "[ info ] " << camerasWithDigital << " of " << real.size()
+              << " cameras have digital settings\n";
+}
+
+//! A camera entry whose red and blue slopes are the green slope times `ratios`.
+std::string colouredEntry(const std::string& model, const std::vector<double>& isos, Vec2d ratios)
+{
+    const double a100 = 1.0 / 40000 * DARKTABLE_HAAR_VARIANCE_RATIO, b = 1e-8;
+    std::string text = "{\"model\": \"" + model + "\", \"profiles\": [";
+    for (size_t k = 0; k < isos.size(); ++k) {
+        const double a = a100 * isos[k] / 100;
+        text +=
+            cv::format("%s{\"name\": \"p\", \"iso\": %g, \"a\": [%.17g, %.17g, %.17g], \"b\": [%g, %g, %g]}",
+                       k ? ", " : "", isos[k], a * ratios[0], a, a * ratios[1], b, b, b);
+    }
+    return text + "]}";
+}
+
+TEST(CameraProfiles, theDemosaicIsJudgedFromTheColourSlopeRatios)
+{
+    const std::string dir = makeTempDir("camera_profiles_demosaic");
+    const std::vector<double> isos = {100, 200, 400, 800};
+    // The lines of python/tools/darktable_haar_ratio.py --demosaics 4: on grey PPG gives 1.23, RCD 1.55.
+    const std::vector<CameraNoiseProfile> cams =
+        readCameraProfiles(writeText(dir, "d.json",
+                                     profileFile("Test", {colouredEntry("copies", isos, Vec2d(1, 1)),
+                                                          colouredEntry("ppg", isos, Vec2d(2.1, 1.3)),
+                                                          colouredEntry("neither", isos, Vec2d(1.05, 1.9)),
+                                                          colouredEntry("both", isos, Vec2d(2.2, 1.8))})));
+    const CameraNoiseProfile& copies = byModel(cams, "copies");
+    EXPECT_EQ(PROFILE_DEMOSAIC_UNDECIDED, copies.demosaic);
+    EXPECT_NE(copies.demosaicReason.find("copies of green"), String::npos) << copies.demosaicReason;
+    const CameraNoiseProfile& ppg = byModel(cams, "ppg");
+    EXPECT_EQ(PROFILE_DEMOSAIC_PPG, ppg.demosaic) << ppg.demosaicReason;
+    EXPECT_NE(ppg.demosaicReason.find("blue would be brighter than green"), String::npos)
+        << ppg.demosaicReason;
+    EXPECT_LT(ppg.balanceRcd[1], 1);
+    EXPECT_EQ(PROFILE_DEMOSAIC_NEITHER, byModel(cams, "neither").demosaic);
+    const CameraNoiseProfile& both = byModel(cams, "both");
+    EXPECT_EQ(PROFILE_DEMOSAIC_UNDECIDED, both.demosaic);
+    EXPECT_NEAR(both.colourSlopeRatios[0], 2.2, 1e-12);
+    EXPECT_NEAR(both.balancePpg[0], (2.2 - 0.284) / 0.946, 1e-12);
+    EXPECT_NEAR(both.balanceRcd[1], (1.8 - 0.592) / 0.962, 1e-12);
+    for (const CameraNoiseProfile& cam : cams)
+        EXPECT_EQ(DARKTABLE_HAAR_VARIANCE_RATIO, cam.haarVarianceRatio);
+    DarktableImportParams rcd;
+    rcd.haarVarianceRatio = DARKTABLE_RCD_HAAR_VARIANCE_RATIO;
+    const std::vector<CameraNoiseProfile> asRcd = readCameraProfiles(dir + "/d.json", rcd);
+    EXPECT_EQ(DARKTABLE_RCD_HAAR_VARIANCE_RATIO, asRcd[0].haarVarianceRatio);
+    // RCD's smaller c makes every variance larger by the ratio of the two, so alpha (1 / full well) too.
+    EXPECT_NEAR(asRcd[0].noise.alpha / copies.noise.alpha,
+                DARKTABLE_HAAR_VARIANCE_RATIO / DARKTABLE_RCD_HAAR_VARIANCE_RATIO, 1e-9);
+
+    const std::string path = darktableProfilesPath();
+    if (path.empty())
+        GTEST_SKIP() << "darktable's noiseprofiles.json not found (run scripts/fetch-darktable-profiles.sh)";
+    std::map<int, int> counts;
+    for (const CameraNoiseProfile& cam : readCameraProfiles(path))
+        if (cam.usable()) {
+            ++counts[cam.demosaic];
+            EXPECT_FALSE(cam.demosaicReason.empty()) << cam.name();
+        }
+    std::cout << "[ info ] demosaic of the usable cameras' profiles: " << counts[PROFILE_DEMOSAIC_PPG]
+              << " PPG, " << counts[PROFILE_DEMOSAIC_UNDECIDED] << " undecided, "
+              << counts[PROFILE_DEMOSAIC_NEITHER] << " neither\n";
+    EXPECT_GT(counts[PROFILE_DEMOSAIC_PPG], 0);
+    EXPECT_GT(counts[PROFILE_DEMOSAIC_UNDECIDED], 0);
 }
 
 /* Flat frames as a real camera: a capture at the lowest ISO (half of the range), taken to every measured

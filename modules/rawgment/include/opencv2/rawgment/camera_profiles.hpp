@@ -30,6 +30,30 @@ enum CameraProfileVerdict
 //! "GOOD", "ROUGH" or "REFUSED". @throws cv::Exception for another value.
 CV_RAWGMENT_EXPORTS String cameraProfileVerdictName(int verdict);
 
+/** @brief Which demosaic darktable's profiling export used for a camera's profiles, as far as their colours
+ * tell (CameraNoiseProfile::demosaic; docs/real_cameras.md has the evidence).
+ *
+ * For raw shot noise every colour has the same slope per DN; after demosaicing, the red or blue slope over
+ * the green one is r = u + v k, where k is green's raw level over that colour's (the scene's colour in the
+ * un-white-balanced export, unknown per camera) and (u, v) is the demosaic's: PPG 0.284 + 0.946 k,
+ * RCD 0.592 + 0.962 k (`python/tools/darktable_haar_ratio.py --demosaics 4`). A raw of a grey scene has
+ * green brightest (k >= 1) under daylight and tungsten alike, so the lowest colour ratio can rule RCD out,
+ * never prove it. */
+enum ProfileDemosaic
+{
+    /** Both demosaics fit: each implies a colour balance k >= 1 (CameraNoiseProfile::balancePpg and
+     * balanceRcd), or the colours are copies of green and carry no evidence. */
+    PROFILE_DEMOSAIC_UNDECIDED = 0,
+    /** PPG: with RCD a colour would be brighter than green in the raw (k < 1, by more than the margin). */
+    PROFILE_DEMOSAIC_PPG = 1,
+    /** Neither: a colour ratio is below what PPG gives on grey, so neither demosaic fits a scene with green
+     * brightest (a colour fit that failed, processing in the camera, or a sensor that is not Bayer). */
+    PROFILE_DEMOSAIC_NEITHER = 2
+};
+
+//! "undecided", "PPG" or "neither". @throws cv::Exception for another value.
+CV_RAWGMENT_EXPORTS String profileDemosaicName(int demosaic);
+
 /** @brief How darktable's measured noise profiles are read as per-pixel raw noise, and the bounds of the
  * verdicts.
  *
@@ -76,6 +100,9 @@ struct CV_RAWGMENT_EXPORTS CameraIsoFit
     /** Largest over smallest shot slope of the colours with a positive slope (1 when the colours agree,
      * as in profiles that copy green to every colour). */
     double colourSpread = 1;
+    /** Red and blue shot slope over green's, as darktable measured them (0 for a colour whose slope is not
+     * positive); ProfileDemosaic says what they tell. */
+    Vec2d colourSlopeRatios;
     /** An expanded low setting: its green slope falls less than its ISO below the next ISO (its raw is a
      * higher ISO's). Measured and followed by the augmentation, but not the base ISO, not fitted to Eq. 5
      * and not counted in the verdict's figures (readCameraProfiles() says how it is told). */
@@ -85,8 +112,16 @@ struct CV_RAWGMENT_EXPORTS CameraIsoFit
      * Named, but left out of the fit, the verdict's figures and the measured lines (the ISO's line then comes
      * from its neighbours). */
     bool inconsistent = false;
-    //! Whether the ISO is fitted to Eq. 5 and counted in the verdict: neither expanded nor inconsistent.
-    bool fitted() const { return !expanded && !inconsistent; }
+    /** A digital setting: the ISO (above the expanded ones) whose raw this one is, 0 for an analog step.
+     * darktable normalises each file by its own white level, so a setting that scales an analog ISO's raw
+     * together with its white level (Canon's third stops 160, 320, 640, ... from 200, 400, 800), or keeps
+     * a lower ISO's raw and marks it for brightening (Fujifilm's high settings), has that ISO's slope a
+     * third of a stop or more away. Measured and followed like an expanded setting, not fitted. */
+    double rawIso = 0;
+    //! Whether the setting is digital (rawIso set).
+    bool digital() const { return rawIso > 0; }
+    //! Whether the ISO is fitted to Eq. 5 and counted in the verdict: an analog, consistent setting.
+    bool fitted() const { return !expanded && !inconsistent && !digital(); }
 };
 
 /** @brief A real camera's noise, fitted to Eq. 5 from its measured profiles, in units of a raw range of 1.
@@ -103,8 +138,8 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
     String reason;                        //!< why the verdict is not GOOD (empty when GOOD)
     /** The fitted model over a raw range of 1: alpha is the shot slope at gain 1 (1 / full well in
      * electrons), sigmaD2 and sigmaR2 the read variances before and after the gain over the range
-     * squared, and baseIso the lowest usable ISO that is not expanded (gain 1). All zero while the camera is
-     * REFUSED before its fit. */
+     * squared, and baseIso the lowest usable ISO that is neither expanded nor digital (gain 1). All zero
+     * while the camera is REFUSED before its fit. */
     NoiseModel noise;
     std::vector<CameraIsoFit> isos; //!< the usable profiles, by ascending ISO (an ISO measured twice twice)
     int skippedProfiles = 0;        //!< profiles marked "skip" or without a positive green slope
@@ -116,8 +151,22 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
     double medianColourSpread = 1;  //!< median over ISOs of CameraIsoFit::colourSpread
     int negativeOffsets = 0;        //!< fitted ISOs whose measured offset is below zero
     int expandedIsos = 0;           //!< expanded low ISOs (CameraIsoFit::expanded), below the base ISO
+    int digitalIsos = 0;            //!< digital settings (CameraIsoFit::rawIso), never the base ISO
     int inconsistentProfiles = 0; //!< profiles with a negative colour shot slope (CameraIsoFit::inconsistent)
     bool monotoneSlope = true;    //!< whether the measured slope never falls as the ISO rises
+    //! Median over fitted ISOs of CameraIsoFit::colourSlopeRatios (red over green, blue over green).
+    Vec2d colourSlopeRatios;
+    //! Green over red and over blue raw level that colourSlopeRatios imply if the profiles were made with
+    //! PPG.
+    Vec2d balancePpg;
+    //! The same if they were made with RCD.
+    Vec2d balanceRcd;
+    int demosaic = PROFILE_DEMOSAIC_UNDECIDED; //!< a ProfileDemosaic
+    String demosaicReason;                     //!< the evidence for `demosaic`, in a sentence
+    /** c, the Haar variance ratio the profiles were divided by (DarktableImportParams::haarVarianceRatio):
+     * PPG's green unless set otherwise. With demosaic UNDECIDED it is an assumption, and the camera's
+     * full well would be 0.0794 / 0.0474 = 1.68 times larger with RCD's c. */
+    double haarVarianceRatio = 0;
 
     //! "maker model", the name cameras are selected by.
     String name() const;
@@ -140,13 +189,14 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
  * DarktableImportParams::haarVarianceRatio to per-pixel units; expanded low settings found (from the
  * lowest ISO up, each whose green slope falls less than its ISO towards the next ISO down: slope ratio over
  * ISO ratio above 1.15, where an analog step gives 1 and an expanded setting that reuses the next ISO's raw
- * gives 1.26 to 2) and left out of the fit and the verdict, but kept as measured lines; alpha by least
- * squares on the relative
- * slope residuals through the origin; sigma_d^2 and sigma_r^2 >= 0 by weighted non-negative least
- * squares of the offsets, each weighted by 1 / (|b| + a x_ref)^2. An entry that is malformed (a value
- * that is not a number, a list of another length, an unknown key) is REFUSED with the reason naming its
- * place, and the other cameras are still read. The project's own exports (darktableNoiseProfiles()) come
- * back GOOD with their model.
+ * gives 1.26 to 2) and digital settings found (above those, neighbouring ISOs a third of a stop or more
+ * apart whose slopes differ by less than 8%: one raw; the member nearest the camera's trend is the analog
+ * one, CameraIsoFit::rawIso), both left out of the fit and the verdict but kept as measured lines; the
+ * demosaic judged from the colours (ProfileDemosaic); alpha by least squares on the relative slope residuals
+ * through the origin; sigma_d^2 and sigma_r^2 >= 0 by weighted non-negative least squares of the offsets,
+ * each weighted by 1 / (|b| + a x_ref)^2. An entry that is malformed (a value that is not a number, a list of
+ * another length, an unknown key) is REFUSED with the reason naming its place, and the other cameras are
+ * still read. The project's own exports (darktableNoiseProfiles()) come back GOOD with their model.
  * @param path the JSON file (at most the size openFileStorageForReading() allows)
  * @param params how to read the values and the verdicts' bounds
  * @throws cv::Exception naming the file when it cannot be read or its top level is not darktable's form

@@ -100,6 +100,11 @@ CV_RAWGMENT_EXPORTS NoiseModel withDngNoiseProfileLine(const NoiseModel& model, 
  * tool measures: the Haar-MAD variance of a PPG-demosaiced export (docs/real_cameras.md). */
 constexpr double DARKTABLE_HAAR_VARIANCE_RATIO = 0.0794;
 
+/** @brief The same ratio for a profile made with darktable's RCD demosaic (its default for Bayer sensors
+ * from 3.6), green channel on grey (`python/tools/darktable_haar_ratio.py --demosaics 4`). Set
+ * DarktableImportParams::haarVarianceRatio to it for profiles known to be made with RCD. */
+constexpr double DARKTABLE_RCD_HAAR_VARIANCE_RATIO = 0.0474;
+
 /** @brief A noise model as darktable's noise profiles (the `noiseprofiles.json` that its "denoise
  * (profiled)" module reads): one profile per ISO, each with per-colour `a` and `b` (red, green, blue)
  * in darktable's units: the variance darktable's profiling tool would measure on a signal x normalised
