@@ -292,8 +292,9 @@ std::string realCamerasSection(const DemoOptions& o, const SensorParams& sensorP
           "the "
           "range among the GOOD cameras whose profiles reach 8x their base ISO. Previews are brightened back "
           "to the input's level.\n\n| camera | verdict | full well (e-) | read noise at base ISO (e-) | read "
-          "noise at base ISO (DN of this 12-bit sensor) | shot slope at 8x, measured | Eq. 5's |"
-          "\n|---|---|---|---|---|---|---|\n";
+          "noise at base ISO (DN of this 12-bit sensor) | shot slope at 8x, measured | Eq. 5's | profiles' "
+          "demosaic "
+          "(c) |\n|---|---|---|---|---|---|---|---|\n";
     std::vector<cv::Mat> tiles;
     for (size_t k = 0; k < chosen.size(); ++k) {
         const CameraNoiseProfile& cam = chosen[k];
@@ -317,12 +318,13 @@ std::string realCamerasSection(const DemoOptions& o, const SensorParams& sensorP
         NoiseModel eq5 = model;
         eq5.measuredLines.clear();
         const double targetGain = format.gain * scene.jitter.gainRatio;
-        md += cv::format("| %s | %s | %.0f | %.2f | %.2f | %.4g | %.4g (%+.1f%%) |\n", cam.name().c_str(),
-                         cameraProfileVerdictName(cam.verdict).c_str(), 1 / cam.noise.alpha,
-                         std::sqrt(cam.noise.lineAtGain(1).b) / cam.noise.alpha,
+        md += cv::format("| %s | %s | %.0f | %.2f | %.2f | %.4g | %.4g (%+.1f%%) | %s (%.4f) |\n",
+                         cam.name().c_str(), cameraProfileVerdictName(cam.verdict).c_str(),
+                         1 / cam.noise.alpha, std::sqrt(cam.noise.lineAtGain(1).b) / cam.noise.alpha,
                          std::sqrt(model.lineAtGain(1).b), model.lineAtGain(targetGain).a,
                          eq5.lineAtGain(targetGain).a,
-                         100 * (eq5.lineAtGain(targetGain).a / model.lineAtGain(targetGain).a - 1));
+                         100 * (eq5.lineAtGain(targetGain).a / model.lineAtGain(targetGain).a - 1),
+                         profileDemosaicName(cam.demosaic).c_str(), cam.haarVarianceRatio);
     }
     cv::Mat side;
     cv::hconcat(tiles, side);

@@ -1421,7 +1421,9 @@ TEST(Apps, demoWritesAReportAndAGallery)
     EXPECT_NE(std::string::npos, report.find("## Real cameras")) << report;
     if (!cv::rawgment::darktableProfilesPath().empty()) {
         EXPECT_NE(std::string::npos, report.find("| camera | verdict | full well (e-) |")) << report;
-        EXPECT_NE(std::string::npos, report.find("| shot slope at 8x, measured | Eq. 5's |")) << report;
+        EXPECT_NE(std::string::npos,
+                  report.find("| shot slope at 8x, measured | Eq. 5's | profiles' demosaic (c) |"))
+            << report;
         expectPngDecodes(dir + "/demo/real_cameras.png");
         cv::Mat mosaic;
         EXPECT_FALSE(
