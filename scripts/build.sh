@@ -4,9 +4,13 @@
 #   scripts/build.sh asan      -> build/asan    (RelWithDebInfo + AddressSanitizer + UBSan, no benchmarks,
 #                                                no Python module: an instrumented extension needs the
 #                                                sanitizer runtime preloaded into the interpreter)
+#   scripts/build.sh release rawgment_demo   -> only the named targets (and what they need) of that flavour
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 flavour=${1:-release}
+shift $(( $# > 0 ? 1 : 0 ))
+targets=()
+for target in "$@"; do targets+=(--target "$target"); done
 jobs=${RAWGMENT_JOBS:-$(nproc)}
 
 generator=()
@@ -22,4 +26,4 @@ build="$root/build/$flavour"
 if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S "$root" -B "$build" "${generator[@]}" "${args[@]}"
 fi
-cmake --build "$build" --parallel "$jobs"
+cmake --build "$build" --parallel "$jobs" "${targets[@]}"
