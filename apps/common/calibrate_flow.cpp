@@ -352,19 +352,23 @@ BurstInputs readBursts(const CalibrateOptions& o, const std::vector<CalibrationM
     BurstInputs in;
     int gaussian = 0;
     ProgressBar progress("calibrate", totalFrames);
+    // One object for every burst, reset between them: its 12 MP state's pages are touched once.
+    std::unique_ptr<BurstStatistics> stats;
     for (size_t i = 0; i < specs.size(); ++i) {
         const CalibrationManifest::Burst& spec = specs[i];
         const double gain = dbToLinearGain(gainsDb[i]);
-        std::unique_ptr<BurstStatistics> stats;
         LoadedMosaic first;
         std::vector<cv::Point> tested;
         cv::Mat series;
         for (size_t t = 0; t < spec.files.size(); ++t) {
             const LoadedMosaic m = loadMosaicFile(spec.files[t]);
-            if (!stats) {
+            if (t == 0) {
                 RawFormat f = m.format;
                 f.gain = gain;
-                stats.reset(new BurstStatistics(f));
+                if (stats)
+                    stats->reset(f);
+                else
+                    stats.reset(new BurstStatistics(f));
                 if (i == 0)
                     in.firstFormat = m.format;
                 first = m;

@@ -23,6 +23,9 @@ void bindBurstSampling(py::module_& m)
                 withoutGil("BurstStatistics.add", [&] { self.add(in); });
             },
             py::arg("frame"), doc("BurstStatistics::add"))
+        .def(
+            "reset", [](BurstStatistics& self, const RawFormat& format) { self.reset(format); },
+            py::arg("format"), doc("BurstStatistics::reset"))
         .def("frames", &BurstStatistics::frames, doc("BurstStatistics::frames"))
         .def("size", &BurstStatistics::size, doc("BurstStatistics::size"))
         .def("format", &BurstStatistics::format, doc("BurstStatistics::format"))

@@ -278,10 +278,17 @@ def test_calibration_errors_intervals_and_projections(sensor, tmp_path):
     and what more data would buy."""
     _, mean = chart_mean()
     samples = []
+    # One object for both bursts, reset between them (as a calibration over many bursts reuses its memory):
+    # the same statistics as a new object's, bit for bit.
+    stats = rg.BurstStatistics(sensor.rawFormat(1.0))
     for gain in (1.0, 4.0):
-        stats = rg.BurstStatistics(sensor.rawFormat(gain))
+        stats.reset(sensor.rawFormat(gain))
+        fresh = rg.BurstStatistics(sensor.rawFormat(gain))
         for frame in sensor.captureBurst(mean, gain, 1.0 / gain, 16, 5):
             stats.add(frame)
+            fresh.add(frame)
+        assert stats.frames() == 16 and stats.format().gain == gain
+        assert (stats.variance() == fresh.variance()).all() and (stats.mean() == fresh.mean()).all()
         samples += rg.sampleStaticScene(stats, gain)
     assert all(s.pixel >= 0 for s in samples)
     report = rg.calibrateNoiseModel(samples, rg.CalibrationParams(bootstrapReplicates=50))

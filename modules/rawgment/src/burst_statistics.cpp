@@ -374,12 +374,20 @@ void BurstStatistics::add(InputArray _frame)
                             "or CV_32FC1",
                             typeToString(frame.type()).c_str()));
     Impl& d = *impl_;
-    if (d.type < 0) {
+    if (d.type < 0 || (frames() == 0 && (frame.type() != d.type || frame.size() != d.mean.size()))) {
+        // The first frame of the first burst, or of a burst after reset() of another size or type. The
+        // state is written, not accumulated, by the first merge (mergeGroupRows()), so a reused state
+        // needs no clearing.
+        const bool resized = frame.size() != d.mean.size();
+        if (resized) {
+            d.mean = largeBuffer(frame.size(), CV_MAKETYPE(d.stateDepth, 1));
+            d.m2 = largeBuffer(frame.size(), CV_MAKETYPE(d.stateDepth, 1));
+            d.clipped = largeBuffer(frame.size(), CV_8UC1);
+        }
+        if (resized || frame.type() != d.type)
+            for (Mat& buffer : d.buffers)
+                buffer.release();
         d.type = frame.type();
-        // Zeroed by the first merge (mergeGroupRows()), in parallel.
-        d.mean = largeBuffer(frame.size(), CV_MAKETYPE(d.stateDepth, 1));
-        d.m2 = largeBuffer(frame.size(), CV_MAKETYPE(d.stateDepth, 1));
-        d.clipped = largeBuffer(frame.size(), CV_8UC1);
     } else if (frame.type() != d.type || frame.size() != d.mean.size()) {
         CV_Error(Error::StsBadArg,
                  cv::format("BurstStatistics::add: frame %d is %dx%d of type %s; the burst is %dx%d "
@@ -400,6 +408,15 @@ void BurstStatistics::add(InputArray _frame)
     });
     if (d.pending == d.groupFrames)
         d.flush();
+}
+
+void BurstStatistics::reset(const RawFormat& format)
+{
+    format.validate();
+    Impl& d = *impl_;
+    d.format = format;
+    d.merged = 0;
+    d.pending = 0;
 }
 
 int BurstStatistics::frames() const

@@ -298,6 +298,61 @@ TEST(Calibration, staticSceneSamplingNeedsNoChartAndLeavesOutEdgesThatShakeMoves
     EXPECT_CV_ERROR_CONTAINS(sampleStaticScene(two, 1, 3), "maxSamples");
 }
 
+/* A reset burst statistics object gives the bits of a new one: bursts of one size and type in the same
+ * memory (the group of 3 leaves a partial group pending at each reset), then one of another size and type. */
+TEST(Calibration, burstStatisticsResetGivesTheBitsOfANewObject)
+{
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d(60, 64, 64, 62);
+    fmt.whiteLevel = 4095;
+    RawFormat other = fmt;
+    other.blackLevel = Vec4d::all(200);
+    other.gain = 4;
+    RNG rng(5);
+    const auto burst = [&](Size size, int type, int frames, double level) {
+        std::vector<Mat> b;
+        for (int t = 0; t < frames; ++t) {
+            Mat f(size, type);
+            rng.fill(f, RNG::NORMAL, level, 40);
+            b.push_back(f);
+        }
+        return b;
+    };
+    const std::vector<std::vector<Mat>> bursts = {burst(Size(64, 48), CV_16UC1, 7, 900),
+                                                  burst(Size(64, 48), CV_16UC1, 5, 4050),
+                                                  burst(Size(30, 20), CV_32FC1, 4, 300)};
+    BurstStatistics reused(fmt, 3);
+    for (size_t k = 0; k < bursts.size(); ++k) {
+        SCOPED_TRACE(cv::format("burst %zu", k));
+        const RawFormat& f = k == 1 ? other : fmt;
+        if (k > 0)
+            reused.reset(f);
+        EXPECT_EQ(0, reused.frames());
+        EXPECT_EQ(f.blackLevel, reused.format().blackLevel);
+        BurstStatistics fresh(f, 3);
+        for (const Mat& frame : bursts[k]) {
+            reused.add(frame);
+            fresh.add(frame);
+        }
+        EXPECT_EQ(fresh.frames(), reused.frames());
+        Mat m1, m2, v1, v2, c1, c2;
+        fresh.mean(m1);
+        reused.mean(m2);
+        fresh.variance(v1);
+        reused.variance(v2);
+        fresh.clippedMask(c1);
+        reused.clippedMask(c2);
+        EXPECT_EQ(bursts[k][0].size(), reused.size());
+        EXPECT_EQ(0, cv::norm(m1, m2, NORM_INF));
+        EXPECT_EQ(0, cv::norm(v1, v2, NORM_INF));
+        EXPECT_EQ(0, cv::norm(c1, c2, NORM_INF));
+        EXPECT_GT(countNonZero(c1), k == 1 ? 10 : -1) << "the second burst reaches white";
+    }
+    RawFormat bad = fmt;
+    bad.whiteLevel = -1;
+    EXPECT_CV_ERROR_CONTAINS(reused.reset(bad), "whiteLevel");
+}
+
 TEST(Calibration, burstStatisticsMarkClippedPixelsAndCheckFrames)
 {
     RawFormat fmt;
