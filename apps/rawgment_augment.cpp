@@ -21,7 +21,8 @@ int main(int argc, char** argv)
         "{out o          |      | output directory (required) }"
         "{variants n     | 1    | variants per input }"
         "{seed           | 1    | seed: same seed, same outputs, on any number of threads }"
-        "{format         |      | output container: dng, png or tif (default: dng for RAW inputs) }"
+        "{format         |      | output container: dng, png, tif or npy (npy: numpy's uncompressed format, "
+        "fastest to train from; default: dng for RAW inputs) }"
         "{preview        | false| also write an sRGB preview PNG of each output }"
         "{accept_failed_calibration | false | also use a model whose calibration's verdict was FAIL }"
         "{@inputs        |      | input files (RAW files, or mosaics with a .yml sidecar) }";
@@ -60,8 +61,8 @@ int main(int argc, char** argv)
         return 2;
     }
     if (!format.empty()) {
-        if (format != "dng" && format != "png" && format != "tif") {
-            std::cerr << "rawgment_augment: --format must be dng, png or tif\n";
+        if (format != "dng" && format != "png" && format != "tif" && format != "npy") {
+            std::cerr << "rawgment_augment: --format must be dng, png, tif or npy\n";
             return 2;
         }
         o.extension = "." + format;

@@ -12,12 +12,7 @@ namespace rawgment_pipeline {
 
 using namespace cv::rawgment;
 
-namespace {
-
-/** The name of each input's outputs: its stem, unique per input. Inputs that share a stem (a/x.dng and
- * b/x.dng) each add 8 hex digits of a hash of their path, so that no output or sidecar of one can be
- * taken for the other's. The same file given twice is an error. */
-std::vector<std::string> outputNames(const std::vector<std::string>& inputs)
+std::vector<std::string> uniqueOutputNames(const std::vector<std::string>& inputs)
 {
     std::map<std::string, int> stems;
     std::map<std::string, std::string> seen; // canonical path -> the name it was given as first
@@ -39,6 +34,8 @@ std::vector<std::string> outputNames(const std::vector<std::string>& inputs)
     }
     return names;
 }
+
+namespace {
 
 //! Throws unless `out`'s sidecar says it was made from `input` with `seed`: only then is it skipped.
 void requireFinishedBy(const std::string& out, const std::string& input, uint64_t seed)
@@ -132,7 +129,7 @@ AugmentPlan planAugmentJobs(const AugmentOptions& o)
     prepareOutputDirectory(o.outDir);
 
     AugmentPlan plan;
-    const std::vector<std::string> names = outputNames(o.inputs);
+    const std::vector<std::string> names = uniqueOutputNames(o.inputs);
     for (size_t i = 0; i < o.inputs.size(); ++i) {
         const size_t dot = o.inputs[i].find_last_of('.');
         const std::string inExt = dot == std::string::npos ? std::string() : o.inputs[i].substr(dot);

@@ -10,6 +10,7 @@
 #include <opencv2/rawgment.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -20,11 +21,34 @@ struct LoadedMosaic
 {
     cv::Mat mosaic;
     cv::rawgment::RawFormat format;
-    bool hasCamera = false;      //!< a camera RAW file, or a mosaic whose sidecar has camera tags
-    bool fromCameraFile = false; //!< read by LibRaw (no sidecar): format.gain is 1, whatever the ISO
+    bool hasCamera = false; //!< a camera RAW file, or a mosaic whose sidecar has camera tags
+    /** Read by LibRaw (no sidecar), or converted from such a file (MosaicMetadata::gainFromIso):
+     * format.gain is 1, whatever the ISO. */
+    bool fromCameraFile = false;
     cv::rawgment::CameraTags camera;
 };
 LoadedMosaic loadMosaicFile(const std::string& path);
+
+/** The name of each input's outputs: its stem, unique per input. Inputs that share a stem (a/x.dng and
+ * b/x.dng) each add 8 hex digits of a hash of their path, so that no output or sidecar of one can be
+ * taken for the other's. The same file given twice is an error. */
+std::vector<std::string> uniqueOutputNames(const std::vector<std::string>& inputs);
+
+//! What convertMosaics() did: outputs written, and outputs a previous run of the same inputs had finished.
+struct ConvertResult
+{
+    int written = 0;
+    int skipped = 0;
+    std::vector<std::string> outputs; //!< every output, in input order
+};
+
+/** Converts each input (a camera RAW that LibRaw reads, or a mosaic with a sidecar) into `outDir` (created
+ * when missing) as `<name><extension>` with its sidecar: the same mosaic, format and camera tags, with
+ * `source` naming the input. A camera RAW's sidecar sets MosaicMetadata::gainFromIso, so the converted
+ * file augments exactly as the RAW. An existing output is skipped when its sidecar says it was converted
+ * from the same input, and is an error otherwise. `advance` is called once per input. */
+ConvertResult convertMosaics(const std::vector<std::string>& inputs, const std::string& outDir,
+                             const std::string& extension, const std::function<void()>& advance);
 
 //! An sRGB-like 8-bit preview of a mosaic (tone curve gamma 2.2 with the sRGB toe, white balance 1).
 cv::Mat previewOf(const cv::Mat& mosaic, const cv::rawgment::RawFormat& format, double exposure = 1.0);

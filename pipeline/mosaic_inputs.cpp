@@ -14,6 +14,7 @@ LoadedMosaic loadMosaicFile(const std::string& path)
         out.format = meta.format;
         out.hasCamera = meta.hasCamera;
         out.camera = meta.camera;
+        out.fromCameraFile = meta.gainFromIso;
     } else {
         RawImage image = readRaw(path);
         out.mosaic = image.mosaic;

@@ -118,8 +118,9 @@ void expectPngDecodes(const std::string& path)
 
 TEST(Apps, everyAppHasHelpAndRejectsBadArguments)
 {
-    for (const char* app : {"rawgment_demo", "rawgment_simulate", "rawgment_calibrate", "rawgment_validate",
-                            "rawgment_augment", "rawgment_tradeoffs", "rawgment_cameras"}) {
+    for (const char* app :
+         {"rawgment_demo", "rawgment_simulate", "rawgment_calibrate", "rawgment_validate", "rawgment_augment",
+          "rawgment_tradeoffs", "rawgment_cameras", "rawgment_convert"}) {
         const AppRun help = runApp(app, "--help");
         EXPECT_EQ(0, help.status) << app;
         EXPECT_NE(std::string::npos, help.output.find(app)) << app << " --help:\n" << help.output;
@@ -709,6 +710,76 @@ TEST(Apps, augmentTakesACameraFilesGainFromItsIsoAndTheModelsBaseIso)
                   cv::rawgment::dngNoiseProfile(withBase, meta.format))
             << c.first;
     }
+}
+
+/* rawgment_convert: a camera file and a mosaic with its sidecar into .npy, the same pixels, format and tags;
+ * the camera file's conversion augments to the same bytes as the camera file (its gain from its ISO); a
+ * second run skips; an output holding another input is never overwritten. */
+TEST(Apps, convertWritesNpyThatAugmentsAsItsSource)
+{
+    const std::string dir = freshDir("convert");
+    AppRun r =
+        runApp("rawgment_simulate",
+               "--out='" + dir + "/sim' --frames=3 --gains=6 --levels=0.5 --validation=false --format=png");
+    ASSERT_EQ(0, r.status) << r.output;
+    r = runApp("rawgment_simulate",
+               "--out='" + dir + "/dng' --frames=3 --gains=6 --levels=0.5 --validation=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    ASSERT_EQ(0, ::mkdir((dir + "/camera").c_str(), 0755));
+    {
+        std::ifstream in(dir + "/dng/g06dB_level0.50/frame_000.dng", std::ios::binary);
+        std::ofstream out(dir + "/camera/shot.dng", std::ios::binary);
+        out << in.rdbuf();
+        ASSERT_TRUE(out.good());
+    }
+    const std::string png = dir + "/sim/g06dB_level0.50/frame_001.png", camera = dir + "/camera/shot.dng";
+    r = runApp("rawgment_convert", "--out='" + dir + "/npy' '" + png + "' '" + camera + "'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("wrote 2 files, skipped 0")) << r.output;
+    cv::Mat fromPng, pngMosaic, fromCamera;
+    const cv::rawgment::MosaicMetadata pngMeta =
+        cv::rawgment::readMosaic(dir + "/npy/frame_001.npy", fromPng);
+    const cv::rawgment::MosaicMetadata original = cv::rawgment::readMosaic(png, pngMosaic);
+    EXPECT_EQ(0, cv::norm(fromPng, pngMosaic, cv::NORM_INF));
+    EXPECT_EQ(original.format.gain, pngMeta.format.gain);
+    EXPECT_FALSE(pngMeta.gainFromIso) << "a mosaic with a sidecar keeps its gain";
+    EXPECT_EQ(png, pngMeta.source);
+    const cv::rawgment::MosaicMetadata cameraMeta =
+        cv::rawgment::readMosaic(dir + "/npy/shot.npy", fromCamera);
+    const cv::rawgment::RawImage raw = cv::rawgment::readRaw(camera);
+    EXPECT_EQ(0, cv::norm(fromCamera, raw.mosaic, cv::NORM_INF));
+    EXPECT_TRUE(cameraMeta.gainFromIso && cameraMeta.hasCamera);
+    EXPECT_EQ(raw.iso, cameraMeta.camera.iso);
+    // The same augmentation of the camera file and of its conversion: the same pixels and gain.
+    {
+        cv::rawgment::Scene scene;
+        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 2.0);
+        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
+        scene.write(fs, "scene");
+    }
+    const std::string model = dir + "/dng/truth_noise_model.yml";
+    for (const char* input : {"/camera/shot.dng", "/npy/shot.npy"}) {
+        r = runApp("rawgment_augment", "--model='" + model + "' --scene='" + dir +
+                                           "/scene.yml' --format=npy --out='" + dir + "/aug" +
+                                           std::string(input).substr(1, 3) + "' '" + dir + input + "'");
+        ASSERT_EQ(0, r.status) << r.output;
+    }
+    cv::Mat a, b;
+    const cv::rawgment::MosaicMetadata ma = cv::rawgment::readMosaic(dir + "/augcam/shot_v00.npy", a);
+    const cv::rawgment::MosaicMetadata mb = cv::rawgment::readMosaic(dir + "/augnpy/shot_v00.npy", b);
+    EXPECT_EQ(0, cv::norm(a, b, cv::NORM_INF));
+    EXPECT_DOUBLE_EQ(ma.format.gain, mb.format.gain);
+    EXPECT_DOUBLE_EQ(4.0, mb.format.gain) << "ISO 200 over the model's base ISO 100, times 2";
+    // Again: nothing to do. Another input with the same output name: an error, the output untouched.
+    r = runApp("rawgment_convert", "--out='" + dir + "/npy' '" + png + "' '" + camera + "'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("wrote 0 files, skipped 2")) << r.output;
+    r = runApp("rawgment_convert", "--out='" + dir + "/npy' '" + dir + "/sim/g06dB_level0.50/frame_000.png'");
+    EXPECT_EQ(0, r.status) << r.output;
+    r = runApp("rawgment_convert", "--out='" + dir + "/npy' '" + dir + "/dng/g06dB_level0.50/frame_001.dng'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("never overwritten")) << r.output;
+    EXPECT_EQ(2, runApp("rawgment_convert", "--out='" + dir + "/x' --format=jpg '" + png + "'").status);
 }
 
 TEST(Apps, augmentAsRealCamerasDrawsOnePerOutputAndRecordsIt)

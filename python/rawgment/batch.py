@@ -44,7 +44,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
         model: the noise model file: a NoiseModel, an Android profile YAML, or darktable's
             noiseprofiles.json with ``camera``. policy / scene: exactly one, a file.
         out: output folder (created). variants: outputs per input. seed: the run's seed.
-        format: output container "dng", "png" or "tif" (default: dng for RAW inputs, else the input's).
+        format: output container "dng", "png", "tif" or "npy" (default: dng for RAW inputs, else the input's).
         previews: also write an sRGB preview PNG per output.
         client: a ``dask.distributed.Client`` to run the jobs on; None runs them here, one by one.
         progress: a callable(done, total), or None for a line on stderr per 5% when stderr is a terminal.
@@ -61,8 +61,8 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     """
     if (policy is None) == (scene is None):
         raise ValueError("give exactly one of policy and scene")
-    if format not in (None, "dng", "png", "tif"):
-        raise ValueError("format must be 'dng', 'png' or 'tif', not %r" % (format,))
+    if format not in (None, "dng", "png", "tif", "npy"):
+        raise ValueError("format must be 'dng', 'png', 'tif' or 'npy', not %r" % (format,))
     seed = _checkedSeed(seed)
     camera = "" if camera is None else str(camera)
     inputs = [os.fspath(p) for p in inputs]
@@ -149,7 +149,7 @@ def main(argv=None):
     parser.add_argument("--variants", type=int, default=1, help="variants per input (default 1)")
     parser.add_argument("--seed", type=int, default=1,
                         help="seed from 0 to 2**64 - 1: same seed, same files (default 1)")
-    parser.add_argument("--format", choices=("dng", "png", "tif"), help="output container")
+    parser.add_argument("--format", choices=("dng", "png", "tif", "npy"), help="output container")
     parser.add_argument("--preview", action="store_true", help="also write an sRGB preview PNG per output")
     parser.add_argument("--accept_failed_calibration", action="store_true",
                         help="also use a model whose calibration's verdict was FAIL")

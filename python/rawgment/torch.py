@@ -23,7 +23,7 @@ from rawgment.batch import RAW_EXTENSIONS
 
 __all__ = ["sampleSeed", "Augmented", "RandomNoiseScene", "RawFolderDataset", "packCfaPlanes", "loadMosaic"]
 
-MOSAIC_EXTENSIONS = (".png", ".tif", ".tiff")
+MOSAIC_EXTENSIONS = (".npy", ".png", ".tif", ".tiff")
 
 Augmented = collections.namedtuple("Augmented", ["raw", "format", "boxes", "report", "scene", "camera"],
                                    defaults=(None,))
@@ -204,6 +204,19 @@ def packCfaPlanes(signal, format):
     return torch.from_numpy(np.stack([planes[s] for s in order]))
 
 
+def _tensorOf(mosaic, fmt, pack, normalize):
+    """The sample's tensor in one pass over the mosaic, written into the tensor's own memory: black
+    subtraction, normalisation and (with pack) the CFA planes together."""
+    if pack:
+        rows, cols = mosaic.shape
+        if rows % 2 or cols % 2:
+            raise ValueError("RawFolderDataset: pack=True needs even sides; the mosaic is %dx%d" % (cols, rows))
+        planes = torch.empty((4, rows // 2, cols // 2), dtype=torch.float32)
+        _rg.packCfaPlanes(mosaic, fmt, normalize=normalize, out=planes.numpy())
+        return planes
+    return torch.from_numpy(_rg.subtractBlackLevel(mosaic, fmt, normalize=normalize)).unsqueeze(0)
+
+
 def loadMosaic(path):
     """(mosaic, format) of a camera RAW file (readRaw) or of a mosaic with a sidecar (readMosaic)."""
     path = os.fspath(path)
@@ -309,6 +322,5 @@ class RawFolderDataset(torch.utils.data.Dataset):
         if self.augment:
             result = self.transform(mosaic, fmt, index=index, epoch=self.epoch)
             mosaic, fmt, camera = result.raw, result.format, result.camera or ""
-        signal = _rg.subtractBlackLevel(mosaic, fmt, normalize=self.normalize)
-        raw = packCfaPlanes(signal, fmt) if self.pack else torch.from_numpy(signal).unsqueeze(0)
+        raw = _tensorOf(mosaic, fmt, self.pack, self.normalize)
         return {"raw": raw, "gain": float(fmt.gain), "index": int(index), "path": self.files[index], "camera": camera}

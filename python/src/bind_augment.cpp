@@ -461,6 +461,7 @@ void bindMosaicFiles(py::module_& m)
         .def_readwrite("hasCamera", &MosaicMetadata::hasCamera, doc("MosaicMetadata::hasCamera"))
         .def_readwrite("camera", &MosaicMetadata::camera, doc("MosaicMetadata::camera"))
         .def_readwrite("noiseCamera", &MosaicMetadata::noiseCamera, doc("MosaicMetadata::noiseCamera"))
+        .def_readwrite("gainFromIso", &MosaicMetadata::gainFromIso, doc("MosaicMetadata::gainFromIso"))
         .def_readwrite("size", &MosaicMetadata::size, doc("MosaicMetadata::size"))
         .def_readwrite("type", &MosaicMetadata::type, doc("MosaicMetadata::type"));
     m.def("sidecarPathOf", &sidecarPathOf, py::arg("path"), doc("sidecarPathOf"));

@@ -314,6 +314,33 @@ void bindBayer(py::module_& m)
         py::arg("src"), py::arg("format"), py::arg("normalize") = false,
         doc("subtractBlackLevel", "Python: returns dst (float32)."));
     m.def(
+        "packCfaPlanes",
+        [](const py::object& mosaic, const RawFormat& format, bool normalize, const py::object& out) {
+            const cv::Mat in = matFromArray(mosaic, "mosaic", {CV_16U, CV_32F});
+            if (out.is_none()) {
+                py::array planes = arrayFromCall(
+                    "packCfaPlanes", [&](cv::Mat& dst) { packCfaPlanes(in, format, dst, normalize); });
+                return py::object(planes.attr("reshape")(4, in.rows / 2, in.cols / 2));
+            }
+            // The caller's memory (a tensor's numpy view): float32, C-contiguous, 4 x rows/2 x cols/2.
+            const auto target = py::array::ensure(out);
+            if (!target || !py::isinstance<py::array_t<float>>(target))
+                throw py::type_error("packCfaPlanes: out must be a float32 numpy array");
+            if (target.ndim() != 3 || target.shape(0) != 4 || target.shape(1) != in.rows / 2 ||
+                target.shape(2) != in.cols / 2)
+                throw py::value_error(
+                    cv::format("packCfaPlanes: out must have shape (4, %d, %d)", in.rows / 2, in.cols / 2));
+            if (!(target.flags() & py::array::c_style) || !target.writeable())
+                throw py::value_error("packCfaPlanes: out must be C-contiguous and writable");
+            cv::Mat dst(2 * in.rows, in.cols / 2, CV_32FC1, const_cast<void*>(target.data()));
+            withoutGil("packCfaPlanes", [&] { packCfaPlanes(in, format, dst, normalize); });
+            return out;
+        },
+        py::arg("mosaic"), py::arg("format"), py::arg("normalize") = true, py::arg("out") = py::none(),
+        doc("packCfaPlanes",
+            "Python: returns a float32 array of shape (4, rows/2, cols/2), or writes into "
+            "`out` (such an array: a torch tensor's .numpy(), for example) and returns it."));
+    m.def(
         "addBlackLevel",
         [](const py::object& src, const RawFormat& format, int ddepth, bool normalized) {
             const cv::Mat in = matFromArray(src, "src", {CV_32F});

@@ -1,5 +1,8 @@
 """rawgment.torch: the transform on tensors and arrays (boxes follow), and a DataLoader over a folder
 that gives the same samples with 0 and 2 workers."""
+import os
+import subprocess
+
 import numpy as np
 import pytest
 import torch
@@ -152,3 +155,61 @@ def test_a_crop_is_augmented_with_its_own_pixels_dark_shading(folder, sensor):
     path = folder.parent / "crop_origin.png"
     rg.writeMosaic(str(path), np.ascontiguousarray(first_crop), rg.MosaicMetadata(format=first_fmt))
     assert rgt.loadMosaic(str(path))[1].sensorOrigin == first_fmt.sensorOrigin
+
+
+def test_packed_tensors_are_written_in_one_pass_into_their_own_memory(folder, sensor):
+    """packCfaPlanes(out=tensor.numpy()) is black subtraction, normalisation and the CFA split of
+    rawgment.torch.packCfaPlanes, to the bit, in the tensor's memory; the dataset's packed items too."""
+    from conftest import chart_mean
+
+    _, mean = chart_mean()
+    raw = sensor.capture(mean, 1.0, 1.0, seed=3)
+    fmt = sensor.rawFormat(1.0)
+    for normalize in (False, True):
+        expected = rgt.packCfaPlanes(rg.subtractBlackLevel(raw, fmt, normalize=normalize), fmt)
+        tensor = torch.full(expected.shape, -1.0)
+        result = rg.packCfaPlanes(raw, fmt, normalize=normalize, out=tensor.numpy())
+        assert torch.equal(tensor, expected)
+        assert np.shares_memory(result, tensor.numpy())
+        assert np.array_equal(rg.packCfaPlanes(raw, fmt, normalize=normalize), expected.numpy())
+    with pytest.raises(ValueError, match=r"shape \(4, "):
+        rg.packCfaPlanes(raw, fmt, out=np.zeros((4, 2, 2), np.float32))
+    with pytest.raises(TypeError, match="float32"):
+        rg.packCfaPlanes(raw, fmt, out=np.zeros(expected.shape, np.float64))
+    dataset = rgt.RawFolderDataset(folder, rg.NoiseModel(0.25, 1.5, 0.8), baseSeed=5, pack=True, augment=False)
+    item = dataset[2]
+    mosaic, itemFmt = rgt.loadMosaic(dataset.files[2])
+    assert torch.equal(item["raw"], rgt.packCfaPlanes(rg.subtractBlackLevel(mosaic, itemFmt, normalize=True), itemFmt))
+
+
+def test_npy_mosaics_are_numpys_own_files_and_the_dataset_reads_them(folder, tmp_path, sensor):
+    """.npy mosaics: np.load (and its memory map) reads what writeMosaic wrote, readMosaic reads what np.save
+    wrote beside a sidecar, and a dataset of conversions gives the samples of the camera files."""
+    from conftest import chart_mean
+
+    _, mean = chart_mean()
+    raw = sensor.capture(mean, 1.0, 1.0, seed=4)
+    meta = rg.MosaicMetadata(format=sensor.rawFormat(1.0))
+    rg.writeMosaic(str(tmp_path / "a.npy"), raw, meta)
+    assert np.array_equal(np.load(tmp_path / "a.npy"), raw)
+    assert np.array_equal(np.load(tmp_path / "a.npy", mmap_mode="r"), raw)
+    floats = raw.astype(np.float32) * 0.5 - 3
+    np.save(tmp_path / "b.npy", floats)
+    # The sidecar of the same array written by writeMosaic, put beside numpy's file.
+    rg.writeMosaic(str(tmp_path / "c.npy"), floats, meta)
+    os.replace(tmp_path / "c.npy.yml", tmp_path / "b.npy.yml")
+    back, _ = rg.readMosaic(str(tmp_path / "b.npy"))
+    assert back.dtype == np.float32 and np.array_equal(back, floats)
+    # Conversions of the folder's camera files, as rawgment_convert writes them: the same samples.
+    converted = tmp_path / "converted"
+    run = subprocess.run([os.path.join(os.environ["RAWGMENT_APP_DIR"], "rawgment_convert"), "--out=%s" % converted]
+                         + [str(folder / name) for name in sorted(os.listdir(folder)) if name.endswith(".dng")],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stdout + run.stderr
+    model = rg.NoiseModel(0.25, 1.5, 0.8)
+    fromDng = rgt.RawFolderDataset(folder, model, baseSeed=9, pack=True)
+    fromNpy = rgt.RawFolderDataset(converted, model, baseSeed=9, pack=True)
+    assert [os.path.splitext(os.path.basename(f))[0] for f in fromNpy.files] == \
+        [os.path.splitext(os.path.basename(f))[0] for f in fromDng.files]
+    for index in range(len(fromDng)):
+        assert torch.equal(fromDng[index]["raw"], fromNpy[index]["raw"])

@@ -405,6 +405,28 @@ std::vector<Target> targets(const std::string& dataDir)
                  rawgment_helpers::readChartPatches(m.patches);
              return std::string();
          }});
+    t.push_back({"npy", "input.npy", true, Errors::LIBRARY,
+                 [](const std::string& work) {
+                     // The .npy is the input and its seed's sidecar stays beside it (a seed must be
+                     // accepted, so there is one: mutations reach the other dtype through the header).
+                     const std::string seedDir = work + "/npy_seed";
+                     fs::remove_all(seedDir);
+                     fs::create_directories(seedDir);
+                     MosaicMetadata meta;
+                     meta.format.whiteLevel = 4095;
+                     meta.format.blackLevel = cv::Vec4d::all(64);
+                     writeMosaic(seedDir + "/u16.npy", seedMosaic(cv::Size(16, 12), 4095, 3), meta);
+                     fs::copy_file(seedDir + "/u16.npy.yml", work + "/input.npy.yml",
+                                   fs::copy_options::overwrite_existing);
+                     return std::vector<std::string>{readBytes(seedDir + "/u16.npy")};
+                 },
+                 [](const std::string& in) {
+                     cv::Mat mosaic;
+                     const MosaicMetadata meta = readMosaic(in, mosaic);
+                     if (mosaic.size() != meta.size || mosaic.type() != meta.type)
+                         return std::string("accepted a .npy whose array is not the one its sidecar states");
+                     return checkFormat(meta.format);
+                 }});
     t.push_back({"raw", "input.dng", true, Errors::LIBRARY,
                  [dataDir](const std::string& work) {
                      std::vector<std::string> seeds;

@@ -301,6 +301,65 @@ void subtractBlackLevel(InputArray _src, const RawFormat& format, OutputArray _d
     _dst.assign(dst);
 }
 
+namespace {
+
+/* Each pair of mosaic rows read once and written to the four plane rows it feeds; `plane[site]` is where
+ * that site's plane starts in the output, its row `i` from mosaic rows 2i and 2i + 1. */
+template <typename Src>
+void packPerSite(const Mat& src, Mat& dst, const int planeOfSite[4], const Vec4d& offset, const Vec4d& scale)
+{
+    const int half = src.rows / 2, width = src.cols / 2;
+    parallel_for_(Range(0, half), [&](const Range& rows) {
+        for (int i = rows.start; i < rows.end; ++i)
+            for (int dy = 0; dy < 2; ++dy) {
+                const Src* s = src.ptr<Src>(2 * i + dy);
+                const int even = 2 * dy, odd = 2 * dy + 1;
+                float* de = dst.ptr<float>(planeOfSite[even] * half + i);
+                float* dodd = dst.ptr<float>(planeOfSite[odd] * half + i);
+                const float oe = static_cast<float>(offset[even]), oo = static_cast<float>(offset[odd]);
+                const float ke = static_cast<float>(scale[even]), ko = static_cast<float>(scale[odd]);
+                for (int j = 0; j < width; ++j) {
+                    de[j] = (static_cast<float>(s[2 * j]) - oe) * ke;
+                    dodd[j] = (static_cast<float>(s[2 * j + 1]) - oo) * ko;
+                }
+            }
+    });
+}
+
+} // namespace
+
+void packCfaPlanes(InputArray _mosaic, const RawFormat& format, OutputArray _planes, bool normalize)
+{
+    format.validate();
+    const Mat src = _mosaic.getMat();
+    checkMosaic(src, "packCfaPlanes: mosaic");
+    if (src.type() != CV_16UC1 && src.type() != CV_32FC1)
+        CV_Error(Error::StsBadArg,
+                 cv::format("packCfaPlanes: mosaic type %s is not supported; expected CV_16UC1 "
+                            "or CV_32FC1",
+                            typeToString(src.type()).c_str()));
+    if (src.rows % 2 || src.cols % 2)
+        CV_Error(Error::StsBadArg, cv::format("packCfaPlanes: the mosaic is %dx%d; its sides must be even",
+                                              src.cols, src.rows));
+    Vec4d scale = Vec4d::all(1);
+    if (normalize)
+        for (int s = 0; s < 4; ++s)
+            scale[s] = 1.0 / (format.whiteLevel - format.blackLevel[s]);
+    int planeOfSite[4];
+    const CfaChannel order[4] = {CFA_R, CFA_G1, CFA_G2, CFA_B};
+    for (int k = 0; k < 4; ++k)
+        planeOfSite[cfaSiteOfChannel(format.pattern, order[k])] = k;
+    _planes.create(2 * src.rows, src.cols / 2, CV_32FC1);
+    Mat dst = _planes.getMat();
+    // The output may be the caller's memory; it must not be the input's.
+    if (dst.data == src.data)
+        CV_Error(Error::StsBadArg, "packCfaPlanes: planes must not share the mosaic's memory");
+    if (src.depth() == CV_16U)
+        packPerSite<ushort>(src, dst, planeOfSite, format.blackLevel, scale);
+    else
+        packPerSite<float>(src, dst, planeOfSite, format.blackLevel, scale);
+}
+
 void addBlackLevel(InputArray _src, const RawFormat& format, OutputArray _dst, int ddepth, bool normalized)
 {
     format.validate();

@@ -15,8 +15,13 @@ namespace rawgment {
 void MosaicMetadata::write(FileStorage& fs, const String& name) const
 {
     format.validate();
+    if (gainFromIso && !(hasCamera && camera.iso > 0 && format.gain == 1))
+        CV_Error(Error::StsBadArg,
+                 "mosaic metadata: gainFromIso needs camera tags with an ISO and a gain of 1");
     fs << name << "{";
-    fs << "format_version" << FORMAT_VERSION;
+    // Version 4 only where its one addition is used, so that every other sidecar stays readable by older
+    // releases and its bytes stay what they were.
+    fs << "format_version" << (gainFromIso ? FORMAT_VERSION : 3);
     format.write(fs, "raw_format");
     fs << "size" << size;
     fs << "type" << typeToString(type);
@@ -31,6 +36,8 @@ void MosaicMetadata::write(FileStorage& fs, const String& name) const
         camera.write(fs, "camera");
     if (!noiseCamera.empty())
         fs << "noise_camera" << noiseCamera;
+    if (gainFromIso)
+        fs << "gain_from_iso" << 1;
     fs << "}";
 }
 
@@ -45,7 +52,7 @@ MosaicMetadata MosaicMetadata::read(const FileNode& node)
             cv::format("mosaic metadata: format_version is missing or not one of 1..%d", FORMAT_VERSION));
     try {
         rejectUnknownKeys(node, {"format_version", "raw_format", "size", "type", "source", "has_scene",
-                                 "scene", "seed", "camera", "noise_camera"});
+                                 "scene", "seed", "camera", "noise_camera", "gain_from_iso"});
     } catch (const Exception& e) {
         CV_Error(e.code, "mosaic metadata: " + e.err);
     }
@@ -82,6 +89,16 @@ MosaicMetadata MosaicMetadata::read(const FileNode& node)
     m.hasCamera = !node["camera"].empty();
     if (m.hasCamera)
         m.camera = CameraTags::read(node["camera"]);
+    const FileNode gainFromIso = node["gain_from_iso"];
+    if (!gainFromIso.empty()) {
+        if (!gainFromIso.isInt() || (int(gainFromIso) != 0 && int(gainFromIso) != 1))
+            CV_Error(Error::StsParseError, "mosaic metadata: field 'gain_from_iso' must be 0 or 1");
+        m.gainFromIso = int(gainFromIso) == 1;
+        if (m.gainFromIso && !(m.hasCamera && m.camera.iso > 0 && m.format.gain == 1))
+            CV_Error(
+                Error::StsParseError,
+                "mosaic metadata: gain_from_iso needs camera tags with an ISO and a raw_format gain of 1");
+    }
     return m;
 }
 
@@ -95,16 +112,17 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
 {
     const Mat mosaic = _mosaic.getMat();
     const String ext = lowerExtensionOf(path);
-    const bool tiff = ext == ".tif" || ext == ".tiff";
-    if (ext != ".png" && ext != ".dng" && !tiff)
+    const bool tiff = ext == ".tif" || ext == ".tiff", npy = ext == ".npy", takesFloat = tiff || npy;
+    if (ext != ".png" && ext != ".dng" && !tiff && !npy)
         CV_Error(Error::StsBadArg, "writeMosaic: '" + path +
                                        "': unsupported extension; expected .png, .tif, "
-                                       ".tiff or .dng");
-    if (mosaic.empty() || (mosaic.type() != CV_16UC1 && !(tiff && mosaic.type() == CV_32FC1)))
+                                       ".tiff, .dng or .npy");
+    if (mosaic.empty() || (mosaic.type() != CV_16UC1 && !(takesFloat && mosaic.type() == CV_32FC1)))
         CV_Error(Error::StsBadArg,
                  cv::format("writeMosaic: '%s': a %s mosaic cannot be stored as %s; expected CV_16UC1%s",
                             path.c_str(), mosaic.empty() ? "empty" : typeToString(mosaic.type()).c_str(),
-                            ext.c_str(), tiff ? " or CV_32FC1" : " (TIFF also takes CV_32FC1)"));
+                            ext.c_str(),
+                            takesFloat ? " or CV_32FC1" : " (TIFF and .npy also take CV_32FC1)"));
     if (detail::fileExists(path))
         CV_Error(Error::StsError, "writeMosaic: '" + path + "' already exists; it is never overwritten");
     MosaicMetadata meta = metadata;
@@ -133,6 +151,11 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
             if (meta.hasCamera)
                 meta.camera.applyTo(image);
             writeDng(path, image);
+            return;
+        }
+        if (npy) {
+            const std::vector<uchar> bytes = detail::npyFileBytes(mosaic);
+            writeFileAtomically(path, bytes.data(), bytes.size(), false);
             return;
         }
         std::vector<uchar> bytes;
@@ -182,6 +205,8 @@ MosaicMetadata readMosaic(const String& path, OutputArray _mosaic)
                            meta.format.blackLevel[1], meta.format.blackLevel[2], meta.format.blackLevel[3],
                            meta.format.whiteLevel));
         mosaic = raw.mosaic;
+    } else if (lowerExtensionOf(path) == ".npy") {
+        mosaic = detail::readNpyMosaic(path);
     } else {
         mosaic = imread(path, IMREAD_UNCHANGED);
     }

@@ -69,6 +69,11 @@ std::string readTextFile(const String& path);
 void checkRegularFile(const String& path, const String& what);
 //! Why a file of this st_mode is not read ("it is a FIFO ...").
 const char* notRegularReason(unsigned mode);
+//! The bytes of a .npy file (format 1.0, little-endian, C order) holding `mosaic`, CV_16UC1 or CV_32FC1.
+std::vector<uchar> npyFileBytes(const Mat& mosaic);
+/** The mosaic of a .npy file as npyFileBytes() writes it (format 1.0 to 3.0, a 2-D '<u2' or '<f4' array
+ * in C order, the file exactly that long); throws naming the file otherwise, before allocating. */
+Mat readNpyMosaic(const String& path);
 /** Throws StsParseError naming the file (`path`) unless `text` is JSON or a single-document YAML stream
  * whose root collection starts a line at column 0 (empty text and XML are refused too): OpenCV 4.6's
  * YAML parser loops forever on some streams with more than one document. */

@@ -219,6 +219,45 @@ TEST_P(BayerPlanes, splitPlacesEverySiteInItsPlaneAndMergeInvertsIt)
 
 INSTANTIATE_TEST_CASE_P(AllDepths, BayerPlanes, ::testing::Values(CV_8UC1, CV_16UC1, CV_32FC1, CV_64FC1));
 
+/* packCfaPlanes is subtractBlackLevel then splitCfaPlanes in R, G1, G2, B order, to the bit, for every
+ * pattern, both input types and both scales; into a Mat over the caller's memory it writes in place. */
+TEST(Bayer, packCfaPlanesIsBlackSubtractionAndSplitInOnePass)
+{
+    const CfaPattern patterns[] = {CFA_RGGB, CFA_GRBG, CFA_GBRG, CFA_BGGR};
+    RawFormat format;
+    format.blackLevel = Vec4d(60, 64.5, 63, 61);
+    format.whiteLevel = 4095;
+    for (int type : {CV_16UC1, CV_32FC1})
+        for (CfaPattern pattern : patterns)
+            for (bool normalize : {false, true}) {
+                SCOPED_TRACE(cv::format("type %d, pattern %s, normalize %d", type,
+                                        cfaPatternName(pattern).c_str(), int(normalize)));
+                format.pattern = pattern;
+                Mat mosaic(34, 50, type);
+                randu(mosaic, 0, 4096);
+                Mat signal, packed;
+                std::vector<Mat> planes;
+                subtractBlackLevel(mosaic, format, signal, normalize);
+                splitCfaPlanes(signal, planes);
+                packCfaPlanes(mosaic, format, packed, normalize);
+                ASSERT_EQ(Size(25, 68), packed.size());
+                ASSERT_EQ(CV_32FC1, packed.type());
+                const CfaChannel order[4] = {CFA_R, CFA_G1, CFA_G2, CFA_B};
+                for (int k = 0; k < 4; ++k)
+                    EXPECT_EQ(0, norm(packed.rowRange(17 * k, 17 * (k + 1)),
+                                      planes[cfaSiteOfChannel(pattern, order[k])], NORM_INF))
+                        << "plane " << k;
+                std::vector<float> memory(68 * 25, -1.f);
+                Mat inPlace(68, 25, CV_32FC1, memory.data());
+                packCfaPlanes(mosaic, format, inPlace, normalize);
+                EXPECT_EQ(static_cast<void*>(memory.data()), static_cast<void*>(inPlace.data));
+                EXPECT_EQ(0, norm(inPlace, packed, NORM_INF));
+            }
+    Mat out;
+    EXPECT_CV_ERROR_CONTAINS(packCfaPlanes(Mat(5, 4, CV_16UC1, Scalar(1)), format, out), "must be even");
+    EXPECT_CV_ERROR_CONTAINS(packCfaPlanes(Mat(4, 4, CV_8UC1, Scalar(1)), format, out), "not supported");
+}
+
 TEST(Bayer, splitRejectsBadMosaics)
 {
     std::vector<Mat> planes;

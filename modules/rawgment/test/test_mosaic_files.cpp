@@ -142,7 +142,7 @@ TEST(MosaicFiles, mosaicRoundTripsWithItsSidecarInEveryContainer)
     meta.scene.jitter.gainRatio = 2.0;
     meta.seed = 18446744073709551557ull; // the largest 64-bit prime: the seed needs all 64 bits
     meta.source = "input.dng";
-    for (const char* ext : {".png", ".tif", ".dng"}) {
+    for (const char* ext : {".png", ".tif", ".dng", ".npy"}) {
         const std::string path = dir + "/out" + ext;
         writeMosaic(path, m16, meta);
         Mat back;
@@ -164,11 +164,88 @@ TEST(MosaicFiles, mosaicRoundTripsWithItsSidecarInEveryContainer)
     Mat back;
     readMosaic(dir + "/float.tiff", back);
     EXPECT_EQ(0, norm(f32, back, NORM_INF)) << "float TIFF is lossless";
+    writeMosaic(dir + "/float.npy", f32, meta);
+    readMosaic(dir + "/float.npy", back);
+    EXPECT_EQ(0, norm(f32, back, NORM_INF)) << "float .npy is lossless";
+    EXPECT_EQ(CV_32FC1, back.type());
     EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/float.png", f32, meta), "cannot be stored as .png");
     EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/x.jpg", m16, meta), "unsupported extension");
-    const std::vector<std::string> expected = {"float.tiff", "float.tiff.yml", "out.dng", "out.dng.yml",
-                                               "out.png",    "out.png.yml",    "out.tif", "out.tif.yml"};
+    const std::vector<std::string> expected = {"float.npy", "float.npy.yml", "float.tiff", "float.tiff.yml",
+                                               "out.dng",   "out.dng.yml",   "out.npy",    "out.npy.yml",
+                                               "out.png",   "out.png.yml",   "out.tif",    "out.tif.yml"};
     EXPECT_EQ(expected, filesIn(dir)) << "no temporary files are left behind";
+}
+
+/* The .npy container as numpy writes it: a 64-byte-aligned header, and the data right after; and every
+ * malformed file an error naming it, decided before the array is allocated. */
+TEST(MosaicFiles, npyMosaicsAreNumpysFormatAndMalformedOnesAreErrors)
+{
+    const std::string dir = makeTempDir("mosaic_npy");
+    Mat m(6, 10, CV_16UC1);
+    randu(m, 0, 65536);
+    MosaicMetadata meta;
+    meta.format.whiteLevel = 65535;
+    const std::string good = dir + "/good.npy";
+    writeMosaic(good, m, meta);
+    const std::vector<char> bytes = readBytes(good);
+    const std::string expectedHeader = "{'descr': '<u2', 'fortran_order': False, 'shape': (6, 10), }";
+    ASSERT_EQ(bytes.size(), 128u + 120u) << "a 128-byte header (aligned to 64), then 6 x 10 x 2 bytes";
+    EXPECT_EQ(std::string(bytes.begin(), bytes.begin() + 6), "\x93NUMPY");
+    EXPECT_EQ(std::string(bytes.begin() + 10, bytes.begin() + 10 + long(expectedHeader.size())),
+              expectedHeader);
+    EXPECT_EQ(bytes[127], '\n');
+    EXPECT_EQ(0, std::memcmp(bytes.data() + 128, m.data, 120));
+
+    const std::string header(bytes.begin() + 10, bytes.begin() + 128);
+    // Each case: a file with the good one's sidecar (so that only the .npy is wrong) and the error.
+    const auto variant = [&](const std::string& name, std::vector<char> content) {
+        const std::string path = dir + "/" + name + ".npy";
+        writeBytes(path, content);
+        writeBytes(sidecarPathOf(path), readBytes(sidecarPathOf(good)));
+        return path;
+    };
+    const auto withHeader = [&](std::string h, size_t dataBytes = 120) {
+        h.resize(118, ' ');
+        h.back() = '\n';
+        std::vector<char> c(bytes.begin(), bytes.begin() + 10);
+        c.insert(c.end(), h.begin(), h.end());
+        c.insert(c.end(), bytes.begin() + 128, bytes.begin() + 128 + long(std::min<size_t>(dataBytes, 120)));
+        c.resize(128 + dataBytes, 0);
+        return c;
+    };
+    const std::vector<std::pair<std::vector<char>, std::string>> cases = {
+        {{}, "numpy's magic string"},
+        {std::vector<char>(bytes.begin(), bytes.begin() + 9), "numpy's magic string"},
+        {std::vector<char>(bytes.begin(), bytes.begin() + 60), "ends inside its header"},
+        {std::vector<char>(bytes.begin(), bytes.end() - 1), "247 bytes, but its header describes 248"},
+        {withHeader(header, 121), "249 bytes, but its header describes 248"},
+        {withHeader("{'descr': '>u2', 'fortran_order': False, 'shape': (6, 10), }"), "dtype '>u2'"},
+        {withHeader("{'descr': '<u2', 'fortran_order': True, 'shape': (6, 10), }"), "Fortran order"},
+        {withHeader("{'descr': '<u2', 'fortran_order': False, 'shape': (6, 10, 1), }"), "3 dimensions"},
+        {withHeader("{'descr': '<u2', 'fortran_order': False, 'shape': (60000, 60000), }"),
+         "pixels be at most"},
+        {withHeader("{'descr': '<u2', 'fortran_order': False, 'shape': (600, 1000), }"),
+         "but its header describes"},
+        {withHeader("{'descr': '<u2', 'fortran_order': False, 'shape': (6, 10), 'x': 1}"),
+         "unknown header key 'x'"},
+        {withHeader("{'descr': '<u2', 'descr': '<u2', 'shape': (6, 10), }"), "'descr' appears twice"},
+        {withHeader("{'descr': '<u2', 'shape': (6, 10), }"), "lacks"},
+        {withHeader("{'descr': '<u2', 'fortran_order': False, 'shape': (6, -10), }"),
+         "non-negative integers"},
+        {withHeader("{'descr': '<u2', 'fortran_order': False, 'shape': (6, 10), } x"), "text after"},
+    };
+    int k = 0;
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.second);
+        const std::string path = variant(cv::format("bad%d", k++), c.first);
+        Mat back;
+        EXPECT_CV_ERROR_CONTAINS(readMosaic(path, back), c.second);
+        EXPECT_CV_ERROR_CONTAINS(readMosaic(path, back), path);
+    }
+    std::vector<char> version = bytes;
+    version[6] = 4;
+    Mat back;
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(variant("version", version), back), "format version 4.0");
 }
 
 TEST(MosaicFiles, writeMosaicNeverReplacesASidecarAndLeavesNoneWithoutItsImage)

@@ -145,6 +145,21 @@ CV_RAWGMENT_EXPORTS void mergeCfaPlanes(InputArrayOfArrays planes, OutputArray m
 CV_RAWGMENT_EXPORTS void subtractBlackLevel(InputArray src, const RawFormat& format, OutputArray dst,
                                             bool normalize = false);
 
+/** @brief subtractBlackLevel() and splitCfaPlanes() in one pass, in the R, G1, G2, B order whatever the
+ * pattern: the input layout of most RAW networks, written straight into the memory it will be used from.
+ *
+ * Plane k of the output is rows [k h, (k + 1) h) with h = rows / 2: the planes of channel CFA_R, CFA_G1,
+ * CFA_G2, CFA_B (cfaSiteOfChannel()), each black-subtracted per site and, with `normalize`, divided by
+ * white - black; the same values as splitCfaPlanes() of subtractBlackLevel(). When `planes` is already a
+ * CV_32FC1 Mat of that size (for example a tensor's memory wrapped in a Mat), it is written in place.
+ * @param mosaic CV_16UC1 or CV_32FC1, even sides
+ * @param format its format (validated)
+ * @param planes output: CV_32FC1, (2 rows) x (cols / 2), the four planes stacked
+ * @param normalize divide by the per-site range
+ */
+CV_RAWGMENT_EXPORTS void packCfaPlanes(InputArray mosaic, const RawFormat& format, OutputArray planes,
+                                       bool normalize = true);
+
 /** @brief The inverse of subtractBlackLevel(): adds the black level back (after scaling by the per-site
  * range if `normalized`), rounds and clips to [0, white] for integer output.
  * @param src CV_32FC1 signal

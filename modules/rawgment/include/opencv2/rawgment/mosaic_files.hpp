@@ -17,8 +17,9 @@ namespace rawgment {
 /** @brief What a sidecar file says about a mosaic written by writeMosaic(). */
 struct CV_RAWGMENT_EXPORTS MosaicMetadata
 {
-    /** Version written to files; versions 1 (no camera tags), 2 (no noise camera) and 3 are read. */
-    static constexpr int FORMAT_VERSION = 3;
+    /** Version written to files that set gainFromIso (3 otherwise, so that their bytes stay as they
+     * were); versions 1 (no camera tags), 2 (no noise camera), 3 and 4 are read. */
+    static constexpr int FORMAT_VERSION = 4;
     RawFormat format;       //!< the mosaic's format, with the gain after augmentation
     bool hasScene = false;  //!< whether `scene` and `seed` describe how the mosaic was made
     Scene scene;            //!< the scene applied to the source
@@ -29,6 +30,10 @@ struct CV_RAWGMENT_EXPORTS MosaicMetadata
     /** The real camera whose measured noise the scene simulated (a darktable profile's "maker model",
      * CameraNoiseProfile::name()); empty when the noise model came from elsewhere. */
     String noiseCamera;
+    /** The mosaic is a camera file's raw as LibRaw reads it (gain 1), converted (rawgment_convert): its
+     * gain is the ISO of `camera` over a noise model's base ISO, as for the camera file itself. Needs
+     * camera tags with an ISO and format.gain 1. */
+    bool gainFromIso = false;
     Size size;           //!< the mosaic's size; set by writeMosaic(), checked by readMosaic()
     int type = CV_16UC1; //!< the mosaic's type; set by writeMosaic(), checked by readMosaic()
 
@@ -43,14 +48,17 @@ CV_RAWGMENT_EXPORTS String sidecarPathOf(const String& path);
 
 /** @brief Writes a mosaic and its sidecar YAML (top-level map `mosaic_metadata`).
  *
- * The container follows the extension: `.png` (16-bit), `.tif`/`.tiff` (16-bit or 32-bit float) or
- * `.dng` (16-bit, see writeDng()). The sidecar is written first and the image last, each atomically,
- * and neither replaces an existing file: an existing image marks a finished output, and an input can
- * never be overwritten. An existing sidecar without its image is kept when it holds exactly the text
- * this call would write (an interrupted run of the same job) and is an error otherwise. When the image
- * cannot be written, the sidecar this call wrote is removed: no sidecar is left without its image.
+ * The container follows the extension: `.png` (16-bit), `.tif`/`.tiff` (16-bit or 32-bit float,
+ * uncompressed), `.dng` (16-bit, see writeDng()) or `.npy` (16-bit or 32-bit float: numpy's format,
+ * uncompressed and C-ordered, the one to train from: readMosaic() reads it at the speed of a copy from
+ * the page cache, and numpy maps it without a copy, `np.load(path, mmap_mode="r")`). The sidecar is written
+ * first and the image last, each atomically, and neither replaces an existing file: an existing image marks a
+ * finished output, and an input can never be overwritten. An existing sidecar without its image is kept when
+ * it holds exactly the text this call would write (an interrupted run of the same job) and is an error
+ * otherwise. When the image cannot be written, the sidecar this call wrote is removed: no sidecar is left
+ * without its image.
  * @param path destination image, which must not exist
- * @param mosaic CV_16UC1 (any container) or CV_32FC1 (TIFF only)
+ * @param mosaic CV_16UC1 (any container) or CV_32FC1 (TIFF and .npy)
  * @param metadata the format, and optionally the scene and seed that made the mosaic and the camera tags
  *        (validated); a DNG carries the camera tags when `hasCamera`
  * @throws cv::Exception when `path` exists, the type does not fit the container, the camera tags do not

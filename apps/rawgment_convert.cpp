@@ -1,0 +1,61 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Converts camera RAWs and mosaics into the .npy container once, so that a training run decodes nothing.
+#include "app_tools.hpp"
+#include "pipeline.hpp"
+
+#include <opencv2/core/utility.hpp>
+
+#include <iostream>
+
+int main(int argc, char** argv)
+{
+    const char* keys = "{help h usage ? |      | print this message }"
+                       "{out o          |      | output directory (required; created if missing) }"
+                       "{format         | npy  | output container: npy, tif, png or dng }"
+                       "{@inputs        |      | input files (camera RAWs, or mosaics with a .yml sidecar) }";
+    if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_convert"))
+        return 2;
+    rawgment_apps::installInterruptCleanup();
+    cv::CommandLineParser parser(argc, argv, keys);
+    parser.about(
+        "rawgment_convert: RAW files and mosaics rewritten once as <out>/<input stem>.npy with a .yml "
+        "sidecar\n"
+        "(format, camera tags, source): numpy's uncompressed format, which readMosaic(), RawFolderDataset "
+        "and\n"
+        "np.load(mmap_mode='r') read at the speed of a copy. The mosaic is unchanged: a camera RAW augments\n"
+        "from its conversion exactly as from itself. Existing outputs of the same inputs are skipped, so an\n"
+        "interrupted run resumes; nothing is ever overwritten.");
+    if (parser.has("help")) {
+        parser.printMessage();
+        return 0;
+    }
+    const std::string outDir = parser.get<std::string>("out"), format = parser.get<std::string>("format");
+    std::vector<std::string> inputs;
+    // CommandLineParser keeps one positional value; the rest of the command line are inputs too.
+    for (int i = 1; i < argc; ++i)
+        if (argv[i][0] != '-')
+            inputs.push_back(argv[i]);
+    if (!parser.check() || outDir.empty() || inputs.empty()) {
+        parser.printErrors();
+        std::cerr << "usage: rawgment_convert --out=<dir> [--format=npy] <inputs...>\n";
+        return 2;
+    }
+    if (format != "npy" && format != "tif" && format != "png" && format != "dng") {
+        std::cerr << "rawgment_convert: --format must be npy, tif, png or dng (got '" << format << "')\n";
+        return 2;
+    }
+    try {
+        rawgment_apps::OutputDirectory outputDirectory(outDir);
+        rawgment_apps::ProgressBar progress("convert", inputs.size());
+        const rawgment_apps::ConvertResult r =
+            rawgment_apps::convertMosaics(inputs, outDir, "." + format, [&] { progress.advance(); });
+        progress.finish();
+        std::cout << "wrote " << r.written << " files, skipped " << r.skipped << " converted before, in "
+                  << outDir << "\n";
+        outputDirectory.keep();
+        return 0;
+    } catch (const std::exception& e) {
+        std::cerr << "rawgment_convert: " << e.what() << "\n";
+        return 1;
+    }
+}
