@@ -91,7 +91,8 @@ void bindNoiseOptions(py::module_& m)
                        doc("AugmentReport::brighteningPixels"))
         .def_readwrite("saturatedPixels", &AugmentReport::saturatedPixels,
                        doc("AugmentReport::saturatedPixels"))
-        .def_readwrite("steps", &AugmentReport::steps, doc("AugmentReport::steps"));
+        .def_readwrite("steps", &AugmentReport::steps, doc("AugmentReport::steps"))
+        .def_readwrite("stepSeconds", &AugmentReport::stepSeconds, doc("AugmentReport::stepSeconds"));
 }
 
 //! Colour jitter, motion blur and scaling.

@@ -29,6 +29,15 @@ void checkResampleInput(const Mat& src, const RawFormat& format, const NoiseMode
                  cv::format("%s: both sides must be even (got %dx%d)", who, src.cols, src.rows));
 }
 
+void recordStep(AugmentReport* report, const char* name, std::chrono::steady_clock::time_point start)
+{
+    if (!report)
+        return;
+    report->steps.push_back(name);
+    report->stepSeconds.push_back(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+}
+
 void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* report, OutputArray mask)
 {
     if (!report && !mask.needed())

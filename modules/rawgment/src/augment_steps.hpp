@@ -11,6 +11,7 @@
 #include "random.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <type_traits>
 
 namespace cv {
@@ -27,6 +28,8 @@ void checkResampleInput(const Mat& src, const RawFormat& format, const NoiseMode
 
 //! Counts or masks saturated input pixels, only when the caller asks: the hot loops do not pay for it.
 void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* report, OutputArray mask);
+//! Adds a step that ran to `report` (when given): its name and its wall time since `start`.
+void recordStep(AugmentReport* report, const char* name, std::chrono::steady_clock::time_point start);
 
 /** The Mat a noise step writes its result into: the caller's dst when it is a Mat of src's size and type
  * that shares no memory with src, else a new one. A buffer reused call after call costs no page faults:

@@ -365,6 +365,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
                  const NoiseOptions& noise, uint64 seed, OutputArray _dst, RawFormat& dstFormat,
                  AugmentReport* report, OutputArray saturatedMask)
 {
+    const auto start = std::chrono::steady_clock::now();
     const Mat src = _src.getMat();
     detail::checkMosaicInput(src, "colorJitter");
     format.validate();
@@ -478,7 +479,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     dstFormat.gain = newGain;
     if (report) {
         report->brighteningPixels += brightening.load();
-        report->steps.push_back("colorJitter");
+        detail::recordStep(report, "colorJitter", start);
     }
 }
 

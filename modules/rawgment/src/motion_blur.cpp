@@ -244,6 +244,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
 void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& model, InputArray _kernel,
                 const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
 {
+    const auto start = std::chrono::steady_clock::now();
     const Mat src = _src.getMat();
     detail::checkResampleInput(src, format, model, noise, "motionBlur");
     const Mat w = detail::normalisedKernel(_kernel, "motionBlur");
@@ -281,8 +282,7 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
     if (nonFinite)
         detail::throwNonFiniteShading("motionBlur");
     _dst.assign(dst);
-    if (report)
-        report->steps.push_back("motionBlur");
+    detail::recordStep(report, "motionBlur", start);
 }
 
 } // namespace rawgment

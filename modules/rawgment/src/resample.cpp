@@ -390,6 +390,7 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
 void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& model, double scale,
                  const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
 {
+    const auto start = std::chrono::steady_clock::now();
     const Mat src = _src.getMat();
     detail::checkResampleInput(src, format, model, noise, "scaleMosaic");
     if (!std::isfinite(scale) || !(scale > 0))
@@ -432,8 +433,7 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
     if (nonFinite)
         detail::throwNonFiniteShading("scaleMosaic");
     _dst.assign(dst);
-    if (report)
-        report->steps.push_back("scale");
+    detail::recordStep(report, "scale", start);
 }
 
 Rect scaleBox(const Rect& box, Size size, double scale)

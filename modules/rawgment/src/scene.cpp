@@ -206,6 +206,7 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
                                               scene.shift.x, scene.shift.y, current.cols, current.rows));
     const Point shift(2 * cvRound(scene.shift.x / 2.0), 2 * cvRound(scene.shift.y / 2.0));
     if (shift != Point(0, 0)) {
+        const auto start = std::chrono::steady_clock::now();
         // Into a new Mat: `current` still shares the caller's data, which must never be written.
         Mat shifted;
         shiftMosaic(current, shift, shifted);
@@ -221,8 +222,7 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
         if (boxes)
             for (Rect& b : *boxes)
                 b = (b + shift) & Rect(0, 0, current.cols, current.rows);
-        if (report)
-            report->steps.push_back("shift");
+        detail::recordStep(report, "shift", start);
     }
     if (scene.scale != 1) {
         scaleMosaic(current, fmt, model, scene.scale, scene.noise, seed, current, report);

@@ -667,7 +667,21 @@ TEST(Augment, identityStepsAreSkippedAndReturnTheInputItself)
     applyScene(src, fmt, model, Scene(), 1, out, outFmt, &report);
     EXPECT_EQ(out.data, src.data); // no copy
     EXPECT_TRUE(report.steps.empty());
+    EXPECT_TRUE(report.stepSeconds.empty());
     EXPECT_EQ(outFmt.gain, fmt.gain);
+    // Every step that runs is named and timed, in order.
+    Scene all;
+    all.shift = Point(2, 4);
+    all.scale = 1.02;
+    all.jitter = ColorJitter::exposureChange(0.5, 2);
+    all.motionKernel = linearMotionKernel(5, 30);
+    const Mat big(64, 48, CV_16UC1, Scalar(900));
+    AugmentReport timed;
+    applyScene(big, fmt, model, all, 1, out, outFmt, &timed);
+    EXPECT_EQ(timed.steps, (std::vector<std::string>{"shift", "scale", "colorJitter", "motionBlur"}));
+    ASSERT_EQ(timed.stepSeconds.size(), timed.steps.size());
+    for (double seconds : timed.stepSeconds)
+        EXPECT_TRUE(seconds >= 0 && seconds < 60) << seconds;
     Scene identityKernel;
     identityKernel.motionKernel = linearMotionKernel(1.0, 30); // length 0 or 1: identity
     EXPECT_TRUE(identityKernel.isIdentity());

@@ -91,6 +91,9 @@ struct CV_RAWGMENT_EXPORTS AugmentReport
         0; //!< pixels whose noise variance to add was negative (brightening), clipped to 0
     int64 saturatedPixels = 0;      //!< input pixels at or above the white level (their signal is unknown)
     std::vector<std::string> steps; //!< the steps that ran, in order; skipped identity steps are absent
+    /** The wall time of each step of `steps`, in seconds (its checks, noise and output; for a profile of
+     * where a sample's time goes, as python/bench/pipeline.py reports it). Never part of a result. */
+    std::vector<double> stepSeconds;
 };
 
 /** @brief A change of contrast, brightness and hue, simulated as a change of photons and gain (Eq. 13).
