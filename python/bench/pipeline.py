@@ -9,11 +9,13 @@ In one run, on 12 MP mosaics (4000 x 3000, 12-bit, a simulated sensor):
   scene): the time in reading and decoding (rawgment.torch.loadMosaic), in each augmentation step
   (AugmentReport.stepSeconds: shift, scale, colorJitter, motionBlur), in the conversion to the tensor (one
   pass: rawgment.packCfaPlanes into the tensor), and everything else (the sample's own time less those: the
-  policy's draw, Python, copies), as medians over samples and rounds.
+  policy's draw, Python, copies), as medians over samples and rounds, each part timed inside the item's own
+  call (RawFolderDataset(timings=True)).
 * **The floor**, in the same run: a copy (np.copyto) of the sample's uint16 mosaic and of its float32
   tensor into memory already touched, and np.load of the .npy.
 * **A DataLoader** over the .npy folder with 0, 1 and 2 workers (persistent, batch size 1), augmentation off
-  and the default policy: samples per second, after a warm-up epoch.
+  and the default policy: samples per second, after a warm-up epoch, medians of interleaved rounds of at
+  least 2 s each.
 * **POISSON against the Gaussian jitter**: colorJitter of the mosaic with each shot sampling.
 
     PYTHONPATH=build/release/python /usr/bin/python3 python/bench/pipeline.py [--samples 4] [--rounds 3]
@@ -22,7 +24,6 @@ import argparse
 import os
 import platform
 import statistics
-import subprocess
 import tempfile
 import time
 
@@ -63,72 +64,74 @@ def policies():
 
 
 def profile_samples(folder, model, policy, rounds):
-    """Median seconds per part of a sample, and of the whole sample, over every sample and round."""
-    dataset = rgt.RawFolderDataset(folder, model, policy=policy, baseSeed=1, pack=True, augment=policy is not None)
-    parts = {k: [] for k in ("read",) + STEPS + ("tensor", "other", "total")}
+    """Median seconds per part of a sample, and of the whole sample, over every sample and round, as the
+    dataset records them (RawFolderDataset(timings=True): each part timed inside the item's own call)."""
+    dataset = rgt.RawFolderDataset(folder, model, policy=policy, baseSeed=1, pack=True, augment=policy is not None,
+                                   timings=True)
     for r in range(rounds):
         dataset.set_epoch(r)
         for index in range(len(dataset)):
-            start = time.perf_counter()
             dataset[index]
-            total = time.perf_counter() - start
-            # The same sample's parts, timed one by one (the same seed: the same scene and steps).
-            start = time.perf_counter()
-            mosaic, fmt = rgt.loadMosaic(dataset.files[index])
-            read = time.perf_counter() - start
-            steps = dict.fromkeys(STEPS, 0.0)
-            if policy is not None:
-                result = dataset.transform(mosaic, fmt, index=index, epoch=r)
-                for name, seconds in zip(result.report.steps, result.report.stepSeconds):
-                    steps[name] += seconds
-                mosaic, fmt = result.raw, result.format
-            start = time.perf_counter()
-            rgt._tensorOf(mosaic, fmt, True, True)
-            tensor = time.perf_counter() - start
-            parts["read"].append(read)
-            for name in STEPS:
-                parts[name].append(steps[name])
-            parts["tensor"].append(tensor)
-            parts["total"].append(total)
-            parts["other"].append(max(0.0, total - read - sum(steps.values()) - tensor))
-    return {k: statistics.median(v) for k, v in parts.items()}
+    keys = ("read",) + STEPS + ("tensor", "other", "total")
+    return {k: statistics.median(t.get(k, 0.0) for t in dataset.timings) for k in keys}
 
 
 def floor(folder, rounds):
-    """Medians of a copy of the uint16 mosaic and of its float32 planes into touched memory, and of np.load."""
+    """Medians of the floor and of the tensor's pass, like with like: copies of the uint16 mosaic and of the
+    float32 planes into memory already touched and into new memory (a new tensor's pages are first touched
+    by whatever writes it), np.load of the .npy, and the one-pass conversion into touched and new tensors
+    beside the conversion before it (subtractBlackLevel, then the planes split and stacked)."""
     path = os.path.join(folder, sorted(os.listdir(folder))[0])
     mosaic = np.load(path)
+    fmt = rg.readMosaic(path)[1].format
     copy16 = np.empty_like(mosaic)
-    planes = np.ones((4, SIZE[1] // 2, SIZE[0] // 2), np.float32)
-    copy32 = np.empty_like(planes)
-    times = {"memcpy mosaic": [], "memcpy tensor": [], "np.load": []}
+    planes = torch.ones((4, SIZE[1] // 2, SIZE[0] // 2))
+    touched = torch.zeros_like(planes)
+    cases = {
+        "memcpy mosaic, touched memory": lambda: np.copyto(copy16, mosaic),
+        "np.load of the .npy": lambda: np.load(path),
+        "memcpy tensor, touched memory": lambda: touched.copy_(planes),
+        "memcpy tensor, new memory": lambda: planes.clone(),
+        "tensor pass, touched memory": lambda: rg.packCfaPlanes(mosaic, fmt, out=touched.numpy()),
+        "tensor pass, new tensor": lambda: rg.packCfaPlanes(mosaic, fmt, out=torch.empty(planes.shape).numpy()),
+        "before: subtract, split, stack": lambda: rgt.packCfaPlanes(rg.subtractBlackLevel(mosaic, fmt, normalize=True),
+                                                                    fmt),
+    }
+    times = {name: [] for name in cases}
     for _ in range(5 * rounds):
-        start = time.perf_counter()
-        np.copyto(copy16, mosaic)
-        times["memcpy mosaic"].append(time.perf_counter() - start)
-        start = time.perf_counter()
-        np.copyto(copy32, planes)
-        times["memcpy tensor"].append(time.perf_counter() - start)
-        start = time.perf_counter()
-        np.load(path)
-        times["np.load"].append(time.perf_counter() - start)
+        for name, fn in cases.items():
+            start = time.perf_counter()
+            fn()
+            times[name].append(time.perf_counter() - start)
     return {k: statistics.median(v) for k, v in times.items()}
 
 
-def loader_rate(folder, model, policy, workers, samples):
-    dataset = rgt.RawFolderDataset(folder, model, policy=policy, baseSeed=1, pack=True, augment=policy is not None)
-    loader = torch.utils.data.DataLoader(dataset, batch_size=1, num_workers=workers,
-                                         persistent_workers=workers > 0)
-    dataset.set_epoch(0)
-    for _ in loader:  # warm-up: workers started, files in the page cache
-        pass
-    epochs = max(1, 12 // samples)
-    start = time.perf_counter()
-    for epoch in range(1, epochs + 1):
-        dataset.set_epoch(epoch)
-        for _ in loader:
+def loader_rates(folder, model, policy, rounds, seconds=2.0):
+    """Samples per second of a DataLoader with 0, 1 and 2 workers (persistent, batch size 1): the three loaders
+    made once and warmed up, then timed in interleaved rounds of whole epochs lasting at least `seconds`
+    each (a loaded moment of the machine falls on all three), medians of the rounds."""
+    loaders = {}
+    for workers in (0, 1, 2):
+        dataset = rgt.RawFolderDataset(folder, model, policy=policy, baseSeed=1, pack=True,
+                                       augment=policy is not None)
+        loader = torch.utils.data.DataLoader(dataset, batch_size=1, num_workers=workers,
+                                             persistent_workers=workers > 0)
+        dataset.set_epoch(0)
+        for _ in loader:  # warm-up: workers started, files in the page cache
             pass
-    return epochs * len(dataset) / (time.perf_counter() - start)
+        loaders[workers] = (dataset, loader)
+    rates = {workers: [] for workers in loaders}
+    epoch = 1
+    for _ in range(rounds):
+        for workers, (dataset, loader) in loaders.items():
+            count, start = 0, time.perf_counter()
+            while time.perf_counter() - start < seconds:
+                dataset.set_epoch(epoch)
+                epoch += 1
+                for _ in loader:
+                    count += 1
+            rates[workers].append(count / (time.perf_counter() - start))
+    return [statistics.median(rates[w]) for w in (0, 1, 2)]
 
 
 def jitter_ratio(folder, model, rounds):
@@ -179,16 +182,20 @@ def main():
                 print("| %s | %s | %s | %.1f | %.0f%% |" % (
                     ext, name, " | ".join("%.1f" % (1e3 * p[k]) for k in ("read",) + STEPS + ("tensor", "other")),
                     1e3 * p["total"], 100 * p["other"] / p["total"]))
-        npy = profiles[("npy", "off")]
-        print("\nGoals (.npy): read %.2fx a memcpy of the mosaic (goal <= 2); tensor %.2fx a memcpy of the float "
-              "output (goal <= 1.5); time outside the library's kernels (read, steps and tensor are the kernels) "
-              "%.0f%% of the sample with the default policy (goal <= 15%%)." % (
-                  npy["read"] / base["memcpy mosaic"], npy["tensor"] / base["memcpy tensor"],
-                  100 * profiles[("npy", "default")]["other"] / profiles[("npy", "default")]["total"]))
+        npy, default = profiles[("npy", "off")], profiles[("npy", "default")]
+        print("\nGoals (.npy): read %.2fx a memcpy of the mosaic (goal <= 2); the tensor pass %.2fx a memcpy of the "
+              "float output into new memory, %.2fx into touched memory (goal <= 1.5); time outside the library's "
+              "kernels (read, steps and tensor are the kernels) %.0f%% of the sample with the default policy, "
+              "%.0f%% with jitter only (goal <= 15%%)." % (
+                  npy["read"] / base["memcpy mosaic, touched memory"],
+                  base["tensor pass, new tensor"] / base["memcpy tensor, new memory"],
+                  base["tensor pass, touched memory"] / base["memcpy tensor, touched memory"],
+                  100 * default["other"] / default["total"],
+                  100 * profiles[("npy", "jitter only")]["other"] / profiles[("npy", "jitter only")]["total"]))
         print("\n| DataLoader over .npy | 0 workers | 1 worker | 2 workers | 2 over 1 |\n|---|---:|---:|---:|---:|")
         for name in ("off", "default"):
             policy = policies()[name]
-            rates = [loader_rate(folders["npy"], model, policy, w, args.samples) for w in (0, 1, 2)]
+            rates = loader_rates(folders["npy"], model, policy, args.rounds)
             print("| augmentation %s (samples/s) | %.2f | %.2f | %.2f | %.2fx |" % (name, *rates, rates[2] / rates[1]))
         ratio = jitter_ratio(folders["npy"], model, args.rounds)
         print("\ncolorJitter of 12 MP: GAUSSIAN %.1f ms, POISSON %.1f ms: %.2fx (goal <= 4x)." % (

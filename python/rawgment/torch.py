@@ -14,6 +14,7 @@ Importing this module needs torch; importing ``rawgment`` does not.
 """
 import collections
 import os
+import time
 
 import numpy as np
 import torch
@@ -246,10 +247,15 @@ class RawFolderDataset(torch.utils.data.Dataset):
             the sample's seed, at even offsets), taken before the augmentation with its place on the sensor
             (RawFormat.cropped sets sensorOrigin), so that a model's dark shading is read at the crop's own
             pixels. A file smaller than the crop is an error naming it.
+        timings: record where each item's time went, in this process: a dict per item appended to the list
+            ``timings``, in seconds: ``read`` (reading and decoding the file), one key per augmentation step
+            that ran (AugmentReport.stepSeconds: ``shift``, ``scale``, ``colorJitter``, ``motionBlur``),
+            ``tensor`` (black subtraction, normalisation and packing in one pass), ``other`` (the rest: the
+            scene's draw, the crop, Python) and ``total``. python/bench/pipeline.py reports them.
     """
 
     def __init__(self, folder, model, policy=None, baseSeed=0, pack=False, normalize=True, augment=True,
-                 crop=None, camera=None):
+                 crop=None, camera=None, timings=False):
         if crop is not None:
             if len(crop) != 2 or any(int(v) != v or v <= 0 or int(v) % 2 for v in crop):
                 raise ValueError("RawFolderDataset: crop must be (height, width), both even and > 0, not %r"
@@ -275,6 +281,7 @@ class RawFolderDataset(torch.utils.data.Dataset):
         self.pack = bool(pack)
         self.normalize = bool(normalize)
         self.augment = bool(augment)
+        self.timings = [] if timings else None
         # In shared memory: a DataLoader's workers hold copies of the dataset, and persistent workers keep
         # theirs across epochs; a plain attribute set after they started never reached them, and they
         # repeated epoch 0's augmentations.
@@ -315,12 +322,23 @@ class RawFolderDataset(torch.utils.data.Dataset):
             # A worker process is one of several running samples in parallel: OpenCV's own threads
             # would only oversubscribe the cores (the samples are the same on any thread count).
             _rg.setNumThreads(1)
+        start = time.perf_counter()
         mosaic, fmt = loadMosaic(self.files[index])
+        read = time.perf_counter()
         if self.crop is not None:
             mosaic, fmt = self._cropped(mosaic, fmt, index)
         camera = ""
+        steps = {}
         if self.augment:
             result = self.transform(mosaic, fmt, index=index, epoch=self.epoch)
             mosaic, fmt, camera = result.raw, result.format, result.camera or ""
+            for name, seconds in zip(result.report.steps, result.report.stepSeconds):
+                steps[name] = steps.get(name, 0.0) + seconds
+        beforeTensor = time.perf_counter()
         raw = _tensorOf(mosaic, fmt, self.pack, self.normalize)
+        if self.timings is not None:
+            end = time.perf_counter()
+            record = dict(steps, read=read - start, tensor=end - beforeTensor, total=end - start)
+            record["other"] = record["total"] - record["read"] - record["tensor"] - sum(steps.values())
+            self.timings.append(record)
         return {"raw": raw, "gain": float(fmt.gain), "index": int(index), "path": self.files[index], "camera": camera}

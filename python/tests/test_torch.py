@@ -213,3 +213,17 @@ def test_npy_mosaics_are_numpys_own_files_and_the_dataset_reads_them(folder, tmp
         [os.path.splitext(os.path.basename(f))[0] for f in fromDng.files]
     for index in range(len(fromDng)):
         assert torch.equal(fromDng[index]["raw"], fromNpy[index]["raw"])
+
+
+def test_a_dataset_records_where_each_items_time_went(folder):
+    dataset = rgt.RawFolderDataset(folder, rg.NoiseModel(0.25, 1.5, 0.8), baseSeed=2, pack=True, timings=True)
+    plain = rgt.RawFolderDataset(folder, rg.NoiseModel(0.25, 1.5, 0.8), baseSeed=2, pack=True)
+    assert plain.timings is None
+    for index in range(3):
+        assert torch.equal(dataset[index]["raw"], plain[index]["raw"]), "recording changes no sample"
+    assert len(dataset.timings) == 3
+    for t in dataset.timings:
+        steps = {k: v for k, v in t.items() if k not in ("read", "tensor", "other", "total")}
+        assert set(steps) <= {"shift", "scale", "colorJitter", "motionBlur"}
+        assert all(v >= 0 for v in t.values())
+        assert abs(t["read"] + t["tensor"] + t["other"] + sum(steps.values()) - t["total"]) < 1e-9

@@ -58,7 +58,9 @@ Mat stepOutput(const Mat& src, OutputArray dst)
         if (!m.empty() && m.size() == src.size() && m.type() == src.type() && !overlaps)
             return m;
     }
-    return Mat(src.size(), src.type());
+    Mat out(src.size(), src.type());
+    adviseHugePages(out);
+    return out;
 }
 
 void throwNonFiniteShading(const char* who)

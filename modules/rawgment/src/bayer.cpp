@@ -294,6 +294,7 @@ void subtractBlackLevel(InputArray _src, const RawFormat& format, OutputArray _d
             scale[s] = 1.0 / (format.whiteLevel - format.blackLevel[s]);
     // A fresh Mat keeps src intact when the caller passes the same Mat as src and dst.
     Mat dst(src.size(), CV_32FC1);
+    detail::adviseHugePages(dst);
     if (src.depth() == CV_16U)
         affinePerSite<ushort>(src, dst, format.blackLevel, scale);
     else
@@ -351,6 +352,8 @@ void packCfaPlanes(InputArray _mosaic, const RawFormat& format, OutputArray _pla
         planeOfSite[cfaSiteOfChannel(format.pattern, order[k])] = k;
     _planes.create(2 * src.rows, src.cols / 2, CV_32FC1);
     Mat dst = _planes.getMat();
+    // Often a tensor's new memory, first touched here.
+    detail::adviseHugePages(dst);
     // The output may be the caller's memory; it must not be the input's.
     if (dst.data == src.data)
         CV_Error(Error::StsBadArg, "packCfaPlanes: planes must not share the mosaic's memory");

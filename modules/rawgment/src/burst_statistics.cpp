@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #if defined(__linux__)
-#include <sys/mman.h>
 #endif
 #include <cstring>
 #include <type_traits>
@@ -283,13 +282,7 @@ void mergeGroupRows(const std::vector<Mat>& group, int merged, const Vec4d& blac
 Mat largeBuffer(Size size, int type)
 {
     Mat m(size, type);
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    const size_t kHuge = size_t(2) << 20;
-    const uintptr_t begin = (reinterpret_cast<uintptr_t>(m.data) + kHuge - 1) & ~(kHuge - 1);
-    const uintptr_t end = (reinterpret_cast<uintptr_t>(m.data) + m.total() * m.elemSize()) & ~(kHuge - 1);
-    if (end > begin) // advice only: a kernel without THP refuses it and nothing changes
-        (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#endif
+    detail::adviseHugePages(m);
     return m;
 }
 

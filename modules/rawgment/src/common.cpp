@@ -13,6 +13,7 @@
 #include <iterator>
 #include <poll.h>
 #include <sstream>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
@@ -22,6 +23,21 @@
 namespace cv {
 namespace rawgment {
 namespace detail {
+
+void adviseHugePages(const Mat& m)
+{
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    const size_t huge = size_t(2) << 20;
+    if (!m.isContinuous() || m.total() * m.elemSize() < 2 * huge)
+        return;
+    const uintptr_t begin = (reinterpret_cast<uintptr_t>(m.data) + huge - 1) & ~(huge - 1);
+    const uintptr_t end = (reinterpret_cast<uintptr_t>(m.data) + m.total() * m.elemSize()) & ~(huge - 1);
+    if (end > begin) // advice only: a kernel without THP refuses it and nothing changes
+        (void)madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+    (void)m;
+#endif
+}
 
 void checkFinitePositive(double value, const char* what)
 {

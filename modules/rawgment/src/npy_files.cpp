@@ -272,6 +272,7 @@ Mat readNpyMosaic(const String& path)
                   format("%lld bytes, but its header describes %lld (%lld x %lld values after %lld bytes)",
                          fileBytes, dataOffset + dataBytes, rows, cols, dataOffset));
     Mat mosaic(static_cast<int>(rows), static_cast<int>(cols), type);
+    adviseHugePages(mosaic);
     if (!readFully(fd, mosaic.data, static_cast<size_t>(dataBytes), static_cast<off_t>(dataOffset), path))
         CV_Error(Error::StsError, "readMosaic: '" + path + "' became shorter while it was read");
     return mosaic;

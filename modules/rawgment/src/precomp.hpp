@@ -69,6 +69,11 @@ std::string readTextFile(const String& path);
 void checkRegularFile(const String& path, const String& what);
 //! Why a file of this st_mode is not read ("it is a FIFO ...").
 const char* notRegularReason(unsigned mode);
+/** Asks for transparent huge pages over a large buffer (4 MiB or more) that is about to be written for the
+ * first time: on a virtual machine each 4 KiB page fault costs microseconds, so a new 12 MP float mosaic
+ * (48 MB) spends more time faulting than being written. Advice only: nothing changes without THP, on
+ * memory already touched, or off Linux. */
+void adviseHugePages(const Mat& m);
 //! The bytes of a .npy file (format 1.0, little-endian, C order) holding `mosaic`, CV_16UC1 or CV_32FC1.
 std::vector<uchar> npyFileBytes(const Mat& mosaic);
 /** The mosaic of a .npy file as npyFileBytes() writes it (format 1.0 to 3.0, a 2-D '<u2' or '<f4' array
