@@ -13,8 +13,8 @@ In one run, on 12 MP mosaics (4000 x 3000, 12-bit, a simulated sensor):
   call (RawFolderDataset(timings=True)).
 * **The floor**, in the same run: a copy (np.copyto) of the sample's uint16 mosaic and of its float32
   tensor into memory already touched, and np.load of the .npy.
-* **A DataLoader** over the .npy folder with 0, 1 and 2 workers (persistent, batch size 1), augmentation off
-  and the default policy: samples per second, after a warm-up epoch, medians of interleaved rounds of at
+* **A DataLoader** over each container's folder with 0, 1 and 2 workers (persistent, batch size 1), for each
+  policy: samples per second, after a warm-up epoch, medians of interleaved rounds of at
   least 2 s each.
 * **POISSON against the Gaussian jitter**: colorJitter of the mosaic with each shot sampling.
 
@@ -192,11 +192,12 @@ def main():
                   base["tensor pass, touched memory"] / base["memcpy tensor, touched memory"],
                   100 * default["other"] / default["total"],
                   100 * profiles[("npy", "jitter only")]["other"] / profiles[("npy", "jitter only")]["total"]))
-        print("\n| DataLoader over .npy | 0 workers | 1 worker | 2 workers | 2 over 1 |\n|---|---:|---:|---:|---:|")
-        for name in ("off", "default"):
-            policy = policies()[name]
-            rates = loader_rates(folders["npy"], model, policy, args.rounds)
-            print("| augmentation %s (samples/s) | %.2f | %.2f | %.2f | %.2fx |" % (name, *rates, rates[2] / rates[1]))
+        print("\n| DataLoader, samples/s | policy | 0 workers | 1 worker | 2 workers | 2 over 1 |\n"
+              "|---|---|---:|---:|---:|---:|")
+        for ext in ("npy", "tif", "png", "dng"):
+            for name in ("off", "jitter only", "default"):
+                rates = loader_rates(folders[ext], model, policies()[name], args.rounds)
+                print("| %s | %s | %.2f | %.2f | %.2f | %.2fx |" % (ext, name, *rates, rates[2] / rates[1]))
         ratio = jitter_ratio(folders["npy"], model, args.rounds)
         print("\ncolorJitter of 12 MP: GAUSSIAN %.1f ms, POISSON %.1f ms: %.2fx (goal <= 4x)." % (
             1e3 * ratio["GAUSSIAN"], 1e3 * ratio["POISSON"], ratio["POISSON"] / ratio["GAUSSIAN"]))
