@@ -41,13 +41,6 @@ constexpr RatioLine RCD_RATIO{0.592, 0.962};
  * darktable measures), so 0.1 is three of them for a single ISO and more for a median over ISOs. */
 constexpr double RATIO_MARGIN = 0.1;
 
-double median(std::vector<double> v)
-{
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 } // namespace
 
 void judgeProfileDemosaic(CameraNoiseProfile& cam)
@@ -71,7 +64,7 @@ void judgeProfileDemosaic(CameraNoiseProfile& cam)
         cam.demosaicReason = "red and blue are copies of green at every ISO: no evidence";
         return;
     }
-    cam.colourSlopeRatios = Vec2d(median(red), median(blue));
+    cam.colourSlopeRatios = Vec2d(medianOf(red), medianOf(blue));
     for (int k = 0; k < 2; ++k) {
         cam.balancePpg[k] = PPG_RATIO.balanceOf(cam.colourSlopeRatios[k]);
         cam.balanceRcd[k] = RCD_RATIO.balanceOf(cam.colourSlopeRatios[k]);

@@ -18,19 +18,21 @@ namespace {
 constexpr double EXPANDED_SLOPE_OVER_ISO = 1.15;
 /* Two ISOs at least MIN_DIGITAL_STEP apart (a little under a third of a stop, 1.26) whose slopes differ by
  * less than SAME_RAW_SLOPE share one raw: an analog third of a stop raises the slope by 26%, while the
- * slopes of one raw measured twice (darktable's 19 cameras with two profiles at one ISO) differ by a few
- * percent. */
+ * 107 ISOs that darktable 4.2.1's file measured twice differ by 0.9% (median) and 2.4% (75th percentile)
+ * between their two green slopes. */
 constexpr double MIN_DIGITAL_STEP = 1.2;
 constexpr double SAME_RAW_SLOPE = 0.08;
 
-double median(std::vector<double> v)
-{
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 } // namespace
+
+double medianOf(std::vector<double> values)
+{
+    if (values.empty())
+        return 0;
+    std::sort(values.begin(), values.end());
+    const size_t n = values.size();
+    return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
 
 /* Expanded low settings: from the lowest ISO up, each whose slope falls less than its ISO (the Canon EOS 5D
  * Mark III's ISO 50, the Nikon D3's ISO 100 to 159); two ISOs are always kept.
@@ -79,7 +81,7 @@ IsoSettings classifyIsoSettings(const std::vector<double>& isos, const std::vect
     if (perIso.empty())
         for (size_t k = first; k < n; ++k)
             perIso.push_back(slopes[k] / isos[k]);
-    const double trend = median(perIso);
+    const double trend = medianOf(perIso);
     std::map<double, double> digital;
     for (const auto& run : runs) {
         size_t analog = run.first;

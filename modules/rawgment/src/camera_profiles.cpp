@@ -97,15 +97,6 @@ NoiseModel CameraNoiseProfile::modelFor(const RawFormat& format) const
 
 namespace {
 
-double median(std::vector<double> v)
-{
-    if (v.empty())
-        return 0;
-    std::sort(v.begin(), v.end());
-    const size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 //! The smallest shot slope (of the white level) a measured profile may have: a full well of 1e12 electrons.
 constexpr double MIN_SHOT_SLOPE = 1e-12;
 
@@ -372,8 +363,8 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
             cam.monotoneSlope = false;
         previous = &f;
     }
-    cam.medianSlopeResidual = median(slopeResiduals);
-    cam.medianColourSpread = median(spreads);
+    cam.medianSlopeResidual = medianOf(slopeResiduals);
+    cam.medianColourSpread = medianOf(spreads);
     judgeProfileDemosaic(cam);
     if (cam.negativeOffsets == int(g.size())) {
         cam.verdict = CAMERA_PROFILE_REFUSED;

@@ -18,6 +18,9 @@ struct IsoSettings
     std::map<double, double> digital; //!< digital ISO -> the ISO whose raw it is (CameraIsoFit::rawIso)
 };
 
+//! The median of `values` (0 for none).
+double medianOf(std::vector<double> values);
+
 /** The expanded and digital settings among distinct ISOs in increasing order, each with its mean green
  * slope (camera_iso_settings.cpp says how they are told). */
 IsoSettings classifyIsoSettings(const std::vector<double>& isos, const std::vector<double>& slopes);
