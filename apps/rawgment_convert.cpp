@@ -5,14 +5,48 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include <algorithm>
+#include <filesystem>
 #include <iostream>
+
+namespace {
+
+/** The files of the command line, each folder replaced by its files in name order (not its sub-folders,
+ * sidecars or hidden files): every one must then be a camera RAW or a mosaic with a sidecar. */
+std::vector<std::string> filesOf(const std::vector<std::string>& inputs)
+{
+    std::vector<std::string> files;
+    for (const std::string& in : inputs) {
+        std::error_code error;
+        if (!std::filesystem::is_directory(in, error)) {
+            files.push_back(in);
+            continue;
+        }
+        std::vector<std::string> inFolder;
+        for (const auto& entry : std::filesystem::directory_iterator(in)) {
+            const std::string name = entry.path().filename().string();
+            const bool sidecar = name.size() > 4 && name.compare(name.size() - 4, 4, ".yml") == 0;
+            if (entry.is_regular_file() && !sidecar && name[0] != '.')
+                inFolder.push_back(entry.path().string());
+        }
+        if (inFolder.empty())
+            throw std::runtime_error("'" + in + "' holds no file to convert");
+        std::sort(inFolder.begin(), inFolder.end());
+        files.insert(files.end(), inFolder.begin(), inFolder.end());
+    }
+    return files;
+}
+
+} // namespace
 
 int main(int argc, char** argv)
 {
-    const char* keys = "{help h usage ? |      | print this message }"
-                       "{out o          |      | output directory (required; created if missing) }"
-                       "{format         | npy  | output container: npy, tif, png or dng }"
-                       "{@inputs        |      | input files (camera RAWs, or mosaics with a .yml sidecar) }";
+    const char* keys =
+        "{help h usage ? |      | print this message }"
+        "{out o          |      | output directory (required; created if missing) }"
+        "{format         | npy  | output container: npy, tif, png or dng }"
+        "{@inputs        |      | input files (camera RAWs, or mosaics with a .yml sidecar) or folders of "
+        "them }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_convert"))
         return 2;
     rawgment_apps::installInterruptCleanup();
@@ -37,7 +71,7 @@ int main(int argc, char** argv)
             inputs.push_back(argv[i]);
     if (!parser.check() || outDir.empty() || inputs.empty()) {
         parser.printErrors();
-        std::cerr << "usage: rawgment_convert --out=<dir> [--format=npy] <inputs...>\n";
+        std::cerr << "usage: rawgment_convert --out=<dir> [--format=npy] <files or folders...>\n";
         return 2;
     }
     if (format != "npy" && format != "tif" && format != "png" && format != "dng") {
@@ -45,10 +79,11 @@ int main(int argc, char** argv)
         return 2;
     }
     try {
+        const std::vector<std::string> files = filesOf(inputs);
         rawgment_apps::OutputDirectory outputDirectory(outDir);
-        rawgment_apps::ProgressBar progress("convert", inputs.size());
+        rawgment_apps::ProgressBar progress("convert", files.size());
         const rawgment_apps::ConvertResult r =
-            rawgment_apps::convertMosaics(inputs, outDir, "." + format, [&] { progress.advance(); });
+            rawgment_apps::convertMosaics(files, outDir, "." + format, [&] { progress.advance(); });
         progress.finish();
         std::cout << "wrote " << r.written << " files, skipped " << r.skipped << " converted before, in "
                   << outDir << "\n";

@@ -780,6 +780,11 @@ TEST(Apps, convertWritesNpyThatAugmentsAsItsSource)
     EXPECT_EQ(1, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("never overwritten")) << r.output;
     EXPECT_EQ(2, runApp("rawgment_convert", "--out='" + dir + "/x' --format=jpg '" + png + "'").status);
+    // A folder: its files (not its sidecars), each converted.
+    r = runApp("rawgment_convert", "--out='" + dir + "/folder' '" + dir + "/sim/g06dB_level0.50'");
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("wrote 3 files, skipped 0")) << r.output;
+    EXPECT_TRUE(exists(dir + "/folder/frame_002.npy") && exists(dir + "/folder/frame_002.npy.yml"));
 }
 
 TEST(Apps, augmentAsRealCamerasDrawsOnePerOutputAndRecordsIt)
