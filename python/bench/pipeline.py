@@ -19,6 +19,10 @@ In one run, on 12 MP mosaics (4000 x 3000, 12-bit, a simulated sensor):
 * **POISSON against the Gaussian jitter**: colorJitter of the mosaic with each shot sampling.
 
     PYTHONPATH=build/release/python /usr/bin/python3 python/bench/pipeline.py [--samples 4] [--rounds 3]
+
+Before and after a change, on the same files: `--keep DIR` writes the files into DIR (and keeps them), and
+`--loaders FOLDER` prints only the DataLoader rates over one of its folders with whichever build of
+rawgment is on PYTHONPATH (an older build's RawFolderDataset, for instance).
 """
 import argparse
 import os
@@ -162,9 +166,23 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0], allow_abbrev=False)
     parser.add_argument("--samples", type=int, default=4, help="files per container (12 MP each)")
     parser.add_argument("--rounds", type=int, default=3, help="passes over the files per measurement")
+    parser.add_argument("--keep", metavar="DIR", help="write the files into DIR (new) and keep them")
+    parser.add_argument("--loaders", metavar="FOLDER", help="only the DataLoader rates over FOLDER's files")
     args = parser.parse_args()
     if args.samples < 1 or args.rounds < 1:
         parser.error("--samples and --rounds must be >= 1")
+    if args.loaders:
+        model = rg.NoiseModel(0.25, 1.5, 0.8)
+        print("| folder | policy | 0 workers | 1 worker | 2 workers |\n|---|---|---:|---:|---:|")
+        for name in ("off", "default"):
+            rates = loader_rates(args.loaders, model, policies()[name], args.rounds)
+            print("| %s | %s | %.2f | %.2f | %.2f |" % (args.loaders, name, *rates))
+        return
+    if args.keep:
+        os.makedirs(args.keep)
+        make_folders(args.keep, args.samples)
+        print("wrote %s/{npy,tif,png,dng}" % args.keep)
+        return
     print("Host: %s; rawgment threads %d.\n" % (host(), rg.getNumThreads()))
     with tempfile.TemporaryDirectory() as root:
         model, folders = make_folders(root, args.samples)
