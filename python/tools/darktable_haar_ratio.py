@@ -16,6 +16,12 @@ written here from the algorithm's description. Result (seed 1, 16 frames of 1024
 cv::rawgment's DARKTABLE_HAAR_VARIANCE_RATIO is the second.
 Run: /usr/bin/python3 python/tools/darktable_haar_ratio.py
 
+With --demosaics FRAMES it also measures c per colour for darktable's PPG and RCD demosaics
+(python/tools/darktable_demosaic.py) on flat fields of shot noise at colour balances (green's level over
+red's and blue's) 1 to 3, and the line the red or blue over green slope ratio follows in the balance:
+PPG 0.284 + 0.946 k, RCD 0.592 + 0.962 k with FRAMES = 4; on grey, c of green is 0.0798 (PPG) and 0.0474
+(RCD), of red and blue 0.098 and 0.073. docs/real_cameras.md ("Which demosaic") shows the whole output.
+
 With --study N (and the build's Python module on PYTHONPATH) it also measures a known sensor the way
 darktable's tool does, N times, and imports each result with rawgment.readCameraProfiles: the check of
 the whole chain that python/tests/test_camera_profiles.py runs twice. Result of --study 8 (seeds 1-8),

@@ -164,8 +164,8 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
     int demosaic = PROFILE_DEMOSAIC_UNDECIDED; //!< a ProfileDemosaic
     String demosaicReason;                     //!< the evidence for `demosaic`, in a sentence
     /** c, the Haar variance ratio the profiles were divided by (DarktableImportParams::haarVarianceRatio):
-     * PPG's green unless set otherwise. With demosaic UNDECIDED it is an assumption, and the camera's
-     * full well would be 0.0794 / 0.0474 = 1.68 times larger with RCD's c. */
+     * PPG's green unless set otherwise. With demosaic UNDECIDED it is an assumption: with RCD's c every
+     * variance would be 0.0794 / 0.0474 = 1.68 times larger and the full well as much smaller. */
     double haarVarianceRatio = 0;
 
     //! "maker model", the name cameras are selected by.
