@@ -57,8 +57,8 @@ public:
     void add(InputArray frame);
     /** @brief Starts a new burst of `format` (validated) in the same memory: frames() becomes 0, and the
      * state and the group buffers stay allocated, so a calibration over many bursts of one size and type
-     * touches each page once instead of once per burst (a new object for a 12 MP burst spends about a
-     * quarter of its time on the first touch of 120 MB; perf_calibration's `reused` benchmark shows it).
+     * touches each page once instead of once per burst (100 frames of 12 MP took 432 ms with a new object
+     * and 362 ms reset on host H3: perf_calibration's `reused` benchmark).
      * A burst of another size or type may follow: the first frame then reallocates. Results are the
      * same bits as a new object's. */
     void reset(const RawFormat& format);
