@@ -50,6 +50,30 @@ void checkRegularFile(const String& path, const String& what)
                  "cannot open " + what + " '" + path + "': " + notRegularReason(status.st_mode));
 }
 
+RegularFileForReading::RegularFileForReading(const String& path, const String& what)
+{
+    // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer that may never come.
+    fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd_ < 0)
+        CV_Error(Error::StsError, "cannot open " + what + " '" + path +
+                                      "': " + (errno == ENOENT ? "no such file" : std::strerror(errno)));
+    struct stat status;
+    const bool statted = ::fstat(fd_, &status) == 0;
+    const int statError = errno;
+    if (!statted || !S_ISREG(status.st_mode)) {
+        ::close(fd_);
+        CV_Error(Error::StsError,
+                 "cannot open " + what + " '" + path +
+                     "': " + (statted ? notRegularReason(status.st_mode) : std::strerror(statError)));
+    }
+    size_ = static_cast<long long>(status.st_size);
+}
+
+RegularFileForReading::~RegularFileForReading()
+{
+    ::close(fd_);
+}
+
 const char* notRegularReason(unsigned mode)
 {
     if (S_ISDIR(mode))
@@ -71,32 +95,17 @@ std::string readFileBounded(const String& path, long long maxBytes, const String
         CV_Error(Error::StsBadArg, "cannot open " + what + ": the path is empty");
     if (maxBytes < 0)
         CV_Error(Error::StsBadArg, format("readFileBounded: maxBytes must be >= 0 (got %lld)", maxBytes));
-    // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer that may never come; the
-    // type is decided on the opened file itself, so nothing can swap it in between.
-    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-    if (fd < 0)
-        CV_Error(Error::StsError, "cannot open " + what + " '" + path +
-                                      "': " + (errno == ENOENT ? "no such file" : std::strerror(errno)));
-    struct Closer
-    {
-        int fd;
-        ~Closer() { ::close(fd); }
-    } closer{fd};
-    struct stat status;
-    if (::fstat(fd, &status) != 0)
-        CV_Error(Error::StsError, "cannot open " + what + " '" + path + "': " + std::strerror(errno));
-    if (!S_ISREG(status.st_mode))
-        CV_Error(Error::StsError,
-                 "cannot open " + what + " '" + path + "': " + detail::notRegularReason(status.st_mode));
+    const detail::RegularFileForReading file(path, what);
+    const int fd = file.fd();
     const auto tooLarge = [&](long long bytes) {
         CV_Error(Error::StsError,
                  format("cannot open %s '%s': %lld bytes, more than the %lld bytes such a file may have",
                         what.c_str(), path.c_str(), bytes, maxBytes));
     };
-    if (status.st_size > maxBytes)
-        tooLarge(static_cast<long long>(status.st_size));
+    if (file.size() > maxBytes)
+        tooLarge(file.size());
     // One byte beyond the limit is asked for, so that a file that grew while being read is noticed.
-    std::string data(static_cast<size_t>(std::min<long long>(status.st_size, maxBytes)) + 1, '\0');
+    std::string data(static_cast<size_t>(std::min<long long>(file.size(), maxBytes)) + 1, '\0');
     size_t got = 0;
     for (;;) {
         if (got == data.size()) {

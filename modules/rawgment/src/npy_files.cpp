@@ -7,8 +7,6 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fcntl.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 namespace cv {
@@ -160,12 +158,6 @@ private:
     size_t at_ = 0;
 };
 
-struct FileCloser
-{
-    int fd;
-    ~FileCloser() { ::close(fd); }
-};
-
 //! Reads exactly `size` bytes at `offset`; false when the file ends first.
 bool readFully(int fd, void* data, size_t size, off_t offset, const String& path)
 {
@@ -211,19 +203,9 @@ std::vector<uchar> npyFileBytes(const Mat& mosaic)
 
 Mat readNpyMosaic(const String& path)
 {
-    // O_NONBLOCK: a FIFO put in a mosaic's place must not block the open (it is refused below).
-    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
-    if (fd < 0)
-        CV_Error(Error::StsError, "readMosaic: cannot open '" + path +
-                                      "': " + (errno == ENOENT ? "no such file" : std::strerror(errno)));
-    const FileCloser closer{fd};
-    struct stat status;
-    if (::fstat(fd, &status) != 0)
-        CV_Error(Error::StsError, "readMosaic: cannot open '" + path + "': " + std::strerror(errno));
-    if (!S_ISREG(status.st_mode))
-        CV_Error(Error::StsError,
-                 "readMosaic: cannot open '" + path + "': " + notRegularReason(status.st_mode));
-    const long long fileBytes = static_cast<long long>(status.st_size);
+    const RegularFileForReading file(path, "mosaic");
+    const int fd = file.fd();
+    const long long fileBytes = file.size();
     uchar preamble[12];
     if (fileBytes < 10 || !readFully(fd, preamble, 10, 0, path) ||
         std::memcmp(preamble, kMagic, kMagicBytes) != 0)

@@ -69,6 +69,23 @@ std::string readTextFile(const String& path);
 void checkRegularFile(const String& path, const String& what);
 //! Why a file of this st_mode is not read ("it is a FIFO ...").
 const char* notRegularReason(unsigned mode);
+/** A regular file opened for reading, closed with the object. A FIFO (opened without waiting for a
+ * writer), a device, a socket or a directory is refused with StsError naming `what` and `path`, decided on
+ * the opened file itself, so nothing can be swapped in between. */
+class RegularFileForReading
+{
+public:
+    RegularFileForReading(const String& path, const String& what);
+    ~RegularFileForReading();
+    RegularFileForReading(const RegularFileForReading&) = delete;
+    RegularFileForReading& operator=(const RegularFileForReading&) = delete;
+    int fd() const { return fd_; }
+    long long size() const { return size_; } //!< at the time it was opened
+
+private:
+    int fd_;
+    long long size_ = 0;
+};
 /** Asks for transparent huge pages over a large buffer (4 MiB or more) that is about to be written for the
  * first time: on a virtual machine each 4 KiB page fault costs microseconds, so a new 12 MP float mosaic
  * (48 MB) spends more time faulting than being written. Advice only: nothing changes without THP, on
