@@ -88,6 +88,18 @@ int main(int argc, char** argv)
 
         const RawFormat format = sim.rawFormat(2.0);
         const NoiseModel model = sim.effectiveModel();
+        // The inputs as numbers, for the test of cv2.rawgment (python/tests_opencv), which has no simulator.
+        numbers << "format_black " << format.blackLevel[0] << " " << format.blackLevel[1] << " "
+                << format.blackLevel[2] << " " << format.blackLevel[3] << "\nformat_white "
+                << format.whiteLevel << "\nformat_gain " << format.gain << "\n";
+        numbers << "model_alpha " << model.alpha << "\nmodel_sigmaD2 " << model.sigmaD2 << "\nmodel_sigmaR2 "
+                << model.sigmaR2 << "\nmodel_variance_100_3 " << model.variance(100, 3) << "\n";
+        RawImage dngImage;
+        dngImage.mosaic = capture;
+        dngImage.format = format;
+        dngImage.format.gain = 1;
+        dngImage.iso = 200;
+        writeDng(folder + "/capture.dng", dngImage);
         ColorJitter jitter = ColorJitter::exposureChange(0.2, 2.0);
         jitter.contrast = Vec4d(0.4, 0.38, 0.41, 0.5);
         jitter.brightness = -3;
@@ -132,6 +144,9 @@ int main(int argc, char** argv)
 
         std::vector<NoiseSample> samples;
         const std::vector<Rect> squares = cfaAlignedSquares(chart.patches, 8);
+        for (const Rect& patch : chart.patches)
+            numbers << "patch " << patch.x << " " << patch.y << " " << patch.width << " " << patch.height
+                    << "\n";
         for (int g = 0; g < 3; ++g) {
             const double gain = dbToLinearGain(6.0 * g);
             std::vector<Mat> burst;
@@ -139,6 +154,9 @@ int main(int argc, char** argv)
             BurstStatistics stats(sim.rawFormat(gain));
             for (const Mat& f : burst)
                 stats.add(f);
+            Mat stacked;
+            vconcat(burst, stacked);
+            saveNpy("burst_g" + std::to_string(g), stacked);
             if (g == 0) {
                 Mat v;
                 stats.variance(v);
@@ -195,6 +213,17 @@ int main(int argc, char** argv)
         Mat bgr;
         renderSimpleIsp(capture, format, bgr);
         saveNpy("isp", bgr);
+
+        // The camera catalogue, when darktable's file is installed.
+        const String profiles = darktableProfilesPath();
+        if (!profiles.empty()) {
+            const std::vector<CameraNoiseProfile> cameras = readCameraProfiles(profiles);
+            numbers << "cameras " << cameras.size() << "\n";
+            const CameraNoiseProfile d3 = findCameraProfile(cameras, "Nikon D3");
+            const NoiseModel d3Model = d3.modelFor(format);
+            numbers << "camera_d3 " << d3.verdict << " " << d3Model.alpha << " " << d3Model.variance(100, 3)
+                    << "\n";
+        }
         if (!numbers)
             throw std::runtime_error("cannot write numbers.txt");
     } catch (const std::exception& e) {

@@ -87,9 +87,11 @@ double linearGainToDb(double gain)
     return 20.0 * std::log10(gain);
 }
 
-NoiseModel::NoiseModel(double alpha_, double sigmaD2_, double sigmaR2_)
-    : alpha(alpha_), sigmaD2(sigmaD2_), sigmaR2(sigmaR2_)
+NoiseModel::NoiseModel(double alpha_, double sigmaD2_, double sigmaR2_) : NoiseModel()
 {
+    alpha = alpha_;
+    sigmaD2 = sigmaD2_;
+    sigmaR2 = sigmaR2_;
     validate();
 }
 

@@ -67,17 +67,22 @@ enum class BlurNoiseSum
  *
  * Implicitly constructible from a NoiseAlignment, so `colorJitter(..., NoiseAlignment::NONE, ...)`
  * keeps the other defaults. */
-struct CV_RAWGMENT_EXPORTS NoiseOptions
+struct CV_EXPORTS_W_SIMPLE NoiseOptions
 {
-    NoiseAlignment alignment = NoiseAlignment::ACCOUNT_PRIOR;     //!< how the prior noise is treated
-    ShotNoiseSampling shotSampling = ShotNoiseSampling::GAUSSIAN; //!< shape of the added shot noise
-    PriorMeanEstimate priorMean = PriorMeanEstimate::PIXEL_VALUE; //!< the estimate of mu_x
-    BlurNoiseSum blurNoiseSum = BlurNoiseSum::EXACT;              //!< motion blur's shot-noise term
+    CV_PROP_RW NoiseAlignment alignment;       //!< how the prior noise is treated
+    CV_PROP_RW ShotNoiseSampling shotSampling; //!< shape of the added shot noise
+    CV_PROP_RW PriorMeanEstimate priorMean;    //!< the estimate of mu_x
+    CV_PROP_RW BlurNoiseSum blurNoiseSum;      //!< motion blur's shot-noise term
 
-    NoiseOptions() {} //!< the defaults above
+    //! The defaults above.
+    CV_WRAP NoiseOptions()
+        : alignment(NoiseAlignment::ACCOUNT_PRIOR), shotSampling(ShotNoiseSampling::GAUSSIAN),
+          priorMean(PriorMeanEstimate::PIXEL_VALUE), blurNoiseSum(BlurNoiseSum::EXACT)
+    {
+    }
     //! The given alignment with the other defaults; implicit on purpose (see above).
-    NoiseOptions(NoiseAlignment a) : alignment(a) {}
-    void validate() const; //!< throws naming an unknown enum value
+    CV_WRAP NoiseOptions(NoiseAlignment a) : NoiseOptions() { alignment = a; }
+    CV_WRAP void validate() const; //!< throws naming an unknown enum value
     //! Writes the options as fields of the current map (`alignment`, `shot_sampling`, ...).
     void writeFields(FileStorage& fs) const;
     //! Reads the fields written by writeFields(); missing ones keep their defaults.
@@ -85,15 +90,18 @@ struct CV_RAWGMENT_EXPORTS NoiseOptions
 };
 
 /** @brief What augmentation steps did, for logs and for the user's trust. */
-struct CV_RAWGMENT_EXPORTS AugmentReport
+struct CV_EXPORTS_W_SIMPLE AugmentReport
 {
-    int64 brighteningPixels =
-        0; //!< pixels whose noise variance to add was negative (brightening), clipped to 0
-    int64 saturatedPixels = 0;      //!< input pixels at or above the white level (their signal is unknown)
-    std::vector<std::string> steps; //!< the steps that ran, in order; skipped identity steps are absent
+    //! Nothing counted, no step.
+    CV_WRAP AugmentReport() : brighteningPixels(0), saturatedPixels(0) {}
+    CV_PROP int64
+        brighteningPixels; //!< pixels whose noise variance to add was negative (brightening), clipped to 0
+    CV_PROP int64 saturatedPixels; //!< input pixels at or above the white level (their signal is unknown)
+    CV_PROP std::vector<std::string>
+        steps; //!< the steps that ran, in order; skipped identity steps are absent
     /** The wall time of each step of `steps`, in seconds (its checks, noise and output; for a profile of
      * where a sample's time goes, as python/bench/pipeline.py reports it). Never part of a result. */
-    std::vector<double> stepSeconds;
+    CV_PROP std::vector<double> stepSeconds;
 };
 
 /** @brief A change of contrast, brightness and hue, simulated as a change of photons and gain (Eq. 13).
@@ -107,16 +115,18 @@ struct CV_RAWGMENT_EXPORTS AugmentReport
  * describes a capture a camera could make. Exposure change (Eq. 11) is \f$ p_c = p_u p_g, p_b = 0 \f$:
  * see exposureChange().
  */
-struct CV_RAWGMENT_EXPORTS ColorJitter
+struct CV_EXPORTS_W_SIMPLE ColorJitter
 {
-    Vec4d contrast = Vec4d::all(1); //!< p_c per CFA site (index = cfaSite()), > 0
-    double brightness = 0;          //!< p_b in DN
-    double gainRatio = 1;           //!< p_g: target gain / input gain, > 0
+    //! The identity.
+    CV_WRAP ColorJitter() : contrast(Vec4d::all(1)), brightness(0), gainRatio(1) {}
+    CV_PROP_RW Vec4d contrast;    //!< p_c per CFA site (index = cfaSite()), > 0
+    CV_PROP_RW double brightness; //!< p_b in DN
+    CV_PROP_RW double gainRatio;  //!< p_g: target gain / input gain, > 0
 
     //! A pure exposure change: photons x photonRatio, gain x gainRatio (paper Eq. 11).
-    static ColorJitter exposureChange(double photonRatio, double gainRatio);
+    CV_WRAP static ColorJitter exposureChange(double photonRatio, double gainRatio);
     //! True when the step changes nothing (contrast 1, brightness 0, gain ratio 1).
-    bool isIdentity() const;
+    CV_WRAP bool isIdentity() const;
 };
 
 /** @brief Noise-accounted contrast, brightness and hue (paper Eq. 11 and 13).
@@ -150,6 +160,13 @@ CV_RAWGMENT_EXPORTS void colorJitter(InputArray src, const RawFormat& format, co
                                      OutputArray dst, RawFormat& dstFormat, AugmentReport* report = nullptr,
                                      OutputArray saturatedMask = noArray());
 
+/** @overload
+ * For the binding generator: the report is always returned. */
+CV_EXPORTS_W void colorJitter(InputArray src, const RawFormat& format, const NoiseModel& model,
+                              const ColorJitter& jitter, const NoiseOptions& noise, uint64 seed,
+                              OutputArray dst, CV_OUT RawFormat& dstFormat, CV_OUT AugmentReport& report,
+                              OutputArray saturatedMask = noArray());
+
 //! The longest motion linearMotionKernel() and RandomScenePolicy take, in mosaic pixels: a kernel of
 //! up to 513 x 513 plane pixels (the paper's longest is 13).
 constexpr double MAX_MOTION_LENGTH = 1024;
@@ -160,7 +177,7 @@ constexpr double MAX_MOTION_LENGTH = 1024;
  * @param angleDegrees direction of the motion, counter-clockwise from the x axis
  * @return CV_32FC1 kernel, odd size, sum 1
  */
-CV_RAWGMENT_EXPORTS Mat linearMotionKernel(double length, double angleDegrees);
+CV_EXPORTS_W Mat linearMotionKernel(double length, double angleDegrees);
 
 /** @brief Noise-accounted blur (paper Eq. 15) on each CFA plane.
  *
@@ -182,6 +199,12 @@ CV_RAWGMENT_EXPORTS Mat linearMotionKernel(double length, double angleDegrees);
 CV_RAWGMENT_EXPORTS void motionBlur(InputArray src, const RawFormat& format, const NoiseModel& model,
                                     InputArray kernel, const NoiseOptions& noise, uint64 seed,
                                     OutputArray dst, AugmentReport* report = nullptr);
+
+/** @overload
+ * For the binding generator: the report is always returned. */
+CV_EXPORTS_W void motionBlur(InputArray src, const RawFormat& format, const NoiseModel& model,
+                             InputArray kernel, const NoiseOptions& noise, uint64 seed, OutputArray dst,
+                             CV_OUT AugmentReport& report);
 
 /** @brief Noise-accounted scaling about the mosaic centre, each CFA plane resampled bilinearly.
  *
@@ -208,9 +231,15 @@ CV_RAWGMENT_EXPORTS void scaleMosaic(InputArray src, const RawFormat& format, co
                                      double scale, const NoiseOptions& noise, uint64 seed, OutputArray dst,
                                      AugmentReport* report = nullptr);
 
+/** @overload
+ * For the binding generator: the report is always returned. */
+CV_EXPORTS_W void scaleMosaic(InputArray src, const RawFormat& format, const NoiseModel& model, double scale,
+                              const NoiseOptions& noise, uint64 seed, OutputArray dst,
+                              CV_OUT AugmentReport& report);
+
 /** @brief A bounding box (mosaic pixels) after scaleMosaic(): its edges scale about the frame centre,
  * it grows to whole pixels and is clipped to the frame; an empty result means it left the frame. */
-CV_RAWGMENT_EXPORTS Rect scaleBox(const Rect& box, Size size, double scale);
+CV_EXPORTS_W Rect scaleBox(const Rect& box, Size size, double scale);
 
 /** @brief The capture to simulate: what changes from the input, applied by applyScene().
  *
@@ -218,15 +247,17 @@ CV_RAWGMENT_EXPORTS Rect scaleBox(const Rect& box, Size size, double scale);
  * effects a scene asks for are simulated: a step at identity costs nothing, and the identity scene returns
  * the input itself (dst shares its data), bit for bit.
  */
-struct CV_RAWGMENT_EXPORTS Scene
+struct CV_EXPORTS_W_SIMPLE Scene
 {
-    Point shift = Point(0, 0); //!< translation in mosaic pixels; each component rounded to even (CFA phase)
-    double scale = 1;          //!< magnification about the centre (see scaleMosaic()); 1: none
-    ColorJitter jitter;        //!< exposure, gain, contrast, brightness, hue
-    Mat motionKernel;          //!< blur on the plane grid (empty or 1x1: none)
-    NoiseOptions noise;        //!< for every noise step
+    //! The identity scene.
+    CV_WRAP Scene() : shift(Point(0, 0)), scale(1) {}
+    CV_PROP_RW Point shift;  //!< translation in mosaic pixels; each component rounded to even (CFA phase)
+    CV_PROP_RW double scale; //!< magnification about the centre (see scaleMosaic()); 1: none
+    CV_PROP_RW ColorJitter jitter; //!< exposure, gain, contrast, brightness, hue
+    CV_PROP_RW Mat motionKernel;   //!< blur on the plane grid (empty or 1x1: none)
+    CV_PROP_RW NoiseOptions noise; //!< for every noise step
 
-    bool isIdentity() const; //!< true when no step would change anything
+    CV_WRAP bool isIdentity() const; //!< true when no step would change anything
     //! Writes the scene as a map under `name` (the kernel as a matrix).
     void write(FileStorage& fs, const String& name) const;
     //! Reads a scene written by write(). @throws cv::Exception naming an invalid field.
@@ -244,6 +275,12 @@ CV_RAWGMENT_EXPORTS void applyScene(InputArray src, const RawFormat& format, con
                                     const Scene& scene, uint64 seed, OutputArray dst, RawFormat& dstFormat,
                                     AugmentReport* report = nullptr, std::vector<Rect>* boxes = nullptr);
 
+/** @overload
+ * For the binding generator: the report is always returned, and `boxes` are moved in place. */
+CV_EXPORTS_W void applyScene(InputArray src, const RawFormat& format, const NoiseModel& model,
+                             const Scene& scene, uint64 seed, OutputArray dst, CV_OUT RawFormat& dstFormat,
+                             CV_OUT AugmentReport& report, CV_IN_OUT std::vector<Rect>& boxes);
+
 /** @brief The seed of one augmented output: a function of (seed, input name, variant) only, so that
  * any order of inputs, any number of processes and the C++ and Python front ends give the same file.
  * The same seed draws the scene (RandomScenePolicy::draw()) and applies it (applyScene()): the two
@@ -252,7 +289,7 @@ CV_RAWGMENT_EXPORTS void applyScene(InputArray src, const RawFormat& format, con
  * @param inputName the input's file name without directory and extension (its stem)
  * @param variant the variant number, 0 for the first
  */
-CV_RAWGMENT_EXPORTS uint64 augmentedOutputSeed(uint64 seed, const String& inputName, int variant);
+CV_EXPORTS_W uint64 augmentedOutputSeed(uint64 seed, const String& inputName, int variant);
 
 /** @brief Draws random scenes with the paper's augmentation ranges (its defaults)
  * @cite yoshimura2023rawgment.
@@ -265,33 +302,40 @@ CV_RAWGMENT_EXPORTS uint64 augmentedOutputSeed(uint64 seed, const String& inputN
  * [0, blurLengthMax] and uniform angle; with probability geometryProbability a shift of up to maxShift
  * of each side and a scale within 1 +- maxScale. File keys are the snake_case names (contrast_min, ...).
  */
-struct CV_RAWGMENT_EXPORTS RandomScenePolicy
+struct CV_EXPORTS_W_SIMPLE RandomScenePolicy
 {
-    double contrastMin = 0.01;        //!< lowest contrast (photon and gain ratio), > 0
-    double contrastMax = 1.0;         //!< highest contrast
-    double brightnessMin = -0.1;      //!< lowest brightness, as a fraction of the input's minimum
-    double brightnessMax = 0.1;       //!< highest brightness, as a fraction of the input's minimum
-    double hueProbability = 0.5;      //!< probability of a per-site contrast factor (a hue shift)
-    double hueMin = 0.8;              //!< lowest per-site factor, > 0
-    double hueMax = 1.2;              //!< highest per-site factor
-    double gainDbMin = 0;             //!< lowest gain change in dB
-    double gainDbMax = 12;            //!< highest gain change in dB
-    double blurProbability = 0.5;     //!< probability of a motion blur
-    double blurLengthMax = 13;        //!< longest motion, in mosaic pixels
-    double geometryProbability = 0.8; //!< probability of a shift and a scale
-    double maxShift = 0.1;            //!< largest shift, as a fraction of each side, in [0, 1)
-    double maxScale = 0.03;           //!< largest relative scale change, in [0, 1)
-    NoiseOptions noise;               //!< copied into every scene
+    //! The paper's ranges.
+    CV_WRAP RandomScenePolicy()
+        : contrastMin(0.01), contrastMax(1.0), brightnessMin(-0.1), brightnessMax(0.1), hueProbability(0.5),
+          hueMin(0.8), hueMax(1.2), gainDbMin(0), gainDbMax(12), blurProbability(0.5), blurLengthMax(13),
+          geometryProbability(0.8), maxShift(0.1), maxScale(0.03)
+    {
+    }
+    CV_PROP_RW double contrastMin;         //!< lowest contrast (photon and gain ratio), > 0
+    CV_PROP_RW double contrastMax;         //!< highest contrast
+    CV_PROP_RW double brightnessMin;       //!< lowest brightness, as a fraction of the input's minimum
+    CV_PROP_RW double brightnessMax;       //!< highest brightness, as a fraction of the input's minimum
+    CV_PROP_RW double hueProbability;      //!< probability of a per-site contrast factor (a hue shift)
+    CV_PROP_RW double hueMin;              //!< lowest per-site factor, > 0
+    CV_PROP_RW double hueMax;              //!< highest per-site factor
+    CV_PROP_RW double gainDbMin;           //!< lowest gain change in dB
+    CV_PROP_RW double gainDbMax;           //!< highest gain change in dB
+    CV_PROP_RW double blurProbability;     //!< probability of a motion blur
+    CV_PROP_RW double blurLengthMax;       //!< longest motion, in mosaic pixels
+    CV_PROP_RW double geometryProbability; //!< probability of a shift and a scale
+    CV_PROP_RW double maxShift;            //!< largest shift, as a fraction of each side, in [0, 1)
+    CV_PROP_RW double maxScale;            //!< largest relative scale change, in [0, 1)
+    CV_PROP_RW NoiseOptions noise;         //!< copied into every scene
 
-    void validate() const; //!< throws naming the first inconsistent range
+    CV_WRAP void validate() const; //!< throws naming the first inconsistent range
     /** @brief A scene for `src` (its minimum sets the brightness scale), from `seed` alone. */
-    Scene draw(InputArray src, const RawFormat& format, uint64 seed) const;
+    CV_WRAP Scene draw(InputArray src, const RawFormat& format, uint64 seed) const;
     //! Writes the policy as a map under `name` (snake_case keys, the noise options included).
     void write(FileStorage& fs, const String& name) const;
     static RandomScenePolicy read(const FileNode& node); //!< missing fields keep their defaults
-    void save(const String& path) const;                 //!< .yml/.yaml/.json, atomically
+    CV_WRAP void save(const String& path) const;         //!< .yml/.yaml/.json, atomically
     //! Loads a policy saved by save() (top-level map `random_scene_policy`); errors name the file.
-    static RandomScenePolicy load(const String& path);
+    CV_WRAP static RandomScenePolicy load(const String& path);
 };
 
 //! @}

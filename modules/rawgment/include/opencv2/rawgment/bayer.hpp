@@ -17,7 +17,10 @@ namespace rawgment {
  * The underlying type is fixed so that any int cast to it is a valid value that the functions can
  * reject with a clear error.
  */
-enum CfaPattern : int
+// OpenCV 4.6's binding parser reads an enum's base only with no space before ':'.
+// clang-format off
+enum CfaPattern: int
+// clang-format on
 {
     CFA_RGGB = 0, //!< R G / G B
     CFA_BGGR = 1, //!< B G / G R
@@ -30,7 +33,10 @@ enum CfaPattern : int
  * The two greens are told apart by their row: `CFA_G1` shares its row with red, `CFA_G2` with blue
  * (often called Gr and Gb).
  */
-enum CfaChannel : int
+// OpenCV 4.6's binding parser reads an enum's base only with no space before ':'.
+// clang-format off
+enum CfaChannel: int
+// clang-format on
 {
     CFA_R = 0,  //!< red
     CFA_G1 = 1, //!< green on the red rows (Gr)
@@ -45,32 +51,32 @@ enum CfaChannel : int
  * @param row pixel row, any integer (negative rows are taken modulo 2 as well)
  * @param col pixel column, any integer
  */
-CV_RAWGMENT_EXPORTS int cfaSite(int row, int col);
+CV_EXPORTS_W int cfaSite(int row, int col);
 
 /** @brief The colour channel at (row, col) of a mosaic with the given pattern.
  * @param pattern CFA layout of the mosaic
  * @param row pixel row, any integer
  * @param col pixel column, any integer
  */
-CV_RAWGMENT_EXPORTS CfaChannel cfaChannelAt(CfaPattern pattern, int row, int col);
+CV_EXPORTS_W CfaChannel cfaChannelAt(CfaPattern pattern, int row, int col);
 
 /** @brief The site (0..3, see cfaSite()) where a channel lies in the 2x2 block of a pattern. */
-CV_RAWGMENT_EXPORTS int cfaSiteOfChannel(CfaPattern pattern, CfaChannel channel);
+CV_EXPORTS_W int cfaSiteOfChannel(CfaPattern pattern, CfaChannel channel);
 
 /** @brief The pattern of a crop of a mosaic whose top-left corner is at (rowOffset, colOffset).
  *
  * An odd offset in a direction swaps the phase in that direction (RGGB cropped at (0, 1) is GRBG).
  * Offsets may be negative (padding).
  */
-CV_RAWGMENT_EXPORTS CfaPattern cfaPatternOfCrop(CfaPattern pattern, int rowOffset, int colOffset);
+CV_EXPORTS_W CfaPattern cfaPatternOfCrop(CfaPattern pattern, int rowOffset, int colOffset);
 
 /** @brief The pattern's name ("RGGB", ...). Throws on a value outside the enumeration. */
-CV_RAWGMENT_EXPORTS String cfaPatternName(CfaPattern pattern);
+CV_EXPORTS_W String cfaPatternName(CfaPattern pattern);
 
 /** @brief The pattern with the given name, case-insensitive ("rggb", "BGGR", ...).
  * @throws cv::Exception (StsBadArg) naming the valid names when the name is unknown.
  */
-CV_RAWGMENT_EXPORTS CfaPattern cfaPatternFromName(const String& name);
+CV_EXPORTS_W CfaPattern cfaPatternFromName(const String& name);
 
 /** @brief How a Bayer mosaic encodes light: CFA layout, black and white levels, and the analog gain at
  * which it was captured.
@@ -80,31 +86,37 @@ CV_RAWGMENT_EXPORTS CfaPattern cfaPatternFromName(const String& name);
  * \f$ x = raw - black(site) \f$. The gain is the *linear* analog gain (0 dB = 1, see dbToLinearGain()),
  * relative to the gain at which the noise model was calibrated; augmentation steps update it.
  */
-struct CV_RAWGMENT_EXPORTS RawFormat
+struct CV_EXPORTS_W_SIMPLE RawFormat
 {
-    CfaPattern pattern = CFA_RGGB;    //!< CFA layout of the top-left 2x2 block
-    Vec4d blackLevel = Vec4d::all(0); //!< black level per site, in DN (index = cfaSite())
-    double whiteLevel = 65535;        //!< saturation level in DN, on the stored (black-included) scale
-    double gain = 1.0;                //!< linear analog gain of the capture (> 0)
+    //! RGGB, no black level, white 65535, gain 1.
+    CV_WRAP RawFormat()
+        : pattern(CFA_RGGB), blackLevel(Vec4d::all(0)), whiteLevel(65535), gain(1.0),
+          sensorOrigin(Point(0, 0))
+    {
+    }
+    CV_PROP_RW CfaPattern pattern; //!< CFA layout of the top-left 2x2 block
+    CV_PROP_RW Vec4d blackLevel;   //!< black level per site, in DN (index = cfaSite())
+    CV_PROP_RW double whiteLevel;  //!< saturation level in DN, on the stored (black-included) scale
+    CV_PROP_RW double gain;        //!< linear analog gain of the capture (> 0)
     /** Where the mosaic's top-left pixel lies on the sensor, (x, y) >= 0: (0, 0) for a whole frame, the
      * crop's offset for a crop (cropped() adds it). Per-pixel maps of the sensor (a NoiseModel's dark
      * shading) are read there, so a crop gets its own pixels' pattern. */
-    Point sensorOrigin = Point(0, 0);
+    CV_PROP_RW Point sensorOrigin;
 
     /** @brief Throws cv::Exception (StsBadArg) naming the field when the format is not usable: pattern
      * outside the enumeration, non-finite or negative black level, white level not above every black
      * level, gain not finite and positive, a negative sensorOrigin.
      */
-    void validate() const;
+    CV_WRAP void validate() const;
 
     /** @brief Black level of the pixel at (row, col). */
-    double blackAt(int row, int col) const { return blackLevel[cfaSite(row, col)]; }
+    CV_WRAP double blackAt(int row, int col) const { return blackLevel[cfaSite(row, col)]; }
 
     /** @brief The format of a crop whose top-left corner is at (rowOffset, colOffset): the pattern and
      * the per-site black levels follow the phase, sensorOrigin moves by the offset; levels and gain are
      * unchanged.
      */
-    RawFormat cropped(int rowOffset, int colOffset) const;
+    CV_WRAP RawFormat cropped(int rowOffset, int colOffset) const;
 
     /** @brief Writes the format as a map under `name` (fields pattern, black_level, white_level, gain,
      * and sensor_origin [x, y] when it is not (0, 0)). */
@@ -124,13 +136,13 @@ struct CV_RAWGMENT_EXPORTS RawFormat
  * @param planes output: a vector of four Mats of the mosaic's type, each (rows/2) x (cols/2)
  * @throws cv::Exception when the mosaic is empty, has more than one channel, or an odd side.
  */
-CV_RAWGMENT_EXPORTS void splitCfaPlanes(InputArray mosaic, OutputArrayOfArrays planes);
+CV_EXPORTS_W void splitCfaPlanes(InputArray mosaic, OutputArrayOfArrays planes);
 
 /** @brief Interleaves four CFA planes back into a mosaic: the exact inverse of splitCfaPlanes().
  * @param planes four single-channel Mats of one type and one size
  * @param mosaic output of twice the planes' size and their type
  */
-CV_RAWGMENT_EXPORTS void mergeCfaPlanes(InputArrayOfArrays planes, OutputArray mosaic);
+CV_EXPORTS_W void mergeCfaPlanes(InputArrayOfArrays planes, OutputArray mosaic);
 
 /** @brief Subtracts the per-site black level and optionally normalises to [0, 1].
  *
@@ -142,8 +154,8 @@ CV_RAWGMENT_EXPORTS void mergeCfaPlanes(InputArrayOfArrays planes, OutputArray m
  * @param dst output, CV_32FC1, same size
  * @param normalize divide by the per-site range white - black
  */
-CV_RAWGMENT_EXPORTS void subtractBlackLevel(InputArray src, const RawFormat& format, OutputArray dst,
-                                            bool normalize = false);
+CV_EXPORTS_W void subtractBlackLevel(InputArray src, const RawFormat& format, OutputArray dst,
+                                     bool normalize = false);
 
 /** @brief subtractBlackLevel() and splitCfaPlanes() in one pass, in the R, G1, G2, B order whatever the
  * pattern: the input layout of most RAW networks, written straight into the memory it will be used from.
@@ -157,8 +169,8 @@ CV_RAWGMENT_EXPORTS void subtractBlackLevel(InputArray src, const RawFormat& for
  * @param planes output: CV_32FC1, (2 rows) x (cols / 2), the four planes stacked
  * @param normalize divide by the per-site range
  */
-CV_RAWGMENT_EXPORTS void packCfaPlanes(InputArray mosaic, const RawFormat& format, OutputArray planes,
-                                       bool normalize = true);
+CV_EXPORTS_W void packCfaPlanes(InputArray mosaic, const RawFormat& format, OutputArray planes,
+                                bool normalize = true);
 
 /** @brief The inverse of subtractBlackLevel(): adds the black level back (after scaling by the per-site
  * range if `normalized`), rounds and clips to [0, white] for integer output.
@@ -169,8 +181,8 @@ CV_RAWGMENT_EXPORTS void packCfaPlanes(InputArray mosaic, const RawFormat& forma
  *        [0, white level], not rounded)
  * @param normalized src is on the [0, 1] scale of subtractBlackLevel(..., true)
  */
-CV_RAWGMENT_EXPORTS void addBlackLevel(InputArray src, const RawFormat& format, OutputArray dst,
-                                       int ddepth = CV_16U, bool normalized = false);
+CV_EXPORTS_W void addBlackLevel(InputArray src, const RawFormat& format, OutputArray dst, int ddepth = CV_16U,
+                                bool normalized = false);
 
 //! @}
 

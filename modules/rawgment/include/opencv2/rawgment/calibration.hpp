@@ -34,7 +34,7 @@ namespace rawgment {
  * level, or at or below zero, in any frame is marked clipped: its variance is biased and calibration
  * excludes it.
  */
-class CV_RAWGMENT_EXPORTS BurstStatistics
+class CV_EXPORTS_W BurstStatistics
 {
 public:
     /** @param format the burst's format (validated); its black and white levels are used
@@ -46,7 +46,7 @@ public:
      *         1e-7 relative on the mean, whose rounding at each merge then enters M2 through the
      *         merge's delta: at mean 60000 and variance 1 the variance errs by up to ~2e-3 relative
      *         (rawgment_tradeoffs measures it), at ordinary means far less. */
-    explicit BurstStatistics(const RawFormat& format, int groupFrames = 8, int stateDepth = CV_64F);
+    CV_WRAP explicit BurstStatistics(const RawFormat& format, int groupFrames = 8, int stateDepth = CV_64F);
     ~BurstStatistics();
     BurstStatistics(const BurstStatistics&) = delete;
     BurstStatistics& operator=(const BurstStatistics&) = delete;
@@ -54,23 +54,23 @@ public:
     /** @brief Adds a frame: CV_16UC1 or CV_32FC1 raw mosaic (black level included). The first frame
      * of a burst fixes the size and type; later frames must match. NaN or Inf in a CV_32FC1 frame is
      * rejected. */
-    void add(InputArray frame);
+    CV_WRAP void add(InputArray frame);
     /** @brief Starts a new burst of `format` (validated) in the same memory: frames() becomes 0, and the
      * state and the group buffers stay allocated, so a calibration over many bursts of one size and type
      * touches each page once instead of once per burst (100 frames of 12 MP took 432 ms with a new object
      * and 362 ms reset on host H3: perf_calibration's `reused` benchmark).
      * A burst of another size or type may follow: the first frame then reallocates. Results are the
      * same bits as a new object's. */
-    void reset(const RawFormat& format);
-    int frames() const;              //!< frames added so far in this burst
-    Size size() const;               //!< size of the frames (empty before the first)
-    const RawFormat& format() const; //!< the format given to the constructor or the last reset()
+    CV_WRAP void reset(const RawFormat& format);
+    CV_WRAP int frames() const;              //!< frames added so far in this burst
+    CV_WRAP Size size() const;               //!< size of the frames (empty before the first)
+    CV_WRAP const RawFormat& format() const; //!< the format given to the constructor or the last reset()
     /** @brief Temporal mean, black-subtracted, CV_64FC1. Needs at least one frame. */
-    void mean(OutputArray dst) const;
+    CV_WRAP void mean(OutputArray dst) const;
     /** @brief Unbiased temporal variance (divided by frames - 1), CV_64FC1. Needs at least 2 frames. */
-    void variance(OutputArray dst) const;
+    CV_WRAP void variance(OutputArray dst) const;
     /** @brief CV_8UC1 mask, 255 where the pixel was clipped (<= 0 or >= white) in any frame. */
-    void clippedMask(OutputArray dst) const;
+    CV_WRAP void clippedMask(OutputArray dst) const;
 
 private:
     struct Impl;
@@ -79,22 +79,24 @@ private:
 
 /** @brief One (mean, variance) observation of the noise: a pixel's temporal statistics over a burst,
  * or the spatial statistics of a uniform patch in single-frame mode. */
-struct CV_RAWGMENT_EXPORTS NoiseSample
+struct CV_EXPORTS_W_SIMPLE NoiseSample
 {
-    double mean = 0;     //!< black-subtracted mean (DN)
-    double variance = 0; //!< unbiased variance (DN^2)
-    double gain = 1;     //!< linear gain of the capture
-    int dof = 1;         //!< degrees of freedom of the variance (frames - 1 for a burst)
-    int channel = -1;    //!< CfaChannel of the pixel (or patch plane)
+    //! The defaults below.
+    CV_WRAP NoiseSample() : mean(0), variance(0), gain(1), dof(1), channel(-1), pixel(-1) {}
+    CV_PROP_RW double mean;     //!< black-subtracted mean (DN)
+    CV_PROP_RW double variance; //!< unbiased variance (DN^2)
+    CV_PROP_RW double gain;     //!< linear gain of the capture
+    CV_PROP_RW int dof;         //!< degrees of freedom of the variance (frames - 1 for a burst)
+    CV_PROP_RW int channel;     //!< CfaChannel of the pixel (or patch plane)
     /** The pixel's position on the sensor, row * width + column, or -1 when the sample is not one pixel
      * (single-frame patches). calibrateNoiseModel() leaves a pixel that is an outlier in one burst out
      * of every burst (a noisy or stuck pixel), so samples of one sensor must number pixels alike. */
-    int64 pixel = -1;
+    CV_PROP int64 pixel;
 };
 
 /** @brief Squares of side `side` (even) centred in each patch, with even corners so that each holds
  * whole 2x2 CFA blocks. @throws cv::Exception when a patch is smaller than the square. */
-CV_RAWGMENT_EXPORTS std::vector<Rect> cfaAlignedSquares(const std::vector<Rect>& patches, int side = 24);
+CV_EXPORTS_W std::vector<Rect> cfaAlignedSquares(const std::vector<Rect>& patches, int side = 24);
 
 /** @brief The temporal noise samples of every unclipped pixel of the squares.
  * @param stats statistics of a burst with at least 2 frames
@@ -141,6 +143,20 @@ CV_RAWGMENT_EXPORTS std::vector<NoiseSample> sampleDarkBurst(const BurstStatisti
 CV_RAWGMENT_EXPORTS std::vector<NoiseSample> sampleStaticScene(const BurstStatistics& stats, double gain,
                                                                int maxSamples = 100000);
 
+/** @name The samplers for a burst held by Ptr
+ * The overloads OpenCV's binding generator wraps: its classes live in a Ptr, and a null one is an error. */
+//! @{
+//! @overload
+CV_EXPORTS_W std::vector<NoiseSample> sampleBurstPatches(const Ptr<BurstStatistics>& stats,
+                                                         const std::vector<Rect>& squares, double gain);
+//! @overload
+CV_EXPORTS_W std::vector<NoiseSample> sampleDarkBurst(const Ptr<BurstStatistics>& stats,
+                                                      const std::vector<Rect>& squares, double gain);
+//! @overload
+CV_EXPORTS_W std::vector<NoiseSample> sampleStaticScene(const Ptr<BurstStatistics>& stats, double gain,
+                                                        int maxSamples = 100000);
+//! @}
+
 /** @brief Single-frame mode: the spatial mean and variance of each CFA plane of each square.
  *
  * A plane a + b x + c y is fitted to each square's CFA plane and removed first, which takes out the
@@ -153,29 +169,33 @@ CV_RAWGMENT_EXPORTS std::vector<NoiseSample> sampleStaticScene(const BurstStatis
  * @param squares CFA-aligned rectangles of uniform patches (each plane needs >= 4 pixels)
  * @param gain linear gain of the capture
  */
-CV_RAWGMENT_EXPORTS std::vector<NoiseSample> sampleSingleFramePatches(InputArray raw, const RawFormat& format,
-                                                                      const std::vector<Rect>& squares,
-                                                                      double gain);
+CV_EXPORTS_W std::vector<NoiseSample> sampleSingleFramePatches(InputArray raw, const RawFormat& format,
+                                                               const std::vector<Rect>& squares, double gain);
 
 /** @brief Settings of the per-gain line fit. */
-struct CV_RAWGMENT_EXPORTS LineFitParams
+struct CV_EXPORTS_W_SIMPLE LineFitParams
 {
-    bool robust = true;         //!< RANSAC, then least squares on the inliers; false: least squares on all
-    int ransacIterations = 500; //!< line hypotheses drawn from random pairs of samples
+    //! The defaults below.
+    CV_WRAP LineFitParams()
+        : robust(true), ransacIterations(500), inlierThreshold(4.0), seed(0), readExcessKurtosis(0)
+    {
+    }
+    CV_PROP_RW bool robust; //!< RANSAC, then least squares on the inliers; false: least squares on all
+    CV_PROP_RW int ransacIterations; //!< line hypotheses drawn from random pairs of samples
     /** Inlier band: a sample is kept when its variance lies where a sample variance of `dof` degrees of
      * freedom lies with the probability that a normal variable lies within +-k,
      * \f$ \chi^2_{dof}(\Phi(-k))/dof \le v / line(\mu) \le \chi^2_{dof}(\Phi(k))/dof \f$ (about
      * +-k standard errors for large dof; equal in probability on both sides, because a sample variance is
      * skewed and a band of equal width keeps every zero variance and cuts only the high tail). */
-    double inlierThreshold = 4.0;
-    uint64 seed = 0; //!< seed of the RANSAC draws (deterministic)
+    CV_PROP_RW double inlierThreshold;
+    CV_PROP_RW uint64 seed; //!< seed of the RANSAC draws (deterministic)
     /** Excess kurtosis of the read noise (\f$ g n_d + n_r \f$ together; 0: Gaussian, in [-2, 1000]).
      * With the Poisson part it sets how far a sample variance spreads, \f$ Var(s^2) = 2v^2/dof +
      * \kappa_4/(dof + 1) \f$ with fourth cumulant \f$ \kappa_4 = \kappa b^2 + a^3\mu \f$: the inlier
      * band is that of the scaled chi-square with the same spread, and the weights are its inverse, so
      * heavy tails are neither trimmed nor down-weighted as if they were defects.
      * calibrateNoiseModel() sets it from CalibrationParams::readExcessKurtosis or its estimate. */
-    double readExcessKurtosis = 0;
+    CV_PROP_RW double readExcessKurtosis;
 };
 
 /** @brief The line \f$ \sigma^2 = a\mu + b \f$ fitted to the samples of one gain.
@@ -183,33 +203,42 @@ struct CV_RAWGMENT_EXPORTS LineFitParams
  * The final fit is iterated weighted least squares with weights \f$ dof / (2 v^2) \f$, the inverse
  * variance of a sample variance, which makes the offset b far more precise than ordinary least squares
  * (paper) does on the same inliers. */
-struct CV_RAWGMENT_EXPORTS NoiseLineFit
+struct CV_EXPORTS_W_SIMPLE NoiseLineFit
 {
-    double gain = 1;     //!< linear gain
-    NoiseLine line;      //!< slope a and offset b (unconstrained: a negative value is reported as is)
-    double rSquared = 0; //!< coefficient of determination on the inliers
-    int inliers = 0;     //!< samples used by the final least squares
-    int samples = 0;     //!< samples offered
+    //! The defaults below.
+    CV_WRAP NoiseLineFit()
+        : gain(1), rSquared(0), inliers(0), samples(0), slopeStdError(0), offsetStdError(0),
+          slopeOffsetCorrelation(0)
+    {
+    }
+    CV_PROP_RW double gain;     //!< linear gain
+    CV_PROP_RW NoiseLine line;  //!< slope a and offset b (unconstrained: a negative value is reported as is)
+    CV_PROP_RW double rSquared; //!< coefficient of determination on the inliers
+    CV_PROP_RW int inliers;     //!< samples used by the final least squares
+    CV_PROP_RW int samples;     //!< samples offered
     /** Standard errors of a and b and their correlation: the sandwich (Huber-White) covariance of the
      * final weighted least squares, \f$ A^{-1} B A^{-1} \f$ with \f$ A = \sum w_i x_i x_i^T \f$ and
      * \f$ B = \sum w_i^2 e_i^2 x_i x_i^T \f$, \f$ x_i = (\mu_i, 1) \f$: it takes the scatter the data
      * show rather than the \f$ 2v^2/dof \f$ of Gaussian noise, so excess kurtosis (Poisson at low
      * counts, quantisation, noisy pixels inside the inlier band) widens it as it should. Conditional on
      * the inliers chosen. 0 when there are fewer than 3 inliers. */
-    double slopeStdError = 0;
-    double offsetStdError = 0;         //!< standard error of b (see slopeStdError)
-    double slopeOffsetCorrelation = 0; //!< correlation of the errors of a and b (see slopeStdError)
+    CV_PROP_RW double slopeStdError;
+    CV_PROP_RW double offsetStdError;         //!< standard error of b (see slopeStdError)
+    CV_PROP_RW double slopeOffsetCorrelation; //!< correlation of the errors of a and b (see slopeStdError)
 };
 
 /** @brief Fits \f$ \sigma^2 = a\mu + b \f$ to samples of one gain (paper Eq. 6), robustly by default.
  * @throws cv::Exception with fewer than 2 samples, samples of different gains, non-finite values, or
  *         when all samples share one mean (the slope is then undefined).
  */
-CV_RAWGMENT_EXPORTS NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples,
-                                              const LineFitParams& params = LineFitParams());
+CV_EXPORTS_W NoiseLineFit fitNoiseLine(const std::vector<NoiseSample>& samples,
+                                       const LineFitParams& params = LineFitParams());
 
 /** @brief How the cross-gain parameters are estimated. */
-enum NoiseFitMethod : int
+// OpenCV 4.6's binding parser reads an enum's base only with no space before ':'.
+// clang-format off
+enum NoiseFitMethod: int
+// clang-format on
 {
     /** One fit of \f$ \sigma^2 = g\alpha\mu + g^2\sigma_d^2 + \sigma_r^2 \f$ over all samples of all gains,
      * each weighted by the inverse squared standard error of a sample variance, \f$ dof / (2\sigma^4) \f$
@@ -224,36 +253,45 @@ enum NoiseFitMethod : int
 };
 
 /** @brief Settings of calibrateNoiseModel(). */
-struct CV_RAWGMENT_EXPORTS CalibrationParams
+struct CV_EXPORTS_W_SIMPLE CalibrationParams
 {
-    NoiseFitMethod method = NOISE_FIT_JOINT; //!< cross-gain method
-    LineFitParams line;                      //!< per-gain line fits (also select the joint fit's inliers)
-    int reweightIterations = 8;              //!< joint fit: re-weighting rounds from the two-stage fit
+    //! The defaults below.
+    CV_WRAP CalibrationParams()
+        : method(NOISE_FIT_JOINT), reweightIterations(8), lossScale(0.0), minGainRatio(1.12),
+          bootstrapReplicates(200), readExcessKurtosis(std::numeric_limits<double>::quiet_NaN())
+    {
+    }
+    CV_PROP_RW NoiseFitMethod method;  //!< cross-gain method
+    CV_PROP_RW LineFitParams line;     //!< per-gain line fits (also select the joint fit's inliers)
+    CV_PROP_RW int reweightIterations; //!< joint fit: re-weighting rounds from the two-stage fit
     /** Joint fit: Huber loss scale in standard errors, 0 for none (the default). The per-gain band
      * (LineFitParams::inlierThreshold) has already removed what cannot be noise, and a loss on a skewed
      * residual (a sample variance is chi-squared) cuts its long tail only and biases the fit low: Cauchy
      * at 3 by ~0.4%, and even Huber at 4 measurably. */
-    double lossScale = 0.0;
+    CV_PROP_RW double lossScale;
     /** Gains closer than this ratio count as one when deciding whether sigma_d^2 and sigma_r^2 are
      * separable (1.12 is 1 dB). */
-    double minGainRatio = 1.12;
+    CV_PROP_RW double minGainRatio;
     /** Bootstrap replicates of the final fit (0: none), the check of the covariance and its stand-in
      * where the covariance does not hold (see ModelUncertainty). Each replicate draws the samples of
      * each gain anew with replacement and repeats the final weighted fit; 200 give each standard
      * error to about 5% (\f$ 1/\sqrt{2R} \f$). Keyed by `line.seed`: the same seed gives the same
      * errors on any number of threads. */
-    int bootstrapReplicates = 200;
+    CV_PROP_RW int bootstrapReplicates;
     /** Excess kurtosis of the read noise (see LineFitParams::readExcessKurtosis), or NaN (the default) to
      * estimate it from the spread of the sample variances around their lines (CalibrationReport::
      * readExcessKurtosis). Give it when dark frames have measured it: NoiseModel::readExcessKurtosis() of
      * calibrateDarkNoise()'s model (0 for Gaussian read noise). The estimate needs samples where read
      * noise dominates (dark frames or dark patches); without them the fit takes 0 and says so. */
-    double readExcessKurtosis = std::numeric_limits<double>::quiet_NaN();
+    CV_PROP_RW double readExcessKurtosis;
 };
 
 /** @brief The parameters of a NoiseModel, as indices into the vectors and matrices of
  * ModelUncertainty. */
-enum NoiseModelParameter : int
+// OpenCV 4.6's binding parser reads an enum's base only with no space before ':'.
+// clang-format off
+enum NoiseModelParameter: int
+// clang-format on
 {
     NOISE_PARAM_ALPHA = 0,    //!< \f$ \alpha \f$
     NOISE_PARAM_SIGMA_D2 = 1, //!< \f$ \sigma_d^2 \f$
@@ -261,7 +299,10 @@ enum NoiseModelParameter : int
 };
 
 /** @brief Where the standard errors of a calibration come from. */
-enum UncertaintySource : int
+// OpenCV 4.6's binding parser reads an enum's base only with no space before ':'.
+// clang-format off
+enum UncertaintySource: int
+// clang-format on
 {
     UNCERTAINTY_NONE = 0, //!< none were computed (a report of format 1)
     /** The sandwich covariance of the final fit (see NoiseLineFit::slopeStdError), confirmed by the
@@ -280,50 +321,60 @@ enum UncertaintySource : int
  * describe scatter, not bias, and the coverage study (study_calibration_coverage) measures how often
  * the 95% interval holds the simulator's truth. When sigma_d^2 and sigma_r^2 are not separable only
  * alpha has an error. */
-struct CV_RAWGMENT_EXPORTS ModelUncertainty
+struct CV_EXPORTS_W_SIMPLE ModelUncertainty
 {
-    UncertaintySource source = UNCERTAINTY_NONE; //!< which of the two estimates below is used
-    Vec3d stdError;                              //!< standard errors used, indexed by NoiseModelParameter
-    Matx33d covariance;                          //!< their covariance (DN units squared of each pair)
-    Vec3d fitStdError;           //!< from the sandwich covariance of the fit (0 for a parameter at its bound)
-    Vec3d bootstrapStdError;     //!< from the bootstrap (0 when none ran)
-    int bootstrapReplicates = 0; //!< replicates of the bootstrap that ran
+    //! The defaults below.
+    CV_WRAP ModelUncertainty() : source(UNCERTAINTY_NONE), bootstrapReplicates(0) {}
+    CV_PROP_RW UncertaintySource source; //!< which of the two estimates below is used
+    CV_PROP_RW Vec3d stdError;           //!< standard errors used, indexed by NoiseModelParameter
+    CV_PROP_RW Matx33d covariance;       //!< their covariance (DN units squared of each pair)
+    CV_PROP_RW Vec3d
+        fitStdError; //!< from the sandwich covariance of the fit (0 for a parameter at its bound)
+    CV_PROP_RW Vec3d bootstrapStdError; //!< from the bootstrap (0 when none ran)
+    CV_PROP_RW int bootstrapReplicates; //!< replicates of the bootstrap that ran
 
     /** @brief The correlation of the errors of two parameters (0 when either has no error). The one
      * of sigma_d^2 and sigma_r^2 is usually strongly negative: both make up each gain's offset. */
-    double correlation(NoiseModelParameter first, NoiseModelParameter second) const;
+    CV_WRAP double correlation(NoiseModelParameter first, NoiseModelParameter second) const;
 };
 
 /** @brief Everything a calibration found, readable and writable as YAML or JSON. */
-struct CV_RAWGMENT_EXPORTS CalibrationReport
+struct CV_EXPORTS_W_SIMPLE CalibrationReport
 {
+    //! The defaults below.
+    CV_WRAP CalibrationReport()
+        : method(NOISE_FIT_JOINT), separable(false), rSquaredSlope(0), rSquaredOffset(0), samples(0),
+          samplesUsed(0), readExcessKurtosis(0), readExcessKurtosisEstimated(false)
+    {
+    }
     /** Newest version of the file format. Version 2 adds the uncertainty and the per-gain standard
      * errors, version 3 the read noise's excess kurtosis; a report without an uncertainty (source
      * UNCERTAINTY_NONE) is written as version 1, and files of versions 1 and 2 still load (kurtosis 0). */
     static constexpr int FORMAT_VERSION = 3;
 
-    NoiseFitMethod method = NOISE_FIT_JOINT; //!< the method that ran
+    CV_PROP_RW NoiseFitMethod method; //!< the method that ran
     /** The fitted model. Valid only when `separable`; with a single gain (or gains closer than
      * CalibrationParams::minGainRatio) only alpha is known, and sigma_d^2, sigma_r^2 are left at 0. */
-    NoiseModel model;
-    bool separable = false;            //!< sigma_d^2 and sigma_r^2 could be told apart
-    std::vector<NoiseLineFit> perGain; //!< the per-gain lines, by increasing gain
-    double rSquaredSlope = 0;          //!< R^2 of a_g = g alpha over the gains (paper: 1.0000)
-    double rSquaredOffset = 0;         //!< R^2 of b_g = g^2 sigma_d^2 + sigma_r^2 (paper: 0.9984)
-    int samples = 0;                   //!< samples offered
-    int samplesUsed = 0;               //!< samples in the final fit
-    std::vector<std::string> notes;    //!< what the user should know (bounds hit, not separable, ...)
-    ModelUncertainty uncertainty;      //!< standard errors of the model's parameters
+    CV_PROP_RW NoiseModel model;
+    CV_PROP_RW bool separable;                    //!< sigma_d^2 and sigma_r^2 could be told apart
+    CV_PROP_RW std::vector<NoiseLineFit> perGain; //!< the per-gain lines, by increasing gain
+    CV_PROP_RW double rSquaredSlope;              //!< R^2 of a_g = g alpha over the gains (paper: 1.0000)
+    CV_PROP_RW double rSquaredOffset;             //!< R^2 of b_g = g^2 sigma_d^2 + sigma_r^2 (paper: 0.9984)
+    CV_PROP_RW int samples;                       //!< samples offered
+    CV_PROP_RW int samplesUsed;                   //!< samples in the final fit
+    CV_PROP_RW std::vector<std::string> notes; //!< what the user should know (bounds hit, not separable, ...)
+    CV_PROP_RW ModelUncertainty uncertainty;   //!< standard errors of the model's parameters
     /** The read noise's excess kurtosis the bands, weights and errors used: the given one, or the
      * estimate (see CalibrationParams::readExcessKurtosis). */
-    double readExcessKurtosis = 0;
-    bool readExcessKurtosisEstimated = false; //!< whether readExcessKurtosis was estimated from the samples
+    CV_PROP_RW double readExcessKurtosis;
+    CV_PROP_RW bool
+        readExcessKurtosisEstimated; //!< whether readExcessKurtosis was estimated from the samples
 
     /** @brief The two-sided confidence interval of a parameter, value \f$ \pm z_{(1+level)/2} \f$
      * standard errors (normal: each estimate is a weighted sum over thousands of samples). Not cut at
      * 0, so that an interval that spans 0 shows the data cannot tell the parameter from 0.
      * @throws cv::Exception when level is not in (0, 1) or the report has no uncertainty. */
-    Vec2d interval(NoiseModelParameter parameter, double level = 0.95) const;
+    CV_WRAP Vec2d interval(NoiseModelParameter parameter, double level = 0.95) const;
 
     /** @brief Writes the report as a map under `name`; its model without the dark-shading maps, which
      * NoiseModel::save() writes beside the model file. */
@@ -333,7 +384,7 @@ struct CV_RAWGMENT_EXPORTS CalibrationReport
     /** @brief Saves to .yml/.yaml/.json atomically (top-level map `calibration_report`). */
     void save(const String& path) const;
     /** @brief Loads a report saved by save(). */
-    static CalibrationReport load(const String& path);
+    CV_WRAP static CalibrationReport load(const String& path);
 };
 
 /** @brief A change to the data of a calibration, for projectedStdError(): what a user could shoot more of. */
@@ -373,8 +424,8 @@ CV_RAWGMENT_EXPORTS Vec3d projectedStdError(const std::vector<NoiseSample>& samp
  * @throws cv::Exception when there are no samples, a value is not finite, or a gain has fewer than
  *         2 distinct means.
  */
-CV_RAWGMENT_EXPORTS CalibrationReport calibrateNoiseModel(
-    const std::vector<NoiseSample>& samples, const CalibrationParams& params = CalibrationParams());
+CV_EXPORTS_W CalibrationReport calibrateNoiseModel(const std::vector<NoiseSample>& samples,
+                                                   const CalibrationParams& params = CalibrationParams());
 
 /** @brief What the verdict of a calibration needs to know about one burst besides its samples. */
 struct CV_RAWGMENT_EXPORTS CalibrationBurstFacts
@@ -405,7 +456,7 @@ struct CV_RAWGMENT_EXPORTS CalibrationVerdict
 /** @brief The variance a calibration predicts at `mean` and linear `gain`: the model when sigma_d^2 and
  * sigma_r^2 were separable; otherwise the line fitted at the nearest calibrated gain, since the model then
  * holds alpha alone and would leave out the read noise. */
-CV_RAWGMENT_EXPORTS double fittedVariance(const CalibrationReport& report, double mean, double gain);
+CV_EXPORTS_W double fittedVariance(const CalibrationReport& report, double mean, double gain);
 
 /** @brief Judges a calibration from its samples, its report and its bursts, each check a measured figure
  * against a stated threshold (docs/calibrate_your_camera.md says where each comes from): frames per burst,

@@ -28,7 +28,7 @@ enum CameraProfileVerdict
 };
 
 //! "GOOD", "ROUGH" or "REFUSED". @throws cv::Exception for another value.
-CV_RAWGMENT_EXPORTS String cameraProfileVerdictName(int verdict);
+CV_EXPORTS_W String cameraProfileVerdictName(int verdict);
 
 /** @brief Which demosaic darktable's profiling export used for a camera's profiles, as far as their colours
  * tell (CameraNoiseProfile::demosaic; docs/real_cameras.md has the evidence).
@@ -52,7 +52,7 @@ enum ProfileDemosaic
 };
 
 //! "undecided", "PPG" or "neither". @throws cv::Exception for another value.
-CV_RAWGMENT_EXPORTS String profileDemosaicName(int demosaic);
+CV_EXPORTS_W String profileDemosaicName(int demosaic);
 
 /** @brief How darktable's measured noise profiles are read as per-pixel raw noise, and the bounds of the
  * verdicts.
@@ -63,65 +63,78 @@ CV_RAWGMENT_EXPORTS String profileDemosaicName(int demosaic);
  * variance v the HH coefficient's variance is c v, with c = 1/4 without demosaicing; darktable's PPG
  * demosaic (the default when most profiles were made) interpolates half the green sites from their
  * neighbours and lowers it. docs/real_cameras.md has the derivation and the reference. */
-struct CV_RAWGMENT_EXPORTS DarktableImportParams
+struct CV_EXPORTS_W_SIMPLE DarktableImportParams
 {
+    //! The defaults below.
+    CV_WRAP DarktableImportParams()
+        : haarVarianceRatio(DARKTABLE_HAAR_VARIANCE_RATIO), offsetReferenceLevel(1e-3),
+          goodMedianSlopeResidual(0.10), goodWorstSlopeResidual(0.35), goodWorstOffsetResidual(1.0),
+          goodMinIsos(3)
+    {
+    }
     /** c: darktable's variance over the per-pixel raw variance, for the green channel. The default,
      * DARKTABLE_HAAR_VARIANCE_RATIO = 0.0794, is darktable's PPG green interpolation followed by its Haar-MAD
      * measurement, simulated on white noise (`python/tools/darktable_haar_ratio.py`); 0.25 would assume no
      * demosaicing. In (0, 1]. */
-    double haarVarianceRatio = DARKTABLE_HAAR_VARIANCE_RATIO;
+    CV_PROP_RW double haarVarianceRatio;
     /** The signal level, as a fraction of white, at which offsets are compared: an offset's residual is
      * the error of the fitted offset over |b| + a x_ref, the profile's variance there. Offsets can be
      * zero or negative, so they have no scale of their own. In (0, 1). */
-    double offsetReferenceLevel = 1e-3;
+    CV_PROP_RW double offsetReferenceLevel;
     //! GOOD needs the median over ISOs of |slope residual| at most this ...
-    double goodMedianSlopeResidual = 0.10;
+    CV_PROP_RW double goodMedianSlopeResidual;
     //! ... and the worst at most this ...
-    double goodWorstSlopeResidual = 0.35;
+    CV_PROP_RW double goodWorstSlopeResidual;
     //! ... the worst |offset residual| at most this ...
-    double goodWorstOffsetResidual = 1.0;
+    CV_PROP_RW double goodWorstOffsetResidual;
     //! ... and at least this many ISOs.
-    int goodMinIsos = 3;
+    CV_PROP_RW int goodMinIsos;
 
     //! @throws cv::Exception naming a value outside its range.
-    void validate() const;
+    CV_WRAP void validate() const;
 };
 
 /** @brief One ISO of a camera's profiles, as the fit sees it (green channel, per-pixel units normalised to
  * white - black = 1). */
-struct CV_RAWGMENT_EXPORTS CameraIsoFit
+struct CV_EXPORTS_W_SIMPLE CameraIsoFit
 {
-    double iso = 0;            //!< the profile's ISO
-    double gain = 0;           //!< iso / CameraNoiseProfile::baseIso
-    double slope = 0;          //!< measured shot slope a / c
-    double offset = 0;         //!< measured offset b / c (may be negative)
-    double slopeResidual = 0;  //!< (fitted slope - measured) / measured
-    double offsetResidual = 0; //!< (fitted offset - measured) / (|measured| + slope x_ref)
+    //! The defaults below.
+    CV_WRAP CameraIsoFit()
+        : iso(0), gain(0), slope(0), offset(0), slopeResidual(0), offsetResidual(0), colourSpread(1),
+          expanded(false), inconsistent(false), rawIso(0)
+    {
+    }
+    CV_PROP_RW double iso;            //!< the profile's ISO
+    CV_PROP_RW double gain;           //!< iso / CameraNoiseProfile::baseIso
+    CV_PROP_RW double slope;          //!< measured shot slope a / c
+    CV_PROP_RW double offset;         //!< measured offset b / c (may be negative)
+    CV_PROP_RW double slopeResidual;  //!< (fitted slope - measured) / measured
+    CV_PROP_RW double offsetResidual; //!< (fitted offset - measured) / (|measured| + slope x_ref)
     /** Largest over smallest shot slope of the colours with a positive slope (1 when the colours agree,
      * as in profiles that copy green to every colour). */
-    double colourSpread = 1;
+    CV_PROP_RW double colourSpread;
     /** Red and blue shot slope over green's, as darktable measured them (0 for a colour whose slope is not
      * positive); ProfileDemosaic says what they tell. */
-    Vec2d colourSlopeRatios;
+    CV_PROP_RW Vec2d colourSlopeRatios;
     /** An expanded low setting: its green slope falls less than its ISO below the next ISO (its raw is a
      * higher ISO's). Measured and followed by the augmentation, but not the base ISO, not fitted to Eq. 5
      * and not counted in the verdict's figures (readCameraProfiles() says how it is told). */
-    bool expanded = false;
+    CV_PROP_RW bool expanded;
     /** A colour's shot slope is negative (a variance cannot fall as the signal rises): darktable's fit of
      * that profile failed (the Canon EOS 5D Mark III's ISO 160, 320, 640, ... have negative blue slopes).
      * Named, but left out of the fit, the verdict's figures and the measured lines (the ISO's line then comes
      * from its neighbours). */
-    bool inconsistent = false;
+    CV_PROP_RW bool inconsistent;
     /** A digital setting: the ISO (above the expanded ones) whose raw this one is, 0 for an analog step.
      * darktable normalises each file by its own white level, so a setting that scales an analog ISO's raw
      * together with its white level (Canon's third stops 160, 320, 640, ... from 200, 400, 800), or keeps
      * a lower ISO's raw and marks it for brightening (Fujifilm's high settings), has that ISO's slope a
      * third of a stop or more away. Measured and followed like an expanded setting, not fitted. */
-    double rawIso = 0;
+    CV_PROP_RW double rawIso;
     //! Whether the setting is digital (rawIso set).
-    bool digital() const { return rawIso > 0; }
+    CV_WRAP bool digital() const { return rawIso > 0; }
     //! Whether the ISO is fitted to Eq. 5 and counted in the verdict: an analog, consistent setting.
-    bool fitted() const { return !expanded && !inconsistent && !digital(); }
+    CV_WRAP bool fitted() const { return !expanded && !inconsistent && !digital(); }
 };
 
 /** @brief A real camera's noise, fitted to Eq. 5 from its measured profiles, in units of a raw range of 1.
@@ -129,56 +142,66 @@ struct CV_RAWGMENT_EXPORTS CameraIsoFit
  * `noise` is the fitted model: the per-pixel variance of a signal x in [0, 1] at gain
  * g = ISO / noise.baseIso is noise.variance(x, g), \f$ g\alpha x + g^2\sigma_d^2 + \sigma_r^2 \f$.
  * modelFor() scales it to a RawFormat's range. */
-struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
+struct CV_EXPORTS_W_SIMPLE CameraNoiseProfile
 {
-    String maker; //!< maker as the file names it
-    String model; //!< model as the file names it
-    String place; //!< where the entry is in the file, e.g. "noiseprofiles[5].models[12]"
-    int verdict = CAMERA_PROFILE_REFUSED; //!< a CameraProfileVerdict
-    String reason;                        //!< why the verdict is not GOOD (empty when GOOD)
+    //! The defaults below.
+    CV_WRAP CameraNoiseProfile()
+        : verdict(CAMERA_PROFILE_REFUSED), skippedProfiles(0), medianSlopeResidual(0), worstSlopeResidual(0),
+          worstSlopeIso(0), worstOffsetResidual(0), worstOffsetIso(0), medianColourSpread(1),
+          negativeOffsets(0), expandedIsos(0), digitalIsos(0), inconsistentProfiles(0), monotoneSlope(true),
+          demosaic(PROFILE_DEMOSAIC_UNDECIDED), haarVarianceRatio(0)
+    {
+    }
+    CV_PROP_RW String maker;  //!< maker as the file names it
+    CV_PROP_RW String model;  //!< model as the file names it
+    CV_PROP_RW String place;  //!< where the entry is in the file, e.g. "noiseprofiles[5].models[12]"
+    CV_PROP_RW int verdict;   //!< a CameraProfileVerdict
+    CV_PROP_RW String reason; //!< why the verdict is not GOOD (empty when GOOD)
     /** The fitted model over a raw range of 1: alpha is the shot slope at gain 1 (1 / full well in
      * electrons), sigmaD2 and sigmaR2 the read variances before and after the gain over the range
      * squared, and baseIso the lowest usable ISO that is neither expanded nor digital (gain 1). All zero
      * while the camera is REFUSED before its fit. */
-    NoiseModel noise;
-    std::vector<CameraIsoFit> isos; //!< the usable profiles, by ascending ISO (an ISO measured twice twice)
-    int skippedProfiles = 0;        //!< profiles marked "skip" or without a positive green slope
-    double medianSlopeResidual = 0; //!< median over ISOs of |slope residual|
-    double worstSlopeResidual = 0;  //!< largest |slope residual|
-    double worstSlopeIso = 0;       //!< its ISO
-    double worstOffsetResidual = 0; //!< largest |offset residual|
-    double worstOffsetIso = 0;      //!< its ISO
-    double medianColourSpread = 1;  //!< median over ISOs of CameraIsoFit::colourSpread
-    int negativeOffsets = 0;        //!< fitted ISOs whose measured offset is below zero
-    int expandedIsos = 0;           //!< expanded low ISOs (CameraIsoFit::expanded), below the base ISO
-    int digitalIsos = 0;            //!< digital settings (CameraIsoFit::rawIso), never the base ISO
-    int inconsistentProfiles = 0; //!< profiles with a negative colour shot slope (CameraIsoFit::inconsistent)
-    bool monotoneSlope = true;    //!< whether the measured slope never falls as the ISO rises
+    CV_PROP_RW NoiseModel noise;
+    CV_PROP_RW std::vector<CameraIsoFit>
+        isos;                       //!< the usable profiles, by ascending ISO (an ISO measured twice twice)
+    CV_PROP_RW int skippedProfiles; //!< profiles marked "skip" or without a positive green slope
+    CV_PROP_RW double medianSlopeResidual; //!< median over ISOs of |slope residual|
+    CV_PROP_RW double worstSlopeResidual;  //!< largest |slope residual|
+    CV_PROP_RW double worstSlopeIso;       //!< its ISO
+    CV_PROP_RW double worstOffsetResidual; //!< largest |offset residual|
+    CV_PROP_RW double worstOffsetIso;      //!< its ISO
+    CV_PROP_RW double medianColourSpread;  //!< median over ISOs of CameraIsoFit::colourSpread
+    CV_PROP_RW int negativeOffsets;        //!< fitted ISOs whose measured offset is below zero
+    CV_PROP_RW int expandedIsos;           //!< expanded low ISOs (CameraIsoFit::expanded), below the base ISO
+    CV_PROP_RW int digitalIsos;            //!< digital settings (CameraIsoFit::rawIso), never the base ISO
+    CV_PROP_RW int
+        inconsistentProfiles; //!< profiles with a negative colour shot slope (CameraIsoFit::inconsistent)
+    CV_PROP_RW bool monotoneSlope; //!< whether the measured slope never falls as the ISO rises
     //! Median over fitted ISOs of CameraIsoFit::colourSlopeRatios (red over green, blue over green).
-    Vec2d colourSlopeRatios;
+    CV_PROP_RW Vec2d colourSlopeRatios;
     //! Green over red and over blue raw level that colourSlopeRatios imply if the profiles were made with
     //! PPG.
-    Vec2d balancePpg;
+    CV_PROP_RW Vec2d balancePpg;
     //! The same if they were made with RCD.
-    Vec2d balanceRcd;
-    int demosaic = PROFILE_DEMOSAIC_UNDECIDED; //!< a ProfileDemosaic
-    String demosaicReason;                     //!< the evidence for `demosaic`, in a sentence
+    CV_PROP_RW Vec2d balanceRcd;
+    CV_PROP_RW int demosaic;          //!< a ProfileDemosaic
+    CV_PROP_RW String demosaicReason; //!< the evidence for `demosaic`, in a sentence
     /** c, the Haar variance ratio the profiles were divided by (DarktableImportParams::haarVarianceRatio):
      * PPG's green unless set otherwise. With demosaic UNDECIDED it is an assumption: with RCD's c every
      * variance would be 0.0794 / 0.0474 = 1.68 times larger and the full well as much smaller. */
-    double haarVarianceRatio = 0;
+    CV_PROP_RW double haarVarianceRatio;
 
     //! "maker model", the name cameras are selected by.
-    String name() const;
+    CV_WRAP String name() const;
     //! Whether the camera is imported (GOOD or ROUGH).
-    bool usable() const { return verdict != CAMERA_PROFILE_REFUSED; }
+    CV_WRAP bool usable() const { return verdict != CAMERA_PROFILE_REFUSED; }
     /** @brief The camera's noise model in DN for mosaics of `format`: `noise` with alpha times r and the
      * variances times r^2, with r = white - mean black (its baseIso kept), and every usable ISO's
      * measured line (isos: slope times r, offset times r^2, at its gain) as NoiseModel::measuredLines,
      * which the augmentation follows; an ISO measured twice takes the mean of its lines, a negative
      * measured offset is taken as 0, an inconsistent profile is left out.
      * @throws cv::Exception when the camera is REFUSED (naming the reason) or the format is invalid. */
-    NoiseModel modelFor(const RawFormat& format) const;
+    CV_WRAP NoiseModel modelFor(const RawFormat& format) const;
 };
 
 /** @brief Every camera of a darktable noise-profile file (`noiseprofiles.json`), each fitted to Eq. 5 with
@@ -202,33 +225,33 @@ struct CV_RAWGMENT_EXPORTS CameraNoiseProfile
  * @throws cv::Exception naming the file when it cannot be read or its top level is not darktable's form
  *         (a map with a list `noiseprofiles` of maps with `maker` and `models`).
  */
-CV_RAWGMENT_EXPORTS std::vector<CameraNoiseProfile>
+CV_EXPORTS_W std::vector<CameraNoiseProfile>
 readCameraProfiles(const String& path, const DarktableImportParams& params = DarktableImportParams());
 
 /** @brief The camera named `name` ("maker model", compared ignoring case and repeated spaces).
  * @throws cv::Exception when no camera has that name, listing the five closest names; or when it is
  *         REFUSED, with the reason.
  */
-CV_RAWGMENT_EXPORTS CameraNoiseProfile findCameraProfile(const std::vector<CameraNoiseProfile>& cameras,
-                                                         const String& name);
+CV_EXPORTS_W CameraNoiseProfile findCameraProfile(const std::vector<CameraNoiseProfile>& cameras,
+                                                  const String& name);
 
 /** @brief The cameras a selection names: a comma-separated list of camera names, or one of the words
  * "good" (every GOOD camera) and "usable" (every GOOD or ROUGH camera).
  * @throws cv::Exception as findCameraProfile() for a name, or when the selection is empty.
  */
-CV_RAWGMENT_EXPORTS std::vector<CameraNoiseProfile>
+CV_EXPORTS_W std::vector<CameraNoiseProfile>
 selectCameraProfiles(const std::vector<CameraNoiseProfile>& cameras, const String& selection);
 
 /** @brief The index of the camera a sample with `seed` draws from `count` cameras: uniform, and the same
  * for the same seed on every machine and from Python.
  * @throws cv::Exception when count < 1. */
-CV_RAWGMENT_EXPORTS int drawCameraIndex(int count, uint64 seed);
+CV_EXPORTS_W int drawCameraIndex(int count, uint64 seed);
 
 /** @brief The darktable noise-profile file of this machine: the environment variable
  * RAWGMENT_DARKTABLE_PROFILES when set, else the install script's copy
  * (`${RAWGMENT_CACHE_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/rawgment}/darktable/noiseprofiles.json`), else an
  * installed darktable's `/usr/share/darktable/noiseprofiles.json`; empty when none exists. */
-CV_RAWGMENT_EXPORTS String darktableProfilesPath();
+CV_EXPORTS_W String darktableProfilesPath();
 
 //! The kinds of file a noise model is taken from (noiseModelFileKind()).
 enum NoiseModelFileKind
@@ -262,9 +285,8 @@ CV_RAWGMENT_EXPORTS NoiseModel noiseModelFromAndroidFile(const String& path, con
  * @throws cv::Exception when the file cannot be read as any of them, a darktable file is given without a
  *         camera, or a camera is given with another kind of file.
  */
-CV_RAWGMENT_EXPORTS NoiseModel loadAnyNoiseModel(const String& path, const String& camera,
-                                                 const RawFormat& format,
-                                                 bool acceptFailedCalibration = false);
+CV_EXPORTS_W NoiseModel loadAnyNoiseModel(const String& path, const String& camera, const RawFormat& format,
+                                          bool acceptFailedCalibration = false);
 
 //! @}
 

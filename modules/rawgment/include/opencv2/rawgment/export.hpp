@@ -2,24 +2,24 @@
 #ifndef OPENCV_RAWGMENT_EXPORT_HPP
 #define OPENCV_RAWGMENT_EXPORT_HPP
 
+#include <opencv2/core/cvdef.h>
+
 /** @file
  * The one place that says how cv::rawgment exports symbols.
  *
- * OpenCV's own `CV_EXPORTS` expands to nothing in Debian's build unless `CVAPI_EXPORTS` is defined,
- * so this out-of-tree module uses its own macro. The library is built with hidden visibility and every
- * public class and function carries `CV_RAWGMENT_EXPORTS`, so that the shared object exports exactly
- * the documented API.
+ * The library is compiled as OpenCV compiles its own modules: hidden visibility, with `CVAPI_EXPORTS`
+ * defined, so that OpenCV's `CV_EXPORTS` (and `CV_EXPORTS_W`, which is `CV_EXPORTS`) marks a symbol as
+ * exported. This holds in both builds, the standalone one (`modules/rawgment/CMakeLists.txt` defines it)
+ * and the one inside OpenCV (`ocv_create_module` defines it). What OpenCV's binding generator wraps
+ * carries `CV_EXPORTS_W`, `CV_EXPORTS_W_SIMPLE` and `CV_WRAP`; the rest of the public API carries
+ * `CV_RAWGMENT_EXPORTS`, which is `CV_EXPORTS` under a name the generator does not read.
  */
 
-#if defined(_WIN32)
-#if defined(RAWGMENT_BUILDING_LIBRARY)
-#define CV_RAWGMENT_EXPORTS __declspec(dllexport)
-#else
-#define CV_RAWGMENT_EXPORTS __declspec(dllimport)
+#if defined(RAWGMENT_BUILDING_LIBRARY) && !defined(CVAPI_EXPORTS)
+#error "cv::rawgment is built with CVAPI_EXPORTS defined, or CV_EXPORTS would export nothing"
 #endif
-#else
-//! Marks a public class or function of cv::rawgment: exported from the shared library.
-#define CV_RAWGMENT_EXPORTS __attribute__((visibility("default")))
-#endif
+
+//! Marks a public class or function of cv::rawgment that the binding generator does not wrap.
+#define CV_RAWGMENT_EXPORTS CV_EXPORTS
 
 #endif // OPENCV_RAWGMENT_EXPORT_HPP

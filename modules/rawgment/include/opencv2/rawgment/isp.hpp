@@ -69,7 +69,10 @@ CV_RAWGMENT_EXPORTS void applyToneCurve(InputArray linear, OutputArray dst, cons
                                         int ddepth = -1);
 
 /** @brief How renderSimpleIsp() turns the mosaic into three colours per pixel. */
-enum DemosaicMethod : int
+// OpenCV 4.6's binding parser reads an enum's base only with no space before ':'.
+// clang-format off
+enum DemosaicMethod: int
+// clang-format on
 {
     DEMOSAIC_BILINEAR = 0,   //!< OpenCV's bilinear Bayer demosaicing (cv::COLOR_BayerBG2BGR family)
     DEMOSAIC_EDGE_AWARE = 1, //!< OpenCV's edge-aware demosaicing (cv::COLOR_BayerBG2BGR_EA family)

@@ -31,19 +31,21 @@ namespace rawgment {
 /** @brief Linear analog gain of a gain in decibels: \f$ g = 10^{dB/20} \f$ (0 dB = 1).
  * @throws cv::Exception when dB is not finite.
  */
-CV_RAWGMENT_EXPORTS double dbToLinearGain(double db);
+CV_EXPORTS_W double dbToLinearGain(double db);
 
 /** @brief Gain in decibels of a linear gain: \f$ dB = 20 \log_{10} g \f$.
  * @throws cv::Exception when g is not finite and positive.
  */
-CV_RAWGMENT_EXPORTS double linearGainToDb(double gain);
+CV_EXPORTS_W double linearGainToDb(double gain);
 
 /** @brief The noise of one gain as a line in the mean: \f$ \sigma^2 = a\,\mu + b \f$
  * @cite yoshimura2023rawgment. */
-struct CV_RAWGMENT_EXPORTS NoiseLine
+struct CV_EXPORTS_W_SIMPLE NoiseLine
 {
-    double a = 0; //!< slope, \f$ a = g\alpha \f$
-    double b = 0; //!< offset, \f$ b = g^2\sigma_d^2 + \sigma_r^2 \f$
+    //! a = b = 0.
+    CV_WRAP NoiseLine() : a(0), b(0) {}
+    CV_PROP_RW double a; //!< slope, \f$ a = g\alpha \f$
+    CV_PROP_RW double b; //!< offset, \f$ b = g^2\sigma_d^2 + \sigma_r^2 \f$
 };
 
 /** @brief A noise line measured at one gain: darktable's profile of one ISO, one gain's fit of a
@@ -51,13 +53,15 @@ struct CV_RAWGMENT_EXPORTS NoiseLine
  *
  * NoiseModel::measuredLines holds them; the augmentation then follows the measurements at every gain
  * (NoiseModel::lineAtGain()) instead of Eq. 5's three parameters. */
-struct CV_RAWGMENT_EXPORTS MeasuredNoiseLine
+struct CV_EXPORTS_W_SIMPLE MeasuredNoiseLine
 {
-    double gain = 0;           //!< linear gain it was measured at, finite and > 0
-    NoiseLine line;            //!< slope a and offset b, finite and >= 0
-    double slopeStdError = 0;  //!< standard error of a (0: not stated)
-    double offsetStdError = 0; //!< standard error of b (0: not stated)
-    double iso = 0;            //!< the ISO it was measured at (0: not stated); informative only
+    //! Every field 0: not yet a valid line.
+    CV_WRAP MeasuredNoiseLine() : gain(0), slopeStdError(0), offsetStdError(0), iso(0) {}
+    CV_PROP_RW double gain;           //!< linear gain it was measured at, finite and > 0
+    CV_PROP_RW NoiseLine line;        //!< slope a and offset b, finite and >= 0
+    CV_PROP_RW double slopeStdError;  //!< standard error of a (0: not stated)
+    CV_PROP_RW double offsetStdError; //!< standard error of b (0: not stated)
+    CV_PROP_RW double iso;            //!< the ISO it was measured at (0: not stated); informative only
 };
 
 /** @brief Heteroscedastic Gaussian sensor noise model (paper Eq. 5) @cite yoshimura2023rawgment.
@@ -71,7 +75,7 @@ struct CV_RAWGMENT_EXPORTS MeasuredNoiseLine
  * an estimate such as a single noisy value can) has no photon shot noise: the shot term uses
  * \f$ \max(\mu, 0) \f$, so the variance is never below the read-noise floor and never negative.
  */
-struct CV_RAWGMENT_EXPORTS NoiseModel
+struct CV_EXPORTS_W_SIMPLE NoiseModel
 {
     //! Newest version of the file format; read() rejects newer versions (see write()).
     static constexpr int FORMAT_VERSION = 5;
@@ -81,20 +85,20 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
     static constexpr double MIN_BASE_ISO = 1;
     static constexpr double MAX_BASE_ISO = 1e7; //!< see MIN_BASE_ISO
 
-    double alpha = 0;   //!< shot-noise slope at gain 1, DN per electron (>= 0)
-    double sigmaD2 = 0; //!< read-noise variance before the analog gain, DN^2 at gain 1 (>= 0)
-    double sigmaR2 = 0; //!< noise variance after the analog gain, DN^2 (>= 0)
+    CV_PROP_RW double alpha;   //!< shot-noise slope at gain 1, DN per electron (>= 0)
+    CV_PROP_RW double sigmaD2; //!< read-noise variance before the analog gain, DN^2 at gain 1 (>= 0)
+    CV_PROP_RW double sigmaR2; //!< noise variance after the analog gain, DN^2 (>= 0)
     /** ISO of gain 1, when the model was calibrated from files that say their ISO (0: unknown; else in
      * [MIN_BASE_ISO, MAX_BASE_ISO]). It
      * lets a camera file give its own gain, \f$ g = \mathrm{ISO} / \mathrm{baseIso} \f$; the noise
      * terms do not depend on it. */
-    double baseIso = 0;
+    CV_PROP_RW double baseIso;
 
     /** Why the calibration that made this model failed its verdict (the failed checks), or empty when it
      * is not known to have failed. A model that carries it is written with it (format version 4), and
      * load() refuses it unless the caller accepts it explicitly, so that a failed calibration never
      * leaves a file that silently works. */
-    String failedCalibration;
+    CV_PROP_RW String failedCalibration;
 
     /** @name Dark-frame components beyond the paper (each absent by default)
      * An absent component changes no output and costs nothing; see docs/mathematics.md, "Dark-frame
@@ -102,34 +106,41 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
     //! @{
     /** Row noise (banding) before the analog gain, DN^2 at gain 1: every pixel of a row shares one
      * offset of variance \f$ g^2\sigma_{row,d}^2 + \sigma_{row,r}^2 \f$ per frame. */
-    double rowSigmaD2 = 0;
-    double rowSigmaR2 = 0; //!< row noise after the analog gain, DN^2 (see rowSigmaD2)
+    CV_PROP_RW double rowSigmaD2;
+    CV_PROP_RW double rowSigmaR2; //!< row noise after the analog gain, DN^2 (see rowSigmaD2)
     /** Dark shading per unit gain, \f$ B_d \f$: CV_32FC1 of the sensor's size, DN. A dark frame at gain
      * g has the fixed per-pixel offset \f$ g B_d + B_r \f$ above the black level. Empty: no dark
      * shading (then darkShadingOffset must be empty too). */
-    Mat darkShadingPerGain;
-    Mat darkShadingOffset; //!< dark shading independent of the gain, \f$ B_r \f$ (see darkShadingPerGain)
+    CV_PROP_RW Mat darkShadingPerGain;
+    CV_PROP_RW Mat
+        darkShadingOffset; //!< dark shading independent of the gain, \f$ B_r \f$ (see darkShadingPerGain)
     /** Whether the read noise (\f$ g^2\sigma_d^2 + \sigma_r^2 \f$ together, variance unchanged) has the
      * heavy-tailed Tukey-lambda shape of tukeyLambda instead of a Gaussian one. An explicit flag:
      * lambda = 0 is the logistic shape, not "absent". */
-    bool tukeyRead = false;
+    CV_PROP_RW bool tukeyRead;
     /** Shape of the read noise when tukeyRead: -0.2 <= lambda <= 1 (validate()); about 0.14 is Gaussian,
      * smaller values have heavier tails (0: logistic, excess kurtosis 1.2). */
-    double tukeyLambda = 0;
+    CV_PROP_RW double tukeyLambda;
 
-    bool hasRowNoise() const { return rowSigmaD2 > 0 || rowSigmaR2 > 0; } //!< whether row noise is present
-    bool hasDarkShading() const { return !darkShadingPerGain.empty(); }   //!< whether dark shading is present
+    CV_WRAP bool hasRowNoise() const
+    {
+        return rowSigmaD2 > 0 || rowSigmaR2 > 0;
+    } //!< whether row noise is present
+    CV_WRAP bool hasDarkShading() const
+    {
+        return !darkShadingPerGain.empty();
+    } //!< whether dark shading is present
     //! Whether any dark-frame component is present.
-    bool hasDarkComponents() const { return hasRowNoise() || hasDarkShading() || tukeyRead; }
+    CV_WRAP bool hasDarkComponents() const { return hasRowNoise() || hasDarkShading() || tukeyRead; }
     /** @brief Excess kurtosis of the read noise: 0 unless tukeyRead, else that of the Tukey-lambda shape
      * (19 at lambda -0.2, 1.2 at 0, about 0 at 0.14, -1.2 at 1). What CalibrationParams::
      * readExcessKurtosis takes from a model that calibrateDarkNoise() fitted to dark frames. */
-    double readExcessKurtosis() const;
+    CV_WRAP double readExcessKurtosis() const;
     /** @brief Variance of the row offset at linear gain g: \f$ g^2\sigma_{row,d}^2 + \sigma_{row,r}^2 \f$. */
-    double rowVariance(double gain) const;
+    CV_WRAP double rowVariance(double gain) const;
     /** @brief The dark shading at linear gain g, \f$ g B_d + B_r \f$ (CV_32FC1), or an empty Mat without
      * dark shading. */
-    Mat darkShadingAt(double gain) const;
+    CV_WRAP Mat darkShadingAt(double gain) const;
     //! @}
 
     /** @brief Noise lines measured at some gains, by increasing gain (empty: Eq. 5 alone, the paper's
@@ -146,24 +157,34 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      * measured offset into the parts before and after the gain (which a contrast change scales
      * differently, Eq. 13) is Eq. 5's at that gain. validate() requires increasing gains and finite,
      * non-negative values. */
-    std::vector<MeasuredNoiseLine> measuredLines;
-    bool hasMeasuredLines() const { return !measuredLines.empty(); } //!< whether measuredLines is present
+    CV_PROP_RW std::vector<MeasuredNoiseLine> measuredLines;
+    CV_WRAP bool hasMeasuredLines() const
+    {
+        return !measuredLines.empty();
+    } //!< whether measuredLines is present
 
-    NoiseModel() = default;
-    /** @brief A validated model. @throws cv::Exception when a parameter is negative or not finite. */
+    //! Every parameter 0.
+    CV_WRAP NoiseModel()
+        : alpha(0), sigmaD2(0), sigmaR2(0), baseIso(0), rowSigmaD2(0), rowSigmaR2(0), tukeyRead(false),
+          tukeyLambda(0)
+    {
+    }
+    /** @brief A validated model. @throws cv::Exception when a parameter is negative or not finite.
+     * Not in cv2.rawgment: OpenCV 4.6's generated constructors turn a C++ exception into a SystemError,
+     * so there a model is made empty, filled and validate()d. */
     NoiseModel(double alpha, double sigmaD2, double sigmaR2);
 
     /** @brief Throws cv::Exception (StsBadArg) naming the parameter that is negative or not finite, a
      * tukeyLambda outside [-0.2, 1], or dark-shading maps that are not two CV_32FC1 Mats of one size.
      * Cheap, so every step calls it; a map that holds NaN or Inf is refused where a model is read,
      * written or simulated, and by the steps in the rows they read. */
-    void validate() const;
+    CV_WRAP void validate() const;
 
     /** @brief The per-gain line: \f$ a = g\alpha,\; b = g^2\sigma_d^2 + \sigma_r^2 \f$, or the
      * measured lines' (measuredLines) when the model has them.
      * @param gain linear gain, finite and > 0
      */
-    NoiseLine lineAtGain(double gain) const;
+    CV_WRAP NoiseLine lineAtGain(double gain) const;
 
     /** @brief Variance of a pixel with mean `mean` at linear gain `gain`:
      * \f$ g\alpha\max(\mu,0) + g^2\sigma_d^2 + \sigma_r^2 \f$ (with measuredLines, \f$ a\max(\mu,0) + b
@@ -171,14 +192,14 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      * @param mean black-subtracted expected value in DN (any finite value)
      * @param gain linear gain, finite and > 0
      */
-    double variance(double mean, double gain) const;
+    CV_WRAP double variance(double mean, double gain) const;
 
     /** @brief variance() of every element of a mean image.
      * @param mean CV_32FC1 or CV_64FC1 Mat of black-subtracted means (finite values)
      * @param gain linear gain, finite and > 0
      * @param dst variance, same size and type as `mean`
      */
-    void variance(InputArray mean, double gain, OutputArray dst) const;
+    CV_WRAP void variance(InputArray mean, double gain, OutputArray dst) const;
 
     /** @brief Writes the model as a map under `name`: format_version, alpha, sigma_d2, sigma_r2,
      * base_iso when it is known, the dark-frame components that are present (row_sigma_d2,
@@ -216,7 +237,7 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      * model file's earlier saves removed. When any write fails (a full disk), the maps this call made
      * are removed and the model file and its maps are as they were.
      */
-    void save(const String& path) const;
+    CV_WRAP void save(const String& path) const;
 
     /** @brief Loads a model saved by save() (the top-level map is `noise_model`), with its dark-shading
      * images.
@@ -225,7 +246,7 @@ struct CV_RAWGMENT_EXPORTS NoiseModel
      *        that made it failed its verdict); without it such a model is refused with an error that
      *        names the file and the failed checks
      */
-    static NoiseModel load(const String& path, bool acceptFailedCalibration = false);
+    CV_WRAP static NoiseModel load(const String& path, bool acceptFailedCalibration = false);
 };
 
 //! @}

@@ -14,12 +14,14 @@ namespace rawgment {
 //! @{
 
 /** @brief Result of a Shapiro-Wilk test of one sample. */
-struct CV_RAWGMENT_EXPORTS ShapiroWilkResult
+struct CV_EXPORTS_W_SIMPLE ShapiroWilkResult
 {
-    double W = 0;          //!< the W statistic, in [0, 1]; 1 for a sample that lies exactly on a normal
-    double pValue = 0;     //!< probability of a W this small or smaller if the sample were normal
-    int n = 0;             //!< sample size
-    bool constant = false; //!< every value was equal (see shapiroWilk() for what W and pValue are then)
+    //! The defaults below.
+    CV_WRAP ShapiroWilkResult() : W(0), pValue(0), n(0), constant(false) {}
+    CV_PROP_RW double W;      //!< the W statistic, in [0, 1]; 1 for a sample that lies exactly on a normal
+    CV_PROP_RW double pValue; //!< probability of a W this small or smaller if the sample were normal
+    CV_PROP_RW int n;         //!< sample size
+    CV_PROP_RW bool constant; //!< every value was equal (see shapiroWilk() for what W and pValue are then)
 };
 
 /** @brief Shapiro-Wilk test of normality @cite shapiro1965analysis, with Royston's approximation of the
@@ -52,10 +54,13 @@ struct CV_RAWGMENT_EXPORTS ShapiroWilkResult
  * @throws cv::Exception (StsBadArg) when n < 3 or n > 5000 (the message gives the valid range), when
  *         a value is NaN or infinite, or when the input has more than one channel.
  */
-CV_RAWGMENT_EXPORTS ShapiroWilkResult shapiroWilk(InputArray samples);
+CV_EXPORTS_W ShapiroWilkResult shapiroWilk(InputArray samples);
 
 /** @brief Where the series of a batch lie in its Mat. */
-enum ShapiroWilkLayout : int
+// OpenCV 4.6's binding parser reads an enum's base only with no space before ':'.
+// clang-format off
+enum ShapiroWilkLayout: int
+// clang-format on
 {
     SW_SERIES_IN_COLUMNS = 0, //!< each column is one series of `rows` values
     SW_SERIES_IN_ROWS = 1     //!< each row is one series of `cols` values
@@ -70,8 +75,8 @@ enum ShapiroWilkLayout : int
  * @param layout whether the series are the columns or the rows of `series`
  * @throws cv::Exception as shapiroWilk(), naming the first series that holds a NaN or infinite value.
  */
-CV_RAWGMENT_EXPORTS void shapiroWilkBatch(InputArray series, std::vector<ShapiroWilkResult>& results,
-                                          ShapiroWilkLayout layout = SW_SERIES_IN_COLUMNS);
+CV_EXPORTS_W void shapiroWilkBatch(InputArray series, CV_OUT std::vector<ShapiroWilkResult>& results,
+                                   ShapiroWilkLayout layout = SW_SERIES_IN_COLUMNS);
 
 /** @brief Per-pixel Shapiro-Wilk tests of a burst: the temporal series of each chosen position. */
 struct CV_RAWGMENT_EXPORTS BurstNormality

@@ -23,43 +23,49 @@ namespace rawgment {
  * white point. Values hold the TIFF values as numbers: a RATIONAL or SRATIONAL as its numerator and
  * denominator, so `values` has 2 x count entries and nothing is rounded.
  */
-struct CV_RAWGMENT_EXPORTS DngTag
+struct CV_EXPORTS_W_SIMPLE DngTag
 {
-    int tag = 0;   //!< TIFF tag number (one of the colour tags above)
-    int type = 0;  //!< TIFF type: 3 SHORT, 4 LONG, 5 RATIONAL, 10 SRATIONAL, 11 FLOAT or 12 DOUBLE
-    int count = 0; //!< number of values as TIFF counts them (1 to 64)
-    std::vector<double> values; //!< the values (numerator, denominator pairs for rationals)
+    //! The defaults below.
+    CV_WRAP DngTag() : tag(0), type(0), count(0) {}
+    CV_PROP_RW int tag;   //!< TIFF tag number (one of the colour tags above)
+    CV_PROP_RW int type;  //!< TIFF type: 3 SHORT, 4 LONG, 5 RATIONAL, 10 SRATIONAL, 11 FLOAT or 12 DOUBLE
+    CV_PROP_RW int count; //!< number of values as TIFF counts them (1 to 64)
+    CV_PROP_RW std::vector<double> values; //!< the values (numerator, denominator pairs for rationals)
     //! Throws cv::Exception (prefixed by `what`) unless the tag is one of the colour tags, of a type
     //! above, and its values fit the type (integers in range, non-zero denominators).
     void validate(const char* what) const;
 };
 
 /** @brief A Bayer mosaic read from a camera RAW file, with what the file says about its capture. */
-struct CV_RAWGMENT_EXPORTS RawImage
+struct CV_EXPORTS_W_SIMPLE RawImage
 {
-    Mat mosaic;              //!< the visible area as stored (black included), CV_16UC1
-    RawFormat format;        //!< CFA pattern of the visible area, per-site black, white level; gain 1
-    double iso = 0;          //!< ISO speed, 0 when the file does not say
-    double exposureTime = 0; //!< seconds, 0 when the file does not say
-    String make;             //!< camera maker, empty when unknown
-    String model;            //!< camera model, empty when unknown
+    //! The defaults below.
+    CV_WRAP RawImage() : iso(0), exposureTime(0), whiteBalance(Vec3d(1, 1, 1)), cameraToSrgb(Matx33d::eye())
+    {
+    }
+    CV_PROP_RW Mat mosaic;          //!< the visible area as stored (black included), CV_16UC1
+    CV_PROP_RW RawFormat format;    //!< CFA pattern of the visible area, per-site black, white level; gain 1
+    CV_PROP_RW double iso;          //!< ISO speed, 0 when the file does not say
+    CV_PROP_RW double exposureTime; //!< seconds, 0 when the file does not say
+    CV_PROP_RW String make;         //!< camera maker, empty when unknown
+    CV_PROP_RW String model;        //!< camera model, empty when unknown
     /** As-shot white-balance multipliers for R, G, B, normalised to green = 1; (1, 1, 1) when the file
      * has none. Pass them to IspParams::whiteBalance for a neutral preview. */
-    Vec3d whiteBalance = Vec3d(1, 1, 1);
+    CV_PROP_RW Vec3d whiteBalance;
     /** Camera RGB to linear sRGB, rows summing to 1 (from the file's colour matrix as LibRaw derives
      * it); the identity when the file has none. Pass it to IspParams::colorMatrix. */
-    Matx33d cameraToSrgb = Matx33d::eye();
+    CV_PROP_RW Matx33d cameraToSrgb;
     /** The DNG NoiseProfile (tag 51041): for the signal x of a colour plane normalised to [0, 1] by
      * (white - black), the noise variance is S x + O, with one (S, O) pair per colour plane (red, green,
      * blue) or one pair for all. Empty when the file has none. readRaw() reads it from a DNG's IFDs
      * (LibRaw does not expose it), writeDng() writes it; dngNoiseProfile() makes it from a NoiseModel. */
-    std::vector<Vec2d> noiseProfile;
+    CV_PROP_RW std::vector<Vec2d> noiseProfile;
     /** The DNG colour tags, sorted by tag. From a DNG: its IFD0's tags, verbatim. From another RAW file:
      * ColorMatrix1, the XYZ (D65) to camera matrix LibRaw knows for the camera (the Adobe coefficients,
      * given for D65 as the DNG specification defines it), with CalibrationIlluminant1 = D65; empty when
      * LibRaw knows none. writeDng() writes them as they are, adding only what a DNG needs and they lack
      * (ColorMatrix1, from cameraToSrgb, and AsShotNeutral, from whiteBalance). */
-    std::vector<DngTag> colorTags;
+    CV_PROP_RW std::vector<DngTag> colorTags;
 };
 
 /** @brief The DNG NoiseProfile of a noise model at the format's gain (for RawImage::noiseProfile).
@@ -71,7 +77,7 @@ struct CV_RAWGMENT_EXPORTS RawImage
  * @throws cv::Exception when the format is invalid or the model gives S <= 0 (alpha = 0): a DNG reader
  *         requires a positive S.
  */
-CV_RAWGMENT_EXPORTS std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, const RawFormat& format);
+CV_EXPORTS_W std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, const RawFormat& format);
 
 /** @brief The noise line of one CFA site at its capture's gain, from a DNG NoiseProfile: a = S r and
  * b = O r^2 in DN, with r the white level minus the mean black level of the site's colour plane (the
@@ -94,7 +100,7 @@ CV_RAWGMENT_EXPORTS NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& 
  * @throws cv::Exception when the file has no NoiseProfile or no ISO, the model no base ISO, or the
  *         profile is invalid for the file's format.
  */
-CV_RAWGMENT_EXPORTS NoiseModel withDngNoiseProfileLine(const NoiseModel& model, const RawImage& image);
+CV_EXPORTS_W NoiseModel withDngNoiseProfileLine(const NoiseModel& model, const RawImage& image);
 
 /** @brief darktable's noise variance over the per-pixel raw variance (green channel), as its profiling
  * tool measures: the Haar-MAD variance of a PPG-demosaiced export (docs/real_cameras.md). */
@@ -208,7 +214,7 @@ CV_RAWGMENT_EXPORTS NoiseModel noiseModelFromAndroid(const AndroidNoiseProfile& 
  *         mosaic (X-Trans, Foveon, four-colour, or a linear/demosaiced DNG), or has a malformed
  *         NoiseProfile tag.
  */
-CV_RAWGMENT_EXPORTS RawImage readRaw(const String& path);
+CV_EXPORTS_W RawImage readRaw(const String& path);
 
 /** @brief Writes a mosaic as an uncompressed DNG 1.4 file that LibRaw and RAW viewers open.
  *
@@ -222,7 +228,7 @@ CV_RAWGMENT_EXPORTS RawImage readRaw(const String& path);
  * @throws cv::Exception when `path` exists, the mosaic is unsupported, the noise profile is invalid
  *         (see noiseLineFromDngProfile()), or any write fails.
  */
-CV_RAWGMENT_EXPORTS void writeDng(const String& path, const RawImage& image);
+CV_EXPORTS_W void writeDng(const String& path, const RawImage& image);
 
 /** @brief What a RAW file says about its camera and capture beside the mosaic. Augmentation keeps it
  * (MosaicMetadata::camera), so that an augmented DNG is still the camera's for a raw converter: the same

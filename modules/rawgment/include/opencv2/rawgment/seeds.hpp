@@ -16,7 +16,10 @@ namespace rawgment {
  * Every random number of the library comes from a registered family of counter-based streams; these
  * are the families of the apps and of programs built on the library, so that one seed reproduces a
  * whole run and no two uses of it share random numbers. */
-enum SeedPurpose : int
+// OpenCV 4.6's binding parser reads an enum's base only with no space before ':'.
+// clang-format off
+enum SeedPurpose: int
+// clang-format on
 {
     SEED_SIMULATED_BURST = 16,            //!< a simulated burst; index: the burst's number in the run
     SEED_SIMULATED_VALIDATION_BURST = 17, //!< a validation burst; index: 0 bright, 1 and 2 the darker ones
