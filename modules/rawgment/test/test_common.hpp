@@ -3,7 +3,29 @@
 #ifndef OPENCV_RAWGMENT_TEST_COMMON_HPP
 #define OPENCV_RAWGMENT_TEST_COMMON_HPP
 
+#ifdef RAWGMENT_OPENCV_TEST_FRAMEWORK
+// Built inside OpenCV (opencv_test_rawgment): OpenCV's own copy of GoogleTest, whose TEST macros report
+// its SkipTestException as a skip. That copy predates GTEST_SKIP(), which the tests use as usual.
+#include <opencv2/ts.hpp>
+// OpenCV's TEST macros check that a test lives in namespace opencv_test; these live in cv::rawgment.
+using opencv_test::required_opencv_test_namespace;
+namespace cv {
+namespace rawgment {
+namespace test {
+struct SkipWithMessage
+{
+    [[noreturn]] void operator=(const ::testing::Message& message) const
+    {
+        throw ::cvtest::SkipTestException(message.GetString());
+    }
+};
+} // namespace test
+} // namespace rawgment
+} // namespace cv
+#define GTEST_SKIP() return ::cv::rawgment::test::SkipWithMessage() = ::testing::Message()
+#else
 #include <gtest/gtest.h>
+#endif
 #include <opencv2/core.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 

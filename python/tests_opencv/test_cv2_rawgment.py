@@ -1,0 +1,192 @@
+"""cv2.rawgment, the binding OpenCV's generator makes when rawgment is built inside OpenCV, gives the C++
+library's bits: every result of python/tests/cxx_reference.cpp (the standalone library, in its own
+process) is recomputed through cv2.rawgment from the same inputs and seeds and compared bit for bit.
+
+Run by scripts/build-in-opencv.sh with that build's cv2 first on PYTHONPATH. This folder has no
+conftest of the pybind module: loading both libraries (and two builds of OpenCV) into one process
+would let one library's symbols stand in for the other's, and the comparison would prove nothing.
+"""
+import os
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+
+cv2 = pytest.importorskip("cv2")
+if not hasattr(cv2, "rawgment"):
+    pytest.skip("this cv2 (%s) has no rawgment module: run scripts/build-in-opencv.sh" % cv2.__file__,
+                allow_module_level=True)
+rg = cv2.rawgment
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The C++ reference folder: arrays as .npy, numbers in numbers.txt."""
+    program = os.environ.get("RAWGMENT_PYTHON_REFERENCE")
+    if not program:
+        pytest.fail("RAWGMENT_PYTHON_REFERENCE names no program (scripts/build-in-opencv.sh sets it)")
+    folder = tmp_path_factory.mktemp("cxx_reference")
+    subprocess.run([program, str(folder)], check=True)
+    numbers = {}
+    for line in (folder / "numbers.txt").read_text().splitlines():
+        key, *values = line.split()
+        numbers.setdefault(key, []).append(values)
+    return folder, numbers
+
+
+def number(numbers, key, index=0):
+    return float(numbers[key][0][index])
+
+
+def same(folder, name, array):
+    expected = np.load(folder / (name + ".npy"))
+    assert array.dtype == expected.dtype and array.shape == expected.shape, name
+    assert np.array_equal(array, expected), "%s differs from C++ in %d elements" % (
+        name, int(np.count_nonzero(array != expected)))
+
+
+def inputs(numbers):
+    fmt = rg.RawFormat()
+    fmt.blackLevel = tuple(float(v) for v in numbers["format_black"][0])
+    fmt.whiteLevel = number(numbers, "format_white")
+    fmt.gain = number(numbers, "format_gain")
+    model = rg.NoiseModel()
+    model.alpha = number(numbers, "model_alpha")
+    model.sigmaD2 = number(numbers, "model_sigmaD2")
+    model.sigmaR2 = number(numbers, "model_sigmaR2")
+    model.validate()
+    return fmt, model
+
+
+def test_this_is_the_built_cv2():
+    prefix = os.environ.get("RAWGMENT_OPENCV_PREFIX")
+    if prefix:
+        assert pathlib.Path(cv2.__file__).resolve().is_relative_to(pathlib.Path(prefix).resolve()), cv2.__file__
+    assert cv2.__version__.startswith("4.6")
+
+
+def test_noise_model(reference, tmp_path):
+    _, numbers = reference
+    _, model = inputs(numbers)
+    assert model.variance(100, 3) == number(numbers, "model_variance_100_3")
+    means = np.array([[0, 100], [2000, -5]], np.float64)
+    assert np.array_equal(model.variance(means, 3), [[model.variance(float(m), 3) for m in row] for row in means])
+    path = str(tmp_path / "model.yml")
+    model.save(path)
+    back = rg.NoiseModel_load(path)
+    assert (back.alpha, back.sigmaD2, back.sigmaR2) == (model.alpha, model.sigmaD2, model.sigmaR2)
+    model.sigmaD2 = -1
+    with pytest.raises(cv2.error, match="NoiseModel.sigmaD2"):
+        model.validate()
+    with pytest.raises(cv2.error, match="NoiseModel.sigmaD2"):
+        model.variance(100, 3)
+
+
+def test_noise_steps(reference):
+    folder, numbers = reference
+    fmt, model = inputs(numbers)
+    capture = np.load(folder / "capture.npy")
+    jitter = rg.ColorJitter_exposureChange(0.2, 2.0)
+    jitter.contrast = (0.4, 0.38, 0.41, 0.5)
+    jitter.brightness = -3
+    noise = rg.NoiseOptions(rg.NoiseAlignment_ACCOUNT_PRIOR)
+    out, outFormat, report, mask = rg.colorJitter(capture, fmt, model, jitter, noise, 5)
+    same(folder, "jitter", out)
+    same(folder, "jitter_mask", mask)
+    assert outFormat.gain == number(numbers, "jitter_gain")
+    assert report.brighteningPixels == int(numbers["jitter_brightening"][0][0])
+    assert report.steps == ("colorJitter",)
+
+    blurred, _ = rg.motionBlur(capture, fmt, model, rg.linearMotionKernel(9, 30), noise, 6)
+    same(folder, "blur", blurred)
+    scaled, _ = rg.scaleMosaic(capture, fmt, model, 1.03, rg.NoiseOptions(rg.NoiseAlignment_IGNORE_PRIOR), 7)
+    same(folder, "scale", scaled)
+
+
+def test_scene_policy_and_boxes(reference):
+    folder, numbers = reference
+    fmt, model = inputs(numbers)
+    capture = np.load(folder / "capture.npy")
+    policy = rg.RandomScenePolicy()
+    policy.blurProbability = 1
+    policy.geometryProbability = 1
+    seed = rg.augmentedOutputSeed(1, "frame", 2)
+    scene = policy.draw(capture, fmt, seed)
+    out, outFormat, report, boxes = rg.applyScene(capture, fmt, model, scene, seed, boxes=[(10, 12, 30, 20),
+                                                                                         (100, 80, 20, 10)])
+    same(folder, "scene", out)
+    assert outFormat.gain == number(numbers, "scene_gain")
+    assert [tuple(int(v) for v in box) for box in boxes] == [
+        tuple(int(v) for v in numbers["scene_box%d" % i][0]) for i in range(2)]
+    assert report.steps and len(report.stepSeconds) == len(report.steps)
+
+
+def test_shapiro_wilk(reference):
+    folder, numbers = reference
+    normals = np.load(folder / "normal.npy")
+    result = rg.shapiroWilk(normals)
+    assert result.W == number(numbers, "sw_W") and result.pValue == number(numbers, "sw_p")
+    # The batch gives the single test's bits for every column.
+    batch = rg.shapiroWilkBatch(normals, layout=rg.SW_SERIES_IN_COLUMNS)
+    single = [rg.shapiroWilk(np.ascontiguousarray(normals[:, c])) for c in range(normals.shape[1])]
+    assert [(r.W, r.pValue) for r in batch] == [(r.W, r.pValue) for r in single]
+
+
+def test_burst_statistics_and_calibration(reference):
+    folder, numbers = reference
+    fmt, _ = inputs(numbers)
+    patches = [tuple(int(v) for v in p) for p in numbers["patch"]]
+    squares = rg.cfaAlignedSquares(patches, 8)
+    samples = []
+    for g in range(3):
+        gain = rg.dbToLinearGain(6.0 * g)
+        frames = np.load(folder / ("burst_g%d.npy" % g)).reshape(16, 96, 128)
+        burstFormat = rg.RawFormat()
+        burstFormat.blackLevel, burstFormat.whiteLevel, burstFormat.gain = fmt.blackLevel, fmt.whiteLevel, gain
+        stats = rg.BurstStatistics(burstFormat)
+        for frame in frames:
+            stats.add(frame)
+        assert stats.frames() == 16 and stats.format().gain == gain
+        if g == 0:
+            same(folder, "burst_variance", stats.variance())
+        samples += rg.sampleBurstPatches(stats, squares, gain)
+    assert len(samples) == int(numbers["calibration_samples"][0][0])
+    report = rg.calibrateNoiseModel(samples)
+    assert report.model.alpha == number(numbers, "calibration_alpha")
+    assert report.model.sigmaD2 == number(numbers, "calibration_sigmaD2")
+    assert report.model.sigmaR2 == number(numbers, "calibration_sigmaR2")
+
+
+def test_raw_files(reference, tmp_path):
+    folder, numbers = reference
+    fmt, _ = inputs(numbers)
+    fmt.gain = 1
+    image = rg.RawImage()
+    image.mosaic = np.load(folder / "capture.npy")
+    image.format = fmt
+    image.iso = 200
+    path = tmp_path / "capture.dng"
+    rg.writeDng(str(path), image)
+    # The same image written by the C++ library and by cv2.rawgment: the same file.
+    assert path.read_bytes() == (folder / "capture.dng").read_bytes()
+    back = rg.readRaw(str(path))
+    assert np.array_equal(back.mosaic, image.mosaic) and back.iso == 200
+    assert back.format.blackLevel == fmt.blackLevel
+    with pytest.raises(cv2.error, match="missing.dng"):
+        rg.readRaw(str(tmp_path / "missing.dng"))
+
+
+def test_camera_catalogue(reference):
+    _, numbers = reference
+    path = rg.darktableProfilesPath()
+    if "cameras" not in numbers or not path:
+        pytest.skip("darktable's noiseprofiles.json is not installed (scripts/install-deps.sh fetches it)")
+    cameras = rg.readCameraProfiles(path)
+    assert len(cameras) == int(numbers["cameras"][0][0])
+    d3 = rg.findCameraProfile(cameras, "Nikon D3")
+    verdict, alpha, variance = numbers["camera_d3"][0]
+    fmt, _ = inputs(numbers)
+    d3Model = d3.modelFor(fmt)
+    assert (d3.verdict, d3Model.alpha, d3Model.variance(100, 3)) == (int(verdict), float(alpha), float(variance))
+    assert d3.name() == "Nikon D3" and d3.usable()
