@@ -62,6 +62,7 @@ fi
 # A minimal OpenCV. Debian's source lacks the bundled third-party code, hence the features turned off
 # (OpenCL, for one: its install step needs a licence file that the source lacks).
 # The module's tests only: OPENCV_BUILD_(PERF_)TEST_MODULES_LIST keeps OpenCV's own tests out.
+mkdir -p "$build"
 cmake -S "$source_dir" -B "$build/build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_INSTALL_PREFIX="$prefix" \
   -DOPENCV_EXTRA_MODULES_PATH="$root/modules" \
