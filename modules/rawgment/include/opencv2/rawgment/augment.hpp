@@ -74,7 +74,7 @@ struct CV_EXPORTS_W_SIMPLE NoiseOptions
     CV_PROP_RW PriorMeanEstimate priorMean;    //!< the estimate of mu_x
     CV_PROP_RW BlurNoiseSum blurNoiseSum;      //!< motion blur's shot-noise term
 
-    //! The defaults above.
+    //! Every field at its default, as initialised here.
     CV_WRAP NoiseOptions()
         : alignment(NoiseAlignment::ACCOUNT_PRIOR), shotSampling(ShotNoiseSampling::GAUSSIAN),
           priorMean(PriorMeanEstimate::PIXEL_VALUE), blurNoiseSum(BlurNoiseSum::EXACT)

@@ -81,7 +81,7 @@ private:
  * or the spatial statistics of a uniform patch in single-frame mode. */
 struct CV_EXPORTS_W_SIMPLE NoiseSample
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP NoiseSample() : mean(0), variance(0), gain(1), dof(1), channel(-1), pixel(-1) {}
     CV_PROP_RW double mean;     //!< black-subtracted mean (DN)
     CV_PROP_RW double variance; //!< unbiased variance (DN^2)
@@ -175,7 +175,7 @@ CV_EXPORTS_W std::vector<NoiseSample> sampleSingleFramePatches(InputArray raw, c
 /** @brief Settings of the per-gain line fit. */
 struct CV_EXPORTS_W_SIMPLE LineFitParams
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP LineFitParams()
         : robust(true), ransacIterations(500), inlierThreshold(4.0), seed(0), readExcessKurtosis(0)
     {
@@ -205,7 +205,7 @@ struct CV_EXPORTS_W_SIMPLE LineFitParams
  * (paper) does on the same inliers. */
 struct CV_EXPORTS_W_SIMPLE NoiseLineFit
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP NoiseLineFit()
         : gain(1), rSquared(0), inliers(0), samples(0), slopeStdError(0), offsetStdError(0),
           slopeOffsetCorrelation(0)
@@ -255,7 +255,7 @@ enum NoiseFitMethod: int
 /** @brief Settings of calibrateNoiseModel(). */
 struct CV_EXPORTS_W_SIMPLE CalibrationParams
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP CalibrationParams()
         : method(NOISE_FIT_JOINT), reweightIterations(8), lossScale(0.0), minGainRatio(1.12),
           bootstrapReplicates(200), readExcessKurtosis(std::numeric_limits<double>::quiet_NaN())
@@ -323,7 +323,7 @@ enum UncertaintySource: int
  * alpha has an error. */
 struct CV_EXPORTS_W_SIMPLE ModelUncertainty
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP ModelUncertainty() : source(UNCERTAINTY_NONE), bootstrapReplicates(0) {}
     CV_PROP_RW UncertaintySource source; //!< which of the two estimates below is used
     CV_PROP_RW Vec3d stdError;           //!< standard errors used, indexed by NoiseModelParameter
@@ -341,7 +341,7 @@ struct CV_EXPORTS_W_SIMPLE ModelUncertainty
 /** @brief Everything a calibration found, readable and writable as YAML or JSON. */
 struct CV_EXPORTS_W_SIMPLE CalibrationReport
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP CalibrationReport()
         : method(NOISE_FIT_JOINT), separable(false), rSquaredSlope(0), rSquaredOffset(0), samples(0),
           samplesUsed(0), readExcessKurtosis(0), readExcessKurtosisEstimated(false)

@@ -65,7 +65,7 @@ CV_EXPORTS_W String profileDemosaicName(int demosaic);
  * neighbours and lowers it. docs/real_cameras.md has the derivation and the reference. */
 struct CV_EXPORTS_W_SIMPLE DarktableImportParams
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP DarktableImportParams()
         : haarVarianceRatio(DARKTABLE_HAAR_VARIANCE_RATIO), offsetReferenceLevel(1e-3),
           goodMedianSlopeResidual(0.10), goodWorstSlopeResidual(0.35), goodWorstOffsetResidual(1.0),
@@ -98,7 +98,7 @@ struct CV_EXPORTS_W_SIMPLE DarktableImportParams
  * white - black = 1). */
 struct CV_EXPORTS_W_SIMPLE CameraIsoFit
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP CameraIsoFit()
         : iso(0), gain(0), slope(0), offset(0), slopeResidual(0), offsetResidual(0), colourSpread(1),
           expanded(false), inconsistent(false), rawIso(0)
@@ -144,7 +144,7 @@ struct CV_EXPORTS_W_SIMPLE CameraIsoFit
  * modelFor() scales it to a RawFormat's range. */
 struct CV_EXPORTS_W_SIMPLE CameraNoiseProfile
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP CameraNoiseProfile()
         : verdict(CAMERA_PROFILE_REFUSED), skippedProfiles(0), medianSlopeResidual(0), worstSlopeResidual(0),
           worstSlopeIso(0), worstOffsetResidual(0), worstOffsetIso(0), medianColourSpread(1),

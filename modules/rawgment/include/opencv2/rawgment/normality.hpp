@@ -16,7 +16,7 @@ namespace rawgment {
 /** @brief Result of a Shapiro-Wilk test of one sample. */
 struct CV_EXPORTS_W_SIMPLE ShapiroWilkResult
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP ShapiroWilkResult() : W(0), pValue(0), n(0), constant(false) {}
     CV_PROP_RW double W;      //!< the W statistic, in [0, 1]; 1 for a sample that lies exactly on a normal
     CV_PROP_RW double pValue; //!< probability of a W this small or smaller if the sample were normal

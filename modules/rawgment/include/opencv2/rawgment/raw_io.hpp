@@ -25,7 +25,7 @@ namespace rawgment {
  */
 struct CV_EXPORTS_W_SIMPLE DngTag
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP DngTag() : tag(0), type(0), count(0) {}
     CV_PROP_RW int tag;   //!< TIFF tag number (one of the colour tags above)
     CV_PROP_RW int type;  //!< TIFF type: 3 SHORT, 4 LONG, 5 RATIONAL, 10 SRATIONAL, 11 FLOAT or 12 DOUBLE
@@ -39,7 +39,7 @@ struct CV_EXPORTS_W_SIMPLE DngTag
 /** @brief A Bayer mosaic read from a camera RAW file, with what the file says about its capture. */
 struct CV_EXPORTS_W_SIMPLE RawImage
 {
-    //! The defaults below.
+    //! Every field at its default, as initialised here.
     CV_WRAP RawImage() : iso(0), exposureTime(0), whiteBalance(Vec3d(1, 1, 1)), cameraToSrgb(Matx33d::eye())
     {
     }
