@@ -190,7 +190,7 @@ double rangeOfColourPlane(const RawFormat& format, int plane)
 }
 
 //! Whether a regular file starts with a TIFF header of either byte order (DNG, NEF, ...).
-bool isTiffBased(const String& path)
+static bool isTiffBased(const String& path)
 {
     checkRegularFile(path, "RAW file");
     std::ifstream probe(path, std::ios::binary);

@@ -106,8 +106,10 @@ TEST(Augment, exposureChangeMatchesTheModelOnlyWhenThePriorIsAccounted)
             SCOPED_TRACE(testing::Message() << "x" << factor << ", level block " << b);
             EXPECT_NEAR(ratio[2][b], 1.0, tolerance) << "ACCOUNT_PRIOR";
             EXPECT_LT(ratio[0][b], 1.0 - tolerance) << "NONE keeps only the scaled prior noise";
-            if (factor == 0.5 || b >= 4) // the prior noise matters: f^2 v_in is a sizeable part of the target
+            // The prior noise matters where f^2 v_in is a sizeable part of the target.
+            if (factor == 0.5 || b >= 4) {
                 EXPECT_GT(ratio[1][b], 1.0 + tolerance) << "IGNORE_PRIOR adds the target on top of the prior";
+            }
         }
         std::cout << "x" << factor << " variance / model, brightest block: NONE " << ratio[0][7]
                   << ", IGNORE_PRIOR " << ratio[1][7] << ", ACCOUNT_PRIOR " << ratio[2][7] << "\n";
@@ -199,8 +201,9 @@ TEST(Augment, measuredLinesAreFollowedAtTheSourceAndTargetGains)
                 expected += prior - (m / in) * (m / in) * model.variance(in, kGain);
             }
             EXPECT_NEAR(v / expected, 1.0, tolerance);
-            if (b >= 4 && c.alignment == NoiseAlignment::ACCOUNT_PRIOR)
+            if (b >= 4 && c.alignment == NoiseAlignment::ACCOUNT_PRIOR) {
                 EXPECT_GT(std::abs(v / eq5.variance(m, outGain) - 1), tolerance) << "Eq. 5 would pass too";
+            }
         }
     }
 }
@@ -329,16 +332,19 @@ TEST(Augment, scaleKeepsTheModelVarianceAtEveryInterpolationPosition)
                 // A column averages 128 variances of 64 frames (relative standard error sqrt(2/63) =
                 // 17.8% each); neighbouring rows share source rows, so count 64 independent ones:
                 // 2.2%, and 5 of them is 11%.
-                if (mode == NoiseAlignment::ACCOUNT_PRIOR)
+                if (mode == NoiseAlignment::ACCOUNT_PRIOR) {
                     EXPECT_NEAR(ratio, 1.0, 0.11) << "scale " << scale << ", column " << c;
+                }
             }
             const double average = total / (size.width - 16);
             std::cout << "scale " << scale << ", mode " << static_cast<int>(mode)
                       << ": variance / model, average over columns " << average << "\n";
-            if (mode == NoiseAlignment::ACCOUNT_PRIOR) // ~14,000 pixels, half independent: 0.8% s.e.
+            if (mode == NoiseAlignment::ACCOUNT_PRIOR) { // ~14,000 pixels, half independent: 0.8% s.e.
                 EXPECT_NEAR(average, 1.0, 0.04);
-            if (mode == NoiseAlignment::IGNORE_PRIOR) // the prior noise is counted twice
+            }
+            if (mode == NoiseAlignment::IGNORE_PRIOR) { // the prior noise is counted twice
                 EXPECT_GT(average, 1.1);
+            }
         }
         // Halfway between two pixels in both directions a bilinear mix keeps a quarter of the
         // variance; columns at x fraction 0.5 keep at most half: plain resampling is far too clean.
@@ -1322,8 +1328,9 @@ TEST(Augment, blurNoiseFromTheBlurredMeanIsExactWhereTheTapsAgree)
     for (int r = 0; r < size.height; ++r) {
         const int c = 2 * 15 + r % 2; // both sites of the row
         const float e = exact.at<float>(r, c), a = approx.at<float>(r, c);
-        if (std::abs(e) > 1) // far from zero, so the ratio is well conditioned
+        if (std::abs(e) > 1) { // far from zero, so the ratio is well conditioned
             EXPECT_NEAR(a / e, std::sqrt(vApprox / vExact), 1e-3);
+        }
     }
 }
 

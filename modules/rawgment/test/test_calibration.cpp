@@ -346,8 +346,9 @@ TEST(Calibration, burstStatisticsResetGivesTheBitsOfANewObject)
         EXPECT_EQ(0, cv::norm(m1, m2, NORM_INF));
         EXPECT_EQ(0, cv::norm(v1, v2, NORM_INF));
         EXPECT_EQ(0, cv::norm(c1, c2, NORM_INF));
-        if (k == 1)
+        if (k == 1) {
             EXPECT_GT(countNonZero(c1), 10) << "the second burst reaches white";
+        }
     }
     RawFormat bad = fmt;
     bad.whiteLevel = -1;

@@ -203,8 +203,9 @@ TEST(CameraProfiles, malformedAndUnusableEntriesAreRefusedNamingTheirPlaceAndThe
     // "Maker good" repeats "Maker Good" but for case: selection by name would be ambiguous.
     EXPECT_NE(cams[6].reason.find("repeats an earlier entry"), std::string::npos);
     for (const CameraNoiseProfile& cam : cams)
-        if (!cam.usable())
+        if (!cam.usable()) {
             EXPECT_FALSE(cam.reason.empty()) << cam.name();
+        }
 
     // A file that is not darktable's form is an error naming it.
     const std::string notProfiles = writeText(dir, "other.json", "{\"noiseprofiles\": 3}\n");
@@ -407,7 +408,7 @@ struct DarktableProfile
 };
 
 //! Every profile of darktable's file not marked skip, read here without the catalogue (the truth).
-std::vector<DarktableProfile> darktableGreenProfiles(const std::string& path)
+static std::vector<DarktableProfile> darktableGreenProfiles(const std::string& path)
 {
     std::vector<DarktableProfile> out;
     FileStorage fs = openFileStorageForReading(path, "darktable noise profiles");
@@ -422,7 +423,7 @@ std::vector<DarktableProfile> darktableGreenProfiles(const std::string& path)
     return out;
 }
 
-double quantile(std::vector<double> v, double q)
+static double quantile(std::vector<double> v, double q)
 {
     std::sort(v.begin(), v.end());
     return v[static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
@@ -583,7 +584,7 @@ TEST(CameraProfiles, digitalSettingsAreNamedWithTheirRawIsoAndNotFitted)
 }
 
 //! A camera entry whose red and blue slopes are the green slope times `ratios`.
-std::string colouredEntry(const std::string& model, const std::vector<double>& isos, Vec2d ratios)
+static std::string colouredEntry(const std::string& model, const std::vector<double>& isos, Vec2d ratios)
 {
     const double a100 = 1.0 / 40000 * DARKTABLE_HAAR_VARIANCE_RATIO, b = 1e-8;
     std::string text = "{\"model\": \"" + model + "\", \"profiles\": [";

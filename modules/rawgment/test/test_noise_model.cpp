@@ -606,8 +606,9 @@ TEST(NoiseModel, tukeyLambdaMomentsAndQuantilesMatchScipy)
             << r.lambda;
         EXPECT_NEAR(r.q001, detail::tukeyLambdaQuantile(0.001, r.lambda), 1e-12 * (1 + std::abs(r.q001)))
             << r.lambda;
-        if (r.lambda >= detail::kTukeyLambdaMin)
+        if (r.lambda >= detail::kTukeyLambdaMin) {
             EXPECT_NEAR(r.lambda, detail::tukeyLambdaOfExcessKurtosis(r.kurtosis), 1e-9) << r.lambda;
+        }
     }
     // The added part needs more kurtosis than the whole when the prior keeps part of the tails, and the
     // model's own lambda when nothing of the prior is kept.
