@@ -36,11 +36,13 @@ if [ "${#missing[@]}" -gt 0 ]; then
   "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-# Debian's OpenCV source: apt-get source needs a deb-src entry, made from the machine's own deb entry.
+# Debian's OpenCV source, kept in the cache.
 source_dir="$cache/opencv-src/opencv-4.6.0"
 if [ ! -f "$source_dir/CMakeLists.txt" ]; then
   mkdir -p "$cache/opencv-src"
-  if ! grep -rqs "deb-src" /etc/apt/sources.list /etc/apt/sources.list.d/; then
+  # apt-get source needs a deb-src entry for bookworm's main: when the first try finds none, one is
+  # made from the machine's own deb entry and the download tried again.
+  if ! (cd "$cache/opencv-src" && apt-get source --download-only opencv); then
     uri=$(awk '/^URIs:/ {print $2; exit}' /etc/apt/sources.list.d/debian.sources 2>/dev/null || true)
     uri=${uri:-http://deb.debian.org/debian}
     echo "build-in-opencv: adding a deb-src entry for $uri bookworm main"
@@ -48,8 +50,8 @@ if [ ! -f "$source_dir/CMakeLists.txt" ]; then
       /usr/share/keyrings/debian-archive-keyring.gpg |
       "${sudo_cmd[@]}" tee /etc/apt/sources.list.d/rawgment-debian-src.sources >/dev/null
     "${sudo_cmd[@]}" apt-get update -qq
+    (cd "$cache/opencv-src" && apt-get source --download-only opencv)
   fi
-  (cd "$cache/opencv-src" && apt-get source --download-only opencv)
   tarball=$(ls "$cache"/opencv-src/opencv_4.6.0*.orig.tar.xz 2>/dev/null | grep -v contrib | head -n 1)
   if [ -z "$tarball" ]; then
     echo "build-in-opencv: Debian's source of OpenCV 4.6.0 was not downloaded" >&2
