@@ -151,7 +151,7 @@ void checkDarkShadingSize(const NoiseModel& model, Size size, Point origin, cons
 // subtracting 2^23 (where the float spacing is 1) leaves the rounding to IEEE's default mode, the same
 // on every vector width. Adding 0.5 and truncating would round every tie up, a bias of +1/4 DN wherever
 // ties are common: integer mosaics halved with no noise added (NoiseAlignment::NONE, brightening pixels).
-template <typename V> inline __attribute__((always_inline)) V roundHalfToEven(V v)
+template <typename V> RAWGMENT_ALWAYS_INLINE V roundHalfToEven(V v)
 {
     const float spacingOne = 8388608.0f;
     return (v + spacingOne) - spacingOne;
@@ -165,7 +165,7 @@ inline float outputWhite(const RawFormat& format, int depth)
 }
 
 // Clipped to [0, white]; 16-bit output is rounded half to even.
-template <typename T> inline __attribute__((always_inline)) T storeValue(float out, float white)
+template <typename T> RAWGMENT_ALWAYS_INLINE T storeValue(float out, float white)
 {
     out = std::min(std::max(out, 0.0f), white);
     return std::is_same<T, ushort>::value ? static_cast<T>(static_cast<int>(roundHalfToEven(out)))

@@ -91,9 +91,9 @@ RAWGMENT_DISPATCHED(void, mergeGroupColumns,
 // Half the lanes of a kernel of width W: int32, double and float.
 template <int W> struct HalfLanes
 {
-    typedef int32_t I __attribute__((vector_size(2 * W)));
-    typedef double D __attribute__((vector_size(4 * W)));
-    typedef float F __attribute__((vector_size(2 * W)));
+    typedef RAWGMENT_VECTOR(int32_t, 2 * W) I;
+    typedef RAWGMENT_VECTOR(double, 4 * W) D;
+    typedef RAWGMENT_VECTOR(float, 2 * W) F;
 };
 
 //! Half h of a vector of W lanes.
@@ -115,7 +115,7 @@ template <int W> RAWGMENT_KERNEL typename HalfLanes<W>::D loadState(const float*
 {
     typename HalfLanes<W>::F f;
     std::memcpy(&f, p, sizeof(f));
-    return __builtin_convertvector(f, typename HalfLanes<W>::D);
+    return convertLanes<typename HalfLanes<W>::D>(f);
 }
 template <int W> RAWGMENT_KERNEL void storeState(double* p, typename HalfLanes<W>::D d)
 {
@@ -123,7 +123,7 @@ template <int W> RAWGMENT_KERNEL void storeState(double* p, typename HalfLanes<W
 }
 template <int W> RAWGMENT_KERNEL void storeState(float* p, typename HalfLanes<W>::D d)
 {
-    const typename HalfLanes<W>::F f = __builtin_convertvector(d, typename HalfLanes<W>::F);
+    const typename HalfLanes<W>::F f = convertLanes<typename HalfLanes<W>::F>(d);
     std::memcpy(p, &f, sizeof(f));
 }
 
@@ -153,12 +153,12 @@ RAWGMENT_KERNEL void mergeGroup16Body(const ushort* const* rows, int m, int n, d
     for (; c + W <= n; c += W) {
         U16 raw;
         std::memcpy(&raw, rows[0] + c, sizeof(raw));
-        const I first = __builtin_convertvector(raw, I);
+        const I first = convertLanes<I>(raw);
         I sum = {}, low = first, high = first;
         U squareLow = {}, squareHigh = {};
         for (int k = 1; k < m; ++k) {
             std::memcpy(&raw, rows[k] + c, sizeof(raw));
-            const I v = __builtin_convertvector(raw, I);
+            const I v = convertLanes<I>(raw);
             const I d = v - first;
             sum += d;
             const U square = (U)d * (U)d; // |d| <= 65535: exact modulo 2^32, so exact
@@ -168,10 +168,10 @@ RAWGMENT_KERNEL void mergeGroup16Body(const ushort* const* rows, int m, int n, d
             high = detail::maxLanes(high, v);
         }
         for (int h = 0; h < 2; ++h) {
-            const D s1 = __builtin_convertvector(halfOf<HalfI>(sum, h), D);
-            const D s2 = __builtin_convertvector(halfOf<HalfI>((I)squareHigh, h), D) * 65536.0 +
-                         __builtin_convertvector(halfOf<HalfI>((I)squareLow, h), D);
-            const D groupMean = __builtin_convertvector(halfOf<HalfI>(first, h), D) - black + s1 / md;
+            const D s1 = convertLanes<D>(halfOf<HalfI>(sum, h));
+            const D s2 = convertLanes<D>(halfOf<HalfI>((I)squareHigh, h)) * 65536.0 +
+                         convertLanes<D>(halfOf<HalfI>((I)squareLow, h));
+            const D groupMean = convertLanes<D>(halfOf<HalfI>(first, h)) - black + s1 / md;
             const D groupM2 = (md * s2 - s1 * s1) / md;
             S* const muAt = mu + c + h * W / 2;
             S* const accAt = acc + c + h * W / 2;
@@ -181,7 +181,7 @@ RAWGMENT_KERNEL void mergeGroup16Body(const ushort* const* rows, int m, int n, d
             storeState<W>(accAt, loadState<W>(accAt) + groupM2 + delta * delta * wCross);
         }
         for (int bits = detail::maskBits((low <= 0) | (high >= whiteFloor)); bits; bits &= bits - 1)
-            clip[c + __builtin_ctz(static_cast<unsigned>(bits))] = 255;
+            clip[c + lowestSetBit(static_cast<unsigned>(bits))] = 255;
     }
     if (c == n)
         return;

@@ -38,7 +38,7 @@ RAWGMENT_KERNEL void poissonSplitBlock(const T* s, const float* prior, const Jit
     const F read = tails ? minLanes(maxLanes(v.rest, zero), total) : zero;
     const F shot = tails ? total - read : (scale.q > 0 ? minLanes(maxLanes(v.shot, zero), total) : zero);
     const I drawn = (shot > 0.0f) & (shot <= scale.maxShot);
-    const F shotDrawn = drawn ? shot : zero;
+    const F shotDrawn = selectLanes(drawn, shot, zero);
     const F z = (total - read) - shotDrawn;
     storeScaledAsDoubles(shotDrawn, scale.invQ2, means + c);
     std::memcpy(zVar + c, &z, sizeof(z));

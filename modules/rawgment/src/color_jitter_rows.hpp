@@ -79,13 +79,13 @@ template <int W> struct PixelLanes<W, ushort>
     {
         typename Lanes<W>::U16 v;
         std::memcpy(&v, p, sizeof(v));
-        return __builtin_convertvector(v, F);
+        return convertLanes<F>(v);
     }
     RAWGMENT_KERNEL void store(ushort* p, F out, F white)
     {
         out = roundHalfToEven(minLanes(maxLanes(out, F{}), white));
-        const typename Lanes<W>::U16 v = __builtin_convertvector(
-            __builtin_convertvector(out, typename Lanes<W>::I), typename Lanes<W>::U16);
+        const typename Lanes<W>::U16 v =
+            convertLanes<typename Lanes<W>::U16>(convertLanes<typename Lanes<W>::I>(out));
         std::memcpy(p, &v, sizeof(v));
     }
 };

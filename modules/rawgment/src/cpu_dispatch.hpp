@@ -1,7 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Run-time dispatch of the hot loops to the instruction sets of opencv2/rawgment/cpu.hpp.
 //
-// A hot loop is written once, as an always-inline kernel on GCC vector extensions (or plain loops), and
+// A hot loop is written once, as an always-inline kernel on the vector types of lanes.hpp (GCC's vector
+// extensions, or arrays of lanes on the portable path) or plain loops, and
 // RAWGMENT_DISPATCHED compiles that one source four times, for x86-64, x86-64-v2, -v3 and -v4, and
 // defines the entry point that calls the version of the active CpuPath. The vectors are written at one
 // width in every version (the compiler splits them into registers), or, for kernels that compare and
@@ -12,8 +13,11 @@
 #ifndef OPENCV_RAWGMENT_SRC_CPU_DISPATCH_HPP
 #define OPENCV_RAWGMENT_SRC_CPU_DISPATCH_HPP
 
+#include "lanes.hpp"
+
 #include <opencv2/rawgment/cpu.hpp>
 
+#include <cmath>
 #include <cstdint>
 
 namespace cv {
@@ -27,10 +31,10 @@ CpuPath dispatchPath();
 //! The vectors of a kernel of width W (RAWGMENT_DISPATCHED_BY_WIDTH): W floats, int32, uint32, uint16.
 template <int W> struct Lanes
 {
-    typedef float F __attribute__((vector_size(4 * W)));
-    typedef int32_t I __attribute__((vector_size(4 * W)));
-    typedef uint32_t U __attribute__((vector_size(4 * W)));
-    typedef uint16_t U16 __attribute__((vector_size(2 * W)));
+    typedef RAWGMENT_VECTOR(float, 4 * W) F;
+    typedef RAWGMENT_VECTOR(int32_t, 4 * W) I;
+    typedef RAWGMENT_VECTOR(uint32_t, 4 * W) U;
+    typedef RAWGMENT_VECTOR(uint16_t, 2 * W) U16;
 };
 
 //! The widest kernel width, AVX-512's 16 floats. A row buffer of the module sized by wholeBlocks() lets
@@ -43,27 +47,22 @@ inline size_t wholeBlocks(int n)
 }
 
 //! Lane-wise std::max and std::min (the same operand chosen when one is NaN).
-template <typename V> inline __attribute__((always_inline)) V maxLanes(V a, V b)
+template <typename V> RAWGMENT_ALWAYS_INLINE V maxLanes(V a, V b)
 {
-    return a < b ? b : a;
+    return selectLanes(a < b, b, a);
 }
-template <typename V> inline __attribute__((always_inline)) V minLanes(V a, V b)
+template <typename V> RAWGMENT_ALWAYS_INLINE V minLanes(V a, V b)
 {
-    return b < a ? b : a;
+    return selectLanes(b < a, b, a);
 }
 
 //! IEEE square roots lane by lane, of float or double lanes: exact to the rounding on every path,
 //! compiled to (v)sqrtps or (v)sqrtpd.
-template <typename V> inline __attribute__((always_inline)) V sqrtLanes(V v)
+template <typename V> RAWGMENT_ALWAYS_INLINE V sqrtLanes(V v)
 {
-    constexpr bool isDouble = sizeof(v[0]) == sizeof(double);
     V r;
-    for (int i = 0; i < static_cast<int>(sizeof(V) / sizeof(v[0])); ++i) {
-        if constexpr (isDouble)
-            r[i] = __builtin_sqrt(v[i]);
-        else
-            r[i] = __builtin_sqrtf(v[i]);
-    }
+    for (int i = 0; i < static_cast<int>(sizeof(V) / sizeof(v[0])); ++i)
+        r[i] = std::sqrt(v[i]);
     return r;
 }
 
@@ -75,7 +74,7 @@ template <typename V> inline __attribute__((always_inline)) V sqrtLanes(V v)
  * lambda's body: it is a function of its own, compiled for the baseline, which on AVX2 then passes 256-bit
  * vectors to the AVX helpers by another ABI (GCC's -Wpsabi, which the build silences). Such a lambda once
  * gave wrong Poisson counts on the AVX2 path only; a kernel's helper is a RAWGMENT_KERNEL function. */
-#define RAWGMENT_KERNEL static inline __attribute__((always_inline))
+#define RAWGMENT_KERNEL static RAWGMENT_ALWAYS_INLINE
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(RAWGMENT_NO_MULTIVERSIONING)
 #define RAWGMENT_HAVE_CPU_PATHS 1
@@ -178,8 +177,7 @@ __attribute__((target("arch=x86-64-v3"))) inline __m256 differenceAsFloats8(cons
  * kernel vector (8 doubles, two AVX registers) through the stack and general registers: the POISSON
  * jitter's split and noise passes took 3.5 ms more of its 77 on host H2's AVX2 path. So the x86 paths
  * convert half registers with cvtps2pd. */
-template <typename F>
-inline __attribute__((always_inline)) void storeScaledAsDoubles(F v, double scale, double* out)
+template <typename F> RAWGMENT_ALWAYS_INLINE void storeScaledAsDoubles(F v, double scale, double* out)
 {
     constexpr int lanes = static_cast<int>(sizeof(F) / sizeof(v[0]));
 #if RAWGMENT_HAVE_CPU_PATHS
@@ -201,8 +199,7 @@ inline __attribute__((always_inline)) void storeScaledAsDoubles(F v, double scal
 /** The W floats float(a[i] - b[i]): the difference rounded to double, then to float (to nearest), as
  * __builtin_convertvector of a double vector gives; with cvtpd2ps on half registers on x86, for the reason
  * storeScaledAsDoubles() gives. */
-template <typename F>
-inline __attribute__((always_inline)) F differenceAsFloats(const double* a, const double* b)
+template <typename F> RAWGMENT_ALWAYS_INLINE F differenceAsFloats(const double* a, const double* b)
 {
     constexpr int lanes = static_cast<int>(sizeof(F) / sizeof(float));
 #if RAWGMENT_HAVE_CPU_PATHS
@@ -223,7 +220,7 @@ inline __attribute__((always_inline)) F differenceAsFloats(const double* a, cons
 /** Bit i set where lane i of a comparison mask (lanes of 0 or -1, 4 or 8 bytes each) is set: a kernel
  * tests "any lane" or walks the set lanes with this. One movemask on x86 (reading a mask lane by lane
  * costs two instructions per lane, which showed in the samplers' profiles); a loop elsewhere. */
-template <typename M> inline __attribute__((always_inline)) int maskBits(M mask)
+template <typename M> RAWGMENT_ALWAYS_INLINE int maskBits(M mask)
 {
     constexpr int lanes = static_cast<int>(sizeof(M) / sizeof(mask[0]));
 #if RAWGMENT_HAVE_CPU_PATHS

@@ -103,7 +103,7 @@ template <int W> RAWGMENT_KERNEL typename Lanes<W>::F logPositiveLanes(typename 
     const F m = (F)mantissaBits;
     const I small = m < 0.70710678f; // -1 where true
     e += small;
-    const F f = (small ? m + m : m) - 1.0f;
+    const F f = selectLanes(small, m + m, m) - 1.0f;
     const F z = f * f;
     const F z2 = z * z;
     const F p01 = f * -2.4999993993e-1f + 3.3333331174e-1f;
@@ -113,7 +113,7 @@ template <int W> RAWGMENT_KERNEL typename Lanes<W>::F logPositiveLanes(typename 
     const F p8 = z2 * z2 * 7.0376836292e-2f;
     F y = (p01 + z * p23) + z2 * (p45 + z * p67) + p8;
     y = y * f * z - 0.5f * z + f;
-    return y + __builtin_convertvector(e, F) * 0.693147180559945f;
+    return y + convertLanes<F>(e) * 0.693147180559945f;
 }
 
 /* W Box-Muller pairs from W words for the radius (w1) and W for the angle (w2). u1 in (0, 1] from 24
@@ -131,11 +131,10 @@ RAWGMENT_KERNEL void boxMullerLanes(const uint32_t* radiusWords, const uint32_t*
     U w1, w2;
     std::memcpy(&w1, radiusWords, sizeof(w1));
     std::memcpy(&w2, angleWords, sizeof(w2));
-    const F u1 = (__builtin_convertvector((I)(w1 >> 8), F) + 1.0f) * (1.0f / 16777216.0f);
+    const F u1 = (convertLanes<F>((I)(w1 >> 8)) + 1.0f) * (1.0f / 16777216.0f);
     const F radius = sqrtLanes(-2.0f * logPositiveLanes<W>(u1));
     const I q = (I)(w2 >> 30);
-    const F phi =
-        (__builtin_convertvector((I)((w2 >> 8) & 0x3fffff), F) * (1.0f / 4194304.0f) - 0.5f) * 1.5707963268f;
+    const F phi = (convertLanes<F>((I)((w2 >> 8) & 0x3fffff)) * (1.0f / 4194304.0f) - 0.5f) * 1.5707963268f;
     const F p2 = phi * phi;
     const F s = phi + phi * p2 * (-1.6666654611e-1f + p2 * (8.3321608736e-3f + p2 * -1.9515295891e-4f));
     const F c =
@@ -147,8 +146,8 @@ RAWGMENT_KERNEL void boxMullerLanes(const uint32_t* radiusWords, const uint32_t*
     const I signBit = I{} + std::numeric_limits<int32_t>::min();
     const I cosSign = ((q == 1) | (q == 2)) & signBit;
     const I sinSign = (q >= 2) & signBit;
-    const F cosRot = (F)((I)(odd ? s : c) ^ cosSign);
-    const F sinRot = (F)((I)(odd ? c : s) ^ sinSign);
+    const F cosRot = (F)((I)selectLanes(odd, s, c) ^ cosSign);
+    const F sinRot = (F)((I)selectLanes(odd, c, s) ^ sinSign);
     const F zc = radius * cosRot, zs = radius * sinRot;
     std::memcpy(cosOut, &zc, sizeof(zc));
     std::memcpy(sinOut, &zs, sizeof(zs));
@@ -192,7 +191,7 @@ template <int W> RAWGMENT_KERNEL typename Lanes<W>::F expLanes(typename Lanes<W>
             r +
         5.0000001201e-1f;
     const F er = p * r2 + r + 1.0f;
-    const I scale = (__builtin_convertvector(n, I) + 127) << 23;
+    const I scale = (convertLanes<I>(n) + 127) << 23;
     return er * (F)scale;
 }
 
@@ -218,7 +217,7 @@ RAWGMENT_KERNEL typename Lanes<W>::F tukeyTermLanes(typename Lanes<W>::F l, type
     if (!maskBits(large))
         return series;
     const F direct = (expLanes<W>(x) - 1.0f) / safeLambda;
-    return large ? direct : series;
+    return selectLanes(large, direct, series);
 }
 
 /* W unit-variance Tukey-lambda values from W pairs of words: the sign from the top bit of the first, u in
@@ -231,13 +230,13 @@ RAWGMENT_KERNEL typename Lanes<W>::F tukeyValuesLanes(typename Lanes<W>::U w1, t
 {
     typedef typename Lanes<W>::F F;
     typedef typename Lanes<W>::I I;
-    const F hi = __builtin_convertvector((I)(w1 & 0x7fffffffu), F);
-    const F lo = (__builtin_convertvector((I)(w2 >> 8), F) + 0.5f) * (1.0f / 16777216.0f);
+    const F hi = convertLanes<F>((I)(w1 & 0x7fffffffu));
+    const F lo = (convertLanes<F>((I)(w2 >> 8)) + 0.5f) * (1.0f / 16777216.0f);
     const F u = (hi + lo) * (1.0f / 4294967296.0f);
     const F q = tukeyTermLanes<W>(logPositiveLanes<W>(u), lambda, safeLambda) -
                 tukeyTermLanes<W>(logPositiveLanes<W>(1.0f - u), lambda, safeLambda);
     const I negative = (I)(w1 >> 31) != 0;
-    return invSd * (negative ? -q : q);
+    return invSd * selectLanes(negative, -q, q);
 }
 
 /* Lane i of c0..c3 from the four floats at table + offset[i]: 16-byte loads transposed in registers (a
@@ -315,16 +314,15 @@ RAWGMENT_KERNEL typename Lanes<W>::F tukeyTableLanes(typename Lanes<W>::U w, con
     static_assert(TukeyQuantileTable::kCellsPerOctave == 1 << (23 - kPositionBits), "cells per octave");
     // m 2^-32 has the exponent of m less 32: the cell of u from the bits of m as a float.
     constexpr int kFirstCell = (TukeyQuantileTable::kLowestExponent + 32) << (23 - kPositionBits);
-    const F m = __builtin_convertvector((I)(w & 0x7fffffffu), F);
+    const F m = convertLanes<F>((I)(w & 0x7fffffffu));
     const I bits = (I)m;
     const I cell = detail::maxLanes((bits >> kPositionBits) - kFirstCell, I{});
-    const F x =
-        __builtin_convertvector(bits & ((1 << kPositionBits) - 1), F) * (1.0f / (1 << kPositionBits)) - 0.5f;
+    const F x = convertLanes<F>(bits & ((1 << kPositionBits) - 1)) * (1.0f / (1 << kPositionBits)) - 0.5f;
     F c0, c1, c2, c3;
     loadCells<W>(table, cell * 4 + siteOffset, c0, c1, c2, c3);
     const F q = c0 + x * (c1 + x * (c2 + x * c3));
     const I negative = (I)(w >> 31) != 0;
-    return negative ? -q : q;
+    return selectLanes(negative, -q, q);
 }
 
 /* n unit-variance Tukey-lambda values from the stream, one Philox word each (value h of a chunk of 32 takes
@@ -368,7 +366,7 @@ RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, const T
             std::memcpy(dst + h, &v, sizeof(v));
             if (int coarse = maskBits((w1 & 0x7fffffffu) < fine))
                 for (; coarse; coarse &= coarse - 1) {
-                    const int lane = __builtin_ctz(static_cast<unsigned>(coarse));
+                    const int lane = lowestSetBit(static_cast<unsigned>(coarse));
                     if (base + h + lane < n) {
                         refine.push_back(base + h + lane);
                         refineWords.push_back(stepWords[h + lane]);
@@ -410,7 +408,7 @@ RAWGMENT_KERNEL void fillTukeyUnitKernel(uint64_t seed, uint64_t stream, const T
             std::memcpy(&w2, seconds + h, sizeof(w2));
             std::memcpy(&l, lambdas + h, sizeof(l));
             std::memcpy(&sd, invSds + h, sizeof(sd));
-            const F v = tukeyValuesLanes<W>(w1, w2, l, sd, l == 0.0f ? F{} + 1.0f : l);
+            const F v = tukeyValuesLanes<W>(w1, w2, l, sd, selectLanes(l == 0.0f, F{} + 1.0f, l));
             std::memcpy(values + h, &v, sizeof(v));
         }
         for (int i = 0; i < live; ++i)

@@ -48,12 +48,12 @@ inline std::array<uint32_t, 4> philox4x32(std::array<uint32_t, 4> c, std::array<
 // Eight Philox4x32-10 blocks side by side, one per 64-bit lane, each 32-bit word of the state in the
 // low half of a lane, on GCC vector extensions: the portable version, used where there are no CPU paths
 // (cpu_dispatch.hpp); x86 uses the intrinsic versions below, which compute the same words.
-typedef uint64_t U64x8 __attribute__((vector_size(64)));
+typedef RAWGMENT_VECTOR(uint64_t, 64) U64x8;
 
 //! Ten rounds on eight blocks whose counters are in c0..c3 (one block per lane, words in the low
 //! halves), then word j of block b to words[8 j + b].
-inline __attribute__((always_inline)) void philox8Rounds(U64x8 c0, U64x8 c1, U64x8 c2, U64x8 c3,
-                                                         const std::array<uint32_t, 2>& key, uint32_t* words)
+RAWGMENT_ALWAYS_INLINE void philox8Rounds(U64x8 c0, U64x8 c1, U64x8 c2, U64x8 c3,
+                                          const std::array<uint32_t, 2>& key, uint32_t* words)
 {
     const U64x8 low = {0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu,
                        0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu};
@@ -69,9 +69,9 @@ inline __attribute__((always_inline)) void philox8Rounds(U64x8 c0, U64x8 c1, U64
         k1 = (k1 + kPhiloxW1) & 0xffffffffu;
     }
     // Narrowed as whole vectors (one vpmovqd, or shuffles), not lane by lane.
-    typedef uint32_t U32x8 __attribute__((vector_size(32)));
-    const U32x8 w0 = __builtin_convertvector(c0, U32x8), w1 = __builtin_convertvector(c1, U32x8),
-                w2 = __builtin_convertvector(c2, U32x8), w3 = __builtin_convertvector(c3, U32x8);
+    typedef RAWGMENT_VECTOR(uint32_t, 32) U32x8;
+    const U32x8 w0 = convertLanes<U32x8>(c0), w1 = convertLanes<U32x8>(c1), w2 = convertLanes<U32x8>(c2),
+                w3 = convertLanes<U32x8>(c3);
     std::memcpy(words, &w0, sizeof(w0));
     std::memcpy(words + 8, &w1, sizeof(w1));
     std::memcpy(words + 16, &w2, sizeof(w2));
@@ -80,8 +80,8 @@ inline __attribute__((always_inline)) void philox8Rounds(U64x8 c0, U64x8 c1, U64
 
 /** The blocks (firstBlock + b, 0, stream) for b in 0..7, as philox4x32() computes them one by one:
  * word j of block b goes to words[8 j + b]. */
-inline __attribute__((always_inline)) void philox8Blocks(uint32_t firstBlock, uint64_t stream,
-                                                         const std::array<uint32_t, 2>& key, uint32_t* words)
+RAWGMENT_ALWAYS_INLINE void philox8Blocks(uint32_t firstBlock, uint64_t stream,
+                                          const std::array<uint32_t, 2>& key, uint32_t* words)
 {
     const U64x8 zero = {}, lanes = {0, 1, 2, 3, 4, 5, 6, 7};
     philox8Rounds((lanes + firstBlock) & 0xffffffffu, zero, zero + static_cast<uint32_t>(stream),
@@ -90,8 +90,8 @@ inline __attribute__((always_inline)) void philox8Blocks(uint32_t firstBlock, ui
 
 /** The blocks (block, 0, streams[b]) for b in 0..7: block `block` of eight streams, one from each, in the
  * layout of philox8Blocks(). */
-inline __attribute__((always_inline)) void philox8Streams(uint32_t block, const uint64_t* streams,
-                                                          const std::array<uint32_t, 2>& key, uint32_t* words)
+RAWGMENT_ALWAYS_INLINE void philox8Streams(uint32_t block, const uint64_t* streams,
+                                           const std::array<uint32_t, 2>& key, uint32_t* words)
 {
     U64x8 s;
     std::memcpy(&s, streams, sizeof(s));
@@ -112,8 +112,8 @@ inline __attribute__((always_inline)) void philox8Streams(uint32_t block, const 
 constexpr int kSwapHalves = _MM_SHUFFLE(2, 3, 0, 1);
 constexpr _MM_PERM_ENUM kSwapHalves512 = _MM_PERM_CDAB;
 //! One Philox round on two blocks in four registers (state words in the low halves of 64-bit lanes).
-inline __attribute__((always_inline)) void philoxRoundSse2(__m128i& c0, __m128i& c1, __m128i& c2, __m128i& c3,
-                                                           __m128i m0, __m128i m1, __m128i kv0, __m128i kv1)
+RAWGMENT_ALWAYS_INLINE void philoxRoundSse2(__m128i& c0, __m128i& c1, __m128i& c2, __m128i& c3, __m128i m0,
+                                            __m128i m1, __m128i kv0, __m128i kv1)
 {
     const __m128i p0 = _mm_mul_epu32(c0, m0), p1 = _mm_mul_epu32(c2, m1);
     c0 = _mm_xor_si128(_mm_shuffle_epi32(p1, kSwapHalves), _mm_xor_si128(c1, kv0));
@@ -123,17 +123,17 @@ inline __attribute__((always_inline)) void philoxRoundSse2(__m128i& c0, __m128i&
 }
 
 //! The low halves of the two lanes of `pair` (two blocks of one state word), side by side at `to`.
-inline __attribute__((always_inline)) void storeWordPairSse2(__m128i pair, uint32_t* to)
+RAWGMENT_ALWAYS_INLINE void storeWordPairSse2(__m128i pair, uint32_t* to)
 {
     _mm_storel_epi64(reinterpret_cast<__m128i*>(to), _mm_shuffle_epi32(pair, _MM_SHUFFLE(3, 1, 2, 0)));
 }
 
 /* Ten rounds on eight blocks, two per register (blocks 2p and 2p + 1 in the registers p*), then word j of
  * block b to words[8 j + b]. Named registers, not arrays, as philox8RoundsAvx2(). */
-inline __attribute__((always_inline)) void
-philox8RoundsSse2(__m128i a0, __m128i a1, __m128i a2, __m128i a3, __m128i b0, __m128i b1, __m128i b2,
-                  __m128i b3, __m128i c0, __m128i c1, __m128i c2, __m128i c3, __m128i d0, __m128i d1,
-                  __m128i d2, __m128i d3, const std::array<uint32_t, 2>& key, uint32_t* words)
+RAWGMENT_ALWAYS_INLINE void philox8RoundsSse2(__m128i a0, __m128i a1, __m128i a2, __m128i a3, __m128i b0,
+                                              __m128i b1, __m128i b2, __m128i b3, __m128i c0, __m128i c1,
+                                              __m128i c2, __m128i c3, __m128i d0, __m128i d1, __m128i d2,
+                                              __m128i d3, const std::array<uint32_t, 2>& key, uint32_t* words)
 {
     const __m128i m0 = _mm_set1_epi64x(kPhiloxM0), m1 = _mm_set1_epi64x(kPhiloxM1);
     uint32_t k0 = key[0], k1 = key[1];

@@ -75,10 +75,10 @@ namespace {
  * vectors would compare and select lane by lane in scalar code, cpu_dispatch.hpp). */
 template <int W> struct DoubleLanes
 {
-    typedef double D __attribute__((vector_size(4 * W)));
-    typedef int64_t L __attribute__((vector_size(4 * W)));
-    typedef uint64_t UL __attribute__((vector_size(4 * W)));
-    typedef uint32_t U32 __attribute__((vector_size(2 * W))); // a 32-bit word per double lane
+    typedef RAWGMENT_VECTOR(double, 4 * W) D;
+    typedef RAWGMENT_VECTOR(int64_t, 4 * W) L;
+    typedef RAWGMENT_VECTOR(uint64_t, 4 * W) UL;
+    typedef RAWGMENT_VECTOR(uint32_t, 2 * W) U32; // a 32-bit word per double lane
     static constexpr int kCount = W / 2;
 };
 
@@ -110,7 +110,7 @@ template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D logLanesD(typename D
     L e = (L)(bits >> 52) - 1023;
     D m = (D)((bits & 0x000fffffffffffffull) | 0x3ff0000000000000ull); // in [1, 2)
     const L big = m > 1.4142135623730951;
-    m = big ? m * 0.5 : m;
+    m = selectLanes(big, m * 0.5, m);
     e -= big;
     const D s = (m - 1.0) / (m + 1.0), s2 = s * s, s4 = s2 * s2, s8 = s4 * s4;
     // 1 + s2/3 + ... + s2^9/19 by Estrin's scheme (a short dependency chain, as logPositiveLanes()).
@@ -145,7 +145,7 @@ RAWGMENT_KERNEL typename DoubleLanes<W>::D floorNonNegativeLanesD(typename Doubl
 {
     typedef typename DoubleLanes<W>::D D;
     const D r = (x + kTwo52) - kTwo52;
-    return r > x ? r - 1.0 : r;
+    return selectLanes(r > x, r - 1.0, r);
 }
 
 //! Uniforms of 32 bits in (0, 1): (w + 1/2) 2^-32, exact, through 64-bit lanes (no vector uint32 -> double
@@ -202,7 +202,7 @@ RAWGMENT_KERNEL void normalPairsLanesD(const uint32_t* radiusWords, const uint32
     typename DoubleLanes<W>::U32 a, b;
     std::memcpy(&a, radiusWords, sizeof(a));
     std::memcpy(&b, angleWords, sizeof(b));
-    const UL w1 = __builtin_convertvector(a, UL), w2 = __builtin_convertvector(b, UL);
+    const UL w1 = convertLanes<UL>(a), w2 = convertLanes<UL>(b);
     const D radius = sqrtLanes(-2.0 * logLanesD<W>(uniform32LanesD<W>(w1)));
     const D fraction =
         (((D)((w2 & 0x3fffffffull) | 0x4330000000000000ull) - kTwo52) + 0.5) * (1.0 / 1073741824.0);
@@ -219,9 +219,9 @@ RAWGMENT_KERNEL void normalPairsLanesD(const uint32_t* radiusWords, const uint32
     // Rotate (cos, sin) by q quarter turns, as boxMullerLanes() does in float.
     const L q = (L)(w2 >> 30);
     const L odd = (q & 1) != 0;
-    D c = odd ? sinPhi : cosPhi, s = odd ? cosPhi : sinPhi;
-    c = ((q == 1) | (q == 2)) ? -c : c;
-    s = q >= 2 ? -s : s;
+    D c = selectLanes(odd, sinPhi, cosPhi), s = selectLanes(odd, cosPhi, sinPhi);
+    c = selectLanes((q == 1) | (q == 2), -c, c);
+    s = selectLanes(q >= 2, -s, s);
     cosNormal = radius * c;
     sinNormal = radius * s;
 }
@@ -260,8 +260,8 @@ RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint3
         std::memcpy(&m, chunkMeans + g * kLanes, sizeof(m));
         std::memcpy(&a, ownWords + g * kLanes, sizeof(a));
         small[g] = m < kInversionBelow;
-        lambda[g] = small[g] ? m : D{};
-        u[g] = uniform32LanesD<W>(__builtin_convertvector(a, UL));
+        lambda[g] = selectLanes(small[g], m, D{});
+        u[g] = uniform32LanesD<W>(convertLanes<UL>(a));
         p[g] = expLanesD<W>(-lambda[g]);
         cdf[g] = p[g];
         k[g] = D{};
@@ -279,7 +279,7 @@ RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint3
             any |= active;
             p[g] = p[g] * (lambda[g] * invNext);
             cdf[g] = cdf[g] + p[g];
-            k[g] = active ? D{} + next : k[g];
+            k[g] = selectLanes(active, D{} + next, k[g]);
         }
         if (!maskBits(any))
             break;
@@ -287,7 +287,7 @@ RAWGMENT_KERNEL void poissonInversionLanes(const double* chunkMeans, const uint3
     for (int g = 0; g < G; ++g) {
         D counts;
         std::memcpy(&counts, chunkCounts + g * kLanes, sizeof(counts));
-        counts = small[g] ? k[g] : counts;
+        counts = selectLanes(small[g], k[g], counts);
         std::memcpy(chunkCounts + g * kLanes, &counts, sizeof(counts));
     }
 }
@@ -311,15 +311,15 @@ template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D log1pMinusLanesD(typ
     typedef typename DoubleLanes<W>::D D;
     typedef typename DoubleLanes<W>::L L;
     const L small = (v < 0.25) & (v > -0.25);
-    const D vs = small ? v : D{};
+    const D vs = selectLanes(small, v, D{});
     const D s = vs / (2.0 + vs), s2 = s * s, s4 = s2 * s2, s8 = s4 * s4;
     const D p01 = 1.0 / 3 + s2 * (1.0 / 5), p23 = 1.0 / 7 + s2 * (1.0 / 9), p45 = 1.0 / 11 + s2 * (1.0 / 13),
             p67 = 1.0 / 15 + s2 * (1.0 / 17), p89 = 1.0 / 19 + s2 * (1.0 / 21);
     const D series = -s * vs + 2.0 * s * s2 * (((p01 + s4 * p23) + s8 * (p45 + s4 * p67)) + s8 * s8 * p89);
     if (maskBits(~small) == 0)
         return series;
-    const D direct = logLanesD<W>(small ? D{} + 1.0 : 1.0 + v) - v;
-    return small ? series : direct;
+    const D direct = logLanesD<W>(selectLanes(small, D{} + 1.0, 1.0 + v)) - v;
+    return selectLanes(small, series, direct);
 }
 
 /* The log of the Poisson probability of k >= 0 at mean mu in lanes, to about 1e-13 + 1e-16 |mu - k| absolute
@@ -332,7 +332,7 @@ RAWGMENT_KERNEL typename DoubleLanes<W>::D logPoissonProbabilityLanesD(typename 
     typedef typename DoubleLanes<W>::D D;
     typedef typename DoubleLanes<W>::L L;
     const L zero = k < 1.0;
-    const D kk = zero ? D{} + 1.0 : k;
+    const D kk = selectLanes(zero, D{} + 1.0, k);
     const D inv = 1.0 / kk, inv2 = inv * inv;
     D remainder = inv * (1.0 / 12 - inv2 * (1.0 / 360 - inv2 * (1.0 / 1260)));
     if (maskBits(kk < 32.0))
@@ -341,14 +341,14 @@ RAWGMENT_KERNEL typename DoubleLanes<W>::D logPoissonProbabilityLanesD(typename 
                 remainder[i] = stirlingRemainder(kk[i]);
     const D v = (mu - kk) * inv;
     const D lp = kk * log1pMinusLanesD<W>(v) - 0.5 * logLanesD<W>(2.0 * CV_PI * kk) - remainder;
-    return zero ? -mu : lp;
+    return selectLanes(zero, -mu, lp);
 }
 
 //! e^x for x <= 40 in lanes, with x below -700 taken as -700 (e^-700 is 1e-304: every comparison PD makes
 //! with it has the same outcome as with 0).
 template <int W> RAWGMENT_KERNEL typename DoubleLanes<W>::D expClampedLanesD(typename DoubleLanes<W>::D x)
 {
-    return expLanesD<W>(x < -700.0 ? typename DoubleLanes<W>::D{} - 700.0 : x);
+    return expLanesD<W>(selectLanes(x < -700.0, typename DoubleLanes<W>::D{} - 700.0, x));
 }
 
 //! CounterRng::uniform() from its two words in lanes: (first << 21) ^ (second >> 11), 53 bits, plus 1/2,
@@ -438,7 +438,7 @@ RAWGMENT_KERNEL void poissonPdRestLanes(uint64_t key, const double* means, const
             std::memcpy(&g, g8 + gr * kLanes, sizeof(D));
             std::memcpy(&u, u8 + gr * kLanes, sizeof(D));
             const L quotient = g >= 0.0;
-            const D k = floorNonNegativeLanesD<W>(quotient ? g : D{});
+            const D k = floorNonNegativeLanesD<W>(selectLanes(quotient, g, D{}));
             pdModifiedNormalLanes<W>(hat[gr], k, fx, fy);
             const L accept =
                 quotient & (fy - u * fy <= expClampedLanesD<W>(logPoissonProbabilityLanesD<W>(k, mu) - fx));
@@ -458,23 +458,21 @@ RAWGMENT_KERNEL void poissonPdRestLanes(uint64_t key, const double* means, const
                 std::memcpy(&a2, words + 16 + gr * kLanes, sizeof(U32));
                 std::memcpy(&a3, words + 24 + gr * kLanes, sizeof(U32));
                 const PdHatLanes<W>& h = hat[gr];
-                const D e = -logLanesD<W>(
-                    uniform53LanesD<W>(__builtin_convertvector(a0, UL), __builtin_convertvector(a1, UL)));
-                const D signedUniform = 2.0 * uniform53LanesD<W>(__builtin_convertvector(a2, UL),
-                                                                 __builtin_convertvector(a3, UL)) -
-                                        1.0;
-                const D t = 1.8 + (signedUniform < 0.0 ? -e : e);
+                const D e = -logLanesD<W>(uniform53LanesD<W>(convertLanes<UL>(a0), convertLanes<UL>(a1)));
+                const D signedUniform =
+                    2.0 * uniform53LanesD<W>(convertLanes<UL>(a2), convertLanes<UL>(a3)) - 1.0;
+                const D t = 1.8 + selectLanes(signedUniform < 0.0, -e, e);
                 const L valid = t > -0.6744;
-                const D k = floorNonNegativeLanesD<W>(valid ? h.mu + h.s * t : D{});
+                const D k = floorNonNegativeLanesD<W>(selectLanes(valid, h.mu + h.s * t, D{}));
                 D fx, fy;
                 pdModifiedNormalLanes<W>(h, k, fx, fy);
                 const D lp = logPoissonProbabilityLanesD<W>(k, h.mu);
-                const D absU = signedUniform < 0.0 ? -signedUniform : signedUniform;
+                const D absU = selectLanes(signedUniform < 0.0, -signedUniform, signedUniform);
                 const L accept =
                     valid & (h.c * absU <= expClampedLanesD<W>(lp + e) - fy * expClampedLanesD<W>(fx + e));
                 const int taken = maskBits(accept) & groupBits;
                 for (int bits = taken; bits; bits &= bits - 1) {
-                    const int i = __builtin_ctz(static_cast<unsigned>(bits));
+                    const int i = lowestSetBit(static_cast<unsigned>(bits));
                     k8[gr * kLanes + i] = k[i];
                 }
                 pending &= ~(taken << (gr * kLanes));
@@ -522,18 +520,18 @@ RAWGMENT_KERNEL void pdFastStepsLanes(const uint32_t* words, const double* chunk
         std::memcpy(&t, normals + g * kLanes, sizeof(t));
         std::memcpy(&w, words + kChunk + g * kLanes, sizeof(w));
         const L pd = (m >= kInversionBelow) & (m <= kMaxLaneMean);
-        const D mu = pd ? m : D{} + kInversionBelow; // other lanes compute on a valid mean, unused
+        const D mu = selectLanes(pd, m, D{} + kInversionBelow); // other lanes compute on a valid mean, unused
         const D gv = mu + sqrtLanes(mu) * t;
-        const D k = floorNonNegativeLanesD<W>(gv > 0.0 ? gv : D{});
-        const D u = uniform32LanesD<W>(__builtin_convertvector(w, UL));
+        const D k = floorNonNegativeLanesD<W>(selectLanes(gv > 0.0, gv, D{}));
+        const D u = uniform32LanesD<W>(convertLanes<UL>(w));
         const D dif = mu - k;
         const L taken = (gv >= 0.0) & ((k >= floorNonNegativeLanesD<W>(mu - 1.1484)) |
                                        (6.0 * mu * mu * u >= dif * dif * dif));
-        const D kept = pd ? k : D{}; // other lanes: 0, or their inversion's count later
+        const D kept = selectLanes(pd, k, D{}); // other lanes: 0, or their inversion's count later
         std::memcpy(chunkCounts + g * kLanes, &kept, sizeof(kept));
         // The rest (1-5%) rarely appear, so a branch costs less than appending every lane.
         for (int open = maskBits(~taken) & bits; open; open &= open - 1) {
-            const int i = __builtin_ctz(static_cast<unsigned>(open));
+            const int i = lowestSetBit(static_cast<unsigned>(open));
             rest[rests] = base + g * kLanes + i;
             restG[rests] = gv[i];
             restU[rests] = u[i];
@@ -595,7 +593,7 @@ RAWGMENT_KERNEL void fillPoissonKernel(uint64_t seed, uint64_t stream, const dou
             for (int g = 0; g < kGroups; ++g) { // as the loop below, in lanes (NaN and negatives give 0)
                 D m;
                 std::memcpy(&m, means + base + g * kLanes, sizeof(m));
-                m = m > 0.0 ? m : D{};
+                m = selectLanes(m > 0.0, m, D{});
                 std::memcpy(chunkMeans + g * kLanes, &m, sizeof(m));
             }
         } else {

@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Scenes (what one augmentation simulates, applied step by step) and the random scene policy.
 #include "augment_steps.hpp"
+#include "lanes.hpp"
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/seeds.hpp>
@@ -244,7 +245,7 @@ namespace {
 // lane-wise minima vectorise on every path; the row's tail, fewer than 16 values, goes one by one.
 template <typename T> void siteMinima(const Mat& src, const Range& rows, T lowest[4])
 {
-    typedef T Block __attribute__((vector_size(16 * sizeof(T))));
+    typedef RAWGMENT_VECTOR(T, 16 * sizeof(T)) Block;
     for (int r = rows.start; r < rows.end; ++r) {
         const T* p = src.ptr<T>(r);
         T* lo = lowest + 2 * (r & 1);
