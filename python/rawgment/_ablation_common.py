@@ -2,12 +2,22 @@
 Private: import them from rawgment.ablation."""
 import rawgment as _rg
 
-ARMS = ("NONE", "IGNORE_PRIOR", "ACCOUNT_PRIOR", "ORACLE", "NOISY")
-TRAINED_ARMS = ARMS[:4]
+#: The study's arms: the paper's three alignments, the oracle and the noisy floor, then the control arms that
+#: take the blind result apart (docs/ablation.md#the-control-arms). New arms go at the end: an arm's index
+#: seeds its bootstrap, so the earlier arms keep their numbers.
+ARMS = ("NONE", "IGNORE_PRIOR", "ACCOUNT_PRIOR", "ORACLE", "NOISY", "IGNORE_RESCALED", "ORACLE_PLUS_SHARE",
+        "ACCOUNT_POISSON")
+#: The control arms: IGNORE_PRIOR's inputs with their noise scaled to the target's variance, the oracle's
+#: captures with the prior share of extra Gaussian noise, ACCOUNT_PRIOR with exact Poisson shot draws.
+CONTROL_ARMS = ARMS[5:]
+TRAINED_ARMS = tuple(a for a in ARMS if a != "NOISY")
 #: The arms of a run without --arms. NONE (no noise added) trails every other arm by 2 to 6 dB in every
 #: condition (docs/results.md): it is left out so that 6 replicates of both kinds of network, the fewest
 #: whose sign-flip test can reach p <= 0.05, fit the study's 30 minutes on 2 cores.
 DEFAULT_ARMS = ("IGNORE_PRIOR", "ACCOUNT_PRIOR", "ORACLE", "NOISY")
+#: The training designs: one network per arm on every condition pooled (each crop draws its condition), or
+#: one network per arm and condition, trained on that condition's inputs alone.
+DESIGNS = ("pooled", "per-condition")
 # Roles of the derived seeds (the high 32 bits of deriveSeed's index under SEED_ABLATION).
 (_ROLE_TRAIN_SCENES, _ROLE_TEST_SCENES, _ROLE_TEST_CAPTURE, _ROLE_BATCH, _ROLE_SAMPLE, _ROLE_NETWORK,
  _ROLE_BOOTSTRAP) = range(7)

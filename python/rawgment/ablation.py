@@ -29,19 +29,22 @@ import numpy as np
 import torch
 
 import rawgment as _rg
-from rawgment._ablation_common import (ARMS, BLIND_STEP, DEFAULT_ARMS, TRAINED_ARMS, _ROLE_BATCH, _ROLE_NETWORK,
+from rawgment._ablation_common import (ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_ARMS, DESIGNS, TRAINED_ARMS, _ROLE_BATCH, _ROLE_NETWORK,
                                        _ROLE_SAMPLE, _ROLE_TEST_CAPTURE, _ROLE_TEST_SCENES, _ROLE_TRAIN_SCENES,
                                        _seed)
-from rawgment.ablation_report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, pairedSignificance,
-                                      summarize, writeNetworksOutputs, writeOutputs)
+from rawgment.ablation_report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, contrastRows, correctFamily,
+                                      holmAdjusted, pairedSignificance, seedsForFamily, seedsToConfirm, studyName,
+                                      summarize, writeOutputs, writeStudiesOutputs)
+from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS
 from rawgment.ablation_network import Denoiser, psnr, ssim
 from rawgment.ablation_scenes import mosaicOfScene, renderScene
 from rawgment.torch import packCfaPlanes
 
-__all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "defaultConditions",
+__all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "CONTROL_ARMS", "DESIGNS", "defaultConditions",
            "quickConditions", "renderScene", "mosaicOfScene", "Denoiser", "psnr", "ssim", "runAblation",
            "pairedSignificance", "summarize", "writeOutputs", "NETWORKS", "BLIND_STEP", "SIGNIFICANCE",
-           "writeNetworksOutputs", "main"]
+           "writeStudiesOutputs", "studyName", "holmAdjusted", "seedsForFamily", "seedsToConfirm", "contrastRows",
+           "correctFamily", "PREDICTIONS", "CONTROL_CONTRASTS", "main"]
 
 ALIGNMENTS = {"NONE": _rg.NoiseAlignment.NONE, "IGNORE_PRIOR": _rg.NoiseAlignment.IGNORE_PRIOR,
               "ACCOUNT_PRIOR": _rg.NoiseAlignment.ACCOUNT_PRIOR}
@@ -105,6 +108,9 @@ class AblationConfig:
     # Whether the network is told the noise level (a noise map per plane, as the default denoiser) or is
     # blind, seeing only the image, as the paper's detectors do (--blind).
     noiseMaps: bool = True
+    # The training design (DESIGNS): "pooled", one network per arm on all conditions, or "per-condition",
+    # one per arm and condition (--per-condition runs both).
+    design: str = "pooled"
     # The blind network's residual unit (Denoiser.blindScale): a design choice, so a run can vary it to
     # see whether a verdict depends on it.
     blindStep: float = BLIND_STEP
@@ -160,6 +166,8 @@ class AblationConfig:
             raise ValueError("patch (%d) is larger than trainSceneSize (%d)" % (self.patch, self.trainSceneSize))
         if self.baseGain <= 0 or not (self.learningRate > 0) or not (0 < self.blindStep <= 1):
             raise ValueError("baseGain and learningRate must be > 0, blindStep in (0, 1]")
+        if self.design not in DESIGNS:
+            raise ValueError("design must be one of %s, got %r" % (", ".join(DESIGNS), self.design))
         if self.shotSampling not in ("GAUSSIAN", "POISSON") or self.priorMean not in ("PIXEL_VALUE", "LOCAL_MEAN"):
             raise ValueError("shotSampling must be GAUSSIAN or POISSON and priorMean PIXEL_VALUE or LOCAL_MEAN, "
                              "got %r and %r" % (self.shotSampling, self.priorMean))
@@ -203,9 +211,8 @@ class _Study:
         return [mosaicOfScene(renderScene(np.random.default_rng(_seed(self.config.seed, role, i)), size, size),
                               self.params.pattern, self.level) for i in range(count)]
 
-    def cleanPlanes(self, mean, condition):
-        """The clean reference: the expected bright capture (blurred as the target is), black-subtracted,
-        normalised by white - black and packed."""
+    def brightSignal(self, mean, condition):
+        """The bright capture's expected signal (DN above black, float32), blurred as the target is."""
         signal = (mean * self.config.baseGain).astype(np.float32)
         if condition.blurLength > 0:
             fmt = self.format
@@ -213,7 +220,12 @@ class _Study:
             blurred, _ = _rg.motionBlur(withBlack, fmt, self.model, self.kernel(condition),
                                         _rg.NoiseOptions(_rg.NoiseAlignment.NONE), seed=0)
             signal = blurred - np.float32(fmt.blackLevel[0])
-        return packCfaPlanes(signal / np.float32(self.range), self.format)
+        return signal
+
+    def cleanPlanes(self, mean, condition):
+        """The clean reference: the expected bright capture (blurred as the target is), black-subtracted,
+        normalised by white - black and packed."""
+        return packCfaPlanes(self.brightSignal(mean, condition) / np.float32(self.range), self.format)
 
     def targetCapture(self, mean, condition, seed):
         """A capture simulated directly at the target exposure and gain (exact Poisson)."""
@@ -227,10 +239,11 @@ class _Study:
         """The bright capture of a training crop (its own noise): the input of every augmented arm."""
         return self.simulator(mean.shape[0]).capture(mean, self.config.baseGain, 1.0, seed)
 
-    def augmented(self, bright, condition, arm, seed):
-        """The bright capture darkened (and blurred) by the library with the arm's alignment."""
-        options = _rg.NoiseOptions(ALIGNMENTS[arm])
-        options.shotSampling = getattr(_rg.ShotNoiseSampling, self.config.shotSampling)
+    def augmented(self, bright, condition, alignment, seed, shotSampling=None):
+        """The bright capture darkened (and blurred) by the library with an alignment (a name of
+        ALIGNMENTS); the shot part drawn as the run's --shot-sampling, or as `shotSampling` if given."""
+        options = _rg.NoiseOptions(ALIGNMENTS[alignment])
+        options.shotSampling = getattr(_rg.ShotNoiseSampling, shotSampling or self.config.shotSampling)
         options.priorMean = getattr(_rg.PriorMeanEstimate, self.config.priorMean)
         stepSeeds = [_rg.deriveSeed(seed, _rg.SEED_ABLATION, step) for step in (1, 2)]
         if condition.blurLength > 0:
@@ -239,6 +252,37 @@ class _Study:
         change = _rg.ColorJitter.exposureChange(condition.photonRatio, condition.gainRatio)
         dark, _, _ = _rg.colorJitter(bright, self.format, self.model, change, options, seed=stepSeeds[1])
         return dark
+
+    def expectedTarget(self, mean, condition):
+        """The target capture's expected signal (DN above black, float64)."""
+        return self.brightSignal(mean, condition).astype(np.float64) * (condition.photonRatio * condition.gainRatio)
+
+    def priorAndTargetVariance(self, mean, condition):
+        """Per pixel, the model's variance (DN^2 at the target) of the darkened prior noise and of the
+        target capture: what IGNORE_PRIOR adds twice over and what a capture carries."""
+        g0, p, g = self.config.baseGain, condition.photonRatio, condition.gainRatio
+        expected = self.expectedTarget(mean, condition)
+        bright = self.model.variance(np.clip(expected / (p * g), 0.0, None), g0)
+        if condition.blurLength > 0:
+            bright = bright * float(np.sum(self.kernel(condition).astype(np.float64) ** 2))
+        return (p * g) ** 2 * bright, self.model.variance(np.clip(expected, 0.0, None), g0 * g), expected
+
+    def rescaledToTarget(self, raw, mean, condition):
+        """IGNORE_RESCALED: IGNORE_PRIOR's input with its noise (the input minus the expected target)
+        scaled pixel by pixel by sqrt(var_target / (var_prior + var_target)), so that it carries the
+        target's variance while keeping IGNORE_PRIOR's make-up (the prior's own noise plus the whole target
+        variance added from the noisy value)."""
+        prior, target, expected = self.priorAndTargetVariance(mean, condition)
+        black = float(self.format.blackLevel[0])
+        noise = raw.astype(np.float64) - black - expected
+        return (black + expected + noise * np.sqrt(target / (prior + target))).astype(np.float32)
+
+    def withPriorShare(self, raw, mean, condition, seed):
+        """ORACLE_PLUS_SHARE: a capture at the target plus Gaussian noise of the darkened prior's
+        variance, so that it carries what IGNORE_PRIOR carries in excess of the target, on real noise."""
+        prior, _, _ = self.priorAndTargetVariance(mean, condition)
+        draw = np.random.default_rng(_rg.deriveSeed(seed, _rg.SEED_ABLATION, 4)).standard_normal(raw.shape)
+        return (raw.astype(np.float64) + np.sqrt(prior) * draw).astype(np.float32)
 
     def inputPlanes(self, raw, condition):
         """A dark mosaic as the network sees it: black-subtracted, normalised, packed and brightened by
@@ -261,16 +305,28 @@ class _Study:
 
     def trainingInputs(self, mean, condition, arms, seed):
         """Each trained arm's input for one crop: the augmented arms share one bright capture (so they
-        differ only in their alignment), the oracle gets a capture simulated at the target."""
-        bright = self.brightCapture(mean, seed) if any(a in ALIGNMENTS for a in arms) else None
-        inputs = {}
-        for arm in arms:
-            if arm == "ORACLE":
-                raw = self.targetCapture(mean, condition, _rg.deriveSeed(seed, _rg.SEED_ABLATION, 3))
-            else:
-                raw = self.augmented(bright, condition, arm, seed)
-            inputs[arm] = self.inputPlanes(raw, condition)
-        return inputs
+        differ only in their alignment), the oracle gets a capture simulated at the target; the control
+        arms derive theirs from IGNORE_PRIOR's and the oracle's (the same draws: the control differs in
+        its one change alone)."""
+        raws = {}
+
+        def raw(arm):
+            if arm not in raws:
+                if arm == "ORACLE":
+                    raws[arm] = self.targetCapture(mean, condition, _rg.deriveSeed(seed, _rg.SEED_ABLATION, 3))
+                elif arm == "IGNORE_RESCALED":
+                    raws[arm] = self.rescaledToTarget(raw("IGNORE_PRIOR"), mean, condition)
+                elif arm == "ORACLE_PLUS_SHARE":
+                    raws[arm] = self.withPriorShare(raw("ORACLE"), mean, condition, seed)
+                else:
+                    if "bright" not in raws:
+                        raws["bright"] = self.brightCapture(mean, seed)
+                    alignment = "ACCOUNT_PRIOR" if arm == "ACCOUNT_POISSON" else arm
+                    raws[arm] = self.augmented(raws["bright"], condition, alignment, seed,
+                                               "POISSON" if arm == "ACCOUNT_POISSON" else None)
+            return raws[arm]
+
+        return {arm: self.inputPlanes(raw(arm), condition) for arm in arms}
 
     def targetVariance(self, condition):
         """The target capture's noise variance at mid-grey green on the network's scale (normalised and
@@ -295,10 +351,10 @@ class _Study:
         return (p * g) ** 2 * brightVar / targetVar
 
 
-def _train(study, arms, replicate, trainMeans, log=None):
-    """Trains one network per arm, in lockstep, on every condition of the run (each crop draws its
-    condition): the network one would deploy for all of the camera's exposures, told the noise level by
-    its noise map. The crops, their conditions, the noise seeds and the initialisation depend on the
+def _train(study, arms, replicate, trainMeans, conditions, log=None):
+    """Trains one network per arm, in lockstep, on `conditions` (each crop draws one of them; all of the
+    run's in the pooled design: the network one would deploy for all of the camera's exposures; one in the
+    per-condition design, whose networks see that condition's inputs alone). The crops, their conditions, the noise seeds and the initialisation depend on the
     replicate only, so every arm sees the same scenes in the same order from the same starting weights;
     the augmented arms even start from the same bright captures."""
     config = study.config
@@ -313,7 +369,7 @@ def _train(study, arms, replicate, trainMeans, log=None):
         rng = np.random.default_rng(_seed(config.seed, _ROLE_BATCH, (replicate << 24) | it))
         inputs, targets, weights = {arm: [] for arm in arms}, [], []
         for b in range(config.batch):
-            condition = config.conditions[int(rng.integers(0, len(config.conditions)))]
+            condition = conditions[int(rng.integers(0, len(conditions)))]
             scene = int(rng.integers(0, len(trainMeans)))
             y0, x0 = 2 * int(rng.integers(0, limit)), 2 * int(rng.integers(0, limit))
             mean = np.ascontiguousarray(trainMeans[scene][y0:y0 + config.patch, x0:x0 + config.patch])
@@ -336,15 +392,21 @@ def _train(study, arms, replicate, trainMeans, log=None):
 
 
 def _evaluate(net, testSet):
-    """Mean PSNR and SSIM over the test set (network output clipped to [0, 1]; net None: the input)."""
-    psnrs, ssims = [], []
+    """Mean PSNR and SSIM over the test set (network output clipped to [0, 1]; net None: the input), and
+    the network's implicit noise estimate: the variance of what it removed (input minus output) over the
+    variance of the true noise (input minus clean), summed over the test set. 1 removes as much as the
+    noise holds; below 1 the network takes the noise for less than it is, above 1 for more (or removes
+    signal); 0 for the input itself."""
+    psnrs, ssims, removed, noise = [], [], 0.0, 0.0
     with torch.no_grad():
         for noisy, clean in testSet:
             out = noisy[:4] if net is None else net(noisy[None])[0]
             out = out.clamp(0.0, 1.0)
             psnrs.append(psnr(out, clean))
             ssims.append(ssim(out, clean))
-    return float(np.mean(psnrs)), float(np.mean(ssims))
+            removed += float(torch.sum((noisy[:4].double() - out.double()) ** 2))
+            noise += float(torch.sum((noisy[:4].double() - clean.double()) ** 2))
+    return float(np.mean(psnrs)), float(np.mean(ssims)), removed / noise
 
 
 def _defaultThreads():
@@ -376,19 +438,28 @@ def runAblation(config, log=None):
             raw = study.targetCapture(mean, condition, _seed(config.seed, _ROLE_TEST_CAPTURE, (ci << 16) | i))
             testSet.append((study.inputPlanes(raw, condition), study.cleanPlanes(mean, condition)))
         testSets.append(testSet)
-    scores = {arm: [{"psnr": [], "ssim": []} for _ in config.conditions] for arm in config.arms}
+    scores = {arm: [{"psnr": [], "ssim": [], "removedNoiseRatio": []} for _ in config.conditions]
+              for arm in config.arms}
     trained = [a for a in config.arms if a in TRAINED_ARMS]
+    # The pooled design trains one set of networks per replicate on every condition; the per-condition
+    # design one set per replicate and condition, each tested on its own condition only.
+    groups = [list(range(len(config.conditions)))] if config.design == "pooled" else \
+        [[ci] for ci in range(len(config.conditions))]
     for replicate in range(config.seeds):
-        nets = _train(study, trained, replicate, trainMeans, log) if trained else {}
-        for arm in config.arms:
-            for ci, testSet in enumerate(testSets):
-                value = _evaluate(nets.get(arm), testSet)
-                scores[arm][ci]["psnr"].append(value[0])
-                scores[arm][ci]["ssim"].append(value[1])
-            if log is not None:
-                log("  seed %d %-13s PSNR %s dB" % (replicate, arm,
-                                                    " ".join("%.2f" % s["psnr"][-1] for s in scores[arm])))
+        for group in groups:
+            if trained and len(groups) > 1 and log is not None:
+                log("  seed %d: networks for %s" % (replicate, config.conditions[group[0]].name))
+            nets = _train(study, trained, replicate, trainMeans, [config.conditions[ci] for ci in group], log) \
+                if trained else {}
+            for arm in config.arms:
+                for ci in group:
+                    value = _evaluate(nets.get(arm), testSets[ci])
+                    for key, v in zip(("psnr", "ssim", "removedNoiseRatio"), value):
+                        scores[arm][ci][key].append(v)
         if log is not None:
+            for arm in config.arms:
+                log("  seed %d %-17s PSNR %s dB" % (replicate, arm,
+                                                    " ".join("%.2f" % s["psnr"][-1] for s in scores[arm])))
             elapsed = time.monotonic() - started
             log("[%d/%d seeds] %.0f s, about %.0f s left" % (replicate + 1, config.seeds, elapsed,
                                                            elapsed / (replicate + 1) * (config.seeds - replicate - 1)))
@@ -449,6 +520,14 @@ def _parser():
                              "default both, each in its own subfolder with a report.md beside them that "
                              "sets them side by side; one alone writes its report into --out itself")
     parser.add_argument("--blind", action="store_true", help="the same as --networks blind")
+    parser.add_argument("--designs", default="pooled",
+                        help="the training designs, comma-separated: pooled (one network per arm on all the "
+                             "conditions, each crop drawing its condition; default) and per-condition (one network "
+                             "per arm and condition, trained on that condition alone); each study is a network and "
+                             "a design, written into its own subfolder when there are several")
+    parser.add_argument("--per-condition", action="store_true",
+                        help="the same as --designs pooled,per-condition: per-condition networks beside the pooled "
+                             "ones, the report setting both side by side")
     parser.add_argument("--shot-sampling", default="GAUSSIAN", type=str.upper,
                         help="the augmented arms' shot noise: GAUSSIAN (the paper's, default) or POISSON")
     parser.add_argument("--prior-mean", default="PIXEL_VALUE", type=str.upper,
@@ -465,7 +544,8 @@ OUTPUT_FILES = ("results.json", "results.csv", "psnr.png", "report.md")
 
 def _outputConflicts(outDir, networks):
     """Why the outputs could not be written into outDir (None when they can), checked before any training:
-    the files are never replaced, so a previous run's would make the whole run fail at its end."""
+    the files are never replaced, so a previous run's would make the whole run fail at its end. `networks`:
+    the studies' folder names (studyName())."""
     if os.path.lexists(outDir) and not os.path.isdir(outDir):
         return "--out '%s' exists and is not a folder" % outDir
     folders = [outDir] if len(networks) == 1 else [os.path.join(outDir, n) for n in networks]
@@ -544,6 +624,12 @@ def main(argv=None):
         print("rawgment.ablation: --networks must be told, blind or told,blind, got '%s'" % args.networks,
               file=sys.stderr)
         return 2
+    designs = ["pooled", "per-condition"] if args.per_condition else \
+        [d.strip() for d in args.designs.split(",") if d.strip()]
+    if not designs or any(d not in DESIGNS for d in designs) or len(set(designs)) != len(designs):
+        print("rawgment.ablation: --designs must be pooled, per-condition or pooled,per-condition, got '%s'"
+              % args.designs, file=sys.stderr)
+        return 2
     config.blindStep = args.blind_step
     config.shotSampling, config.priorMean = args.shot_sampling, args.prior_mean
     if args.seeds is not None:
@@ -566,7 +652,8 @@ def main(argv=None):
     except (ValueError, _rg.error) as e:
         print("rawgment.ablation: %s" % e, file=sys.stderr)
         return 2
-    conflict = _outputConflicts(args.out, networks)
+    studies = [(n, d) for n in networks for d in designs]
+    conflict = _outputConflicts(args.out, [studyName(n, d) for n, d in studies])
     if conflict is not None:
         print("rawgment.ablation: %s" % conflict, file=sys.stderr)
         return 2
@@ -574,15 +661,16 @@ def main(argv=None):
     def log(line):
         print(line, file=sys.stderr, flush=True)
 
-    byNetwork = {}
-    for network in networks:
-        if len(networks) > 1:
-            log("rawgment.ablation: %s networks" % network)
-        byNetwork[network] = runAblation(dataclasses.replace(config, noiseMaps=network == "told"), log)
-    if len(networks) == 1:
-        written, notes = writeOutputs(byNetwork[networks[0]], args.out)
+    byStudy = {}
+    for network, design in studies:
+        if len(studies) > 1:
+            log("rawgment.ablation: %s networks, %s design" % (network, design))
+        byStudy[studyName(network, design)] = runAblation(
+            dataclasses.replace(config, noiseMaps=network == "told", design=design), log)
+    if len(studies) == 1:
+        written, notes = writeOutputs(next(iter(byStudy.values())), args.out)
     else:
-        written, notes = writeNetworksOutputs(byNetwork, args.out)
+        written, notes = writeStudiesOutputs(byStudy, args.out)
     for note in notes:
         log("rawgment.ablation: " + note)
     for path in written:

@@ -5,13 +5,16 @@ import json
 import math
 import os
 import subprocess
+from statistics import NormalDist
 
 import numpy as np
 
 import rawgment as _rg
 from rawgment._ablation_common import ARMS, BLIND_STEP, TRAINED_ARMS, _ROLE_BOOTSTRAP, _seed
+from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS, predictionOutcome
 
-__all__ = ["pairedSignificance", "summarize", "writeOutputs", "writeNetworksOutputs", "NETWORKS", "SIGNIFICANCE"]
+__all__ = ["pairedSignificance", "summarize", "writeOutputs", "writeStudiesOutputs", "studyName", "holmAdjusted", "seedsForFamily",
+           "seedsToConfirm", "contrastRows", "correctFamily", "NETWORKS", "SIGNIFICANCE"]
 
 
 def _meanSd(values):
@@ -42,50 +45,150 @@ def pairedSignificance(differences, seed):
     return float(low), float(high), p
 
 
-#: The sign-flip p at or below which a difference whose interval excludes 0 is a verdict, not a lean.
+#: The family-wise error rate of a report's tests: each report corrects its p-values by Holm's method over
+#: every paired test it makes, and calls a difference a verdict only when its corrected p is at most this.
 SIGNIFICANCE = 0.05
 
 
-def _verdict(low, high, pValue):
-    """'tie' when the 95% bootstrap interval holds 0; when it does not, 'ACCOUNT_PRIOR better' (or
-    'worse') if the exact sign-flip p is at most SIGNIFICANCE too, else 'ACCOUNT_PRIOR leans better' (or
-    'leans worse'). A percentile bootstrap over a handful of replicates is too narrow (3 replicates of
-    one sign always give an interval off 0), so the interval alone never makes a verdict: with fewer than
-    6 replicates p cannot reach 0.05 and the most a difference can do is lean."""
+def _verdict(low, high, pValue, subject="ACCOUNT_PRIOR", words=("better", "worse")):
+    """'tie' when the 95% bootstrap interval holds 0; when it does not, '<subject> better' (or 'worse') if
+    the sign-flip p is at most SIGNIFICANCE too, else '<subject> leans better' (or 'leans worse'). A
+    percentile bootstrap over a handful of replicates is too narrow (3 replicates of one sign always give
+    an interval off 0), so the interval alone never makes a verdict: with fewer than 6 replicates p cannot
+    reach 0.05 and the most a difference can do is lean. Given a Holm-corrected p, the verdict is the
+    family's."""
     if low <= 0 <= high:
         return "tie"
-    direction = "better" if low > 0 else "worse"
-    return "ACCOUNT_PRIOR " + (direction if pValue <= SIGNIFICANCE else "leans " + direction)
+    direction = words[0] if low > 0 else words[1]
+    return subject + " " + (direction if pValue <= SIGNIFICANCE else "leans " + direction)
 
 
-def summarize(results):
-    """Per condition and arm: PSNR and SSIM mean and standard deviation over the replicates, and for
-    each arm against ACCOUNT_PRIOR the paired difference (ACCOUNT_PRIOR minus the arm, replicate by
-    replicate) with its significance (pairedSignificance()) and a verdict (_verdict(); 'n/a' with a
-    single replicate)."""
+def holmAdjusted(pValues):
+    """Holm's step-down adjusted p-values, in the given order: the i-th smallest p times (m - i + 1),
+    never below an earlier one's, at most 1. A test is significant at family-wise level alpha when its
+    adjusted p is at most alpha; it controls the family-wise error under any dependence between the tests
+    (the conditions of one pooled network are far from independent)."""
+    p = np.asarray(pValues, dtype=np.float64)
+    m = p.size
+    adjusted = np.empty(m)
+    running = 0.0
+    for rank, i in enumerate(np.argsort(p, kind="stable")):
+        running = max(running, min(1.0, (m - rank) * p[i]))
+        adjusted[i] = running
+    return [float(v) for v in adjusted]
+
+
+def seedsForFamily(tests, alpha=SIGNIFICANCE):
+    """The fewest replicates whose exact sign-flip test can reach Holm's strictest threshold alpha / tests:
+    all replicates agreeing give p = 2 / 2^n."""
+    n = 1
+    while 2.0 / 2.0 ** n > alpha / max(1, tests):
+        n += 1
+    return n
+
+
+def seedsToConfirm(mean, sd, tests, alpha=SIGNIFICANCE):
+    """A planning figure: the replicates at which a paired difference of this mean and standard deviation
+    would reach alpha / tests (the strictest Holm step) by the normal approximation of its mean,
+    n = (z sd / mean)^2, and never fewer than seedsForFamily(tests); None when the mean is 0."""
+    floor = seedsForFamily(tests, alpha)
+    if mean == 0:
+        return None
+    if sd == 0:
+        return floor
+    z = NormalDist().inv_cdf(1.0 - alpha / (2.0 * max(1, tests)))
+    return max(floor, int(math.ceil((z * sd / abs(mean)) ** 2)))
+
+
+def contrastPairs(arms):
+    """The paired tests a study's report makes, (a, b, metric) for a minus b: ACCOUNT_PRIOR against NONE,
+    IGNORE_PRIOR and ORACLE (the paper's question), then the control contrasts (ablation_controls), each
+    where both arms ran."""
+    pairs = [("ACCOUNT_PRIOR", b, "psnr") for b in ("NONE", "IGNORE_PRIOR", "ORACLE")
+             if "ACCOUNT_PRIOR" in arms and b in arms]
+    return pairs + [c for c in CONTROL_CONTRASTS if c[0] in arms and c[1] in arms]
+
+
+def _bootstrapItem(ci, a, b, metric):
+    """The bootstrap seed's item of a contrast: ACCOUNT_PRIOR's PSNR contrasts keep the item they had before
+    the control arms existed, so earlier runs' intervals are reproduced."""
+    if a == "ACCOUNT_PRIOR" and metric == "psnr":
+        return (ci << 8) | ARMS.index(b)
+    return (ci << 8) | 0x80 | (0x40 if metric != "psnr" else 0) | (ARMS.index(a) << 3) | ARMS.index(b)
+
+
+def contrastRows(results):
+    """Every paired test of a study (contrastPairs() in every condition): the mean difference and its s.d.,
+    the 95% bootstrap interval, the sign-flip p, and, corrected by Holm over this study's tests
+    (correctFamily()), the adjusted p and the verdict. With a single replicate there is no test (p None)."""
     baseSeed = int(results.get("config", {}).get("seed", 0))
+    design = results.get("config", {}).get("design", "pooled")
+    network = "told" if results.get("config", {}).get("noiseMaps", True) else "blind"
     rows = []
     for ci, entry in enumerate(results["conditions"]):
         arms = entry["arms"]
-        for arm, runs in arms.items():
+        for a, b, metric in contrastPairs(list(arms)):
+            if metric not in arms[a] or metric not in arms[b]:
+                continue
+            diff = np.asarray(arms[a][metric]) - np.asarray(arms[b][metric])
+            d, ds = _meanSd(diff)
+            row = {"condition": entry["condition"]["name"], "priorShare": entry["priorShare"], "a": a, "b": b,
+                   "metric": metric, "design": design, "network": network, "n": int(diff.size), "mean": d,
+                   "sd": ds, "low": d, "high": d, "p": None}
+            if diff.size >= 2:
+                row["low"], row["high"], row["p"] = pairedSignificance(
+                    diff, _seed(baseSeed, _ROLE_BOOTSTRAP, _bootstrapItem(ci, a, b, metric)))
+            rows.append(row)
+    return correctFamily(rows)
+
+
+def correctFamily(rows):
+    """Holm-corrects the p-values of `rows` (contrastRows' rows, of one study or of several) as one family:
+    sets pHolm, the corrected verdict and its direction ("a", "b" or None), the family's size and the
+    seeds that reaching SIGNIFICANCE after correction needs (seedsForFamily, and seedsToConfirm for each
+    difference). Returns the rows."""
+    tested = [r for r in rows if r["p"] is not None]
+    for r, adjusted in zip(tested, holmAdjusted([r["p"] for r in tested])):
+        r["pHolm"] = adjusted
+    for r in rows:
+        r["family"] = len(tested)
+        r["seedsForFamily"] = seedsForFamily(len(tested))
+        r["seedsToConfirm"] = seedsToConfirm(r["mean"], r["sd"], len(tested))
+        if r["p"] is None:
+            r["pHolm"], r["verdictHolm"], r["directionHolm"] = None, "n/a", None
+            continue
+        subject, words = (r["a"], ("better", "worse")) if r["metric"] == "psnr" else \
+            ("%s's removed/noise" % r["a"], ("larger", "smaller"))
+        r["verdict"] = _verdict(r["low"], r["high"], r["p"], subject, words)
+        r["verdictHolm"] = _verdict(r["low"], r["high"], r["pHolm"], subject, words)
+        decided = not (r["low"] <= 0 <= r["high"]) and r["pHolm"] <= SIGNIFICANCE
+        r["directionHolm"] = ("a" if r["low"] > 0 else "b") if decided else None
+    return rows
+
+
+def summarize(results):
+    """Per condition and arm: PSNR, SSIM and the implicit noise estimate (removed/noise), mean and standard
+    deviation over the replicates, and for NONE, IGNORE_PRIOR and ORACLE the paired difference
+    ACCOUNT_PRIOR minus the arm (replicate by replicate) with its significance (pairedSignificance()), its
+    uncorrected verdict (_verdict(); 'n/a' with a single replicate) and its verdict after Holm's correction
+    over the study's tests (contrastRows())."""
+    contrasts = {(r["condition"], r["b"]): r for r in contrastRows(results)
+                 if r["a"] == "ACCOUNT_PRIOR" and r["metric"] == "psnr"}
+    rows = []
+    for entry in results["conditions"]:
+        for arm, runs in entry["arms"].items():
             p, ps = _meanSd(runs["psnr"])
             s, ss = _meanSd(runs["ssim"])
             row = {"condition": entry["condition"]["name"], "arm": arm, "psnr": p, "psnrSd": ps, "ssim": s,
                    "ssimSd": ss, "priorShare": entry["priorShare"], "photonRatio": entry["condition"]["photonRatio"],
                    "gainRatio": entry["condition"]["gainRatio"], "blurLength": entry["condition"]["blurLength"]}
-            if "ACCOUNT_PRIOR" in arms and arm != "ACCOUNT_PRIOR":
-                account = arms["ACCOUNT_PRIOR"]["psnr"]
-                diff = np.asarray(account) - np.asarray(runs["psnr"])
-                d, ds = _meanSd(diff)
-                low, high, pValue = (d, d, 1.0)
-                if len(account) < 2:
-                    verdict = "n/a"
-                else:
-                    low, high, pValue = pairedSignificance(
-                        diff, _seed(baseSeed, _ROLE_BOOTSTRAP, (ci << 8) | ARMS.index(arm)))
-                    verdict = _verdict(low, high, pValue)
-                row.update({"accountMinus": d, "accountMinusSd": ds, "accountMinusLow": low,
-                            "accountMinusHigh": high, "pValue": pValue, "verdict": verdict})
+            if "removedNoiseRatio" in runs:
+                row["removed"], row["removedSd"] = _meanSd(runs["removedNoiseRatio"])
+            c = contrasts.get((row["condition"], arm))
+            if c is not None:
+                row.update({"accountMinus": c["mean"], "accountMinusSd": c["sd"], "accountMinusLow": c["low"],
+                            "accountMinusHigh": c["high"], "pValue": 1.0 if c["p"] is None else c["p"],
+                            "verdict": c.get("verdict", "n/a"), "pHolm": c["pHolm"], "verdictHolm": c["verdictHolm"]})
             rows.append(row)
     return rows
 
@@ -95,7 +198,7 @@ def _plotScript(rows, arms):
     the gain over the noisy input (where the arms' differences of tenths of a dB are visible); one column
     at the bright gain, one with the gain change, one for the blur condition. Without the NOISY arm there is
     no gain to draw: the PSNR row alone."""
-    styles = {"NONE": 1, "IGNORE_PRIOR": 2, "ACCOUNT_PRIOR": 3, "ORACLE": 4, "NOISY": 5}
+    styles = {arm: i + 1 for i, arm in enumerate(ARMS)}
     panels = [("at the bright gain", lambda r: r["gainRatio"] == 1 and r["blurLength"] == 0),
               ("gain raised by 1/ratio (at most +12 dB)", lambda r: r["gainRatio"] > 1 and r["blurLength"] == 0),
               ("with motion blur", lambda r: r["blurLength"] > 0)]
@@ -198,22 +301,21 @@ def _report(results, rows, plotNote):
     for name in conditions:
         out.append("| %s | " % name +
                    " | ".join(_fmt(byKey[(name, a)]["ssim"], byKey[(name, a)]["ssimSd"], 4) for a in arms) + " |")
-    others = [a for a in arms if a != "ACCOUNT_PRIOR"]
-    if "ACCOUNT_PRIOR" in arms and others:
-        out += ["", "## ACCOUNT_PRIOR minus each arm (PSNR dB, paired by seed)", "",
-                "Mean difference [95%% bootstrap interval over the paired seeds], the exact sign-flip test's "
-                "two-sided p and the verdict: better or worse when the interval excludes 0 and p <= %g, "
-                "leans better or worse when the interval excludes 0 but p is larger, tie when the interval "
-                "holds 0. With n seeds p cannot fall below 2 / 2^n (0.25 at 3 seeds, 0.0625 at 5, 0.031 "
-                "at 6): fewer than 6 seeds can only lean." % SIGNIFICANCE, "",
-                "| condition | " + " | ".join(others) + " |", "|---|" + "---|" * len(others)]
+    contrasts = contrastRows(results)
+    if contrasts:
+        out += ["", "## ACCOUNT_PRIOR minus each arm, and the control contrasts (paired by seed)", ""]
+        out += _testsTable(contrasts)
+    if any("removed" in r for r in rows):
+        trained = [a for a in arms if a in TRAINED_ARMS]
+        out += ["", "## The networks' implicit noise estimate: removed / noise, mean ± s.d. over seeds", "",
+                "The variance of what each network removes from the test inputs (input minus output) over the "
+                "variance of their true noise (input minus clean): 1 removes as much as the noise holds, below 1 "
+                "the network takes the noise for less than it is, above 1 for more (or it removes signal too).",
+                "", "| condition | " + " | ".join(trained) + " |", "|---|" + "---|" * len(trained)]
         for name in conditions:
-            cells = []
-            for a in others:
-                r = byKey[(name, a)]
-                cells.append("%+.2f [%+.2f, %+.2f], p %.3g (%s)" % (
-                    r["accountMinus"], r["accountMinusLow"], r["accountMinusHigh"], r["pValue"], r["verdict"]))
-            out.append("| %s | " % name + " | ".join(cells) + " |")
+            out.append("| %s | " % name + " | ".join(
+                _fmt(byKey[(name, a)]["removed"], byKey[(name, a)]["removedSd"], 3) for a in trained) + " |")
+    out += _predictionsSection(contrasts)
     out += ["", "## Reading it", ""]
     out += _findings(rows, conditions, arms)
     out += ["", "Prior share: the part of the target's noise variance (mid-grey green) that the darkened bright "
@@ -238,15 +340,68 @@ def _findings(rows, conditions, arms):
     for other in [a for a in ("NONE", "IGNORE_PRIOR", "ORACLE") if a in arms]:
         verdicts = {}
         for c in conditions:
-            verdicts.setdefault(byKey[(c, other)]["verdict"], []).append(c)
+            verdicts.setdefault(byKey[(c, other)].get("verdictHolm") or byKey[(c, other)]["verdict"], []).append(c)
         parts = ["%s in %s" % (v, ", ".join(cs)) for v, cs in sorted(verdicts.items())]
-        lines.append("- ACCOUNT_PRIOR against %s: %s." % (other, "; ".join(parts)))
+        lines.append("- ACCOUNT_PRIOR against %s (after Holm's correction): %s." % (other, "; ".join(parts)))
     return lines
+
+
+def _cell(r):
+    """A paired test as a table cell: mean [interval], p, Holm-corrected p and the corrected verdict."""
+    if r["p"] is None:
+        return "%+.3g (one seed: no test)" % r["mean"]
+    return "%+.2f [%+.2f, %+.2f], p %.2g, Holm %.2g (%s)" % (r["mean"], r["low"], r["high"], r["p"], r["pHolm"],
+                                                           r["verdictHolm"])
+
+
+def _testsTable(contrasts):
+    """The report's paired tests, one row each, with the family statement: how many tests, the seeds run
+    and the seeds that reaching SIGNIFICANCE after Holm's correction needs."""
+    family = contrasts[0]["family"]
+    seeds = max(r["n"] for r in contrasts)
+    out = ["Mean difference a minus b [95%% bootstrap interval over the paired seeds], the exact sign-flip "
+           "test's two-sided p, and p corrected by Holm's method over all %d tests of this report (the "
+           "family-wise error held at %g whatever the dependence between the tests: the conditions of a pooled "
+           "network share one network). Verdict after correction: better or worse when the interval excludes "
+           "0 and the corrected p is at most %g, leans when only the interval does, tie when the interval holds "
+           "0. With n seeds p cannot fall below 2 / 2^n, so these %d tests need at least %d seeds, all agreeing, "
+           "for any verdict; this run has %d. Seeds to confirm: the seeds at which a difference of this mean and "
+           "spread would reach the strictest Holm step (normal approximation; a planning figure)."
+           % (family, SIGNIFICANCE, SIGNIFICANCE, family, seedsForFamily(family), seeds), "",
+           "| condition | prior share | a minus b | measure | difference | seeds to confirm |", "|---|---|---|---|---|---|"]
+    for r in contrasts:
+        out.append("| %s | %.3f | %s minus %s | %s | %s | %s |" % (
+            r["condition"], r["priorShare"], r["a"], r["b"], "PSNR dB" if r["metric"] == "psnr" else "removed/noise",
+            _cell(r), "-" if r["seedsToConfirm"] is None else r["seedsToConfirm"]))
+    return out
+
+
+def _predictionsSection(contrasts, studies=None):
+    """The control arms' predictions (ablation_controls.PREDICTIONS, stated before the runs) whose arms,
+    network, design and conditions the contrasts hold, each with its outcome after the family's correction."""
+    out = []
+    for prediction in PREDICTIONS:
+        scoped = [r for r in contrasts if r["network"] == prediction.network and r["design"] == prediction.design]
+        outcome = predictionOutcome(prediction, scoped)
+        if outcome is None:
+            continue
+        state, rows = outcome
+        if not out:
+            out = ["", "## The controls: predictions stated before the run, and outcomes", "",
+                   "Each prediction was written into rawgment/ablation_controls.py before the runs that test it; "
+                   "the outcome is read from the Holm-corrected tests above: a direction holds when every "
+                   "condition in its scope has that corrected verdict and is contradicted when any has the "
+                   "other; a tie holds when none has a corrected verdict.", ""]
+        out.append("- **%s** (%s networks, %s design). Hypothesis: %s Prediction: %s **Outcome: %s.** %s" % (
+            prediction.name, prediction.network, prediction.design, prediction.hypothesis, prediction.text, state,
+            "; ".join("%s: %s minus %s %s" % (r["condition"], r["a"], r["b"], _cell(r)) for r in rows)))
+    return out
 
 
 def _csv(rows):
     keys = ["condition", "arm", "photonRatio", "gainRatio", "blurLength", "priorShare", "psnr", "psnrSd", "ssim",
-            "ssimSd", "accountMinus", "accountMinusSd", "accountMinusLow", "accountMinusHigh", "pValue", "verdict"]
+            "ssimSd", "removed", "removedSd", "accountMinus", "accountMinusSd", "accountMinusLow", "accountMinusHigh",
+            "pValue", "verdict", "pHolm", "verdictHolm"]
     out = [",".join(keys)]
     for r in rows:
         out.append(",".join(("%.6g" % r[k]) if isinstance(r.get(k), float) else str(r.get(k, "")) for k in keys))
@@ -278,58 +433,90 @@ def writeOutputs(results, outDir):
 NETWORKS = ("told", "blind")
 
 
-def writeNetworksOutputs(byNetwork, outDir):
-    """Writes one study per kind of network (a dict from NETWORKS' names to runAblation's results) into
-    outDir/<network>/ (writeOutputs()) and, beside them, report.md: each condition's ACCOUNT_PRIOR minus
-    the other trained arms for every network side by side, so the one page answers whether accounting
-    matters when the network is told the noise level and when it is not. Returns the paths written and
+def studyName(network, design):
+    """The folder of one study in a run of several: the network's name for the pooled design (as before
+    the designs existed), "<network>-per-condition" for the other."""
+    return network if design == "pooled" else "%s-%s" % (network, design)
+
+
+def writeStudiesOutputs(byStudy, outDir):
+    """Writes several studies (a dict from studyName() to runAblation's results: the kinds of network and the
+    designs) into outDir/<study>/ (writeOutputs()) and, beside them, report.md: each condition's ACCOUNT_PRIOR
+    minus the other trained arms and the control contrasts for every study side by side, Holm-corrected
+    over all their tests together, and the control predictions' outcomes. Returns the paths written and
     the notes."""
     os.makedirs(outDir, exist_ok=True)
     written, notes, rowsOf = [], [], {}
-    for network, results in byNetwork.items():
-        paths, more = writeOutputs(results, os.path.join(outDir, network))
+    for name, results in byStudy.items():
+        paths, more = writeOutputs(results, os.path.join(outDir, name))
         written += paths
-        notes += ["%s: %s" % (network, n) for n in more]
-        rowsOf[network] = summarize(results)
+        notes += ["%s: %s" % (name, n) for n in more]
+        rowsOf[name] = summarize(results)
     path = os.path.join(outDir, "report.md")
-    _rg.writeFileAtomically(path, _networksReport(byNetwork, rowsOf).encode())
+    _rg.writeFileAtomically(path, _studiesReport(byStudy, rowsOf).encode())
     return written + [path], notes
 
 
-def _networksReport(byNetwork, rowsOf):
-    networks = list(byNetwork)
-    first = byNetwork[networks[0]]
-    config = first["config"]
+def _studiesReport(byStudy, rowsOf):
+    names = list(byStudy)
+    first = byStudy[names[0]]
     conditions = [entry["condition"]["name"] for entry in first["conditions"]]
-    arms = config["arms"]
-    others = [a for a in arms if a in TRAINED_ARMS and a != "ACCOUNT_PRIOR"]
-    out = ["# Noise-alignment ablation: networks told the noise level and blind ones", "",
-           "The same study (sensor, scenes, seeds, budget) run for each kind of network; each has its own "
-           "full report. A told network takes a noise-level map per plane beside the image; a blind one "
-           "sees the image only, as the paper's detectors do.", ""]
-    for network in networks:
-        r = byNetwork[network]
+    shares = {entry["condition"]["name"]: entry["priorShare"] for entry in first["conditions"]}
+    contrastsOf = {n: contrastRows(byStudy[n]) for n in names}
+    family = correctFamily([r for n in names for r in contrastsOf[n]])
+    out = ["# Noise-alignment ablation: the studies side by side", "",
+           "The same sensor, scenes, seeds and budget per network in every study; each has its own full report. "
+           "A told network takes a noise-level map per plane beside the image; a blind one sees the image only, "
+           "as the paper's detectors do. The pooled design trains one network per arm on all conditions (each "
+           "crop draws its condition): it answers whether an arm's training set makes a better network for "
+           "every exposure, and a difference it shows in one condition may be made in another. The "
+           "per-condition design trains one network per arm and condition on that condition alone: it answers "
+           "whether that condition's own inputs make the difference.", ""]
+    for n in names:
+        r = byStudy[n]
         out.append("- **%s**: [%s/report.md](%s/report.md), %d seed(s), %.0f s, CPU path %s." % (
-            network, network, network, r["config"]["seeds"], r["seconds"], r["cpuPath"]))
-    if "ACCOUNT_PRIOR" in arms and others:
-        out += ["", "## ACCOUNT_PRIOR minus each arm, by network (PSNR dB, paired by seed)", "",
-                "Mean difference [95%% bootstrap interval over the paired seeds], the exact sign-flip test's "
-                "two-sided p and the verdict (better or worse: the interval excludes 0 and p <= %g; leans: "
-                "the interval excludes 0, p is larger; tie: the interval holds 0)." % SIGNIFICANCE, ""]
-        header = ["condition", "prior share"] + ["%s: minus %s" % (n, a) for a in others for n in networks]
-        out += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-        byKey = {n: {(r["condition"], r["arm"]): r for r in rowsOf[n]} for n in networks}
-        for name in conditions:
-            cells = [name, "%.3f" % byKey[networks[0]][(name, "ACCOUNT_PRIOR")]["priorShare"]]
-            for a in others:
-                for n in networks:
-                    r = byKey[n][(name, a)]
-                    cells.append("%+.2f [%+.2f, %+.2f], p %.3g (%s)" % (
-                        r["accountMinus"], r["accountMinusLow"], r["accountMinusHigh"], r["pValue"],
-                        r["verdict"]))
+            n, n, n, r["config"]["seeds"], r["seconds"], r["cpuPath"]))
+    if family:
+        tested = family[0]["family"]
+        seeds = max(r["n"] for r in family)
+        out += ["", "Every test below is corrected by Holm's method over all %d tests of this page together (the "
+                "studies' own reports correct over their own tests only, so this page's verdicts are the "
+                "stricter and the ones to quote). With n seeds the sign-flip p cannot fall below 2 / 2^n: %d "
+                "tests need at least %d seeds, all agreeing, for any verdict; these studies have %d. Cells: mean "
+                "difference [95%% bootstrap interval], p, Holm-corrected p (verdict after correction)."
+                % (tested, tested, seedsForFamily(tested), seeds)]
+    for title, pairs in (("ACCOUNT_PRIOR minus each arm, by study (PSNR dB, paired by seed)",
+                          [(a, b, m) for a, b, m in {(r["a"], r["b"], r["metric"]) for r in family}
+                           if a == "ACCOUNT_PRIOR" and m == "psnr"]),
+                         ("The control contrasts, by study", list(dict.fromkeys(
+                             (r["a"], r["b"], r["metric"]) for r in family
+                             if (r["a"], r["b"], r["metric"]) in CONTROL_CONTRASTS)))):
+        pairs = sorted(pairs, key=lambda c: ARMS.index(c[1])) if title.startswith("ACCOUNT") else pairs
+        columns = [(n, c) for c in pairs for n in names
+                   if any((r["a"], r["b"], r["metric"]) == c for r in contrastsOf[n])]
+        if not columns:
+            continue
+        header = ["condition", "prior share"] + ["%s: %s" % (n, ("minus %s" % c[1]) if title.startswith("ACCOUNT")
+                                                          else "%s minus %s%s" % (c[0], c[1], "" if c[2] == "psnr"
+                                                                                  else " (removed/noise)"))
+                                                 for n, c in columns]
+        out += ["", "## " + title, "", "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+        byKey = {(n, r["condition"], r["a"], r["b"], r["metric"]): r for n in names for r in contrastsOf[n]}
+        for condition in conditions:
+            cells = [condition, "%.3f" % shares[condition]]
+            for n, c in columns:
+                r = byKey.get((n, condition) + c)
+                cells.append("-" if r is None else _cell(r))
             out.append("| " + " | ".join(cells) + " |")
-    for network in networks:
-        out += ["", "## %s networks" % network.capitalize(), ""]
-        out += _findings(rowsOf[network], conditions, arms)
-        out += ["", "![PSNR against darkening, %s](%s/psnr.png)" % (network, network)]
+    out += _predictionsSection(family)
+    for n in names:
+        # The findings read this page's family-corrected verdicts, not the study's own.
+        corrected = {(r["condition"], r["b"]): r["verdictHolm"] for r in contrastsOf[n]
+                     if r["a"] == "ACCOUNT_PRIOR" and r["metric"] == "psnr"}
+        for row in rowsOf[n]:
+            if (row["condition"], row["arm"]) in corrected:
+                row["verdictHolm"] = corrected[(row["condition"], row["arm"])]
+        out += ["", "## %s" % n, ""]
+        out += _findings(rowsOf[n], conditions, byStudy[n]["config"]["arms"])
+        out += ["", "![PSNR against darkening, %s](%s/psnr.png)" % (n, n)]
     return "\n".join(out) + "\n"

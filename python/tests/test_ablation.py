@@ -53,8 +53,36 @@ def test_quick_run_writes_the_report_and_the_oracle_beats_the_noisy_input(tmp_pa
     assert "[told/report.md](told/report.md)" in both and "[blind/report.md](blind/report.md)" in both
     assert "| condition | prior share | told: minus IGNORE_PRIOR | blind: minus IGNORE_PRIOR | told: minus ORACLE |" \
         in both
-    assert both.count("| x0.01 +12dB |") == 1
+    # One row per condition in each side-by-side table: ACCOUNT_PRIOR's tests and the control contrasts (here
+    # only what IGNORE_PRIOR's and ACCOUNT_PRIOR's networks remove, the default run having no control arm).
+    assert both.count("| x0.01 +12dB |") == 2
+    assert "| condition | prior share | told: IGNORE_PRIOR minus ACCOUNT_PRIOR (removed/noise) |" in both
     assert "![PSNR against darkening, blind](blind/psnr.png)" in both
+
+
+def test_per_condition_and_the_control_arms_from_the_command(tmp_path):
+    # --per-condition trains per-condition networks beside the pooled ones, each study in its own folder; the
+    # control arms run as any arm, and the page beside the studies states the predictions with outcomes.
+    out = tmp_path / "mechanism"
+    arms = "IGNORE_PRIOR,ACCOUNT_PRIOR,ORACLE,NOISY," + ",".join(ab.CONTROL_ARMS)
+    assert ab.main(["--quick", "--per-condition", "--networks", "blind", "--arms", arms, "--seeds", "2",
+                    "--iterations", "2", "--out", str(out)]) == 0
+    for study, design in (("blind", "pooled"), ("blind-per-condition", "per-condition")):
+        results = json.loads((out / study / "results.json").read_text())
+        assert results["config"]["design"] == design and results["config"]["noiseMaps"] is False
+        assert set(results["conditions"][0]["arms"]) == set(arms.split(","))
+        assert all(len(v["removedNoiseRatio"]) == 2 for v in results["conditions"][0]["arms"].values())
+        assert "The networks' implicit noise estimate" in (out / study / "report.md").read_text()
+    page = (out / "report.md").read_text()
+    assert "## The controls: predictions stated before the run, and outcomes" in page
+    for prediction in ab.PREDICTIONS:
+        assert "**%s** (blind networks, %s design)" % (prediction.name, prediction.design) in page
+    # Two seeds cannot reach any corrected verdict: every prediction is undecided, none held by default.
+    assert page.count("**Outcome: undecided (too few seeds") == len(ab.PREDICTIONS)
+    assert "| condition | prior share | blind: IGNORE_PRIOR minus IGNORE_RESCALED | blind-per-condition:" in page
+    run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--designs", "pooled,shuffled",
+                          "--out", str(tmp_path / "x")], capture_output=True, text=True)
+    assert run.returncode == 2 and "--designs must be pooled, per-condition or pooled,per-condition" in run.stderr
 
 
 def test_the_plot_is_drawn_for_any_choice_of_arms():
@@ -72,24 +100,53 @@ def test_the_plot_is_drawn_for_any_choice_of_arms():
         assert why is None and png.startswith(b"\x89PNG"), why
 
 
-def test_the_networks_report_sets_each_networks_differences_side_by_side(tmp_path):
-    # The side-by-side table takes each cell from its own network's summary: a cell is that network's
-    # ACCOUNT_PRIOR minus the arm, interval and verdict, as summarize() gives it.
-    byNetwork = {"told": ab.runAblation(tiny_config()), "blind": ab.runAblation(tiny_config(noiseMaps=False))}
-    written, _ = ab.writeNetworksOutputs(byNetwork, str(tmp_path / "both"))
-    assert str(tmp_path / "both" / "report.md") in written
-    report = (tmp_path / "both" / "report.md").read_text()
-    for network, results in byNetwork.items():
-        for r in ab.summarize(results):
-            if r["arm"] == "IGNORE_PRIOR":
-                cell = "%+.2f [%+.2f, %+.2f], p %.3g (%s)" % (r["accountMinus"], r["accountMinusLow"],
-                                                             r["accountMinusHigh"], r["pValue"], r["verdict"])
-                line = next(l for l in report.splitlines() if l.startswith("| %s |" % r["condition"]))
-                # Columns: condition, share, then per trained arm but ACCOUNT_PRIOR, told and blind.
-                others = [a for a in results["config"]["arms"] if a in ab.TRAINED_ARMS and a != "ACCOUNT_PRIOR"]
-                column = 2 + 2 * others.index("IGNORE_PRIOR") + (0 if network == "told" else 1)
-                assert line.strip("|").split(" | ")[column].strip() == cell, (network, line)
-        assert (tmp_path / "both" / network / "results.json").exists()
+def test_the_studies_report_sets_each_studys_differences_side_by_side_corrected_together(tmp_path):
+    # The side-by-side table takes each cell from its own study's tests, Holm-corrected over all the page's
+    # tests together: the same difference, interval and p as the study's own, a corrected p at least as large.
+    byStudy = {"told": ab.runAblation(tiny_config()), "blind": ab.runAblation(tiny_config(noiseMaps=False)),
+               "blind-per-condition": ab.runAblation(tiny_config(noiseMaps=False, design="per-condition"))}
+    written, _ = ab.writeStudiesOutputs(byStudy, str(tmp_path / "all"))
+    assert str(tmp_path / "all" / "report.md") in written
+    report = (tmp_path / "all" / "report.md").read_text()
+    family = ab.correctFamily([r for results in byStudy.values() for r in ab.contrastRows(results)])
+    # 3 studies x 2 conditions x 3 tests: ACCOUNT_PRIOR minus IGNORE_PRIOR and ORACLE, and what IGNORE_PRIOR's
+    # networks remove minus what ACCOUNT_PRIOR's do.
+    assert len(family) == 3 * 2 * 3
+    assert "over all 18 tests of this page together" in report
+    header = next(l for l in report.splitlines() if l.startswith("| condition | prior share | told: minus"))
+    columns = [c.strip() for c in header.strip("|").split(" | ")]
+    for r in family:
+        if r["metric"] != "psnr":
+            continue
+        study = "%s%s" % (r["network"], "" if r["design"] == "pooled" else "-per-condition")
+        own = next(o for o in ab.contrastRows(byStudy[study]) if (o["condition"], o["b"]) == (r["condition"], r["b"]))
+        assert (own["mean"], own["low"], own["high"], own["p"]) == (r["mean"], r["low"], r["high"], r["p"])
+        assert r["pHolm"] >= own["pHolm"]
+        line = next(l for l in report.splitlines() if l.startswith("| %s |" % r["condition"]))
+        cell = line.strip("|").split(" | ")[columns.index("%s: minus %s" % (study, r["b"]))].strip()
+        assert cell == "%+.2f [%+.2f, %+.2f], p %.2g, Holm %.2g (%s)" % (r["mean"], r["low"], r["high"], r["p"],
+                                                                       r["pHolm"], r["verdictHolm"])
+    for study in byStudy:
+        assert (tmp_path / "all" / study / "results.json").exists()
+        assert "[%s/report.md](%s/report.md)" % (study, study) in report
+
+
+def test_per_condition_networks_see_their_own_condition_alone():
+    # A per-condition network of the first condition is the pooled network of a run with that condition
+    # alone (the same crops, seeds and initial weights; its test captures are the first condition's in
+    # both); the pooled networks of both conditions differ from it.
+    conditions = tiny_config().conditions
+    perCondition = ab.runAblation(tiny_config(design="per-condition"))
+    alone = ab.runAblation(tiny_config(conditions=conditions[:1]))
+    pooled = ab.runAblation(tiny_config())
+    assert perCondition["config"]["design"] == "per-condition"
+    assert perCondition["conditions"][0]["arms"] == alone["conditions"][0]["arms"]
+    assert pooled["conditions"][0]["arms"]["ORACLE"]["psnr"] != alone["conditions"][0]["arms"]["ORACLE"]["psnr"]
+    assert perCondition["conditions"][1]["arms"]["ORACLE"]["psnr"] != pooled["conditions"][1]["arms"]["ORACLE"]["psnr"]
+    # The untrained floor does not depend on the design.
+    assert perCondition["conditions"][1]["arms"]["NOISY"] == pooled["conditions"][1]["arms"]["NOISY"]
+    with pytest.raises(ValueError, match="design must be one of pooled, per-condition"):
+        tiny_config(design="mixed").validate()
 
 
 def test_the_same_seeds_give_the_same_numbers_and_another_seed_does_not():
@@ -131,7 +188,9 @@ def test_a_blind_study_feeds_its_networks_the_image_only(tmp_path):
 def test_the_arms_are_fed_the_noise_they_claim():
     """On a flat mid-grey scene, the training inputs' noise variance (green planes, network scale) is the
     target's for ORACLE and ACCOUNT_PRIOR, (1 + prior share) times it for IGNORE_PRIOR and the share alone
-    for NONE: the four arms differ in exactly what the study says they differ in."""
+    for NONE: the four arms differ in exactly what the study says they differ in. The control arms too:
+    IGNORE_PRIOR rescaled and ACCOUNT_PRIOR with Poisson draws carry the target's variance, the oracle with
+    the prior share added (1 + share) times it."""
     config = ab.AblationConfig(conditions=[ab.Condition("x0.5", 0.5)], patch=256)
     study = ab._Study(config)
     condition = config.conditions[0]
@@ -141,7 +200,9 @@ def test_the_arms_are_fed_the_noise_they_claim():
     target = study.targetVariance(condition)
     share = study.priorShare(condition)
     expected = {"ORACLE": target, "ACCOUNT_PRIOR": target, "IGNORE_PRIOR": (1 + share) * target,
-                "NONE": share * target}
+                "NONE": share * target, "IGNORE_RESCALED": target, "ORACLE_PLUS_SHARE": (1 + share) * target,
+                "ACCOUNT_POISSON": target}
+    assert set(expected) == set(ab.TRAINED_ARMS)
     # 2 x 128 x 128 green samples: a sample variance's relative standard deviation is sqrt(2 / n) = 0.55%;
     # 4% is above 7 of them, and far below the 49% that separates ACCOUNT_PRIOR from IGNORE_PRIOR here.
     assert 0.4 < share < 0.6
@@ -151,6 +212,16 @@ def test_the_arms_are_fed_the_noise_they_claim():
         assert variance == pytest.approx(expected[arm], rel=0.04), arm
         # The noise map the network is given is the model's prediction for the target, for every arm.
         assert float(planes[5:7].double().pow(2).mean()) == pytest.approx(target, rel=0.04), arm
+    # Each control changes one thing of the arm it is made from and keeps its draws: IGNORE_RESCALED is
+    # IGNORE_PRIOR's noise scaled (on a flat plane by one factor, so perfectly correlated with it, up to
+    # float32 rounding), and ORACLE_PLUS_SHARE is the oracle's capture plus independent noise of the share's
+    # variance.
+    for plane in range(4):
+        ignore, rescaled = inputs["IGNORE_PRIOR"][plane].flatten(), inputs["IGNORE_RESCALED"][plane].flatten()
+        assert float(torch.corrcoef(torch.stack([ignore, rescaled]).double())[0, 1]) > 0.99999, plane
+    extra = (inputs["ORACLE_PLUS_SHARE"][1:3] - inputs["ORACLE"][1:3]).double()
+    assert float(extra.var()) == pytest.approx(share * target, rel=0.04)
+    assert abs(float(torch.corrcoef(torch.stack([extra.flatten(), inputs["ORACLE"][1:3].flatten().double()]))[0, 1])) < 0.02
 
 
 def test_ssim_and_psnr_on_known_cases():
@@ -195,6 +266,52 @@ def test_the_verdict_needs_the_interval_and_the_sign_flip_test():
     assert rows["NONE"]["pValue"] == pytest.approx(2 / 64) and rows["NONE"]["verdict"] == "ACCOUNT_PRIOR better"
     assert rows["ORACLE"]["accountMinusHigh"] < 0 and rows["ORACLE"]["pValue"] == pytest.approx(4 / 64)
     assert rows["ORACLE"]["verdict"] == "ACCOUNT_PRIOR leans worse"
+
+
+#: R 4.2.2's p.adjust(c(0.01, 0.04, 0.03, 0.005, 0.2, 0.03), "holm").
+HOLM_REFERENCE = [0.05, 0.12, 0.12, 0.03, 0.2, 0.12]
+
+
+def test_holms_correction_against_r():
+    # Reference: R 4.2's p.adjust(p, "holm") (Rscript -e 'print(p.adjust(c(0.01, 0.04, 0.03, 0.005, 0.2, 0.03),
+    # "holm"), digits=17)'), values exact to the float rounding of (m - i + 1) p; ties keep their order.
+    p = [0.01, 0.04, 0.03, 0.005, 0.2, 0.03]
+    assert ab.holmAdjusted(p) == pytest.approx(HOLM_REFERENCE, rel=1e-12)
+    assert ab.holmAdjusted([]) == [] and ab.holmAdjusted([0.7]) == [0.7]
+    # The fewest seeds whose exact sign-flip test reaches 0.05 / m: 2 / 2^n <= 0.05 / m.
+    assert [ab.seedsForFamily(m) for m in (1, 2, 12, 36, 51, 52)] == [6, 7, 9, 11, 11, 12]
+    # The planning figure: never fewer than the family's floor, more for a noisy difference, none for 0.
+    assert ab.seedsToConfirm(1.0, 0.0, 12) == 9 and ab.seedsToConfirm(0.0, 1.0, 12) is None
+    # (z sd / mean)^2 with z the normal quantile at 1 - 0.05 / (2 x 12): R's qnorm(1 - 0.05/24) = 2.865260239,
+    # so (2.865260239 x 2)^2 = 32.84, 33 seeds.
+    assert ab.seedsToConfirm(0.2, 0.4, 12) == 33
+
+
+def test_a_prediction_holds_only_when_every_condition_in_its_scope_agrees():
+    prediction = next(p for p in ab.PREDICTIONS if p.name == "excess variance (rescaled)")
+    assert (prediction.a, prediction.b, prediction.network, prediction.design, prediction.expect) == \
+        ("IGNORE_PRIOR", "IGNORE_RESCALED", "blind", "pooled", "a")
+
+    def row(condition, share, direction):
+        return {"condition": condition, "priorShare": share, "a": "IGNORE_PRIOR", "b": "IGNORE_RESCALED",
+                "metric": "psnr", "network": "blind", "design": "pooled", "directionHolm": direction, "n": 12,
+                "seedsForFamily": 11}
+
+    from rawgment.ablation_controls import predictionOutcome
+    # The small-share condition is out of its scope, whatever it shows.
+    assert predictionOutcome(prediction, [row("x0.5", 0.48, "a"), row("x0.2", 0.17, "a"), row("x0.01", 0.002, "b")])[0] \
+        == "held"
+    assert predictionOutcome(prediction, [row("x0.5", 0.48, "a"), row("x0.2", 0.17, None)])[0] == "undecided"
+    assert predictionOutcome(prediction, [row("x0.5", 0.48, "a"), row("x0.2", 0.17, "b")])[0] == "contradicted"
+    assert predictionOutcome(prediction, [row("x0.01", 0.002, "a")]) is None
+    tie = next(p for p in ab.PREDICTIONS if p.expect == "tie" and p.design == "pooled")
+    ties = [dict(row("x0.5", 0.48, None), a=tie.a, b=tie.b), dict(row("x0.2", 0.17, None), a=tie.a, b=tie.b)]
+    assert predictionOutcome(tie, ties)[0] == "held"
+    ties[1]["directionHolm"] = "b"
+    assert predictionOutcome(tie, ties)[0] == "contradicted"
+    # Below the seeds any corrected verdict needs, a tie is no evidence and nothing is decided.
+    ties[1].update(directionHolm=None, n=6)
+    assert predictionOutcome(tie, ties)[0].startswith("undecided (too few seeds")
 
 
 def test_paired_significance_against_known_cases():
