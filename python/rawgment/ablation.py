@@ -32,7 +32,8 @@ import rawgment as _rg
 from rawgment._ablation_common import (ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_ARMS, DESIGNS, TRAINED_ARMS, _ROLE_BATCH, _ROLE_NETWORK,
                                        _ROLE_SAMPLE, _ROLE_TEST_CAPTURE, _ROLE_TEST_SCENES, _ROLE_TRAIN_SCENES,
                                        _seed)
-from rawgment.ablation_report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, contrastRows, correctFamily,
+from rawgment.ablation_report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, contrastPairs, contrastRows,
+                                      correctFamily,
                                       holmAdjusted, pairedSignificance, seedsForFamily, seedsToConfirm, studyName,
                                       summarize, writeOutputs, writeStudiesOutputs)
 from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS
@@ -43,7 +44,7 @@ from rawgment.torch import packCfaPlanes
 __all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "CONTROL_ARMS", "DESIGNS", "defaultConditions",
            "quickConditions", "renderScene", "mosaicOfScene", "Denoiser", "psnr", "ssim", "runAblation",
            "pairedSignificance", "summarize", "writeOutputs", "NETWORKS", "BLIND_STEP", "SIGNIFICANCE",
-           "writeStudiesOutputs", "studyName", "holmAdjusted", "seedsForFamily", "seedsToConfirm", "contrastRows",
+           "writeStudiesOutputs", "studyName", "seedsNeeded", "holmAdjusted", "seedsForFamily", "seedsToConfirm", "contrastRows",
            "correctFamily", "PREDICTIONS", "CONTROL_CONTRASTS", "main"]
 
 ALIGNMENTS = {"NONE": _rg.NoiseAlignment.NONE, "IGNORE_PRIOR": _rg.NoiseAlignment.IGNORE_PRIOR,
@@ -95,7 +96,9 @@ class AblationConfig:
     baseGain: float = 10.0 ** (12.0 / 20.0)
     conditions: list = dataclasses.field(default_factory=defaultConditions)
     arms: tuple = DEFAULT_ARMS
-    seeds: int = 6                  # training replicates (network initialisation and data order)
+    # Training replicates (network initialisation and data order); 0: the fewest whose tests can reach a
+    # verdict after Holm's correction over the study's tests (seedsNeeded()).
+    seeds: int = 0
     seed: int = 0                   # the base seed of everything
     iterations: int = 800
     batch: int = 16
@@ -154,7 +157,9 @@ class AblationConfig:
         unknown = [a for a in self.arms if a not in ARMS]
         if unknown or not self.arms:
             raise ValueError("unknown arm(s) %s; the arms are %s" % (", ".join(unknown), ", ".join(ARMS)))
-        for name in ("seeds", "iterations", "batch", "trainScenes", "testScenes", "width"):
+        if int(self.seeds) < 0:
+            raise ValueError("seeds must be >= 1 (or 0: as many as the study's tests need), got %r" % self.seeds)
+        for name in ("iterations", "batch", "trainScenes", "testScenes", "width"):
             if int(getattr(self, name)) < 1:
                 raise ValueError("%s must be >= 1, got %r" % (name, getattr(self, name)))
         for name in ("patch", "trainSceneSize", "testSceneSize"):
@@ -354,7 +359,8 @@ class _Study:
 def _train(study, arms, replicate, trainMeans, conditions, log=None):
     """Trains one network per arm, in lockstep, on `conditions` (each crop draws one of them; all of the
     run's in the pooled design: the network one would deploy for all of the camera's exposures; one in the
-    per-condition design, whose networks see that condition's inputs alone). The crops, their conditions, the noise seeds and the initialisation depend on the
+    per-condition design, whose networks see that condition's inputs alone). The crops, their conditions,
+    the noise seeds and the initialisation depend on the
     replicate only, so every arm sees the same scenes in the same order from the same starting weights;
     the augmented arms even start from the same bright captures."""
     config = study.config
@@ -420,10 +426,20 @@ def _defaultThreads():
     return value if value > 0 else (os.cpu_count() or 1)
 
 
+def seedsNeeded(config, studies=1):
+    """The fewest replicates whose exact sign-flip tests can reach SIGNIFICANCE after Holm's correction
+    over the tests of `studies` studies of this configuration (each makes contrastPairs() in every
+    condition): seedsForFamily() of their number; 6 when they make no test."""
+    return seedsForFamily(len(contrastPairs(config.arms)) * len(config.conditions) * studies)
+
+
 def runAblation(config, log=None):
     """Runs the study and returns its results as a dict (see results.json): for every condition and
-    arm, the PSNR and SSIM of each replicate. `log` (a function of one string) receives progress."""
+    arm, the PSNR and SSIM of each replicate. `log` (a function of one string) receives progress.
+    config.seeds 0 runs seedsNeeded(config)."""
     config.validate()
+    if not config.seeds:
+        config = dataclasses.replace(config, seeds=seedsNeeded(config))
     threads = int(config.threads) if config.threads else _defaultThreads()
     torch.set_num_threads(threads)
     torch.use_deterministic_algorithms(True)
@@ -488,9 +504,10 @@ def _parser():
                     "IGNORE_PRIOR, ACCOUNT_PRIOR), an oracle trained on captures simulated at the target, and "
                     "the noisy input as the floor; tests all on captures simulated at the target; writes "
                     "report.md, results.json, results.csv and psnr.png.",
-        epilog="The default budget (9 conditions x 3 trained arms x 6 seeds, told and blind networks) takes "
-               "about 20 minutes on 2 cores; --quick, a smoke test that learns almost nothing, about 30 s. "
-               "See docs/ablation.md.")
+        epilog="The default run (9 conditions x 3 trained arms, told and blind networks, 12 seeds: the fewest "
+               "whose 54 tests can reach a verdict after Holm's correction) takes about 40 minutes on 2 cores; "
+               "--per-condition trains as many more networks per study as there are conditions; --quick, a "
+               "smoke test that learns almost nothing, about 30 s. See docs/ablation.md.")
     parser.add_argument("--model", help="the sensor's noise model: rawgment_calibrate's model.yml (with its "
                                         "dark-frame components, if any), an Android profile YAML, or darktable's "
                                         "noiseprofiles.json with --camera; default: the simulator's default "
@@ -504,7 +521,9 @@ def _parser():
     parser.add_argument("--quick", action="store_true",
                         help="2 conditions, 2 seeds, 100 iterations of 8 crops, 4 test scenes: a check that it "
                              "all runs")
-    parser.add_argument("--seeds", type=int, help="training replicates (default 6; --quick 2)")
+    parser.add_argument("--seeds", type=int,
+                        help="training replicates (default: the fewest whose sign-flip tests can reach p <= 0.05 "
+                             "after Holm's correction over the run's tests, 12 for the default run; --quick 2)")
     parser.add_argument("--seed", type=int, default=0, help="base seed of everything (default 0)")
     parser.add_argument("--iterations", type=int, help="training iterations per network (default 800)")
     parser.add_argument("--arms", help="comma-separated subset of %s (default %s)"
@@ -583,7 +602,7 @@ def _argumentErrors(args):
         errors.append("--black-level must be finite and >= 0, got %r" % args.black_level)
     if not math.isfinite(args.blind_step):
         errors.append("--blind-step must be finite, got %r" % args.blind_step)
-    for name in ("seeds", "iterations"):
+    for name in ("seeds", "iterations"):  # argparse's None: the default
         value = getattr(args, name)
         if value is not None and value < 1:
             errors.append("--%s must be >= 1, got %d" % (name, value))
@@ -653,6 +672,8 @@ def main(argv=None):
         print("rawgment.ablation: %s" % e, file=sys.stderr)
         return 2
     studies = [(n, d) for n in networks for d in designs]
+    if not config.seeds:
+        config.seeds = seedsNeeded(config, len(studies))
     conflict = _outputConflicts(args.out, [studyName(n, d) for n, d in studies])
     if conflict is not None:
         print("rawgment.ablation: %s" % conflict, file=sys.stderr)

@@ -280,6 +280,11 @@ def test_holms_correction_against_r():
     assert ab.holmAdjusted([]) == [] and ab.holmAdjusted([0.7]) == [0.7]
     # The fewest seeds whose exact sign-flip test reaches 0.05 / m: 2 / 2^n <= 0.05 / m.
     assert [ab.seedsForFamily(m) for m in (1, 2, 12, 36, 51, 52)] == [6, 7, 9, 11, 11, 12]
+    # The default run's 2 studies of 9 conditions make 3 tests each (ACCOUNT_PRIOR minus IGNORE_PRIOR and
+    # ORACLE, and the removed/noise contrast): 54 tests, 12 seeds. Without a test, the old default of 6.
+    assert ab.seedsNeeded(ab.AblationConfig(), 2) == 12
+    assert ab.seedsNeeded(ab.AblationConfig(arms=("ORACLE", "NOISY"))) == 6
+    assert ab.runAblation(tiny_config(seeds=0, arms=("ORACLE", "NOISY")))["config"]["seeds"] == 6
     # The planning figure: never fewer than the family's floor, more for a noisy difference, none for 0.
     assert ab.seedsToConfirm(1.0, 0.0, 12) == 9 and ab.seedsToConfirm(0.0, 1.0, 12) is None
     # (z sd / mean)^2 with z the normal quantile at 1 - 0.05 / (2 x 12): R's qnorm(1 - 0.05/24) = 2.865260239,
