@@ -280,14 +280,20 @@ class _Study:
         prior, target, expected = self.priorAndTargetVariance(mean, condition)
         black = float(self.format.blackLevel[0])
         noise = raw.astype(np.float64) - black - expected
-        return (black + expected + noise * np.sqrt(target / (prior + target))).astype(np.float32)
+        return self.asCapture(black + expected + noise * np.sqrt(target / (prior + target)))
 
     def withPriorShare(self, raw, mean, condition, seed):
         """ORACLE_PLUS_SHARE: a capture at the target plus Gaussian noise of the darkened prior's
         variance, so that it carries what IGNORE_PRIOR carries in excess of the target, on real noise."""
         prior, _, _ = self.priorAndTargetVariance(mean, condition)
         draw = np.random.default_rng(_rg.deriveSeed(seed, _rg.SEED_ABLATION, 4)).standard_normal(raw.shape)
-        return (raw.astype(np.float64) + np.sqrt(prior) * draw).astype(np.float32)
+        return self.asCapture(raw.astype(np.float64) + np.sqrt(prior) * draw)
+
+    def asCapture(self, values):
+        """Values in DN rounded and clipped to the sensor's range, in the captures' type: the control arms'
+        inputs are on the same integer grid as every other arm's (a network could tell a continuous input
+        from a quantised one, which is not the change a control is about)."""
+        return np.clip(np.rint(values), 0, self.format.whiteLevel).astype(np.uint16)
 
     def inputPlanes(self, raw, condition):
         """A dark mosaic as the network sees it: black-subtracted, normalised, packed and brightened by
