@@ -35,7 +35,7 @@ from rawgment._ablation_common import (ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_A
 from rawgment.ablation_report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, contrastPairs, contrastRows,
                                       correctFamily,
                                       holmAdjusted, pairedSignificance, seedsForFamily, seedsToConfirm, studyName,
-                                      summarize, writeOutputs, writeStudiesOutputs)
+                                      summarize, writeCombinedReport, writeOutputs, writeStudiesOutputs)
 from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS
 from rawgment.ablation_network import Denoiser, psnr, ssim
 from rawgment.ablation_scenes import mosaicOfScene, renderScene
@@ -44,7 +44,8 @@ from rawgment.torch import packCfaPlanes
 __all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "CONTROL_ARMS", "DESIGNS", "defaultConditions",
            "quickConditions", "renderScene", "mosaicOfScene", "Denoiser", "psnr", "ssim", "runAblation",
            "pairedSignificance", "summarize", "writeOutputs", "NETWORKS", "BLIND_STEP", "SIGNIFICANCE",
-           "writeStudiesOutputs", "studyName", "seedsNeeded", "holmAdjusted", "seedsForFamily", "seedsToConfirm", "contrastRows",
+           "writeStudiesOutputs", "writeCombinedReport", "studyName", "seedsNeeded", "holmAdjusted", "seedsForFamily",
+           "seedsToConfirm", "contrastRows",
            "correctFamily", "PREDICTIONS", "CONTROL_CONTRASTS", "main"]
 
 ALIGNMENTS = {"NONE": _rg.NoiseAlignment.NONE, "IGNORE_PRIOR": _rg.NoiseAlignment.IGNORE_PRIOR,
@@ -550,6 +551,10 @@ def _parser():
                              "conditions, each crop drawing its condition; default) and per-condition (one network "
                              "per arm and condition, trained on that condition alone); each study is a network and "
                              "a design, written into its own subfolder when there are several")
+    parser.add_argument("--combine", nargs="+", metavar="STUDY",
+                        help="train nothing: write --out/report.md setting side by side the studies of earlier runs "
+                             "(their folders, each with its results.json), Holm-corrected over all their tests "
+                             "together")
     parser.add_argument("--per-condition", action="store_true",
                         help="the same as --designs pooled,per-condition: per-condition networks beside the pooled "
                              "ones, the report setting both side by side")
@@ -616,12 +621,26 @@ def _argumentErrors(args):
 
 
 def main(argv=None):
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
     errors = _argumentErrors(args)
     if errors:
         for e in errors:
             print("rawgment.ablation: %s" % e, file=sys.stderr)
         return 2
+    if args.combine:
+        unused = ["--" + a.dest.replace("_", "-") for a in parser._actions
+                  if a.dest not in ("help", "combine", "out") and getattr(args, a.dest) != a.default]
+        if unused:
+            print("rawgment.ablation: --combine trains nothing, so %s would be ignored" % ", ".join(unused),
+                  file=sys.stderr)
+            return 2
+        try:
+            print(writeCombinedReport(args.combine, args.out))
+        except ValueError as e:
+            print("rawgment.ablation: %s" % e, file=sys.stderr)
+            return 2
+        return 0
     config = AblationConfig()
     if args.quick:
         config.conditions = quickConditions()

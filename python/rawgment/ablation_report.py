@@ -13,7 +13,7 @@ import rawgment as _rg
 from rawgment._ablation_common import ARMS, BLIND_STEP, TRAINED_ARMS, _ROLE_BOOTSTRAP, _seed
 from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS, predictionOutcome
 
-__all__ = ["pairedSignificance", "summarize", "writeOutputs", "writeStudiesOutputs", "studyName", "holmAdjusted", "seedsForFamily",
+__all__ = ["pairedSignificance", "summarize", "writeOutputs", "writeStudiesOutputs", "writeCombinedReport", "loadStudy", "studyName", "holmAdjusted", "seedsForFamily",
            "seedsToConfirm", "contrastRows", "correctFamily", "NETWORKS", "SIGNIFICANCE"]
 
 
@@ -457,7 +457,54 @@ def writeStudiesOutputs(byStudy, outDir):
     return written + [path], notes
 
 
-def _studiesReport(byStudy, rowsOf):
+def loadStudy(folder):
+    """A study's results.json from its folder, checked for what the side-by-side page reads; a ValueError
+    naming the file when it is missing or not a study's."""
+    path = os.path.join(folder, "results.json")
+    try:
+        with open(path, encoding="utf-8") as f:
+            results = json.load(f)
+        config = results["config"]
+        if not isinstance(results["conditions"], list) or not results["conditions"] or "seeds" not in config:
+            raise KeyError("conditions")
+    except OSError as e:
+        raise ValueError("'%s' cannot be read: %s" % (path, e.strerror or e)) from None
+    except (ValueError, KeyError, TypeError) as e:
+        raise ValueError("'%s' is not the results.json of a rawgment.ablation study (%s)" % (path, e)) from None
+    return results
+
+
+def writeCombinedReport(folders, outDir):
+    """The side-by-side page of studies written by separate runs (their folders, each with its
+    results.json): outDir/report.md, Holm-corrected over all their tests together, linking to each study's
+    own report. Refuses (ValueError) two studies of one network and design (their shared arms would be
+    counted twice), studies of different conditions, and an existing report.md. Returns its path."""
+    byStudy, links = {}, {}
+    for folder in folders:
+        results = loadStudy(folder)
+        config = results["config"]
+        name = studyName("told" if config.get("noiseMaps", True) else "blind", config.get("design", "pooled"))
+        if name in byStudy:
+            raise ValueError("'%s' and '%s' are both a %s study: give one of them" % (links[name], folder, name))
+        byStudy[name], links[name] = results, folder
+    conditions = [[e["condition"] for e in r["conditions"]] for r in byStudy.values()]
+    if any(c != conditions[0] for c in conditions):
+        raise ValueError("the studies were run on different conditions: %s" % "; ".join(
+            "%s: %s" % (n, ", ".join(c["name"] for c in cs)) for n, cs in zip(byStudy, conditions)))
+    path = os.path.join(outDir, "report.md")
+    if os.path.lexists(path):
+        raise ValueError("'%s' exists: outputs are never replaced" % path)
+    os.makedirs(outDir, exist_ok=True)
+    relative = {n: os.path.relpath(f, outDir) for n, f in links.items()}
+    _rg.writeFileAtomically(path, _studiesReport(byStudy, {n: summarize(r) for n, r in byStudy.items()},
+                                                 relative).encode())
+    return path
+
+
+def _studiesReport(byStudy, rowsOf, folders=None):
+    """The side-by-side page; `folders` maps each study to its folder relative to the page (default: its
+    name, a subfolder)."""
+    folders = folders or {n: n for n in byStudy}
     names = list(byStudy)
     first = byStudy[names[0]]
     conditions = [entry["condition"]["name"] for entry in first["conditions"]]
@@ -475,7 +522,7 @@ def _studiesReport(byStudy, rowsOf):
     for n in names:
         r = byStudy[n]
         out.append("- **%s**: [%s/report.md](%s/report.md), %d seed(s), %.0f s, CPU path %s." % (
-            n, n, n, r["config"]["seeds"], r["seconds"], r["cpuPath"]))
+            n, folders[n], folders[n], r["config"]["seeds"], r["seconds"], r["cpuPath"]))
     if family:
         tested = family[0]["family"]
         seeds = max(r["n"] for r in family)
@@ -518,5 +565,5 @@ def _studiesReport(byStudy, rowsOf):
                 row["verdictHolm"] = corrected[(row["condition"], row["arm"])]
         out += ["", "## %s" % n, ""]
         out += _findings(rowsOf[n], conditions, byStudy[n]["config"]["arms"])
-        out += ["", "![PSNR against darkening, %s](%s/psnr.png)" % (n, n)]
+        out += ["", "![PSNR against darkening, %s](%s/psnr.png)" % (n, folders[n])]
     return "\n".join(out) + "\n"

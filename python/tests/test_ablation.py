@@ -131,6 +131,38 @@ def test_the_studies_report_sets_each_studys_differences_side_by_side_corrected_
         assert "[%s/report.md](%s/report.md)" % (study, study) in report
 
 
+def test_studies_of_separate_runs_are_combined_into_one_corrected_page(tmp_path):
+    # --combine reads the studies' results.json and writes the side-by-side page alone, Holm-corrected over
+    # all their tests, linking to each study where it is; it refuses what would make a wrong page.
+    studies = {"told": tiny_config(), "blind-per-condition": tiny_config(noiseMaps=False, design="per-condition")}
+    for name, config in studies.items():
+        ab.writeOutputs(ab.runAblation(config), str(tmp_path / "runs" / name / "study"))
+    folders = [str(tmp_path / "runs" / name / "study") for name in studies]
+    page = tmp_path / "page"
+    assert ab.main(["--combine", *folders, "--out", str(page)]) == 0
+    report = (page / "report.md").read_text()
+    assert "over all 12 tests of this page together" in report  # 2 studies x 2 conditions x 3 tests
+    assert "[../runs/told/study/report.md](../runs/told/study/report.md)" in report
+    assert "| condition | prior share | told: minus IGNORE_PRIOR | blind-per-condition: minus IGNORE_PRIOR |" in report
+
+    def refused(argv, message):
+        run = subprocess.run([sys.executable, "-m", "rawgment.ablation", *argv], capture_output=True, text=True)
+        assert run.returncode == 2 and message in run.stderr and "Traceback" not in run.stderr, run.stderr
+
+    refused(["--combine", *folders, "--out", str(page)], "exists: outputs are never replaced")
+    refused(["--combine", folders[0], folders[0], "--out", str(tmp_path / "p2")], "are both a told study")
+    refused(["--combine", str(tmp_path), "--out", str(tmp_path / "p3")], "results.json' cannot be read")
+    (tmp_path / "bad").mkdir()
+    (tmp_path / "bad" / "results.json").write_text("{\"config\": {}}")
+    refused(["--combine", str(tmp_path / "bad"), "--out", str(tmp_path / "p4")], "is not the results.json of a")
+    refused(["--combine", *folders, "--seeds", "3", "--out", str(tmp_path / "p5")],
+            "--combine trains nothing, so --seeds would be ignored")
+    other = str(tmp_path / "runs" / "other")
+    ab.writeOutputs(ab.runAblation(tiny_config(conditions=tiny_config().conditions[:1])), other)
+    refused(["--combine", folders[1], other, "--out", str(tmp_path / "p6")], "run on different conditions")
+    assert not any((tmp_path / p).exists() for p in ("p2", "p3", "p4", "p5", "p6"))
+
+
 def test_per_condition_networks_see_their_own_condition_alone():
     # A per-condition network of the first condition is the pooled network of a run with that condition
     # alone (the same crops, seeds and initial weights; its test captures are the first condition's in
