@@ -29,24 +29,22 @@ import numpy as np
 import torch
 
 import rawgment as _rg
-from rawgment._ablation_common import (ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_ARMS, DESIGNS, TRAINED_ARMS, _ROLE_BATCH, _ROLE_NETWORK,
-                                       _ROLE_SAMPLE, _ROLE_TEST_CAPTURE, _ROLE_TEST_SCENES, _ROLE_TRAIN_SCENES,
-                                       _seed)
+from rawgment._ablation_common import (ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_ARMS, DESIGNS, TRAINED_ARMS,
+                                       _ROLE_BATCH, _ROLE_NETWORK, _ROLE_SAMPLE, _ROLE_TEST_CAPTURE, _ROLE_TEST_SCENES,
+                                       _ROLE_TRAIN_SCENES, _seed)
 from rawgment.ablation_report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, contrastPairs, contrastRows,
-                                      correctFamily,
-                                      holmAdjusted, pairedSignificance, seedsForFamily, seedsToConfirm, studyName,
-                                      summarize, writeCombinedReport, writeOutputs, writeStudiesOutputs)
+                                      correctFamily, holmAdjusted, pairedSignificance, seedsForFamily, seedsToConfirm,
+                                      studyName, summarize, writeCombinedReport, writeOutputs, writeStudiesOutputs)
 from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS
 from rawgment.ablation_network import Denoiser, psnr, ssim
 from rawgment.ablation_scenes import mosaicOfScene, renderScene
 from rawgment.torch import packCfaPlanes
 
-__all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "CONTROL_ARMS", "DESIGNS", "defaultConditions",
-           "quickConditions", "renderScene", "mosaicOfScene", "Denoiser", "psnr", "ssim", "runAblation",
-           "pairedSignificance", "summarize", "writeOutputs", "NETWORKS", "BLIND_STEP", "SIGNIFICANCE",
+__all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "CONTROL_ARMS", "DESIGNS",
+           "defaultConditions", "quickConditions", "renderScene", "mosaicOfScene", "Denoiser", "psnr", "ssim",
+           "runAblation", "pairedSignificance", "summarize", "writeOutputs", "NETWORKS", "BLIND_STEP", "SIGNIFICANCE",
            "writeStudiesOutputs", "writeCombinedReport", "studyName", "seedsNeeded", "holmAdjusted", "seedsForFamily",
-           "seedsToConfirm", "contrastRows",
-           "correctFamily", "PREDICTIONS", "CONTROL_CONTRASTS", "main"]
+           "seedsToConfirm", "contrastRows", "correctFamily", "PREDICTIONS", "CONTROL_CONTRASTS", "main"]
 
 ALIGNMENTS = {"NONE": _rg.NoiseAlignment.NONE, "IGNORE_PRIOR": _rg.NoiseAlignment.IGNORE_PRIOR,
               "ACCOUNT_PRIOR": _rg.NoiseAlignment.ACCOUNT_PRIOR}
@@ -367,9 +365,9 @@ def _train(study, arms, replicate, trainMeans, conditions, log=None):
     """Trains one network per arm, in lockstep, on `conditions` (each crop draws one of them; all of the
     run's in the pooled design: the network one would deploy for all of the camera's exposures; one in the
     per-condition design, whose networks see that condition's inputs alone). The crops, their conditions,
-    the noise seeds and the initialisation depend on the
-    replicate only, so every arm sees the same scenes in the same order from the same starting weights;
-    the augmented arms even start from the same bright captures."""
+    the noise seeds and the initialisation depend on the replicate only, so every arm sees the same scenes
+    in the same order from the same starting weights; the augmented arms even start from the same bright
+    captures."""
     config = study.config
     nets, optimisers, schedules = {}, {}, {}
     for arm in arms:
@@ -406,10 +404,10 @@ def _train(study, arms, replicate, trainMeans, conditions, log=None):
 
 def _evaluate(net, testSet):
     """Mean PSNR and SSIM over the test set (network output clipped to [0, 1]; net None: the input), and
-    the network's implicit noise estimate: the variance of what it removed (input minus output) over the
-    variance of the true noise (input minus clean), summed over the test set. 1 removes as much as the
-    noise holds; below 1 the network takes the noise for less than it is, above 1 for more (or removes
-    signal); 0 for the input itself."""
+    the network's implicit noise estimate: the mean square of what it removed (input minus output) over
+    that of the true noise (input minus clean), over the whole test set. 1 removes as much as the noise
+    holds; below 1 the network takes the noise for less than it is, above 1 for more (or removes signal);
+    about 0 for the input itself (only the clip to [0, 1] removes anything)."""
     psnrs, ssims, removed, noise = [], [], 0.0, 0.0
     with torch.no_grad():
         for noisy, clean in testSet:
@@ -572,15 +570,15 @@ def _parser():
 OUTPUT_FILES = ("results.json", "results.csv", "psnr.png", "report.md")
 
 
-def _outputConflicts(outDir, networks):
+def _outputConflicts(outDir, studies):
     """Why the outputs could not be written into outDir (None when they can), checked before any training:
-    the files are never replaced, so a previous run's would make the whole run fail at its end. `networks`:
+    the files are never replaced, so a previous run's would make the whole run fail at its end. `studies`:
     the studies' folder names (studyName())."""
     if os.path.lexists(outDir) and not os.path.isdir(outDir):
         return "--out '%s' exists and is not a folder" % outDir
-    folders = [outDir] if len(networks) == 1 else [os.path.join(outDir, n) for n in networks]
+    folders = [outDir] if len(studies) == 1 else [os.path.join(outDir, n) for n in studies]
     paths = [os.path.join(f, name) for f in folders for name in OUTPUT_FILES]
-    if len(networks) > 1:
+    if len(studies) > 1:
         paths += [os.path.join(outDir, "report.md")]
         paths = [p for p in paths if not os.path.isdir(p)]
         for f in folders:

@@ -308,8 +308,8 @@ def _report(results, rows, plotNote):
     if any("removed" in r for r in rows):
         trained = [a for a in arms if a in TRAINED_ARMS]
         out += ["", "## The networks' implicit noise estimate: removed / noise, mean ± s.d. over seeds", "",
-                "The variance of what each network removes from the test inputs (input minus output) over the "
-                "variance of their true noise (input minus clean): 1 removes as much as the noise holds, below 1 "
+                "The mean square of what each network removes from the test inputs (input minus output) over "
+                "that of their true noise (input minus clean): 1 removes as much as the noise holds, below 1 "
                 "the network takes the noise for less than it is, above 1 for more (or it removes signal too).",
                 "", "| condition | " + " | ".join(trained) + " |", "|---|" + "---|" * len(trained)]
         for name in conditions:
