@@ -10,7 +10,8 @@ __all__ = ["Prediction", "PREDICTIONS", "CONTROL_CONTRASTS", "predictionOutcome"
 #: The contrasts of the control arms, each (a, b, metric): a minus b, paired by replicate. The first three
 #: isolate one change each; the last compares what the networks of the two alignments remove.
 CONTROL_CONTRASTS = (("IGNORE_PRIOR", "IGNORE_RESCALED", "psnr"), ("ORACLE_PLUS_SHARE", "ORACLE", "psnr"),
-                     ("ACCOUNT_POISSON", "ACCOUNT_PRIOR", "psnr"), ("IGNORE_PRIOR", "ACCOUNT_PRIOR", "removedNoiseRatio"))
+                     ("ACCOUNT_POISSON", "ACCOUNT_PRIOR", "psnr"),
+                     ("IGNORE_PRIOR", "ACCOUNT_PRIOR", "removedNoiseRatio"))
 
 #: Where the prior share is large enough for IGNORE_PRIOR's excess variance to matter (x0.5 and x0.2 of the
 #: default conditions: 0.48 and 0.17), and where it is negligible (x0.05 and x0.01: 0.028 and 0.002).

@@ -1,6 +1,6 @@
-"""The report of rawgment.ablation: paired significance by sign-flip bootstrap, the summary rows, the PSNR
-plot, report.md, results.json and results.csv, for one kind of network or both side by side. Use it through
-rawgment.ablation."""
+"""The report of rawgment.ablation: paired significance (bootstrap interval, sign-flip test) with Holm's
+correction over a report's tests, the summary rows, the PSNR plot, report.md, results.json and results.csv,
+for one study or several side by side. Use it through rawgment.ablation."""
 import json
 import math
 import os
@@ -13,8 +13,9 @@ import rawgment as _rg
 from rawgment._ablation_common import ARMS, BLIND_STEP, TRAINED_ARMS, _ROLE_BOOTSTRAP, _seed
 from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS, predictionOutcome
 
-__all__ = ["pairedSignificance", "summarize", "writeOutputs", "writeStudiesOutputs", "writeCombinedReport", "loadStudy", "studyName", "holmAdjusted", "seedsForFamily",
-           "seedsToConfirm", "contrastRows", "correctFamily", "NETWORKS", "SIGNIFICANCE"]
+__all__ = ["pairedSignificance", "summarize", "writeOutputs", "writeStudiesOutputs", "writeCombinedReport", "loadStudy",
+           "studyName", "holmAdjusted", "seedsForFamily", "seedsToConfirm", "contrastRows", "correctFamily", "NETWORKS",
+           "SIGNIFICANCE"]
 
 
 def _meanSd(values):
@@ -368,7 +369,8 @@ def _testsTable(contrasts):
            "for any verdict; this run has %d. Seeds to confirm: the seeds at which a difference of this mean and "
            "spread would reach the strictest Holm step (normal approximation; a planning figure)."
            % (family, SIGNIFICANCE, SIGNIFICANCE, family, seedsForFamily(family), seeds), "",
-           "| condition | prior share | a minus b | measure | difference | seeds to confirm |", "|---|---|---|---|---|---|"]
+           "| condition | prior share | a minus b | measure | difference | seeds to confirm |",
+           "|---|---|---|---|---|---|"]
     for r in contrasts:
         out.append("| %s | %.3f | %s minus %s | %s | %s | %s |" % (
             r["condition"], r["priorShare"], r["a"], r["b"], "PSNR dB" if r["metric"] == "psnr" else "removed/noise",
