@@ -98,6 +98,10 @@ class AblationConfig:
     # Training replicates (network initialisation and data order); 0: the fewest whose tests can reach a
     # verdict after Holm's correction over the study's tests (seedsNeeded()).
     seeds: int = 0
+    # The index of the first replicate: a run with firstReplicate = n trains replicates n, n+1, ... of the
+    # same base seed (the same scenes and test captures), so that a study can be extended with more seeds
+    # and the runs merged (--combine).
+    firstReplicate: int = 0
     seed: int = 0                   # the base seed of everything
     iterations: int = 800
     batch: int = 16
@@ -156,6 +160,8 @@ class AblationConfig:
         unknown = [a for a in self.arms if a not in ARMS]
         if unknown or not self.arms:
             raise ValueError("unknown arm(s) %s; the arms are %s" % (", ".join(unknown), ", ".join(ARMS)))
+        if not 0 <= int(self.firstReplicate) < 1 << 16:
+            raise ValueError("firstReplicate must be in [0, 65536), got %r" % self.firstReplicate)
         if int(self.seeds) < 0:
             raise ValueError("seeds must be >= 1 (or 0: as many as the study's tests need), got %r" % self.seeds)
         for name in ("iterations", "batch", "trainScenes", "testScenes", "width"):
@@ -466,7 +472,8 @@ def runAblation(config, log=None):
     # design one set per replicate and condition, each tested on its own condition only.
     groups = [list(range(len(config.conditions)))] if config.design == "pooled" else \
         [[ci] for ci in range(len(config.conditions))]
-    for replicate in range(config.seeds):
+    replicates = range(config.firstReplicate, config.firstReplicate + config.seeds)
+    for done, replicate in enumerate(replicates):
         for group in groups:
             if trained and len(groups) > 1 and log is not None:
                 log("  seed %d: networks for %s" % (replicate, config.conditions[group[0]].name))
@@ -482,8 +489,8 @@ def runAblation(config, log=None):
                 log("  seed %d %-17s PSNR %s dB" % (replicate, arm,
                                                     " ".join("%.2f" % s["psnr"][-1] for s in scores[arm])))
             elapsed = time.monotonic() - started
-            log("[%d/%d seeds] %.0f s, about %.0f s left" % (replicate + 1, config.seeds, elapsed,
-                                                           elapsed / (replicate + 1) * (config.seeds - replicate - 1)))
+            log("[%d/%d seeds] %.0f s, about %.0f s left" % (done + 1, config.seeds, elapsed,
+                                                           elapsed / (done + 1) * (config.seeds - done - 1)))
     conditions = [{"condition": dataclasses.asdict(c), "priorShare": study.priorShare(c),
                    "arms": {arm: scores[arm][ci] for arm in config.arms}} for ci, c in enumerate(config.conditions)]
     configDict = {k: v for k, v in dataclasses.asdict(config).items() if k not in ("model", "conditions")}
@@ -530,6 +537,10 @@ def _parser():
                         help="training replicates (default: the fewest whose sign-flip tests can reach p <= 0.05 "
                              "after Holm's correction over the run's tests, 12 for the default run; --quick 2)")
     parser.add_argument("--seed", type=int, default=0, help="base seed of everything (default 0)")
+    parser.add_argument("--first-replicate", type=int, default=0,
+                        help="index of the first replicate (default 0): --first-replicate 12 --seeds 12 trains "
+                             "replicates 12 to 23 of the same base seed, which --combine merges with a run of "
+                             "replicates 0 to 11 into one study")
     parser.add_argument("--iterations", type=int, help="training iterations per network (default 800)")
     parser.add_argument("--arms", help="comma-separated subset of %s (default %s)"
                                        % (",".join(ARMS), ",".join(DEFAULT_ARMS)))
@@ -601,6 +612,8 @@ def _argumentErrors(args):
     errors = []
     if not 0 <= args.seed < 2 ** 64:
         errors.append("--seed must be in [0, 2^64), got %d" % args.seed)
+    if not 0 <= args.first_replicate < 1 << 16:
+        errors.append("--first-replicate must be in [0, 65536), got %d" % args.first_replicate)
     if args.threads < 0:
         errors.append("--threads must be >= 0 (0: all cores), got %d" % args.threads)
     if not math.isfinite(args.base_gain_db):
@@ -660,7 +673,7 @@ def main(argv=None):
         print("rawgment.ablation: --camera needs --model (a darktable profile file)", file=sys.stderr)
         return 2
     config.baseGain = _rg.dbToLinearGain(args.base_gain_db)
-    config.seed, config.threads = args.seed, args.threads
+    config.seed, config.threads, config.firstReplicate = args.seed, args.threads, args.first_replicate
     networks = ["blind"] if args.blind else [n.strip() for n in args.networks.split(",") if n.strip()]
     if not networks or any(n not in NETWORKS for n in networks) or len(set(networks)) != len(networks):
         print("rawgment.ablation: --networks must be told, blind or told,blind, got '%s'" % args.networks,
