@@ -34,7 +34,8 @@ from rawgment._ablation_common import (ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_A
                                        _ROLE_TRAIN_SCENES, _seed)
 from rawgment.ablation_report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, contrastPairs, contrastRows,
                                       correctFamily, holmAdjusted, pairedSignificance, seedsForFamily, seedsToConfirm,
-                                      studyName, summarize, writeCombinedReport, writeOutputs, writeStudiesOutputs)
+                                      mergeReplicates, studyName, summarize, writeCombinedReport, writeOutputs,
+                                      writeStudiesOutputs)
 from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS
 from rawgment.ablation_network import Denoiser, psnr, ssim
 from rawgment.ablation_scenes import mosaicOfScene, renderScene
@@ -43,7 +44,7 @@ from rawgment.torch import packCfaPlanes
 __all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "CONTROL_ARMS", "DESIGNS",
            "defaultConditions", "quickConditions", "renderScene", "mosaicOfScene", "Denoiser", "psnr", "ssim",
            "runAblation", "pairedSignificance", "summarize", "writeOutputs", "NETWORKS", "BLIND_STEP", "SIGNIFICANCE",
-           "writeStudiesOutputs", "writeCombinedReport", "studyName", "seedsNeeded", "holmAdjusted", "seedsForFamily",
+           "writeStudiesOutputs", "writeCombinedReport", "mergeReplicates", "studyName", "seedsNeeded", "holmAdjusted", "seedsForFamily",
            "seedsToConfirm", "contrastRows", "correctFamily", "PREDICTIONS", "CONTROL_CONTRASTS", "main"]
 
 ALIGNMENTS = {"NONE": _rg.NoiseAlignment.NONE, "IGNORE_PRIOR": _rg.NoiseAlignment.IGNORE_PRIOR,

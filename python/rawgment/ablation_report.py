@@ -13,7 +13,7 @@ import rawgment as _rg
 from rawgment._ablation_common import ARMS, BLIND_STEP, TRAINED_ARMS, _ROLE_BOOTSTRAP, _seed
 from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS, predictionOutcome
 
-__all__ = ["pairedSignificance", "summarize", "writeOutputs", "writeStudiesOutputs", "writeCombinedReport", "loadStudy",
+__all__ = ["pairedSignificance", "summarize", "writeOutputs", "writeStudiesOutputs", "writeCombinedReport", "mergeReplicates", "loadStudy",
            "studyName", "holmAdjusted", "seedsForFamily", "seedsToConfirm", "contrastRows", "correctFamily", "NETWORKS",
            "SIGNIFICANCE"]
 
@@ -476,19 +476,58 @@ def loadStudy(folder):
     return results
 
 
+#: What may differ between runs of one study that --combine merges: the replicates, the threads and the time.
+_MERGEABLE = ("seeds", "firstReplicate", "threads", "replicates")
+
+
+def mergeReplicates(runs):
+    """One study from runs of it that differ only in their replicates (firstReplicate and seeds: the same
+    base seed, sensor, scenes, arms, conditions and budget), each replicate once: every arm's numbers in
+    replicate order, the seeds summed, the time summed, config["replicates"] the merged index ranges. A
+    ValueError names what differs, or the replicate run twice."""
+    def key(run):
+        return {k: v for k, v in run["config"].items() if k not in _MERGEABLE}
+
+    for run in runs[1:]:
+        differing = sorted(k for k in set(key(run)) | set(key(runs[0])) if key(run).get(k) != key(runs[0]).get(k))
+        if differing:
+            raise ValueError("runs of one study differ in %s: only their replicates may" % ", ".join(differing))
+    ranges = sorted((r["config"].get("firstReplicate", 0), r["config"]["seeds"], i) for i, r in enumerate(runs))
+    for (first, count, _), (nextFirst, _, _) in zip(ranges, ranges[1:]):
+        if first + count > nextFirst:
+            raise ValueError("two runs of one study both trained replicate %d" % nextFirst)
+    ordered = [runs[i] for _, _, i in ranges]
+    merged = json.loads(json.dumps(ordered[0]))
+    for run in ordered[1:]:
+        for entry, more in zip(merged["conditions"], run["conditions"]):
+            for arm, values in entry["arms"].items():
+                for metric in values:
+                    values[metric] = values[metric] + more["arms"][arm][metric]
+    merged["config"]["seeds"] = sum(r["config"]["seeds"] for r in runs)
+    merged["config"]["replicates"] = [[first, first + count - 1] for first, count, _ in ranges]
+    merged["seconds"] = sum(r["seconds"] for r in runs)
+    return merged
+
+
 def writeCombinedReport(folders, outDir):
     """The side-by-side page of studies written by separate runs (their folders, each with its
     results.json): outDir/report.md, Holm-corrected over all their tests together, linking to each study's
-    own report. Refuses (ValueError) two studies of one network and design (their shared arms would be
-    counted twice), studies of different conditions, and an existing report.md. Returns its path."""
-    byStudy, links = {}, {}
+    own report. Runs of one network and design are merged into one study when they differ only in their
+    replicates (mergeReplicates: a study extended with --first-replicate); otherwise they are refused,
+    as are studies of different conditions and an existing report.md (ValueError). Returns its path."""
+    runsOf, links = {}, {}
     for folder in folders:
         results = loadStudy(folder)
         config = results["config"]
         name = studyName("told" if config.get("noiseMaps", True) else "blind", config.get("design", "pooled"))
-        if name in byStudy:
-            raise ValueError("'%s' and '%s' are both a %s study: give one of them" % (links[name], folder, name))
-        byStudy[name], links[name] = results, folder
+        runsOf.setdefault(name, []).append(results)
+        links.setdefault(name, []).append(folder)
+    byStudy = {}
+    for name, runs in runsOf.items():
+        try:
+            byStudy[name] = mergeReplicates(runs) if len(runs) > 1 else runs[0]
+        except ValueError as e:
+            raise ValueError("%s (%s): %s" % (name, ", ".join("'%s'" % f for f in links[name]), e)) from None
     conditions = [[e["condition"] for e in r["conditions"]] for r in byStudy.values()]
     if any(c != conditions[0] for c in conditions):
         raise ValueError("the studies were run on different conditions: %s" % "; ".join(
@@ -497,16 +536,16 @@ def writeCombinedReport(folders, outDir):
     if os.path.lexists(path):
         raise ValueError("'%s' exists: outputs are never replaced" % path)
     os.makedirs(outDir, exist_ok=True)
-    relative = {n: os.path.relpath(f, outDir) for n, f in links.items()}
+    relative = {n: [os.path.relpath(f, outDir) for f in fs] for n, fs in links.items()}
     _rg.writeFileAtomically(path, _studiesReport(byStudy, {n: summarize(r) for n, r in byStudy.items()},
                                                  relative).encode())
     return path
 
 
 def _studiesReport(byStudy, rowsOf, folders=None):
-    """The side-by-side page; `folders` maps each study to its folder relative to the page (default: its
-    name, a subfolder)."""
-    folders = folders or {n: n for n in byStudy}
+    """The side-by-side page; `folders` maps each study to its folders relative to the page (default: its
+    name, a subfolder; several for a study merged from several runs)."""
+    folders = folders or {n: [n] for n in byStudy}
     names = list(byStudy)
     first = byStudy[names[0]]
     conditions = [entry["condition"]["name"] for entry in first["conditions"]]
@@ -523,8 +562,11 @@ def _studiesReport(byStudy, rowsOf, folders=None):
            "whether that condition's own inputs make the difference.", ""]
     for n in names:
         r = byStudy[n]
-        out.append("- **%s**: [%s/report.md](%s/report.md), %d seed(s), %.0f s, CPU path %s." % (
-            n, folders[n], folders[n], r["config"]["seeds"], r["seconds"], r["cpuPath"]))
+        ranges = r["config"].get("replicates")
+        out.append("- **%s**: %s, %d seed(s)%s, %.0f s, CPU path %s." % (
+            n, ", ".join("[%s/report.md](%s/report.md)" % (f, f) for f in folders[n]), r["config"]["seeds"],
+            "" if not ranges else " (replicates %s, merged)" % ", ".join("%d-%d" % tuple(x) for x in ranges),
+            r["seconds"], r["cpuPath"]))
     if family:
         tested = family[0]["family"]
         seeds = max(r["n"] for r in family)
@@ -567,5 +609,5 @@ def _studiesReport(byStudy, rowsOf, folders=None):
                 row["verdictHolm"] = corrected[(row["condition"], row["arm"])]
         out += ["", "## %s" % n, ""]
         out += _findings(rowsOf[n], conditions, byStudy[n]["config"]["arms"])
-        out += ["", "![PSNR against darkening, %s](%s/psnr.png)" % (n, folders[n])]
+        out += ["", "![PSNR against darkening, %s](%s/psnr.png)" % (n, folders[n][0])]
     return "\n".join(out) + "\n"

@@ -150,7 +150,7 @@ def test_studies_of_separate_runs_are_combined_into_one_corrected_page(tmp_path)
         assert run.returncode == 2 and message in run.stderr and "Traceback" not in run.stderr, run.stderr
 
     refused(["--combine", *folders, "--out", str(page)], "exists: outputs are never replaced")
-    refused(["--combine", folders[0], folders[0], "--out", str(tmp_path / "p2")], "are both a told study")
+    refused(["--combine", folders[0], folders[0], "--out", str(tmp_path / "p2")], "both trained replicate 0")
     refused(["--combine", str(tmp_path), "--out", str(tmp_path / "p3")], "results.json' cannot be read")
     (tmp_path / "bad").mkdir()
     (tmp_path / "bad" / "results.json").write_text("{\"config\": {}}")
@@ -161,6 +161,23 @@ def test_studies_of_separate_runs_are_combined_into_one_corrected_page(tmp_path)
     ab.writeOutputs(ab.runAblation(tiny_config(conditions=tiny_config().conditions[:1])), other)
     refused(["--combine", folders[1], other, "--out", str(tmp_path / "p6")], "run on different conditions")
     assert not any((tmp_path / p).exists() for p in ("p2", "p3", "p4", "p5", "p6"))
+
+
+def test_a_study_extended_with_later_replicates_merges_into_the_study_of_all_of_them(tmp_path):
+    # Replicates 0-1 in one run, or replicate 1 then replicate 0 in two (--first-replicate): the same numbers,
+    # merged in replicate order; runs that differ in more than their replicates are refused.
+    whole = ab.runAblation(tiny_config(seeds=2))
+    for first in (1, 0):
+        ab.writeOutputs(ab.runAblation(tiny_config(seeds=1, firstReplicate=first)), str(tmp_path / ("r%d" % first)))
+    from rawgment.ablation_report import loadStudy
+    merged = ab.mergeReplicates([loadStudy(str(tmp_path / "r1")), loadStudy(str(tmp_path / "r0"))])
+    assert [e["arms"] for e in merged["conditions"]] == [e["arms"] for e in whole["conditions"]]
+    assert merged["config"]["seeds"] == 2 and merged["config"]["replicates"] == [[0, 0], [1, 1]]
+    assert ab.main(["--combine", str(tmp_path / "r1"), str(tmp_path / "r0"), "--out", str(tmp_path / "page")]) == 0
+    assert "2 seed(s) (replicates 0-0, 1-1, merged)" in (tmp_path / "page" / "report.md").read_text()
+    ab.writeOutputs(ab.runAblation(tiny_config(seeds=1, firstReplicate=2, iterations=4)), str(tmp_path / "r2"))
+    with pytest.raises(ValueError, match="differ in iterations: only their replicates may"):
+        ab.writeCombinedReport([str(tmp_path / "r0"), str(tmp_path / "r2")], str(tmp_path / "page2"))
 
 
 def test_per_condition_networks_see_their_own_condition_alone():
