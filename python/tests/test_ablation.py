@@ -385,6 +385,11 @@ def test_paired_significance_against_known_cases():
     assert (low, high) == (1.0, 1.0) and p == pytest.approx(2 / 64)
     low, high, p = ab.pairedSignificance([0.5, -0.5, 0.3, -0.3], seed=1)
     assert low < 0 < high and p == pytest.approx(1.0)
+    # Above 16 replicates the p of a random 65536 sign patterns counts the data's own: never 0, and for 24
+    # agreeing replicates (an exact p of 2 / 2^24) at most 1 / 65537 plus the chance of drawing either
+    # all-equal pattern.
+    p = ab.pairedSignificance([0.3] * 24, seed=1)[2]
+    assert 0 < p <= 2 / 65537
     # The same seed, the same interval.
     assert ab.pairedSignificance([0.2, 0.5, -0.1, 0.4, 0.3], seed=9) == ab.pairedSignificance(
         [0.2, 0.5, -0.1, 0.4, 0.3], seed=9)
