@@ -378,7 +378,7 @@ def _testsTable(contrasts):
     return out
 
 
-def _predictionsSection(contrasts, studies=None):
+def _predictionsSection(contrasts):
     """The control arms' predictions (ablation_controls.PREDICTIONS, stated before the runs) whose arms,
     network, design and conditions the contrasts hold, each with its outcome after the family's correction."""
     out = []

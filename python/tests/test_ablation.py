@@ -323,6 +323,10 @@ def test_the_verdict_needs_the_interval_and_the_sign_flip_test():
         "ORACLE": {"psnr": [31.0, 31.2, 31.4, 31.1, 31.3, 29.9], "ssim": [0.95] * 6}}}]}
     rows = {row["arm"]: row for row in ab.summarize(six)}
     assert rows["NONE"]["pValue"] == pytest.approx(2 / 64) and rows["NONE"]["verdict"] == "ACCOUNT_PRIOR better"
+    # Corrected over the report's 2 tests (ACCOUNT_PRIOR minus NONE and minus ORACLE), the smaller p doubles
+    # (Holm's first step) to 0.0625: no longer a verdict, a lean; 7 seeds would be needed for any verdict.
+    assert rows["NONE"]["pHolm"] == pytest.approx(4 / 64) and rows["NONE"]["verdictHolm"] == "ACCOUNT_PRIOR leans better"
+    assert ab.seedsForFamily(2) == 7
     assert rows["ORACLE"]["accountMinusHigh"] < 0 and rows["ORACLE"]["pValue"] == pytest.approx(4 / 64)
     assert rows["ORACLE"]["verdict"] == "ACCOUNT_PRIOR leans worse"
 
