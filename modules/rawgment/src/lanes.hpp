@@ -90,6 +90,15 @@ template <typename T> RAWGMENT_ALWAYS_INLINE T shiftLeft(T a, int s)
     return static_cast<T>(static_cast<std::make_unsigned_t<T>>(a) << s);
 }
 
+//! A scalar in every lane: how GCC's vector extensions widen a scalar operand of a vector operator.
+template <typename T, int N, typename S> RAWGMENT_ALWAYS_INLINE LaneArray<T, N> broadcastLanes(S s)
+{
+    LaneArray<T, N> r;
+    for (int i = 0; i < N; ++i)
+        r.lane[i] = static_cast<T>(s);
+    return r;
+}
+
 #define RAWGMENT_LANES_BINARY(op, expr)                                                                      \
     template <typename T, int N>                                                                             \
     RAWGMENT_ALWAYS_INLINE LaneArray<T, N> operator op(const LaneArray<T, N>& a, const LaneArray<T, N>& b)   \
@@ -104,18 +113,12 @@ template <typename T> RAWGMENT_ALWAYS_INLINE T shiftLeft(T a, int s)
     template <typename T, int N, typename S, std::enable_if_t<std::is_arithmetic_v<S>, int> = 0>             \
     RAWGMENT_ALWAYS_INLINE LaneArray<T, N> operator op(const LaneArray<T, N>& a, S s)                        \
     {                                                                                                        \
-        LaneArray<T, N> b;                                                                                   \
-        for (int i = 0; i < N; ++i)                                                                          \
-            b.lane[i] = static_cast<T>(s);                                                                   \
-        return a op b;                                                                                       \
+        return a op broadcastLanes<T, N>(s);                                                                 \
     }                                                                                                        \
     template <typename T, int N, typename S, std::enable_if_t<std::is_arithmetic_v<S>, int> = 0>             \
     RAWGMENT_ALWAYS_INLINE LaneArray<T, N> operator op(S s, const LaneArray<T, N>& b)                        \
     {                                                                                                        \
-        LaneArray<T, N> a;                                                                                   \
-        for (int i = 0; i < N; ++i)                                                                          \
-            a.lane[i] = static_cast<T>(s);                                                                   \
-        return a op b;                                                                                       \
+        return broadcastLanes<T, N>(s) op b;                                                                 \
     }                                                                                                        \
     template <typename T, int N, typename S>                                                                 \
     RAWGMENT_ALWAYS_INLINE LaneArray<T, N>& operator op##=(LaneArray<T, N>& a, const S& b)                   \
@@ -148,18 +151,12 @@ RAWGMENT_LANES_BINARY(>>, x >> y)
     template <typename T, int N, typename S, std::enable_if_t<std::is_arithmetic_v<S>, int> = 0>             \
     RAWGMENT_ALWAYS_INLINE LaneArray<MaskLane<T>, N> operator op(const LaneArray<T, N>& a, S s)              \
     {                                                                                                        \
-        LaneArray<T, N> b;                                                                                   \
-        for (int i = 0; i < N; ++i)                                                                          \
-            b.lane[i] = static_cast<T>(s);                                                                   \
-        return a op b;                                                                                       \
+        return a op broadcastLanes<T, N>(s);                                                                 \
     }                                                                                                        \
     template <typename T, int N, typename S, std::enable_if_t<std::is_arithmetic_v<S>, int> = 0>             \
     RAWGMENT_ALWAYS_INLINE LaneArray<MaskLane<T>, N> operator op(S s, const LaneArray<T, N>& b)              \
     {                                                                                                        \
-        LaneArray<T, N> a;                                                                                   \
-        for (int i = 0; i < N; ++i)                                                                          \
-            a.lane[i] = static_cast<T>(s);                                                                   \
-        return a op b;                                                                                       \
+        return broadcastLanes<T, N>(s) op b;                                                                 \
     }
 
 RAWGMENT_LANES_COMPARE(<)
