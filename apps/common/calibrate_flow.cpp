@@ -83,6 +83,8 @@ CalibrationManifest readCalibrationManifest(const std::string& path)
     }
     for (const cv::FileNode& b : root["bursts"]) {
         const std::string where = cv::format("'%s' burst %zu", path.c_str(), manifest.bursts.size() + 1);
+        if (!b.isMap())
+            throw std::runtime_error(where + ": expected a map with 'files'");
         requireKnownKeys(b, {"gain_db", "level", "dark", "files"}, where);
         CalibrationManifest::Burst burst;
         if (!b["gain_db"].empty()) {
@@ -94,13 +96,10 @@ CalibrationManifest readCalibrationManifest(const std::string& path)
                 throw std::runtime_error(where + ": 'gain_db' is not finite");
         }
         if (!b["dark"].empty()) {
-            // OpenCV reads YAML's true and false as strings, and writes booleans as 1 and 0.
+            // The module's reader reads YAML's and JSON's true and false as 1 and 0, as OpenCV writes them.
             const cv::FileNode dark = b["dark"];
-            const std::string word = dark.isString() ? std::string(dark) : std::string();
             if (dark.isInt() && (int(dark) == 0 || int(dark) == 1))
                 burst.dark = int(dark) == 1;
-            else if (word == "true" || word == "false")
-                burst.dark = word == "true";
             else
                 throw std::runtime_error(where + ": 'dark' must be true or false");
         }

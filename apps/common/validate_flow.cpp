@@ -45,6 +45,8 @@ ValidationManifest readValidationManifest(const std::string& path)
     m.bright = readFileList(root["bright"], base, "'" + path + "' bright");
     for (const cv::FileNode& t : root["targets"]) {
         const std::string where = cv::format("'%s' target %zu", path.c_str(), m.targets.size() + 1);
+        if (!t.isMap())
+            throw std::runtime_error(where + ": expected a map with 'factor' and 'files'");
         requireKnownKeys(t, {"factor", "files"}, where);
         const cv::FileNode factor = t["factor"];
         if (!(factor.isReal() || factor.isInt()) || !(double(factor) > 0 && double(factor) <= 1))

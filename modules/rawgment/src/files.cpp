@@ -152,33 +152,20 @@ FileStorage openFileStorageForReading(const String& path, const String& what)
 {
     if (path.empty())
         CV_Error(Error::StsBadArg, "cannot open " + what + ": the path is empty");
-    // Read once and parsed from memory: the integer check and OpenCV's parser see the same bytes.
-    std::string text = readFileBounded(path, MAX_TEXT_FILE_BYTES, what);
-    // A UTF-8 byte-order mark (some Windows editors write one) is not part of the YAML or JSON.
-    if (text.compare(0, 3, "\xEF\xBB\xBF") == 0)
-        text.erase(0, 3);
-    detail::rejectUnsupportedStructure(path, text);
-    // A maintained parser reads the text first, iteratively and with a depth limit: OpenCV's readers
-    // recurse once per level (60,000 nested brackets overflow the stack) and loop forever on some
-    // malformed YAML streams, so they only ever see text that is valid, shallow and of one document.
-    // OpenCV tells YAML from JSON by the first bytes only: JSON must start with its brace, and YAML
-    // with a %YAML line, which hand-written files often lack.
-    const size_t first = text.find_first_not_of(" \t\r\n");
-    std::string parsed;
-    if (text[first] == '{') {
-        text.erase(0, first);
-        parsed = detail::validateJson(path, std::move(text));
-    } else {
-        detail::validateYaml(path, text);
-        parsed = text.compare(0, 5, "%YAML") == 0 ? std::move(text) : "%YAML:1.0\n" + text;
-    }
+    // libyaml or nlohmann-json parses the text, iteratively and with a depth limit, and OpenCV's own writer
+    // writes its values anew: OpenCV's recursive parser, which loops forever on some malformed YAML and
+    // reads numbers and keys otherwise than YAML does, only ever reads text its writer made.
+    const std::string parsed = detail::textForOpenCv(path, readFileBounded(path, MAX_TEXT_FILE_BYTES, what));
     FileStorage fs;
     try {
         fs.open(parsed, FileStorage::READ | FileStorage::MEMORY);
     } catch (const Exception& e) {
-        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.err);
+        CV_Error(Error::StsParseError,
+                 "'" + path + "': OpenCV could not read back the text its own writer made of it: " + e.err);
     } catch (const std::exception& e) {
-        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.what());
+        CV_Error(Error::StsParseError,
+                 "'" + path +
+                     "': OpenCV could not read back the text its own writer made of it: " + e.what());
     }
     if (!fs.isOpened())
         CV_Error(Error::StsError, "cannot open " + what + " '" + path + "'");

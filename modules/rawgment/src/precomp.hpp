@@ -96,23 +96,17 @@ std::vector<uchar> npyFileBytes(const Mat& mosaic);
 /** The mosaic of a .npy file as npyFileBytes() writes it (format 1.0 to 3.0, a 2-D '<u2' or '<f4' array
  * in C order, the file exactly that long); throws naming the file otherwise, before allocating. */
 Mat readNpyMosaic(const String& path);
-/** Throws StsParseError naming the file (`path`) unless `text` is JSON or a single-document YAML stream
- * whose root collection starts a line at column 0 (empty text and XML are refused too): OpenCV 4.6's
- * YAML parser loops forever on some streams with more than one document. */
-void rejectUnsupportedStructure(const String& path, const std::string& text);
 //! The deepest nesting of maps and lists openFileStorageForReading() accepts; this module's files nest
 //! at most five levels, and OpenCV's readers recurse once per level.
 constexpr int MAX_NESTING_DEPTH = 64;
-/** Parses `text` (a file's whole content, OpenCV's "%YAML:1.0" line allowed) with libyaml, iteratively,
- * and throws StsParseError naming the file (`path`), the line and what is wrong unless it is one YAML
- * document whose root is a block map or list at column 0, nested at most MAX_NESTING_DEPTH levels, with
- * no anchor or alias and no integer literal beyond 32 bits (OpenCV's reader would wrap it). */
-CV_RAWGMENT_EXPORTS void validateYaml(const String& path, const std::string& text);
-/** Parses `text` with nlohmann's JSON parser, iteratively, and throws StsParseError naming the file
- * (`path`), the line and what is wrong unless it is valid JSON nested at most MAX_NESTING_DEPTH levels
- * with no integer beyond 32 bits. Returns the text OpenCV's reader is given: the same, with the escapes it
- * lacks (\uXXXX, \/) written out as UTF-8. */
-CV_RAWGMENT_EXPORTS std::string validateJson(const String& path, std::string text);
+/** The text OpenCV's reader is given for a file's whole content `text` (YAML, OpenCV's "%YAML:1.0" line
+ * allowed, or JSON when it starts with a brace): parsed by libyaml or nlohmann-json, iteratively, scalars
+ * typed by YAML 1.2's core schema, and the values written anew by OpenCV's own JSON writer. Throws
+ * StsParseError naming the file (`path`), the line where it is known and what is wrong for text that is not
+ * one YAML document or JSON value whose root is a map, nesting deeper than MAX_NESTING_DEPTH, anchors or
+ * aliases, a repeated key in any map, a key OpenCV's files cannot hold, an integer beyond 32 bits, a plain
+ * value OpenCV's own reader would read as another type or value, and UTF-16 or UTF-32 text. */
+CV_RAWGMENT_EXPORTS std::string textForOpenCv(const String& path, std::string text);
 
 //! The text that writeFileStorageAtomically() would write to `path`.
 template <typename Writer> std::string fileStorageText(const String& path, Writer&& writeBody)

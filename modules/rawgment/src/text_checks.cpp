@@ -1,15 +1,19 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// The files topic (files.hpp), its text checks: what every YAML/JSON text passes before OpenCV's parser
-// sees it. libyaml or nlohmann-json parses it first, in the calling thread and without recursion, and the
-// structure OpenCV 4.6's reader loops forever on is refused; openFileStorageForReading() (files.cpp)
-// calls them.
+// The files topic (files.hpp), its text checks: every YAML/JSON text a reader of this module opens is
+// parsed by libyaml (YAML) or nlohmann-json (JSON), in the calling thread and without recursion, its
+// scalars typed by YAML 1.2's core schema, and the values written anew by OpenCV's own JSON writer. That
+// text is the only one OpenCV's parser is ever given: whatever libyaml and OpenCV 4.6's hand-written
+// parser disagree on (numbers it wraps, keys it finds inside plain values, escapes and exponents it does
+// not know, streams it loops on) never reaches it. openFileStorageForReading() (files.cpp) calls this.
 #include "precomp.hpp"
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <climits>
 #include <cstring>
-#include <sstream>
+#include <limits>
+#include <map>
 
 #include <nlohmann/json.hpp>
 #include <yaml.h>
@@ -19,47 +23,209 @@ namespace rawgment {
 namespace detail {
 namespace {
 
-//! Whether a plain scalar is an integer literal, [+-]?[0-9]+, as OpenCV's readers would take it.
-bool isIntegerLiteral(const char* s, size_t n)
+// OpenCV 4.6's persistence keeps a string in a buffer of CV_FS_MAX_LEN (4096) bytes with its terminator.
+constexpr size_t kMaxStringBytes = 4095;
+
+//! The line (1-based) of byte `offset` of `text`.
+int lineAt(const std::string& text, size_t offset)
 {
-    size_t i = n > 0 && (s[0] == '-' || s[0] == '+') ? 1 : 0;
-    if (i == n)
-        return false;
-    for (; i < n; ++i)
-        if (s[i] < '0' || s[i] > '9')
-            return false;
-    return true;
+    offset = std::min(offset, text.size());
+    return 1 + static_cast<int>(
+                   std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(offset), '\n'));
 }
 
-bool fitsInt(const std::string& literal)
+//! "'path' line N: why", or "'path': why" where no line is known (line <= 0).
+[[noreturn]] void refuseAt(const String& path, int line, const std::string& why)
 {
-    // More than ten significant digits never fit; fewer are parsed exactly.
-    size_t first = literal.find_first_not_of("+-");
-    first = literal.find_first_not_of('0', first);
-    if (first == std::string::npos)
-        return true;
-    if (literal.size() - first > 10)
-        return false;
-    const long long value = std::strtoll(literal.c_str(), nullptr, 10);
-    return value >= INT_MIN && value <= INT_MAX;
+    if (line > 0)
+        CV_Error(Error::StsParseError, format("'%s' line %d: %s", path.c_str(), line, why.c_str()));
+    CV_Error(Error::StsParseError, format("'%s': %s", path.c_str(), why.c_str()));
 }
 
 [[noreturn]] void refuseWrappingInteger(const String& path, int line, const std::string& literal)
 {
-    CV_Error(
-        Error::StsParseError,
-        format("'%s' line %d: the integer %s does not fit 32 bits (OpenCV's reader would wrap it); write "
-               "it as a real (%s.0) if that is the value meant",
-               path.c_str(), line, literal.c_str(), literal.c_str()));
+    const bool decimal = literal.find_first_of("xX") == std::string::npos;
+    refuseAt(path, line,
+             format("the integer %s does not fit 32 bits (OpenCV's reader would wrap it); write it as a real "
+                    "(%s) if that is the value meant",
+                    literal.c_str(), decimal ? (literal + ".0").c_str() : "in decimal, with a fraction"));
 }
 
 [[noreturn]] void refuseDepth(const String& path, int line)
 {
-    CV_Error(Error::StsParseError,
-             format("'%s' line %d: collections nested more than %d levels deep; no file of this module nests "
-                    "so deep (OpenCV's recursive reader would overflow the stack)",
-                    path.c_str(), line, MAX_NESTING_DEPTH));
+    refuseAt(path, line,
+             format("collections nested more than %d levels deep; no file of this module nests so deep "
+                    "(OpenCV's recursive reader would overflow the stack)",
+                    MAX_NESTING_DEPTH));
 }
+
+bool isAsciiDigit(char c)
+{
+    return c >= '0' && c <= '9';
+}
+
+bool isAsciiAlpha(char c)
+{
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
+}
+
+size_t digitsFrom(const std::string& s, size_t at)
+{
+    size_t n = 0;
+    while (at + n < s.size() && isAsciiDigit(s[at + n]))
+        ++n;
+    return n;
+}
+
+/** Writes the values of a parsed text with OpenCV's own JSON writer: the text OpenCV's reader is given.
+ * It refuses what that writer cannot write so that its reader reads it back the same (keys outside
+ * OpenCV's alphabet, strings it would misquote or truncate), repeated keys, nesting beyond
+ * MAX_NESTING_DEPTH and integers beyond 32 bits. The root must be a map: it is the storage's own. */
+class OpenCvTextWriter
+{
+public:
+    explicit OpenCvTextWriter(const String& path)
+        : path_(path), out_(".json", FileStorage::WRITE | FileStorage::MEMORY | FileStorage::FORMAT_JSON)
+    {
+    }
+
+    bool expectsKey() const { return !levels_.empty() && levels_.back().map && !levels_.back().hasKey; }
+    bool empty() const { return !rootSeen_; }
+
+    void startCollection(bool map, int line)
+    {
+        if (levels_.empty()) {
+            if (rootSeen_)
+                refuseAt(path_, line, "a second root collection");
+            if (!map)
+                refuseAt(path_, line, "the root is a list, not a map (every file of this module is a map)");
+            rootSeen_ = true;
+        } else {
+            const std::string key = takeKey();
+            write(line,
+                  [&] { out_.startWriteStruct(key, map ? FileNode::MAP : FileNode::SEQ | FileNode::FLOW); });
+        }
+        levels_.emplace_back();
+        levels_.back().map = map;
+        if (static_cast<int>(levels_.size()) > MAX_NESTING_DEPTH)
+            refuseDepth(path_, line);
+    }
+
+    void endCollection()
+    {
+        levels_.pop_back();
+        if (!levels_.empty())
+            out_.endWriteStruct();
+    }
+
+    void key(const std::string& name, int line)
+    {
+        // OpenCV's writer takes these keys only, and its readers find no other reliably.
+        const bool valid = !name.empty() && name.size() <= kMaxStringBytes &&
+                           (isAsciiAlpha(name[0]) || name[0] == '_') &&
+                           std::all_of(name.begin(), name.end(), [](char c) {
+                               return isAsciiAlpha(c) || isAsciiDigit(c) || c == '_' || c == '-' || c == ' ';
+                           });
+        if (!valid)
+            refuseAt(path_, line,
+                     format("the key '%s' is not one OpenCV's files can hold (a letter or '_', then letters, "
+                            "digits, '_', '-' or spaces)",
+                            name.substr(0, 80).c_str()));
+        Level& level = levels_.back();
+        const auto repeated = level.keys.emplace(name, line);
+        if (!repeated.second)
+            refuseAt(
+                path_, line,
+                repeated.first->second > 0
+                    ? format("key '%s' appears twice (first on line %d); which value counts would be a guess",
+                             name.c_str(), repeated.first->second)
+                    : format("key '%s' appears twice in one map; which value counts would be a guess",
+                             name.c_str()));
+        level.key = name;
+        level.hasKey = true;
+    }
+
+    void integer(long long value, int line, const std::string& literal)
+    {
+        if (value < INT_MIN || value > INT_MAX)
+            refuseWrappingInteger(path_, line, literal);
+        const std::string key = takeKey();
+        write(line, [&] { out_.write(key, static_cast<int>(value)); });
+    }
+
+    void real(double value, int line)
+    {
+        const std::string key = takeKey();
+        write(line, [&] { out_.write(key, value); });
+    }
+
+    void text(const std::string& value, int line)
+    {
+        if (value.find('\0') != std::string::npos)
+            refuseAt(path_, line, "a NUL character in a string; OpenCV's strings end at a NUL");
+        if (value.size() > kMaxStringBytes)
+            refuseAt(path_, line,
+                     format("a string of %zu bytes; OpenCV's files hold at most %zu", value.size(),
+                            kMaxStringBytes));
+        // OpenCV's JSON writer writes a string that starts and ends with one quote character as it is,
+        // taking those for its own quotes, and its reader takes "$base64$..." for binary data.
+        if (!value.empty() && (value[0] == '"' || value[0] == '\'') && value.back() == value[0])
+            refuseAt(path_, line,
+                     format("a string that starts and ends with the quote character %c, which OpenCV's "
+                            "writer would take for its own quotes",
+                            value[0]));
+        if (value.compare(0, 8, "$base64$") == 0)
+            refuseAt(path_, line,
+                     "a string that starts with $base64$, which OpenCV's reader takes for binary data");
+        const std::string key = takeKey();
+        write(line, [&] { out_.write(key, value); });
+    }
+
+    //! A JSON null: a key without a value is left out (a lookup finds nothing, as for a null).
+    void null(int line)
+    {
+        if (!levels_.back().map)
+            refuseAt(path_, line, "a null in a list; OpenCV's files have no null");
+        takeKey();
+    }
+
+    std::string finish() { return out_.releaseAndGetString(); }
+
+private:
+    struct Level
+    {
+        bool map = true;
+        bool hasKey = false;
+        std::string key;
+        std::map<std::string, int> keys;
+    };
+
+    std::string takeKey()
+    {
+        Level& level = levels_.back();
+        if (!level.map)
+            return std::string();
+        level.hasKey = false;
+        return level.key;
+    }
+
+    template <typename Write> void write(int line, Write&& w)
+    {
+        try {
+            w();
+        } catch (const Exception& e) {
+            refuseAt(path_, line, "OpenCV's writer refused a value: " + e.err);
+        }
+    }
+
+    String path_;
+    FileStorage out_;
+    std::vector<Level> levels_;
+    bool rootSeen_ = false;
+};
+
+// --------------------------------------------------------------------------------------------------
+// YAML: libyaml's events, plain scalars typed by YAML 1.2's core schema.
 
 //! The libyaml parser of one text, freed on every path out.
 struct YamlParser
@@ -87,215 +253,179 @@ struct YamlEvent
     }
 };
 
-//! The line (1-based) of byte `offset` of `text`.
-int lineAt(const std::string& text, size_t offset)
+/** Whether OpenCV 4.6's YAML reader takes a plain value for a number: it starts with a digit, a sign
+ * before a digit or a dot, or a dot before a letter or digit (persistence_yml.cpp, parseValue). */
+bool opencvReadsANumber(const std::string& v)
 {
-    offset = std::min(offset, text.size());
-    return 1 + static_cast<int>(
-                   std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(offset), '\n'));
+    const char c = v.empty() ? '\0' : v[0], d = v.size() > 1 ? v[1] : '\0';
+    return isAsciiDigit(c) || ((c == '-' || c == '+') && (isAsciiDigit(d) || d == '.')) ||
+           (c == '.' && (isAsciiDigit(d) || isAsciiAlpha(d)));
 }
 
-/** A JSON validator's events (nlohmann's SAX interface): the depth and 32-bit integers checked as the
- * text streams by, nothing stored. nlohmann's parser keeps its own state on the heap, not the stack. */
-class JsonChecks : public nlohmann::json_sax<nlohmann::json>
+//! An integer of `digits` in `base`, or false when it does not fit a long long.
+bool parseMagnitude(const std::string& digits, int base, long long& value)
+{
+    const auto result = std::from_chars(digits.data(), digits.data() + digits.size(), value, base);
+    return result.ec == std::errc() && result.ptr == digits.data() + digits.size();
+}
+
+//! Whether `v` is YAML 1.2's core float: [-+]?(.[0-9]+|[0-9]+(.[0-9]*)?)([eE][-+]?[0-9]+)?
+bool isCoreFloat(const std::string& v)
+{
+    size_t at = v.empty() || (v[0] != '-' && v[0] != '+') ? 0 : 1;
+    const size_t whole = digitsFrom(v, at);
+    at += whole;
+    size_t fraction = 0;
+    if (at < v.size() && v[at] == '.') {
+        fraction = digitsFrom(v, at + 1);
+        at += 1 + fraction;
+    }
+    if (whole == 0 && fraction == 0)
+        return false;
+    if (at < v.size() && (v[at] == 'e' || v[at] == 'E')) {
+        ++at;
+        if (at < v.size() && (v[at] == '-' || v[at] == '+'))
+            ++at;
+        const size_t exponent = digitsFrom(v, at);
+        if (exponent == 0)
+            return false;
+        at += exponent;
+    }
+    return at == v.size();
+}
+
+class YamlScalarTyper
 {
 public:
-    enum class Stop
+    YamlScalarTyper(const String& path, OpenCvTextWriter& out) : path_(path), out_(out) {}
+
+    //! A plain untagged value, typed by YAML 1.2's core schema; refused where OpenCV's own reader would
+    //! have read another type or another value from the same text.
+    void plain(const std::string& v, bool inFlow, int line)
     {
-        NONE,
-        SYNTAX,
-        DEPTH,
-        INTEGER
-    };
-    Stop stop = Stop::NONE;
-    std::string message;
-    std::string literal;
-    bool null() override { return true; }
-    bool boolean(bool) override { return true; }
-    bool number_integer(number_integer_t value) override
-    {
-        return value >= INT_MIN && value <= INT_MAX ? true : wraps(std::to_string(value));
+        if (v.empty() || v == "~" || v == "null" || v == "Null" || v == "NULL")
+            refuse(line,
+                   "an empty or null value; OpenCV's files have no null: write a value, or leave the key "
+                   "out");
+        // A boolean is 1 or 0, as OpenCV's JSON reader reads JSON's and as its writer writes a bool.
+        if (v == "true" || v == "True" || v == "TRUE" || v == "false" || v == "False" || v == "FALSE") {
+            out_.integer(v[0] == 't' || v[0] == 'T' ? 1 : 0, line, v);
+            return;
+        }
+        if (integer(v, line))
+            return;
+        if (realNumber(v, line))
+            return;
+        if (opencvReadsANumber(v))
+            refuse(line, format("'%s' is a string to YAML 1.2, but OpenCV's reader takes it for a number: "
+                                "quote it if it is text, or write the number as YAML does (1000, 0x1F, "
+                                "1.5e-3)",
+                                v.substr(0, 80).c_str()));
+        if (!inFlow && v.find(':') != std::string::npos)
+            refuse(line,
+                   format("the plain value '%s' holds ':', which OpenCV's reader takes for a key: quote "
+                          "it",
+                          v.substr(0, 80).c_str()));
+        out_.text(v, line);
     }
-    bool number_unsigned(number_unsigned_t value) override
+
+    //! A scalar with an explicit tag (!!str, !!int, !!float), read as the tag says.
+    void tagged(const std::string& v, const std::string& tag, bool plainStyle, int line)
     {
-        return value <= static_cast<number_unsigned_t>(INT_MAX) ? true : wraps(std::to_string(value));
-    }
-    bool number_float(number_float_t, const string_t&) override { return true; }
-    bool string(string_t&) override { return true; }
-    bool binary(binary_t&) override { return true; }
-    bool key(string_t&) override { return true; }
-    bool start_object(std::size_t) override { return enter(); }
-    bool start_array(std::size_t) override { return enter(); }
-    bool end_object() override { return leave(); }
-    bool end_array() override { return leave(); }
-    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override
-    {
-        stop = Stop::SYNTAX;
-        message = e.what();
-        // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." without the class.
-        const size_t bracket = message.find("] ");
-        if (message.compare(0, 1, "[") == 0 && bracket != std::string::npos)
-            message.erase(0, bracket + 2);
-        return false;
+        static const std::string core = "tag:yaml.org,2002:";
+        const std::string name =
+            tag.compare(0, core.size(), core) == 0 ? "!!" + tag.substr(core.size()) : tag;
+        if (name == "!!str") {
+            out_.text(v, line);
+        } else if (name == "!!int" && plainStyle) {
+            if (!integer(v, line))
+                refuse(line, format("'!!int %s' is not an integer", v.substr(0, 80).c_str()));
+        } else if (name == "!!float" && plainStyle) {
+            if (!realNumber(v, line) && !(isCoreFloat(v) && real(v, line)))
+                refuse(line, format("'!!float %s' is not a number", v.substr(0, 80).c_str()));
+        } else if (name == "!!binary") {
+            refuse(line, "base64 data (!!binary); no file of this module holds binary data");
+        } else {
+            refuse(line, format("the tag %s; this module reads !!str, !!int and !!float on plain values",
+                                name.c_str()));
+        }
     }
 
 private:
-    int depth_ = 0;
-    bool enter()
+    [[noreturn]] void refuse(int line, const std::string& why) { refuseAt(path_, line, why); }
+
+    //! A core-schema integer (decimal, 0x hexadecimal; 0o octal refused): written and true, or false.
+    bool integer(const std::string& v, int line)
     {
-        if (++depth_ <= MAX_NESTING_DEPTH)
+        const bool signed_ = !v.empty() && (v[0] == '-' || v[0] == '+');
+        const size_t from = signed_ ? 1 : 0;
+        if (v.size() > from && digitsFrom(v, from) == v.size() - from) {
+            if (v.size() - from > 1 && v[from] == '0')
+                refuse(line,
+                       format("'%s' has a leading zero: YAML 1.2 reads it as decimal, OpenCV's reader as "
+                              "octal; write it without the zero",
+                              v.c_str()));
+            long long magnitude = 0;
+            if (!parseMagnitude(v.substr(from), 10, magnitude))
+                refuseWrappingInteger(path_, line, v);
+            out_.integer(v[0] == '-' ? -magnitude : magnitude, line, v);
             return true;
-        stop = Stop::DEPTH;
+        }
+        const bool hex =
+            v.size() > 2 && v[0] == '0' && v[1] == 'x' && std::all_of(v.begin() + 2, v.end(), [](char c) {
+                return std::isxdigit(static_cast<unsigned char>(c)) != 0;
+            });
+        if (hex) {
+            long long value = 0;
+            if (!parseMagnitude(v.substr(2), 16, value))
+                refuseWrappingInteger(path_, line, v);
+            out_.integer(value, line, v);
+            return true;
+        }
+        const bool octal = v.size() > 2 && v[0] == '0' && v[1] == 'o' &&
+                           std::all_of(v.begin() + 2, v.end(), [](char c) { return c >= '0' && c <= '7'; });
+        if (octal)
+            refuse(line, format("'%s' is octal to YAML 1.2, which OpenCV's reader does not read: write it in "
+                                "decimal",
+                                v.c_str()));
         return false;
     }
-    bool leave()
+
+    //! A core-schema float (with .inf and .nan): written and true, or false. An exponent may be written
+    //! with a capital E: OpenCV's reader stops at it, but every other reader takes the same number.
+    bool realNumber(const std::string& v, int line)
     {
-        --depth_;
+        const bool negative = !v.empty() && v[0] == '-';
+        const std::string unsigned_ = !v.empty() && (v[0] == '-' || v[0] == '+') ? v.substr(1) : v;
+        if (unsigned_ == ".inf" || unsigned_ == ".Inf" || unsigned_ == ".INF") {
+            out_.real(negative ? -std::numeric_limits<double>::infinity()
+                               : std::numeric_limits<double>::infinity(),
+                      line);
+            return true;
+        }
+        if (v == ".nan" || v == ".NaN" || v == ".NAN") {
+            out_.real(std::numeric_limits<double>::quiet_NaN(), line);
+            return true;
+        }
+        return isCoreFloat(v) && real(v, line);
+    }
+
+    bool real(const std::string& v, int line)
+    {
+        const char* first = v.data() + (v[0] == '+' ? 1 : 0);
+        double value = 0;
+        const auto result = std::from_chars(first, v.data() + v.size(), value);
+        if (result.ec == std::errc::result_out_of_range)
+            refuse(line, format("the number %s is beyond the range of a double", v.c_str()));
+        if (result.ec != std::errc() || result.ptr != v.data() + v.size())
+            return false;
+        out_.real(value, line);
         return true;
     }
-    bool wraps(std::string value)
-    {
-        stop = Stop::INTEGER;
-        literal = std::move(value);
-        return false;
-    }
+
+    String path_;
+    OpenCvTextWriter& out_;
 };
-
-//! Where the JSON text first opens a collection deeper than MAX_NESTING_DEPTH (strings skipped).
-size_t offsetBeyondDepth(const std::string& text)
-{
-    int depth = 0;
-    bool inString = false;
-    for (size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        if (inString) {
-            if (c == '\\')
-                ++i;
-            else if (c == '"')
-                inString = false;
-        } else if (c == '"') {
-            inString = true;
-        } else if (c == '[' || c == '{') {
-            if (++depth > MAX_NESTING_DEPTH)
-                return i;
-        } else if (c == ']' || c == '}') {
-            --depth;
-        }
-    }
-    return text.size();
-}
-
-/** Where the number `literal` stands alone in the JSON text (not inside a longer number); the text's end if
- * nowhere. Only for the line of an error: a string that holds the same digits may be taken for it. */
-size_t offsetOfNumber(const std::string& text, const std::string& literal)
-{
-    const auto partOfNumber = [](char c) {
-        return (c >= '0' && c <= '9') || c == '.' || c == 'e' || c == 'E';
-    };
-    for (size_t at = text.find(literal); at != std::string::npos; at = text.find(literal, at + 1)) {
-        const size_t end = at + literal.size();
-        if ((at == 0 || (!partOfNumber(text[at - 1]) && text[at - 1] != '-')) &&
-            (end == text.size() || !partOfNumber(text[end])))
-            return at;
-    }
-    return text.size();
-}
-
-void appendUtf8(std::string& out, unsigned codePoint)
-{
-    if (codePoint < 0x80) {
-        out += static_cast<char>(codePoint);
-    } else if (codePoint < 0x800) {
-        out += static_cast<char>(0xC0 | (codePoint >> 6));
-        out += static_cast<char>(0x80 | (codePoint & 0x3F));
-    } else if (codePoint < 0x10000) {
-        out += static_cast<char>(0xE0 | (codePoint >> 12));
-        out += static_cast<char>(0x80 | ((codePoint >> 6) & 0x3F));
-        out += static_cast<char>(0x80 | (codePoint & 0x3F));
-    } else {
-        out += static_cast<char>(0xF0 | (codePoint >> 18));
-        out += static_cast<char>(0x80 | ((codePoint >> 12) & 0x3F));
-        out += static_cast<char>(0x80 | ((codePoint >> 6) & 0x3F));
-        out += static_cast<char>(0x80 | (codePoint & 0x3F));
-    }
-}
-
-unsigned hex4(const std::string& text, size_t at)
-{
-    return static_cast<unsigned>(std::stoul(text.substr(at, 4), nullptr, 16));
-}
-
-} // namespace
-
-void rejectUnsupportedStructure(const String& path, const std::string& text)
-{
-    const size_t first = text.find_first_not_of(" \t\r\n");
-    if (first == std::string::npos)
-        CV_Error(Error::StsParseError, "'" + path + "' is empty");
-    if (text[first] == '<')
-        CV_Error(Error::StsParseError, "'" + path + "' looks like XML; this module reads YAML and JSON");
-    if (text[first] == '{')
-        return; // JSON
-    // OpenCV 4.6's YAML parser never returns when a stream goes on after its first document with a '-'
-    // that does not start '---' (test/fuzz found three such files, for example "---[][  -"). The files
-    // of this module hold one document whose root is a block collection starting a line of its own at
-    // column 0, which ends only at the end of the file: anything else is refused before OpenCV sees it.
-    std::istringstream lines(text);
-    std::string line;
-    bool header = false, content = false;
-    for (int number = 1; std::getline(lines, line); ++number) {
-        const size_t start = line.find_first_not_of(" \r");
-        if (start == std::string::npos || line[start] == '#')
-            continue;
-        const auto refuse = [&](const char* why) {
-            CV_Error(Error::StsParseError, format("'%s' line %d: %s (this module reads single-document YAML "
-                                                  "files whose root is a block map or list at column 0)",
-                                                  path.c_str(), number, why));
-        };
-        const bool marker = line.compare(start, 3, "---") == 0 || line.compare(start, 3, "...") == 0;
-        if (!content) {
-            if (line[start] == '%')
-                continue;
-            if (line.compare(start, 3, "---") == 0 && !header) {
-                const size_t rest = line.find_first_not_of(" \r", start + 3);
-                if (start != 0 || (rest != std::string::npos && line[rest] != '#'))
-                    refuse("content on the document's '---' line");
-                header = true;
-                continue;
-            }
-            if (marker)
-                refuse("a second document marker");
-            if (start != 0)
-                refuse("the root collection does not start at column 0");
-            if (line[start] == '[' || line[start] == '{')
-                refuse("the root is a flow collection");
-            content = true;
-        }
-        // At column 0 only the root's own keys or items: anything else ends the root early, and OpenCV's
-        // reader loops forever when a '-' follows (test/fuzz found "!: -.\n{  -").
-        const unsigned char lead = static_cast<unsigned char>(line[start]);
-        if (start == 0 && !marker && !std::isalnum(lead) && lead != '_' && lead != '"' && lead != '\'' &&
-            !(lead == '-' && (line.size() == 1 || line[1] == ' ' || line[1] == '\r')))
-            refuse("a line at column 0 that is neither a key nor an item of the root collection");
-        if (marker)
-            refuse("a document marker after the first document's content");
-    }
-}
-
-namespace {
-
-/** OpenCV's \\' escapes in `text` from byte `from` written as \\" (the same length, and a quote inside the
- * string for a parser that knows only YAML's or JSON's escapes); with `oneString`, only up to the end of the
- * double-quoted string `from` is in. Every backslash is taken as an escape of the next byte. */
-void apostropheEscapesAsQuotes(std::string& text, size_t from, bool oneString)
-{
-    for (size_t i = from; i + 1 < text.size() && !(oneString && text[i] == '"'); ++i)
-        if (text[i] == '\\') {
-            if (text[i + 1] == '\'')
-                text[i + 1] = '"';
-            ++i;
-        }
-}
 
 //! The byte offset of a libyaml mark (its line and column count characters) in `text`.
 size_t byteOffsetOf(const std::string& text, size_t from, const yaml_mark_t& mark)
@@ -312,58 +442,39 @@ size_t byteOffsetOf(const std::string& text, size_t from, const yaml_mark_t& mar
     return at;
 }
 
-/** Parses `text` from byte `from` once; returns the offset of a backslash where libyaml found an unknown
- * escape and the text has OpenCV's \' there (std::string::npos when it parsed or failed otherwise). */
-size_t validateYamlOnce(const String& path, const std::string& text, size_t from, int lineOffset);
-
-} // namespace
-
-void validateYaml(const String& path, const std::string& text)
+/** OpenCV's \' escape in `text` from byte `from` written as `replacement` (an escape of the apostrophe the
+ * other parser knows); with `oneString`, only up to the end of the double-quoted string `from` is in. Every
+ * backslash is taken as an escape of the next byte. Lines stay where they are. */
+std::string withApostropheEscapes(const std::string& text, size_t from, bool oneString,
+                                  const char* replacement)
 {
-    // OpenCV's own header line ("%YAML:1.0") is no YAML directive: libyaml reads from the next line.
-    size_t from = 0;
-    int lineOffset = 0;
-    if (text.compare(0, 5, "%YAML") == 0) {
-        const size_t newline = text.find('\n');
-        from = newline == std::string::npos ? text.size() : newline + 1;
-        lineOffset = 1;
-    }
-    // OpenCV's writer escapes an apostrophe in a double-quoted string as \', which YAML does not have
-    // (a calibration report's notes hold them). libyaml says exactly where it meets one, always in a
-    // double-quoted scalar: that scalar's \' become \" (the same length, so lines and columns stay) and
-    // the text is parsed again. A budget of bytes re-parsed keeps a file full of them from costing
-    // more than a second.
-    std::string patched;
-    const std::string* parsed = &text;
-    long long budget = 64LL << 20;
-    for (;;) {
-        const size_t escape = validateYamlOnce(path, *parsed, from, lineOffset);
-        if (escape == std::string::npos)
-            return;
-        budget -= static_cast<long long>(parsed->size() - from);
-        if (budget < 0)
-            CV_Error(Error::StsParseError,
-                     format("'%s' line %d: too many double-quoted strings with OpenCV's \\' escape to check",
-                            path.c_str(), lineAt(*parsed, escape)));
-        if (parsed == &text) {
-            patched = text;
-            parsed = &patched;
+    std::string out = text.substr(0, from);
+    size_t i = from;
+    for (; i < text.size() && !(oneString && text[i] == '"'); ++i) {
+        if (text[i] == '\\' && i + 1 < text.size()) {
+            if (text[i + 1] == '\'')
+                out += replacement;
+            else
+                out.append(text, i, 2);
+            ++i;
+        } else {
+            out += text[i];
         }
-        apostropheEscapesAsQuotes(patched, escape, true);
     }
+    out.append(text, i, std::string::npos);
+    return out;
 }
 
-namespace {
-
-size_t validateYamlOnce(const String& path, const std::string& text, size_t from, int lineOffset)
+/** Parses `text` from byte `from` once into `out`; returns the offset of a backslash where libyaml found
+ * an unknown escape and the text has OpenCV's \' there (std::string::npos when it parsed). */
+size_t parseYamlOnce(const String& path, const std::string& text, size_t from, int lineOffset,
+                     OpenCvTextWriter& out)
 {
     YamlParser yaml(text.data() + from, text.size() - from);
+    YamlScalarTyper typer(path, out);
     const auto lineOf = [&](const yaml_mark_t& mark) { return static_cast<int>(mark.line) + 1 + lineOffset; };
-    const auto refuse = [&](int line, const std::string& why) {
-        CV_Error(Error::StsParseError, format("'%s' line %d: %s", path.c_str(), line, why.c_str()));
-    };
-    int depth = 0, documents = 0;
-    bool root = false;
+    std::vector<bool> flow;
+    int documents = 0;
     for (;;) {
         YamlEvent e;
         if (!yaml_parser_parse(&yaml.parser, &e.event)) {
@@ -376,62 +487,61 @@ size_t validateYamlOnce(const String& path, const std::string& text, size_t from
             std::string why = p.problem ? p.problem : "malformed YAML";
             if (p.context)
                 why += std::string(" ") + p.context + format(" (from line %d)", lineOf(p.context_mark));
-            refuse(lineOf(p.problem_mark), "not valid YAML: " + why);
+            refuseAt(path, lineOf(p.problem_mark), "not valid YAML: " + why);
         }
         e.held = true;
         const yaml_event_t& ev = e.event;
         const int line = lineOf(ev.start_mark);
         switch (ev.type) {
         case YAML_STREAM_END_EVENT:
-            if (!root)
+            if (out.empty())
                 CV_Error(Error::StsParseError, "'" + path + "' holds no map (only comments or directives)");
             return std::string::npos;
         case YAML_DOCUMENT_START_EVENT:
             if (++documents > 1)
-                refuse(line, "a second document (this module reads single-document YAML files)");
+                refuseAt(path, line, "a second document (this module reads single-document YAML files)");
             break;
         case YAML_ALIAS_EVENT:
-            refuse(line, "an alias (*name): OpenCV's reader has no anchors or aliases");
-            break;
-        case YAML_SCALAR_EVENT:
-            if (ev.data.scalar.anchor)
-                refuse(line, "an anchor (&name): OpenCV's reader has no anchors or aliases");
-            if (depth == 0)
-                refuse(line, "the root is a single value, not a map (this module reads single-document YAML "
-                             "files whose root is a block map or list at column 0)");
-            // An untagged plain scalar; "!!str 4294967297" is a string to OpenCV too.
-            if (ev.data.scalar.style == YAML_PLAIN_SCALAR_STYLE && ev.data.scalar.plain_implicit) {
-                const char* value = reinterpret_cast<const char*>(ev.data.scalar.value);
-                const size_t length = ev.data.scalar.length;
-                if (isIntegerLiteral(value, length) && !fitsInt(std::string(value, length)))
-                    refuseWrappingInteger(path, line, std::string(value, length));
+            refuseAt(path, line, "an alias (*name): this module's files have no anchors or aliases");
+        case YAML_SCALAR_EVENT: {
+            const auto& s = ev.data.scalar;
+            if (s.anchor)
+                refuseAt(path, line, "an anchor (&name): this module's files have no anchors or aliases");
+            if (flow.empty())
+                refuseAt(path, line, "the root is a single value, not a map");
+            const std::string value(reinterpret_cast<const char*>(s.value), s.length);
+            const bool plainStyle = s.style == YAML_PLAIN_SCALAR_STYLE;
+            const bool untagged = plainStyle ? s.plain_implicit != 0 : s.quoted_implicit != 0;
+            if (out.expectsKey()) {
+                if (!untagged)
+                    refuseAt(path, line, "a tagged key");
+                out.key(value, line);
+            } else if (!untagged) {
+                typer.tagged(value, s.tag ? reinterpret_cast<const char*>(s.tag) : "!", plainStyle, line);
+            } else if (plainStyle) {
+                typer.plain(value, flow.back(), line);
+            } else {
+                out.text(value, line);
             }
             break;
+        }
         case YAML_SEQUENCE_START_EVENT:
         case YAML_MAPPING_START_EVENT: {
             const bool mapping = ev.type == YAML_MAPPING_START_EVENT;
-            const yaml_char_t* anchor =
-                mapping ? ev.data.mapping_start.anchor : ev.data.sequence_start.anchor;
-            if (anchor)
-                refuse(line, "an anchor (&name): OpenCV's reader has no anchors or aliases");
-            if (depth == 0) {
-                const bool flow = mapping ? ev.data.mapping_start.style == YAML_FLOW_MAPPING_STYLE
-                                          : ev.data.sequence_start.style == YAML_FLOW_SEQUENCE_STYLE;
-                if (flow)
-                    refuse(line, "the root is a flow collection (this module reads single-document YAML "
-                                 "files whose root is a block map or list at column 0)");
-                if (ev.start_mark.column != 0)
-                    refuse(line, "the root collection does not start at column 0 (this module reads "
-                                 "single-document YAML files whose root is a block map or list at column 0)");
-                root = true;
-            }
-            if (++depth > MAX_NESTING_DEPTH)
-                refuseDepth(path, line);
+            if (mapping ? ev.data.mapping_start.anchor : ev.data.sequence_start.anchor)
+                refuseAt(path, line, "an anchor (&name): this module's files have no anchors or aliases");
+            if (out.expectsKey())
+                refuseAt(path, line, "a collection as a key");
+            const bool flowStyle = mapping ? ev.data.mapping_start.style == YAML_FLOW_MAPPING_STYLE
+                                           : ev.data.sequence_start.style == YAML_FLOW_SEQUENCE_STYLE;
+            out.startCollection(mapping, line);
+            flow.push_back(flowStyle || (!flow.empty() && flow.back()));
             break;
         }
         case YAML_SEQUENCE_END_EVENT:
         case YAML_MAPPING_END_EVENT:
-            --depth;
+            out.endCollection();
+            flow.pop_back();
             break;
         default:
             break;
@@ -439,76 +549,198 @@ size_t validateYamlOnce(const String& path, const std::string& text, size_t from
     }
 }
 
+std::string yamlForOpenCv(const String& path, const std::string& text)
+{
+    // OpenCV's own header line ("%YAML:1.0") is no YAML directive: libyaml reads from the next line.
+    size_t from = 0;
+    int lineOffset = 0;
+    if (text.compare(0, 5, "%YAML") == 0) {
+        const size_t newline = text.find('\n');
+        from = newline == std::string::npos ? text.size() : newline + 1;
+        lineOffset = 1;
+    }
+    // OpenCV's writer escapes an apostrophe in a double-quoted string as \', which YAML does not have (a
+    // calibration report's notes hold them). libyaml says exactly where it meets one, always in a
+    // double-quoted scalar: that scalar's \' become \x27 (YAML's escape of the same character, on the same
+    // line) and the text is parsed again. A budget of bytes re-parsed keeps a file full of them from
+    // costing more than a second.
+    std::string patched;
+    const std::string* parsed = &text;
+    long long budget = 64LL << 20;
+    for (;;) {
+        OpenCvTextWriter out(path);
+        const size_t escape = parseYamlOnce(path, *parsed, from, lineOffset, out);
+        if (escape == std::string::npos)
+            return out.finish();
+        budget -= static_cast<long long>(parsed->size() - from);
+        if (budget < 0)
+            refuseAt(path, lineAt(*parsed, escape),
+                     "too many double-quoted strings with OpenCV's \\' escape to check");
+        patched = withApostropheEscapes(*parsed, escape, true, "\\x27");
+        parsed = &patched;
+    }
+}
+
+// --------------------------------------------------------------------------------------------------
+// JSON: nlohmann's events (its parser keeps its state on the heap, not the stack).
+
+class JsonToOpenCv : public nlohmann::json_sax<nlohmann::json>
+{
+public:
+    JsonToOpenCv(const String& path, const std::string& text) : path_(path), text_(text), out_(path) {}
+
+    bool null() override
+    {
+        out_.null(0);
+        return true;
+    }
+    bool boolean(bool value) override
+    {
+        // As OpenCV's own JSON reader takes them.
+        out_.integer(value ? 1 : 0, 0, value ? "true" : "false");
+        return true;
+    }
+    bool number_integer(number_integer_t value) override
+    {
+        checkInteger(value >= INT_MIN && value <= INT_MAX, std::to_string(value));
+        out_.integer(value, 0, std::to_string(value));
+        return true;
+    }
+    bool number_unsigned(number_unsigned_t value) override
+    {
+        checkInteger(value <= static_cast<number_unsigned_t>(INT_MAX), std::to_string(value));
+        out_.integer(static_cast<long long>(value), 0, std::to_string(value));
+        return true;
+    }
+    bool number_float(number_float_t value, const string_t&) override
+    {
+        out_.real(value, 0);
+        return true;
+    }
+    bool string(string_t& value) override
+    {
+        out_.text(value, 0);
+        return true;
+    }
+    bool binary(binary_t&) override { refuseAt(path_, 0, "binary data; no file of this module holds any"); }
+    bool key(string_t& value) override
+    {
+        out_.key(value, 0);
+        return true;
+    }
+    bool start_object(std::size_t) override { return enter(true); }
+    bool start_array(std::size_t) override { return enter(false); }
+    bool end_object() override { return leave(); }
+    bool end_array() override { return leave(); }
+    bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception& e) override
+    {
+        std::string message = e.what();
+        // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." without the class.
+        const size_t bracket = message.find("] ");
+        if (message.compare(0, 1, "[") == 0 && bracket != std::string::npos)
+            message.erase(0, bracket + 2);
+        CV_Error(Error::StsParseError, "'" + path_ + "' is not valid JSON: " + message);
+    }
+
+    std::string finish() { return out_.finish(); }
+
+private:
+    bool enter(bool map)
+    {
+        if (++depth_ > MAX_NESTING_DEPTH)
+            refuseDepth(path_, lineAt(text_, offsetBeyondDepth()));
+        out_.startCollection(map, 0);
+        return true;
+    }
+    bool leave()
+    {
+        --depth_;
+        out_.endCollection();
+        return true;
+    }
+    void checkInteger(bool fits, const std::string& literal)
+    {
+        if (!fits)
+            refuseWrappingInteger(path_, lineAt(text_, offsetOfNumber(literal)), literal);
+    }
+
+    //! Where the text first opens a collection deeper than MAX_NESTING_DEPTH (strings skipped).
+    size_t offsetBeyondDepth() const
+    {
+        int depth = 0;
+        bool inString = false;
+        for (size_t i = 0; i < text_.size(); ++i) {
+            const char c = text_[i];
+            if (inString) {
+                if (c == '\\')
+                    ++i;
+                else if (c == '"')
+                    inString = false;
+            } else if (c == '"') {
+                inString = true;
+            } else if (c == '[' || c == '{') {
+                if (++depth > MAX_NESTING_DEPTH)
+                    return i;
+            } else if (c == ']' || c == '}') {
+                --depth;
+            }
+        }
+        return text_.size();
+    }
+
+    /** Where the number `literal` stands alone in the text (not inside a longer number); the text's end if
+     * nowhere. Only for the line of an error: a string that holds the same digits may be taken for it. */
+    size_t offsetOfNumber(const std::string& literal) const
+    {
+        const auto partOfNumber = [](char c) { return isAsciiDigit(c) || c == '.' || c == 'e' || c == 'E'; };
+        for (size_t at = text_.find(literal); at != std::string::npos; at = text_.find(literal, at + 1)) {
+            const size_t end = at + literal.size();
+            if ((at == 0 || (!partOfNumber(text_[at - 1]) && text_[at - 1] != '-')) &&
+                (end == text_.size() || !partOfNumber(text_[end])))
+                return at;
+        }
+        return text_.size();
+    }
+
+    String path_;
+    const std::string& text_;
+    OpenCvTextWriter out_;
+    int depth_ = 0;
+};
+
+std::string jsonForOpenCv(const String& path, const std::string& text)
+{
+    // OpenCV's JSON writer escapes an apostrophe as \', which JSON does not have (its reader takes it). In
+    // JSON every backslash belongs to a string, so each \' is such an escape: nlohmann is given \u0027.
+    const std::string patched = text.find("\\'") == std::string::npos
+                                    ? std::string()
+                                    : withApostropheEscapes(text, 0, false, "\\u0027");
+    const std::string& parsed = patched.empty() ? text : patched;
+    JsonToOpenCv events(path, parsed);
+    nlohmann::json::sax_parse(parsed, &events);
+    return events.finish();
+}
+
 } // namespace
 
-std::string validateJson(const String& path, std::string text)
+std::string textForOpenCv(const String& path, std::string text)
 {
-    // OpenCV's JSON writer escapes an apostrophe as \', which JSON does not have (its reader takes it).
-    // In JSON every backslash belongs to a string, so each \' is such an escape: the validator is given
-    // \" in its place (the same length and string), and OpenCV the text as it is.
-    std::string forValidator;
-    if (text.find("\\'") != std::string::npos) {
-        forValidator = text;
-        apostropheEscapesAsQuotes(forValidator, 0, false);
-    }
-    JsonChecks checks;
-    nlohmann::json::sax_parse(forValidator.empty() ? text : forValidator, &checks);
-    switch (checks.stop) {
-    case JsonChecks::Stop::SYNTAX:
-        CV_Error(Error::StsParseError, "'" + path + "' is not valid JSON: " + checks.message);
-    case JsonChecks::Stop::DEPTH:
-        refuseDepth(path, lineAt(text, offsetBeyondDepth(text)));
-    case JsonChecks::Stop::INTEGER:
-        refuseWrappingInteger(path, lineAt(text, offsetOfNumber(text, checks.literal)), checks.literal);
-    case JsonChecks::Stop::NONE:
-        break;
-    }
-    // OpenCV's JSON reader knows the escapes \" \\ \' \n \r \t \b \f but not \u or \/, which JSON allows
-    // and common writers use (Python's json.dump writes every non-ASCII letter as \u00f8): those are
-    // written out as UTF-8. The text is valid JSON here, so every backslash is an escape in a string.
-    if (text.find("\\u") == std::string::npos && text.find("\\/") == std::string::npos)
-        return text;
-    std::string out;
-    out.reserve(text.size());
-    for (size_t i = 0; i < text.size(); ++i) {
-        if (text[i] != '\\') {
-            out += text[i];
-            continue;
-        }
-        const char kind = text[i + 1];
-        if (kind == '/') {
-            out += '/';
-            ++i;
-            continue;
-        }
-        if (kind != 'u') {
-            out.append(text, i, 2);
-            ++i;
-            continue;
-        }
-        unsigned codePoint = hex4(text, i + 2);
-        size_t length = 6;
-        // A high surrogate is followed by its low one (the validator has checked the pair).
-        if (codePoint >= 0xD800 && codePoint <= 0xDBFF) {
-            codePoint = 0x10000 + ((codePoint - 0xD800) << 10) + (hex4(text, i + 8) - 0xDC00);
-            length = 12;
-        }
-        if (codePoint == 0)
-            CV_Error(Error::StsParseError,
-                     format("'%s' line %d: a \\u0000 (NUL) in a string; OpenCV's strings "
-                            "end at a NUL",
-                            path.c_str(), lineAt(text, i)));
-        if (codePoint == '"' || codePoint == '\\')
-            out += '\\';
-        if (codePoint == '\n')
-            out += "\\n";
-        else if (codePoint == '\r')
-            out += "\\r";
-        else
-            appendUtf8(out, codePoint);
-        i += length - 1;
-    }
-    return out;
+    // A UTF-8 byte-order mark (some Windows editors write one) is not part of the YAML or JSON.
+    if (text.compare(0, 3, "\xEF\xBB\xBF") == 0)
+        text.erase(0, 3);
+    if (text.find('\0') != std::string::npos || text.compare(0, 2, "\xFF\xFE") == 0 ||
+        text.compare(0, 2, "\xFE\xFF") == 0)
+        CV_Error(Error::StsParseError, "'" + path +
+                                           "' holds NUL bytes or a UTF-16 byte-order mark: UTF-16 or UTF-32 "
+                                           "text? This module reads UTF-8; save it as UTF-8");
+    const size_t first = text.find_first_not_of(" \t\r\n");
+    if (first == std::string::npos)
+        CV_Error(Error::StsParseError, "'" + path + "' is empty");
+    if (text[first] == '<')
+        CV_Error(Error::StsParseError, "'" + path + "' looks like XML; this module reads YAML and JSON");
+    if (text[first] == '{')
+        return jsonForOpenCv(path, text);
+    return yamlForOpenCv(path, text);
 }
 
 } // namespace detail
