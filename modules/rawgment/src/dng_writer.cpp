@@ -237,6 +237,18 @@ std::vector<uint32_t> checkDngImage(const String& path, const RawImage& image)
         CV_Error(Error::StsBadArg, format("writeDng: '%s': exposure time %g s does not fit its DNG tag "
                                           "(a rational of at most 4294967295 s)",
                                           path.c_str(), image.exposureTime));
+    if (!(image.iso >= 0 && image.iso < 4294967295.5))
+        CV_Error(Error::StsBadArg,
+                 format("writeDng: '%s': ISO %g is not one a DNG can state (0 for unknown, or "
+                        "up to 4294967295, rounded to an integer)",
+                        path.c_str(), image.iso));
+    // LibRaw, and so readRaw(), reads no mosaic smaller than this on a side.
+    const int smallest = 22;
+    if (m.rows < smallest || m.cols < smallest)
+        CV_Error(Error::StsBadArg,
+                 format("writeDng: '%s': the mosaic is %dx%d; LibRaw (readRaw) reads no RAW file "
+                        "smaller than %d pixels on a side",
+                        path.c_str(), m.cols, m.rows, smallest));
     if (!image.noiseProfile.empty())
         detail::checkDngNoiseProfile(image.noiseProfile, ("writeDng: '" + path + "': noiseProfile").c_str());
 
@@ -329,8 +341,16 @@ void writeDng(const String& path, const RawImage& image)
                     dngColourOf(cfaChannelAt(p, 1, 0)), dngColourOf(cfaChannelAt(p, 1, 1))});
     if (image.exposureTime > 0)
         t.rationals(33434, {image.exposureTime}, false);
-    if (image.iso > 0)
-        t.shorts(34855, {static_cast<uint16_t>(std::min(65535.0, std::round(image.iso)))});
+    if (image.iso > 0) {
+        // EXIF 2.3: ISOSpeedRatings holds 16 bits, and 65535 there says that ISOSpeed (32 bits) holds the
+        // value; SensitivityType 3 says that ISOSpeed is the one stated. ISO tags hold integers.
+        const double iso = std::round(image.iso);
+        t.shorts(34855, {static_cast<uint16_t>(std::min(65535.0, iso))});
+        if (iso >= 65535) {
+            t.shorts(34864, {3});
+            t.longs(34867, {static_cast<uint32_t>(iso)});
+        }
+    }
     t.bytes(50706, {1, 4, 0, 0});
     t.bytes(50707, {1, 1, 0, 0});
     t.ascii(50708, image.make.empty() && image.model.empty() ? String("cv::rawgment")
@@ -355,7 +375,7 @@ void writeDng(const String& path, const RawImage& image)
         }
         t.doubles(51041, pairs);
     }
-    t.moveToExif({33434, 34855});
+    t.moveToExif({33434, 34855, 34864, 34867});
     const std::vector<uint8_t> bytes = t.build(m);
     writeFileAtomically(path, bytes.data(), bytes.size(), false);
 }

@@ -269,6 +269,31 @@ std::vector<Vec2d> readDngNoiseProfile(const String& path)
     return profile;
 }
 
+double readExifIsoSpeed(const String& path)
+{
+    if (!isTiffBased(path))
+        return 0;
+    TiffFile tiff(path);
+    const auto tagIn = [&](uint64_t ifd, uint16_t wanted, uint64_t& entry) {
+        const uint16_t entries = tiff.u16(ifd);
+        for (uint16_t i = 0; i < entries; ++i)
+            if (tiff.u16(ifd + 2 + 12ull * i) == wanted) {
+                entry = ifd + 2 + 12ull * i;
+                return true;
+            }
+        return false;
+    };
+    uint64_t exifPointer = 0, iso = 0;
+    if (!tagIn(tiff.u32(4), 34665, exifPointer))
+        return 0;
+    const uint64_t exif = tiff.u32(exifPointer + 8);
+    // ISOSpeed (34867), else RecommendedExposureIndex (34866): one LONG each.
+    for (uint16_t tag : {uint16_t(34867), uint16_t(34866)})
+        if (tagIn(exif, tag, iso) && tiff.u16(iso + 2) == kTypeLong && tiff.u32(iso + 4) == 1)
+            return tiff.u32(iso + 8);
+    return 0;
+}
+
 void checkDngNoiseProfile(const std::vector<Vec2d>& profile, const char* what)
 {
     if (profile.size() != 1 && profile.size() != 3)

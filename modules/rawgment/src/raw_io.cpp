@@ -181,6 +181,12 @@ RawImage readRaw(const String& path)
         failOn(path, "LibRaw's levels do not make a valid format: " + e.err);
     }
     out.iso = d.other.iso_speed > 0 ? shortestDecimal(d.other.iso_speed) : 0.0;
+    // LibRaw 0.20 reads ISOSpeedRatings only, which stops at 65535 (EXIF 2.3 states more in ISOSpeed).
+    if (out.iso >= 65535) {
+        const double exifIso = detail::readExifIsoSpeed(path);
+        if (exifIso > 0)
+            out.iso = exifIso;
+    }
     out.exposureTime = d.other.shutter > 0 ? shortestDecimal(d.other.shutter) : 0.0;
     out.make = d.idata.make;
     out.model = d.idata.model;

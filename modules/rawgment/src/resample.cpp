@@ -438,14 +438,27 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
 
 Rect scaleBox(const Rect& box, Size size, double scale)
 {
-    // Edges in continuous coordinates (pixel k covers [k, k + 1)); the box grows to whole pixels.
-    const double cx = size.width / 2.0, cy = size.height / 2.0;
-    const int x0 = static_cast<int>(std::floor(cx + (box.x - cx) * scale));
-    const int y0 = static_cast<int>(std::floor(cy + (box.y - cy) * scale));
-    const int x1 = static_cast<int>(std::ceil(cx + (box.x + box.width - cx) * scale));
-    const int y1 = static_cast<int>(std::ceil(cy + (box.y + box.height - cy) * scale));
+    if (!(std::isfinite(scale) && scale > 0))
+        CV_Error(Error::StsBadArg, format("scaleBox: scale must be finite and > 0 (got %g)", scale));
+    if (size.width <= 0 || size.height <= 0)
+        CV_Error(Error::StsBadArg,
+                 format("scaleBox: the frame size must be positive (got %dx%d)", size.width, size.height));
+    if (box.width < 0 || box.height < 0)
+        CV_Error(Error::StsBadArg, format("scaleBox: the box (%d, %d, %d x %d) has a negative size", box.x,
+                                          box.y, box.width, box.height));
     if (box.area() == 0)
         return Rect();
+    // Edges in continuous coordinates (pixel k covers [k, k + 1)); the box grows to whole pixels. An edge
+    // beyond the frame is clipped before it becomes an int, which it might not fit.
+    const double cx = size.width / 2.0, cy = size.height / 2.0;
+    const auto edge = [](double v, int limit, bool up) {
+        return static_cast<int>(
+            std::min<double>(std::max<double>(up ? std::ceil(v) : std::floor(v), -1), limit + 1.0));
+    };
+    const int x0 = edge(cx + (box.x - cx) * scale, size.width, false);
+    const int y0 = edge(cy + (box.y - cy) * scale, size.height, false);
+    const int x1 = edge(cx + (double(box.x) + box.width - cx) * scale, size.width, true);
+    const int y1 = edge(cy + (double(box.y) + box.height - cy) * scale, size.height, true);
     return Rect(Point(x0, y0), Point(x1, y1)) & Rect(Point(0, 0), size);
 }
 

@@ -205,6 +205,16 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
         std::abs(static_cast<double>(scene.shift.y)) > current.rows)
         CV_Error(Error::StsBadArg, cv::format("applyScene: shift (%d, %d) is larger than the %dx%d mosaic",
                                               scene.shift.x, scene.shift.y, current.cols, current.rows));
+    // Every box is checked and clipped to the frame on every path, whichever steps the scene has.
+    if (boxes)
+        for (size_t i = 0; i < boxes->size(); ++i) {
+            Rect& b = (*boxes)[i];
+            if (b.width < 0 || b.height < 0)
+                CV_Error(Error::StsBadArg,
+                         cv::format("applyScene: box %zu (%d, %d, %d x %d) has a negative size", i, b.x, b.y,
+                                    b.width, b.height));
+            b &= Rect(0, 0, current.cols, current.rows);
+        }
     const Point shift(2 * cvRound(scene.shift.x / 2.0), 2 * cvRound(scene.shift.y / 2.0));
     if (shift != Point(0, 0)) {
         const auto start = std::chrono::steady_clock::now();

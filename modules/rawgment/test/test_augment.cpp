@@ -352,6 +352,41 @@ TEST(Augment, scaleKeepsTheModelVarianceAtEveryInterpolationPosition)
     }
 }
 
+TEST(Augment, boxesAreCheckedAndClippedOnEveryPath)
+{
+    // A box outside the frame came back unchanged from an identity or jitter-only scene, and with scale
+    // 1.1 a box of negative size became a real 21x10 box; scaleBox took a NaN scale to int.
+    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    const Mat src(32, 48, CV_16UC1, Scalar(500));
+    Mat out;
+    RawFormat f;
+    Scene jitterOnly;
+    jitterOnly.jitter.brightness = 1;
+    for (const Scene& scene : {Scene(), jitterOnly}) {
+        std::vector<Rect> boxes = {Rect(40, 20, 20, 20), Rect(100, 100, 5, 5), Rect(-4, -4, 8, 8)};
+        applyScene(src, fmt, model, scene, 1, out, f, nullptr, &boxes);
+        EXPECT_EQ(boxes[0], Rect(40, 20, 8, 12));
+        EXPECT_EQ(boxes[1].area(), 0);
+        EXPECT_EQ(boxes[2], Rect(0, 0, 4, 4));
+    }
+    Scene scaled;
+    scaled.scale = 1.1;
+    for (const Scene& scene : {Scene(), scaled}) {
+        std::vector<Rect> boxes = {Rect(4, 4, 8, 8), Rect(10, 10, -21, 10)};
+        EXPECT_CV_ERROR_CONTAINS(applyScene(src, fmt, model, scene, 1, out, f, nullptr, &boxes),
+                                 "applyScene: box 1 (10, 10, -21 x 10) has a negative size");
+    }
+    for (double scale :
+         {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(), 0.0, -1.0})
+        EXPECT_CV_ERROR_CONTAINS(scaleBox(Rect(1, 1, 2, 2), Size(8, 8), scale),
+                                 "scale must be finite and > 0");
+    EXPECT_CV_ERROR_CONTAINS(scaleBox(Rect(1, 1, -2, 2), Size(8, 8), 1.5), "negative size");
+    // Edges far beyond the frame are clipped before they become ints.
+    EXPECT_EQ(scaleBox(Rect(0, 0, 8, 8), Size(8, 8), 1e300), Rect(0, 0, 8, 8));
+    EXPECT_EQ(scaleBox(Rect(0, 0, 1, 1), Size(8, 8), 1e300).area(), 0);
+}
+
 TEST(Augment, scaleMovesBoxesKeepsThePhaseAndSkipsTheIdentity)
 {
     const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);

@@ -143,10 +143,42 @@ TEST(RawIo, writeDngRejectsWhatDngCannotHold)
     EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "CV_16UC1");
     img.mosaic = Mat(5, 4, CV_16UC1, Scalar(1));
     EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "even");
-    img.mosaic = Mat(4, 4, CV_16UC1, Scalar(1));
+    img.mosaic = Mat(22, 22, CV_16UC1, Scalar(1));
     img.format.blackLevel = Vec4d(10.5, 10, 10, 10);
     EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "not an integer");
+    img.format.blackLevel = Vec4d::all(10);
+    // LibRaw reads no RAW file under 22 pixels on a side: such a DNG would be written, then refused by
+    // readRaw as "not RAW file".
+    for (const Size size : {Size(2, 2), Size(16, 16), Size(20, 64), Size(64, 20)}) {
+        img.mosaic = Mat(size, CV_16UC1, Scalar(1));
+        EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "smaller than 22 pixels on a side");
+    }
+    // An ISO a DNG cannot state is refused, not clamped to 0 or 65535.
+    img.mosaic = Mat(22, 22, CV_16UC1, Scalar(1));
+    for (double iso :
+         {std::numeric_limits<double>::quiet_NaN(), -1.0, std::numeric_limits<double>::infinity(), 5e9}) {
+        img.iso = iso;
+        EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "is not one a DNG can state");
+    }
     EXPECT_TRUE(filesIn(dir).empty()) << "a refused write leaves nothing behind";
+}
+
+TEST(RawIo, anIsoBeyond16BitsIsWrittenAndReadExactly)
+{
+    // Augment multiplies ISO by the gain ratio, so real runs reach ISO 102400 and beyond; ISOSpeedRatings
+    // holds 16 bits, EXIF 2.3's ISOSpeed 32. The smallest mosaic LibRaw reads is written and read back.
+    const std::string dir = makeTempDir("raw_io_dng_iso");
+    RawImage img;
+    img.mosaic = Mat(22, 22, CV_16UC1, Scalar(100));
+    img.format.whiteLevel = 4095;
+    for (double iso : {100.0, 65534.0, 65535.0, 102400.0, 409600.0, 4294967295.0, 141.4}) {
+        img.iso = iso;
+        const std::string path = dir + format("/iso_%g.dng", iso);
+        writeDng(path, img);
+        const RawImage back = readRaw(path);
+        EXPECT_EQ(std::round(iso), back.iso) << iso;
+        EXPECT_EQ(Size(22, 22), back.mosaic.size());
+    }
 }
 
 TEST(RawIo, dngNoiseProfileRoundTripsAndGivesBackTheModelsLines)
