@@ -144,7 +144,7 @@ def test_burst_statistics_and_calibration(reference):
         frames = np.load(folder / ("burst_g%d.npy" % g)).reshape(16, 96, 128)
         burstFormat = rg.RawFormat()
         burstFormat.blackLevel, burstFormat.whiteLevel, burstFormat.gain = fmt.blackLevel, fmt.whiteLevel, gain
-        stats = rg.BurstStatistics(burstFormat)
+        stats = rg.BurstStatistics_create(burstFormat)
         for frame in frames:
             stats.add(frame)
         assert stats.frames() == 16 and stats.format().gain == gain
@@ -190,3 +190,30 @@ def test_camera_catalogue(reference):
     d3Model = d3.modelFor(fmt)
     assert (d3.verdict, d3Model.alpha, d3Model.variance(100, 3)) == (int(verdict), float(alpha), float(variance))
     assert d3.name() == "Nikon D3" and d3.usable()
+
+
+def test_arrays_the_binding_would_misread_are_cv2_errors(reference):
+    """Issue #60's cv2 round: the generated binding hands an N-D array to C++ as an N-D Mat, a (3, 3, 3)
+    kernel as three channels, and its constructors report errors as SystemError. The checks are in the C++
+    entry points every binding calls, and BurstStatistics is made by a function that can raise cv2.error."""
+    folder, numbers = reference
+    fmt, model = inputs(numbers)
+    capture = np.load(folder / "capture.npy")
+    four_d = capture.reshape(1, 1, *capture.shape)
+    noise = rg.NoiseOptions(rg.NoiseAlignment_ACCOUNT_PRIOR)
+    stats = rg.BurstStatistics_create(fmt)
+    with pytest.raises(cv2.error, match="4 dimensions"):
+        stats.add(four_d)
+    with pytest.raises(cv2.error, match="4 dimensions"):
+        model.variance(np.ones((1, 1, 2, 2), np.float64), 1.0)
+    with pytest.raises(cv2.error, match="4 dimensions"):
+        rg.colorJitter(four_d, fmt, model, rg.ColorJitter(), noise, 1)
+    kernel = np.ones((3, 3, 3), np.float64)
+    with pytest.raises(cv2.error, match="3 channels"):
+        rg.motionBlur(capture, fmt, model, kernel, noise, 1)
+    with pytest.raises(cv2.error, match="groupFrames"):
+        rg.BurstStatistics_create(fmt, 0)
+    bad = rg.RawFormat()
+    bad.gain = float("nan")
+    with pytest.raises(cv2.error):
+        rg.BurstStatistics_create(bad)

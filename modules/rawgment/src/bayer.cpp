@@ -220,7 +220,7 @@ RawFormat RawFormat::read(const FileNode& node)
 
 void splitCfaPlanes(InputArray _mosaic, OutputArrayOfArrays _planes)
 {
-    const Mat mosaic = _mosaic.getMat();
+    const Mat mosaic = detail::twoDimensional(_mosaic, "splitCfaPlanes: mosaic");
     checkMosaic(mosaic, "splitCfaPlanes: mosaic");
     if (mosaic.rows % 2 != 0 || mosaic.cols % 2 != 0)
         CV_Error(Error::StsBadArg,
@@ -255,6 +255,7 @@ void mergeCfaPlanes(InputArrayOfArrays _planes, OutputArray _mosaic)
         CV_Error(Error::StsBadArg, format("mergeCfaPlanes: got %d planes; expected 4 (one per CFA site)",
                                           static_cast<int>(planes.size())));
     for (int s = 0; s < 4; ++s) {
+        detail::twoDimensional(planes[s], "mergeCfaPlanes: plane");
         checkMosaic(planes[s], "mergeCfaPlanes: plane");
         if (planes[s].size() != planes[0].size() || planes[s].type() != planes[0].type())
             CV_Error(Error::StsBadArg,
@@ -282,7 +283,7 @@ void mergeCfaPlanes(InputArrayOfArrays _planes, OutputArray _mosaic)
 void subtractBlackLevel(InputArray _src, const RawFormat& format, OutputArray _dst, bool normalize)
 {
     format.validate();
-    const Mat src = _src.getMat();
+    const Mat src = detail::twoDimensional(_src, "subtractBlackLevel: src");
     checkMosaic(src, "subtractBlackLevel: src");
     if (src.type() != CV_16UC1 && src.type() != CV_32FC1)
         CV_Error(Error::StsBadArg, cv::format("subtractBlackLevel: src type %s is not supported; expected "
@@ -332,7 +333,7 @@ void packPerSite(const Mat& src, Mat& dst, const int planeOfSite[4], const Vec4d
 void packCfaPlanes(InputArray _mosaic, const RawFormat& format, OutputArray _planes, bool normalize)
 {
     format.validate();
-    const Mat src = _mosaic.getMat();
+    const Mat src = detail::twoDimensional(_mosaic, "packCfaPlanes: mosaic");
     checkMosaic(src, "packCfaPlanes: mosaic");
     if (src.type() != CV_16UC1 && src.type() != CV_32FC1)
         CV_Error(Error::StsBadArg,
@@ -366,7 +367,7 @@ void packCfaPlanes(InputArray _mosaic, const RawFormat& format, OutputArray _pla
 void addBlackLevel(InputArray _src, const RawFormat& format, OutputArray _dst, int ddepth, bool normalized)
 {
     format.validate();
-    const Mat src = _src.getMat();
+    const Mat src = detail::twoDimensional(_src, "addBlackLevel: src");
     checkMosaic(src, "addBlackLevel: src");
     if (src.type() != CV_32FC1)
         CV_Error(Error::StsBadArg,

@@ -358,7 +358,7 @@ BurstStatistics::~BurstStatistics() = default;
 
 void BurstStatistics::add(InputArray _frame)
 {
-    const Mat frame = _frame.getMat();
+    const Mat frame = detail::twoDimensional(_frame, "BurstStatistics::add: frame");
     if (frame.empty())
         CV_Error(Error::StsBadArg, "BurstStatistics::add: frame is empty");
     if (frame.type() != CV_16UC1 && frame.type() != CV_32FC1)

@@ -161,7 +161,7 @@ std::vector<NoiseSample> sampleSingleFramePatches(InputArray _raw, const RawForm
 {
     detail::checkFinitePositive(gain, "sampleSingleFramePatches: gain");
     format.validate();
-    const Mat raw = _raw.getMat();
+    const Mat raw = detail::twoDimensional(_raw, "sampleSingleFramePatches: raw");
     if (raw.type() != CV_16UC1 && raw.type() != CV_32FC1)
         CV_Error(Error::StsBadArg, "sampleSingleFramePatches: raw must be CV_16UC1 or CV_32FC1");
     checkSquares(squares, raw.size(), "sampleSingleFramePatches");

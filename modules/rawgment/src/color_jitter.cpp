@@ -366,7 +366,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
                  AugmentReport* report, OutputArray saturatedMask)
 {
     const auto start = std::chrono::steady_clock::now();
-    const Mat src = _src.getMat();
+    const Mat src = detail::twoDimensional(_src, "colorJitter: src");
     detail::checkMosaicInput(src, "colorJitter");
     format.validate();
     model.validate();

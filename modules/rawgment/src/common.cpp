@@ -51,10 +51,29 @@ void checkFiniteNonNegative(double value, const char* what)
         CV_Error(Error::StsBadArg, format("%s must be finite and >= 0 (got %g)", what, value));
 }
 
+Mat twoDimensional(InputArray array, const char* what)
+{
+    const Mat m = array.getMat();
+    if (m.dims > 2) {
+        std::string shape;
+        for (int d = 0; d < m.dims; ++d)
+            shape += (d ? " x " : "") + std::to_string(m.size[d]);
+        CV_Error(Error::StsBadArg,
+                 format("%s has %d dimensions (%s); expected a 2-D matrix (a (rows, cols) array)", what,
+                        m.dims, shape.c_str()));
+    }
+    return m;
+}
+
 Mat normalisedKernel(InputArray _kernel, const char* who)
 {
+    const Mat given = twoDimensional(_kernel, format("%s: kernel", who).c_str());
+    // A kernel of several channels would be read interleaved, its channels taken for taps.
+    if (given.channels() != 1)
+        CV_Error(Error::StsBadArg, format("%s: kernel has %d channels; expected a single-channel 2-D kernel",
+                                          who, given.channels()));
     Mat kernel;
-    _kernel.getMat().convertTo(kernel, CV_64F);
+    given.convertTo(kernel, CV_64F);
     if (kernel.empty() || !checkRange(kernel, true))
         CV_Error(Error::StsBadArg, format("%s: kernel must be non-empty and finite", who));
     double lo = 0;

@@ -222,7 +222,7 @@ void toneMapBgr(const Mat& bgr16, const Matx33d& rgbMatrix, const std::vector<T>
 void applyToneCurve(InputArray _linear, OutputArray _dst, const ToneCurve& curve, int ddepth)
 {
     curve.validate();
-    const Mat linear = _linear.getMat();
+    const Mat linear = detail::twoDimensional(_linear, "applyToneCurve: linear");
     if (linear.empty())
         CV_Error(Error::StsBadArg, "applyToneCurve: linear is empty");
     if (linear.depth() != CV_32F && linear.depth() != CV_64F)
@@ -257,7 +257,7 @@ void renderSimpleIsp(InputArray _mosaic, const RawFormat& format, OutputArray _b
 {
     format.validate();
     params.validate();
-    const Mat mosaic = _mosaic.getMat();
+    const Mat mosaic = detail::twoDimensional(_mosaic, "renderSimpleIsp: mosaic");
     if (mosaic.empty())
         CV_Error(Error::StsBadArg, "renderSimpleIsp: mosaic is empty");
     if (mosaic.type() != CV_16UC1 && mosaic.type() != CV_32FC1)

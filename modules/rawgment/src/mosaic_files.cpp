@@ -110,7 +110,7 @@ using detail::lowerExtensionOf;
 
 void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& metadata)
 {
-    const Mat mosaic = _mosaic.getMat();
+    const Mat mosaic = detail::twoDimensional(_mosaic, "writeMosaic: mosaic");
     const String ext = lowerExtensionOf(path);
     const bool tiff = ext == ".tif" || ext == ".tiff", npy = ext == ".npy", takesFloat = tiff || npy;
     if (ext != ".png" && ext != ".dng" && !tiff && !npy)

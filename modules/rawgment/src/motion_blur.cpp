@@ -245,7 +245,7 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
                 const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
 {
     const auto start = std::chrono::steady_clock::now();
-    const Mat src = _src.getMat();
+    const Mat src = detail::twoDimensional(_src, "motionBlur: src");
     detail::checkResampleInput(src, format, model, noise, "motionBlur");
     const Mat w = detail::normalisedKernel(_kernel, "motionBlur");
     if (w.total() == 1) {

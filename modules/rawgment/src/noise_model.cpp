@@ -176,7 +176,7 @@ double NoiseModel::variance(double mean, double gain) const
 void NoiseModel::variance(InputArray _mean, double gain, OutputArray _dst) const
 {
     const NoiseLine line = lineAtGain(gain);
-    const Mat mean = _mean.getMat();
+    const Mat mean = detail::twoDimensional(_mean, "NoiseModel::variance: mean");
     if (mean.empty())
         CV_Error(Error::StsBadArg, "NoiseModel::variance: mean is empty");
     if (mean.type() != CV_32FC1 && mean.type() != CV_64FC1)

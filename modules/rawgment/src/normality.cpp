@@ -368,7 +368,7 @@ void forEachSortedSeries(int count, int n, const Load& load, const Emit& emit, F
 
 ShapiroWilkResult shapiroWilk(InputArray _samples)
 {
-    const Mat samples = _samples.getMat();
+    const Mat samples = detail::twoDimensional(_samples, "shapiroWilk: samples");
     checkNumeric(samples, "shapiroWilk: samples");
     const int n = static_cast<int>(samples.total());
     checkSampleSize(n);
@@ -386,7 +386,7 @@ ShapiroWilkResult shapiroWilk(InputArray _samples)
 
 void shapiroWilkBatch(InputArray _series, std::vector<ShapiroWilkResult>& results, ShapiroWilkLayout layout)
 {
-    const Mat series = _series.getMat();
+    const Mat series = detail::twoDimensional(_series, "shapiroWilkBatch: series");
     if (series.empty())
         CV_Error(Error::StsBadArg, "shapiroWilkBatch: series is empty");
     checkNumeric(series, "shapiroWilkBatch: series");
@@ -426,6 +426,7 @@ BurstNormality shapiroWilkBurst(InputArrayOfArrays _frames, const std::vector<Po
     for (int t = 0; t < n; ++t) {
         if (frames[t].empty())
             CV_Error(Error::StsBadArg, format("shapiroWilkBurst: frame %d is empty", t));
+        detail::twoDimensional(frames[t], "shapiroWilkBurst: frame");
         checkNumeric(frames[t], "shapiroWilkBurst: frame");
         if (frames[t].size() != frames[0].size() || frames[t].type() != frames[0].type())
             CV_Error(Error::StsBadArg,

@@ -26,6 +26,10 @@ void checkFiniteNonNegative(double value, const char* what);
  * blurred captures. Throws StsBadArg naming `who` unless it is non-empty, finite, non-negative and of
  * positive sum. */
 Mat normalisedKernel(InputArray kernel, const char* who);
+/** The Mat of an array argument, refused with StsBadArg naming `what` ("colorJitter: src") unless it has at
+ * most two dimensions: an N-D array (numpy's (1, 1, H, W) through cv2) would otherwise be read as 1x1. The
+ * check every entry point makes, so that every binding gets it. */
+Mat twoDimensional(InputArray array, const char* what);
 
 /** The border rule of every blur: BORDER_REPLICATE, the nearest visible pixel stands for the light just
  * outside the frame. A motion blur at the edge integrates light the sensor never saw; the nearest

@@ -391,7 +391,7 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
                  const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
 {
     const auto start = std::chrono::steady_clock::now();
-    const Mat src = _src.getMat();
+    const Mat src = detail::twoDimensional(_src, "scaleMosaic: src");
     detail::checkResampleInput(src, format, model, noise, "scaleMosaic");
     if (!std::isfinite(scale) || !(scale > 0))
         CV_Error(Error::StsBadArg, cv::format("scaleMosaic: scale must be finite and > 0 (got %g)", scale));

@@ -194,7 +194,7 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
                 uint64 seed, OutputArray _dst, RawFormat& dstFormat, AugmentReport* report,
                 std::vector<Rect>* boxes)
 {
-    Mat current = _src.getMat();
+    Mat current = detail::twoDimensional(_src, "applyScene: src");
     detail::checkMosaicInput(current, "applyScene");
     format.validate();
     model.validate();
@@ -360,7 +360,7 @@ void RandomScenePolicy::validate() const
 Scene RandomScenePolicy::draw(InputArray _src, const RawFormat& format, uint64 seed) const
 {
     validate();
-    const Mat src = _src.getMat();
+    const Mat src = detail::twoDimensional(_src, "RandomScenePolicy::draw: src");
     detail::checkMosaicInput(src, "RandomScenePolicy::draw");
     const double minX = minimumAboveBlack(src, format);
     detail::CounterRng rng(detail::stepKey(seed, detail::RandomStream::POLICY_DRAW), 0);

@@ -109,7 +109,7 @@ NoiseModel SensorSimulator::effectiveModel() const
 void SensorSimulator::capture(InputArray _mean, double gain, double exposure, uint64 seed, int frameIndex,
                               OutputArray _raw) const
 {
-    const Mat mean = _mean.getMat();
+    const Mat mean = detail::twoDimensional(_mean, "SensorSimulator::capture: meanAtUnitGain");
     if (mean.type() != CV_32FC1 || mean.size() != size_)
         CV_Error(Error::StsBadArg,
                  format("SensorSimulator::capture: meanAtUnitGain must be CV_32FC1 of %dx%d "

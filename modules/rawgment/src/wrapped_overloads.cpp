@@ -1,8 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 //
 // The overloads that OpenCV's binding generator wraps (cv2.rawgment): a report it can return instead of
-// an optional pointer, boxes it can move in place, and a burst held by Ptr. Each starts from an empty
-// report and forwards to the one implementation, so both doors give the same bits.
+// an optional pointer, boxes it can move in place, and a burst made and held by Ptr. Each starts from an
+// empty report and forwards to the one implementation, so both doors give the same bits.
 #include "precomp.hpp"
 
 #include <opencv2/rawgment/augment.hpp>
@@ -21,6 +21,11 @@ const BurstStatistics& heldBurst(const Ptr<BurstStatistics>& stats, const char* 
 }
 
 } // namespace
+
+Ptr<BurstStatistics> BurstStatistics::create(const RawFormat& format, int groupFrames, int stateDepth)
+{
+    return makePtr<BurstStatistics>(format, groupFrames, stateDepth);
+}
 
 void colorJitter(InputArray src, const RawFormat& format, const NoiseModel& model, const ColorJitter& jitter,
                  const NoiseOptions& noise, uint64 seed, OutputArray dst, RawFormat& dstFormat,

@@ -626,6 +626,54 @@ TEST(NumericalStability, shapiroWilkIsScaleFreeFromDenormalsToTheLargestDoubles)
     EXPECT_NEAR(huge.pValue, 0.6829615316, 1e-9);
 }
 
+TEST(NumericalStability, anNdArrayOrAMultichannelKernelIsRefusedByEveryEntryPoint)
+{
+    // Through cv2, numpy's (1, 1, H, W) arrives as a 4-D Mat, whose rows and cols are -1 and size() 1x1:
+    // BurstStatistics read it as 1x1 (undefined data), variance gave one value for four means. A (3, 3, 3)
+    // kernel arrives as 3 channels, read interleaved as taps. Each entry point refuses both.
+    const int sizes[] = {1, 1, 4, 6};
+    const Mat nd16(4, sizes, CV_16UC1, Scalar(100)), nd32(4, sizes, CV_32FC1, Scalar(100));
+    const Mat nd64(4, sizes, CV_64FC1, Scalar(100));
+    RawFormat format;
+    format.whiteLevel = 4095;
+    const NoiseModel model(0.4, 0.5, 2.0);
+    Mat out;
+    RawFormat outFormat;
+    const char* const fragment = "has 4 dimensions (1 x 1 x 4 x 6); expected a 2-D matrix";
+    BurstStatistics stats(format);
+    EXPECT_CV_ERROR_CONTAINS(stats.add(nd16), fragment);
+    EXPECT_EQ(0, stats.frames());
+    EXPECT_CV_ERROR_CONTAINS(model.variance(nd64, 1.0, out), fragment);
+    EXPECT_CV_ERROR_CONTAINS(
+        colorJitter(nd16, format, model, ColorJitter(), NoiseOptions(), 1, out, outFormat), fragment);
+    EXPECT_CV_ERROR_CONTAINS(
+        motionBlur(nd16, format, model, linearMotionKernel(3, 0), NoiseOptions(), 1, out), fragment);
+    EXPECT_CV_ERROR_CONTAINS(scaleMosaic(nd16, format, model, 1.1, NoiseOptions(), 1, out), fragment);
+    EXPECT_CV_ERROR_CONTAINS(applyScene(nd16, format, model, Scene(), 1, out, outFormat), fragment);
+    EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy().draw(nd16, format, 1), fragment);
+    EXPECT_CV_ERROR_CONTAINS(shapiroWilk(nd64), fragment);
+    std::vector<ShapiroWilkResult> results;
+    EXPECT_CV_ERROR_CONTAINS(shapiroWilkBatch(nd64, results), fragment);
+    EXPECT_CV_ERROR_CONTAINS(shapiroWilkBurst(std::vector<Mat>{nd64, nd64, nd64}), fragment);
+    std::vector<Mat> planes;
+    EXPECT_CV_ERROR_CONTAINS(splitCfaPlanes(nd16, planes), fragment);
+    EXPECT_CV_ERROR_CONTAINS(mergeCfaPlanes(std::vector<Mat>(4, nd16), out), fragment);
+    EXPECT_CV_ERROR_CONTAINS(subtractBlackLevel(nd16, format, out), fragment);
+    EXPECT_CV_ERROR_CONTAINS(packCfaPlanes(nd16, format, out), fragment);
+    EXPECT_CV_ERROR_CONTAINS(addBlackLevel(nd32, format, out), fragment);
+    EXPECT_CV_ERROR_CONTAINS(applyToneCurve(nd32, out, ToneCurve()), fragment);
+    EXPECT_CV_ERROR_CONTAINS(renderSimpleIsp(nd16, format, out), fragment);
+    const Mat mosaic(8, 8, CV_16UC1, Scalar(500));
+    Mat kernel3(3, 3, CV_64FC3, Scalar::all(1));
+    EXPECT_CV_ERROR_CONTAINS(motionBlur(mosaic, format, model, kernel3, NoiseOptions(), 1, out),
+                             "motionBlur: kernel has 3 channels; expected a single-channel 2-D kernel");
+    const int kernelSizes[] = {1, 3, 3};
+    EXPECT_CV_ERROR_CONTAINS(
+        motionBlur(mosaic, format, model, Mat(3, kernelSizes, CV_64FC1, Scalar(1)), NoiseOptions(), 1, out),
+        "motionBlur: kernel has 3 dimensions");
+    EXPECT_CV_ERROR_CONTAINS(shapiroWilk(Mat(5, 1, CV_64FC3, Scalar::all(1))), "3 channels");
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv

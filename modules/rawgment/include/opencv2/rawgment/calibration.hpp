@@ -46,7 +46,12 @@ public:
      *         1e-7 relative on the mean, whose rounding at each merge then enters M2 through the
      *         merge's delta: at mean 60000 and variance 1 the variance errs by up to ~2e-3 relative
      *         (rawgment_tradeoffs measures it), at ordinary means far less. */
-    CV_WRAP explicit BurstStatistics(const RawFormat& format, int groupFrames = 8, int stateDepth = CV_64F);
+    explicit BurstStatistics(const RawFormat& format, int groupFrames = 8, int stateDepth = CV_64F);
+    /** @brief The constructor's object, held by a Ptr: the way bindings make one. OpenCV 4.6's generated
+     * cv2 constructor cannot raise cv2.error (a refused argument came out as SystemError), a function can.
+     * @throws cv::Exception as the constructor does. */
+    CV_WRAP static Ptr<BurstStatistics> create(const RawFormat& format, int groupFrames = 8,
+                                               int stateDepth = CV_64F);
     ~BurstStatistics();
     BurstStatistics(const BurstStatistics&) = delete;
     BurstStatistics& operator=(const BurstStatistics&) = delete;
