@@ -217,3 +217,20 @@ def test_arrays_the_binding_would_misread_are_cv2_errors(reference):
     bad.gain = float("nan")
     with pytest.raises(cv2.error):
         rg.BurstStatistics_create(bad)
+
+
+def test_integer_samples_beyond_32_bits_are_taken_exactly():
+    """cv2 casts int64 arrays to int32: [1, 2, 3, 2**40] wrapped and Shapiro-Wilk gave W 0.9929 instead of
+    0.6298 (the value R's shapiro.test and the pybind module give)."""
+    samples = np.array([1, 2, 3, 2 ** 40], np.int64)
+    exact = rg.shapiroWilk(samples.astype(np.float64))
+    assert abs(exact.W - 0.6298) < 5e-5
+    for dtype in (np.int64, np.uint64):
+        result = rg.shapiroWilk(samples.astype(dtype))
+        assert (result.W, result.pValue) == (exact.W, exact.pValue)
+    batch = rg.shapiroWilkBatch(np.stack([samples, samples], axis=1), layout=rg.SW_SERIES_IN_COLUMNS)
+    assert [r.W for r in batch] == [exact.W, exact.W]
+    with pytest.raises(ValueError, match="beyond 2\\*\\*53"):
+        rg.shapiroWilk(np.array([1, 2, 3, 2 ** 60], np.int64))
+    # Small integers keep their own depths.
+    assert rg.shapiroWilk(np.array([1, 2, 4, 9], np.int32)).W == rg.shapiroWilk(np.array([1., 2., 4., 9.])).W
