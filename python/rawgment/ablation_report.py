@@ -461,7 +461,8 @@ def writeStudiesOutputs(byStudy, outDir):
 
 def loadStudy(folder):
     """A study's results.json from its folder, checked for what the side-by-side page reads; a ValueError
-    naming the file when it is missing or not a study's."""
+    naming the file when it is missing or not a study's, or when an arm holds another number of values than
+    the study's seeds (one value would otherwise be paired with every seed of another arm)."""
     path = os.path.join(folder, "results.json")
     try:
         with open(path, encoding="utf-8") as f:
@@ -469,9 +470,21 @@ def loadStudy(folder):
         config = results["config"]
         if not isinstance(results["conditions"], list) or not results["conditions"] or "seeds" not in config:
             raise KeyError("conditions")
+        seeds = config["seeds"]
+        for entry in results["conditions"]:
+            for arm, metrics in entry["arms"].items():
+                for metric, values in metrics.items():
+                    if not isinstance(values, list) or len(values) != seeds:
+                        raise ValueError("'%s': condition %s, arm %s holds %s %s value(s) for its %d seed(s)" % (
+                            path, entry["condition"]["name"], arm,
+                            len(values) if isinstance(values, list) else "not a list of", metric, seeds))
     except OSError as e:
         raise ValueError("'%s' cannot be read: %s" % (path, e.strerror or e)) from None
-    except (ValueError, KeyError, TypeError) as e:
+    except ValueError as e:
+        if str(e).startswith("'%s': condition" % path):
+            raise
+        raise ValueError("'%s' is not the results.json of a rawgment.ablation study (%s)" % (path, e)) from None
+    except (KeyError, TypeError) as e:
         raise ValueError("'%s' is not the results.json of a rawgment.ablation study (%s)" % (path, e)) from None
     return results
 
@@ -488,10 +501,20 @@ def mergeReplicates(runs):
     def key(run):
         return {k: v for k, v in run["config"].items() if k not in _MERGEABLE}
 
+    def conditions(run):
+        return [entry["condition"] for entry in run["conditions"]]
+
+    def names(run):
+        return ", ".join(str(c.get("name")) for c in conditions(run))
+
     for run in runs[1:]:
         differing = sorted(k for k in set(key(run)) | set(key(runs[0])) if key(run).get(k) != key(runs[0]).get(k))
         if differing:
             raise ValueError("runs of one study differ in %s: only their replicates may" % ", ".join(differing))
+        # The conditions are the study's too (they are not in its config): their order pairs the numbers.
+        if conditions(run) != conditions(runs[0]):
+            raise ValueError("runs of one study differ in their conditions (%s against %s): only their replicates "
+                             "may" % (names(runs[0]), names(run)))
     ranges = sorted((r["config"].get("firstReplicate", 0), r["config"]["seeds"], i) for i, r in enumerate(runs))
     for (first, count, _), (nextFirst, _, _) in zip(ranges, ranges[1:]):
         if first + count > nextFirst:

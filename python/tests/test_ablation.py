@@ -180,6 +180,37 @@ def test_a_study_extended_with_later_replicates_merges_into_the_study_of_all_of_
         ab.writeCombinedReport([str(tmp_path / "r0"), str(tmp_path / "r2")], str(tmp_path / "page2"))
 
 
+def test_runs_of_other_conditions_or_short_result_lists_are_never_merged(tmp_path):
+    # The conditions are no part of a run's config: runs on x0.5, x0.2 and on x0.05, x0.01 (or the same
+    # conditions reordered, or one condition against two) were merged into "4 seed(s)" over mixed PSNRs.
+    def run(folder, conditions, first):
+        ab.writeOutputs(ab.runAblation(tiny_config(seeds=1, firstReplicate=first, conditions=conditions)),
+                        str(tmp_path / folder))
+        return str(tmp_path / folder)
+
+    bright = [ab.Condition("x0.5", 0.5), ab.Condition("x0.2", 0.2)]
+    dark = [ab.Condition("x0.05", 0.05), ab.Condition("x0.01", 0.01)]
+    base = run("bright0", bright, 0)
+    for name, conditions in (("dark", dark), ("reordered", bright[::-1]), ("one", bright[:1])):
+        other = run(name, conditions, 1)
+        proc = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--combine", base, other, "--out",
+                               str(tmp_path / ("page-" + name))], capture_output=True, text=True)
+        assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+        assert "differ in their conditions (x0.5, x0.2 against %s)" % ", ".join(
+            c.name for c in conditions) in proc.stderr, proc.stderr
+        assert not (tmp_path / ("page-" + name)).exists()
+    # An arm whose list is shorter than the seeds was broadcast: one value paired with every seed.
+    results = json.loads((tmp_path / "bright0" / "results.json").read_text())
+    results["config"]["seeds"] = 4
+    (tmp_path / "short").mkdir()
+    (tmp_path / "short" / "results.json").write_text(json.dumps(results))
+    proc = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--combine", str(tmp_path / "short"),
+                           "--out", str(tmp_path / "page-short")], capture_output=True, text=True)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
+    assert "short/results.json': condition x0.5, arm " in proc.stderr and "holds 1 psnr value(s) for its 4 seed(s)" \
+        in proc.stderr, proc.stderr
+
+
 def test_per_condition_networks_see_their_own_condition_alone():
     # A per-condition network of the first condition is the pooled network of a run with that condition
     # alone (the same crops, seeds and initial weights; its test captures are the first condition's in
