@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -12,9 +13,15 @@ namespace rawgment_pipeline {
 
 using namespace cv::rawgment;
 
-std::vector<std::string> uniqueOutputNames(const std::vector<std::string>& inputs)
+bool sameInput(const std::string& recorded, const std::string& input)
 {
-    std::map<std::string, int> stems;
+    return recorded == input || (!recorded.empty() && canonicalPath(recorded) == canonicalPath(input));
+}
+
+std::vector<std::string> uniqueOutputNames(
+    const std::vector<std::string>& inputs,
+    const std::function<std::optional<std::string>(size_t input, const std::string& name)>& sourceOf)
+{
     std::map<std::string, std::string> seen; // canonical path -> the name it was given as first
     for (const std::string& in : inputs) {
         const auto given = seen.emplace(canonicalPath(in), in);
@@ -22,17 +29,56 @@ std::vector<std::string> uniqueOutputNames(const std::vector<std::string>& input
             throw std::runtime_error(
                 "input '" + in + "' is given twice" +
                 (given.first->second == in ? std::string() : " (also as '" + given.first->second + "')"));
-        ++stems[stemOf(in)];
     }
+    // An input keeps the name its existing output has (plain or hashed, from this version or an earlier one),
+    // so that inputs added to a later run never rename it; otherwise the plain stem when no earlier input of
+    // the run and no other input's output has it, else the stem and a hash of the input's path.
+    std::set<std::string> claimed;
     std::vector<std::string> names;
-    for (const std::string& in : inputs) {
-        const std::string stem = stemOf(in);
-        names.push_back(stems[stem] == 1
-                            ? stem
-                            : stem + cv::format("-%08llx", static_cast<unsigned long long>(
-                                                               augmentedOutputSeed(0, in, 0) >> 32)));
+    for (size_t i = 0; i < inputs.size(); ++i) {
+        const std::string& in = inputs[i];
+        const std::string plain = stemOf(in);
+        const std::string hashed =
+            plain +
+            cv::format("-%08llx", static_cast<unsigned long long>(augmentedOutputSeed(0, in, 0) >> 32));
+        const std::optional<std::string> plainSource = sourceOf(i, plain);
+        std::string name;
+        if (plainSource && sameInput(*plainSource, in))
+            name = plain;
+        else if (const std::optional<std::string> hashedSource = sourceOf(i, hashed);
+                 hashedSource && sameInput(*hashedSource, in))
+            name = hashed;
+        else
+            name = !plainSource && !claimed.count(plain) ? plain : hashed;
+        if (!claimed.insert(name).second)
+            throw std::runtime_error("input '" + in + "' would share the output name '" + name +
+                                     "' with another input; rename one of them");
+        names.push_back(name);
     }
     return names;
+}
+
+std::optional<std::string> sourceOfOutput(const std::string& out)
+{
+    const std::string sidecar = sidecarPathOf(out);
+    if (!pathExists(out) && !pathExists(sidecar))
+        return std::nullopt;
+    try {
+        cv::FileStorage fs = openFileStorageForReading(sidecar, "sidecar");
+        return std::string(MosaicMetadata::read(fs["mosaic_metadata"]).source);
+    } catch (const cv::Exception&) {
+        return std::string(); // there, but of no input this run can tell: another's
+    }
+}
+
+void refuseOutputsAmongInputs(const std::string& outDir, const std::vector<std::string>& inputs)
+{
+    const std::string out = canonicalPath(outDir);
+    for (const std::string& in : inputs)
+        if (canonicalPath(directoryOf(in)) == out)
+            throw std::runtime_error("input '" + in + "' lies in the output folder '" + outDir +
+                                     "': a later run over that folder would take the outputs for inputs; "
+                                     "choose another --out");
 }
 
 namespace {
@@ -52,7 +98,7 @@ void requireFinishedBy(const std::string& out, const std::string& input, uint64_
     } catch (const cv::Exception& e) {
         throw std::runtime_error("'" + sidecar + "': " + e.err);
     }
-    if (meta.source != input || !meta.hasScene || meta.seed != seed)
+    if (!sameInput(meta.source, input) || !meta.hasScene || meta.seed != seed)
         throw std::runtime_error("'" + out + "' exists but was made from '" + meta.source + "', not from '" +
                                  input +
                                  "' with this seed; it is never overwritten (choose "
@@ -126,15 +172,24 @@ AugmentPlan planAugmentJobs(const AugmentOptions& o)
         if (!isRegularFile(in))
             throw std::runtime_error("input '" + in + "' is not a file (a directory?)");
     }
+    refuseOutputsAmongInputs(o.outDir, o.inputs);
     prepareOutputDirectory(o.outDir);
 
     AugmentPlan plan;
-    const std::vector<std::string> names = uniqueOutputNames(o.inputs);
+    std::vector<std::string> extensions;
+    for (const std::string& in : o.inputs) {
+        const size_t dot = in.find_last_of('.');
+        const std::string inExt = dot == std::string::npos ? std::string() : in.substr(dot);
+        const bool ours = pathExists(sidecarPathOf(in));
+        extensions.push_back(!o.extension.empty() ? o.extension : (ours ? inExt : std::string(".dng")));
+    }
+    // An input's outputs are known by its first variant.
+    const std::vector<std::string> names =
+        uniqueOutputNames(o.inputs, [&](size_t i, const std::string& name) {
+            return sourceOfOutput(o.outDir + "/" + name + "_v00" + extensions[i]);
+        });
     for (size_t i = 0; i < o.inputs.size(); ++i) {
-        const size_t dot = o.inputs[i].find_last_of('.');
-        const std::string inExt = dot == std::string::npos ? std::string() : o.inputs[i].substr(dot);
-        const bool ours = pathExists(sidecarPathOf(o.inputs[i]));
-        const std::string ext = !o.extension.empty() ? o.extension : (ours ? inExt : std::string(".dng"));
+        const std::string& ext = extensions[i];
         for (int v = 0; v < o.variants; ++v) {
             const std::string stem = o.outDir + "/" + names[i] + cv::format("_v%02d", v);
             AugmentJob job;
@@ -181,11 +236,10 @@ void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe)
     LoadedMosaic m = loadMosaicFile(job.input);
     std::string cameraName;
     const NoiseModel model = modelOfJob(recipe, m.format, job.seed, cameraName);
-    // A camera file read without a sidecar is at the gain its ISO says, relative to the ISO of the
-    // model's gain 1 (a model calibrated from the camera's files knows it). A file that does not say its
-    // ISO, or a model without a base ISO, leaves gain 1: the capture is taken to be at the base ISO.
-    if (m.fromCameraFile && m.camera.iso > 0 && model.baseIso > 0)
-        m.format.gain = m.camera.iso / model.baseIso;
+    // A camera file (or its conversion) is at the gain its ISO says for the model (formatAtIso()); one that
+    // states no ISO is taken at the gain its format says.
+    if (m.fromCameraFile)
+        m.format = formatAtIso(m.format, m.camera.iso, model);
     const Scene scene = recipe.randomScenes ? recipe.policy.draw(m.mosaic, m.format, job.seed) : recipe.scene;
     cv::Mat out;
     RawFormat outFormat;

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,10 +30,23 @@ struct LoadedMosaic
 };
 LoadedMosaic loadMosaicFile(const std::string& path);
 
-/** The name of each input's outputs: its stem, unique per input. Inputs that share a stem (a/x.dng and
- * b/x.dng) each add 8 hex digits of a hash of their path, so that no output or sidecar of one can be
- * taken for the other's. The same file given twice is an error. */
-std::vector<std::string> uniqueOutputNames(const std::vector<std::string>& inputs);
+/** The name of each input's outputs, unique per input and never changed by the other inputs of a later run:
+ * the name of the input's existing output when it has one (`sourceOf(i, name)`: the source recorded by the
+ * existing output of input i named `name`, an empty string when it exists but names none, nullopt when there
+ * is none), whether plain or hashed; else its stem, unless an earlier input of the run or another input's
+ * existing output has it: then the stem and 8 hex digits of a hash of the input's path (a/x.dng stays x when
+ * b/x.dng joins a later run, which names b/x.dng x-<hash>). The same file given twice is an error. */
+std::vector<std::string> uniqueOutputNames(
+    const std::vector<std::string>& inputs,
+    const std::function<std::optional<std::string>(size_t input, const std::string& name)>& sourceOf);
+//! Whether an output's recorded `source` names `input` (as given, or the same file by another path).
+bool sameInput(const std::string& recorded, const std::string& input);
+//! The `source` an existing output's sidecar records ("" when it names none or cannot be read), or nullopt
+//! when neither the output nor its sidecar exists.
+std::optional<std::string> sourceOfOutput(const std::string& out);
+/** Throws std::runtime_error naming the input when one lies in `outDir`: a later run over that folder would
+ * take the outputs for inputs (rawgment_convert --out=raws raws converted its own outputs again). */
+void refuseOutputsAmongInputs(const std::string& outDir, const std::vector<std::string>& inputs);
 
 //! What convertMosaics() did: outputs written, and outputs a previous run of the same inputs had finished.
 struct ConvertResult

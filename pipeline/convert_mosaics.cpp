@@ -14,8 +14,11 @@ ConvertResult convertMosaics(const std::vector<std::string>& inputs, const std::
 {
     if (inputs.empty())
         throw std::runtime_error("no input to convert");
-    const std::vector<std::string> names = uniqueOutputNames(inputs);
+    refuseOutputsAmongInputs(outDir, inputs);
     prepareOutputDirectory(outDir);
+    const std::vector<std::string> names = uniqueOutputNames(inputs, [&](size_t, const std::string& name) {
+        return sourceOfOutput(outDir + "/" + name + extension);
+    });
     ConvertResult result;
     for (size_t k = 0; k < inputs.size(); ++k) {
         const std::string& input = inputs[k];
@@ -29,7 +32,7 @@ ConvertResult convertMosaics(const std::vector<std::string>& inputs, const std::
                 throw std::runtime_error("'" + out + "' exists without its sidecar; it is never overwritten");
             cv::Mat existing;
             const MosaicMetadata meta = readMosaic(out, existing);
-            if (meta.source != input || meta.hasScene)
+            if (!sameInput(meta.source, input) || meta.hasScene)
                 throw std::runtime_error("'" + out + "' exists but holds '" + meta.source + "', not '" +
                                          input + "'; it is never overwritten (choose another --out)");
             ++result.skipped;

@@ -139,7 +139,7 @@ def loader_rates(folder, model, policy, rounds, seconds=2.0):
 
 
 def jitter_ratio(folder, model, rounds):
-    mosaic, fmt = rgt.loadMosaic(os.path.join(folder, sorted(os.listdir(folder))[0]))
+    mosaic, fmt, _ = rgt.loadMosaic(os.path.join(folder, sorted(os.listdir(folder))[0]))
     jitter = rg.ColorJitter.exposureChange(0.1, 4.0)
     out = {}
     for name, sampling in (("GAUSSIAN", rg.ShotNoiseSampling.GAUSSIAN), ("POISSON", rg.ShotNoiseSampling.POISSON)):

@@ -163,12 +163,15 @@ class RandomNoiseScene:
         """The real cameras samples draw from (empty when the model is not a real camera's)."""
         return list(self._models.cameras)
 
-    def __call__(self, raw, format, boxes=None, *, index, epoch=0):
+    def __call__(self, raw, format, boxes=None, *, index, epoch=0, iso=0.0):
         """Augments one mosaic.
 
         Args:
             raw: HxW mosaic with its black level: a float32 CPU tensor, or a uint16/float32 array.
             format: its rawgment.RawFormat.
+            iso: the ISO the capture was taken at when it sets the gain (loadMosaic's third value; 0: the
+                format's gain stands). The sample's format then has gain iso / baseIso of the sample's model
+                (rawgment.formatAtIso), as rawgment_augment takes a camera file.
             boxes: None, a sequence of (x, y, w, h), an N x 4 array or an N x 4 tensor (mosaic pixels).
             index: the sample's index in the dataset; epoch: the epoch (both set the seed).
 
@@ -180,8 +183,9 @@ class RandomNoiseScene:
         boxesIn = boxes
         if isinstance(boxes, torch.Tensor):
             boxesIn = boxes.detach().cpu().numpy().astype(np.int64).reshape(-1, 4)
-        scene = self.policy.draw(array, format, seed)
         model, camera = self._models.at(format, seed)
+        format = _rg.formatAtIso(format, iso, model)
+        scene = self.policy.draw(array, format, seed)
         out, outFormat, report, outBoxes = _rg.applyScene(array, format, model, scene, seed=seed, boxes=boxesIn)
         if isTensor:
             out = torch.from_numpy(out)
@@ -219,13 +223,17 @@ def _tensorOf(mosaic, fmt, pack, normalize):
 
 
 def loadMosaic(path):
-    """(mosaic, format) of a camera RAW file (readRaw) or of a mosaic with a sidecar (readMosaic)."""
+    """(mosaic, format, iso) of a camera RAW file (readRaw) or of a mosaic with a sidecar (readMosaic).
+
+    ``iso`` is the ISO that sets the capture's gain for a noise model (a camera file's, or a converted one's
+    whose sidecar says gainFromIso), 0 when the format's own gain stands: give it to RandomNoiseScene, which
+    turns it into the gain of each sample's model (rawgment.formatAtIso)."""
     path = os.fspath(path)
     if os.path.exists(_rg.sidecarPathOf(path)):
         mosaic, meta = _rg.readMosaic(path)
-        return mosaic, meta.format
+        return mosaic, meta.format, meta.camera.iso if meta.gainFromIso else 0.0
     image = _rg.readRaw(path)
-    return image.mosaic, image.format
+    return image.mosaic, image.format, image.iso
 
 
 class RawFolderDataset(torch.utils.data.Dataset):
@@ -323,14 +331,14 @@ class RawFolderDataset(torch.utils.data.Dataset):
             # would only oversubscribe the cores (the samples are the same on any thread count).
             _rg.setNumThreads(1)
         start = time.perf_counter()
-        mosaic, fmt = loadMosaic(self.files[index])
+        mosaic, fmt, iso = loadMosaic(self.files[index])
         read = time.perf_counter()
         if self.crop is not None:
             mosaic, fmt = self._cropped(mosaic, fmt, index)
         camera = ""
         steps = {}
         if self.augment:
-            result = self.transform(mosaic, fmt, index=index, epoch=self.epoch)
+            result = self.transform(mosaic, fmt, index=index, epoch=self.epoch, iso=iso)
             mosaic, fmt, camera = result.raw, result.format, result.camera or ""
             for name, seconds in zip(result.report.steps, result.report.stepSeconds):
                 steps[name] = steps.get(name, 0.0) + seconds

@@ -260,8 +260,11 @@ void bindRawIo(py::module_& m)
         .def_readwrite("whiteBalance", &RawImage::whiteBalance, doc("RawImage::whiteBalance"))
         .def_readwrite("cameraToSrgb", &RawImage::cameraToSrgb, doc("RawImage::cameraToSrgb"))
         .def_readwrite("noiseProfile", &RawImage::noiseProfile, doc("RawImage::noiseProfile"))
-        .def_readwrite("colorTags", &RawImage::colorTags, doc("RawImage::colorTags"));
+        .def_readwrite("colorTags", &RawImage::colorTags, doc("RawImage::colorTags"))
+        .def("formatFor", &RawImage::formatFor, py::arg("model"), doc("RawImage::formatFor"));
     defMatProperty(rawImage, "mosaic", &RawImage::mosaic, doc("RawImage::mosaic"), {CV_16U});
+    m.def("formatAtIso", &formatAtIso, py::arg("format"), py::arg("iso"), py::arg("model"),
+          doc("formatAtIso"));
     m.def(
         "readRaw",
         [](const std::string& path) { return withoutGil("readRaw", [&] { return readRaw(path); }); },
@@ -464,7 +467,8 @@ void bindMosaicFiles(py::module_& m)
         .def_readwrite("noiseCamera", &MosaicMetadata::noiseCamera, doc("MosaicMetadata::noiseCamera"))
         .def_readwrite("gainFromIso", &MosaicMetadata::gainFromIso, doc("MosaicMetadata::gainFromIso"))
         .def_readwrite("size", &MosaicMetadata::size, doc("MosaicMetadata::size"))
-        .def_readwrite("type", &MosaicMetadata::type, doc("MosaicMetadata::type"));
+        .def_readwrite("type", &MosaicMetadata::type, doc("MosaicMetadata::type"))
+        .def("formatFor", &MosaicMetadata::formatFor, py::arg("model"), doc("MosaicMetadata::formatFor"));
     m.def("sidecarPathOf", &sidecarPathOf, py::arg("path"), doc("sidecarPathOf"));
     m.def(
         "writeMosaic",

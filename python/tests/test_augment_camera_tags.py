@@ -49,7 +49,9 @@ def camera_file(name):
 @pytest.mark.parametrize("name", ["RAW_NIKON_D1.NEF", "colorchart.dng"])
 def test_augmented_dng_keeps_the_camera_and_states_the_simulated_capture(tmp_path, name):
     source = camera_file(name)
+    # Gain 1 at the file's own ISO (a file that states an ISO needs a model with a base ISO).
     model = rg.NoiseModel(alpha=0.8, sigmaD2=2.0, sigmaR2=6.0)
+    model.baseIso = rg.readRaw(source).iso
     model.save(str(tmp_path / "model.yml"))
     contrast = PHOTON_RATIO * GAIN_RATIO
     (tmp_path / "scene.yml").write_text("%%YAML:1.0\nscene: {contrast: [%g, %g, %g, %g], brightness: 0, "
@@ -106,3 +108,67 @@ def test_augmented_dng_keeps_the_camera_and_states_the_simulated_capture(tmp_pat
 
     # The preview's brightness is checked in test/test_apps.cpp (OpenCV reads PNG there).
     assert os.path.getsize(str(tmp_path / "out" / (stem + "_v00_preview.png"))) > 0
+
+
+def test_an_iso_1600_file_is_at_gain_16_through_the_app_the_library_and_the_dataset(tmp_path, app_dir):
+    """Issue #60 items 3 and 4: only the app turned ISO into gain; the dataset read an ISO-1600 file at gain 1
+    and readRaw + applyScene (as the docs showed) too. At base ISO 100 every way gives gain 16, never 1 and
+    never 256, through formatAtIso; a model without a base ISO is refused for a file that states an ISO."""
+    import numpy as np
+    import torch  # noqa: F401 (rawgment.torch needs it)
+    import rawgment.torch as rgt
+
+    folder = tmp_path / "raws"
+    folder.mkdir()
+    mosaic = np.full((64, 64), 1000, np.uint16)
+    fmt = rg.RawFormat(blackLevel=(64, 64, 64, 64), whiteLevel=4095)
+    rg.writeDng(str(folder / "iso1600.dng"), rg.RawImage(mosaic=mosaic, format=fmt, iso=1600))
+    model = rg.NoiseModel(alpha=0.05, sigmaD2=1.25, sigmaR2=0.5)
+    model.baseIso = 100
+    gain16 = rg.RawFormat(blackLevel=(64, 64, 64, 64), whiteLevel=4095, gain=16)
+
+    # The library, as the docs show: the file's format for the model.
+    image = rg.readRaw(str(folder / "iso1600.dng"))
+    assert image.format.gain == 1 and image.formatFor(model).gain == 16
+    _, outFormat, _, _ = rg.applyScene(image.mosaic, image.formatFor(model), model, rg.Scene(), seed=1)
+    assert outFormat.gain == 16
+    # A DNG's own profile is read at its own gain: the measured line at ISO 1600 is the one applied.
+    profiled = rg.withDngNoiseProfileLine(model, rg.RawImage(mosaic=mosaic, format=fmt, iso=1600,
+                                                             noiseProfile=[(2e-4, 4e-6)]))
+    line = profiled.lineAtGain(image.formatFor(profiled).gain)
+    assert (line.a, line.b) == pytest.approx((2e-4 * 4031, 4e-6 * 4031 ** 2), rel=1e-12)
+
+    # The app: the output DNG's NoiseProfile is the model's at the file's gain 16 (the scene keeps the gain).
+    model.save(str(tmp_path / "model.yml"))
+    (tmp_path / "scene.yml").write_text("%YAML:1.0\nscene: {contrast: [0.5, 0.5, 0.5, 0.5], brightness: 0, gain_ratio: 1}\n")
+    app = os.path.join(app_dir, "rawgment_augment")
+    subprocess.run([app, "--model=%s" % (tmp_path / "model.yml"), "--scene=%s" % (tmp_path / "scene.yml"),
+                    "--out=%s" % (tmp_path / "out"), str(folder / "iso1600.dng")], check=True, capture_output=True)
+    out = rg.readRaw(str(tmp_path / "out" / "iso1600_v00.dng"))
+    assert out.noiseProfile == [tuple(so) for so in rg.dngNoiseProfile(model, gain16)]
+
+    # The dataset, from the camera file and from its conversion (whose sidecar says gain_from_iso).
+    policy = rg.RandomScenePolicy()
+    policy.gainDbMin = policy.gainDbMax = 0
+    policy.blurProbability = policy.geometryProbability = 0
+    converted = tmp_path / "converted"
+    subprocess.run([os.path.join(app_dir, "rawgment_convert"), "--out=%s" % converted, str(folder / "iso1600.dng")],
+                   check=True, capture_output=True)
+    for source in (folder, converted):
+        data = rgt.RawFolderDataset(source, model, policy=policy)
+        assert data[0]["gain"] == pytest.approx(16, rel=1e-12), source
+        assert rgt.loadMosaic(data.files[0])[2] == 1600
+
+    # A model without a base ISO cannot say which gain ISO 1600 is: refused everywhere, never gain 1.
+    noBase = rg.NoiseModel(alpha=0.05, sigmaD2=1.25, sigmaR2=0.5)
+    with pytest.raises(rg.error, match="no base ISO"):
+        image.formatFor(noBase)
+    with pytest.raises(rg.error, match="no base ISO"):
+        rgt.RawFolderDataset(folder, noBase, policy=policy)[0]
+    noBase.save(str(tmp_path / "nobase.yml"))
+    run = subprocess.run([app, "--model=%s" % (tmp_path / "nobase.yml"), "--scene=%s" % (tmp_path / "scene.yml"),
+                          "--out=%s" % (tmp_path / "out2"), str(folder / "iso1600.dng")], capture_output=True, text=True)
+    assert run.returncode != 0 and "no base ISO" in run.stderr, run.stderr
+    # A file that states no ISO stays at its format's gain.
+    rg.writeDng(str(tmp_path / "noiso.dng"), rg.RawImage(mosaic=mosaic, format=fmt))
+    assert rg.readRaw(str(tmp_path / "noiso.dng")).formatFor(noBase).gain == 1

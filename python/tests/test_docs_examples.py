@@ -127,9 +127,12 @@ def example_files(tmp_path, sensor, monkeypatch):
 
     _, mean = chart_mean()
     raw = sensor.capture(mean, 2.0, 1.0, seed=5)
-    rg.writeDng(str(tmp_path / "IMG_0001.dng"), rg.RawImage(mosaic=raw, format=sensor.rawFormat(2.0)))
+    # Captured at gain 2: ISO 200 for a model whose gain 1 is ISO 100.
+    rg.writeDng(str(tmp_path / "IMG_0001.dng"), rg.RawImage(mosaic=raw, format=sensor.rawFormat(2.0), iso=200))
+    model = sensor.effectiveModel()
+    model.baseIso = 100
     for name in ("camera.yml", "noise_model.yml"):
-        sensor.effectiveModel().save(str(tmp_path / name))
+        model.save(str(tmp_path / name))
     monkeypatch.chdir(tmp_path)
     return tmp_path
 

@@ -105,7 +105,7 @@ def test_persistent_workers_see_every_epoch(folder, sensor):
 def test_dataset_options_and_errors(folder, tmp_path, sensor):
     plain = rgt.RawFolderDataset(folder, sensor.effectiveModel(), augment=False, normalize=False)
     raw = plain[0]["raw"]
-    mosaic, fmt = rgt.loadMosaic(plain.files[0])
+    mosaic, fmt, _ = rgt.loadMosaic(plain.files[0])
     assert torch.equal(raw[0], torch.from_numpy(rg.subtractBlackLevel(mosaic, fmt)))
     with pytest.raises(IndexError):
         plain[6]
@@ -120,7 +120,7 @@ def test_a_crop_is_augmented_with_its_own_pixels_dark_shading(folder, sensor):
     # the sensor (RawFormat.sensorOrigin) and are augmented with the shading of their own pixels: each item
     # is exactly what the transform makes of that crop with that format, and a pattern read at the origin
     # instead would differ.
-    mosaic, fmt = rgt.loadMosaic(str(folder / "frame_00.dng"))
+    mosaic, fmt, _ = rgt.loadMosaic(str(folder / "frame_00.dng"))
     model = sensor.effectiveModel()
     rng = np.random.default_rng(5)
     model.darkShadingPerGain = rng.uniform(0, 4, mosaic.shape).astype(np.float32)
@@ -130,7 +130,7 @@ def test_a_crop_is_augmented_with_its_own_pixels_dark_shading(folder, sensor):
     for index in range(len(data)):
         item = data[index]
         assert tuple(item["raw"].shape) == (1, 32, 48)
-        full, full_fmt = rgt.loadMosaic(data.files[index])
+        full, full_fmt, _ = rgt.loadMosaic(data.files[index])
         crop, crop_fmt = data._cropped(full, full_fmt, index)
         x, y = crop_fmt.sensorOrigin
         seen.add((x, y))
@@ -151,7 +151,7 @@ def test_a_crop_is_augmented_with_its_own_pixels_dark_shading(folder, sensor):
     with pytest.raises(ValueError, match="both even"):
         rgt.RawFolderDataset(folder, model, crop=(31, 48))
     # Through a file: a crop written with writeMosaic keeps its origin in its sidecar.
-    first_crop, first_fmt = data._cropped(*rgt.loadMosaic(data.files[0]), 0)
+    first_crop, first_fmt = data._cropped(*rgt.loadMosaic(data.files[0])[:2], 0)
     path = folder.parent / "crop_origin.png"
     rg.writeMosaic(str(path), np.ascontiguousarray(first_crop), rg.MosaicMetadata(format=first_fmt))
     assert rgt.loadMosaic(str(path))[1].sensorOrigin == first_fmt.sensorOrigin
@@ -178,7 +178,7 @@ def test_packed_tensors_are_written_in_one_pass_into_their_own_memory(folder, se
         rg.packCfaPlanes(raw, fmt, out=np.zeros(expected.shape, np.float64))
     dataset = rgt.RawFolderDataset(folder, rg.NoiseModel(0.25, 1.5, 0.8), baseSeed=5, pack=True, augment=False)
     item = dataset[2]
-    mosaic, itemFmt = rgt.loadMosaic(dataset.files[2])
+    mosaic, itemFmt, _ = rgt.loadMosaic(dataset.files[2])
     assert torch.equal(item["raw"], rgt.packCfaPlanes(rg.subtractBlackLevel(mosaic, itemFmt, normalize=True), itemFmt))
 
 

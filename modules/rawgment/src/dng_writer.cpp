@@ -312,12 +312,12 @@ void addColourTags(TiffBuilder& t, const RawImage& image)
 
 } // namespace
 
-void writeDng(const String& path, const RawImage& image)
+namespace detail {
+
+std::vector<uint8_t> dngFileBytes(const String& path, const RawImage& image)
 {
     const std::vector<uint32_t> blacks = checkDngImage(path, image);
     const Mat& m = image.mosaic;
-    if (detail::fileExists(path))
-        CV_Error(Error::StsError, "writeDng: '" + path + "' already exists; it is never overwritten");
 
     TiffBuilder t;
     t.longs(254, {0});
@@ -376,7 +376,16 @@ void writeDng(const String& path, const RawImage& image)
         t.doubles(51041, pairs);
     }
     t.moveToExif({33434, 34855, 34864, 34867});
-    const std::vector<uint8_t> bytes = t.build(m);
+    return t.build(m);
+}
+
+} // namespace detail
+
+void writeDng(const String& path, const RawImage& image)
+{
+    const std::vector<uint8_t> bytes = detail::dngFileBytes(path, image);
+    if (detail::fileExists(path))
+        CV_Error(Error::StsError, "writeDng: '" + path + "' already exists; it is never overwritten");
     writeFileAtomically(path, bytes.data(), bytes.size(), false);
 }
 

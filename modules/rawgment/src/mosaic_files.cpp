@@ -12,6 +12,11 @@
 namespace cv {
 namespace rawgment {
 
+RawFormat MosaicMetadata::formatFor(const NoiseModel& model) const
+{
+    return gainFromIso ? formatAtIso(format, camera.iso, model) : format;
+}
+
 void MosaicMetadata::write(FileStorage& fs, const String& name) const
 {
     format.validate();
@@ -108,6 +113,39 @@ String sidecarPathOf(const String& path)
 }
 using detail::lowerExtensionOf;
 
+namespace {
+
+//! The bytes of `path`'s container (by its lower-case extension `ext`) holding `mosaic`.
+std::vector<uchar> containerBytes(const String& path, const String& ext, const Mat& mosaic,
+                                  const MosaicMetadata& meta)
+{
+    if (ext == ".dng") {
+        RawImage image;
+        image.mosaic = mosaic;
+        image.format = meta.format;
+        if (meta.hasCamera)
+            meta.camera.applyTo(image);
+        return detail::dngFileBytes(path, image);
+    }
+    if (ext == ".npy")
+        return detail::npyFileBytes(mosaic);
+    std::vector<uchar> bytes;
+    const std::vector<int> params =
+        ext == ".png" ? std::vector<int>{} : std::vector<int>{IMWRITE_TIFF_COMPRESSION, 1};
+    bool encoded = false;
+    try {
+        encoded = imencode(ext, mosaic, bytes, params);
+    } catch (const Exception& e) {
+        CV_Error(Error::StsError, "writeMosaic: '" + path + "': encoding failed: " + e.err);
+    }
+    if (!encoded)
+        CV_Error(Error::StsError,
+                 "writeMosaic: '" + path + "': OpenCV could not encode the mosaic as " + ext);
+    return bytes;
+}
+
+} // namespace
+
 void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& metadata)
 {
     const Mat mosaic = detail::twoDimensional(_mosaic, "writeMosaic: mosaic");
@@ -123,57 +161,55 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
                             path.c_str(), mosaic.empty() ? "empty" : typeToString(mosaic.type()).c_str(),
                             ext.c_str(),
                             takesFloat ? " or CV_32FC1" : " (TIFF and .npy also take CV_32FC1)"));
-    if (detail::fileExists(path))
-        CV_Error(Error::StsError, "writeMosaic: '" + path + "' already exists; it is never overwritten");
     MosaicMetadata meta = metadata;
     meta.size = mosaic.size();
     meta.type = mosaic.type();
     const String sidecar = sidecarPathOf(path);
     const std::string text =
         detail::fileStorageText(sidecar, [&](FileStorage& fs) { meta.write(fs, "mosaic_metadata"); });
+    const std::vector<uchar> bytes = containerBytes(path, ext, mosaic, meta);
+    // Another writer of the same job (a second run into the same folder, started at once) may make the same
+    // files at the same time: its image and sidecar, byte for byte ours, are this call's output too.
+    const auto holds = [](const String& file, const void* data, size_t size) {
+        try {
+            return detail::fileExists(file) && readFileBounded(file, static_cast<long long>(size), "file") ==
+                                                   std::string(static_cast<const char*>(data), size);
+        } catch (const Exception&) {
+            return false; // larger than ours, or unreadable: not this call's output
+        }
+    };
+    const auto sameSidecar = [&] { return holds(sidecar, text.data(), text.size()); };
+    const auto sameImage = [&] { return holds(path, bytes.data(), bytes.size()); };
+    if (detail::fileExists(path)) {
+        if (sameSidecar() && sameImage())
+            return;
+        CV_Error(Error::StsError, "writeMosaic: '" + path + "' already exists; it is never overwritten");
+    }
     // The sidecar is never replaced either. One left by an interrupted run of the same job (the image
     // missing, the same text) is kept; any other is another mosaic's and stops the write.
     bool createdSidecar = false;
     if (detail::fileExists(sidecar)) {
-        if (detail::readTextFile(sidecar) != text)
+        if (!sameSidecar())
             CV_Error(Error::StsError, "writeMosaic: '" + sidecar +
                                           "' exists and describes another mosaic; it is never overwritten "
                                           "(remove it if an interrupted run left it)");
     } else {
-        writeFileAtomically(sidecar, text.data(), text.size(), false);
-        createdSidecar = true;
+        try {
+            writeFileAtomically(sidecar, text.data(), text.size(), false);
+            createdSidecar = true;
+        } catch (const Exception&) {
+            if (!sameSidecar())
+                throw;
+        }
     }
     try {
-        if (ext == ".dng") {
-            RawImage image;
-            image.mosaic = mosaic;
-            image.format = meta.format;
-            if (meta.hasCamera)
-                meta.camera.applyTo(image);
-            writeDng(path, image);
-            return;
-        }
-        if (npy) {
-            const std::vector<uchar> bytes = detail::npyFileBytes(mosaic);
-            writeFileAtomically(path, bytes.data(), bytes.size(), false);
-            return;
-        }
-        std::vector<uchar> bytes;
-        const std::vector<int> params =
-            tiff ? std::vector<int>{IMWRITE_TIFF_COMPRESSION, 1} : std::vector<int>{};
-        bool encoded = false;
-        try {
-            encoded = imencode(ext, mosaic, bytes, params);
-        } catch (const Exception& e) {
-            CV_Error(Error::StsError, "writeMosaic: '" + path + "': encoding failed: " + e.err);
-        }
-        if (!encoded)
-            CV_Error(Error::StsError,
-                     "writeMosaic: '" + path + "': OpenCV could not encode the mosaic as " + ext);
         writeFileAtomically(path, bytes.data(), bytes.size(), false);
     } catch (...) {
-        // No sidecar without its image: a sidecar this call made goes with the failed image.
-        if (createdSidecar)
+        if (sameImage())
+            return;
+        // No sidecar without its image: a sidecar this call made goes with the failed image, unless an
+        // image that another writer made in the meantime now depends on it.
+        if (createdSidecar && !detail::fileExists(path))
             std::remove(sidecar.c_str());
         throw;
     }

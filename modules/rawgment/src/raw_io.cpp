@@ -364,5 +364,32 @@ String lowerExtensionOf(const String& path)
 
 } // namespace detail
 
+RawFormat formatAtIso(const RawFormat& format, double iso, const NoiseModel& model)
+{
+    format.validate();
+    model.validate();
+    if (!(std::isfinite(iso) && iso >= 0))
+        CV_Error(Error::StsBadArg,
+                 cv::format("formatAtIso: the ISO must be finite and >= 0 (0: unknown), not %g", iso));
+    if (iso == 0)
+        return format;
+    if (!(model.baseIso > 0))
+        CV_Error(Error::StsBadArg,
+                 cv::format(
+                     "formatAtIso: the capture is at ISO %g, but the noise model has no base ISO (the ISO of "
+                     "its gain 1), so its gain is unknown; set the model's base_iso (a calibration from "
+                     "files that state their ISO records it), or set the format's gain yourself",
+                     iso));
+    RawFormat out = format;
+    out.gain = iso / model.baseIso;
+    out.validate();
+    return out;
+}
+
+RawFormat RawImage::formatFor(const NoiseModel& model) const
+{
+    return formatAtIso(format, iso, model);
+}
+
 } // namespace rawgment
 } // namespace cv

@@ -17,6 +17,8 @@ std::vector<Vec2d> readDngNoiseProfile(const String& path);
 //! The EXIF ISOSpeed (or RecommendedExposureIndex) of a TIFF-based file, which states an ISO of 65535 or
 //! more (EXIF 2.3) where ISOSpeedRatings holds 65535; 0 when it has none or is not TIFF-based.
 double readExifIsoSpeed(const String& path);
+//! The bytes writeDng() writes to `path` (named in its errors) for `image`, after the same checks.
+std::vector<uint8_t> dngFileBytes(const String& path, const RawImage& image);
 //! White level minus the mean black level of the CFA sites of DNG colour plane 0 (red), 1 or 2.
 double rangeOfColourPlane(const RawFormat& format, int plane);
 //! Throws StsBadArg (prefixed by `what`) unless a NoiseProfile has 1 or 3 pairs, each S > 0, O >= 0.

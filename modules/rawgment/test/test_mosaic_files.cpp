@@ -156,7 +156,15 @@ TEST(MosaicFiles, mosaicRoundTripsWithItsSidecarInEveryContainer)
         EXPECT_EQ(2.0, r.scene.jitter.gainRatio);
         EXPECT_EQ(meta.seed, r.seed);
         EXPECT_EQ("input.dng", r.source);
-        EXPECT_CV_ERROR_CONTAINS(writeMosaic(path, m16, meta), "never overwritten");
+        // The same job's files again (another writer of it) are its output; anything else is never written.
+        const std::vector<char> before = test::readBytes(path);
+        EXPECT_NO_THROW(writeMosaic(path, m16, meta));
+        EXPECT_EQ(before, test::readBytes(path));
+        MosaicMetadata other = meta;
+        other.seed += 1;
+        EXPECT_CV_ERROR_CONTAINS(writeMosaic(path, m16, other), "never overwritten");
+        EXPECT_CV_ERROR_CONTAINS(writeMosaic(path, Mat(m16 + 1), meta), "never overwritten");
+        EXPECT_EQ(before, test::readBytes(path));
     }
     Mat f32(32, 48, CV_32FC1);
     randu(f32, -5.0, 1000.0);

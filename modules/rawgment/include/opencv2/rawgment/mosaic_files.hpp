@@ -37,6 +37,9 @@ struct CV_RAWGMENT_EXPORTS MosaicMetadata
     Size size;           //!< the mosaic's size; set by writeMosaic(), checked by readMosaic()
     int type = CV_16UC1; //!< the mosaic's type; set by writeMosaic(), checked by readMosaic()
 
+    /** @brief The format to augment the mosaic with `model`: formatAtIso() at the camera's ISO when
+     * gainFromIso, else `format` as it is. @throws cv::Exception as formatAtIso(). */
+    RawFormat formatFor(const NoiseModel& model) const;
     //! Writes the metadata as a map under `name`.
     void write(FileStorage& fs, const String& name) const;
     //! Reads metadata written by write(). @throws cv::Exception naming an invalid field.
@@ -55,8 +58,10 @@ CV_RAWGMENT_EXPORTS String sidecarPathOf(const String& path);
  * first and the image last, each atomically, and neither replaces an existing file: an existing image marks a
  * finished output, and an input can never be overwritten. An existing sidecar without its image is kept when
  * it holds exactly the text this call would write (an interrupted run of the same job) and is an error
- * otherwise. When the image cannot be written, the sidecar this call wrote is removed: no sidecar is left
- * without its image.
+ * otherwise; an existing image and sidecar that hold exactly these bytes (another writer of the same job,
+ * such as a second run into the same folder at the same time) are this call's output, and any other existing
+ * image is an error. When the image cannot be written, the sidecar this call wrote is removed unless an image
+ * another writer made meanwhile depends on it: no sidecar is left without its image.
  * @param path destination image, which must not exist
  * @param mosaic CV_16UC1 (any container) or CV_32FC1 (TIFF and .npy)
  * @param metadata the format, and optionally the scene and seed that made the mosaic and the camera tags

@@ -66,7 +66,25 @@ struct CV_EXPORTS_W_SIMPLE RawImage
      * LibRaw knows none. writeDng() writes them as they are, adding only what a DNG needs and they lack
      * (ColorMatrix1, from cameraToSrgb, and AsShotNeutral, from whiteBalance). */
     CV_PROP_RW std::vector<DngTag> colorTags;
+
+    /** @brief The format to augment this file with `model`: formatAtIso(format, iso, model), the file's
+     * gain ISO / model.baseIso (`format` itself says gain 1: LibRaw knows no gain). Pass it, not `format`,
+     * to applyScene() and the other steps. @throws cv::Exception as formatAtIso(). */
+    CV_WRAP RawFormat formatFor(const NoiseModel& model) const;
 };
+
+/** @brief The format of a capture taken at `iso`, for a noise model: `format` with gain iso / model.baseIso,
+ * the gain at which the model gives that capture's noise. The library's one place that turns ISO into gain:
+ * RawImage::formatFor(), MosaicMetadata::formatFor(), rawgment_augment and the Python dataset use it.
+ * @param format the capture's format (its gain is replaced)
+ * @param iso the capture's ISO; 0 (unknown) leaves `format` as it is, the capture taken to be at the gain it
+ *        states
+ * @param model the model the capture is augmented with
+ * @throws cv::Exception when `iso` is negative or not finite, or when the file states an ISO and the model
+ * has no base ISO: its gain 1 is then no ISO, and reading the file at gain 1 would take its noise at the base
+ * gain whatever the ISO (set NoiseModel::baseIso, or the format's gain yourself).
+ */
+CV_EXPORTS_W RawFormat formatAtIso(const RawFormat& format, double iso, const NoiseModel& model);
 
 /** @brief The DNG NoiseProfile of a noise model at the format's gain (for RawImage::noiseProfile).
  *
