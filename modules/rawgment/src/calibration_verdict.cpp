@@ -100,8 +100,10 @@ VerdictCheck gainsAgreeWithSlopes(const CalibrationReport& report,
 
 double fittedVariance(const CalibrationReport& report, double mean, double gain)
 {
+    // A pixel's temporal variance holds its row's noise too: the model's pixel variance (which a calibration
+    // with dark components gives less the row noise) plus the row variance it stated beside it.
     if (report.separable || report.perGain.empty())
-        return report.model.variance(mean, gain);
+        return report.model.variance(mean, gain) + report.model.rowVariance(gain);
     const NoiseLineFit* nearest = &report.perGain.front();
     for (const NoiseLineFit& f : report.perGain)
         if (std::abs(std::log(f.gain / gain)) < std::abs(std::log(nearest->gain / gain)))
@@ -182,12 +184,20 @@ void judgeMeanBins(double g, const std::vector<const NoiseSample*>& gs, const Ca
     const double width = std::max(hi - lo, 1e-9) / kMeanBins;
     std::vector<std::vector<double>> ratios(kMeanBins);
     std::vector<double> dofs(kMeanBins, 0), binMeans(kMeanBins, 0);
+    // Heavy-tailed read noise (the model's Tukey-lambda shape) spreads and skews a sample variance beyond
+    // chi-square's: its variance is sigma^4 (2 / dof + k / n) for excess kurtosis k of the pixel's noise, the
+    // read noise's k weighted by its share of the variance squared (rows and shot noise add none to speak
+    // of). Each sample counts with the chi-square's dof of that spread, whose median the check expects.
+    const double readKurtosis = report.model.readExcessKurtosis();
+    const double readVariance = fittedVariance(report, 0, g) - report.model.rowVariance(g);
     for (const NoiseSample* s : gs) {
         const int bin = std::min(kMeanBins - 1, std::max(0, int((std::max(0.0, s->mean) - lo) / width)));
         const double predicted = fittedVariance(report, s->mean, g);
         if (predicted > 0) {
+            const double share = std::max(0.0, readVariance) / predicted;
+            const double spread = 2.0 / s->dof + readKurtosis * share * share / (s->dof + 1.0);
             ratios[size_t(bin)].push_back(s->variance / predicted);
-            dofs[size_t(bin)] += s->dof;
+            dofs[size_t(bin)] += spread > 0 ? 2 / spread : s->dof;
             binMeans[size_t(bin)] += s->mean;
         }
     }
@@ -275,8 +285,12 @@ std::vector<VerdictCheck> perGainChecks(const std::vector<NoiseSample>& samples,
                            kMinBinSamples, 100 * kMaxBinDeviation)
                   : "worst " + found.badBin +
                         format("; threshold %.0f%% beyond 4 standard errors: the model does not "
-                               "describe these data (see the mean-variance plot)",
-                               100 * kMaxBinDeviation)),
+                               "describe these data (see the mean-variance plot)%s",
+                               100 * kMaxBinDeviation,
+                               found.worstBin > 0 && !report.model.hasDarkComponents()
+                                   ? "; variance beyond the model at low means is often row noise or other "
+                                     "dark-frame noise: add dark bursts and calibrate with --dark_components"
+                                   : "")),
         check("distinct means per gain", found.fewMeans.empty(),
               found.fewMeans.empty()
                   ? format("every gain has >= %d mean bins spanning >= %.0f%% of the range",
