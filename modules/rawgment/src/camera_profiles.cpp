@@ -61,9 +61,10 @@ NoiseModel CameraNoiseProfile::modelFor(const RawFormat& format) const
     if (!usable())
         CV_Error(Error::StsBadArg, "camera '" + name() + "' is REFUSED: " + reason);
     format.validate();
-    const double black =
-        (format.blackLevel[0] + format.blackLevel[1] + format.blackLevel[2] + format.blackLevel[3]) / 4;
-    const double r = format.whiteLevel - black;
+    // Green's range: the catalogue takes green's profile, which darktable (and darktableNoiseProfiles())
+    // normalise by the green sites' own range; the mean of all four sites put a line 3e-5 off where the
+    // sites' black levels differ.
+    const double r = detail::rangeOfColourPlane(format, 1);
     NoiseModel m(noise.alpha * r, noise.sigmaD2 * r * r, noise.sigmaR2 * r * r);
     m.baseIso = noise.baseIso;
     // The augmentation follows what darktable measured at each ISO (NoiseModel::measuredLines); Eq. 5

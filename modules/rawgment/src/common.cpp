@@ -1,6 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "precomp.hpp"
 
+#include <opencv2/rawgment/augment.hpp>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -68,6 +70,11 @@ Mat twoDimensional(InputArray array, const char* what)
 Mat normalisedKernel(InputArray _kernel, const char* who)
 {
     const Mat given = twoDimensional(_kernel, format("%s: kernel", who).c_str());
+    if (given.rows > MAX_MOTION_KERNEL_SIDE || given.cols > MAX_MOTION_KERNEL_SIDE)
+        CV_Error(Error::StsBadArg,
+                 format("%s: the kernel is %dx%d; a blur kernel is at most %d plane pixels on a "
+                        "side (a motion of MAX_MOTION_LENGTH), and its cost grows with its area",
+                        who, given.cols, given.rows, MAX_MOTION_KERNEL_SIDE));
     // A kernel of several channels would be read interleaved, its channels taken for taps.
     if (given.channels() != 1)
         CV_Error(Error::StsBadArg, format("%s: kernel has %d channels; expected a single-channel 2-D kernel",

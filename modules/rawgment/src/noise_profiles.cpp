@@ -564,6 +564,17 @@ std::vector<ExportedProfile> readExportedProfiles(const String& path, const Stri
 
 } // namespace
 
+namespace {
+
+// A calibrated model carries its per-gain fits as measured lines, which its export writes ISO by ISO: no one
+// Eq. 5 model gives them back, but the catalogue reads each ISO's line.
+const char* const kLinesReader = " (an export of a model with measured lines, such as a calibration's, holds "
+                                 "one line per ISO: read it with "
+                                 "readCameraProfiles() and CameraNoiseProfile::modelFor(), or "
+                                 "loadAnyNoiseModel(), which keep each ISO's line)";
+
+} // namespace
+
 NoiseModel noiseModelFromDarktableExport(const String& path, const RawFormat& format, double baseIso,
                                          const String& maker, const String& cameraModel,
                                          double haarVarianceRatio)
@@ -600,8 +611,8 @@ NoiseModel noiseModelFromDarktableExport(const String& path, const RawFormat& fo
                     Error::StsBadArg,
                     cv::format("%s: ISO %g colour %d gives alpha %.9g where another gives %.9g; the model "
                                "has one alpha for every colour and ISO, so this profile has no exact "
-                               "counterpart",
-                               where.c_str(), p.iso, plane, a, alpha));
+                               "counterpart%s",
+                               where.c_str(), p.iso, plane, a, alpha, kLinesReader));
             x.push_back(g * g);
             y.push_back(p.b[size_t(plane)] * r * r / c);
         }
@@ -628,8 +639,8 @@ NoiseModel noiseModelFromDarktableExport(const String& path, const RawFormat& fo
             CV_Error(Error::StsBadArg,
                      cv::format(
                          "%s: the offsets b r^2 are not on one line in g^2 (%.9g at g^2 = %g where the line "
-                         "gives %.9g); the model has no exact counterpart",
-                         where.c_str(), y[k], x[k], model.sigmaD2 * x[k] + model.sigmaR2));
+                         "gives %.9g); the model has no exact counterpart%s",
+                         where.c_str(), y[k], x[k], model.sigmaD2 * x[k] + model.sigmaR2, kLinesReader));
     // Rounding can leave a term that is exactly zero a hair below it.
     if (std::abs(model.sigmaD2) <= kExactRelative * scale)
         model.sigmaD2 = std::max(model.sigmaD2, 0.0);

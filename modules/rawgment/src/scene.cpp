@@ -20,14 +20,14 @@ using detail::isIdentityKernel;
 namespace {
 
 /* A kernel from a file, checked before OpenCV allocates it: a hostile `cols: ~` or `rows: 1e9` would
- * otherwise ask for gigabytes. A motion kernel is at most (MAX_MOTION_LENGTH / 2 + 1) plane pixels on a
- * side; the data must hold rows x cols numbers. */
+ * otherwise ask for gigabytes. A motion kernel is at most MAX_MOTION_KERNEL_SIDE plane pixels on a side;
+ * the data must hold rows x cols numbers. */
 void readMotionKernel(const FileNode& node, Mat& kernel)
 {
     kernel.release();
     if (node.empty() || node.isNone())
         return;
-    const int maxSide = static_cast<int>(MAX_MOTION_LENGTH / 2) + 1;
+    const int maxSide = MAX_MOTION_KERNEL_SIDE;
     const FileNode rows = node["rows"], cols = node["cols"], data = node["data"];
     if (!node.isMap() || !rows.isInt() || !cols.isInt() || !data.isSeq() || static_cast<int>(rows) < 1 ||
         static_cast<int>(cols) < 1 || static_cast<int>(rows) > maxSide || static_cast<int>(cols) > maxSide ||

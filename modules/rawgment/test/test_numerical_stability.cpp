@@ -672,6 +672,13 @@ TEST(NumericalStability, anNdArrayOrAMultichannelKernelIsRefusedByEveryEntryPoin
         motionBlur(mosaic, format, model, Mat(3, kernelSizes, CV_64FC1, Scalar(1)), NoiseOptions(), 1, out),
         "motionBlur: kernel has 3 dimensions");
     EXPECT_CV_ERROR_CONTAINS(shapiroWilk(Mat(5, 1, CV_64FC3, Scalar::all(1))), "3 channels");
+    // A hand-made kernel has the bound of a drawn one (2001 x 2001 ran past 30 s on a 64 x 96 mosaic).
+    EXPECT_CV_ERROR_CONTAINS(motionBlur(mosaic, format, model,
+                                        Mat(1, MAX_MOTION_KERNEL_SIDE + 1, CV_32FC1, Scalar(1)),
+                                        NoiseOptions(), 1, out),
+                             "a blur kernel is at most 513 plane pixels on a side");
+    EXPECT_NO_THROW(motionBlur(mosaic, format, model, Mat(1, MAX_MOTION_KERNEL_SIDE, CV_32FC1, Scalar(1)),
+                               NoiseOptions(), 1, out));
 }
 
 } // namespace

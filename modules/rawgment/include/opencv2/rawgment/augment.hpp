@@ -179,6 +179,10 @@ constexpr double MAX_MOTION_LENGTH = 1024;
  */
 CV_EXPORTS_W Mat linearMotionKernel(double length, double angleDegrees);
 
+/** @brief The largest side of a blur kernel, in plane pixels: that of a motion of MAX_MOTION_LENGTH. A blur's
+ * cost grows with the kernel's area (a hand-made 2001x2001 kernel took over 30 s on a 64x96 mosaic). */
+constexpr int MAX_MOTION_KERNEL_SIDE = static_cast<int>(MAX_MOTION_LENGTH / 2) + 1;
+
 /** @brief Noise-accounted blur (paper Eq. 15) on each CFA plane.
  *
  * \f[ x_{new} = \sum_k w_k x_k + \mathcal{N}\Big(0,\; g\alpha\sum_k (1-w_k)w_k\max(x_k,0)
@@ -189,8 +193,8 @@ CV_EXPORTS_W Mat linearMotionKernel(double length, double angleDegrees);
  * @param src CV_16UC1 or CV_32FC1 mosaic with black level, even sides
  * @param format its format (the gain stays)
  * @param model the noise model
- * @param kernel non-negative CV_32FC1/CV_64FC1 kernel on the plane grid, normalised here; a 1x1 kernel
- *        is the identity and the step is skipped
+ * @param kernel non-negative CV_32FC1/CV_64FC1 kernel on the plane grid, normalised here, at most
+ *        MAX_MOTION_KERNEL_SIDE on a side; a 1x1 kernel is the identity and the step is skipped
  * @param noise how the prior noise is treated (alignment), how the noise is drawn
  * @param seed noise seed
  * @param dst output, same type; reused as colorJitter()'s dst is

@@ -196,7 +196,9 @@ struct CV_EXPORTS_W_SIMPLE CameraNoiseProfile
     //! Whether the camera is imported (GOOD or ROUGH).
     CV_WRAP bool usable() const { return verdict != CAMERA_PROFILE_REFUSED; }
     /** @brief The camera's noise model in DN for mosaics of `format`: `noise` with alpha times r and the
-     * variances times r^2, with r = white - mean black (its baseIso kept), and every usable ISO's
+     * variances times r^2, with r = white - the mean black of the green sites (the catalogue takes green's
+     * profile, normalised by green's range as darktable and darktableNoiseProfiles() do; its baseIso kept),
+     * and every usable ISO's
      * measured line (isos: slope times r, offset times r^2, at its gain) as NoiseModel::measuredLines,
      * which the augmentation follows; an ISO measured twice takes the mean of its lines, a negative
      * measured offset is taken as 0, an inconsistent profile is left out.
