@@ -224,8 +224,10 @@ def test_files_round_trip(tmp_path, capture, sensor):
     rg.writeMosaic(str(tmp_path / "a.png"), capture, meta)
     mosaic, back = rg.readMosaic(str(tmp_path / "a.png"))
     assert np.array_equal(mosaic, capture) and back.format == meta.format and back.size == (128, 96)
+    # The same job's files again are its output; another mosaic at the path is never written.
+    rg.writeMosaic(str(tmp_path / "a.png"), capture, meta)
     with pytest.raises(rg.error, match="never overwritten"):
-        rg.writeMosaic(str(tmp_path / "a.png"), capture, meta)
+        rg.writeMosaic(str(tmp_path / "a.png"), capture + 1, meta)
     image = rg.RawImage(mosaic=capture, format=sensor.rawFormat(1.0), make="Sim", model="S1", iso=200)
     rg.writeDng(str(tmp_path / "a.dng"), image)
     read = rg.readRaw(str(tmp_path / "a.dng"))
