@@ -110,6 +110,15 @@ std::string freshDir(const std::string& name)
     return dir;
 }
 
+//! Writes a scene file of an exposure change (ColorJitter::exposureChange) to `path`.
+void writeExposureScene(const std::string& path, double photonRatio, double gainRatio)
+{
+    cv::rawgment::Scene scene;
+    scene.jitter = cv::rawgment::ColorJitter::exposureChange(photonRatio, gainRatio);
+    cv::FileStorage fs(path, cv::FileStorage::WRITE);
+    scene.write(fs, "scene");
+}
+
 //! gnuplot is a dependency (scripts/install-deps.sh), so every plot must exist and decode.
 void expectPngDecodes(const std::string& path)
 {
@@ -533,12 +542,7 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
     EXPECT_LT(none / real, 0.7);
 
     // 4. Augment two inputs twice each with a fixed scene; a second run resumes (skips everything).
-    {
-        cv::rawgment::Scene scene;
-        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.25, 2.0);
-        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
-        scene.write(fs, "scene");
-    }
+    writeExposureScene(dir + "/scene.yml", 0.25, 2.0);
     const std::string in0 = dir + "/sim/g06dB_level0.90/frame_000.dng",
                       in1 = dir + "/sim/g06dB_level0.90/frame_001.dng";
     const std::string inputBytes = readText(in0);
@@ -568,12 +572,7 @@ TEST(Apps, augmentKeepsInputsWithOneStemApartAndNeverTakesAnotherInputsOutput)
     AppRun r =
         runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=3 --gains=6 --levels=0.5 --format=png");
     ASSERT_EQ(0, r.status) << r.output;
-    {
-        cv::rawgment::Scene scene;
-        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 1.0);
-        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
-        scene.write(fs, "scene");
-    }
+    writeExposureScene(dir + "/scene.yml", 0.5, 1.0);
     const std::string a = dir + "/sim/g06dB_level0.50/frame_000.png",
                       b = dir + "/sim/validation/bright/frame_000.png";
     const std::string common =
@@ -647,12 +646,7 @@ TEST(Apps, twoIdenticalRunsIntoOneFolderBothFinishWithCompletePairs)
         runApp("rawgment_simulate",
                "--out='" + dir + "/sim' --frames=3 --gains=6 --levels=0.5 --validation=false --format=png");
     ASSERT_EQ(0, r.status) << r.output;
-    {
-        cv::rawgment::Scene scene;
-        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 2.0);
-        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
-        scene.write(fs, "scene");
-    }
+    writeExposureScene(dir + "/scene.yml", 0.5, 2.0);
     std::string inputs;
     for (int f = 0; f < 3; ++f)
         inputs += cv::format(" '%s/sim/g06dB_level0.50/frame_%03d.png'", dir.c_str(), f);
@@ -756,12 +750,7 @@ TEST(Apps, augmentTakesACameraFilesGainFromItsIsoAndTheModelsBaseIso)
     cv::rawgment::NoiseModel withoutBase = withBase;
     withoutBase.baseIso = 0;
     withoutBase.save(dir + "/no_base.yml");
-    {
-        cv::rawgment::Scene scene;
-        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 2.0);
-        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
-        scene.write(fs, "scene");
-    }
+    writeExposureScene(dir + "/scene.yml", 0.5, 2.0);
     // ISO 200 over base ISO 100: the input is at gain 2 and the output at 4; the ISO tag is the input's
     // times the gain ratio. Without a base ISO the input's gain is unknown: refused, not taken at gain 1.
     r = runApp("rawgment_augment", "--model='" + dir + "/no_base.yml' --scene='" + dir +
@@ -823,12 +812,7 @@ TEST(Apps, convertWritesNpyThatAugmentsAsItsSource)
     EXPECT_TRUE(cameraMeta.gainFromIso && cameraMeta.hasCamera);
     EXPECT_EQ(raw.iso, cameraMeta.camera.iso);
     // The same augmentation of the camera file and of its conversion: the same pixels and gain.
-    {
-        cv::rawgment::Scene scene;
-        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 2.0);
-        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
-        scene.write(fs, "scene");
-    }
+    writeExposureScene(dir + "/scene.yml", 0.5, 2.0);
     const std::string model = dir + "/dng/truth_noise_model.yml";
     for (const char* input : {"/camera/shot.dng", "/npy/shot.npy"}) {
         r = runApp("rawgment_augment", "--model='" + model + "' --scene='" + dir +
@@ -902,12 +886,7 @@ TEST(Apps, augmentAsRealCamerasDrawsOnePerOutputAndRecordsIt)
             << modelsOf(cv::rawgment::NoiseModel(0.3, 2.0, 30.0), "Loud") << "]}]}\n";
         ASSERT_TRUE(out.good());
     }
-    {
-        cv::rawgment::Scene scene;
-        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 2.0);
-        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
-        scene.write(fs, "scene");
-    }
+    writeExposureScene(dir + "/scene.yml", 0.5, 2.0);
     const std::string input = "'" + dir + "/sim/g06dB_level0.50/frame_000.dng'";
     const std::string common = " --scene='" + dir + "/scene.yml' " + input;
     r = runApp("rawgment_augment", "--model='" + dir +
@@ -1514,12 +1493,7 @@ TEST(Apps, aFailedCalibrationLeavesNoFileThatSilentlyWorks)
     EXPECT_FALSE(exists(dir + "/cal/android_noise_profile.yml"));
     EXPECT_NE(std::string::npos,
               readText(dir + "/cal/noise_model.yml").find("failed_calibration: frames per burst"));
-    {
-        cv::rawgment::Scene scene;
-        scene.jitter = cv::rawgment::ColorJitter::exposureChange(0.5, 1.0);
-        cv::FileStorage fs(dir + "/scene.yml", cv::FileStorage::WRITE);
-        scene.write(fs, "scene");
-    }
+    writeExposureScene(dir + "/scene.yml", 0.5, 1.0);
     const std::string frame = "'" + dir + "/sim/g06dB_level0.90/frame_000.png'";
     r = runApp("rawgment_augment", "--model='" + dir + "/cal/noise_model.yml' --scene='" + dir +
                                        "/scene.yml' --out='" + dir + "/aug' " + frame);
