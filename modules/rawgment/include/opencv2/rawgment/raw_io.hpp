@@ -112,8 +112,8 @@ CV_RAWGMENT_EXPORTS NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& 
 /** @brief A model that also follows a file's own DNG NoiseProfile: the profile's green line (
  * noiseLineFromDngProfile() at CFA_G1) as a measured line (NoiseModel::measuredLines) at the file's gain,
  * ISO / model.baseIso, replacing a line the model had at that gain. The augmentation of that file, at its own
- * gain (`image.formatFor(model)`, RawImage::formatFor()), then takes its prior noise from what the file states
- * (a camera maker's or a converter's measurement).
+ * gain (`image.formatFor(model)`, RawImage::formatFor()), then takes its prior noise from what the file
+ * states (a camera maker's or a converter's measurement).
  * @param model the model, with a base ISO
  * @param image a file read by readRaw() with a NoiseProfile and an ISO
  * @throws cv::Exception when the file has no NoiseProfile or no ISO, the model no base ISO, or the
