@@ -62,24 +62,26 @@ CV_RAWGMENT_EXPORTS std::string readFileBounded(const String& path, long long ma
 /** @brief Opens a YAML or JSON file for reading the way every reader of this module does.
  *
  * What it adds to cv::FileStorage, which readers of your own files (manifests, job files) can use too:
- * the file is a regular file of at most MAX_TEXT_FILE_BYTES; before OpenCV's recursive parser sees the
- * text, libyaml (YAML) or nlohmann-json (JSON: text that starts with a brace) parses it in the calling
- * thread, iteratively, and it must be one document whose root is a map (a block map or list at column 0
- * for YAML), nested at most 64 levels, without YAML anchors or aliases, and without integer literals
- * beyond 32 bits (OpenCV's reader would wrap 4294967297 to 1). JSON's \\uXXXX and \\/ escapes and OpenCV's
- * own \\' are read. No child process or thread is started and no time limit applies: a malformed file is
- * refused by the parse itself. Whatever OpenCV's parser throws, including the std::length_error of some
- * malformed files, becomes a cv::Exception, and every error names the file (and the line where there is
- * one).
+ * the file is a regular file of at most MAX_TEXT_FILE_BYTES; libyaml (YAML) or nlohmann-json (JSON: text
+ * that starts with a brace) parses it in the calling thread, iteratively, its scalars are typed by YAML
+ * 1.2's core schema, and OpenCV's own writer writes the values anew into memory: the storage returned reads
+ * that text, so OpenCV's parser never sees what it would read otherwise than YAML (wrapped integers, keys
+ * inside plain values, escapes and exponents it lacks, streams it loops on). The text must be one document
+ * whose root is a map, nested at most 64 levels, without anchors or aliases, a repeated key in any map, a
+ * key outside OpenCV's alphabet (a letter or '_', then letters, digits, '_', '-' or spaces), an integer
+ * beyond 32 bits, or a plain value OpenCV 4.6's reader would read as another type or value (017, 0o17,
+ * 1_000, 1:20, a value holding ':', an empty value). Booleans read as 1 and 0, a JSON null in a map as a
+ * missing key; JSON's \\uXXXX and OpenCV's own \\' escapes are read. No child process or thread is
+ * started and no time limit applies: a malformed file is refused by the parse itself. Every error names the
+ * file (and the line where there is one).
  *
  * @param path the file (.yml, .yaml or .json; the content decides how it is parsed)
  * @param what what the file is, for the messages ("scene", "calibration manifest")
  * @return an opened storage
  * @throws cv::Exception StsError for a missing, unreadable or oversized file, or anything but a regular
  * file (a directory, a FIFO, a device: see readFileBounded());
- * StsParseError for an empty file, XML, text that is not valid YAML or JSON, nesting deeper than 64
- * levels, or a YAML stream that is not one document whose root collection starts a line at column 0
- * (OpenCV 4.6's parser never returns on some such streams), each with the line where it is known.
+ * StsParseError for an empty, XML or UTF-16/32 file, text that is not valid YAML or JSON, or any of the
+ * refusals above, each with the line where it is known.
  */
 CV_RAWGMENT_EXPORTS FileStorage openFileStorageForReading(const String& path, const String& what);
 
