@@ -872,6 +872,17 @@ int fuzz(const Target& target, const Options& o)
             return 1;
         }
     }
+    // Every seed and corpus file as it is, before any mutation, passes the differential check too.
+    if (!target.binary && target.name != "canary")
+        for (size_t k = 0; k < corpus.size(); ++k) {
+            writeBytes(input, corpus[k]);
+            const std::string why = rawgment_fuzz::differentialCheck(input);
+            if (!why.empty()) {
+                std::cerr << "rawgment_fuzz: FAIL: " << target.name << " corpus entry " << k
+                          << ", differential check: " << why << "\n";
+                return 1;
+            }
+        }
     std::cout << "rawgment_fuzz: " << target.name << ": " << corpus.size() << " seeds (" << generated
               << " made by the writers), budget " << o.seconds << " s, seed " << o.seed
               << "; the input being "
