@@ -14,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 #include <yaml.h>
@@ -95,8 +96,6 @@ public:
     void startCollection(bool map, int line)
     {
         if (levels_.empty()) {
-            if (rootSeen_)
-                refuseAt(path_, line, "a second root collection");
             if (!map)
                 refuseAt(path_, line, "the root is a list, not a map (every file of this module is a map)");
             rootSeen_ = true;
@@ -600,18 +599,8 @@ public:
         out_.integer(value ? 1 : 0, 0, value ? "true" : "false");
         return true;
     }
-    bool number_integer(number_integer_t value) override
-    {
-        checkInteger(value >= INT_MIN && value <= INT_MAX, std::to_string(value));
-        out_.integer(value, 0, std::to_string(value));
-        return true;
-    }
-    bool number_unsigned(number_unsigned_t value) override
-    {
-        checkInteger(value <= static_cast<number_unsigned_t>(INT_MAX), std::to_string(value));
-        out_.integer(static_cast<long long>(value), 0, std::to_string(value));
-        return true;
-    }
+    bool number_integer(number_integer_t value) override { return integer(value); }
+    bool number_unsigned(number_unsigned_t value) override { return integer(value); }
     bool number_float(number_float_t value, const string_t&) override
     {
         out_.real(value, 0);
@@ -658,10 +647,18 @@ private:
         out_.endCollection();
         return true;
     }
-    void checkInteger(bool fits, const std::string& literal)
+    //! Written when it fits 32 bits; else refused with the line of its literal (looked up only then).
+    template <typename Integer> bool integer(Integer value)
     {
-        if (!fits)
+        bool fits = value <= static_cast<Integer>(INT_MAX);
+        if constexpr (std::is_signed_v<Integer>)
+            fits = fits && value >= INT_MIN;
+        if (!fits) {
+            const std::string literal = std::to_string(value);
             refuseWrappingInteger(path_, lineAt(text_, offsetOfNumber(literal)), literal);
+        }
+        out_.integer(static_cast<long long>(value), 0, std::string());
+        return true;
     }
 
     //! Where the text first opens a collection deeper than MAX_NESTING_DEPTH (strings skipped).
