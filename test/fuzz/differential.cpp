@@ -204,10 +204,13 @@ std::string differentialCheck(const std::string& path)
         return std::string();
     if (text.compare(0, 3, "\xEF\xBB\xBF") == 0)
         text.erase(0, 3);
+    // JSON is text that starts with a brace, decided before OpenCV's %YAML line is taken off (a YAML file
+    // may hold a flow map after it), as the reader decides.
+    const size_t first = text.find_first_not_of(" \t\r\n");
+    const bool json = first != std::string::npos && text[first] == '{';
     if (text.compare(0, 5, "%YAML") == 0)
         text.erase(0, std::min(text.size(), text.find('\n')));
-    const size_t first = text.find_first_not_of(" \t\r\n");
-    if (first != std::string::npos && text[first] == '{') {
+    if (json) {
         const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
         if (j.is_discarded())
             return "the reader opened a text nlohmann-json refuses";
