@@ -56,6 +56,10 @@ bool sameReal(double a, double b)
     return a == b || (std::isnan(a) && std::isnan(b));
 }
 
+//! What coreSchemaType() says of a scalar too long for its patterns: the reader's own typing stands, and
+//! the value is compared as a number or a string accordingly.
+constexpr int kUntyped = -1;
+
 //! The value YAML 1.2's core schema gives a plain scalar, as the FileNode type it must be read as.
 int coreSchemaType(const std::string& v, double& number)
 {
@@ -64,7 +68,7 @@ int coreSchemaType(const std::string& v, double& number)
         nan("\\.(nan|NaN|NAN)");
     // std::regex recurses per character: long scalars are strings to both, checked by value alone.
     if (v.size() > 200)
-        return cv::FileNode::STRING;
+        return kUntyped;
     static const std::regex boolean("true|True|TRUE|false|False|FALSE");
     if (std::regex_match(v, boolean)) {
         number = v[0] == 't' || v[0] == 'T' ? 1 : 0;
@@ -129,10 +133,16 @@ std::string compareYaml(yaml_document_t& doc, const yaml_node_t* node, const cv:
     const std::string tag = node->tag ? reinterpret_cast<const char*>(node->tag) : "";
     double number = 0;
     int type = cv::FileNode::STRING;
-    if (tag == YAML_INT_TAG || tag == YAML_FLOAT_TAG)
-        type = tag == YAML_INT_TAG ? cv::FileNode::INT : cv::FileNode::REAL, coreSchemaType(value, number);
-    else if (node->data.scalar.style == YAML_PLAIN_SCALAR_STYLE)
+    if (tag == YAML_INT_TAG || tag == YAML_FLOAT_TAG) {
+        if (coreSchemaType(value, number) == kUntyped)
+            number = std::strtod(value.c_str(), nullptr);
+        type = tag == YAML_INT_TAG ? cv::FileNode::INT : cv::FileNode::REAL;
+    } else if (node->data.scalar.style == YAML_PLAIN_SCALAR_STYLE)
         type = coreSchemaType(value, number); // libyaml's document tags an untagged scalar !!str too
+    if (type == kUntyped) {
+        type = fn.isString() ? int(cv::FileNode::STRING) : fn.type();
+        number = std::strtod(value.c_str(), nullptr);
+    }
     if (type != fn.type())
         return at + cv::format(": '%s' is of type %d to YAML 1.2 and %d to OpenCV",
                                value.substr(0, 60).c_str(), type, fn.type());
