@@ -1,0 +1,352 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The EMVA 1288 descriptor and its images (emva1288 topic). The descriptor is read as the standard's
+// reference implementation reads it (commands v, n, b, d, i; '#' comments; CRLF; Windows separators; a
+// decimal comma), but strictly: what it would warn about and skip is an error naming the line here. An
+// image's header is read before the image is decoded, so a file that claims a huge image allocates nothing.
+#include "precomp.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/rawgment/emva1288.hpp>
+
+#include <cstdlib>
+#include <map>
+#include <sstream>
+#include <tuple>
+
+namespace cv {
+namespace rawgment {
+
+namespace {
+
+//! A descriptor of the largest series the caps allow is a few MB; anything longer is not one.
+constexpr long long kMaxDescriptorBytes = 16LL << 20;
+
+[[noreturn]] void badLine(const String& path, int line, const std::string& why)
+{
+    CV_Error(Error::StsParseError,
+             cv::format("EMVA 1288 descriptor '%s', line %d: %s", path.c_str(), line, why.c_str()));
+}
+
+std::vector<std::string> wordsOf(const std::string& line)
+{
+    std::vector<std::string> words;
+    std::istringstream in(line);
+    for (std::string w; in >> w;)
+        words.push_back(w);
+    return words;
+}
+
+//! A finite real in the descriptor's spelling (a decimal comma is read as a point, as the reference does).
+double realOf(const String& path, int line, std::string word, const char* what)
+{
+    for (char& c : word)
+        if (c == ',')
+            c = '.';
+    const char* begin = word.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(begin, &end);
+    if (end == begin || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+        badLine(path, line, cv::format("%s '%s' is not a finite number", what, word.c_str()));
+    return v;
+}
+
+long long integerOf(const String& path, int line, const std::string& word, const char* what)
+{
+    const char* begin = word.c_str();
+    char* end = nullptr;
+    errno = 0;
+    const long long v = std::strtoll(begin, &end, 10);
+    if (end == begin || *end != '\0' || errno == ERANGE)
+        badLine(path, line, cv::format("%s '%s' is not an integer", what, word.c_str()));
+    return v;
+}
+
+String folderOf(const String& path)
+{
+    const size_t slash = path.find_last_of('/');
+    return slash == String::npos ? String() : path.substr(0, slash + 1);
+}
+
+//! An `i` line's path, Windows separators as '/', resolved against the descriptor's folder.
+String resolvedImagePath(const String& folder, std::string name)
+{
+    for (char& c : name)
+        if (c == '\\')
+            c = '/';
+    return (!name.empty() && name[0] == '/') ? String(name) : folder + name;
+}
+
+uint32_t bigEndian32(const uchar* p)
+{
+    return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | uint32_t(p[3]);
+}
+
+//! What an image file's header states, read before it is decoded.
+struct ImageHeader
+{
+    long long width = 0, height = 0;
+    int bitDepth = 0, channels = 0;
+};
+
+bool pngHeader(const std::string& bytes, ImageHeader& h)
+{
+    static const char kSignature[] = "\x89PNG\r\n\x1a\n";
+    if (bytes.size() < 33 || bytes.compare(0, 8, kSignature, 8) != 0)
+        return false;
+    const uchar* p = reinterpret_cast<const uchar*>(bytes.data());
+    if (std::memcmp(p + 12, "IHDR", 4) != 0)
+        return false;
+    h.width = bigEndian32(p + 16);
+    h.height = bigEndian32(p + 20);
+    h.bitDepth = p[24];
+    const int colourType = p[25];
+    h.channels = colourType == 0 ? 1 : colourType == 4 ? 2 : colourType == 2 ? 3 : colourType == 6 ? 4 : 0;
+    return true;
+}
+
+/** A classic TIFF's first directory: ImageWidth (256), ImageLength (257), BitsPerSample (258),
+ * SamplesPerPixel (277). Every offset is checked against the file's size. */
+bool tiffHeader(const std::string& bytes, ImageHeader& h, std::string& why)
+{
+    if (bytes.size() < 8)
+        return false;
+    const bool little = bytes.compare(0, 4, "II*\0", 4) == 0;
+    const bool big = bytes.compare(0, 4, "MM\0*", 4) == 0;
+    if (!little && !big) {
+        if (bytes.compare(0, 4, "II+\0", 4) == 0 || bytes.compare(0, 4, "MM\0+", 4) == 0)
+            why = "it is a BigTIFF; only classic TIFF and PNG images are read";
+        return false;
+    }
+    const uchar* p = reinterpret_cast<const uchar*>(bytes.data());
+    const auto u16 = [&](size_t at) {
+        return little ? uint32_t(p[at] | (p[at + 1] << 8)) : uint32_t((p[at] << 8) | p[at + 1]);
+    };
+    const auto u32 = [&](size_t at) {
+        return little ? (uint32_t(p[at]) | (uint32_t(p[at + 1]) << 8) | (uint32_t(p[at + 2]) << 16) |
+                         (uint32_t(p[at + 3]) << 24))
+                      : bigEndian32(p + at);
+    };
+    const size_t ifd = u32(4);
+    if (ifd + 2 > bytes.size()) {
+        why = "its TIFF directory lies beyond the end of the file";
+        return false;
+    }
+    const size_t entries = u16(ifd);
+    if (ifd + 2 + 12 * entries > bytes.size()) {
+        why = "its TIFF directory runs beyond the end of the file";
+        return false;
+    }
+    h.channels = 1;
+    for (size_t e = 0; e < entries; ++e) {
+        const size_t at = ifd + 2 + 12 * e;
+        const uint32_t tag = u16(at), type = u16(at + 2), count = u32(at + 4);
+        // SHORT values sit in the first two bytes of the value field, LONG in all four.
+        const uint32_t value = type == 3 ? u16(at + 8) : u32(at + 8);
+        if (tag == 256)
+            h.width = value;
+        else if (tag == 257)
+            h.height = value;
+        else if (tag == 258)
+            h.bitDepth = count == 1 ? int(value) : -1;
+        else if (tag == 277)
+            h.channels = int(value);
+    }
+    if (h.bitDepth == 0)
+        h.bitDepth = 1; // TIFF's default BitsPerSample
+    return true;
+}
+
+} // namespace
+
+Emva1288Series readEmva1288(const String& path)
+{
+    const std::string text = readFileBounded(path, kMaxDescriptorBytes, "EMVA 1288 descriptor");
+    if (text.find('\0') != std::string::npos)
+        CV_Error(Error::StsParseError,
+                 "EMVA 1288 descriptor '" + path + "' is not a descriptor: it holds binary data");
+    Emva1288Series series;
+    series.path = path;
+    const String folder = folderOf(path);
+    std::vector<Emva1288Images> groups;
+    Emva1288Images* open = nullptr;
+    bool sawFormat = false;
+    long long imageCount = 0;
+    std::istringstream lines(text);
+    int lineNumber = 0;
+    for (std::string raw; std::getline(lines, raw);) {
+        ++lineNumber;
+        if (!raw.empty() && raw.back() == '\r')
+            raw.pop_back();
+        const std::vector<std::string> words = wordsOf(raw);
+        if (words.empty() || words[0][0] == '#')
+            continue;
+        const std::string& command = words[0];
+        if (command == "i") {
+            if (!open)
+                badLine(path, lineNumber, "an image ('i') before any 'b' or 'd' line");
+            if (words.size() < 2)
+                badLine(path, lineNumber, "expected 'i <image path>'");
+            // A path may hold spaces: the rest of the line after the command is the path.
+            const size_t start = raw.find_first_not_of(" \t", raw.find('i') + 1);
+            std::string name = raw.substr(start);
+            name.erase(name.find_last_not_of(" \t") + 1);
+            if (++imageCount > MAX_EMVA1288_IMAGES)
+                badLine(path, lineNumber,
+                        cv::format("more than %d images; a descriptor may list at most that many",
+                                   MAX_EMVA1288_IMAGES));
+            const String image = resolvedImagePath(folder, name);
+            if (!detail::fileExists(image))
+                badLine(path, lineNumber, "image '" + image + "' does not exist");
+            detail::checkRegularFile(image, "EMVA 1288 image (descriptor '" + path +
+                                                cv::format("', line %d)", lineNumber));
+            open->images.push_back(image);
+            continue;
+        }
+        if (open && open->images.size() < 2)
+            badLine(path, open->line,
+                    cv::format("the exposure has %d image(s); every step needs at least two",
+                               int(open->images.size())));
+        open = nullptr;
+        if (command == "v") {
+            if (words.size() != 2)
+                badLine(path, lineNumber, "expected 'v <release>'");
+            series.version = words[1];
+        } else if (command == "n") {
+            if (words.size() != 4)
+                badLine(path, lineNumber, "expected 'n <bits> <width> <height>'");
+            if (sawFormat)
+                badLine(path, lineNumber, "a second 'n' line; a descriptor has one");
+            const long long bits = integerOf(path, lineNumber, words[1], "bits");
+            const long long width = integerOf(path, lineNumber, words[2], "width");
+            const long long height = integerOf(path, lineNumber, words[3], "height");
+            if (bits < 1 || bits > MAX_EMVA1288_BITS)
+                badLine(path, lineNumber,
+                        cv::format("bits %lld is outside [1, %d]", bits, MAX_EMVA1288_BITS));
+            if (width < 1 || height < 1)
+                badLine(path, lineNumber, cv::format("the size %lld x %lld is empty", width, height));
+            if (width > MAX_EMVA1288_PIXELS || height > MAX_EMVA1288_PIXELS ||
+                width * height > MAX_EMVA1288_PIXELS)
+                badLine(path, lineNumber,
+                        cv::format("%lld x %lld pixels is more than the %lld pixels an image may have", width,
+                                   height, MAX_EMVA1288_PIXELS));
+            series.bits = int(bits);
+            series.width = int(width);
+            series.height = int(height);
+            sawFormat = true;
+        } else if (command == "b" || command == "d") {
+            const bool dark = command == "d";
+            if (!sawFormat)
+                badLine(path, lineNumber, "an exposure before the 'n <bits> <width> <height>' line");
+            if (words.size() != (dark ? 2u : 3u))
+                badLine(path, lineNumber,
+                        dark ? "expected 'd <exposure>'" : "expected 'b <exposure> <photons>'");
+            Emva1288Images group;
+            group.dark = dark;
+            group.line = lineNumber;
+            group.exposureNs = realOf(path, lineNumber, words[1], "exposure");
+            group.photons = dark ? 0.0 : realOf(path, lineNumber, words[2], "photons");
+            if (group.exposureNs < 0)
+                badLine(path, lineNumber, cv::format("exposure %g is negative", group.exposureNs));
+            if (group.photons < 0)
+                badLine(path, lineNumber, cv::format("photons %g is negative", group.photons));
+            groups.push_back(group);
+            open = &groups.back();
+        } else {
+            badLine(path, lineNumber,
+                    "unknown command '" + command +
+                        "' (a descriptor has 'v', 'n', 'b', 'd', 'i' and '#' comment lines): is it an EMVA "
+                        "1288 descriptor?");
+        }
+    }
+    if (open && open->images.size() < 2)
+        badLine(path, open->line,
+                cv::format("the exposure has %d image(s); every step needs at least two",
+                           int(open->images.size())));
+    if (!sawFormat)
+        CV_Error(Error::StsParseError,
+                 "EMVA 1288 descriptor '" + path +
+                     "' is not a descriptor: it has no 'n <bits> <width> <height>' line");
+    // Temporal and spatial as the reference classifies them; a (kind, exposure, photons) once.
+    std::map<std::tuple<bool, double, double>, int> seen[2];
+    for (const Emva1288Images& g : groups) {
+        const bool temporal = g.images.size() == 2;
+        const int previous =
+            seen[temporal].emplace(std::make_tuple(g.dark, g.exposureNs, g.photons), g.line).first->second;
+        if (previous != g.line)
+            badLine(path, g.line,
+                    cv::format("exposure %g with %s is listed again (first on line %d)", g.exposureNs,
+                               g.dark ? "no light" : cv::format("%g photons", g.photons).c_str(), previous));
+        (temporal ? series.temporal : series.spatial).push_back(g);
+    }
+    for (const Emva1288Images& g : series.temporal) {
+        bool dark = false, bright = false;
+        for (const Emva1288Images& o : series.temporal)
+            if (o.exposureNs == g.exposureNs)
+                (o.dark ? dark : bright) = true;
+        if (!dark || !bright)
+            badLine(path, g.line,
+                    cv::format("exposure %g has %s; every temporal exposure needs a dark pair ('d') and a "
+                               "bright pair ('b')",
+                               g.exposureNs, dark ? "no bright pair" : "no dark pair"));
+    }
+    if (!series.spatial.empty()) {
+        const bool onePair = series.spatial.size() == 2 && series.spatial[0].dark != series.spatial[1].dark &&
+                             series.spatial[0].exposureNs == series.spatial[1].exposureNs;
+        if (!onePair)
+            badLine(
+                path, series.spatial[0].line,
+                "the spatial set (exposures of more than two images) must be one bright and one dark stack "
+                "at one exposure time");
+    }
+    return series;
+}
+
+Mat readEmva1288Image(const Emva1288Series& series, const String& imagePath, int line)
+{
+    const String where = cv::format("EMVA 1288 image '%s' (descriptor '%s', line %d)", imagePath.c_str(),
+                                    series.path.c_str(), line);
+    const auto fail = [&](const std::string& why) { CV_Error(Error::StsError, where + ": " + why); };
+    if (series.width < 1 || series.height < 1 || series.bits < 1 || series.bits > MAX_EMVA1288_BITS ||
+        (long long)series.width * series.height > MAX_EMVA1288_PIXELS)
+        CV_Error(Error::StsBadArg,
+                 "readEmva1288Image: the series' 'n' is invalid; read it with readEmva1288()");
+    // A PNG may be a little larger than its pixels (incompressible noise); 16 bits each, twice, bounds both.
+    const long long maxBytes = 4LL * series.width * series.height + (1LL << 20);
+    const std::string bytes = readFileBounded(imagePath, maxBytes, where);
+    ImageHeader h;
+    std::string why;
+    if (!pngHeader(bytes, h) && !tiffHeader(bytes, h, why))
+        fail(why.empty() ? "it is neither a PNG nor a TIFF image" : why);
+    if (h.width != series.width || h.height != series.height)
+        fail(cv::format("it is %lld x %lld, but the descriptor's 'n' line says %d x %d", h.width, h.height,
+                        series.width, series.height));
+    if (h.channels != 1 || (h.bitDepth != 8 && h.bitDepth != 16))
+        fail(cv::format("it has %d channel(s) of %d bits; the standard's images are one channel in an 8- or "
+                        "16-bit container",
+                        h.channels, h.bitDepth));
+    Mat image;
+    try {
+        image = imdecode(Mat(1, int(bytes.size()), CV_8U, const_cast<char*>(bytes.data())), IMREAD_UNCHANGED);
+    } catch (const Exception& e) {
+        fail(std::string("it cannot be decoded: ") + e.what());
+    }
+    if (image.empty())
+        fail("it cannot be decoded");
+    if (image.size() != Size(series.width, series.height) ||
+        (image.type() != CV_8UC1 && image.type() != CV_16UC1))
+        fail(cv::format("it decodes as %dx%d %s; the header said %lld x %lld, one channel of %d bits",
+                        image.cols, image.rows, typeToString(image.type()).c_str(), h.width, h.height,
+                        h.bitDepth));
+    double maxValue = 0;
+    Point at;
+    minMaxLoc(image, nullptr, &maxValue, nullptr, &at);
+    const double limit = std::ldexp(1.0, series.bits) - 1;
+    if (maxValue > limit)
+        fail(cv::format("pixel (x %d, y %d) is %g, above 2^%d - 1 = %g that the descriptor's bits allow",
+                        at.x, at.y, maxValue, series.bits, limit));
+    return image;
+}
+
+} // namespace rawgment
+} // namespace cv

@@ -1,0 +1,220 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The emva1288 topic: the standard's descriptor (and every way it can be wrong), its figures on the
+// working group's reference set 001 against the reference implementation's, and on written series.
+#include "test_common.hpp"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/rawgment/emva1288.hpp>
+
+#include <fstream>
+
+namespace cv {
+namespace rawgment {
+namespace {
+
+using test::makeTempDir;
+
+const char kSet001[] = "emva1288/EMVA1288_ReferenceSet_001_CCD_12Bit/EMVA1288_Data.txt";
+
+//! Writes `text` as a descriptor in `dir` and returns its path.
+std::string writeDescriptor(const std::string& dir, const std::string& text,
+                            const std::string& name = "EMVA1288_Data.txt")
+{
+    const std::string path = dir + "/" + name;
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    out.close();
+    EXPECT_TRUE(out.good()) << path;
+    return path;
+}
+
+//! A flat 16-bit image of `value` written as `name` (PNG or TIFF by its extension) in `dir`.
+void writeFlat(const std::string& dir, const std::string& name, Size size, int value, int depth = CV_16U)
+{
+    ASSERT_TRUE(imwrite(dir + "/" + name, Mat(size, CV_MAKETYPE(depth, 1), Scalar(value))));
+}
+
+TEST(Emva1288, referenceSet001GivesTheReferenceImplementationsFigures)
+{
+    RAWGMENT_DATA_FILE_OR_SKIP(path, kSet001);
+    const Emva1288Series series = readEmva1288(path);
+    EXPECT_EQ(series.version, "3.0");
+    EXPECT_EQ(series.bits, 12);
+    EXPECT_EQ(series.width, 640);
+    EXPECT_EQ(series.height, 480);
+    EXPECT_EQ(series.temporal.size(), 100u); // 50 bright and 50 dark pairs
+    ASSERT_EQ(series.spatial.size(), 2u);
+    EXPECT_EQ(series.spatial[0].images.size(), 50u);
+
+    const Emva1288Results r = emva1288Results(series);
+    // The reference implementation's figures (data/emva1288/README.md, EMVA1288/emva1288 at 2ed0b40). The
+    // issue's tolerances: 0.5% of each figure, 0.04 dB for dB figures, 0.5% of the value for percentages.
+    // Both implement the same formulas on the same integers, so the differences are the README's rounding.
+    const auto within = [](double value, double reference, double relative) {
+        return std::abs(value - reference) <= relative * std::abs(reference);
+    };
+    EXPECT_PRED3(within, r.K, 0.28006, 0.005);
+    EXPECT_PRED3(within, r.sigmaYDark, 3.0731, 0.005);
+    EXPECT_PRED3(within, r.sigmaD, 10.924, 0.005);
+    EXPECT_PRED3(within, r.muPSat, 30957, 0.005);
+    EXPECT_PRED3(within, r.muESat, 14008, 0.005);
+    EXPECT_PRED3(within, r.eta, 45.25, 0.005);
+    EXPECT_PRED3(within, r.snrMax, 118.35, 0.005);
+    EXPECT_NEAR(r.snrMaxDb, 41.46, 0.04);
+    EXPECT_NEAR(r.dynamicRangeDb, 61.73, 0.04);
+    EXPECT_PRED3(within, r.muPMin, 25.35, 0.005);
+    EXPECT_PRED3(within, r.dsnu1288, 0.553, 0.005);
+    EXPECT_PRED3(within, r.prnu1288, 0.433, 0.005);
+    EXPECT_PRED3(within, r.linearityErrorMin, -0.616, 0.005);
+    EXPECT_PRED3(within, r.linearityErrorMax, 0.480, 0.005);
+    EXPECT_TRUE(r.photonsGiven);
+    EXPECT_EQ(r.mean.size(), 50u);
+    EXPECT_GT(r.saturationIndex, r.sensitivityMaxIndex);
+}
+
+TEST(Emva1288, progressIsCalledOncePerExposure)
+{
+    RAWGMENT_DATA_FILE_OR_SKIP(path, kSet001);
+    Emva1288Series series = readEmva1288(path);
+    series.spatial.clear();
+    // Ten bright steps and their dark pairs (the file lists the 50 bright pairs, then the 50 dark ones).
+    std::vector<Emva1288Images> some(series.temporal.begin(), series.temporal.begin() + 10);
+    some.insert(some.end(), series.temporal.begin() + 50, series.temporal.begin() + 60);
+    series.temporal = some;
+    int calls = 0, last = 0, total = 0;
+    const Emva1288Results r = emva1288Results(series, [&](int done, int all) {
+        ++calls;
+        EXPECT_EQ(done, last + 1);
+        last = done;
+        total = all;
+    });
+    EXPECT_EQ(calls, 20);
+    EXPECT_EQ(total, 20);
+    EXPECT_TRUE(std::isnan(r.dsnu1288)) << "no spatial set, no DSNU";
+}
+
+//! A small valid series: three bright steps of rising flat signal with their dark pairs.
+struct SmallSeries
+{
+    std::string dir;
+    std::string header = "# written by the test\r\nv 4.0\r\nn 12 8 6\r\n";
+    std::string steps;
+
+    explicit SmallSeries(const std::string& name) : dir(makeTempDir(name))
+    {
+        const Size size(8, 6);
+        for (int s = 0; s < 3; ++s) {
+            writeFlat(dir, cv::format("b%d_1.png", s), size, 100 + 400 * s);
+            writeFlat(dir, cv::format("b%d_2.png", s), size, 100 + 400 * s);
+            writeFlat(dir, cv::format("d%d_1.png", s), size, 100);
+            writeFlat(dir, cv::format("d%d_2.png", s), size, 100);
+            steps += cv::format("b %d %d\r\ni b%d_1.png\r\ni b%d_2.png\r\n", 1000 * (s + 1), 50 * s, s, s);
+            steps += cv::format("d %d\r\ni d%d_1.png\r\ni d%d_2.png\r\n", 1000 * (s + 1), s, s);
+        }
+    }
+    std::string write(const std::string& text) const { return writeDescriptor(dir, text); }
+};
+
+TEST(Emva1288, aDescriptorIsReadAsTheReferenceReadsIt)
+{
+    const SmallSeries s("emva1288_read");
+    // Windows separators, CRLF, a decimal comma, comments, and a folder prefix as in set 001.
+    ASSERT_EQ(
+        0,
+        std::system(
+            ("mkdir -p '" + s.dir + "/images' && cp '" + s.dir + "'/*.png '" + s.dir + "/images/'").c_str()));
+    std::string text = s.header + "b 1000,5 12,25\r\ni images\\b0_1.png\r\ni images\\b0_2.png\r\n" + s.steps;
+    text += "d 1000,5\r\ni images\\d0_1.png\r\ni images\\d0_2.png\r\n";
+    const Emva1288Series series = readEmva1288(s.write(text));
+    EXPECT_EQ(series.version, "4.0");
+    ASSERT_EQ(series.temporal.size(), 8u);
+    EXPECT_EQ(series.temporal[0].exposureNs, 1000.5);
+    EXPECT_EQ(series.temporal[0].photons, 12.25);
+    EXPECT_EQ(series.temporal[0].images[0], s.dir + "/images/b0_1.png");
+    EXPECT_EQ(series.temporal[0].line, 4);
+    EXPECT_TRUE(series.spatial.empty());
+}
+
+TEST(Emva1288, everyBadDescriptorIsAnErrorNamingTheFileAndLine)
+{
+    const SmallSeries s("emva1288_bad");
+    const std::string& h = s.header;
+    struct Case
+    {
+        std::string text, fragment;
+    };
+    const std::vector<Case> cases = {
+        {"", "has no 'n <bits> <width> <height>' line"},
+        {"hello world\n", "line 1: unknown command 'hello'"},
+        {std::string("v 3.0\n\0\1\2", 9), "binary data"},
+        {"v 3.0\nb 1 2\ni b0_1.png\ni b0_2.png\n", "line 2: an exposure before the 'n"},
+        {"n 16 100000 100000\n", "line 1: 100000 x 100000 pixels is more than"},
+        {"n 17 8 6\n", "bits 17 is outside [1, 16]"},
+        {"n 12 8\n", "expected 'n <bits> <width> <height>'"},
+        {"n 12 8 6\nn 12 8 6\n", "line 2: a second 'n' line"},
+        {"n twelve 8 6\n", "bits 'twelve' is not an integer"},
+        {h + "b -5 10\ni b0_1.png\ni b0_2.png\n" + s.steps, "line 4: exposure -5 is negative"},
+        {h + "b 5 -10\ni b0_1.png\ni b0_2.png\n" + s.steps, "line 4: photons -10 is negative"},
+        {h + "b 5 nan\ni b0_1.png\ni b0_2.png\n" + s.steps, "photons 'nan' is not a finite number"},
+        {h + "b 5 10\ni b0_1.png\n" + s.steps, "line 4: the exposure has 1 image(s)"},
+        {h + "b 5 10\ni b0_1.png\n", "line 4: the exposure has 1 image(s)"},
+        {h + "i b0_1.png\n", "an image ('i') before any 'b' or 'd' line"},
+        {h + "b 5 10\ni missing.png\ni b0_2.png\n", "image '" + s.dir + "/missing.png' does not exist"},
+        {h + "b 5 10\ni\n", "expected 'i <image path>'"},
+        {h + s.steps + "b 1000 0\ni b0_1.png\ni b0_2.png\n",
+         "exposure 1000 with 0 photons is listed again (first on line 4)"},
+        {h + "b 5 10\ni b0_1.png\ni b0_2.png\n", "exposure 5 has no dark pair"},
+        {h + s.steps + "b 9 10\ni b0_1.png\ni b0_2.png\ni b1_1.png\n",
+         "must be one bright and one dark stack"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.text.substr(0, 80));
+        const std::string path = s.write(c.text);
+        EXPECT_CV_ERROR_CONTAINS(readEmva1288(path), c.fragment);
+        EXPECT_CV_ERROR_CONTAINS(readEmva1288(path), path);
+    }
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288(s.dir + "/none.txt"), "none.txt");
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288(s.dir), "it is a directory");
+}
+
+TEST(Emva1288, anImageThatDoesNotMatchItsDescriptorIsAnErrorNamingItAndTheLine)
+{
+    const SmallSeries s("emva1288_images");
+    // 4096 in a 12-bit series, another size, three channels, a PNG claiming 100000 x 100000 pixels.
+    writeFlat(s.dir, "hot.png", Size(8, 6), 4096);
+    writeFlat(s.dir, "small.png", Size(7, 6), 100);
+    ASSERT_TRUE(imwrite(s.dir + "/colour.png", Mat(6, 8, CV_8UC3, Scalar::all(9))));
+    writeFlat(s.dir, "ok.tif", Size(8, 6), 100);
+    std::vector<char> huge = test::readBytes(s.dir + "/b0_1.png");
+    ASSERT_GT(huge.size(), 24u);
+    for (int i = 16; i < 24; ++i)
+        huge[i] = char(i < 20 ? (i == 17 ? 0x01 : 0x00) : (i == 21 ? 0x01 : 0x00)); // 65536 x 65536
+    test::writeBytes(s.dir + "/huge.png", huge);
+    test::writeBytes(s.dir + "/text.png", {'n', 'o', 't'});
+    const Emva1288Series series = readEmva1288(s.write(s.header + s.steps));
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288Image(series, s.dir + "/hot.png", 7), "above 2^12 - 1 = 4095");
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288Image(series, s.dir + "/hot.png", 7), "line 7");
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288Image(series, s.dir + "/small.png", 7), "it is 7 x 6, but");
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288Image(series, s.dir + "/colour.png", 7), "3 channel(s) of 8 bits");
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288Image(series, s.dir + "/huge.png", 7), "it is 65536 x 65536, but");
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288Image(series, s.dir + "/text.png", 7), "neither a PNG nor a TIFF");
+    const Mat tiff = readEmva1288Image(series, s.dir + "/ok.tif", 7);
+    EXPECT_EQ(tiff.type(), CV_16UC1);
+    EXPECT_EQ(tiff.at<ushort>(5, 7), 100);
+}
+
+TEST(Emva1288, aSeriesWithoutSignalIsAClearError)
+{
+    const SmallSeries s("emva1288_no_signal");
+    // Every step at the dark level: there is no K to fit.
+    std::string flat = s.header;
+    for (int i = 0; i < 3; ++i)
+        flat += cv::format("b %d 10\ni d0_1.png\ni d0_2.png\nd %d\ni d0_1.png\ni d0_2.png\n", i + 1, i + 1);
+    EXPECT_CV_ERROR_CONTAINS(emva1288Results(readEmva1288(s.write(flat))), "K needs a signal that rises");
+    std::string two = s.header + "b 1 10\ni b1_1.png\ni b1_2.png\nd 1\ni d0_1.png\ni d0_2.png\n";
+    EXPECT_CV_ERROR_CONTAINS(emva1288Results(readEmva1288(s.write(two))), "has 1 bright temporal step(s)");
+}
+
+} // namespace
+} // namespace rawgment
+} // namespace cv
