@@ -646,6 +646,7 @@ PYBIND11_MODULE(_rawgment, m)
     bindCalibration(m);
     bindAugment(m);
     bindBatch(m);
+    bindEmva1288(m);
 
     py::module_ testing = m.def_submodule("_testing", "Evidence for the tests (not part of the API).");
     testing.def(

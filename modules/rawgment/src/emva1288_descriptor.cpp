@@ -250,6 +250,14 @@ Emva1288Series readEmva1288(const String& path)
                 badLine(path, lineNumber, cv::format("exposure %g is negative", group.exposureNs));
             if (group.photons < 0)
                 badLine(path, lineNumber, cv::format("photons %g is negative", group.photons));
+            if (group.exposureNs > MAX_EMVA1288_EXPOSURE)
+                badLine(path, lineNumber,
+                        cv::format("exposure %g is beyond the %g a descriptor may state", group.exposureNs,
+                                   MAX_EMVA1288_EXPOSURE));
+            if (group.photons > MAX_EMVA1288_PHOTONS)
+                badLine(path, lineNumber,
+                        cv::format("photons %g is beyond the %g a descriptor may state", group.photons,
+                                   MAX_EMVA1288_PHOTONS));
             groups.push_back(group);
             open = &groups.back();
         } else {

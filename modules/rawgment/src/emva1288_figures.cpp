@@ -54,13 +54,18 @@ struct StackStatistics
 
 StackStatistics stackStatistics(const Emva1288Series& series, const Emva1288Images& stack)
 {
-    Mat sum = Mat::zeros(series.height, series.width, CV_64F);
-    Mat squares = Mat::zeros(series.height, series.width, CV_64F);
-    Mat frame;
+    // The accumulators are made from the first image read, so that a descriptor's 'n' alone allocates
+    // nothing.
+    Mat sum, squares, frame;
     for (const String& image : stack.images) {
         readEmva1288Image(series, image, stack.line).convertTo(frame, CV_64F);
-        sum += frame;
-        squares += frame.mul(frame);
+        if (sum.empty()) {
+            sum = frame.clone();
+            squares = frame.mul(frame);
+        } else {
+            sum += frame;
+            squares += frame.mul(frame);
+        }
     }
     const double L = double(stack.images.size());
     const Mat mean = sum / L;
@@ -209,6 +214,11 @@ Emva1288Results emva1288Results(const Emva1288Series& series, const std::functio
                      "below 70%% of it; K needs a signal that rises over at least two steps",
                      series.path.c_str(), saturated, r.sensitivityMaxIndex + 1));
     r.K = slopeThroughOrigin(signal, excess, 0, r.sensitivityMaxIndex);
+    if (!(std::isfinite(r.K) && r.K > 0))
+        CV_Error(Error::StsBadArg,
+                 cv::format("emva1288Results: '%s': the fitted K is %g; the temporal variance "
+                            "does not rise with the signal up to 70%% of saturation",
+                            series.path.c_str(), r.K));
 
     // The dark noise: the intercept of the dark variance against exposure time (dark current adds the slope).
     std::vector<double> times, darkVariances;
@@ -223,6 +233,12 @@ Emva1288Results emva1288Results(const Emva1288Series& series, const std::functio
 
     if (r.photonsGiven) {
         r.responsivity = slopeThroughOrigin(r.photons, signal, 0, r.sensitivityMaxIndex);
+        if (!(std::isfinite(r.responsivity) && r.responsivity > 0))
+            CV_Error(
+                Error::StsBadArg,
+                cv::format("emva1288Results: '%s': the responsivity is %g DN per photon; the signal does not "
+                           "rise with the descriptor's photon counts",
+                           series.path.c_str(), r.responsivity));
         r.eta = 100.0 * r.responsivity / r.K;
         r.muPSat = r.photons[r.saturationIndex];
         r.muESat = r.eta * r.muPSat / 100.0;
@@ -252,7 +268,9 @@ Emva1288Results emva1288Results(const Emva1288Series& series, const std::functio
             y1 += 1.0 / Y;
             y2 += 1.0 / (Y * Y);
         }
-        const double b = (xy * xy2 - x2y2 * y1) / (xy2 * xy2 - x2y2 * y2);
+        // The determinant vanishes when every X/Y is equal (a response exactly through the origin): b is 0.
+        const double det = xy2 * xy2 - x2y2 * y2;
+        const double b = std::abs(det) > 1e-12 * x2y2 * y2 ? (xy * xy2 - x2y2 * y1) / det : 0.0;
         const double a = (xy - b * xy2) / x2y2;
         r.linearityFitSlope = a;
         r.linearityFitOffset = b;

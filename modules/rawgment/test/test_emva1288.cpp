@@ -156,6 +156,8 @@ TEST(Emva1288, everyBadDescriptorIsAnErrorNamingTheFileAndLine)
         {h + "b -5 10\ni b0_1.png\ni b0_2.png\n" + s.steps, "line 4: exposure -5 is negative"},
         {h + "b 5 -10\ni b0_1.png\ni b0_2.png\n" + s.steps, "line 4: photons -10 is negative"},
         {h + "b 5 nan\ni b0_1.png\ni b0_2.png\n" + s.steps, "photons 'nan' is not a finite number"},
+        {h + "b 5 1e308\ni b0_1.png\ni b0_2.png\n" + s.steps, "photons 1e+308 is beyond the 1e+12"},
+        {h + "d 1e16\ni b0_1.png\ni b0_2.png\n" + s.steps, "exposure 1e+16 is beyond the 1e+15"},
         {h + "b 5 10\ni b0_1.png\n" + s.steps, "line 4: the exposure has 1 image(s)"},
         {h + "b 5 10\ni b0_1.png\n", "line 4: the exposure has 1 image(s)"},
         {h + "i b0_1.png\n", "an image ('i') before any 'b' or 'd' line"},

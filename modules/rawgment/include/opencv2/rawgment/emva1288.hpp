@@ -51,6 +51,10 @@ struct CV_EXPORTS_W_SIMPLE Emva1288Series
 static constexpr int MAX_EMVA1288_BITS = 16;
 //! The largest image a descriptor may describe (pixels): 2^28, a 16384x16384 sensor.
 static constexpr long long MAX_EMVA1288_PIXELS = 1LL << 28;
+//! The largest photon count per pixel a `b` line may state: 10^12, a million times a large full well.
+static constexpr double MAX_EMVA1288_PHOTONS = 1e12;
+//! The longest exposure a line may state: 10^15 (ns: eleven days).
+static constexpr double MAX_EMVA1288_EXPOSURE = 1e15;
 //! The most images a descriptor may list (the standard asks for about 100 steps and 2 x 100 spatial frames).
 static constexpr int MAX_EMVA1288_IMAGES = 100000;
 
@@ -67,10 +71,10 @@ static constexpr int MAX_EMVA1288_IMAGES = 100000;
  * @throws cv::Exception StsParseError naming the file and line for: a file that is not a descriptor (no
  * `n` line, an unknown command, text that is not a descriptor's), a malformed line, `bits` outside
  * [1, 16], dimensions or image counts beyond MAX_EMVA1288_PIXELS or MAX_EMVA1288_IMAGES, a negative or
- * non-finite exposure or photon count, an exposure with fewer than two images, a missing image file, the
- * same (exposure, photons) listed twice, a temporal exposure without its dark pair or without a bright
- * pair, a spatial set that is not one bright and one dark stack at one exposure; StsError for a
- * descriptor that cannot be read (see readFileBounded()).
+ * non-finite exposure or photon count or one beyond MAX_EMVA1288_EXPOSURE or MAX_EMVA1288_PHOTONS, an
+ * exposure with fewer than two images, a missing image file, the same (exposure, photons) listed twice, a
+ * temporal exposure without its dark pair or without a bright pair, a spatial set that is not one bright and
+ * one dark stack at one exposure; StsError for a descriptor that cannot be read (see readFileBounded()).
  */
 CV_EXPORTS_W Emva1288Series readEmva1288(const String& path);
 
@@ -102,21 +106,24 @@ struct CV_EXPORTS_W_SIMPLE Emva1288Results
 {
     //! Every figure NaN and every list empty until emva1288Results() fills them.
     CV_WRAP Emva1288Results();
-    CV_PROP_RW double K;                 //!< overall system gain (DN/e-)
-    CV_PROP_RW double sigmaYDark;        //!< temporal dark noise (DN)
-    CV_PROP_RW double sigmaD;            //!< temporal dark noise in electrons, sqrt(sigmaYDark^2 - 1/12)/K
-    CV_PROP_RW double responsivity;      //!< R, DN per photon
-    CV_PROP_RW double eta;               //!< quantum efficiency (%), NaN when every photon count is 0
-    CV_PROP_RW double muPSat;            //!< saturation (photons), NaN without photon counts
-    CV_PROP_RW double muESat;            //!< saturation capacity (e-): the signal at saturation over K
-    CV_PROP_RW double snrMax;            //!< sqrt(muESat)
-    CV_PROP_RW double snrMaxDb;          //!< 20 log10 snrMax
-    CV_PROP_RW double muPMin;            //!< absolute sensitivity threshold (photons), NaN without photons
-    CV_PROP_RW double dynamicRangeDb;    //!< 20 log10(muPSat / muPMin), NaN without photons
-    CV_PROP_RW double dsnu1288;          //!< dark signal non-uniformity (e-), NaN without a spatial set
-    CV_PROP_RW double prnu1288;          //!< photo-response non-uniformity (%), NaN without a spatial set
-    CV_PROP_RW double linearityErrorMin; //!< (%) smallest relative deviation from the linearity fit
-    CV_PROP_RW double linearityErrorMax; //!< (%) largest relative deviation from the linearity fit
+    CV_PROP_RW double K;              //!< overall system gain (DN/e-)
+    CV_PROP_RW double sigmaYDark;     //!< temporal dark noise (DN)
+    CV_PROP_RW double sigmaD;         //!< temporal dark noise in electrons, sqrt(sigmaYDark^2 - 1/12)/K
+    CV_PROP_RW double responsivity;   //!< R, DN per photon
+    CV_PROP_RW double eta;            //!< quantum efficiency (%), NaN when every photon count is 0
+    CV_PROP_RW double muPSat;         //!< saturation (photons), NaN without photon counts
+    CV_PROP_RW double muESat;         //!< saturation capacity (e-): the signal at saturation over K
+    CV_PROP_RW double snrMax;         //!< sqrt(muESat)
+    CV_PROP_RW double snrMaxDb;       //!< 20 log10 snrMax
+    CV_PROP_RW double muPMin;         //!< absolute sensitivity threshold (photons), NaN without photons
+    CV_PROP_RW double dynamicRangeDb; //!< 20 log10(muPSat / muPMin), NaN without photons
+    CV_PROP_RW double
+        dsnu1288; //!< dark signal non-uniformity (e-); NaN without a spatial set or when its estimate is < 0
+    CV_PROP_RW double prnu1288; //!< photo-response non-uniformity (%); NaN as dsnu1288
+    //! (%) smallest relative deviation from the linearity fit; NaN when fewer than two steps lie between
+    //! 5% and 95% of the saturation signal
+    CV_PROP_RW double linearityErrorMin;
+    CV_PROP_RW double linearityErrorMax; //!< (%) largest relative deviation from the linearity fit, or NaN
     CV_PROP_RW bool photonsGiven;        //!< some bright step states a photon count above 0
 
     /* The temporal points, one per bright step in ascending exposure (then photons). */
@@ -148,7 +155,8 @@ struct CV_EXPORTS_W_SIMPLE Emva1288Results
  * @return the figures and the temporal points they come from
  * @throws cv::Exception StsError naming the image and descriptor line of an image that cannot be read
  * or does not match the descriptor (see readEmva1288Image()); StsBadArg for a series with fewer than
- * three bright temporal points, or one whose signal never rises above its dark level (no K to fit).
+ * three bright temporal points, one whose signal does not rise over two steps below 70% of saturation, whose
+ * variance does not rise with it (K not > 0) or whose signal does not rise with the photon counts given.
  */
 CV_EXPORTS_W Emva1288Results emva1288Results(const Emva1288Series& series);
 

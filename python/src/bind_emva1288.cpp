@@ -1,0 +1,94 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Python bindings of the EMVA 1288 topic: the standard's descriptor and its figures.
+#include "binding_tools.hpp"
+
+namespace rawgment_python {
+
+using namespace cv::rawgment;
+
+void bindEmva1288(py::module_& m)
+{
+    py::class_<Emva1288Images>(m, "Emva1288Images", doc("Emva1288Images"))
+        .def(keywordInit<Emva1288Images>())
+        .def_readwrite("exposureNs", &Emva1288Images::exposureNs, doc("Emva1288Images::exposureNs"))
+        .def_readwrite("photons", &Emva1288Images::photons, doc("Emva1288Images::photons"))
+        .def_readwrite("dark", &Emva1288Images::dark, doc("Emva1288Images::dark"))
+        .def_readwrite("images", &Emva1288Images::images, doc("Emva1288Images::images"))
+        .def_readwrite("line", &Emva1288Images::line, doc("Emva1288Images::line"));
+    py::class_<Emva1288Series>(m, "Emva1288Series", doc("Emva1288Series"))
+        .def(keywordInit<Emva1288Series>())
+        .def_readwrite("path", &Emva1288Series::path, doc("Emva1288Series::path"))
+        .def_readwrite("version", &Emva1288Series::version, doc("Emva1288Series::version"))
+        .def_readwrite("bits", &Emva1288Series::bits, doc("Emva1288Series::bits"))
+        .def_readwrite("width", &Emva1288Series::width, doc("Emva1288Series::width"))
+        .def_readwrite("height", &Emva1288Series::height, doc("Emva1288Series::height"))
+        .def_readwrite("temporal", &Emva1288Series::temporal, doc("Emva1288Series::temporal"))
+        .def_readwrite("spatial", &Emva1288Series::spatial, doc("Emva1288Series::spatial"));
+    m.attr("MAX_EMVA1288_BITS") = MAX_EMVA1288_BITS;
+    m.attr("MAX_EMVA1288_PIXELS") = MAX_EMVA1288_PIXELS;
+    m.attr("MAX_EMVA1288_IMAGES") = MAX_EMVA1288_IMAGES;
+    m.attr("MAX_EMVA1288_PHOTONS") = MAX_EMVA1288_PHOTONS;
+    m.attr("MAX_EMVA1288_EXPOSURE") = MAX_EMVA1288_EXPOSURE;
+    m.def(
+        "readEmva1288",
+        [](const std::string& path) {
+            return withoutGil("readEmva1288", [&] { return readEmva1288(path); });
+        },
+        py::arg("path"), doc("readEmva1288"));
+    m.def(
+        "readEmva1288Image",
+        [](const Emva1288Series& series, const std::string& imagePath, int line) {
+            cv::Mat image;
+            withoutGil("readEmva1288Image", [&] { image = readEmva1288Image(series, imagePath, line); });
+            return arrayFromMat(image);
+        },
+        py::arg("series"), py::arg("imagePath"), py::arg("line") = 0,
+        doc("readEmva1288Image", "Python: returns the uint8 or uint16 array."));
+
+    auto results = py::class_<Emva1288Results>(m, "Emva1288Results", doc("Emva1288Results"));
+    results.def(keywordInit<Emva1288Results>());
+#define RAWGMENT_EMVA_FIELD(name)                                                                            \
+    results.def_readwrite(#name, &Emva1288Results::name, doc("Emva1288Results::" #name))
+    RAWGMENT_EMVA_FIELD(K);
+    RAWGMENT_EMVA_FIELD(sigmaYDark);
+    RAWGMENT_EMVA_FIELD(sigmaD);
+    RAWGMENT_EMVA_FIELD(responsivity);
+    RAWGMENT_EMVA_FIELD(eta);
+    RAWGMENT_EMVA_FIELD(muPSat);
+    RAWGMENT_EMVA_FIELD(muESat);
+    RAWGMENT_EMVA_FIELD(snrMax);
+    RAWGMENT_EMVA_FIELD(snrMaxDb);
+    RAWGMENT_EMVA_FIELD(muPMin);
+    RAWGMENT_EMVA_FIELD(dynamicRangeDb);
+    RAWGMENT_EMVA_FIELD(dsnu1288);
+    RAWGMENT_EMVA_FIELD(prnu1288);
+    RAWGMENT_EMVA_FIELD(linearityErrorMin);
+    RAWGMENT_EMVA_FIELD(linearityErrorMax);
+    RAWGMENT_EMVA_FIELD(photonsGiven);
+    RAWGMENT_EMVA_FIELD(exposureNs);
+    RAWGMENT_EMVA_FIELD(photons);
+    RAWGMENT_EMVA_FIELD(mean);
+    RAWGMENT_EMVA_FIELD(variance);
+    RAWGMENT_EMVA_FIELD(darkMean);
+    RAWGMENT_EMVA_FIELD(darkVariance);
+    RAWGMENT_EMVA_FIELD(saturationIndex);
+    RAWGMENT_EMVA_FIELD(sensitivityMaxIndex);
+    RAWGMENT_EMVA_FIELD(linearityMinIndex);
+    RAWGMENT_EMVA_FIELD(linearityMaxIndex);
+    RAWGMENT_EMVA_FIELD(linearityFitSlope);
+    RAWGMENT_EMVA_FIELD(linearityFitOffset);
+    RAWGMENT_EMVA_FIELD(linearityDeviation);
+    RAWGMENT_EMVA_FIELD(spatialMeanBright);
+    RAWGMENT_EMVA_FIELD(spatialMeanDark);
+    RAWGMENT_EMVA_FIELD(spatialVarianceBright);
+    RAWGMENT_EMVA_FIELD(spatialVarianceDark);
+#undef RAWGMENT_EMVA_FIELD
+    m.def(
+        "emva1288Results",
+        [](const Emva1288Series& series) {
+            return withoutGil("emva1288Results", [&] { return emva1288Results(series); });
+        },
+        py::arg("series"), doc("emva1288Results"));
+}
+
+} // namespace rawgment_python
