@@ -45,6 +45,43 @@ void bindEmva1288(py::module_& m)
         py::arg("series"), py::arg("imagePath"), py::arg("line") = 0,
         doc("readEmva1288Image", "Python: returns the uint8 or uint16 array."));
 
+    py::class_<Emva1288Pair>(m, "Emva1288Pair", doc("Emva1288Pair"))
+        .def(keywordInit<Emva1288Pair>())
+        .def_readwrite("exposureNs", &Emva1288Pair::exposureNs, doc("Emva1288Pair::exposureNs"))
+        .def_readwrite("photons", &Emva1288Pair::photons, doc("Emva1288Pair::photons"))
+        .def_readwrite("dark", &Emva1288Pair::dark, doc("Emva1288Pair::dark"))
+        .def_readwrite("mean", &Emva1288Pair::mean, doc("Emva1288Pair::mean"))
+        .def_readwrite("variance", &Emva1288Pair::variance, doc("Emva1288Pair::variance"))
+        .def_readwrite("varianceStdError", &Emva1288Pair::varianceStdError,
+                       doc("Emva1288Pair::varianceStdError"));
+    m.def(
+        "measureEmva1288Pair",
+        [](const py::object& a, const py::object& b, double exposureNs, double photons, bool dark) {
+            const cv::Mat ma = matFromArray(a, "a", {CV_8U, CV_16U});
+            const cv::Mat mb = matFromArray(b, "b", {CV_8U, CV_16U});
+            return withoutGil("measureEmva1288Pair",
+                              [&] { return measureEmva1288Pair(ma, mb, exposureNs, photons, dark); });
+        },
+        py::arg("a"), py::arg("b"), py::arg("exposureNs"), py::arg("photons"), py::arg("dark"),
+        doc("measureEmva1288Pair"));
+    py::class_<Emva1288Stack>(m, "Emva1288Stack", doc("Emva1288Stack"))
+        .def(keywordInit<Emva1288Stack>())
+        .def_readwrite("exposureNs", &Emva1288Stack::exposureNs, doc("Emva1288Stack::exposureNs"))
+        .def_readwrite("photons", &Emva1288Stack::photons, doc("Emva1288Stack::photons"))
+        .def_readwrite("dark", &Emva1288Stack::dark, doc("Emva1288Stack::dark"))
+        .def_readwrite("frames", &Emva1288Stack::frames, doc("Emva1288Stack::frames"))
+        .def_readwrite("mean", &Emva1288Stack::mean, doc("Emva1288Stack::mean"))
+        .def_readwrite("variance", &Emva1288Stack::variance, doc("Emva1288Stack::variance"));
+    m.def(
+        "measureEmva1288Stack",
+        [](const py::object& frames, double exposureNs, double photons, bool dark) {
+            const std::vector<cv::Mat> in = matsFromList(frames, "frames", {CV_8U, CV_16U});
+            return withoutGil("measureEmva1288Stack",
+                              [&] { return measureEmva1288Stack(in, exposureNs, photons, dark); });
+        },
+        py::arg("frames"), py::arg("exposureNs"), py::arg("photons"), py::arg("dark"),
+        doc("measureEmva1288Stack"));
+
     auto results = py::class_<Emva1288Results>(m, "Emva1288Results", doc("Emva1288Results"));
     results.def(keywordInit<Emva1288Results>());
 #define RAWGMENT_EMVA_FIELD(name)                                                                            \
@@ -78,10 +115,10 @@ void bindEmva1288(py::module_& m)
     RAWGMENT_EMVA_FIELD(linearityFitSlope);
     RAWGMENT_EMVA_FIELD(linearityFitOffset);
     RAWGMENT_EMVA_FIELD(linearityDeviation);
-    RAWGMENT_EMVA_FIELD(spatialMeanBright);
-    RAWGMENT_EMVA_FIELD(spatialMeanDark);
-    RAWGMENT_EMVA_FIELD(spatialVarianceBright);
-    RAWGMENT_EMVA_FIELD(spatialVarianceDark);
+    RAWGMENT_EMVA_FIELD(varianceStdError);
+    RAWGMENT_EMVA_FIELD(darkVarianceStdError);
+    RAWGMENT_EMVA_FIELD(pairs);
+    RAWGMENT_EMVA_FIELD(stacks);
 #undef RAWGMENT_EMVA_FIELD
     m.def(
         "emva1288Results",
@@ -89,6 +126,28 @@ void bindEmva1288(py::module_& m)
             return withoutGil("emva1288Results", [&] { return emva1288Results(series); });
         },
         py::arg("series"), doc("emva1288Results"));
+    m.def(
+        "emva1288Results",
+        [](const std::vector<Emva1288Pair>& pairs, const std::vector<Emva1288Stack>& stacks) {
+            return withoutGil("emva1288Results", [&] { return emva1288Results(pairs, stacks); });
+        },
+        py::arg("pairs"), py::arg("stacks") = std::vector<Emva1288Stack>(), doc("emva1288Results"));
+
+    py::class_<Emva1288CalibrationParams>(m, "Emva1288CalibrationParams", doc("Emva1288CalibrationParams"))
+        .def(keywordInit<Emva1288CalibrationParams>())
+        .def_readwrite("maxSignalFraction", &Emva1288CalibrationParams::maxSignalFraction,
+                       doc("Emva1288CalibrationParams::maxSignalFraction"))
+        .def_readwrite("minGainRatio", &Emva1288CalibrationParams::minGainRatio,
+                       doc("Emva1288CalibrationParams::minGainRatio"));
+    m.def(
+        "calibrateEmva1288",
+        [](const std::vector<Emva1288Results>& measurements, const std::vector<double>& gains,
+           const Emva1288CalibrationParams& params) {
+            return withoutGil("calibrateEmva1288",
+                              [&] { return calibrateEmva1288(measurements, gains, params); });
+        },
+        py::arg("measurements"), py::arg("gains"), py::arg("params") = Emva1288CalibrationParams(),
+        doc("calibrateEmva1288"));
 }
 
 } // namespace rawgment_python

@@ -16,49 +16,38 @@ namespace rawgment {
 
 namespace {
 
-//! Mean and temporal variance of a pair, as the standard defines them: half the variance of A - B.
-struct PairStatistics
+//! The pixel values of a frame as int, read row by row (CV_8U or CV_16U).
+template <typename Visit> void forEachPixelPair(const Mat& a, const Mat& b, Visit&& visit)
 {
-    double mean = 0, variance = 0;
-};
-
-PairStatistics pairStatistics(const Mat& a, const Mat& b)
-{
-    long long sumA = 0, sumB = 0, sumD = 0;
-    unsigned long long sumD2 = 0;
     for (int y = 0; y < a.rows; ++y) {
-        const auto row = [&](const Mat& m, int x) {
-            return m.depth() == CV_8U ? int(m.ptr<uchar>(y)[x]) : int(m.ptr<ushort>(y)[x]);
-        };
-        for (int x = 0; x < a.cols; ++x) {
-            const int va = row(a, x), vb = row(b, x), d = va - vb;
-            sumA += va;
-            sumB += vb;
-            sumD += d;
-            sumD2 += (unsigned long long)((long long)d * d);
+        if (a.depth() == CV_8U) {
+            const uchar *pa = a.ptr<uchar>(y), *pb = b.ptr<uchar>(y);
+            for (int x = 0; x < a.cols; ++x)
+                visit(int(pa[x]), int(pb[x]));
+        } else {
+            const ushort *pa = a.ptr<ushort>(y), *pb = b.ptr<ushort>(y);
+            for (int x = 0; x < a.cols; ++x)
+                visit(int(pa[x]), int(pb[x]));
         }
     }
-    const double n = double(a.total());
-    PairStatistics s;
-    s.mean = double(sumA + sumB) / (2 * n);
-    const double meanD = double(sumD) / n;
-    s.variance = 0.5 * (double(sumD2) / n - meanD * meanD);
-    return s;
 }
 
-//! The spatial figures of one stack (bright or dark): its mean and s_y^2 with the temporal part removed.
-struct StackStatistics
+void checkFrame(const Mat& m, const char* who, const char* what)
 {
-    double mean = 0, variance = 0;
-};
+    if (m.type() != CV_8UC1 && m.type() != CV_16UC1)
+        CV_Error(Error::StsBadArg, cv::format("%s: %s must be CV_8UC1 or CV_16UC1 (got %s)", who, what,
+                                              m.empty() ? "an empty array" : typeToString(m.type()).c_str()));
+}
 
-StackStatistics stackStatistics(const Emva1288Series& series, const Emva1288Images& stack)
+//! The running sums of a stack, made from the first frame added so that nothing is allocated before.
+struct StackAccumulator
 {
-    // The accumulators are made from the first image read, so that a descriptor's 'n' alone allocates
-    // nothing.
     Mat sum, squares, frame;
-    for (const String& image : stack.images) {
-        readEmva1288Image(series, image, stack.line).convertTo(frame, CV_64F);
+    int frames = 0;
+
+    void add(const Mat& image)
+    {
+        image.convertTo(frame, CV_64F);
         if (sum.empty()) {
             sum = frame.clone();
             squares = frame.mul(frame);
@@ -66,21 +55,29 @@ StackStatistics stackStatistics(const Emva1288Series& series, const Emva1288Imag
             sum += frame;
             squares += frame.mul(frame);
         }
+        ++frames;
     }
-    const double L = double(stack.images.size());
-    const Mat mean = sum / L;
-    // Each pixel's unbiased temporal variance, (L sum y^2 - (sum y)^2) / (L (L - 1)).
-    const Mat temporal = (L * squares - sum.mul(sum)) / (L * (L - 1));
-    const double temporalMean = cv::mean(temporal)[0];
-    Scalar m, sd;
-    meanStdDev(mean, m, sd);
-    const double n = double(mean.total());
-    const double spatial = sd[0] * sd[0] * n / (n - 1);
-    StackStatistics s;
-    s.mean = m[0];
-    s.variance = spatial - temporalMean / L;
-    return s;
-}
+
+    //! The standard's s_y^2: the spatial variance of the mean image less the mean temporal variance over L.
+    Emva1288Stack stack(double exposureNs, double photons, bool dark) const
+    {
+        const double L = frames;
+        const Mat mean = sum / L;
+        // Each pixel's unbiased temporal variance, (L sum y^2 - (sum y)^2) / (L (L - 1)).
+        const Mat temporal = (L * squares - sum.mul(sum)) / (L * (L - 1));
+        Scalar m, sd;
+        meanStdDev(mean, m, sd);
+        const double n = double(mean.total());
+        Emva1288Stack s;
+        s.exposureNs = exposureNs;
+        s.photons = photons;
+        s.dark = dark;
+        s.frames = frames;
+        s.mean = m[0];
+        s.variance = sd[0] * sd[0] * n / (n - 1) - cv::mean(temporal)[0] / L;
+        return s;
+    }
+};
 
 //! The slope of y = m x by least squares (the reference's LinearB0).
 double slopeThroughOrigin(const std::vector<double>& x, const std::vector<double>& y, int first, int last)
@@ -128,67 +125,134 @@ int saturationIndexOf(const std::vector<double>& variance)
 
 } // namespace
 
+Emva1288Pair measureEmva1288Pair(InputArray _a, InputArray _b, double exposureNs, double photons, bool dark)
+{
+    const Mat a = detail::twoDimensional(_a, "measureEmva1288Pair: a");
+    const Mat b = detail::twoDimensional(_b, "measureEmva1288Pair: b");
+    checkFrame(a, "measureEmva1288Pair", "a");
+    checkFrame(b, "measureEmva1288Pair", "b");
+    if (a.size() != b.size() || a.type() != b.type() || a.total() < 2)
+        CV_Error(Error::StsBadArg,
+                 cv::format("measureEmva1288Pair: the frames must share one size and type and "
+                            "hold at least 2 pixels (got %dx%d %s and %dx%d %s)",
+                            a.cols, a.rows, typeToString(a.type()).c_str(), b.cols, b.rows,
+                            typeToString(b.type()).c_str()));
+    detail::checkFiniteNonNegative(exposureNs, "measureEmva1288Pair: exposureNs");
+    detail::checkFiniteNonNegative(photons, "measureEmva1288Pair: photons");
+    // Exact integer sums for the mean and the difference's mean; its central moments in a second pass.
+    long long sumAB = 0, sumD = 0;
+    forEachPixelPair(a, b, [&](int va, int vb) {
+        sumAB += va + vb;
+        sumD += va - vb;
+    });
+    const double n = double(a.total());
+    const double meanD = double(sumD) / n;
+    double m2 = 0, m4 = 0;
+    std::vector<double> rowSums(a.rows, 0.0);
+    for (int y = 0; y < a.rows; ++y) {
+        double row = 0;
+        forEachPixelPair(a.row(y), b.row(y), [&](int va, int vb) {
+            const double e = double(va - vb) - meanD, e2 = e * e;
+            row += e2;
+            m4 += e2 * e2;
+        });
+        rowSums[y] = row;
+        m2 += row;
+    }
+    m2 /= n;
+    m4 /= n;
+    // Rows as units as well: noise shared along a row (row noise, in most sensors; set 001 has 0.25 DN^2 of
+    // it) makes pixels of a row dependent, and the spread of the rows' own estimates then exceeds what the
+    // pixels' fourth moment implies. The larger of the two errors is stated.
+    double rowError = 0;
+    if (a.rows >= 8) {
+        double mean = 0, spread = 0;
+        for (double r : rowSums)
+            mean += r / a.cols / a.rows;
+        for (double r : rowSums)
+            spread += (r / a.cols - mean) * (r / a.cols - mean);
+        rowError = 0.5 * std::sqrt(spread / (a.rows - 1) / a.rows);
+    }
+    Emva1288Pair p;
+    p.exposureNs = exposureNs;
+    p.photons = photons;
+    p.dark = dark;
+    p.mean = double(sumAB) / (2 * n);
+    p.variance = 0.5 * m2;
+    p.varianceStdError = std::max(0.5 * std::sqrt(std::max(m4 - m2 * m2, 0.0) / n), rowError);
+    return p;
+}
+
+Emva1288Stack measureEmva1288Stack(InputArrayOfArrays _frames, double exposureNs, double photons, bool dark)
+{
+    std::vector<Mat> frames;
+    _frames.getMatVector(frames);
+    if (frames.size() < 2)
+        CV_Error(
+            Error::StsBadArg,
+            cv::format("measureEmva1288Stack: a stack needs at least 2 frames (got %d)", int(frames.size())));
+    detail::checkFiniteNonNegative(exposureNs, "measureEmva1288Stack: exposureNs");
+    detail::checkFiniteNonNegative(photons, "measureEmva1288Stack: photons");
+    StackAccumulator acc;
+    for (const Mat& f : frames) {
+        checkFrame(f, "measureEmva1288Stack", "every frame");
+        if (f.size() != frames[0].size() || f.type() != frames[0].type())
+            CV_Error(Error::StsBadArg, "measureEmva1288Stack: the frames must share one size and type");
+        acc.add(f);
+    }
+    return acc.stack(exposureNs, photons, dark);
+}
+
 Emva1288Results::Emva1288Results()
     : K(NAN), sigmaYDark(NAN), sigmaD(NAN), responsivity(NAN), eta(NAN), muPSat(NAN), muESat(NAN),
       snrMax(NAN), snrMaxDb(NAN), muPMin(NAN), dynamicRangeDb(NAN), dsnu1288(NAN), prnu1288(NAN),
       linearityErrorMin(NAN), linearityErrorMax(NAN), photonsGiven(false), saturationIndex(-1),
       sensitivityMaxIndex(-1), linearityMinIndex(-1), linearityMaxIndex(-1), linearityFitSlope(NAN),
-      linearityFitOffset(NAN), spatialMeanBright(NAN), spatialMeanDark(NAN), spatialVarianceBright(NAN),
-      spatialVarianceDark(NAN)
+      linearityFitOffset(NAN)
 {
 }
 
-Emva1288Results emva1288Results(const Emva1288Series& series)
+Emva1288Results emva1288Results(const std::vector<Emva1288Pair>& pairs,
+                                const std::vector<Emva1288Stack>& stacks)
 {
-    return emva1288Results(series, std::function<void(int, int)>());
-}
-
-Emva1288Results emva1288Results(const Emva1288Series& series, const std::function<void(int, int)>& progress)
-{
-    std::vector<const Emva1288Images*> bright;
-    for (const Emva1288Images& g : series.temporal)
-        if (!g.dark)
-            bright.push_back(&g);
+    std::vector<const Emva1288Pair*> bright;
+    std::map<double, const Emva1288Pair*> darkByExposure;
+    for (const Emva1288Pair& p : pairs) {
+        if (!(std::isfinite(p.mean) && std::isfinite(p.variance) && std::isfinite(p.varianceStdError) &&
+              std::isfinite(p.exposureNs) && std::isfinite(p.photons)))
+            CV_Error(Error::StsBadArg, "emva1288Results: a pair holds a value that is not finite");
+        if (!p.dark)
+            bright.push_back(&p);
+        else if (!darkByExposure.emplace(p.exposureNs, &p).second)
+            CV_Error(Error::StsBadArg,
+                     cv::format("emva1288Results: two dark pairs at exposure %g; one per exposure time",
+                                p.exposureNs));
+    }
     if (bright.size() < 3)
         CV_Error(Error::StsBadArg,
-                 cv::format("emva1288Results: '%s' has %d bright temporal step(s); the figures "
-                            "need at least three",
-                            series.path.c_str(), int(bright.size())));
-    std::stable_sort(bright.begin(), bright.end(), [](const Emva1288Images* a, const Emva1288Images* b) {
+                 cv::format("emva1288Results: %d bright temporal step(s); the figures need at "
+                            "least three",
+                            int(bright.size())));
+    std::stable_sort(bright.begin(), bright.end(), [](const Emva1288Pair* a, const Emva1288Pair* b) {
         return a->exposureNs != b->exposureNs ? a->exposureNs < b->exposureNs : a->photons < b->photons;
     });
-    const int total = int(series.temporal.size() + series.spatial.size());
-    int done = 0;
-    const auto stepDone = [&] {
-        if (progress)
-            progress(++done, total);
-    };
-    const auto statisticsOf = [&](const Emva1288Images& g) {
-        const Mat a = readEmva1288Image(series, g.images[0], g.line);
-        const Mat b = readEmva1288Image(series, g.images[1], g.line);
-        const PairStatistics s = pairStatistics(a, b);
-        stepDone();
-        return s;
-    };
-    // One dark pair per exposure time, read once, in ascending exposure.
-    std::map<double, PairStatistics> darkByExposure;
-    for (const Emva1288Images& g : series.temporal)
-        if (g.dark)
-            darkByExposure[g.exposureNs] = statisticsOf(g);
     Emva1288Results r;
-    for (const Emva1288Images* g : bright) {
+    r.pairs = pairs;
+    r.stacks = stacks;
+    for (const Emva1288Pair* g : bright) {
         const auto dark = darkByExposure.find(g->exposureNs);
         if (dark == darkByExposure.end())
             CV_Error(Error::StsBadArg,
-                     cv::format("emva1288Results: '%s', line %d: exposure %g has no dark pair",
-                                series.path.c_str(), g->line, g->exposureNs));
-        const PairStatistics s = statisticsOf(*g);
+                     cv::format("emva1288Results: the bright pair at exposure %g has no dark pair",
+                                g->exposureNs));
         r.exposureNs.push_back(g->exposureNs);
         r.photons.push_back(g->photons);
-        r.mean.push_back(s.mean);
-        r.variance.push_back(s.variance);
-        r.darkMean.push_back(dark->second.mean);
-        r.darkVariance.push_back(dark->second.variance);
+        r.mean.push_back(g->mean);
+        r.variance.push_back(g->variance);
+        r.varianceStdError.push_back(g->varianceStdError);
+        r.darkMean.push_back(dark->second->mean);
+        r.darkVariance.push_back(dark->second->variance);
+        r.darkVarianceStdError.push_back(dark->second->varianceStdError);
         r.photonsGiven = r.photonsGiven || g->photons > 0;
     }
     const int n = int(r.mean.size());
@@ -210,21 +274,21 @@ Emva1288Results emva1288Results(const Emva1288Series& series, const std::functio
     if (!(saturated > 0) || r.sensitivityMaxIndex < 1)
         CV_Error(Error::StsBadArg,
                  cv::format(
-                     "emva1288Results: '%s': the signal at saturation is %g DN above dark and %d step(s) lie "
-                     "below 70%% of it; K needs a signal that rises over at least two steps",
-                     series.path.c_str(), saturated, r.sensitivityMaxIndex + 1));
+                     "emva1288Results: the signal at saturation is %g DN above dark and %d step(s) lie below "
+                     "70%% of it; K needs a signal that rises over at least two steps",
+                     saturated, r.sensitivityMaxIndex + 1));
     r.K = slopeThroughOrigin(signal, excess, 0, r.sensitivityMaxIndex);
     if (!(std::isfinite(r.K) && r.K > 0))
         CV_Error(Error::StsBadArg,
-                 cv::format("emva1288Results: '%s': the fitted K is %g; the temporal variance "
-                            "does not rise with the signal up to 70%% of saturation",
-                            series.path.c_str(), r.K));
+                 cv::format("emva1288Results: the fitted K is %g; the temporal variance does not "
+                            "rise with the signal up to 70%% of saturation",
+                            r.K));
 
     // The dark noise: the intercept of the dark variance against exposure time (dark current adds the slope).
     std::vector<double> times, darkVariances;
     for (const auto& d : darkByExposure) {
         times.push_back(d.first);
-        darkVariances.push_back(d.second.variance);
+        darkVariances.push_back(d.second->variance);
     }
     double darkVariance = times.size() <= 2 ? r.darkVariance[0] : interceptOfLine(times, darkVariances);
     darkVariance = std::max(darkVariance, 0.24); // the standard's floor: quantisation noise resolves no less
@@ -234,11 +298,10 @@ Emva1288Results emva1288Results(const Emva1288Series& series, const std::functio
     if (r.photonsGiven) {
         r.responsivity = slopeThroughOrigin(r.photons, signal, 0, r.sensitivityMaxIndex);
         if (!(std::isfinite(r.responsivity) && r.responsivity > 0))
-            CV_Error(
-                Error::StsBadArg,
-                cv::format("emva1288Results: '%s': the responsivity is %g DN per photon; the signal does not "
-                           "rise with the descriptor's photon counts",
-                           series.path.c_str(), r.responsivity));
+            CV_Error(Error::StsBadArg,
+                     cv::format("emva1288Results: the responsivity is %g DN per photon; the "
+                                "signal does not rise with the photon counts given",
+                                r.responsivity));
         r.eta = 100.0 * r.responsivity / r.K;
         r.muPSat = r.photons[r.saturationIndex];
         r.muESat = r.eta * r.muPSat / 100.0;
@@ -253,7 +316,6 @@ Emva1288Results emva1288Results(const Emva1288Series& series, const std::functio
     // Linearity: the weighted fit of the reference over 5%..95% of the saturation signal, against photons
     // (exposure time when no photon count is given).
     const std::vector<double>& light = r.photonsGiven ? r.photons : r.exposureNs;
-    r.linearityMinIndex = -1;
     for (int i = 0; i < n && r.linearityMinIndex < 0; ++i)
         if (signal[i] >= 0.05 * saturated)
             r.linearityMinIndex = i;
@@ -283,24 +345,58 @@ Emva1288Results emva1288Results(const Emva1288Series& series, const std::functio
         r.linearityErrorMax = *range.second;
     }
 
-    if (series.spatial.size() == 2) {
-        const Emva1288Images& brightStack = series.spatial[0].dark ? series.spatial[1] : series.spatial[0];
-        const Emva1288Images& darkStack = series.spatial[0].dark ? series.spatial[0] : series.spatial[1];
-        const StackStatistics b = stackStatistics(series, brightStack);
-        stepDone();
-        const StackStatistics d = stackStatistics(series, darkStack);
-        stepDone();
-        r.spatialMeanBright = b.mean;
-        r.spatialMeanDark = d.mean;
-        r.spatialVarianceBright = b.variance;
-        r.spatialVarianceDark = d.variance;
+    if (!stacks.empty()) {
+        if (stacks.size() != 2 || stacks[0].dark == stacks[1].dark)
+            CV_Error(Error::StsBadArg,
+                     "emva1288Results: the spatial set must be one bright and one dark stack");
+        const Emva1288Stack& b = stacks[0].dark ? stacks[1] : stacks[0];
+        const Emva1288Stack& d = stacks[0].dark ? stacks[0] : stacks[1];
         // A negative estimate means a pattern below what the stack resolves: stated as NaN, as the reference.
         if (d.variance >= 0)
             r.dsnu1288 = std::sqrt(d.variance) / r.K;
-        if (b.variance - d.variance >= 0)
+        if (b.variance - d.variance >= 0 && b.mean > d.mean)
             r.prnu1288 = 100.0 * std::sqrt(b.variance - d.variance) / (b.mean - d.mean);
     }
     return r;
+}
+
+Emva1288Results emva1288Results(const Emva1288Series& series)
+{
+    return emva1288Results(series, std::function<void(int, int)>());
+}
+
+Emva1288Results emva1288Results(const Emva1288Series& series, const std::function<void(int, int)>& progress)
+{
+    const int total = int(series.temporal.size() + series.spatial.size());
+    int done = 0;
+    const auto stepDone = [&] {
+        if (progress)
+            progress(++done, total);
+    };
+    std::vector<Emva1288Pair> pairs;
+    for (const Emva1288Images& g : series.temporal) {
+        if (g.images.size() != 2)
+            CV_Error(Error::StsBadArg,
+                     cv::format("emva1288Results: '%s', line %d: a temporal step has %d images",
+                                series.path.c_str(), g.line, int(g.images.size())));
+        const Mat a = readEmva1288Image(series, g.images[0], g.line);
+        const Mat b = readEmva1288Image(series, g.images[1], g.line);
+        pairs.push_back(measureEmva1288Pair(a, b, g.exposureNs, g.photons, g.dark));
+        stepDone();
+    }
+    std::vector<Emva1288Stack> stacks;
+    for (const Emva1288Images& g : series.spatial) {
+        StackAccumulator acc;
+        for (const String& image : g.images)
+            acc.add(readEmva1288Image(series, image, g.line));
+        stacks.push_back(acc.stack(g.exposureNs, g.photons, g.dark));
+        stepDone();
+    }
+    try {
+        return emva1288Results(pairs, stacks);
+    } catch (const Exception& e) {
+        CV_Error(e.code, "'" + series.path + "': " + e.err);
+    }
 }
 
 } // namespace rawgment

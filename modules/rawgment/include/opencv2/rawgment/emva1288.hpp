@@ -3,6 +3,7 @@
 #define OPENCV_RAWGMENT_EMVA1288_HPP
 
 #include <opencv2/core.hpp>
+#include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/export.hpp>
 
 #include <functional>
@@ -88,6 +89,60 @@ CV_EXPORTS_W Emva1288Series readEmva1288(const String& path);
  * @throws cv::Exception StsError naming the image and the descriptor line. */
 CV_EXPORTS_W Mat readEmva1288Image(const Emva1288Series& series, const String& imagePath, int line);
 
+/** @brief One temporal step measured: the mean and temporal variance of a pair of frames A, B.
+ *
+ * \f$\mu_y = \tfrac12(\langle A\rangle + \langle B\rangle)\f$ and \f$\sigma_y^2 = \tfrac12\left[\langle
+ * (A-B)^2\rangle - \langle A-B\rangle^2\right]\f$ over the P pixels, as the standard defines them: the
+ * difference cancels every fixed pattern (DSNU, PRNU, hot pixels' offsets), so no pixel is left out. The
+ * standard error of \f$\sigma_y^2\f$ is measured, not assumed: \f$\tfrac12\sqrt{(m_4 - m_2^2)/P}\f$ with
+ * \f$m_k\f$ the central moments of A - B, so that Poisson, quantisation and heavy tails widen it as they
+ * should; or, when larger (noise shared along rows), the standard error of the mean of the rows' own
+ * estimates. */
+struct CV_EXPORTS_W_SIMPLE Emva1288Pair
+{
+    //! Every field at its default, as initialised here.
+    CV_WRAP Emva1288Pair() : exposureNs(0), photons(0), dark(false), mean(0), variance(0), varianceStdError(0)
+    {
+    }
+    CV_PROP_RW double exposureNs;       //!< exposure time
+    CV_PROP_RW double photons;          //!< photons per pixel (0 for a dark pair)
+    CV_PROP_RW bool dark;               //!< a dark pair
+    CV_PROP_RW double mean;             //!< mu_y (DN)
+    CV_PROP_RW double variance;         //!< sigma_y^2 (DN^2)
+    CV_PROP_RW double varianceStdError; //!< standard error of sigma_y^2 (DN^2)
+};
+
+/** @brief Measures one temporal step from its two frames (see Emva1288Pair).
+ * @param a first frame, CV_8UC1 or CV_16UC1 (integer values, as the standard's images hold)
+ * @param b second frame, of the same size and type
+ * @param exposureNs the step's exposure time (>= 0)
+ * @param photons its photons per pixel (>= 0, 0 for a dark pair)
+ * @param dark whether it is a dark pair
+ * @throws cv::Exception for frames of other types, different sizes, or fewer than 2 pixels. */
+CV_EXPORTS_W Emva1288Pair measureEmva1288Pair(InputArray a, InputArray b, double exposureNs, double photons,
+                                              bool dark);
+
+/** @brief The spatial set's stack, measured: the mean and the spatial variance of its mean image with the
+ * temporal part removed, \f$s_y^2 = s^2_{measured} - \sigma^2_{stack}/L\f$ (the standard's Eq. for L frames).
+ */
+struct CV_EXPORTS_W_SIMPLE Emva1288Stack
+{
+    //! Every field at its default, as initialised here.
+    CV_WRAP Emva1288Stack() : exposureNs(0), photons(0), dark(false), frames(0), mean(0), variance(0) {}
+    CV_PROP_RW double exposureNs; //!< exposure time
+    CV_PROP_RW double photons;    //!< photons per pixel (0 for the dark stack)
+    CV_PROP_RW bool dark;         //!< the dark stack
+    CV_PROP_RW int frames;        //!< L
+    CV_PROP_RW double mean;       //!< mu_y of the stack (DN)
+    CV_PROP_RW double
+        variance; //!< s_y^2 (DN^2), which may be < 0 when the pattern is below what L frames resolve
+};
+
+/** @brief Measures a stack of L >= 2 frames (CV_8UC1 or CV_16UC1, one size) of the spatial set.
+ * @throws cv::Exception for fewer than two frames or frames of other types or sizes. */
+CV_EXPORTS_W Emva1288Stack measureEmva1288Stack(InputArrayOfArrays frames, double exposureNs, double photons,
+                                                bool dark);
+
 /** @brief The EMVA 1288 figures of a series, defined as the standard (release 3.1/4.0) and its reference
  * implementation define them.
  *
@@ -139,31 +194,74 @@ struct CV_EXPORTS_W_SIMPLE Emva1288Results
     CV_PROP_RW int linearityMaxIndex;     //!< last point of the linearity fit (95% of saturation signal)
     CV_PROP_RW double linearityFitSlope;  //!< a of the linearity fit mu_y - mu_y.dark = a mu_p + b
     CV_PROP_RW double linearityFitOffset; //!< b of that fit (DN)
-    CV_PROP_RW std::vector<double> linearityDeviation; //!< (%) each point's relative deviation from it
-    CV_PROP_RW double spatialMeanBright; //!< mean of the spatial set's bright stack (DN), NaN without one
-    CV_PROP_RW double spatialMeanDark;   //!< mean of its dark stack (DN)
-    CV_PROP_RW double
-        spatialVarianceBright; //!< s_y^2 (DN^2): the spatial variance with its temporal part removed
-    CV_PROP_RW double spatialVarianceDark; //!< s_y.dark^2 (DN^2)
+    CV_PROP_RW std::vector<double> linearityDeviation;   //!< (%) each point's relative deviation from it
+    CV_PROP_RW std::vector<double> varianceStdError;     //!< standard error of each point's variance
+    CV_PROP_RW std::vector<double> darkVarianceStdError; //!< and of its dark variance
+    CV_PROP_RW std::vector<Emva1288Pair> pairs;          //!< every pair measured, bright and dark, as given
+    CV_PROP_RW std::vector<Emva1288Stack> stacks; //!< the spatial set's stacks (none or bright and dark)
 };
 
-/** @brief The standard's figures of a series (see Emva1288Results for the definitions).
+/** @brief The standard's figures of measured pairs and stacks (see Emva1288Results for the definitions).
+ * @param pairs the temporal steps: bright pairs, and one dark pair per exposure time of a bright pair
+ * @param stacks the spatial set: none, or one bright and one dark stack
+ * @return the figures and the temporal points they come from
+ * @throws cv::Exception StsBadArg for fewer than three bright pairs, a bright pair without a dark pair at
+ * its exposure time, stacks that are not one bright and one dark, a signal that does not rise over two
+ * steps below 70% of saturation, a variance that does not rise with it (K not > 0) or a signal that does
+ * not rise with the photon counts given. */
+CV_EXPORTS_W Emva1288Results
+emva1288Results(const std::vector<Emva1288Pair>& pairs,
+                const std::vector<Emva1288Stack>& stacks = std::vector<Emva1288Stack>());
+
+/** @brief The standard's figures of a series read with readEmva1288().
  *
  * Images are read one exposure at a time (the spatial stacks one frame at a time, accumulated), never
  * the whole series at once.
- * @param series a series from readEmva1288()
- * @return the figures and the temporal points they come from
  * @throws cv::Exception StsError naming the image and descriptor line of an image that cannot be read
- * or does not match the descriptor (see readEmva1288Image()); StsBadArg for a series with fewer than
- * three bright temporal points, one whose signal does not rise over two steps below 70% of saturation, whose
- * variance does not rise with it (K not > 0) or whose signal does not rise with the photon counts given.
- */
+ * or does not match the descriptor (see readEmva1288Image()); what emva1288Results() of pairs throws,
+ * with the descriptor named. */
 CV_EXPORTS_W Emva1288Results emva1288Results(const Emva1288Series& series);
 
 /** @brief As emva1288Results(), calling `progress(done, total)` after each exposure is read (an app's
  * progress bar); `progress` may be empty. */
 CV_RAWGMENT_EXPORTS Emva1288Results emva1288Results(const Emva1288Series& series,
                                                     const std::function<void(int, int)>& progress);
+
+/** @brief Settings of calibrateEmva1288(). */
+struct CV_EXPORTS_W_SIMPLE Emva1288CalibrationParams
+{
+    //! Every field at its default, as initialised here.
+    CV_WRAP Emva1288CalibrationParams() : maxSignalFraction(0.3), minGainRatio(1.12) {}
+    /** The bright steps fitted: those whose signal (mean above dark) is at most this fraction of the
+     * signal at saturation, in (0, 1]. 0.3 by default, not the standard's 0.7: the model is for dark scenes,
+     * and a real photon transfer curve bends down at high signal (set 001: K 0.2873 up to 30%, 0.2801 up
+     * to 70%; docs/emva1288.md shows which one predicts the sensor's darker steps). */
+    CV_PROP_RW double maxSignalFraction;
+    //! Gains closer than this ratio count as one when separating sigma_d^2 and sigma_r^2 (1.12 is 1 dB).
+    CV_PROP_RW double minGainRatio;
+};
+
+/** @brief The project's noise model from EMVA 1288 measurements of one or more gains.
+ *
+ * Per gain, the line \f$\sigma_y^2 = a\,(\mu_y - \mu_{y.dark}) + b\f$ is fitted by weighted least squares
+ * to the bright pairs up to `maxSignalFraction` of saturation and the dark pairs of their exposure times
+ * (at signal 0), each point weighted by its measured inverse squared standard error
+ * (Emva1288Pair::varianceStdError). Every pixel of every pair counts; nothing is selected by its own
+ * variance (at two frames per step that selection is what biased calibrateNoiseModel(): see
+ * docs/emva1288.md). The line's covariance is the fit's, scaled by its reduced chi-square when that
+ * exceeds 1 (a curve that bends, correlated pixels), so the stated errors cover what the points show.
+ * Across gains, Eq. 5: \f$a_g = g\alpha\f$ and \f$b_g = g^2\sigma_d^2 + \sigma_r^2\f$, by weighted least
+ * squares with both variances kept >= 0; with one gain (or gains closer than minGainRatio) the model
+ * holds the read noise as sigma_r^2 at that gain, sigma_d^2 0, and `separable` is false.
+ * @param measurements emva1288Results() of each gain's series
+ * @param gains the linear gain of each (> 0; 1 for the camera's base gain)
+ * @param params the fit range and the separability ratio
+ * @return the report: model, per-gain lines (their range in CalibrationReport::notes), standard errors
+ * @throws cv::Exception StsBadArg for no measurements, a gain count that differs, a gain that is not
+ * finite and > 0, params out of range, or a gain with fewer than two bright steps in range. */
+CV_EXPORTS_W CalibrationReport
+calibrateEmva1288(const std::vector<Emva1288Results>& measurements, const std::vector<double>& gains,
+                  const Emva1288CalibrationParams& params = Emva1288CalibrationParams());
 
 //! @}
 

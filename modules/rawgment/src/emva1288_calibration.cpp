@@ -1,0 +1,279 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The project's noise model from EMVA 1288 series (emva1288 topic): per gain, a weighted line through the
+// pairs' pooled statistics; across gains, Eq. 5. At two frames per step, a per-pixel sample variance has one
+// degree of freedom and is 0 whenever the two integer readings tie; calibrateNoiseModel()'s inlier band has a
+// lower edge above 0 and so drops every tie, which biased the read noise high (docs/emva1288.md). The pooled
+// pair statistic selects nothing, and its standard error is measured from the pixels' own fourth moment.
+#include "precomp.hpp"
+
+#include <opencv2/rawgment/emva1288.hpp>
+
+namespace cv {
+namespace rawgment {
+
+namespace {
+
+//! A weighted straight-line fit y = a x + b with its covariance (scaled by the reduced chi-square when > 1).
+struct WeightedLine
+{
+    double a = 0, b = 0;
+    Matx22d covariance;
+    double reducedChiSquare = 0;
+    int points = 0;
+};
+
+WeightedLine weightedLine(const std::vector<double>& x, const std::vector<double>& y,
+                          const std::vector<double>& se)
+{
+    double S = 0, Sx = 0, Sy = 0, Sxx = 0, Sxy = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        const double w = 1.0 / (se[i] * se[i]);
+        S += w;
+        Sx += w * x[i];
+        Sy += w * y[i];
+        Sxx += w * x[i] * x[i];
+        Sxy += w * x[i] * y[i];
+    }
+    const double det = S * Sxx - Sx * Sx;
+    WeightedLine f;
+    f.points = int(x.size());
+    f.a = (S * Sxy - Sx * Sy) / det;
+    f.b = (Sxx * Sy - Sx * Sxy) / det;
+    double chi2 = 0;
+    for (size_t i = 0; i < x.size(); ++i) {
+        const double r = (y[i] - (f.a * x[i] + f.b)) / se[i];
+        chi2 += r * r;
+    }
+    f.reducedChiSquare = x.size() > 2 ? chi2 / double(x.size() - 2) : 0.0;
+    // Inverse of the normal matrix [Sxx Sx; Sx S] for (a, b): the errors the stated weights imply.
+    const double scale = std::max(1.0, f.reducedChiSquare);
+    f.covariance = Matx22d(S / det, -Sx / det, -Sx / det, Sxx / det) * scale;
+    return f;
+}
+
+//! One gain's points: bright pairs up to the fraction of saturation, and the dark pairs of their exposures.
+struct GainPoints
+{
+    std::vector<double> signal, variance, stdError;
+    double maxSignal = 0;
+};
+
+GainPoints pointsOf(const Emva1288Results& r, double fraction, int which)
+{
+    const int n = int(r.mean.size());
+    if (n < 2 || r.saturationIndex < 0 || r.saturationIndex >= n || int(r.variance.size()) != n ||
+        int(r.darkMean.size()) != n || int(r.darkVariance.size()) != n ||
+        int(r.varianceStdError.size()) != n || int(r.darkVarianceStdError.size()) != n)
+        CV_Error(Error::StsBadArg,
+                 cv::format("calibrateEmva1288: measurement %d is not what emva1288Results() "
+                            "gives (its temporal lists differ in length)",
+                            which));
+    const double limit = fraction * (r.mean[r.saturationIndex] - r.darkMean[r.saturationIndex]);
+    GainPoints p;
+    std::vector<double> darkExposures;
+    for (int i = 0; i < n; ++i) {
+        const double signal = r.mean[i] - r.darkMean[i];
+        if (signal > limit)
+            continue;
+        p.signal.push_back(signal);
+        p.variance.push_back(r.variance[i]);
+        p.stdError.push_back(r.varianceStdError[i]);
+        p.maxSignal = std::max(p.maxSignal, signal);
+        // Each exposure's dark pair once, at signal 0: it pins the offset where dark scenes live.
+        if (std::find(darkExposures.begin(), darkExposures.end(), r.exposureNs[i]) == darkExposures.end()) {
+            darkExposures.push_back(r.exposureNs[i]);
+            p.signal.push_back(0.0);
+            p.variance.push_back(r.darkVariance[i]);
+            p.stdError.push_back(r.darkVarianceStdError[i]);
+        }
+    }
+    const int bright = int(p.signal.size() - darkExposures.size());
+    if (bright < 2)
+        CV_Error(Error::StsBadArg,
+                 cv::format("calibrateEmva1288: measurement %d has %d bright step(s) up to %g%% "
+                            "of saturation (%g DN); the line needs at least two",
+                            which, bright, 100 * fraction, limit));
+    for (double se : p.stdError)
+        if (!(se > 0) || !std::isfinite(se))
+            CV_Error(Error::StsBadArg,
+                     cv::format("calibrateEmva1288: measurement %d has a pair whose variance has "
+                                "standard error %g; every pair needs one > 0",
+                                which, se));
+    return p;
+}
+
+} // namespace
+
+CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurements,
+                                    const std::vector<double>& gains, const Emva1288CalibrationParams& params)
+{
+    if (measurements.empty() || measurements.size() != gains.size())
+        CV_Error(Error::StsBadArg,
+                 cv::format("calibrateEmva1288: %d measurements and %d gains; give one gain per "
+                            "measurement, at least one",
+                            int(measurements.size()), int(gains.size())));
+    if (!(params.maxSignalFraction > 0 && params.maxSignalFraction <= 1))
+        CV_Error(Error::StsBadArg,
+                 cv::format("calibrateEmva1288: maxSignalFraction must lie in (0, 1] (got %g)",
+                            params.maxSignalFraction));
+    if (!(params.minGainRatio >= 1 && std::isfinite(params.minGainRatio)))
+        CV_Error(Error::StsBadArg,
+                 cv::format("calibrateEmva1288: minGainRatio must be finite and >= 1 (got %g)",
+                            params.minGainRatio));
+    for (double g : gains)
+        detail::checkFinitePositive(g, "calibrateEmva1288: every gain");
+
+    std::vector<int> order(gains.size());
+    for (size_t i = 0; i < order.size(); ++i)
+        order[i] = int(i);
+    std::stable_sort(order.begin(), order.end(), [&](int i, int j) { return gains[i] < gains[j]; });
+
+    CalibrationReport report;
+    report.method = NOISE_FIT_TWO_STAGE;
+    std::vector<double> g, a, aSe, b, bSe;
+    for (int k : order) {
+        const GainPoints p = pointsOf(measurements[k], params.maxSignalFraction, k);
+        const WeightedLine line = weightedLine(p.signal, p.variance, p.stdError);
+        NoiseLineFit fit;
+        fit.gain = gains[k];
+        fit.line.a = line.a;
+        fit.line.b = line.b;
+        fit.inliers = fit.samples = line.points;
+        fit.slopeStdError = std::sqrt(line.covariance(0, 0));
+        fit.offsetStdError = std::sqrt(line.covariance(1, 1));
+        fit.slopeOffsetCorrelation = line.covariance(0, 1) / (fit.slopeStdError * fit.offsetStdError);
+        // R^2 of the weighted fit, against the weighted mean.
+        double sw = 0, swy = 0;
+        for (size_t i = 0; i < p.signal.size(); ++i) {
+            sw += 1 / (p.stdError[i] * p.stdError[i]);
+            swy += p.variance[i] / (p.stdError[i] * p.stdError[i]);
+        }
+        double ssTot = 0, ssRes = 0;
+        for (size_t i = 0; i < p.signal.size(); ++i) {
+            const double w = 1 / (p.stdError[i] * p.stdError[i]);
+            ssTot += w * (p.variance[i] - swy / sw) * (p.variance[i] - swy / sw);
+            const double e = p.variance[i] - (line.a * p.signal[i] + line.b);
+            ssRes += w * e * e;
+        }
+        fit.rSquared = ssTot > 0 ? 1 - ssRes / ssTot : 1;
+        report.perGain.push_back(fit);
+        report.samples += line.points;
+        report.samplesUsed += line.points;
+        report.notes.push_back(cv::format(
+            "gain %g: the line holds for signals 0 to %.1f DN above dark (steps up to %g%% of saturation), "
+            "%d "
+            "points, reduced chi-square %.2f%s",
+            gains[k], p.maxSignal, 100 * params.maxSignalFraction, line.points, line.reducedChiSquare,
+            line.reducedChiSquare > 1 ? " (errors scaled by its square root)" : ""));
+        g.push_back(gains[k]);
+        a.push_back(line.a);
+        aSe.push_back(fit.slopeStdError);
+        b.push_back(line.b);
+        bSe.push_back(fit.offsetStdError);
+    }
+
+    // alpha: a_g = g alpha through the origin, weighted.
+    double swgg = 0, swga = 0;
+    for (size_t i = 0; i < g.size(); ++i) {
+        const double w = 1 / (aSe[i] * aSe[i]);
+        swgg += w * g[i] * g[i];
+        swga += w * g[i] * a[i];
+    }
+    const double alpha = swga / swgg;
+    double alphaVar = 1 / swgg;
+    if (g.size() > 1) {
+        double chi2 = 0;
+        for (size_t i = 0; i < g.size(); ++i)
+            chi2 += std::pow((a[i] - alpha * g[i]) / aSe[i], 2);
+        alphaVar *= std::max(1.0, chi2 / double(g.size() - 1));
+    }
+    report.rSquaredSlope = 1;
+    report.separable = g.back() / g.front() >= params.minGainRatio;
+    double sigmaD2 = 0, sigmaR2 = 0;
+    Matx22d readCov;
+    if (report.separable) {
+        // b_g = g^2 sigma_d^2 + sigma_r^2, weighted; a negative variance is held at 0 and the other refitted.
+        std::vector<double> g2(g.size());
+        for (size_t i = 0; i < g.size(); ++i)
+            g2[i] = g[i] * g[i];
+        if (g.size() == 2) {
+            // Two gains: exact, with the covariance of the two offsets propagated.
+            const double d = g2[1] - g2[0];
+            sigmaD2 = (b[1] - b[0]) / d;
+            sigmaR2 = (g2[1] * b[0] - g2[0] * b[1]) / d;
+            const double v0 = bSe[0] * bSe[0], v1 = bSe[1] * bSe[1];
+            readCov = Matx22d((v0 + v1) / (d * d), -(g2[1] * v0 + g2[0] * v1) / (d * d),
+                              -(g2[1] * v0 + g2[0] * v1) / (d * d),
+                              (g2[1] * g2[1] * v0 + g2[0] * g2[0] * v1) / (d * d));
+        } else {
+            const WeightedLine read = weightedLine(g2, b, bSe);
+            sigmaD2 = read.a;
+            sigmaR2 = read.b;
+            readCov = read.covariance;
+        }
+        if (sigmaR2 < 0 || sigmaD2 < 0) {
+            report.notes.push_back(
+                cv::format("sigma_d^2 %g and sigma_r^2 %g: the negative one is held at 0 and the "
+                           "other refitted alone",
+                           sigmaD2, sigmaR2));
+            double s0 = 0, s1 = 0;
+            for (size_t i = 0; i < g.size(); ++i) {
+                const double w = 1 / (bSe[i] * bSe[i]);
+                if (sigmaR2 < 0) { // b = g^2 sigma_d^2
+                    s0 += w * g2[i] * g2[i];
+                    s1 += w * g2[i] * b[i];
+                } else { // b = sigma_r^2
+                    s0 += w;
+                    s1 += w * b[i];
+                }
+            }
+            if (sigmaR2 < 0) {
+                sigmaD2 = std::max(s1 / s0, 0.0);
+                sigmaR2 = 0;
+                readCov = Matx22d(1 / s0, 0, 0, 0);
+            } else {
+                sigmaR2 = std::max(s1 / s0, 0.0);
+                sigmaD2 = 0;
+                readCov = Matx22d(0, 0, 0, 1 / s0);
+            }
+        }
+        double ssTot = 0, ssRes = 0, mean = 0;
+        for (double v : b)
+            mean += v / double(b.size());
+        for (size_t i = 0; i < g.size(); ++i) {
+            ssTot += (b[i] - mean) * (b[i] - mean);
+            ssRes += std::pow(b[i] - (g2[i] * sigmaD2 + sigmaR2), 2);
+        }
+        report.rSquaredOffset = ssTot > 0 ? 1 - ssRes / ssTot : 1;
+    } else {
+        // One gain (or gains too close to tell the two variances apart): the read noise at that gain, after
+        // it.
+        double sw = 0, swb = 0;
+        for (size_t i = 0; i < g.size(); ++i) {
+            sw += 1 / (bSe[i] * bSe[i]);
+            swb += b[i] / (bSe[i] * bSe[i]);
+        }
+        sigmaR2 = std::max(swb / sw, 0.0);
+        readCov = Matx22d(0, 0, 0, 1 / sw);
+        report.rSquaredOffset = 1;
+        report.notes.push_back(
+            cv::format("one gain (%g to %g, closer than the ratio %g): the read noise %.4f DN^2 "
+                       "is stated as sigma_r^2, which holds at this gain",
+                       g.front(), g.back(), params.minGainRatio, sigmaR2));
+    }
+    report.model = NoiseModel(alpha, sigmaD2, sigmaR2);
+    ModelUncertainty& u = report.uncertainty;
+    u.source = UNCERTAINTY_COVARIANCE;
+    u.covariance = Matx33d::zeros();
+    u.covariance(NOISE_PARAM_ALPHA, NOISE_PARAM_ALPHA) = alphaVar;
+    u.covariance(NOISE_PARAM_SIGMA_D2, NOISE_PARAM_SIGMA_D2) = readCov(0, 0);
+    u.covariance(NOISE_PARAM_SIGMA_D2, NOISE_PARAM_SIGMA_R2) = readCov(0, 1);
+    u.covariance(NOISE_PARAM_SIGMA_R2, NOISE_PARAM_SIGMA_D2) = readCov(1, 0);
+    u.covariance(NOISE_PARAM_SIGMA_R2, NOISE_PARAM_SIGMA_R2) = readCov(1, 1);
+    for (int i = 0; i < 3; ++i)
+        u.stdError[i] = u.fitStdError[i] = std::sqrt(std::max(u.covariance(i, i), 0.0));
+    return report;
+}
+
+} // namespace rawgment
+} // namespace cv
