@@ -57,8 +57,8 @@ void bindEmva1288(py::module_& m)
     m.def(
         "measureEmva1288Pair",
         [](const py::object& a, const py::object& b, double exposureNs, double photons, bool dark) {
-            const cv::Mat ma = matFromArray(a, "a", {CV_8U, CV_16U});
-            const cv::Mat mb = matFromArray(b, "b", {CV_8U, CV_16U});
+            const cv::Mat ma = matFromArray(a, "a", {CV_8U, CV_16U, CV_32F});
+            const cv::Mat mb = matFromArray(b, "b", {CV_8U, CV_16U, CV_32F});
             return withoutGil("measureEmva1288Pair",
                               [&] { return measureEmva1288Pair(ma, mb, exposureNs, photons, dark); });
         },
@@ -75,7 +75,7 @@ void bindEmva1288(py::module_& m)
     m.def(
         "measureEmva1288Stack",
         [](const py::object& frames, double exposureNs, double photons, bool dark) {
-            const std::vector<cv::Mat> in = matsFromList(frames, "frames", {CV_8U, CV_16U});
+            const std::vector<cv::Mat> in = matsFromList(frames, "frames", {CV_8U, CV_16U, CV_32F});
             return withoutGil("measureEmva1288Stack",
                               [&] { return measureEmva1288Stack(in, exposureNs, photons, dark); });
         },
@@ -132,6 +132,37 @@ void bindEmva1288(py::module_& m)
             return withoutGil("emva1288Results", [&] { return emva1288Results(pairs, stacks); });
         },
         py::arg("pairs"), py::arg("stacks") = std::vector<Emva1288Stack>(), doc("emva1288Results"));
+
+    auto darkening = py::class_<Emva1288Darkening>(m, "Emva1288Darkening", doc("Emva1288Darkening"));
+    darkening.def(keywordInit<Emva1288Darkening>());
+#define RAWGMENT_EMVA_FIELD(name)                                                                            \
+    darkening.def_readwrite(#name, &Emva1288Darkening::name, doc("Emva1288Darkening::" #name))
+    RAWGMENT_EMVA_FIELD(brightPoint);
+    RAWGMENT_EMVA_FIELD(darkPoint);
+    RAWGMENT_EMVA_FIELD(photonRatio);
+    RAWGMENT_EMVA_FIELD(alignment);
+    RAWGMENT_EMVA_FIELD(augmentedVariance);
+    RAWGMENT_EMVA_FIELD(augmentedStdError);
+    RAWGMENT_EMVA_FIELD(realVariance);
+    RAWGMENT_EMVA_FIELD(realStdError);
+    RAWGMENT_EMVA_FIELD(ratio);
+    RAWGMENT_EMVA_FIELD(ratioStdError);
+    RAWGMENT_EMVA_FIELD(pairScatter);
+    RAWGMENT_EMVA_FIELD(histogramEdges);
+    RAWGMENT_EMVA_FIELD(augmentedHistogram);
+    RAWGMENT_EMVA_FIELD(realHistogram);
+#undef RAWGMENT_EMVA_FIELD
+    m.def("emva1288DarkeningSteps", &emva1288DarkeningSteps, py::arg("results"), py::arg("count") = 5,
+          doc("emva1288DarkeningSteps", "Python: returns a list of (bright, dark) points."));
+    m.def(
+        "emva1288Darkening",
+        [](const Emva1288Series& series, const Emva1288Results& results, const NoiseModel& model,
+           const std::vector<cv::Point>& steps, uint64 seed) {
+            return withoutGil("emva1288Darkening",
+                              [&] { return emva1288Darkening(series, results, model, steps, seed); });
+        },
+        py::arg("series"), py::arg("results"), py::arg("model"), py::arg("steps"), py::arg("seed"),
+        doc("emva1288Darkening"));
 
     py::class_<Emva1288CalibrationParams>(m, "Emva1288CalibrationParams", doc("Emva1288CalibrationParams"))
         .def(keywordInit<Emva1288CalibrationParams>())

@@ -16,27 +16,34 @@ namespace rawgment {
 
 namespace {
 
-//! The pixel values of a frame as int, read row by row (CV_8U or CV_16U).
+//! The pixel values of two frames of one type (CV_8U, CV_16U or CV_32F), row by row, as doubles.
 template <typename Visit> void forEachPixelPair(const Mat& a, const Mat& b, Visit&& visit)
 {
     for (int y = 0; y < a.rows; ++y) {
         if (a.depth() == CV_8U) {
             const uchar *pa = a.ptr<uchar>(y), *pb = b.ptr<uchar>(y);
             for (int x = 0; x < a.cols; ++x)
-                visit(int(pa[x]), int(pb[x]));
-        } else {
+                visit(double(pa[x]), double(pb[x]));
+        } else if (a.depth() == CV_16U) {
             const ushort *pa = a.ptr<ushort>(y), *pb = b.ptr<ushort>(y);
             for (int x = 0; x < a.cols; ++x)
-                visit(int(pa[x]), int(pb[x]));
+                visit(double(pa[x]), double(pb[x]));
+        } else {
+            const float *pa = a.ptr<float>(y), *pb = b.ptr<float>(y);
+            for (int x = 0; x < a.cols; ++x)
+                visit(double(pa[x]), double(pb[x]));
         }
     }
 }
 
 void checkFrame(const Mat& m, const char* who, const char* what)
 {
-    if (m.type() != CV_8UC1 && m.type() != CV_16UC1)
-        CV_Error(Error::StsBadArg, cv::format("%s: %s must be CV_8UC1 or CV_16UC1 (got %s)", who, what,
-                                              m.empty() ? "an empty array" : typeToString(m.type()).c_str()));
+    if (m.type() != CV_8UC1 && m.type() != CV_16UC1 && m.type() != CV_32FC1)
+        CV_Error(Error::StsBadArg,
+                 cv::format("%s: %s must be CV_8UC1, CV_16UC1 or CV_32FC1 (got %s)", who, what,
+                            m.empty() ? "an empty array" : typeToString(m.type()).c_str()));
+    if (m.depth() == CV_32F && !checkRange(m))
+        CV_Error(Error::StsBadArg, cv::format("%s: %s holds a value that is not finite", who, what));
 }
 
 //! The running sums of a stack, made from the first frame added so that nothing is allocated before.
@@ -139,20 +146,21 @@ Emva1288Pair measureEmva1288Pair(InputArray _a, InputArray _b, double exposureNs
                             typeToString(b.type()).c_str()));
     detail::checkFiniteNonNegative(exposureNs, "measureEmva1288Pair: exposureNs");
     detail::checkFiniteNonNegative(photons, "measureEmva1288Pair: photons");
-    // Exact integer sums for the mean and the difference's mean; its central moments in a second pass.
-    long long sumAB = 0, sumD = 0;
-    forEachPixelPair(a, b, [&](int va, int vb) {
+    // Sums of integer frames are exact in float64 (at most 2^28 x 2^17 < 2^53); the difference's central
+    // moments in a second pass.
+    double sumAB = 0, sumD = 0;
+    forEachPixelPair(a, b, [&](double va, double vb) {
         sumAB += va + vb;
         sumD += va - vb;
     });
     const double n = double(a.total());
-    const double meanD = double(sumD) / n;
+    const double meanD = sumD / n;
     double m2 = 0, m4 = 0;
     std::vector<double> rowSums(a.rows, 0.0);
     for (int y = 0; y < a.rows; ++y) {
         double row = 0;
-        forEachPixelPair(a.row(y), b.row(y), [&](int va, int vb) {
-            const double e = double(va - vb) - meanD, e2 = e * e;
+        forEachPixelPair(a.row(y), b.row(y), [&](double va, double vb) {
+            const double e = (va - vb) - meanD, e2 = e * e;
             row += e2;
             m4 += e2 * e2;
         });
@@ -177,7 +185,7 @@ Emva1288Pair measureEmva1288Pair(InputArray _a, InputArray _b, double exposureNs
     p.exposureNs = exposureNs;
     p.photons = photons;
     p.dark = dark;
-    p.mean = double(sumAB) / (2 * n);
+    p.mean = sumAB / (2 * n);
     p.variance = 0.5 * m2;
     p.varianceStdError = std::max(0.5 * std::sqrt(std::max(m4 - m2 * m2, 0.0) / n), rowError);
     return p;

@@ -74,6 +74,43 @@ TEST(Emva1288, referenceSet001GivesTheReferenceImplementationsFigures)
     EXPECT_GT(r.saturationIndex, r.sensitivityMaxIndex);
 }
 
+TEST(Emva1288, set001sDarkenedStepsMatchItsRealDarkerStepsWithAccountPriorOnly)
+{
+    RAWGMENT_DATA_FILE_OR_SKIP(path, kSet001);
+    const Emva1288Series series = readEmva1288(path);
+    const Emva1288Results r = emva1288Results(series);
+    const CalibrationReport rep = calibrateEmva1288({r}, {1.0});
+    const std::vector<Point> steps = emva1288DarkeningSteps(r);
+    ASSERT_GE(steps.size(), 4u);
+    const std::vector<Emva1288Darkening> d = emva1288Darkening(series, r, rep.model, steps, 1288);
+    ASSERT_EQ(d.size(), 3 * steps.size());
+    for (const Emva1288Darkening& e : d) {
+        SCOPED_TRACE(cv::format("point %d to %d (photon ratio %.3f), alignment %d: ratio %.4f +- %.4f",
+                                e.brightPoint, e.darkPoint, e.photonRatio, int(e.alignment), e.ratio,
+                                e.ratioStdError));
+        // Three standard errors (pixels and the series' pair-to-pair scatter, 2.6 times the pixels' error
+        // here): ACCOUNT_PRIOR is inside, NONE far below; IGNORE_PRIOR adds k times the bright frame's
+        // variance too much, above three errors once k >= 0.1.
+        const double z = (e.ratio - 1) / e.ratioStdError;
+        if (e.alignment == NoiseAlignment::ACCOUNT_PRIOR)
+            EXPECT_LT(std::abs(z), 3);
+        else if (e.alignment == NoiseAlignment::NONE)
+            EXPECT_LT(z, -3);
+        else if (e.photonRatio >= 0.1)
+            EXPECT_GT(z, 3);
+        double augmented = 0, real = 0;
+        for (size_t b = 0; b < e.realHistogram.size(); ++b) {
+            augmented += e.augmentedHistogram[b];
+            real += e.realHistogram[b];
+        }
+        // +-6 standard deviations hold all but a few pixels of each pair.
+        EXPECT_GT(real, 0.999);
+        if (e.alignment != NoiseAlignment::NONE)
+            EXPECT_GT(augmented, 0.999);
+    }
+    EXPECT_GT(d[0].pairScatter, 1);
+}
+
 TEST(Emva1288, progressIsCalledOncePerExposure)
 {
     RAWGMENT_DATA_FILE_OR_SKIP(path, kSet001);
@@ -364,6 +401,54 @@ TEST(Emva1288, calibrationOfTwelveBitSeriesIsUnbiasedWithCoveringIntervals)
 TEST(Emva1288, calibrationOfEightBitSeriesIsUnbiasedWithCoveringIntervals)
 {
     expectUnbiasedWithCoveringIntervals(eightBitSeries(1.5), "8 bit, K 0.05, sigma_y.dark 1.26 DN");
+}
+
+TEST(Emva1288, seriesAtThreeGainsSeparateReadNoiseBeforeAndAfterTheGain)
+{
+    SimulatedSeries s = twelveBitSeries();
+    s.sensor.noise = NoiseModel(0.1, 2.0, 4.0);
+    const std::vector<double> gains{1, 2, 4};
+    std::vector<Emva1288Results> measured;
+    for (size_t i = 0; i < gains.size(); ++i)
+        measured.push_back(emva1288Results(simulatePairs(s, gains[i], 40 + i)));
+    const CalibrationReport rep = calibrateEmva1288(measured, gains);
+    ASSERT_TRUE(rep.separable);
+    ASSERT_EQ(rep.perGain.size(), 3u);
+    const Vec3d se = rep.uncertainty.stdError;
+    // Eq. 5's truth: alpha 0.1, sigma_d^2 2, sigma_r^2 4 + 1/12 (the ADC's rounding comes after the gain).
+    // Four stated standard errors: a 1-in-16,000 miss per parameter if the errors are right.
+    EXPECT_NEAR(rep.model.alpha, 0.1, 4 * se[NOISE_PARAM_ALPHA]);
+    EXPECT_NEAR(rep.model.sigmaD2, 2.0, 4 * se[NOISE_PARAM_SIGMA_D2]);
+    EXPECT_NEAR(rep.model.sigmaR2, 4.0 + 1.0 / 12, 4 * se[NOISE_PARAM_SIGMA_R2]);
+    // And the errors are small enough for that to mean something: both variances to better than 5%.
+    EXPECT_LT(se[NOISE_PARAM_SIGMA_D2], 0.1);
+    EXPECT_LT(se[NOISE_PARAM_SIGMA_R2], 0.2);
+    EXPECT_LT(rep.uncertainty.correlation(NOISE_PARAM_SIGMA_D2, NOISE_PARAM_SIGMA_R2), 0);
+}
+
+TEST(Emva1288, calibrationRefusesWhatItCannotFit)
+{
+    const std::vector<Emva1288Pair> pairs = simulatePairs(twelveBitSeries(), 1.0, 3);
+    const Emva1288Results r = emva1288Results(pairs);
+    EXPECT_CV_ERROR_CONTAINS(calibrateEmva1288({}, {}), "give one gain per measurement");
+    EXPECT_CV_ERROR_CONTAINS(calibrateEmva1288({r}, {1, 2}), "1 measurements and 2 gains");
+    EXPECT_CV_ERROR_CONTAINS(calibrateEmva1288({r}, {0}), "every gain must be finite and > 0");
+    Emva1288CalibrationParams p;
+    p.maxSignalFraction = 0;
+    EXPECT_CV_ERROR_CONTAINS(calibrateEmva1288({r}, {1}, p), "maxSignalFraction must lie in (0, 1]");
+    p.maxSignalFraction = 0.05; // no bright step lies that low
+    EXPECT_CV_ERROR_CONTAINS(calibrateEmva1288({r}, {1}, p), "the line needs at least two");
+    Emva1288Results cut = r;
+    cut.varianceStdError.pop_back();
+    EXPECT_CV_ERROR_CONTAINS(calibrateEmva1288({cut}, {1}), "is not what emva1288Results() gives");
+    EXPECT_CV_ERROR_CONTAINS(measureEmva1288Pair(Mat(4, 4, CV_64F), Mat(4, 4, CV_64F), 1, 1, false),
+                             "must be CV_8UC1, CV_16UC1 or CV_32FC1");
+    EXPECT_CV_ERROR_CONTAINS(
+        measureEmva1288Pair(Mat(4, 4, CV_32F, Scalar(NAN)), Mat(4, 4, CV_32F), 1, 1, false), "not finite");
+    EXPECT_CV_ERROR_CONTAINS(measureEmva1288Pair(Mat(4, 4, CV_16U), Mat(4, 5, CV_16U), 1, 1, false),
+                             "share one size and type");
+    EXPECT_CV_ERROR_CONTAINS(measureEmva1288Stack(std::vector<Mat>{Mat(4, 4, CV_16U)}, 1, 1, false),
+                             "at least 2 frames");
 }
 
 } // namespace

@@ -3,6 +3,7 @@
 #define OPENCV_RAWGMENT_EMVA1288_HPP
 
 #include <opencv2/core.hpp>
+#include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/export.hpp>
 
@@ -113,12 +114,13 @@ struct CV_EXPORTS_W_SIMPLE Emva1288Pair
 };
 
 /** @brief Measures one temporal step from its two frames (see Emva1288Pair).
- * @param a first frame, CV_8UC1 or CV_16UC1 (integer values, as the standard's images hold)
+ * @param a first frame, CV_8UC1 or CV_16UC1 as the standard's images, or CV_32FC1 (augmented frames)
  * @param b second frame, of the same size and type
  * @param exposureNs the step's exposure time (>= 0)
  * @param photons its photons per pixel (>= 0, 0 for a dark pair)
  * @param dark whether it is a dark pair
- * @throws cv::Exception for frames of other types, different sizes, or fewer than 2 pixels. */
+ * @throws cv::Exception for frames of other types, different sizes, non-finite values or fewer than 2 pixels.
+ */
 CV_EXPORTS_W Emva1288Pair measureEmva1288Pair(InputArray a, InputArray b, double exposureNs, double photons,
                                               bool dark);
 
@@ -138,7 +140,8 @@ struct CV_EXPORTS_W_SIMPLE Emva1288Stack
         variance; //!< s_y^2 (DN^2), which may be < 0 when the pattern is below what L frames resolve
 };
 
-/** @brief Measures a stack of L >= 2 frames (CV_8UC1 or CV_16UC1, one size) of the spatial set.
+/** @brief Measures a stack of L >= 2 frames (CV_8UC1, CV_16UC1 or CV_32FC1, one size and type) of the spatial
+ * set.
  * @throws cv::Exception for fewer than two frames or frames of other types or sizes. */
 CV_EXPORTS_W Emva1288Stack measureEmva1288Stack(InputArrayOfArrays frames, double exposureNs, double photons,
                                                 bool dark);
@@ -262,6 +265,66 @@ struct CV_EXPORTS_W_SIMPLE Emva1288CalibrationParams
 CV_EXPORTS_W CalibrationReport
 calibrateEmva1288(const std::vector<Emva1288Results>& measurements, const std::vector<double>& gains,
                   const Emva1288CalibrationParams& params = Emva1288CalibrationParams());
+
+/** @brief The paper's validation on a real sensor's steps: a brighter step of the series taken to a darker
+ * one with colorJitter(), against the darker step's real frames.
+ *
+ * Steps of one series are the same sensor at the same gain with more and less light: exactly the paper's
+ * "bright burst converted to a darker exposure against a real darker burst". Each frame of the bright pair
+ * is darkened by the photon ratio of the descriptor (its own seed), as float32 so that no second rounding
+ * adds its 1/12 DN^2, and the augmented pair's temporal variance is compared with the real pair's. */
+struct CV_EXPORTS_W_SIMPLE Emva1288Darkening
+{
+    //! Every field at its default, as initialised here.
+    CV_WRAP Emva1288Darkening()
+        : brightPoint(-1), darkPoint(-1), photonRatio(0), alignment(NoiseAlignment::ACCOUNT_PRIOR),
+          augmentedVariance(0), augmentedStdError(0), realVariance(0), realStdError(0), ratio(0),
+          ratioStdError(0), pairScatter(1)
+    {
+    }
+    CV_PROP_RW int brightPoint;          //!< the bright step: an index into Emva1288Results' temporal points
+    CV_PROP_RW int darkPoint;            //!< the darker step it is taken to
+    CV_PROP_RW double photonRatio;       //!< photons of the darker step over the bright one's
+    CV_PROP_RW NoiseAlignment alignment; //!< how the augmentation treated the bright frames' noise
+    CV_PROP_RW double augmentedVariance; //!< sigma_y^2 of the augmented pair (DN^2)
+    CV_PROP_RW double augmentedStdError; //!< its standard error (see Emva1288Pair)
+    CV_PROP_RW double realVariance;      //!< sigma_y^2 of the real darker pair (DN^2)
+    CV_PROP_RW double realStdError;      //!< its standard error
+    CV_PROP_RW double ratio;             //!< augmentedVariance / realVariance
+    /** The ratio's standard error: both pairs' errors, each times sqrt(pairScatter). A pair's variance
+     * varies from pair to pair by more than its pixels imply on real sensors (frame-level noise, drift); the
+     * series shows by how much in its dark pairs, and the comparison takes it. */
+    CV_PROP_RW double ratioStdError;
+    /** The reduced chi-square of the series' dark-pair variances about their weighted mean, at least 1
+     * (set 001: 8.8; a simulated sensor: about 1). A dark current that grows with exposure counts too,
+     * which only widens the error. */
+    CV_PROP_RW double pairScatter;
+    //! Edges of the histograms below: 61 bins over +-6 real standard deviations of (A - B) / sqrt(2)
+    CV_PROP_RW std::vector<double> histogramEdges;
+    CV_PROP_RW std::vector<double> augmentedHistogram; //!< fraction of the augmented pair's pixels per bin
+    CV_PROP_RW std::vector<double> realHistogram;      //!< and of the real pair's
+};
+
+/** @brief Step pairs for emva1288Darkening(): up to `count` bright points inside the model's range (10% to
+ * 30% of the saturation signal), each taken to the brightest point at most a quarter of its signal (darker
+ * scenes are what augmentation makes). Returned as (bright, dark) point indices.
+ * @throws cv::Exception when no such pair exists (too few steps below 30% of saturation). */
+CV_EXPORTS_W std::vector<Point> emva1288DarkeningSteps(const Emva1288Results& results, int count = 5);
+
+/** @brief Takes bright steps of a series to darker ones with NONE, IGNORE_PRIOR and ACCOUNT_PRIOR (three
+ * entries per step pair, in that order) and compares each with the real darker pair.
+ * @param series the series (its images are read again, one step at a time)
+ * @param results its emva1288Results()
+ * @param model the noise model at the series' gain (calibrateEmva1288()'s, at gain 1)
+ * @param steps (bright, dark) point indices, as emva1288DarkeningSteps() gives them
+ * @param seed the noise seed: frame f of step pair k uses deriveSeed(seed, SEED_VALIDATION_CONVERSION, 2k +
+ * f)
+ * @throws cv::Exception for an index outside the points, a dark point not darker than its bright one, or a
+ * point whose images the series does not list. */
+CV_EXPORTS_W std::vector<Emva1288Darkening> emva1288Darkening(const Emva1288Series& series,
+                                                              const Emva1288Results& results,
+                                                              const NoiseModel& model,
+                                                              const std::vector<Point>& steps, uint64 seed);
 
 //! @}
 
