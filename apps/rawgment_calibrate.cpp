@@ -72,6 +72,41 @@ void printCalibration(const rawgment_apps::CalibrateResult& r, const std::string
         std::printf("plot: %s\n", p.c_str());
 }
 
+//! The verdict, the standard's figures of each series, the model and the real-frame validation.
+void printEmva1288(const rawgment_apps::Emva1288FlowResult& r)
+{
+    std::printf("verdict: %s\n", r.verdict.pass ? "PASS" : "FAIL");
+    for (const cv::rawgment::VerdictCheck& c : r.verdict.checks)
+        std::printf("  %s %s: %s\n", c.pass ? "pass" : "FAIL", c.name.c_str(), c.figure.c_str());
+    for (size_t k = 0; k < r.results.size(); ++k) {
+        const cv::rawgment::Emva1288Results& e = r.results[k];
+        std::printf(
+            "EMVA 1288 %s (%.2f dB): K %.5f DN/e-, sigma_y.dark %.4f DN, sigma_d %.3f e-, mu_e.sat %.0f "
+            "e-, eta %.2f%%, SNR_max %.2f dB, DR %.2f dB, mu_p.min %.2f p, DSNU1288 %.3f e-, PRNU1288 "
+            "%.3f%%, linearity %.3f%% to %+.3f%%\n",
+            r.inputs[k].descriptor.c_str(), r.inputs[k].gainDb, e.K, e.sigmaYDark, e.sigmaD, e.muESat, e.eta,
+            e.snrMaxDb, e.dynamicRangeDb, e.muPMin, e.dsnu1288, e.prnu1288, e.linearityErrorMin,
+            e.linearityErrorMax);
+    }
+    const cv::rawgment::CalibrationReport& rep = r.report;
+    std::printf("model: alpha %.6f +- %.2g, sigma_d^2 %.5f +- %.2g, sigma_r^2 %.5f +- %.2g%s\n",
+                rep.model.alpha, rep.uncertainty.stdError[0], rep.model.sigmaD2, rep.uncertainty.stdError[1],
+                rep.model.sigmaR2, rep.uncertainty.stdError[2],
+                rep.separable ? "" : " (one gain: the read noise is sigma_r^2)");
+    for (size_t i = 0; i + 2 < r.darkening.size(); i += 3)
+        std::printf("validation: point %d to %d (photon ratio %.3f): variance ratio NONE %.4f, IGNORE_PRIOR "
+                    "%.4f, ACCOUNT_PRIOR %.4f +- %.4f\n",
+                    r.darkening[i].brightPoint, r.darkening[i].darkPoint, r.darkening[i].photonRatio,
+                    r.darkening[i].ratio, r.darkening[i + 1].ratio, r.darkening[i + 2].ratio,
+                    r.darkening[i + 2].ratioStdError);
+    for (const std::string& n : rep.notes)
+        std::printf("note: %s\n", n.c_str());
+    for (const std::string& n : r.notes)
+        std::printf("note: %s\n", n.c_str());
+    for (const std::string& p : r.pngs)
+        std::printf("plot: %s\n", p.c_str());
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -79,11 +114,13 @@ int main(int argc, char** argv)
     const char* keys =
         "{help h usage ? |       | print this message }"
         "{@manifest      |       | calibration manifest (YAML/JSON), or a folder of burst folders }"
+        "{emva           |       | an EMVA 1288 descriptor (EMVA1288_Data.txt), or a manifest of them }"
+        "{fit_fraction   | 0.3   | with --emva: the steps fitted, up to this fraction of saturation }"
         "{out o          |       | output directory (required) }"
         "{method         | joint | joint (default, beyond the paper) or two-stage (the paper) }"
         "{side           | 24    | square side when the manifest says patches: detect }"
         "{shapiro        | 2000  | pixels per burst tested with Shapiro-Wilk }"
-        "{seed           | 0     | seed of the robust line fits (RANSAC) }"
+        "{seed           | 0     | seed of the robust line fits (RANSAC); with --emva, of the validation }"
         "{plots          | true  | write PNG plots with gnuplot }"
         "{dark_components| false | also row noise, dark shading and the read noise's shape from the dark "
         "bursts }";
@@ -110,10 +147,51 @@ int main(int argc, char** argv)
         "(with --dark_components also dark_calibration.yml, dark_rows.csv, dark_ppcc.csv, their\n"
         "plots, dark_shading.png and the dark-shading TIFFs beside noise_model.yml)\n"
         "and, with gains from ISO, darktable_noiseprofiles.json and android_noise_profile.yml into\n"
-        "--out; never overwrites them. Step by step: docs/calibrate_your_camera.md.");
+        "--out; never overwrites them. Step by step: docs/calibrate_your_camera.md.\n\n"
+        "EMVA 1288 data (--emva instead of the manifest): a descriptor of the standard, whose series\n"
+        "is at gain 0 dB, or a manifest of several gains:\n"
+        "  emva1288_manifest:\n"
+        "    base_iso: 100                       # optional, for series given by ISO\n"
+        "    series:\n"
+        "      - { descriptor: g0/EMVA1288_Data.txt, gain_db: 0 }\n"
+        "      - { descriptor: g12/EMVA1288_Data.txt, iso: 400 }\n"
+        "Writes report.md (verdict, the standard's figures, the model, the real-frame validation),\n"
+        "noise_model.yml, calibration_report.yml, emva1288.yml (the reference implementation's\n"
+        "names), emva1288_points.csv, emva1288_validation.csv and PNG plots.");
     if (parser.has("help")) {
         parser.printMessage();
         return 0;
+    }
+    const std::string emva = parser.get<std::string>("emva");
+    if (!emva.empty()) {
+        rawgment_apps::Emva1288Options e;
+        e.input = emva;
+        e.outDir = parser.get<std::string>("out");
+        e.maxSignalFraction = parser.get<double>("fit_fraction");
+        e.plots = parser.get<bool>("plots");
+        e.seed = rawgment_apps::seedOption(parser, "rawgment_calibrate");
+        if (!parser.check() || e.outDir.empty() || !parser.get<std::string>("@manifest").empty() ||
+            !(e.maxSignalFraction > 0 && e.maxSignalFraction <= 1)) {
+            parser.printErrors();
+            std::cerr << "usage: rawgment_calibrate --emva=<EMVA1288_Data.txt or manifest.yml> --out=<dir> "
+                         "[--fit_fraction=(0, 1]] (no calibration manifest with --emva)\n";
+            return 2;
+        }
+        try {
+            rawgment_apps::OutputDirectory outputDirectory(e.outDir);
+            const rawgment_apps::Emva1288FlowResult r = rawgment_apps::calibrateFromEmva1288(e);
+            printEmva1288(r);
+            outputDirectory.keep();
+            return 0;
+        } catch (const cv::Exception& ex) {
+            // A descriptor, an image or a manifest that is not what it should be: bad input, as a usage
+            // error.
+            std::cerr << "rawgment_calibrate: " << ex.err << "\n";
+            return 2;
+        } catch (const std::exception& ex) {
+            std::cerr << "rawgment_calibrate: " << ex.what() << "\n";
+            return 2;
+        }
     }
     rawgment_apps::CalibrateOptions o;
     o.manifest = parser.get<std::string>("@manifest");

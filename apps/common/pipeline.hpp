@@ -107,6 +107,42 @@ CalibrationManifest readCalibrationManifest(const std::string& path);
 CalibrateResult calibrateFromManifest(const CalibrateOptions& options);
 
 // ---------------------------------------------------------------------------------------------------
+//! One EMVA 1288 series of rawgment_calibrate --emva: its descriptor and its gain.
+struct Emva1288Input
+{
+    std::string descriptor;
+    double gainDb = 0;
+};
+
+struct Emva1288Options
+{
+    std::string input;  //!< an EMVA1288_Data.txt descriptor (gain 0 dB), or a manifest (.yml/.yaml/.json)
+    std::string outDir; //!< must not hold the outputs already
+    double maxSignalFraction = 0.3; //!< Emva1288CalibrationParams::maxSignalFraction
+    uint64_t seed = 0;              //!< seed of the real-frame validation's augmentation
+    bool plots = true;
+};
+
+struct Emva1288FlowResult
+{
+    std::vector<Emva1288Input> inputs;
+    std::vector<cv::rawgment::Emva1288Results> results; //!< per series, as inputs
+    cv::rawgment::CalibrationReport report;
+    cv::rawgment::CalibrationVerdict verdict;
+    std::vector<cv::rawgment::Emva1288Darkening>
+        darkening;                    //!< NONE, IGNORE_PRIOR, ACCOUNT_PRIOR per step pair
+    std::vector<int> darkeningSeries; //!< the series of each darkening entry
+    std::vector<std::string> pngs, notes;
+};
+
+/** Reads the series (one descriptor, or a manifest `emva1288_manifest: {base_iso:, series: [{descriptor:,
+ * gain_db: | iso:}]}`), computes the standard's figures and the model, validates it on each series' own
+ * darker steps, and writes noise_model.yml, calibration_report.yml, emva1288.yml, emva1288_points.csv,
+ * emva1288_validation.csv, the plots and report.md into outDir. Throws naming the file on bad input. */
+Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& options);
+//! report.md of calibrateFromEmva1288().
+std::string emva1288ReportMarkdown(const Emva1288FlowResult& result, const Emva1288Options& options);
+
 struct ValidateOptions
 {
     std::string manifest;

@@ -257,9 +257,13 @@ CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurem
         readCov = Matx22d(0, 0, 0, 1 / sw);
         report.rSquaredOffset = 1;
         report.notes.push_back(
-            cv::format("one gain (%g to %g, closer than the ratio %g): the read noise %.4f DN^2 "
-                       "is stated as sigma_r^2, which holds at this gain",
-                       g.front(), g.back(), params.minGainRatio, sigmaR2));
+            g.size() == 1
+                ? cv::format("one gain: the read noise %.4f DN^2 is stated as sigma_r^2, which holds at "
+                             "this gain",
+                             sigmaR2)
+                : cv::format("gains %g to %g, closer than the ratio %g: the read noise %.4f DN^2 is "
+                             "stated as sigma_r^2, which holds at these gains",
+                             g.front(), g.back(), params.minGainRatio, sigmaR2));
     }
     report.model = NoiseModel(alpha, sigmaD2, sigmaR2);
     ModelUncertainty& u = report.uncertainty;

@@ -23,12 +23,12 @@ const Emva1288Images& imagesOfPoint(const Emva1288Series& series, const Emva1288
                         point, results.exposureNs[point], results.photons[point], series.path.c_str()));
 }
 
-//! The fraction of (A - B) / sqrt(2), about its mean, in each bin of `edges`.
+//! The fraction of (A - B) / sqrt(2) in each bin of `edges`.
 std::vector<double> differenceHistogram(const Mat& a, const Mat& b, const std::vector<double>& edges)
 {
     Mat d;
     subtract(a, b, d, noArray(), CV_64F);
-    d = (d - mean(d)[0]) / std::sqrt(2.0);
+    d /= std::sqrt(2.0);
     const int bins = int(edges.size()) - 1;
     std::vector<double> h(bins, 0.0);
     const double lo = edges.front(), width = (edges.back() - edges.front()) / bins;
@@ -125,9 +125,13 @@ std::vector<Emva1288Darkening> emva1288Darkening(const Emva1288Series& series, c
         const double ratio = results.photons[j] / results.photons[i];
         const Emva1288Pair realPair = measureEmva1288Pair(real[0], real[1], 0, 0, false);
         const double sd = std::sqrt(realPair.variance);
+        // Bins of whole steps of the integer difference (1 / sqrt(2) apart after the scaling), centred on
+        // them, so that the real pair's lattice does not alias into the bins.
+        const double lattice = 1 / std::sqrt(2.0);
+        const double steps = std::max(1.0, std::round(12 * sd / 61 / lattice));
         std::vector<double> edges(62);
         for (int e = 0; e <= 61; ++e)
-            edges[e] = -6 * sd + 12 * sd * e / 61.0;
+            edges[e] = (steps * (e - 30.5) - 0.5 * std::fmod(steps + 1, 2.0)) * lattice;
         const std::vector<double> realHistogram = differenceHistogram(real[0], real[1], edges);
         for (NoiseAlignment alignment :
              {NoiseAlignment::NONE, NoiseAlignment::IGNORE_PRIOR, NoiseAlignment::ACCOUNT_PRIOR}) {

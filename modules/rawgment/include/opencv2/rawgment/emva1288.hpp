@@ -299,7 +299,8 @@ struct CV_EXPORTS_W_SIMPLE Emva1288Darkening
      * (set 001: 8.8; a simulated sensor: about 1). A dark current that grows with exposure counts too,
      * which only widens the error. */
     CV_PROP_RW double pairScatter;
-    //! Edges of the histograms below: 61 bins over +-6 real standard deviations of (A - B) / sqrt(2)
+    //! Edges of the histograms below: 61 bins of (A - B) / sqrt(2) over about +-6 real standard deviations,
+    //! each a whole number of the integer difference's steps wide and centred on them
     CV_PROP_RW std::vector<double> histogramEdges;
     CV_PROP_RW std::vector<double> augmentedHistogram; //!< fraction of the augmented pair's pixels per bin
     CV_PROP_RW std::vector<double> realHistogram;      //!< and of the real pair's

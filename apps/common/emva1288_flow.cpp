@@ -1,0 +1,424 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// rawgment_calibrate --emva: EMVA 1288 series in (one descriptor, or a manifest of descriptors with gains),
+// the standard's figures, the project's model, the real-frame validation and their plots out.
+#include "app_tools.hpp"
+#include "flow_common.hpp"
+#include "pipeline.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace rawgment_apps {
+
+using namespace cv::rawgment;
+
+namespace {
+
+const char* const kColours[] = {"#d62728", "#ff7f0e", "#2ca02c"};
+
+bool isManifestPath(const std::string& path)
+{
+    const std::string ext =
+        path.size() >= 5
+            ? path.substr(path.find_last_of('.') == std::string::npos ? path.size() : path.find_last_of('.'))
+            : std::string();
+    return ext == ".yml" || ext == ".yaml" || ext == ".json";
+}
+
+double readNumber(const cv::FileNode& node, const std::string& where, const char* key)
+{
+    if (!(node.isReal() || node.isInt()) || !std::isfinite(double(node)))
+        throw std::runtime_error(where + ": '" + key + "' is not a finite number");
+    return double(node);
+}
+
+//! The series of a manifest (`emva1288_manifest: {base_iso:, series: [{descriptor:, gain_db: | iso:}]}`).
+std::vector<Emva1288Input> readManifest(const std::string& path)
+{
+    cv::FileStorage fs = openFileStorageForReading(path, "EMVA 1288 manifest");
+    const cv::FileNode root = fs["emva1288_manifest"];
+    if (!root.isMap() || !root["series"].isSeq() || root["series"].size() == 0)
+        throw std::runtime_error("'" + path + "': expected a map 'emva1288_manifest' with a list 'series'");
+    requireKnownKeys(root, {"base_iso", "series"}, "'" + path + "'");
+    double baseIso = 0;
+    if (!root["base_iso"].empty()) {
+        baseIso = readNumber(root["base_iso"], "'" + path + "'", "base_iso");
+        if (!(baseIso >= NoiseModel::MIN_BASE_ISO && baseIso <= NoiseModel::MAX_BASE_ISO))
+            throw std::runtime_error(cv::format("'%s': 'base_iso' must be a number in [%g, %g]", path.c_str(),
+                                                NoiseModel::MIN_BASE_ISO, NoiseModel::MAX_BASE_ISO));
+    }
+    std::vector<Emva1288Input> inputs;
+    for (const cv::FileNode& item : root["series"]) {
+        const std::string where = cv::format("'%s' series %zu", path.c_str(), inputs.size() + 1);
+        if (!item.isMap() || !item["descriptor"].isString())
+            throw std::runtime_error(where +
+                                     ": expected a map with 'descriptor' (the path of EMVA1288_Data.txt)");
+        requireKnownKeys(item, {"descriptor", "gain_db", "iso"}, where);
+        const bool hasDb = !item["gain_db"].empty(), hasIso = !item["iso"].empty();
+        if (hasDb == hasIso)
+            throw std::runtime_error(where + ": give exactly one of 'gain_db' and 'iso'");
+        Emva1288Input in;
+        in.descriptor = resolvePath(directoryOf(path), std::string(item["descriptor"]));
+        if (hasDb) {
+            in.gainDb = readNumber(item["gain_db"], where, "gain_db");
+        } else {
+            const double iso = readNumber(item["iso"], where, "iso");
+            if (!(baseIso > 0) || !(iso > 0))
+                throw std::runtime_error(where + ": an 'iso' needs the manifest's 'base_iso', and both > 0");
+            in.gainDb = linearGainToDb(iso / baseIso);
+        }
+        inputs.push_back(in);
+    }
+    return inputs;
+}
+
+/* The verdict of a calibration from two-frame steps: what such series can show, each a figure against a
+ * threshold (docs/calibrate_your_camera.md, "EMVA 1288 data"). */
+CalibrationVerdict emvaVerdict(const std::vector<Emva1288Results>& results, const CalibrationReport& report,
+                               const Emva1288CalibrationParams& params)
+{
+    CalibrationVerdict v;
+    const auto add = [&](const std::string& name, bool pass, const std::string& figure) {
+        v.checks.push_back({name, pass, figure});
+        v.pass = v.pass && pass;
+    };
+    for (size_t k = 0; k < results.size(); ++k) {
+        const Emva1288Results& r = results[k];
+        const NoiseLineFit& line = report.perGain[k];
+        const double gainDb = linearGainToDb(line.gain);
+        const double limit =
+            params.maxSignalFraction * (r.mean[r.saturationIndex] - r.darkMean[r.saturationIndex]);
+        int steps = 0;
+        double worstRelativeError = 0, worstResidual = 0;
+        for (size_t i = 0; i < r.mean.size(); ++i) {
+            const double signal = r.mean[i] - r.darkMean[i];
+            if (signal > limit)
+                continue;
+            ++steps;
+            worstRelativeError = std::max(worstRelativeError, r.varianceStdError[i] / r.variance[i]);
+            const double fitted = line.line.a * signal + line.line.b;
+            worstResidual = std::max(worstResidual, std::abs(r.variance[i] / fitted - 1));
+        }
+        // Effective degrees of freedom: each step's variance to 2% (a Gaussian pair of P pixels gives
+        // sqrt(2 / P); 2% needs 5,000 pixels), and at least 3 bright steps for a line with a check.
+        add(cv::format("steps in the fit (%.1f dB)", gainDb), steps >= 3,
+            cv::format("%d bright steps up to %.0f%% of saturation (threshold: 3)", steps,
+                       100 * params.maxSignalFraction));
+        add(cv::format("effective degrees of freedom (%.1f dB)", gainDb), worstRelativeError <= 0.02,
+            cv::format(
+                "each step's variance to %.2f%% or better, %.0f effective dof (threshold: 2%%, 5,000 dof)",
+                100 * worstRelativeError, 2 / (worstRelativeError * worstRelativeError)));
+        // Residuals: real pairs scatter by about 1% from frame to frame (set 001: 0.8%); 3% is a misfit.
+        add(cv::format("residuals (%.1f dB)", gainDb), worstResidual <= 0.03,
+            cv::format("largest |variance / line - 1| %.2f%% over the fitted steps (threshold: 3%%)",
+                       100 * worstResidual));
+        // Linearity: the standard's error; beyond 3% one slope cannot hold over the range.
+        const bool linear = std::isfinite(r.linearityErrorMin) && std::abs(r.linearityErrorMin) <= 3 &&
+                            std::abs(r.linearityErrorMax) <= 3;
+        add(cv::format("linearity (%.1f dB)", gainDb), linear,
+            cv::format("the standard's linearity error %.3f%% to %.3f%% (threshold: +-3%%)",
+                       r.linearityErrorMin, r.linearityErrorMax));
+    }
+    return v;
+}
+
+std::string emvaFiguresYaml(const std::vector<Emva1288Input>& inputs,
+                            const std::vector<Emva1288Results>& results)
+{
+    return yamlToString([&](cv::FileStorage& fs) {
+        fs << "emva1288"
+           << "[";
+        for (size_t k = 0; k < results.size(); ++k) {
+            const Emva1288Results& r = results[k];
+            fs << "{";
+            fs << "descriptor" << inputs[k].descriptor << "gain_db" << inputs[k].gainDb;
+            // The reference implementation's names (EMVA1288/emva1288, Results1288), in its units.
+            fs << "K" << r.K << "inverse_K" << 1 / r.K << "QE" << r.eta << "sigma_y_dark" << r.sigmaYDark
+               << "sigma_d" << r.sigmaD << "u_p_min" << r.muPMin << "u_e_min" << r.eta * r.muPMin / 100
+               << "u_p_sat" << r.muPSat << "u_e_sat" << r.muESat << "SNR_max" << r.snrMax << "SNR_max_dB"
+               << r.snrMaxDb << "inverse_SNR_max" << 100 / r.snrMax << "DR"
+               << std::pow(10.0, r.dynamicRangeDb / 20) << "DR_dB" << r.dynamicRangeDb << "LE_min"
+               << r.linearityErrorMin << "LE_max" << r.linearityErrorMax << "DSNU1288" << r.dsnu1288
+               << "DSNU1288_DN" << r.dsnu1288 * r.K << "PRNU1288" << r.prnu1288;
+            fs << "}";
+        }
+        fs << "]";
+    });
+}
+
+void plotSeries(const std::string& outDir, const std::string& pointsCsv, const std::string& validationCsv,
+                const std::string& histogramCsv, const std::vector<Emva1288Results>& results,
+                const CalibrationReport& report, const Emva1288CalibrationParams& params,
+                Emva1288FlowResult& out)
+{
+    const Emva1288Results& r = results.front();
+    const NoiseLineFit& line = report.perGain.front();
+    const double saturated = r.mean[r.saturationIndex] - r.darkMean[r.saturationIndex];
+    const double fitEnd = r.mean[r.sensitivityMaxIndex] - r.darkMean[r.sensitivityMaxIndex];
+    std::string s =
+        "set title 'Photon transfer: temporal variance above dark against signal (first series)'\n";
+    s += "set xlabel 'mean signal above dark (DN)'\nset ylabel 'variance above dark (DN^2)'\nset grid\n";
+    s += "set key left top box opaque\n";
+    s += cv::format(
+        "plot '%s' every ::1 using ($3-$6):($4-$7) with points pt 7 ps 0.8 lc rgb '#1f77b4' title "
+        "'steps', (x <= %.6g ? %.10g*x : 1/0) with lines lw 2 lc rgb '#d62728' title 'standard: K %.5f "
+        "(fitted to 70%% of saturation)', (x <= %.6g ? %.10g*x : 1/0) with lines lw 2 dt 2 lc rgb "
+        "'#2ca02c' title 'model: %.5f (fitted to %.0f%%)'\n",
+        pointsCsv.c_str(), fitEnd, r.K, r.K, params.maxSignalFraction * saturated, line.line.a, line.line.a,
+        100 * params.maxSignalFraction);
+    std::string message;
+    const auto plot = [&](const std::string& png, const std::string& script) {
+        if (plotWithGnuplot(png, script, message))
+            out.pngs.push_back(png);
+        else
+            out.notes.push_back(message);
+    };
+    plot(outDir + "/emva_photon_transfer.png", s);
+    if (r.photonsGiven) {
+        s = "set title 'SNR against photons per pixel (first series)'\nset logscale xy\nset grid\n";
+        s += "set xlabel 'photons per pixel'\nset ylabel 'SNR'\nset key left top box opaque\n";
+        s += cv::format(
+            "plot '%s' every ::1 using 2:(($3-$6)/sqrt($4)) with points pt 7 ps 0.8 lc rgb '#1f77b4' "
+            "title 'measured', sqrt(%.10g*x) with lines lw 2 lc rgb '#2ca02c' title 'ideal sensor (eta "
+            "%.1f%%)', %.10g*x/sqrt(%.10g*x + %.10g) with lines lw 2 dt 2 lc rgb '#d62728' title "
+            "'model'\n",
+            pointsCsv.c_str(), r.eta / 100, r.eta, r.responsivity, line.line.a * r.responsivity, line.line.b);
+        plot(outDir + "/emva_snr.png", s);
+        s = "set title 'Linearity: deviation from the standard''s fit (first series)'\nset grid\n";
+        s += "set xlabel 'photons per pixel'\nset ylabel 'deviation (%)'\nset key left top box opaque\n";
+        s += cv::format(
+            "plot '%s' every ::1 using 2:9 with linespoints pt 7 lc rgb '#1f77b4' title 'deviation "
+            "(fit range %.0f%% to %.0f%% of saturation: 5%% to 95%%)'\n",
+            pointsCsv.c_str(), 5.0, 95.0);
+        plot(outDir + "/emva_linearity.png", s);
+    }
+    if (!validationCsv.empty()) {
+        s = "set title 'Real darker steps: augmented variance over the real one (1 is right)'\nset grid\n";
+        s += "set xlabel 'step pair'\nset ylabel 'variance ratio'\nset key outside right top\nset logscale "
+             "y\n";
+        s += "set xtics 1\n";
+        const char* names[] = {"NONE", "IGNORE\\_PRIOR", "ACCOUNT\\_PRIOR"};
+        s += "plot ";
+        for (int a = 0; a < 3; ++a)
+            s += cv::format(
+                "'%s' every ::1 using ($3 == %d ? $1 + %.2f : 1/0):6:7 with yerrorbars pt 7 lc rgb '%s' "
+                "title '%s', ",
+                validationCsv.c_str(), a + 1, 0.12 * (a - 1), kColours[a], names[a]);
+        s += "1 with lines lc rgb 'black' title 'the real darker pair'\n";
+        plot(outDir + "/emva_validation.png", s);
+        s = "set title 'Pixel differences (A - B) / sqrt 2 of the darker pair: real and augmented'\nset "
+            "grid\n";
+        s += "set xlabel 'DN'\nset ylabel 'fraction of pixels'\nset key left top box opaque\nplot ";
+        s += cv::format("'%s' every ::1 using 1:2 with steps lw 3 lc rgb 'black' title 'real darker pair', ",
+                        histogramCsv.c_str());
+        for (int a = 0; a < 3; ++a)
+            s += cv::format("%s'%s' every ::1 using 1:%d with steps lw 2 lc rgb '%s' title '%s'",
+                            a ? ", " : "", histogramCsv.c_str(), a + 3, kColours[a], names[a]);
+        plot(outDir + "/emva_validation_histograms.png", s + "\n");
+    }
+}
+
+} // namespace
+
+Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
+{
+    Emva1288FlowResult out;
+    std::vector<Emva1288Input> inputs;
+    if (isManifestPath(o.input))
+        inputs = readManifest(o.input);
+    else
+        inputs.push_back({o.input, 0.0});
+    std::vector<Emva1288Series> series;
+    size_t total = 0;
+    for (const Emva1288Input& in : inputs) {
+        series.push_back(readEmva1288(in.descriptor));
+        total += series.back().temporal.size() + series.back().spatial.size();
+    }
+    prepareOutputDirectory(o.outDir);
+    // A finished run is never redone into its folder; one that died before its end is completed (the run is
+    // deterministic: outputs already there must be what this run writes, which writeNewText checks).
+    std::vector<std::string> finished;
+    for (const char* name :
+         {"noise_model.yml", "calibration_report.yml", "emva1288.yml", "emva1288_points.csv", "report.md"})
+        finished.push_back(o.outDir + "/" + name);
+    if (std::all_of(finished.begin(), finished.end(), [](const std::string& p) { return pathExists(p); }))
+        refuseExisting(finished);
+    ProgressBar bar("EMVA 1288 steps", total);
+    std::vector<Emva1288Results> results;
+    std::vector<double> gains;
+    for (size_t k = 0; k < series.size(); ++k) {
+        results.push_back(emva1288Results(series[k], [&](int, int) { bar.advance(); }));
+        gains.push_back(dbToLinearGain(inputs[k].gainDb));
+    }
+    bar.finish();
+    Emva1288CalibrationParams params;
+    params.maxSignalFraction = o.maxSignalFraction;
+    out.report = calibrateEmva1288(results, gains, params);
+    out.verdict = emvaVerdict(results, out.report, params);
+    out.results = results;
+    out.inputs = inputs;
+
+    // The paper's validation on each series' own darker steps, with the model's line at its gain.
+    CsvTable validation({"pair", "bright_point", "alignment", "dark_point", "photon_ratio", "ratio",
+                         "ratio_std_error", "augmented_variance", "real_variance"});
+    for (size_t k = 0; k < series.size(); ++k) {
+        const NoiseLineFit& line = out.report.perGain[k];
+        const NoiseModel atGain(line.line.a, 0.0, std::max(line.line.b, 0.0));
+        std::vector<cv::Point> steps;
+        try {
+            steps = emva1288DarkeningSteps(results[k]);
+        } catch (const cv::Exception& e) {
+            out.notes.push_back("no real-frame validation of '" + inputs[k].descriptor + "': " + e.err);
+            continue;
+        }
+        if (!results[k].photonsGiven) {
+            out.notes.push_back(
+                "no real-frame validation of '" + inputs[k].descriptor +
+                "': it states no photon counts, so no step's light is known relative to another's");
+            continue;
+        }
+        const std::vector<Emva1288Darkening> d =
+            emva1288Darkening(series[k], results[k], atGain, steps, o.seed);
+        for (size_t i = 0; i < d.size(); ++i) {
+            out.darkening.push_back(d[i]);
+            out.darkeningSeries.push_back(int(k));
+            validation.addRow(std::vector<double>{double(i / 3 + 1), double(d[i].brightPoint),
+                                                  double(int(d[i].alignment) + 1), double(d[i].darkPoint),
+                                                  d[i].photonRatio, d[i].ratio, d[i].ratioStdError,
+                                                  d[i].augmentedVariance, d[i].realVariance});
+        }
+    }
+
+    // Files: never over an existing one (writeNewText), each atomically.
+    NoiseModel model = out.report.model;
+    if (!out.verdict.pass) {
+        std::string failed;
+        for (const VerdictCheck& c : out.verdict.checks)
+            if (!c.pass)
+                failed += (failed.empty() ? "" : ", ") + c.name;
+        model.failedCalibration = failed;
+    }
+    writeNewText(o.outDir + "/noise_model.yml",
+                 yamlToString([&](cv::FileStorage& fs) { model.write(fs, "noise_model"); }));
+    writeNewText(o.outDir + "/calibration_report.yml",
+                 yamlToString([&](cv::FileStorage& fs) { out.report.write(fs, "calibration_report"); }));
+    writeNewText(o.outDir + "/emva1288.yml", emvaFiguresYaml(inputs, results));
+    CsvTable points({"series", "photons", "mean", "variance", "variance_std_error", "dark_mean",
+                     "dark_variance", "exposure", "linearity_deviation_percent"});
+    for (size_t k = 0; k < results.size(); ++k) {
+        const Emva1288Results& r = results[k];
+        for (size_t i = 0; i < r.mean.size(); ++i)
+            points.addRow(std::vector<double>{double(k), r.photons[i], r.mean[i], r.variance[i],
+                                              r.varianceStdError[i], r.darkMean[i], r.darkVariance[i],
+                                              r.exposureNs[i],
+                                              r.linearityDeviation.empty() ? NAN : r.linearityDeviation[i]});
+    }
+    const std::string pointsCsv = o.outDir + "/emva1288_points.csv";
+    points.write(pointsCsv);
+    std::string validationCsv, histogramCsv;
+    if (validation.rows() > 0) {
+        validationCsv = o.outDir + "/emva1288_validation.csv";
+        validation.write(validationCsv);
+        // The histograms of the step pair of the largest photon ratio: there the three alignments differ
+        // most.
+        size_t best = 0;
+        for (size_t i = 0; i < out.darkening.size(); i += 3)
+            if (out.darkening[i].photonRatio > out.darkening[best].photonRatio)
+                best = i;
+        const Emva1288Darkening* d = &out.darkening[best];
+        CsvTable histograms({"difference_over_sqrt2_DN", "real", "NONE", "IGNORE_PRIOR", "ACCOUNT_PRIOR"});
+        for (size_t b = 0; b < d[0].realHistogram.size(); ++b)
+            histograms.addRow(std::vector<double>{0.5 * (d[0].histogramEdges[b] + d[0].histogramEdges[b + 1]),
+                                                  d[0].realHistogram[b], d[0].augmentedHistogram[b],
+                                                  d[1].augmentedHistogram[b], d[2].augmentedHistogram[b]});
+        histogramCsv = o.outDir + "/emva1288_validation_histograms.csv";
+        histograms.write(histogramCsv);
+        out.notes.push_back(
+            cv::format("the histograms are those of point %d taken to point %d (photon ratio %.3f)",
+                       d[0].brightPoint, d[0].darkPoint, d[0].photonRatio));
+    }
+    if (o.plots)
+        plotSeries(o.outDir, pointsCsv, validationCsv, histogramCsv, results, out.report, params, out);
+    writeNewText(o.outDir + "/report.md", emva1288ReportMarkdown(out, o));
+    return out;
+}
+
+std::string emva1288ReportMarkdown(const Emva1288FlowResult& r, const Emva1288Options& o)
+{
+    std::string md = "# EMVA 1288 calibration report\n\n";
+    md += std::string("**Verdict: ") + (r.verdict.pass ? "PASS" : "FAIL") + "**\n\n";
+    md += "| check | result | measured figure and threshold |\n|---|---|---|\n";
+    for (const VerdictCheck& c : r.verdict.checks)
+        md += "| " + c.name + " | " + (c.pass ? "pass" : "**FAIL**") + " | " + c.figure + " |\n";
+    md += "\nThresholds: docs/calibrate_your_camera.md, \"EMVA 1288 data\".\n\n## The standard's figures\n\n";
+    md += "| series | gain (dB) | K (DN/e-) | sigma_y.dark (DN) | sigma_d (e-) | mu_e.sat (e-) | eta (%) | "
+          "SNR_max (dB) "
+          "| DR (dB) | mu_p.min (p) | DSNU1288 (e-) | PRNU1288 (%) | linearity error (%) |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (size_t k = 0; k < r.results.size(); ++k) {
+        const Emva1288Results& e = r.results[k];
+        md += cv::format(
+            "| %s | %.2f | %.5f | %.4f | %.3f | %.0f | %.2f | %.2f | %.2f | %.2f | %.3f | %.3f | %.3f to "
+            "%+.3f |\n",
+            r.inputs[k].descriptor.c_str(), r.inputs[k].gainDb, e.K, e.sigmaYDark, e.sigmaD, e.muESat, e.eta,
+            e.snrMaxDb, e.dynamicRangeDb, e.muPMin, e.dsnu1288, e.prnu1288, e.linearityErrorMin,
+            e.linearityErrorMax);
+    }
+    md += "\nEach figure as the standard and its reference implementation define it (emva1288.yml holds them "
+          "under "
+          "the reference implementation's names).\n\n## The noise model\n\n";
+    const CalibrationReport& rep = r.report;
+    const cv::Vec3d se = rep.uncertainty.stdError;
+    md += cv::format("alpha %.6f +- %.2g DN/e- at gain 1; ", rep.model.alpha, se[0]);
+    md += rep.separable
+              ? cv::format("sigma_d^2 %.5f +- %.2g, sigma_r^2 %.5f +- %.2g DN^2 (one standard error).\n\n",
+                           rep.model.sigmaD2, se[1], rep.model.sigmaR2, se[2])
+              : cv::format("read noise %.5f +- %.2g DN^2 (sigma_y.dark %.4f DN), stated as sigma_r^2 at "
+                           "this gain.\n\n",
+                           rep.model.sigmaR2, se[2], std::sqrt(rep.model.sigmaR2));
+    md += "| gain (dB) | slope (K) | offset (DN^2) | points | R^2 |\n|---|---|---|---|---|\n";
+    for (const NoiseLineFit& l : rep.perGain)
+        md += cv::format("| %.2f | %.5f +- %.2g | %.4f +- %.2g | %d | %.5f |\n", linearGainToDb(l.gain),
+                         l.line.a, l.slopeStdError, l.line.b, l.offsetStdError, l.inliers, l.rSquared);
+    md += cv::format(
+        "\nThe model's slope is fitted to the steps up to %.0f%% of saturation, the standard's K to 70%%. "
+        "Where "
+        "they differ by more than their errors the photon transfer curve bends, and the validation below "
+        "shows which one predicts the sensor's own darker steps: the model's range is where augmented dark "
+        "scenes live.\n\n",
+        100 * o.maxSignalFraction);
+    if (!r.darkening.empty()) {
+        md += "## The paper's validation on real frames\n\nEach bright step of the series taken to a darker "
+              "one with "
+              "colorJitter() (photon ratio from the descriptor), against the real darker pair: ratio of "
+              "temporal "
+              "variances, 1 is right, +- one standard error (pixels and the series' own pair-to-pair "
+              "scatter).\n\n";
+        md +=
+            "| series | bright point | darker point | photon ratio | NONE | IGNORE_PRIOR | ACCOUNT_PRIOR |\n"
+            "|---|---|---|---|---|---|---|\n";
+        for (size_t i = 0; i + 2 < r.darkening.size(); i += 3) {
+            const Emva1288Darkening* d = &r.darkening[i];
+            md += cv::format("| %d | %d | %d | %.3f | %.4f +- %.4f | %.4f +- %.4f | %.4f +- %.4f |\n",
+                             r.darkeningSeries[i], d[0].brightPoint, d[0].darkPoint, d[0].photonRatio,
+                             d[0].ratio, d[0].ratioStdError, d[1].ratio, d[1].ratioStdError, d[2].ratio,
+                             d[2].ratioStdError);
+        }
+        md += "\n";
+    }
+    if (!r.pngs.empty()) {
+        md += "## Plots\n\n";
+        for (const std::string& p : r.pngs) {
+            const std::string name = p.substr(p.find_last_of('/') + 1);
+            md += "![" + name + "](" + name + ")\n\n";
+        }
+    }
+    for (const std::string& n : rep.notes)
+        md += "Note: " + n + "\n\n";
+    for (const std::string& n : r.notes)
+        md += "Note: " + n + "\n\n";
+    return md;
+}
+
+} // namespace rawgment_apps
