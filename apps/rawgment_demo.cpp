@@ -422,9 +422,63 @@ std::string darkComponentsSection(const DemoOptions& o, const SensorParams& base
 }
 
 //! Wall time of each step.
+/* An EMVA 1288 series of the simulator in the standard's own form (two frames per step, dark pairs, a spatial
+ * set), through rawgment_calibrate --emva: the standard's figures and the model beside the truth. */
+std::string emva1288Section(const DemoOptions& o)
+{
+    rawgment_apps::SimulatedEmva1288 series;
+    series.sensor.noise = NoiseModel(0.1, 0.0, 9.0);
+    series.sensor.blackLevel = cv::Vec4d::all(64);
+    series.sensor.prnu = 0.01;
+    series.sensor.dsnu = 1.5;
+    series.seed = o.seed;
+    const std::string descriptor = rawgment_apps::writeSimulatedEmva1288(o.out + "/emva1288/series", series);
+    rawgment_apps::Emva1288Options e;
+    e.input = descriptor;
+    e.outDir = o.out + "/emva1288/calibration";
+    e.seed = o.seed;
+    const rawgment_apps::Emva1288FlowResult r = rawgment_apps::calibrateFromEmva1288(e);
+    const Emva1288Results& f = r.results.front();
+    const NoiseModel& m = r.report.model;
+    const double K = series.sensor.noise.alpha, read = series.sensor.noise.sigmaR2 + 1.0 / 12;
+    std::string md = "## EMVA 1288: a sensor in the standard's own form\n\n";
+    md += cv::format(
+        "A simulated 12-bit sensor of %dx%d (K %.2f DN/e-, dark noise 3 DN, DSNU %.1f DN, PRNU %.0f%%, "
+        "quantum efficiency %.0f%%) measured as the standard asks: %d steps of two frames with their "
+        "dark pairs, and %d + %d frames for the spatial set, written as PNGs with the descriptor "
+        "(`emva1288/series/EMVA1288_Data.txt`) and read back by `rawgment_calibrate --emva`. Verdict "
+        "**%s** ([report](emva1288/calibration/report.md)).\n\n",
+        series.size.width, series.size.height, K, series.sensor.dsnu, 100 * series.sensor.prnu,
+        100 * series.quantumEfficiency, series.steps, series.spatialFrames, series.spatialFrames,
+        r.verdict.pass ? "PASS" : "FAIL");
+    md +=
+        "| figure | truth | the standard's estimate | the model (`calibrateEmva1288`) |\n|---|---|---|---|\n";
+    md += cv::format("| K (DN/e-) | %.4f | %.4f | %.4f +- %.4f |\n", K, f.K, m.alpha,
+                     r.report.uncertainty.stdError[0]);
+    md += cv::format("| sigma_y.dark (DN) | %.4f | %.4f | %.4f |\n", std::sqrt(read), f.sigmaYDark,
+                     std::sqrt(m.sigmaR2));
+    md += cv::format("| quantum efficiency (%%) | %.1f | %.2f | |\n", 100 * series.quantumEfficiency, f.eta);
+    md += cv::format("| DSNU1288 (e-) | %.2f | %.2f | |\n", series.sensor.dsnu / K, f.dsnu1288);
+    md += cv::format("| PRNU1288 (%%) | %.2f | %.3f | |\n", 100 * series.sensor.prnu, f.prnu1288);
+    md += cv::format("| SNR_max (dB), DR (dB) | | %.2f, %.2f | |\n", f.snrMaxDb, f.dynamicRangeDb);
+    md += "\nThe paper's validation on the series' own darker steps (variance ratio, 1 is right):\n\n";
+    md += "| photon ratio | NONE | IGNORE_PRIOR | ACCOUNT_PRIOR |\n|---|---|---|---|\n";
+    for (size_t i = 0; i + 2 < r.darkening.size(); i += 3)
+        md += cv::format("| %.3f | %.4f | %.4f | %.4f +- %.4f |\n", r.darkening[i].photonRatio,
+                         r.darkening[i].ratio, r.darkening[i + 1].ratio, r.darkening[i + 2].ratio,
+                         r.darkening[i + 2].ratioStdError);
+    for (const std::string& png : r.pngs)
+        if (png.find("emva_photon_transfer") != std::string::npos ||
+            png.find("emva_validation.png") != std::string::npos)
+            md += "\n![" + rawgment_apps::stemOf(png) + "](" + relativeTo(o.out, png) + ")\n";
+    md += "\nA real sensor (EMVA 1288 reference set 001) against the reference implementation: "
+          "docs/emva1288.md.\n\n";
+    return md;
+}
+
 struct StepSeconds
 {
-    double simulate = 0, calibrate = 0, validate = 0, gallery = 0, cameras = 0, dark = 0;
+    double simulate = 0, calibrate = 0, validate = 0, gallery = 0, cameras = 0, dark = 0, emva = 0;
 };
 
 int runDemo(const DemoOptions& o)
@@ -444,7 +498,7 @@ int runDemo(const DemoOptions& o)
     sim.frames = sim.validationFrames = o.frames;
     sim.sensor.noise = NoiseModel(o.alpha, o.sigmaD2, o.sigmaR2);
     sim.seed = o.seed;
-    std::cout << "1/7 simulating colour-checker bursts (gains 6, 12, 24 dB; 2 light levels; " << o.frames
+    std::cout << "1/8 simulating colour-checker bursts (gains 6, 12, 24 dB; 2 light levels; " << o.frames
               << " frames)\n";
     const rawgment_apps::SimulateResult simulated = rawgment_apps::simulateBursts(sim);
     const NoiseModel truth = NoiseModel::load(simulated.truthModel);
@@ -452,7 +506,7 @@ int runDemo(const DemoOptions& o)
 
     // 2. Calibration, the joint fit (default) and the paper's two-stage fit on the same data.
     t = Clock::now();
-    std::cout << "2/7 calibrating\n";
+    std::cout << "2/8 calibrating\n";
     rawgment_apps::CalibrateOptions cal;
     cal.manifest = simulated.manifest;
     cal.outDir = o.out + "/calibration";
@@ -467,7 +521,7 @@ int runDemo(const DemoOptions& o)
 
     // 3. Validation against real darker bursts.
     t = Clock::now();
-    std::cout << "3/7 validating exposure conversion against real darker bursts\n";
+    std::cout << "3/8 validating exposure conversion against real darker bursts\n";
     rawgment_apps::ValidateOptions val;
     val.manifest = simulated.validationManifest;
     val.model = o.out + "/calibration/noise_model.yml";
@@ -482,29 +536,35 @@ int runDemo(const DemoOptions& o)
 
     // 4. Gallery of augmented scenes.
     t = Clock::now();
-    std::cout << "4/7 augmenting a scene into a gallery\n";
+    std::cout << "4/8 augmenting a scene into a gallery\n";
     md += gallerySection(o, sim.sensor, joint.report.model);
     seconds.gallery = secondsSince(t);
 
     // 5. The same scene as real cameras, from darktable's measured profiles.
     t = Clock::now();
-    std::cout << "5/7 augmenting a dark scene as two real cameras (darktable's profiles)\n";
+    std::cout << "5/8 augmenting a dark scene as two real cameras (darktable's profiles)\n";
     md += realCamerasSection(o, sim.sensor);
     seconds.cameras = secondsSince(t);
 
     // 6. The dark-frame components beyond the paper.
     t = Clock::now();
-    std::cout << "6/7 dark-frame components: calibrating from dark bursts, augmenting with and without\n";
+    std::cout << "6/8 dark-frame components: calibrating from dark bursts, augmenting with and without\n";
     md += darkComponentsSection(o, sim.sensor);
     seconds.dark = secondsSince(t);
 
-    std::cout << "7/7 writing the report\n";
+    // 7. A sensor in the EMVA 1288 standard's own form.
+    t = Clock::now();
+    std::cout << "7/8 EMVA 1288: a simulated series in the standard's form, its figures and the model\n";
+    md += emva1288Section(o);
+    seconds.emva = secondsSince(t);
+
+    std::cout << "8/8 writing the report\n";
     md += "## Time\n\n| step | seconds |\n|---|---|\n";
     md += cv::format("| simulate %d frames | %.1f |\n| calibrate (joint and two-stage) | %.1f |\n"
                      "| validate | %.1f |\n| gallery | %.1f |\n| real cameras | %.1f |\n"
-                     "| dark-frame components | %.1f |\n| total | %.1f |\n",
+                     "| dark-frame components | %.1f |\n| EMVA 1288 | %.1f |\n| total | %.1f |\n",
                      simulated.files, seconds.simulate, seconds.calibrate, seconds.validate, seconds.gallery,
-                     seconds.cameras, seconds.dark, secondsSince(start));
+                     seconds.cameras, seconds.dark, seconds.emva, secondsSince(start));
     if (!joint.verdict.pass)
         md += "\nNote: the calibration's verdict is FAIL (calibration/report.md); the validation uses its "
               "model "

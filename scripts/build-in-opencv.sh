@@ -110,5 +110,6 @@ if [ -z "$site" ] || [ ! -d "$site/cv2" ]; then
 fi
 PYTHONPATH="$site" RAWGMENT_OPENCV_PREFIX="$prefix" \
   RAWGMENT_PYTHON_REFERENCE="$root/build/release/bin/rawgment_python_reference" \
+  RAWGMENT_SHARED_DATA_DIR="$root/../shared/data" \
   /usr/bin/python3 -m pytest -q -p no:cacheprovider "$root/python/tests_opencv"
 echo "=== build-in-opencv.sh: OpenCV 4.6 with rawgment built in $prefix, all its tests passed"

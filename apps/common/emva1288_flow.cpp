@@ -221,6 +221,46 @@ void plotSeries(const std::string& outDir, const std::string& pointsCsv, const s
 
 } // namespace
 
+std::string writeSimulatedEmva1288(const std::string& dir, const SimulatedEmva1288& series)
+{
+    makeDirectories(dir);
+    const SensorSimulator sim(series.sensor, series.size);
+    const double white = std::ldexp(1.0, series.sensor.bitDepth) - 1 - series.sensor.blackLevel[0];
+    const double alpha = series.sensor.noise.alpha;
+    // Light per exposure unit: 1.15 x the white level over the steps; photons = electrons / QE.
+    const double perExposure = 1.15 * white / series.steps;
+    const cv::Mat light(series.size, CV_32FC1, cv::Scalar(perExposure));
+    const cv::Mat dark = cv::Mat::zeros(series.size, CV_32FC1);
+    std::string text =
+        cv::format("# A simulated sensor in the EMVA 1288 form (cv::rawgment)\nv 4.0\nn %d %d %d\n",
+                   series.sensor.bitDepth, series.size.width, series.size.height);
+    std::vector<cv::Mat> frames;
+    const auto write = [&](const std::string& kind, int step, bool isDark, double exposure, int count) {
+        sim.captureBurst(isDark ? dark : light, 1.0, exposure, count,
+                         deriveSeed(series.seed, SEED_SIMULATED_BURST, uint64_t(2 * step + (isDark ? 1 : 0))),
+                         frames);
+        const double photons = perExposure * exposure / alpha / series.quantumEfficiency;
+        text += isDark ? cv::format("d %.6g\n", 1000 * exposure)
+                       : cv::format("b %.6g %.6g\n", 1000 * exposure, photons);
+        for (int f = 0; f < count; ++f) {
+            const std::string name = cv::format("%s%03d_%03d.png", kind.c_str(), step, f);
+            writeNewImage(dir + "/" + name, frames[f]);
+            text += "i " + name + "\n";
+        }
+    };
+    for (int k = 0; k < series.steps; ++k) {
+        write("b", k, false, k + 1, 2);
+        write("d", k, true, k + 1, 2);
+    }
+    if (series.spatialFrames > 0) {
+        const double half = 0.5 * series.steps / 1.15;
+        write("sb", series.steps, false, half, series.spatialFrames);
+        write("sd", series.steps, true, half, series.spatialFrames);
+    }
+    writeNewText(dir + "/EMVA1288_Data.txt", text);
+    return dir + "/EMVA1288_Data.txt";
+}
+
 Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
 {
     Emva1288FlowResult out;

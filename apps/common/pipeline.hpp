@@ -135,6 +135,20 @@ struct Emva1288FlowResult
     std::vector<std::string> pngs, notes;
 };
 
+//! An EMVA 1288 series of the simulator, written in the standard's form (the demo's; a test's own series).
+struct SimulatedEmva1288
+{
+    cv::rawgment::SensorParams sensor; //!< its noise at gain 1, levels, DSNU, PRNU and defects
+    cv::Size size{320, 240};
+    int steps = 24;         //!< bright steps, evenly up to 1.15 x the white level (saturation inside)
+    int spatialFrames = 16; //!< frames of each stack of the spatial set (0: none), at half of saturation
+    double quantumEfficiency = 0.5; //!< photons per electron is its inverse: it sets the photon counts
+    uint64_t seed = 1;
+};
+/** Writes the PNGs and EMVA1288_Data.txt of `series` into `dir` (never over a file) and returns the
+ * descriptor's path. */
+std::string writeSimulatedEmva1288(const std::string& dir, const SimulatedEmva1288& series);
+
 /** Reads the series (one descriptor, or a manifest `emva1288_manifest: {base_iso:, series: [{descriptor:,
  * gain_db: | iso:}]}`), computes the standard's figures and the model, validates it on each series' own
  * darker steps, and writes noise_model.yml, calibration_report.yml, emva1288.yml, emva1288_points.csv,

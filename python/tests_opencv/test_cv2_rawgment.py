@@ -234,3 +234,41 @@ def test_integer_samples_beyond_32_bits_are_taken_exactly():
         rg.shapiroWilk(np.array([1, 2, 3, 2 ** 60], np.int64))
     # Small integers keep their own depths.
     assert rg.shapiroWilk(np.array([1, 2, 4, 9], np.int32)).W == rg.shapiroWilk(np.array([1., 2., 4., 9.])).W
+
+
+def test_emva1288_series_figures_and_calibration(tmp_path):
+    """The EMVA 1288 topic through cv2.rawgment: a series written with cv2, its figures and the model, the
+    same numbers as the C++ library's (pairs measured from the same frames), and set 001's figures against
+    the reference implementation's when ../shared/data holds it."""
+    rng = np.random.default_rng(1288)
+    lines = ["v 4.0", "n 12 64 48"]
+    frames = {}
+    for s in range(8):
+        for kind in ("b", "d"):
+            lines.append("b %d %d" % (s + 1, 400 * (s + 1)) if kind == "b" else "d %d" % (s + 1))
+            for f in range(2):
+                electrons = rng.poisson(200.0 * (s + 1), (48, 64)) if kind == "b" else np.zeros((48, 64))
+                dn = np.clip(np.rint(100 + 0.25 * electrons + rng.normal(0, 3, (48, 64))), 0, 4095)
+                name = "%s%d_%d.png" % (kind, s, f)
+                frames[name] = dn.astype(np.uint16)
+                assert cv2.imwrite(str(tmp_path / name), frames[name])
+                lines.append("i " + name)
+    (tmp_path / "EMVA1288_Data.txt").write_text("\n".join(lines) + "\n")
+    series = rg.readEmva1288(str(tmp_path / "EMVA1288_Data.txt"))
+    assert (series.bits, series.width, series.height) == (12, 64, 48)
+    results = rg.emva1288Results(series)
+    pair = rg.measureEmva1288Pair(frames["b0_0.png"], frames["b0_1.png"], 1, 400, False)
+    assert pair.mean == results.mean[0] and pair.variance == results.variance[0]
+    assert abs(results.K / 0.25 - 1) < 0.06  # 8 steps of 3072 pixels: K to about 1.5%
+    report = rg.calibrateEmva1288([results], [1.0], rg.Emva1288CalibrationParams())
+    assert abs(report.model.alpha / 0.25 - 1) < 0.06
+    with pytest.raises(cv2.error, match="line 2: 100000 x 100000 pixels"):
+        (tmp_path / "huge.txt").write_text("v 4.0\nn 16 100000 100000\n")
+        rg.readEmva1288(str(tmp_path / "huge.txt"))
+    data = os.environ.get("RAWGMENT_SHARED_DATA_DIR", "")
+    set001 = pathlib.Path(data) / "emva1288/EMVA1288_ReferenceSet_001_CCD_12Bit/EMVA1288_Data.txt"
+    if set001.is_file():
+        figures = rg.emva1288Results(rg.readEmva1288(str(set001)))
+        assert abs(figures.K / 0.28006 - 1) < 0.005
+        assert abs(figures.sigmaYDark / 3.0731 - 1) < 0.005
+        assert abs(figures.dynamicRangeDb - 61.73) < 0.04

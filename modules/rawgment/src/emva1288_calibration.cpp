@@ -1,9 +1,9 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // The project's noise model from EMVA 1288 series (emva1288 topic): per gain, a weighted line through the
 // pairs' pooled statistics; across gains, Eq. 5. At two frames per step, a per-pixel sample variance has one
-// degree of freedom and is 0 whenever the two integer readings tie; calibrateNoiseModel()'s inlier band has a
-// lower edge above 0 and so drops every tie, which biased the read noise high (docs/emva1288.md). The pooled
-// pair statistic selects nothing, and its standard error is measured from the pixels' own fourth moment.
+// degree of freedom and is 0 whenever the two integer readings tie; fitNoiseLine()'s inlier band dropped
+// every tie until its lower edge took a continuity correction (docs/emva1288.md). The pooled pair statistic
+// selects nothing, and its standard error is measured from the pixels' own fourth moment (or the rows).
 #include "precomp.hpp"
 
 #include <opencv2/rawgment/emva1288.hpp>
@@ -240,9 +240,10 @@ CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurem
         double ssTot = 0, ssRes = 0, mean = 0;
         for (double v : b)
             mean += v / double(b.size());
+        const NoiseModel readOnly(0.0, sigmaD2, sigmaR2);
         for (size_t i = 0; i < g.size(); ++i) {
             ssTot += (b[i] - mean) * (b[i] - mean);
-            ssRes += std::pow(b[i] - (g2[i] * sigmaD2 + sigmaR2), 2);
+            ssRes += std::pow(b[i] - readOnly.lineAtGain(g[i]).b, 2);
         }
         report.rSquaredOffset = ssTot > 0 ? 1 - ssRes / ssTot : 1;
     } else {

@@ -65,9 +65,11 @@ std::vector<Point> emva1288DarkeningSteps(const Emva1288Results& results, int co
         // Spread over the candidates, brightest last.
         const int i =
             bright[bright.size() == 1 ? 0 : size_t(k) * (bright.size() - 1) / std::max(1, count - 1)];
+        // The darker step nearest (in ratio) a quarter of the bright one's signal, at most half of it.
         int dark = -1;
+        const auto distance = [&](int j) { return std::abs(std::log(signal(j) / (0.25 * signal(i)))); };
         for (int j = 0; j < n; ++j)
-            if (signal(j) > 0 && signal(j) <= 0.25 * signal(i) && (dark < 0 || signal(j) > signal(dark)))
+            if (signal(j) > 0 && signal(j) <= 0.5 * signal(i) && (dark < 0 || distance(j) < distance(dark)))
                 dark = j;
         const Point step(i, dark);
         if (dark >= 0 && std::find(steps.begin(), steps.end(), step) == steps.end())

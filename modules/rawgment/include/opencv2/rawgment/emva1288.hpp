@@ -250,7 +250,7 @@ struct CV_EXPORTS_W_SIMPLE Emva1288CalibrationParams
  * to the bright pairs up to `maxSignalFraction` of saturation and the dark pairs of their exposure times
  * (at signal 0), each point weighted by its measured inverse squared standard error
  * (Emva1288Pair::varianceStdError). Every pixel of every pair counts; nothing is selected by its own
- * variance (at two frames per step that selection is what biased calibrateNoiseModel(): see
+ * variance (at two frames per step such a selection biased fitNoiseLine() before its fix: see
  * docs/emva1288.md). The line's covariance is the fit's, scaled by its reduced chi-square when that
  * exceeds 1 (a curve that bends, correlated pixels), so the stated errors cover what the points show.
  * Across gains, Eq. 5: \f$a_g = g\alpha\f$ and \f$b_g = g^2\sigma_d^2 + \sigma_r^2\f$, by weighted least
@@ -307,8 +307,9 @@ struct CV_EXPORTS_W_SIMPLE Emva1288Darkening
 };
 
 /** @brief Step pairs for emva1288Darkening(): up to `count` bright points inside the model's range (10% to
- * 30% of the saturation signal), each taken to the brightest point at most a quarter of its signal (darker
- * scenes are what augmentation makes). Returned as (bright, dark) point indices.
+ * 30% of the saturation signal), each taken to the point whose signal is nearest (in ratio) a quarter of its
+ * own and at most half of it (darker scenes are what augmentation makes). Returned as (bright, dark) point
+ * indices.
  * @throws cv::Exception when no such pair exists (too few steps below 30% of saturation). */
 CV_EXPORTS_W std::vector<Point> emva1288DarkeningSteps(const Emva1288Results& results, int count = 5);
 
