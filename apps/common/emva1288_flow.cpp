@@ -73,56 +73,6 @@ std::vector<Emva1288Input> readManifest(const std::string& path)
     return inputs;
 }
 
-/* The verdict of a calibration from two-frame steps: what such series can show, each a figure against a
- * threshold (docs/calibrate_your_camera.md, "EMVA 1288 data"). */
-CalibrationVerdict emvaVerdict(const std::vector<Emva1288Results>& results, const CalibrationReport& report,
-                               const Emva1288CalibrationParams& params)
-{
-    CalibrationVerdict v;
-    const auto add = [&](const std::string& name, bool pass, const std::string& figure) {
-        v.checks.push_back({name, pass, figure});
-        v.pass = v.pass && pass;
-    };
-    for (size_t k = 0; k < results.size(); ++k) {
-        const Emva1288Results& r = results[k];
-        const NoiseLineFit& line = report.perGain[k];
-        const double gainDb = linearGainToDb(line.gain);
-        const double limit =
-            params.maxSignalFraction * (r.mean[r.saturationIndex] - r.darkMean[r.saturationIndex]);
-        int steps = 0;
-        double worstRelativeError = 0, worstResidual = 0;
-        for (size_t i = 0; i < r.mean.size(); ++i) {
-            const double signal = r.mean[i] - r.darkMean[i];
-            if (signal > limit)
-                continue;
-            ++steps;
-            worstRelativeError = std::max(worstRelativeError, r.varianceStdError[i] / r.variance[i]);
-            const double fitted = line.line.a * signal + line.line.b;
-            worstResidual = std::max(worstResidual, std::abs(r.variance[i] / fitted - 1));
-        }
-        // Effective degrees of freedom: each step's variance to 2% (a Gaussian pair of P pixels gives
-        // sqrt(2 / P); 2% needs 5,000 pixels), and at least 3 bright steps for a line with a check.
-        add(cv::format("steps in the fit (%.1f dB)", gainDb), steps >= 3,
-            cv::format("%d bright steps up to %.0f%% of saturation (threshold: 3)", steps,
-                       100 * params.maxSignalFraction));
-        add(cv::format("effective degrees of freedom (%.1f dB)", gainDb), worstRelativeError <= 0.02,
-            cv::format(
-                "each step's variance to %.2f%% or better, %.0f effective dof (threshold: 2%%, 5,000 dof)",
-                100 * worstRelativeError, 2 / (worstRelativeError * worstRelativeError)));
-        // Residuals: real pairs scatter by about 1% from frame to frame (set 001: 0.8%); 3% is a misfit.
-        add(cv::format("residuals (%.1f dB)", gainDb), worstResidual <= 0.03,
-            cv::format("largest |variance / line - 1| %.2f%% over the fitted steps (threshold: 3%%)",
-                       100 * worstResidual));
-        // Linearity: the standard's error; beyond 3% one slope cannot hold over the range.
-        const bool linear = std::isfinite(r.linearityErrorMin) && std::abs(r.linearityErrorMin) <= 3 &&
-                            std::abs(r.linearityErrorMax) <= 3;
-        add(cv::format("linearity (%.1f dB)", gainDb), linear,
-            cv::format("the standard's linearity error %.3f%% to %.3f%% (threshold: +-3%%)",
-                       r.linearityErrorMin, r.linearityErrorMax));
-    }
-    return v;
-}
-
 std::string emvaFiguresYaml(const std::vector<Emva1288Input>& inputs,
                             const std::vector<Emva1288Results>& results)
 {
@@ -148,12 +98,12 @@ std::string emvaFiguresYaml(const std::vector<Emva1288Input>& inputs,
 }
 
 void plotSeries(const std::string& outDir, const std::string& pointsCsv, const std::string& validationCsv,
-                const std::string& histogramCsv, const std::vector<Emva1288Results>& results,
+                const std::string& histogramCsv, const std::vector<Emva1288Results>& results, double gain,
                 const CalibrationReport& report, const Emva1288CalibrationParams& params,
                 Emva1288FlowResult& out)
 {
     const Emva1288Results& r = results.front();
-    const NoiseLineFit& line = report.perGain.front();
+    const NoiseLineFit& line = emva1288LineAtGain(report, gain);
     const double saturated = r.mean[r.saturationIndex] - r.darkMean[r.saturationIndex];
     const double fitEnd = r.mean[r.sensitivityMaxIndex] - r.darkMean[r.sensitivityMaxIndex];
     std::string s =
@@ -295,7 +245,7 @@ Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
     Emva1288CalibrationParams params;
     params.maxSignalFraction = o.maxSignalFraction;
     out.report = calibrateEmva1288(results, gains, params);
-    out.verdict = emvaVerdict(results, out.report, params);
+    out.verdict = judgeEmva1288(results, gains, out.report, params);
     out.results = results;
     out.inputs = inputs;
 
@@ -303,7 +253,7 @@ Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
     CsvTable validation({"pair", "bright_point", "alignment", "dark_point", "photon_ratio", "ratio",
                          "ratio_std_error", "augmented_variance", "real_variance"});
     for (size_t k = 0; k < series.size(); ++k) {
-        const NoiseLineFit& line = out.report.perGain[k];
+        const NoiseLineFit& line = emva1288LineAtGain(out.report, gains[k]);
         const NoiseModel atGain(line.line.a, 0.0, std::max(line.line.b, 0.0));
         std::vector<cv::Point> steps;
         try {
@@ -379,7 +329,8 @@ Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
                        d[0].brightPoint, d[0].darkPoint, d[0].photonRatio));
     }
     if (o.plots)
-        plotSeries(o.outDir, pointsCsv, validationCsv, histogramCsv, results, out.report, params, out);
+        plotSeries(o.outDir, pointsCsv, validationCsv, histogramCsv, results, gains.front(), out.report,
+                   params, out);
     writeNewText(o.outDir + "/report.md", emva1288ReportMarkdown(out, o));
     return out;
 }

@@ -179,6 +179,10 @@ void bindEmva1288(py::module_& m)
         },
         py::arg("measurements"), py::arg("gains"), py::arg("params") = Emva1288CalibrationParams(),
         doc("calibrateEmva1288"));
+    m.def("emva1288LineAtGain", &emva1288LineAtGain, py::arg("report"), py::arg("gain"),
+          py::return_value_policy::copy, doc("emva1288LineAtGain"));
+    m.def("judgeEmva1288", &judgeEmva1288, py::arg("results"), py::arg("gains"), py::arg("report"),
+          py::arg("params") = Emva1288CalibrationParams(), doc("judgeEmva1288"));
 }
 
 } // namespace rawgment_python

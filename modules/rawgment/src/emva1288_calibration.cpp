@@ -104,6 +104,14 @@ GainPoints pointsOf(const Emva1288Results& r, double fraction, int which)
 
 } // namespace
 
+const NoiseLineFit& emva1288LineAtGain(const CalibrationReport& report, double gain)
+{
+    for (const NoiseLineFit& l : report.perGain)
+        if (l.gain == gain)
+            return l;
+    CV_Error(Error::StsBadArg, cv::format("emva1288LineAtGain: the report has no line at gain %g", gain));
+}
+
 CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurements,
                                     const std::vector<double>& gains, const Emva1288CalibrationParams& params)
 {
@@ -278,6 +286,62 @@ CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurem
     for (int i = 0; i < 3; ++i)
         u.stdError[i] = u.fitStdError[i] = std::sqrt(std::max(u.covariance(i, i), 0.0));
     return report;
+}
+
+/* The verdict of a calibration from two-frame steps: what such series can show, each a figure against a
+ * threshold (docs/calibrate_your_camera.md, "EMVA 1288 data"). */
+CalibrationVerdict judgeEmva1288(const std::vector<Emva1288Results>& results,
+                                 const std::vector<double>& gains, const CalibrationReport& report,
+                                 const Emva1288CalibrationParams& params)
+{
+    if (results.size() != gains.size() || results.size() != report.perGain.size())
+        CV_Error(Error::StsBadArg,
+                 cv::format("judgeEmva1288: %d measurements, %d gains and %d per-gain lines; give "
+                            "what calibrateEmva1288() was given and its report",
+                            int(results.size()), int(gains.size()), int(report.perGain.size())));
+    CalibrationVerdict v;
+    const auto add = [&](const std::string& name, bool pass, const std::string& figure) {
+        v.checks.push_back({name, pass, figure});
+        v.pass = v.pass && pass;
+    };
+    for (size_t k = 0; k < results.size(); ++k) {
+        const Emva1288Results& r = results[k];
+        const NoiseLineFit& line = emva1288LineAtGain(report, gains[k]);
+        const double gainDb = linearGainToDb(line.gain);
+        const double limit =
+            params.maxSignalFraction * (r.mean[r.saturationIndex] - r.darkMean[r.saturationIndex]);
+        int steps = 0;
+        double worstRelativeError = 0, worstResidual = 0;
+        for (size_t i = 0; i < r.mean.size(); ++i) {
+            const double signal = r.mean[i] - r.darkMean[i];
+            if (signal > limit)
+                continue;
+            ++steps;
+            worstRelativeError = std::max(worstRelativeError, r.varianceStdError[i] / r.variance[i]);
+            const double fitted = line.line.a * signal + line.line.b;
+            worstResidual = std::max(worstResidual, std::abs(r.variance[i] / fitted - 1));
+        }
+        // Effective degrees of freedom: each step's variance to 2% (a Gaussian pair of P pixels gives
+        // sqrt(2 / P); 2% needs 5,000 pixels), and at least 3 bright steps for a line with a check.
+        add(cv::format("steps in the fit (%.1f dB)", gainDb), steps >= 3,
+            cv::format("%d bright steps up to %.0f%% of saturation (threshold: 3)", steps,
+                       100 * params.maxSignalFraction));
+        add(cv::format("effective degrees of freedom (%.1f dB)", gainDb), worstRelativeError <= 0.02,
+            cv::format(
+                "each step's variance to %.2f%% or better, %.0f effective dof (threshold: 2%%, 5,000 dof)",
+                100 * worstRelativeError, 2 / (worstRelativeError * worstRelativeError)));
+        // Residuals: real pairs scatter by about 1% from frame to frame (set 001: 0.8%); 3% is a misfit.
+        add(cv::format("residuals (%.1f dB)", gainDb), worstResidual <= 0.03,
+            cv::format("largest |variance / line - 1| %.2f%% over the fitted steps (threshold: 3%%)",
+                       100 * worstResidual));
+        // Linearity: the standard's error; beyond 3% one slope cannot hold over the range.
+        const bool linear = std::isfinite(r.linearityErrorMin) && std::abs(r.linearityErrorMin) <= 3 &&
+                            std::abs(r.linearityErrorMax) <= 3;
+        add(cv::format("linearity (%.1f dB)", gainDb), linear,
+            cv::format("the standard's linearity error %.3f%% to %.3f%% (threshold: +-3%%)",
+                       r.linearityErrorMin, r.linearityErrorMax));
+    }
+    return v;
 }
 
 } // namespace rawgment

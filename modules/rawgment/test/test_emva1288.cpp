@@ -109,6 +109,15 @@ TEST(Emva1288, set001sDarkenedStepsMatchItsRealDarkerStepsWithAccountPriorOnly)
             EXPECT_GT(augmented, 0.999);
     }
     EXPECT_GT(d[0].pairScatter, 1);
+    // Set 001 passes the verdict for two-frame steps; fitted only to 5% of saturation it has too few steps.
+    const CalibrationVerdict verdict = judgeEmva1288({r}, {1.0}, rep);
+    EXPECT_TRUE(verdict.pass);
+    ASSERT_EQ(verdict.checks.size(), 4u);
+    Emva1288CalibrationParams low;
+    low.maxSignalFraction = 0.05;
+    const CalibrationVerdict few = judgeEmva1288({r}, {1.0}, calibrateEmva1288({r}, {1.0}, low), low);
+    EXPECT_FALSE(few.pass);
+    EXPECT_FALSE(few.checks[0].pass) << few.checks[0].figure;
 }
 
 TEST(Emva1288, progressIsCalledOncePerExposure)
@@ -414,6 +423,12 @@ TEST(Emva1288, seriesAtThreeGainsSeparateReadNoiseBeforeAndAfterTheGain)
     const CalibrationReport rep = calibrateEmva1288(measured, gains);
     ASSERT_TRUE(rep.separable);
     ASSERT_EQ(rep.perGain.size(), 3u);
+    // Given out of order, the lines are found by gain.
+    const CalibrationReport shuffled = calibrateEmva1288({measured[2], measured[0], measured[1]}, {4, 1, 2});
+    EXPECT_EQ(emva1288LineAtGain(shuffled, 4).line.a, emva1288LineAtGain(rep, 4).line.a);
+    EXPECT_CV_ERROR_CONTAINS(emva1288LineAtGain(rep, 3), "no line at gain 3");
+    EXPECT_CV_ERROR_CONTAINS(judgeEmva1288({measured[0]}, {1, 2}, rep),
+                             "give what calibrateEmva1288() was given");
     const Vec3d se = rep.uncertainty.stdError;
     // Eq. 5's truth: alpha 0.1, sigma_d^2 2, sigma_r^2 4 + 1/12 (the ADC's rounding comes after the gain).
     // Four stated standard errors: a 1-in-16,000 miss per parameter if the errors are right.

@@ -266,6 +266,24 @@ CV_EXPORTS_W CalibrationReport
 calibrateEmva1288(const std::vector<Emva1288Results>& measurements, const std::vector<double>& gains,
                   const Emva1288CalibrationParams& params = Emva1288CalibrationParams());
 
+/** @brief The line of a calibrateEmva1288() report at one of its gains (its per-gain lines are sorted by
+ * gain, not in the order of the measurements).
+ * @throws cv::Exception when the report has no line at exactly that gain. */
+CV_EXPORTS_W const NoiseLineFit& emva1288LineAtGain(const CalibrationReport& report, double gain);
+
+/** @brief The verdict of a calibration from EMVA 1288 series: what many two-frame steps can show, each a
+ * measured figure against a stated threshold (docs/calibrate_your_camera.md, "EMVA 1288 data"), per gain:
+ * bright steps in the fit (at least 3), effective degrees of freedom (each fitted step's variance to 2%),
+ * residuals (every fitted step within 3% of the line) and the standard's linearity error (within +-3%).
+ * @param results the measurements given to calibrateEmva1288()
+ * @param gains their gains, as given to it
+ * @param report its report
+ * @param params its settings
+ * @throws cv::Exception when the three lists differ in length or a gain has no line in the report. */
+CV_RAWGMENT_EXPORTS CalibrationVerdict judgeEmva1288(
+    const std::vector<Emva1288Results>& results, const std::vector<double>& gains,
+    const CalibrationReport& report, const Emva1288CalibrationParams& params = Emva1288CalibrationParams());
+
 /** @brief The paper's validation on a real sensor's steps: a brighter step of the series taken to a darker
  * one with colorJitter(), against the darker step's real frames.
  *
