@@ -10,13 +10,31 @@
 
 namespace {
 
+//! The verdict's line (scripts read it) and each check.
+void printVerdict(const cv::rawgment::CalibrationVerdict& verdict)
+{
+    std::printf("verdict: %s\n", verdict.pass ? "PASS" : "FAIL");
+    for (const cv::rawgment::VerdictCheck& c : verdict.checks)
+        std::printf("  %s %s: %s\n", c.pass ? "pass" : "FAIL", c.name.c_str(), c.figure.c_str());
+}
+
+//! The report's notes, the run's notes and the plots written.
+void printNotesAndPlots(const std::vector<std::string>& reportNotes, const std::vector<std::string>& notes,
+                        const std::vector<std::string>& pngs)
+{
+    for (const std::string& n : reportNotes)
+        std::printf("note: %s\n", n.c_str());
+    for (const std::string& n : notes)
+        std::printf("note: %s\n", n.c_str());
+    for (const std::string& p : pngs)
+        std::printf("plot: %s\n", p.c_str());
+}
+
 //! The verdict, the lines, the model with its errors, Shapiro-Wilk, the dark frames' findings and the notes.
 void printCalibration(const rawgment_apps::CalibrateResult& r, const std::string& method)
 {
     const cv::rawgment::CalibrationReport& rep = r.report;
-    std::printf("verdict: %s\n", r.verdict.pass ? "PASS" : "FAIL");
-    for (const cv::rawgment::VerdictCheck& c : r.verdict.checks)
-        std::printf("  %s %s: %s\n", c.pass ? "pass" : "FAIL", c.name.c_str(), c.figure.c_str());
+    printVerdict(r.verdict);
     std::printf("method %s, %d of %d samples used\n", method.c_str(), rep.samplesUsed, rep.samples);
     for (const cv::rawgment::NoiseLineFit& l : rep.perGain)
         std::printf(
@@ -64,20 +82,13 @@ void printCalibration(const rawgment_apps::CalibrateResult& r, const std::string
         for (const std::string& n : r.dark.notes)
             std::printf("note: %s\n", n.c_str());
     }
-    for (const std::string& n : rep.notes)
-        std::printf("note: %s\n", n.c_str());
-    for (const std::string& n : r.notes)
-        std::printf("note: %s\n", n.c_str());
-    for (const std::string& p : r.pngs)
-        std::printf("plot: %s\n", p.c_str());
+    printNotesAndPlots(rep.notes, r.notes, r.pngs);
 }
 
 //! The verdict, the standard's figures of each series, the model and the real-frame validation.
 void printEmva1288(const rawgment_apps::Emva1288FlowResult& r)
 {
-    std::printf("verdict: %s\n", r.verdict.pass ? "PASS" : "FAIL");
-    for (const cv::rawgment::VerdictCheck& c : r.verdict.checks)
-        std::printf("  %s %s: %s\n", c.pass ? "pass" : "FAIL", c.name.c_str(), c.figure.c_str());
+    printVerdict(r.verdict);
     for (size_t k = 0; k < r.results.size(); ++k) {
         const cv::rawgment::Emva1288Results& e = r.results[k];
         std::printf(
@@ -99,12 +110,7 @@ void printEmva1288(const rawgment_apps::Emva1288FlowResult& r)
                     r.darkening[i].brightPoint, r.darkening[i].darkPoint, r.darkening[i].photonRatio,
                     r.darkening[i].ratio, r.darkening[i + 1].ratio, r.darkening[i + 2].ratio,
                     r.darkening[i + 2].ratioStdError);
-    for (const std::string& n : rep.notes)
-        std::printf("note: %s\n", n.c_str());
-    for (const std::string& n : r.notes)
-        std::printf("note: %s\n", n.c_str());
-    for (const std::string& p : r.pngs)
-        std::printf("plot: %s\n", p.c_str());
+    printNotesAndPlots(rep.notes, r.notes, r.pngs);
 }
 
 } // namespace

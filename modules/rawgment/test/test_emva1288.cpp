@@ -294,32 +294,30 @@ std::vector<Emva1288Pair> simulatePairs(const SimulatedSeries& s, double gain, u
     return pairs;
 }
 
-SimulatedSeries twelveBitSeries()
+//! A series of `bits` with gain K, read variance (before rounding), black level and DSNU; PRNU 1%, hot
+//! pixels.
+SimulatedSeries simulatedSeries(int bits, double K, double readVariance, double black, double dsnu)
 {
     SimulatedSeries s;
-    s.sensor.noise = NoiseModel(0.1, 0.0, 9.0);
-    s.sensor.bitDepth = 12;
-    s.sensor.blackLevel = Vec4d::all(64);
+    s.sensor.noise = NoiseModel(K, 0.0, readVariance);
+    s.sensor.bitDepth = bits;
+    s.sensor.blackLevel = Vec4d::all(black);
     s.sensor.prnu = 0.01;
-    s.sensor.dsnu = 1.5;
+    s.sensor.dsnu = dsnu;
     s.sensor.hotPixelFraction = 1e-4;
-    s.truthK = 0.1;
-    s.truthRead = 9.0 + 1.0 / 12;
+    s.truthK = K;
+    s.truthRead = readVariance + 1.0 / 12;
     return s;
+}
+
+SimulatedSeries twelveBitSeries()
+{
+    return simulatedSeries(12, 0.1, 9.0, 64, 1.5);
 }
 
 SimulatedSeries eightBitSeries(double readVariance)
 {
-    SimulatedSeries s;
-    s.sensor.noise = NoiseModel(0.05, 0.0, readVariance);
-    s.sensor.bitDepth = 8;
-    s.sensor.blackLevel = Vec4d::all(8);
-    s.sensor.prnu = 0.01;
-    s.sensor.dsnu = 0.5;
-    s.sensor.hotPixelFraction = 1e-4;
-    s.truthK = 0.05;
-    s.truthRead = readVariance + 1.0 / 12;
-    return s;
+    return simulatedSeries(8, 0.05, readVariance, 8, 0.5);
 }
 
 struct Campaign
