@@ -1717,6 +1717,9 @@ TEST(Apps, calibrateEmvaOnSet001WritesTheStandardsFiguresTheModelPlotsAndTheVali
     const std::string report = readText(dir + "/cal/report.md");
     EXPECT_NE(report.find("ACCOUNT_PRIOR"), std::string::npos);
     EXPECT_NE(report.find("holds for signals 0 to"), std::string::npos);
+    // Which slope is right on a curve that bends: the sensor's own darker steps decide (docs/emva1288.md).
+    EXPECT_NE(report.find("the model's line predicts this sensor's darker steps better"), std::string::npos)
+        << report;
     // A finished run is not redone over its outputs.
     const AppRun again = runApp("rawgment_calibrate", args);
     EXPECT_NE(0, again.status);
