@@ -6,6 +6,7 @@
 #include "pipeline.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 
@@ -17,12 +18,15 @@ namespace {
 
 const char* const kColours[] = {"#d62728", "#ff7f0e", "#2ca02c"};
 
+//! A manifest by its extension (.yml, .yaml, .json, any case); anything else is taken for a descriptor.
 bool isManifestPath(const std::string& path)
 {
-    const std::string ext =
-        path.size() >= 5
-            ? path.substr(path.find_last_of('.') == std::string::npos ? path.size() : path.find_last_of('.'))
-            : std::string();
+    const size_t dot = path.find_last_of('.'), slash = path.find_last_of('/');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
+        return false;
+    std::string ext = path.substr(dot);
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
     return ext == ".yml" || ext == ".yaml" || ext == ".json";
 }
 
@@ -111,7 +115,8 @@ void plotSeries(const std::string& outDir, const std::string& pointsCsv, const s
     s += "set xlabel 'mean signal above dark (DN)'\nset ylabel 'variance above dark (DN^2)'\nset grid\n";
     s += "set key left top box opaque\n";
     s += cv::format(
-        "plot '%s' every ::1 using ($3-$6):($4-$7) with points pt 7 ps 0.8 lc rgb '#1f77b4' title "
+        "plot '%s' every ::1 using ($1 == 0 ? $3-$6 : 1/0):($4-$7) with points pt 7 ps 0.8 lc rgb '#1f77b4' "
+        "title "
         "'steps', (x <= %.6g ? %.10g*x : 1/0) with lines lw 2 lc rgb '#d62728' title 'standard: K %.5f "
         "(fitted to 70%% of saturation)', (x <= %.6g ? %.10g*x : 1/0) with lines lw 2 dt 2 lc rgb "
         "'#2ca02c' title 'model: %.5f (fitted to %.0f%%)'\n",
@@ -119,7 +124,8 @@ void plotSeries(const std::string& outDir, const std::string& pointsCsv, const s
         100 * params.maxSignalFraction);
     std::string message;
     const auto plot = [&](const std::string& png, const std::string& script) {
-        if (plotWithGnuplot(png, script, message))
+        // A plot an interrupted run of the same job already made is kept, never drawn over.
+        if (pathExists(png) || plotWithGnuplot(png, script, message))
             out.pngs.push_back(png);
         else
             out.notes.push_back(message);
@@ -129,7 +135,8 @@ void plotSeries(const std::string& outDir, const std::string& pointsCsv, const s
         s = "set title 'SNR against photons per pixel (first series)'\nset logscale xy\nset grid\n";
         s += "set xlabel 'photons per pixel'\nset ylabel 'SNR'\nset key left top box opaque\n";
         s += cv::format(
-            "plot '%s' every ::1 using 2:(($3-$6)/sqrt($4)) with points pt 7 ps 0.8 lc rgb '#1f77b4' "
+            "plot '%s' every ::1 using ($1 == 0 ? $2 : 1/0):(($3-$6)/sqrt($4)) with points pt 7 ps 0.8 lc "
+            "rgb '#1f77b4' "
             "title 'measured', sqrt(%.10g*x) with lines lw 2 lc rgb '#2ca02c' title 'ideal sensor (eta "
             "%.1f%%)', %.10g*x/sqrt(%.10g*x + %.10g) with lines lw 2 dt 2 lc rgb '#d62728' title "
             "'model'\n",
@@ -137,10 +144,10 @@ void plotSeries(const std::string& outDir, const std::string& pointsCsv, const s
         plot(outDir + "/emva_snr.png", s);
         s = "set title 'Linearity: deviation from the standard''s fit (first series)'\nset grid\n";
         s += "set xlabel 'photons per pixel'\nset ylabel 'deviation (%)'\nset key left top box opaque\n";
-        s += cv::format(
-            "plot '%s' every ::1 using 2:9 with linespoints pt 7 lc rgb '#1f77b4' title 'deviation "
-            "(fit range %.0f%% to %.0f%% of saturation: 5%% to 95%%)'\n",
-            pointsCsv.c_str(), 5.0, 95.0);
+        s += cv::format("plot '%s' every ::1 using ($1 == 0 ? $2 : 1/0):9 with linespoints pt 7 lc rgb "
+                        "'#1f77b4' title 'deviation "
+                        "(fit range %.0f%% to %.0f%% of saturation: 5%% to 95%%)'\n",
+                        pointsCsv.c_str(), 5.0, 95.0);
         plot(outDir + "/emva_linearity.png", s);
     }
     if (!validationCsv.empty()) {
