@@ -170,7 +170,7 @@ struct CV_EXPORTS_W_SIMPLE Emva1288Results
     CV_PROP_RW double responsivity;   //!< R, DN per photon
     CV_PROP_RW double eta;            //!< quantum efficiency (%), NaN when every photon count is 0
     CV_PROP_RW double muPSat;         //!< saturation (photons), NaN without photon counts
-    CV_PROP_RW double muESat;         //!< saturation capacity (e-): the signal at saturation over K
+    CV_PROP_RW double muESat;         //!< saturation capacity (e-): eta mu_p.sat, or signal at saturation / K
     CV_PROP_RW double snrMax;         //!< sqrt(muESat)
     CV_PROP_RW double snrMaxDb;       //!< 20 log10 snrMax
     CV_PROP_RW double muPMin;         //!< absolute sensitivity threshold (photons), NaN without photons
