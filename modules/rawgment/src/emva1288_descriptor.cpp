@@ -62,12 +62,6 @@ long long integerOf(const String& path, int line, const std::string& word, const
     return v;
 }
 
-String folderOf(const String& path)
-{
-    const size_t slash = path.find_last_of('/');
-    return slash == String::npos ? String() : path.substr(0, slash + 1);
-}
-
 //! An `i` line's path, Windows separators as '/', resolved against the descriptor's folder.
 String resolvedImagePath(const String& folder, std::string name)
 {
@@ -167,7 +161,7 @@ Emva1288Series readEmva1288(const String& path)
                  "EMVA 1288 descriptor '" + path + "' is not a descriptor: it holds binary data");
     Emva1288Series series;
     series.path = path;
-    const String folder = folderOf(path);
+    const String folder = detail::folderOf(path);
     std::vector<Emva1288Images> groups;
     Emva1288Images* open = nullptr;
     bool sawFormat = false;

@@ -39,6 +39,12 @@ std::string readTextFile(const String& path)
     return readFileBounded(path, MAX_TEXT_FILE_BYTES, "file");
 }
 
+String folderOf(const String& path)
+{
+    const size_t slash = path.find_last_of('/');
+    return slash == String::npos ? String() : path.substr(0, slash + 1);
+}
+
 void checkRegularFile(const String& path, const String& what)
 {
     struct stat status;

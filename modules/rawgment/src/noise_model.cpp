@@ -46,12 +46,6 @@ std::string mapChecksum(const Mat& map)
     return format("%016" PRIx64, h);
 }
 
-String folderOf(const String& path)
-{
-    const size_t slash = path.find_last_of('/');
-    return slash == String::npos ? String() : path.substr(0, slash + 1);
-}
-
 String baseNameOf(const String& path)
 {
     const size_t slash = path.find_last_of('/');
@@ -459,7 +453,7 @@ void NoiseModel::save(const String& path) const
             images.push_back(shadingImageName(path, i, *maps[i]));
     const std::string text =
         detail::fileStorageText(path, [&](FileStorage& fs) { write(fs, kTopLevelName, images); });
-    const String folder = folderOf(path);
+    const String folder = detail::folderOf(path);
     std::vector<String> created;
     try {
         for (size_t i = 0; i < images.size(); ++i) {
@@ -498,8 +492,9 @@ double NoiseModel::readExcessKurtosis() const
 
 NoiseModel NoiseModel::load(const String& path, bool acceptFailedCalibration)
 {
-    NoiseModel m = detail::loadFileStorage(path, kTopLevelName, "noise model file",
-                                           [&](const FileNode& n) { return read(n, folderOf(path)); });
+    NoiseModel m = detail::loadFileStorage(path, kTopLevelName, "noise model file", [&](const FileNode& n) {
+        return read(n, detail::folderOf(path));
+    });
     if (!m.failedCalibration.empty() && !acceptFailedCalibration)
         CV_Error(
             Error::StsBadArg,

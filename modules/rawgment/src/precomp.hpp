@@ -55,6 +55,9 @@ std::vector<double> readRealList(const FileNode& node, const char* field, int n)
 
 //! The extension of a path's file name, with its dot, in lower case ("" when it has none).
 String lowerExtensionOf(const String& path);
+//! The folder of a path with its trailing '/' ("" for a bare file name): what relative names inside a file
+//! are resolved against.
+String folderOf(const String& path);
 
 /** Writes `path` with a FileStorage, replacing it: the text is built in memory, then written by
  * writeFileAtomically() (checked, synced, atomic). The format follows the extension of `path`
