@@ -34,7 +34,7 @@ tools
     @defgroup rawgment_mosaic_files Mosaics with YAML sidecars (PNG, TIFF, DNG): what augmentation writes and
 reads
     @defgroup rawgment_files Files of every topic: atomic writes, bounded reads, guarded YAML/JSON
-    @defgroup rawgment_emva1288 EMVA 1288 measurement series: the standard's descriptor, figures and calibration
+    @defgroup rawgment_emva1288 EMVA 1288 series: the standard's descriptor, figures and calibration
     @defgroup rawgment_calibration Noise calibration from bursts: statistics, line fits, cross-gain fits
     @defgroup rawgment_cpu Instruction-set paths of the hot loops: one binary, the same bits on every CPU
     @defgroup rawgment_simulate A physical sensor simulator and a ColorChecker scene: the ground truth
