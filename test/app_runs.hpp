@@ -1,0 +1,52 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// Running the apps of this build as a user runs them: what the end-to-end tests (test_apps.cpp,
+// test_app_calibrate_emva.cpp) share. RAWGMENT_APP_DIR names the apps' folder.
+#ifndef RAWGMENT_TEST_APP_RUNS_HPP
+#define RAWGMENT_TEST_APP_RUNS_HPP
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace rawgment_app_tests {
+
+//! An app's exit status and everything it printed.
+struct AppRun
+{
+    int status = -1;
+    std::string output;
+};
+
+//! The content of a file ("" when it cannot be read).
+std::string readText(const std::string& path);
+//! Whether a file can be opened.
+bool exists(const std::string& path);
+
+/** How the sanitizer build's apps record where memory was allocated. FAST follows frame pointers, which
+ * stop at the first frame of Debian's OpenCV (built without them). FULL unwinds every frame from the
+ * debugging information, which more than doubled the time of this file's calibrations (36 s to 89 s for
+ * one test on host H2), so only the runs that detect a chart with cv::mcc ask for it: OpenCV's
+ * colour-conversion tables, which it keeps for the process's life, are allocated deep inside
+ * libopencv_imgproc, and test/lsan_suppressions.txt can match them only on a complete stack. */
+enum class AllocationStacks
+{
+    FAST,
+    FULL
+};
+
+//! Runs an app of this build with arguments (shell-quoted by the caller), capturing stdout and stderr.
+AppRun runApp(const std::string& app, const std::string& args,
+              AllocationStacks stacks = AllocationStacks::FAST);
+
+//! A fresh, empty folder for one test, removed at the end when every test passed.
+std::string freshDir(const std::string& name);
+
+//! Writes a scene file of an exposure change (ColorJitter::exposureChange) to `path`.
+void writeExposureScene(const std::string& path, double photonRatio, double gainRatio);
+
+//! gnuplot is a dependency (scripts/install-deps.sh), so every plot must exist and decode.
+void expectPngDecodes(const std::string& path);
+
+} // namespace rawgment_app_tests
+
+#endif // RAWGMENT_TEST_APP_RUNS_HPP
