@@ -89,7 +89,32 @@ if [ "${#explicit[@]}" -eq 0 ]; then
     esac
   done
 fi
+# A noise step validates its model once and prepares its noise once (src/step_noise.hpp): the rows take
+# the prepared terms, never a NoiseModel, and the steps' sources make no call that validates a model
+# again (only the public entry points name NoiseModel, to wrap it in a ValidatedNoiseModel).
+if [ "${#explicit[@]}" -eq 0 ]; then
+  steps=(modules/rawgment/src/color_jitter.cpp modules/rawgment/src/color_jitter_poisson.cpp
+    modules/rawgment/src/color_jitter_rows.hpp modules/rawgment/src/resample.cpp
+    modules/rawgment/src/resample_rows.hpp modules/rawgment/src/motion_blur.cpp modules/rawgment/src/scene.cpp
+    modules/rawgment/src/augment_steps.cpp modules/rawgment/src/augment_steps.hpp
+    modules/rawgment/src/step_noise.cpp)
+  again='model\.(validate|lineAtGain|variance|rowVariance|darkShadingAt)\(|checkedNoiseTerms\('
+  for f in "${steps[@]}"; do
+    if grep -nE "$again" "$f" >/dev/null; then
+      grep -nE "$again" "$f" | sed "s|^|$f: validates the model again (use the step's StepNoise): |"
+      status=1
+    fi
+    case "$f" in
+      *_rows.hpp|*_poisson.cpp|*/augment_steps.hpp)
+        if grep -nE '[^d]NoiseModel&' "$f" >/dev/null; then
+          grep -nE '[^d]NoiseModel&' "$f" | sed "s|^|$f: row code takes a NoiseModel (take the StepNoise's terms): |"
+          status=1
+        fi ;;
+    esac
+  done
+fi
+
 if [ "$status" -eq 0 ]; then
-  echo "check-sources: ${#files[@]} files, no control characters, no copy of Eq. 5, layers kept, no file over 750 lines"
+  echo "check-sources: ${#files[@]} files, no control characters, no copy of Eq. 5, layers kept, no file over 750 lines, noise steps prepared once"
 fi
 exit "$status"

@@ -17,13 +17,10 @@ void checkMosaicInput(const Mat& src, const char* who)
         CV_Error(Error::StsBadArg, format("%s: src contains NaN or Inf", who));
 }
 
-void checkResampleInput(const Mat& src, const RawFormat& format, const NoiseModel& model,
-                        const NoiseOptions& noise, const char* who)
+void checkResampleInput(const Mat& src, const RawFormat& format, const char* who)
 {
     checkMosaicInput(src, who);
     format.validate();
-    model.validate();
-    noise.validate();
     if (src.rows % 2 || src.cols % 2)
         CV_Error(Error::StsBadArg,
                  cv::format("%s: both sides must be even (got %dx%d)", who, src.cols, src.rows));
@@ -61,59 +58,6 @@ Mat stepOutput(const Mat& src, OutputArray dst)
     Mat out(src.size(), src.type());
     adviseHugePages(out);
     return out;
-}
-
-void throwNonFiniteShading(const char* who)
-{
-    CV_Error(Error::StsBadArg, format("%s: the model's dark shading contains NaN or Inf", who));
-}
-
-bool darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, int r, int cols, float* extra)
-{
-    const int even = 2 * (r & 1);
-    float amp[2] = {0, 0};
-    if (d.row) {
-        detail::CounterRng rng(rowKey, static_cast<uint64_t>(r));
-        const float z = static_cast<float>(rng.gaussian());
-        amp[0] = d.rowSigma[even] * z;
-        amp[1] = d.rowSigma[even + 1] * z;
-    }
-    if (!d.shading) {
-        for (int c = 0; c < cols; ++c)
-            extra[c] = amp[c & 1];
-        return true;
-    }
-    const float* bd = model.darkShadingPerGain.ptr<float>(r + d.origin.y) + d.origin.x;
-    const float* br = model.darkShadingOffset.ptr<float>(r + d.origin.y) + d.origin.x;
-    // A pair of columns (both sites of the row) per iteration, each with its site's coefficients.
-    const float g0 = d.shadingPerGain[even], g1 = d.shadingPerGain[even + 1];
-    const float o0 = d.shadingOffset[even], o1 = d.shadingOffset[even + 1];
-    for (int c = 0; c + 1 < cols; c += 2) {
-        extra[c] = amp[0] + g0 * bd[c] + o0 * br[c];
-        extra[c + 1] = amp[1] + g1 * bd[c + 1] + o1 * br[c + 1];
-    }
-    if (cols & 1)
-        extra[cols - 1] = amp[0] + g0 * bd[cols - 1] + o0 * br[cols - 1];
-    // x - x is 0 for every finite x and NaN for NaN and Inf; the maps are checked, not the products, so
-    // a coefficient of 0 cannot hide a bad value.
-    float check = 0;
-    for (int c = 0; c < cols; ++c)
-        check += (bd[c] - bd[c]) + (br[c] - br[c]);
-    return check == 0;
-}
-
-void checkDarkShadingSize(const NoiseModel& model, Size size, Point origin, const char* who)
-{
-    if (!model.hasDarkShading())
-        return;
-    const Size maps = model.darkShadingPerGain.size();
-    if ((Rect(origin, size) & Rect(Point(), maps)) != Rect(origin, size))
-        CV_Error(
-            Error::StsBadArg,
-            format("%s: the model's dark shading is %dx%d but the mosaic %dx%d at sensor origin (%d, %d) "
-                   "does not lie inside it; the maps are per pixel of the sensor: give a crop its offset "
-                   "(RawFormat::sensorOrigin, or RawFormat::cropped())",
-                   who, maps.width, maps.height, size.width, size.height, origin.x, origin.y));
 }
 
 bool isIdentityKernel(const Mat& kernel)

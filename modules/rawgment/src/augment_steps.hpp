@@ -5,10 +5,9 @@
 #ifndef OPENCV_RAWGMENT_SRC_AUGMENT_STEPS_HPP
 #define OPENCV_RAWGMENT_SRC_AUGMENT_STEPS_HPP
 
-#include "noise_terms.hpp"
 #include "opencv2/rawgment/augment.hpp"
 #include "precomp.hpp"
-#include "random.hpp"
+#include "step_noise.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -21,10 +20,24 @@ namespace detail {
 //! Throws StsBadArg naming `who` unless src is a non-empty CV_16UC1 or finite CV_32FC1 mosaic.
 void checkMosaicInput(const Mat& src, const char* who);
 
-//! checkMosaicInput() plus the format, model and options, and even sides: blur and scale resample each
-//! CFA plane, so they need whole 2x2 blocks.
-void checkResampleInput(const Mat& src, const RawFormat& format, const NoiseModel& model,
-                        const NoiseOptions& noise, const char* who);
+//! checkMosaicInput() plus the format and even sides: blur and scale resample each CFA plane, so they
+//! need whole 2x2 blocks.
+void checkResampleInput(const Mat& src, const RawFormat& format, const char* who);
+
+/** @name The noise steps on a model validated once (ValidatedNoiseModel)
+ * What colorJitter(), motionBlur() and scaleMosaic() run after making their src two-dimensional and
+ * validating their model; applyScene() runs them all on one validated model. Same arguments and errors
+ * as the public functions. */
+//! @{
+void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
+                     const ColorJitter& jitter, const NoiseOptions& noise, uint64 seed, OutputArray dst,
+                     RawFormat& dstFormat, AugmentReport* report, OutputArray saturatedMask);
+void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
+                    InputArray kernel, const NoiseOptions& noise, uint64 seed, OutputArray dst,
+                    AugmentReport* report);
+void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model, double scale,
+                     const NoiseOptions& noise, uint64 seed, OutputArray dst, AugmentReport* report);
+//! @}
 
 //! Counts or masks saturated input pixels, only when the caller asks: the hot loops do not pay for it.
 void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* report, OutputArray mask);
@@ -98,54 +111,6 @@ inline float poissonNoise(const NoiseSplit& s, float q, double count, float z, f
 {
     return q * static_cast<float>(count - s.mean) + std::sqrt(s.zVar) * z + std::sqrt(s.tVar) * t;
 }
-
-/** The dark-frame components a noise step adds (NoiseModel's row noise, dark shading and Tukey read),
- * per CFA site: a row offset of amplitude rowSigma drawn once per mosaic row, the deterministic
- * shadingPerGain B_d + shadingOffset B_r, and the lambda of the read part's heavy tails. */
-struct DarkTerms
-{
-    bool row = false, shading = false, tails = false;
-    float rowSigma[4] = {0, 0, 0, 0};
-    float shadingPerGain[4] = {0, 0, 0, 0}, shadingOffset[4] = {0, 0, 0, 0};
-    Point origin; // where the mosaic lies on the sensor (RawFormat::sensorOrigin): the maps are read there
-    // The quantiles of the added read part's heavy-tailed shapes, when `tails`, for fillTukeyUnit(): a mosaic
-    // row of parity p reads tailTable[p] (sites 2p and 2p + 1); a resampling step, whose sites share one
-    // shape, tailTable[0].
-    TukeyQuantileTable tailTable[2];
-    bool any() const { return row || shading; }
-};
-
-/** The dark shading g B_d + B_r of a model at one gain, read row by row from its maps: a whole-frame
- * map per call (48 MB at 12 MP) would cost more in first-touch page faults than the step itself. */
-struct ShadingRows
-{
-    const Mat* perGain = nullptr; // null: no shading
-    const Mat* offset = nullptr;
-    float gain = 0;
-    Point origin; // the mosaic's (0, 0) on the sensor: row r, column c of the mosaic read the maps there
-    ShadingRows() = default;
-    ShadingRows(const NoiseModel& model, double g, Point sensorOrigin)
-        : perGain(&model.darkShadingPerGain), offset(&model.darkShadingOffset), gain(static_cast<float>(g)),
-          origin(sensorOrigin)
-    {
-    }
-    bool empty() const { return perGain == nullptr; }
-    //! g B_d + B_r of mosaic row r, column c (float: the same on every CPU path).
-    float at(const float* bd, const float* br, int c) const { return gain * bd[c] + br[c]; }
-    const float* perGainRow(int r) const { return perGain->ptr<float>(r + origin.y) + origin.x; }
-    const float* offsetRow(int r) const { return offset->ptr<float>(r + origin.y) + origin.x; }
-};
-
-/** Row r's additive part of `d` into extra[0..cols): d.rowSigma[site] times the row's one draw from
- * stream (rowKey, r), plus the dark shading. Sites of one row share the draw, as a real row offset does.
- * Returns false when the row's shading holds NaN or Inf (the check costs one subtraction per value). */
-bool darkRowExtra(const DarkTerms& d, const NoiseModel& model, uint64_t rowKey, int r, int cols,
-                  float* extra);
-//! The error of a step whose dark-shading rows held NaN or Inf (darkRowExtra() returned false).
-void throwNonFiniteShading(const char* who);
-/** Throws StsBadArg naming `who` when the model has dark shading and a mosaic of `size` at the sensor
- * origin `origin` (RawFormat::sensorOrigin) does not lie inside its maps. */
-void checkDarkShadingSize(const NoiseModel& model, Size size, Point origin, const char* who);
 
 // Rounds a float or a vector of floats in [0, 2^23] to the nearest integer, ties to even: adding and
 // subtracting 2^23 (where the float spacing is 1) leaves the rounding to IEEE's default mode, the same

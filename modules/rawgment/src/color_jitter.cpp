@@ -241,9 +241,9 @@ struct JitterKeys
 // a dark input would otherwise count its dark offset as photons); the extra terms then add the target's
 // shading less the input's.
 template <typename T>
-void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& model, const JitterConstants& k,
+void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstants& k,
                 const JitterColumnTables& tables, const JitterKeys& keys,
-                const detail::ShadingRows& inputShading, const Range& rows, std::atomic<int64>& brightening,
+                const detail::DarkShading& inputShading, const Range& rows, std::atomic<int64>& brightening,
                 std::atomic<bool>& nonFinite)
 {
     const int cols = src.cols;
@@ -261,7 +261,7 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
             detail::fillTukeyUnit(keys.tukey, static_cast<uint64_t>(r), k.dark.tailTable[r & 1], t.data(),
                                   cols);
         }
-        if (dark && !detail::darkRowExtra(k.dark, model, keys.row, r, cols, extra.data()))
+        if (dark && !detail::darkRowExtra(k.dark, keys.row, r, cols, extra.data()))
             nonFinite = true;
         JitterColumns col = tables.forRow(r);
         if (!inputShading.empty()) {
@@ -293,34 +293,32 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const NoiseModel& mo
  *   adds the target's whole shading to the values as they are;
  * - tails: the added read part's lambda (addedReadLambda(): the prior's read p_c^2 b is kept); IGNORE_PRIOR
  *   the model's lambda. */
-detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, Point sensorOrigin,
-                                  const ColorJitter& jitter, NoiseAlignment alignment)
+detail::DarkTerms jitterDarkTerms(const detail::StepNoise& step, const ColorJitter& jitter)
 {
     detail::DarkTerms d;
-    if (alignment == NoiseAlignment::NONE)
+    if (!step.addsNoise())
         return d;
-    d.origin = sensorOrigin;
-    d.row = model.hasRowNoise();
-    d.shading = model.hasDarkShading();
-    d.tails = model.tukeyRead;
-    const double pg = jitter.gainRatio, g = gain;
-    const double readIn = model.lineAtGain(g).b, readOut = model.lineAtGain(pg * g).b;
-    const bool account = alignment == NoiseAlignment::ACCOUNT_PRIOR;
+    d.row = step.rowNoise;
+    d.shading = step.shading;
+    d.tails = step.tails;
+    const double pg = jitter.gainRatio, g = step.gainIn;
+    const double readIn = step.in.read(), readOut = step.out.read();
+    const bool account = step.options.alignment == NoiseAlignment::ACCOUNT_PRIOR;
     detail::TukeyUnitSampler shapes[4]; // the added read part's heavy-tailed shape per site, when `tails`
     for (int s = 0; s < 4; ++s) {
         const double pc = jitter.contrast[s], pu = pc / pg;
         const double rowAdded =
-            account ? (1 - pu * pu) * pg * pg * g * g * model.rowSigmaD2 + (1 - pc * pc) * model.rowSigmaR2
-                    : model.rowVariance(g * pg);
+            account ? (1 - pu * pu) * pg * pg * g * g * step.rowSigmaD2 + (1 - pc * pc) * step.rowSigmaR2
+                    : step.rowVariance(g * pg);
         d.rowSigma[s] = static_cast<float>(std::sqrt(std::max(rowAdded, 0.0)));
         d.shadingPerGain[s] = static_cast<float>(account ? g * (pg - 1) : g * pg);
         d.shadingOffset[s] = static_cast<float>(account ? 0.0 : 1.0);
         if (!d.tails)
             continue;
         shapes[s] = detail::TukeyUnitSampler(
-            account ? detail::addedReadLambda(model.tukeyLambda, readOut, std::pow(pc, 4) * readIn * readIn,
+            account ? detail::addedReadLambda(step.tukeyLambda, readOut, std::pow(pc, 4) * readIn * readIn,
                                               readOut - pc * pc * readIn)
-                    : model.tukeyLambda);
+                    : step.tukeyLambda);
     }
     if (d.tails)
         for (int parity = 0; parity < 2; ++parity) {
@@ -334,13 +332,21 @@ detail::DarkTerms jitterDarkTerms(const NoiseModel& model, double gain, Point se
 
 // PriorMeanEstimate::LOCAL_MEAN: the black-subtracted mean of each pixel's 3x3 neighbourhood on its own
 // CFA plane. On the mosaic that is a separable [1 0 1 0 1] / 3 filter; reflecting about the edge pixel
-// maps an offset of -2 to +2, so the border also averages pixels of the same site.
-Mat localPriorMean(const Mat& src, const RawFormat& format)
+// maps an offset of -2 to +2, so the border also averages pixels of the same site. With ACCOUNT_PRIOR and
+// dark shading the input's shading (`inputShading`, not empty) is taken out too, as from the pixel values.
+Mat localPriorMean(const Mat& src, const RawFormat& format, const detail::DarkShading& inputShading)
 {
     Mat x, mean;
     subtractBlackLevel(src, format, x, false);
     const Matx<float, 1, 5> taps(1.0f / 3, 0, 1.0f / 3, 0, 1.0f / 3);
     sepFilter2D(x, mean, CV_32F, taps, taps.t(), Point(-1, -1), 0, BORDER_REFLECT_101);
+    if (!inputShading.empty())
+        for (int r = 0; r < mean.rows; ++r) {
+            float* m = mean.ptr<float>(r);
+            const float *bd = inputShading.perGainRow(r), *br = inputShading.offsetRow(r);
+            for (int c = 0; c < mean.cols; ++c)
+                m[c] -= inputShading.at(bd, br, c);
+        }
     return mean;
 }
 
@@ -361,31 +367,28 @@ bool ColorJitter::isIdentity() const
     return contrast == Vec4d::all(1) && brightness == 0 && gainRatio == 1;
 }
 
-void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& model, const ColorJitter& jitter,
-                 const NoiseOptions& noise, uint64 seed, OutputArray _dst, RawFormat& dstFormat,
-                 AugmentReport* report, OutputArray saturatedMask)
+namespace detail {
+
+void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
+                     const ColorJitter& jitter, const NoiseOptions& noise, uint64 seed, OutputArray _dst,
+                     RawFormat& dstFormat, AugmentReport* report, OutputArray saturatedMask)
 {
     const auto start = std::chrono::steady_clock::now();
-    const Mat src = detail::twoDimensional(_src, "colorJitter: src");
-    detail::checkMosaicInput(src, "colorJitter");
+    checkMosaicInput(src, "colorJitter");
     format.validate();
-    model.validate();
-    noise.validate();
-    if (noise.alignment != NoiseAlignment::NONE)
-        detail::checkDarkShadingSize(model, src.size(), format.sensorOrigin, "colorJitter");
     for (int s = 0; s < 4; ++s)
-        detail::checkFinitePositive(jitter.contrast[s], "colorJitter: contrast");
+        checkFinitePositive(jitter.contrast[s], "colorJitter: contrast");
     if (!std::isfinite(jitter.brightness))
         CV_Error(Error::StsBadArg, "colorJitter: brightness must be finite");
-    detail::checkFinitePositive(jitter.gainRatio, "colorJitter: gainRatio");
+    checkFinitePositive(jitter.gainRatio, "colorJitter: gainRatio");
     const double newGain = format.gain * jitter.gainRatio;
-    detail::checkFinitePositive(newGain, "colorJitter: the new gain");
+    checkFinitePositive(newGain, "colorJitter: the new gain");
     // The model's terms at the input gain and at the output gain (its own line there with measured lines).
-    const detail::NoiseTerms<double> terms = detail::checkedNoiseTerms(model, format.gain);
-    const detail::NoiseTerms<double> outTerms = detail::checkedNoiseTerms(model, newGain);
+    const StepNoise step(model, format, noise, jitter.gainRatio, src.size(), "colorJitter");
+    const NoiseTerms<double>&terms = step.in, &outTerms = step.out;
     {
         // The row loops run in float: the largest value and variance they can form must fit one.
-        const detail::NoiseTerms<double>& t = terms;
+        const NoiseTerms<double>& t = terms;
         double largestContrast = 0;
         for (int s = 0; s < 4; ++s)
             largestContrast = std::max(largestContrast, jitter.contrast[s]);
@@ -405,7 +408,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
 
     if (jitter.isIdentity()) {
         // Skipped entirely: no copy, no random draw.
-        detail::reportSaturation(src, format, report, saturatedMask);
+        reportSaturation(src, format, report, saturatedMask);
         _dst.assign(src);
         dstFormat = format;
         return;
@@ -417,7 +420,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     }
     k.pb = static_cast<float>(jitter.brightness);
     k.pg = static_cast<float>(jitter.gainRatio);
-    k.white = detail::outputWhite(format, src.depth());
+    k.white = outputWhite(format, src.depth());
     k.in = {static_cast<float>(terms.shot), static_cast<float>(terms.readBeforeGain),
             static_cast<float>(terms.readAfterGain)};
     k.alignment = noise.alignment;
@@ -425,7 +428,7 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
     k.lineBySite = noise.alignment == NoiseAlignment::ACCOUNT_PRIOR && jitter.brightness == 0;
     // The output gain's line: the model's own there with measured lines, else Eq. 5's scaling of the
     // input's (in float, as jitterVariance() had it).
-    k.measured = model.hasMeasuredLines();
+    k.measured = step.measured;
     const double pg2 = jitter.gainRatio * jitter.gainRatio;
     if (k.measured) {
         k.shotOut = static_cast<float>(outTerms.shot);
@@ -445,42 +448,46 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
             perSiteLine(jitter.contrast[s], jitter.gainRatio, terms, k.slope[s], k.offset[s]);
     }
 
-    const detail::ShadingRows inputShading =
-        noise.alignment == NoiseAlignment::ACCOUNT_PRIOR && model.hasDarkShading()
-            ? detail::ShadingRows(model, format.gain, format.sensorOrigin)
-            : detail::ShadingRows();
-    Mat prior = noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && noise.alignment != NoiseAlignment::NONE
-                    ? localPriorMean(src, format)
+    const DarkShading inputShading =
+        noise.alignment == NoiseAlignment::ACCOUNT_PRIOR ? step.shading : DarkShading();
+    Mat prior = noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && step.addsNoise()
+                    ? localPriorMean(src, format, inputShading)
                     : Mat();
-    if (!prior.empty() && !inputShading.empty())
-        prior -= model.darkShadingAt(format.gain)(Rect(format.sensorOrigin, src.size()));
-    k.dark = jitterDarkTerms(model, format.gain, format.sensorOrigin, jitter, noise.alignment);
-    Mat dst = detail::stepOutput(src, _dst);
+    k.dark = jitterDarkTerms(step, jitter);
+    Mat dst = stepOutput(src, _dst);
     std::atomic<int64> brightening{0};
     std::atomic<bool> nonFinite{false};
-    const JitterKeys keys = {detail::stepKey(seed, detail::RandomStream::JITTER_GAUSSIAN),
-                             detail::stepKey(seed, detail::RandomStream::JITTER_POISSON),
-                             detail::stepKey(seed, detail::RandomStream::JITTER_ROW),
-                             detail::stepKey(seed, detail::RandomStream::JITTER_TUKEY)};
+    const JitterKeys keys = {
+        stepKey(seed, RandomStream::JITTER_GAUSSIAN), stepKey(seed, RandomStream::JITTER_POISSON),
+        stepKey(seed, RandomStream::JITTER_ROW), stepKey(seed, RandomStream::JITTER_TUKEY)};
     const JitterColumnTables tables(k, src.cols);
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
-            jitterRows<ushort>(src, prior, dst, model, k, tables, keys, inputShading, rows, brightening,
-                               nonFinite);
+            jitterRows<ushort>(src, prior, dst, k, tables, keys, inputShading, rows, brightening, nonFinite);
         else
-            jitterRows<float>(src, prior, dst, model, k, tables, keys, inputShading, rows, brightening,
-                              nonFinite);
+            jitterRows<float>(src, prior, dst, k, tables, keys, inputShading, rows, brightening, nonFinite);
     });
     if (nonFinite)
-        detail::throwNonFiniteShading("colorJitter");
-    detail::reportSaturation(src, format, report, saturatedMask);
+        throwNonFiniteShading("colorJitter");
+    reportSaturation(src, format, report, saturatedMask);
     _dst.assign(dst);
     dstFormat = format;
     dstFormat.gain = newGain;
     if (report) {
         report->brighteningPixels += brightening.load();
-        detail::recordStep(report, "colorJitter", start);
+        recordStep(report, "colorJitter", start);
     }
+}
+
+} // namespace detail
+
+void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& model, const ColorJitter& jitter,
+                 const NoiseOptions& noise, uint64 seed, OutputArray dst, RawFormat& dstFormat,
+                 AugmentReport* report, OutputArray saturatedMask)
+{
+    const Mat src = detail::twoDimensional(_src, "colorJitter: src");
+    detail::colorJitterStep(src, format, detail::ValidatedNoiseModel(model), jitter, noise, seed, dst,
+                            dstFormat, report, saturatedMask);
 }
 
 } // namespace rawgment

@@ -241,13 +241,16 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
 
 } // namespace
 
-void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& model, InputArray _kernel,
-                const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
+namespace detail {
+
+void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
+                    InputArray _kernel, const NoiseOptions& noise, uint64 seed, OutputArray _dst,
+                    AugmentReport* report)
 {
     const auto start = std::chrono::steady_clock::now();
-    const Mat src = detail::twoDimensional(_src, "motionBlur: src");
-    detail::checkResampleInput(src, format, model, noise, "motionBlur");
-    const Mat w = detail::normalisedKernel(_kernel, "motionBlur");
+    checkResampleInput(src, format, "motionBlur");
+    const StepNoise step(model, format, noise, 1, src.size(), "motionBlur");
+    const Mat w = normalisedKernel(_kernel, "motionBlur");
     if (w.total() == 1) {
         _dst.assign(src);
         return;
@@ -261,18 +264,17 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
                 taps.push_back({y, x, static_cast<float>(wk), static_cast<float>(wk * (1 - wk))});
         }
     std::atomic<bool> nonFinite{false};
-    ResampleConstants k =
-        resampleConstants(src.depth(), format, model, noise, seed, detail::RandomStream::BLUR_GAUSSIAN,
-                          detail::RandomStream::BLUR_POISSON);
+    ResampleConstants k = resampleConstants(src.depth(), format, step, seed, RandomStream::BLUR_GAUSSIAN,
+                                            RandomStream::BLUR_POISSON);
     const float readFactor = static_cast<float>(1 - w.dot(w));
     k.nonFiniteShading = &nonFinite;
-    if (model.hasDarkComponents()) {
+    if (step.hasDarkComponents()) {
         Mat w2 = w.mul(w);
-        resampleDarkTerms(k, model, format, src.size(), sum(w2)[0], w2.dot(w2), seed,
-                          detail::RandomStream::BLUR_ROW, detail::RandomStream::BLUR_TUKEY);
+        resampleDarkTerms(k, step, sum(w2)[0], w2.dot(w2), seed, RandomStream::BLUR_ROW,
+                          RandomStream::BLUR_TUKEY);
     }
     const bool shotFromMean = noise.blurNoiseSum == BlurNoiseSum::FROM_BLURRED_MEAN;
-    Mat dst = detail::stepOutput(src, _dst);
+    Mat dst = stepOutput(src, _dst);
     parallel_for_(Range(0, src.rows / 2), [&](const Range& range) {
         if (src.depth() == CV_16U)
             blurPlaneRows<ushort>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
@@ -280,9 +282,18 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
             blurPlaneRows<float>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
     });
     if (nonFinite)
-        detail::throwNonFiniteShading("motionBlur");
+        throwNonFiniteShading("motionBlur");
     _dst.assign(dst);
-    detail::recordStep(report, "motionBlur", start);
+    recordStep(report, "motionBlur", start);
+}
+
+} // namespace detail
+
+void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& model, InputArray kernel,
+                const NoiseOptions& noise, uint64 seed, OutputArray dst, AugmentReport* report)
+{
+    const Mat src = detail::twoDimensional(_src, "motionBlur: src");
+    detail::motionBlurStep(src, format, detail::ValidatedNoiseModel(model), kernel, noise, seed, dst, report);
 }
 
 } // namespace rawgment

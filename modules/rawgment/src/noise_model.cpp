@@ -1,5 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "opencv2/rawgment/noise_model.hpp"
+#include "dark_shading.hpp"
 #include "noise_terms.hpp"
 #include "precomp.hpp"
 
@@ -122,15 +123,11 @@ Mat NoiseModel::darkShadingAt(double gain) const
     detail::checkFinitePositive(gain, "gain");
     if (!hasDarkShading())
         return Mat();
-    // In float, as the noise steps read it row by row (detail::ShadingRows): one formula, the same bits.
-    const float g = static_cast<float>(gain);
+    // Through the noise steps' own reader of the maps: one formula, the same bits.
+    const detail::DarkShading shading(darkShadingPerGain, darkShadingOffset, gain, Point());
     Mat s(darkShadingPerGain.size(), CV_32FC1);
-    for (int r = 0; r < s.rows; ++r) {
-        const float *bd = darkShadingPerGain.ptr<float>(r), *br = darkShadingOffset.ptr<float>(r);
-        float* out = s.ptr<float>(r);
-        for (int c = 0; c < s.cols; ++c)
-            out[c] = g * bd[c] + br[c];
-    }
+    for (int r = 0; r < s.rows; ++r)
+        shading.row(r, s.cols, s.ptr<float>(r));
     return s;
 }
 
@@ -138,7 +135,12 @@ namespace detail {
 
 NoiseTerms<double> checkedNoiseTerms(const NoiseModel& model, double gain)
 {
-    model.validate();
+    return ValidatedNoiseModel(model).termsAt(gain);
+}
+
+NoiseTerms<double> ValidatedNoiseModel::termsAt(double gain) const
+{
+    const NoiseModel& model = model_;
     checkFinitePositive(gain, "gain");
     const NoiseTerms<double> t = model.hasMeasuredLines()
                                      ? measuredTermsAt(model, gain)

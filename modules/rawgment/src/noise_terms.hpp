@@ -41,9 +41,24 @@ template <typename T> inline NoiseTerms<T> noiseTermsAt(T gain, T alpha, T sigma
     return {gain * alpha, gain * gain * sigmaD2, sigmaR2};
 }
 
-/** The terms of a model at linear gain g, after checking both: throws StsBadArg when the model is
- * invalid, the gain is not finite and positive, or a term overflows. NoiseModel::lineAtGain() is
- * built from it. With measured lines, measuredTermsAt(); else noiseTermsAt() of Eq. 5's parameters. */
+/** A NoiseModel that passed NoiseModel::validate(), once: the only way to its terms without a second
+ * validation. A noise step builds everything it needs from one (StepNoise, step_noise.hpp), and a scene
+ * makes one for all its steps. Holds a reference: it lives no longer than the call that made it. */
+class ValidatedNoiseModel
+{
+public:
+    explicit ValidatedNoiseModel(const NoiseModel& model) : model_(model) { model.validate(); }
+    const NoiseModel& model() const { return model_; }
+    /** The terms at linear gain g: throws StsBadArg when the gain is not finite and positive or a term
+     * overflows. With measured lines, measuredTermsAt(); else noiseTermsAt() of Eq. 5's parameters. */
+    NoiseTerms<double> termsAt(double gain) const;
+
+private:
+    const NoiseModel& model_;
+};
+
+/** The terms of a model at linear gain g, after checking both (ValidatedNoiseModel::termsAt() of a model
+ * validated for this call). NoiseModel::lineAtGain() is built from it. */
 CV_RAWGMENT_EXPORTS NoiseTerms<double> checkedNoiseTerms(const NoiseModel& model, double gain);
 
 /** The terms of a model with measured lines (NoiseModel::measuredLines, which says how they are

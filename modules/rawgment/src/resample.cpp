@@ -118,14 +118,15 @@ bool resampledDarkRow(const ResampleConstants& k, int site, int planeRow, float 
         detail::CounterRng rng(k.rowKey, static_cast<uint64_t>(r));
         amp = static_cast<float>(std::sqrt(std::max(added, 0.0)) * rng.gaussian());
     }
-    if (!k.dark.shading) {
+    const detail::DarkShading& shading = k.dark.shading;
+    if (shading.empty()) {
         std::fill(extra, extra + n, amp);
         return true;
     }
-    const float *bd = k.shading.perGainRow(r) + site % 2, *br = k.shading.offsetRow(r) + site % 2;
+    const float *bd = shading.perGainRow(r) + site % 2, *br = shading.offsetRow(r) + site % 2;
     float check = 0; // as in detail::darkRowExtra(): NaN when a map value is not finite
     for (int j = 0; j < n; ++j) {
-        extra[j] = amp + k.shading.at(bd, br, 2 * j);
+        extra[j] = amp + shading.at(bd, br, 2 * j);
         check += (bd[2 * j] - bd[2 * j]) + (br[2 * j] - br[2 * j]);
     }
     return check == 0;
@@ -224,54 +225,46 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
     }
 }
 
-ResampleConstants resampleConstants(int depth, const RawFormat& format, const NoiseModel& model,
-                                    const NoiseOptions& noise, uint64 seed, detail::RandomStream gaussian,
-                                    detail::RandomStream poisson)
+ResampleConstants resampleConstants(int depth, const RawFormat& format, const StepNoise& step, uint64 seed,
+                                    detail::RandomStream gaussian, detail::RandomStream poisson)
 {
-    const detail::NoiseTerms<double> terms = detail::checkedNoiseTerms(model, format.gain);
     ResampleConstants k;
     for (int s = 0; s < 4; ++s)
         k.black[s] = static_cast<float>(format.blackLevel[s]);
     k.white = detail::outputWhite(format, depth); // storeMosaicRow() converts through int32
-    k.shot = static_cast<float>(terms.shot);
-    k.floorVar = static_cast<float>(terms.read());
-    k.alignment = noise.alignment;
-    k.sampling = noise.shotSampling;
+    k.shot = static_cast<float>(step.in.shot);
+    k.floorVar = static_cast<float>(step.in.read());
+    k.alignment = step.options.alignment;
+    k.sampling = step.options.shotSampling;
     k.key = detail::stepKey(seed, gaussian);
     k.poissonKey = detail::stepKey(seed, poisson);
     return k;
 }
 
-void resampleDarkTerms(ResampleConstants& k, const NoiseModel& model, const RawFormat& format, Size size,
-                       double sumW2, double sumW4, uint64 seed, detail::RandomStream rowStream,
-                       detail::RandomStream tukeyStream)
+void resampleDarkTerms(ResampleConstants& k, const StepNoise& step, double sumW2, double sumW4, uint64 seed,
+                       detail::RandomStream rowStream, detail::RandomStream tukeyStream)
 {
-    if (k.alignment == NoiseAlignment::NONE)
+    if (!step.addsNoise())
         return;
-    detail::checkDarkShadingSize(model, size, format.sensorOrigin, "the resampling step");
     detail::DarkTerms& d = k.dark;
-    d.row = model.hasRowNoise();
-    d.shading = model.hasDarkShading();
-    d.tails = model.tukeyRead;
-    d.origin = format.sensorOrigin;
-    k.rowVariance = model.rowVariance(format.gain);
+    d.row = step.rowNoise;
+    d.shading = step.shading;
+    d.tails = step.tails;
+    k.rowVariance = step.rowVariance(step.gainIn);
     k.rowKey = detail::stepKey(seed, rowStream);
     k.tukeyKey = detail::stepKey(seed, tukeyStream);
     const bool account = k.alignment == NoiseAlignment::ACCOUNT_PRIOR;
     if (d.tails) {
         const double b = k.floorVar;
         const double lambda =
-            account ? detail::addedReadLambda(model.tukeyLambda, b, sumW4 * b * b, (1 - sumW2) * b)
-                    : model.tukeyLambda;
+            account ? detail::addedReadLambda(step.tukeyLambda, b, sumW4 * b * b, (1 - sumW2) * b)
+                    : step.tukeyLambda;
         // One shape for every site, so one table (a plane row is one site).
         d.tailTable[0] = detail::TukeyQuantileTable(
             static_cast<float>(lambda), static_cast<float>(detail::TukeyUnitSampler(lambda).invSd));
     }
-    if (d.shading) {
-        k.shading = detail::ShadingRows(model, format.gain, format.sensorOrigin);
-        if (account)
-            k.inputShading = k.shading;
-    }
+    if (account)
+        k.inputShading = d.shading;
 }
 
 } // namespace detail
@@ -387,12 +380,14 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
 
 } // namespace
 
-void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& model, double scale,
-                 const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
+namespace detail {
+
+void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model, double scale,
+                     const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
 {
     const auto start = std::chrono::steady_clock::now();
-    const Mat src = detail::twoDimensional(_src, "scaleMosaic: src");
-    detail::checkResampleInput(src, format, model, noise, "scaleMosaic");
+    checkResampleInput(src, format, "scaleMosaic");
+    const StepNoise step(model, format, noise, 1, src.size(), "scaleMosaic");
     if (!std::isfinite(scale) || !(scale > 0))
         CV_Error(Error::StsBadArg, cv::format("scaleMosaic: scale must be finite and > 0 (got %g)", scale));
     if (scale == 1) {
@@ -402,11 +397,10 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
     const BilinearAxis cols[2] = {bilinearAxis(src.cols / 2, 0, scale), bilinearAxis(src.cols / 2, 1, scale)};
     const BilinearAxis rows[2] = {bilinearAxis(src.rows / 2, 0, scale), bilinearAxis(src.rows / 2, 1, scale)};
     std::atomic<bool> nonFinite{false};
-    ResampleConstants k =
-        resampleConstants(src.depth(), format, model, noise, seed, detail::RandomStream::SCALE_GAUSSIAN,
-                          detail::RandomStream::SCALE_POISSON);
+    ResampleConstants k = resampleConstants(src.depth(), format, step, seed, RandomStream::SCALE_GAUSSIAN,
+                                            RandomStream::SCALE_POISSON);
     k.nonFiniteShading = &nonFinite;
-    if (model.hasDarkComponents()) {
+    if (step.hasDarkComponents()) {
         // The typical weights: sum w^2 and sum w^4 of the bilinear taps averaged over the output pixels
         // (a product of the two axes' averages).
         double axis2[2] = {0, 0}, axis4[2] = {0, 0};
@@ -420,10 +414,10 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
                     axis4[a] += (std::pow(f, 4) + std::pow(1 - f, 4)) / (2.0 * n);
                 }
         }
-        resampleDarkTerms(k, model, format, src.size(), axis2[0] * axis2[1], axis4[0] * axis4[1], seed,
-                          detail::RandomStream::SCALE_ROW, detail::RandomStream::SCALE_TUKEY);
+        resampleDarkTerms(k, step, axis2[0] * axis2[1], axis4[0] * axis4[1], seed, RandomStream::SCALE_ROW,
+                          RandomStream::SCALE_TUKEY);
     }
-    Mat dst = detail::stepOutput(src, _dst);
+    Mat dst = stepOutput(src, _dst);
     parallel_for_(Range(0, src.rows / 2), [&](const Range& range) {
         if (src.depth() == CV_16U)
             scalePlaneRows<ushort>(src, dst, cols, rows, k, range);
@@ -431,9 +425,18 @@ void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& mod
             scalePlaneRows<float>(src, dst, cols, rows, k, range);
     });
     if (nonFinite)
-        detail::throwNonFiniteShading("scaleMosaic");
+        throwNonFiniteShading("scaleMosaic");
     _dst.assign(dst);
-    detail::recordStep(report, "scale", start);
+    recordStep(report, "scale", start);
+}
+
+} // namespace detail
+
+void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& model, double scale,
+                 const NoiseOptions& noise, uint64 seed, OutputArray dst, AugmentReport* report)
+{
+    const Mat src = detail::twoDimensional(_src, "scaleMosaic: src");
+    detail::scaleMosaicStep(src, format, detail::ValidatedNoiseModel(model), scale, noise, seed, dst, report);
 }
 
 Rect scaleBox(const Rect& box, Size size, double scale)

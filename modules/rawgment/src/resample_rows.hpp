@@ -25,11 +25,10 @@ struct ResampleConstants
     ShotNoiseSampling sampling;
     uint64_t key, poissonKey; // the step's Gaussian and Poisson streams
     // The dark-frame components (resampleDarkTerms()): the rows' variance to restore, the shading to
-    // restore, the tails; their streams; the model that holds the maps.
+    // restore (dark.shading, the target's, added after the step), the tails; their streams.
     DarkTerms dark;
     double rowVariance = 0;   // the input's row variance at its gain
-    ShadingRows inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out before the step
-    ShadingRows shading;      // the target's dark shading, added after it
+    DarkShading inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out before the step
     uint64_t rowKey = 0, tukeyKey = 0;
     std::atomic<bool>* nonFiniteShading = nullptr; // set when a shading row held NaN or Inf
 };
@@ -61,7 +60,7 @@ void storeMosaicRow(const float* even, const float* odd, float* d, int width);
 // on each side.
 template <typename T>
 void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, float* out,
-                  const ShadingRows& shading = ShadingRows())
+                  const DarkShading& shading = DarkShading())
 {
     const int width = src.cols / 2;
     siteColumns(src.ptr<T>(2 * planeRow + site / 2), site % 2, width, black, out + pad);
@@ -83,9 +82,8 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
                     RowScratch& scratch, const ResampleConstants& k, int n, int site, int planeRow,
                     float rowKeep = 1);
 
-ResampleConstants resampleConstants(int depth, const RawFormat& format, const NoiseModel& model,
-                                    const NoiseOptions& noise, uint64 seed, RandomStream gaussian,
-                                    RandomStream poisson);
+ResampleConstants resampleConstants(int depth, const RawFormat& format, const StepNoise& step, uint64 seed,
+                                    RandomStream gaussian, RandomStream poisson);
 
 /* The dark-frame components a resampling step adds (docs/mathematics.md, "Dark-frame noise"). The step
  * keeps the gain, so the target has the input's components in full. A weighted sum keeps sum W^2 of the
@@ -96,9 +94,8 @@ ResampleConstants resampleConstants(int depth, const RawFormat& format, const No
  * lambda is addedReadLambda() with the step's typical weights (sumW2, sumW4; per pixel they vary near
  * edges and, for scaling, along the row: the variance stays exact per pixel, the kurtosis is matched
  * on average). */
-void resampleDarkTerms(ResampleConstants& k, const NoiseModel& model, const RawFormat& format, Size size,
-                       double sumW2, double sumW4, uint64 seed, RandomStream rowStream,
-                       RandomStream tukeyStream);
+void resampleDarkTerms(ResampleConstants& k, const StepNoise& step, double sumW2, double sumW4, uint64 seed,
+                       RandomStream rowStream, RandomStream tukeyStream);
 
 } // namespace detail
 } // namespace rawgment

@@ -154,10 +154,9 @@ void shiftMosaic(const Mat& src, Point shift, Mat& dst)
  * kept in range). Clipped pixels stay clipped. Row by row, from ShiftSource's pixels as shiftMosaic() copied
  * them. */
 template <typename T>
-void swapShiftedShading(const Mat& src, const RawFormat& format, const NoiseModel& model, Point shift,
-                        Mat& dst)
+void swapShiftedShading(const Mat& src, const RawFormat& format, const detail::DarkShading& shading,
+                        Point shift, Mat& dst)
 {
-    const detail::ShadingRows shading(model, format.gain, format.sensorOrigin);
     const ShiftSource from(src.size(), shift);
     const float white = static_cast<float>(format.whiteLevel);
     const float highest = src.depth() == CV_16U ? 65535.f : std::numeric_limits<float>::max();
@@ -197,7 +196,7 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
     Mat current = detail::twoDimensional(_src, "applyScene: src");
     detail::checkMosaicInput(current, "applyScene");
     format.validate();
-    model.validate();
+    const detail::ValidatedNoiseModel valid(model); // once for every step of the scene
     if (current.rows % 2 || current.cols % 2)
         CV_Error(Error::StsBadArg, "applyScene: the mosaic needs even sides");
     RawFormat fmt = format;
@@ -222,12 +221,12 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
         Mat shifted;
         shiftMosaic(current, shift, shifted);
         // The dark shading belongs to the sensor, not to the content: it must not move with the shift.
-        if (model.hasDarkShading() && scene.noise.alignment != NoiseAlignment::NONE) {
-            detail::checkDarkShadingSize(model, current.size(), fmt.sensorOrigin, "applyScene");
+        const detail::StepNoise step(valid, fmt, scene.noise, 1, current.size(), "applyScene");
+        if (!step.shading.empty()) {
             if (current.depth() == CV_16U)
-                swapShiftedShading<ushort>(current, fmt, model, shift, shifted);
+                swapShiftedShading<ushort>(current, fmt, step.shading, shift, shifted);
             else
-                swapShiftedShading<float>(current, fmt, model, shift, shifted);
+                swapShiftedShading<float>(current, fmt, step.shading, shift, shifted);
         }
         current = shifted;
         if (boxes)
@@ -236,14 +235,15 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
         detail::recordStep(report, "shift", start);
     }
     if (scene.scale != 1) {
-        scaleMosaic(current, fmt, model, scene.scale, scene.noise, seed, current, report);
+        detail::scaleMosaicStep(current, fmt, valid, scene.scale, scene.noise, seed, current, report);
         if (boxes)
             for (Rect& b : *boxes)
                 b = scaleBox(b, current.size(), scene.scale);
     }
-    colorJitter(current, fmt, model, scene.jitter, scene.noise, seed, current, fmt, report);
+    detail::colorJitterStep(current, fmt, valid, scene.jitter, scene.noise, seed, current, fmt, report,
+                            noArray());
     if (!isIdentityKernel(scene.motionKernel))
-        motionBlur(current, fmt, model, scene.motionKernel, scene.noise, seed, current, report);
+        detail::motionBlurStep(current, fmt, valid, scene.motionKernel, scene.noise, seed, current, report);
     _dst.assign(current);
     dstFormat = fmt;
 }
