@@ -1,0 +1,317 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The resampling steps (paper Eq. 15): motion blur and scaling against captures, their noise sums, Poisson
+// draws, and the dark-frame components they restore.
+#include "test_augment_common.hpp"
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/rawgment/augment.hpp>
+#include <opencv2/rawgment/simulate.hpp>
+
+#include <functional>
+
+namespace cv {
+namespace rawgment {
+namespace {
+
+using namespace augment_test;
+
+TEST(Augment, motionBlurMatchesACaptureBlurredBeforeTheNoise)
+{
+    const Size size(128, 128);
+    const SensorSimulator sensor(test::referenceSensorParams(), size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(kGain);
+    Mat scene(size, CV_32FC1);
+    for (int c = 0; c < size.width; ++c) // bars of 16 columns: the blur mixes dark and bright photons
+        scene.col(c).setTo((c / 16) % 2 ? 1500.0 : 60.0);
+    const Mat kernel = linearMotionKernel(13, 0); // horizontal, the paper's largest length
+    std::vector<Mat> truth(kFrames), sharp = floatBurst(sensor, scene, 9);
+    for (int t = 0; t < kFrames; ++t) {
+        sensor.captureBlurred(scene, kernel, kGain, 1.0, 77, t, truth[t]);
+        truth[t].convertTo(truth[t], CV_32F);
+    }
+    Mat truthMean, truthVar;
+    temporalStats(truth, fmt, truthMean, truthVar);
+    // The simulator and the augmentation share one border rule (replicate), so every column counts.
+    const Rect inner(Point(0, 0), size);
+    double ratio[3];
+    for (NoiseAlignment mode : kAllAlignments) {
+        Mat mean, var;
+        statsAfterStep(
+            sharp, fmt,
+            [&](const Mat& frame, int t, Mat& out) {
+                motionBlur(frame, fmt, model, kernel, mode, 500 + t, out);
+            },
+            mean, var);
+        ratio[static_cast<int>(mode)] = cv::mean(var(inner))[0] / cv::mean(truthVar(inner))[0];
+        // The mean is the blurred mean whatever the mode. Column means over 128 rows x 64 frames, for
+        // both bursts: the difference has standard error sqrt(2 v / (64 * 128)); 5 of them.
+        for (int c = inner.x; c < inner.x + inner.width; ++c) {
+            const double v = cv::mean(truthVar.col(c))[0];
+            EXPECT_NEAR(cv::mean(mean.col(c))[0], cv::mean(truthMean.col(c))[0],
+                        5 * std::sqrt(2 * v / (64.0 * 128)))
+                << "column " << c;
+        }
+        if (mode == NoiseAlignment::ACCOUNT_PRIOR) {
+            // Column by column (edges included, where Eq. 15's per-pixel sum matters most): each column
+            // averages 128 variances of 64 frames, twice (truth and augmentation): the relative standard
+            // error of the ratio is sqrt(2) * sqrt(2 / 63) / sqrt(128) = 2.2%; 5 of them = 11%.
+            for (int c = inner.x; c < inner.x + inner.width; ++c) {
+                const double rc = cv::mean(var.col(c))[0] / cv::mean(truthVar.col(c))[0];
+                EXPECT_NEAR(rc, 1.0, 0.11) << "column " << c;
+            }
+        }
+    }
+    std::cout << "blur variance / true blurred capture: NONE " << ratio[0] << ", IGNORE_PRIOR " << ratio[1]
+              << ", ACCOUNT_PRIOR " << ratio[2] << "\n";
+    // Over the 16,384 pixels the standard error is 0.55%: 3% is more than 5 of them.
+    EXPECT_NEAR(ratio[2], 1.0, 0.03);
+    EXPECT_LT(ratio[0], 0.5); // a plain blur smooths the read noise too: far too clean
+    EXPECT_GT(ratio[1], 1.03);
+}
+
+TEST(Augment, motionBlurMergesTapsThatReplicateOneEdgePixel)
+{
+    // A flat burst blurred with a peaked 5x5 kernel: at the frame's edges several taps replicate one
+    // pixel, whose prior noise the blur keeps with the square of their summed weight. Eq. 15 over the
+    // distinct pixels gives back exactly the input's variance everywhere; over the taps it would leave
+    // 20-50% too much at the edges and corners.
+    const Size size(128, 128);
+    const SensorSimulator sensor(test::referenceSensorParams(), size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(kGain);
+    const std::vector<Mat> burst = floatBurst(sensor, Mat(size, CV_32FC1, Scalar(800)), 31);
+    const Mat taps = (Mat_<float>(1, 5) << 1, 4, 6, 4, 1);
+    const Mat kernel = taps.t() * taps;
+    Mat mean, var;
+    statsAfterStep(
+        burst, fmt,
+        [&](const Mat& frame, int t, Mat& out) {
+            motionBlur(frame, fmt, model, kernel, NoiseAlignment::ACCOUNT_PRIOR, 40 + t, out);
+        },
+        mean, var);
+    const double truth = model.variance(800 * kGain, kGain);
+    // Averages of 128 pixels (a row or column) or 16 (a 4x4 corner) of 64-frame variances: relative
+    // standard errors sqrt(2 / 63) / sqrt(n) = 1.6% and 4.5%; 5 of them.
+    const double lineTolerance = 5 * std::sqrt(2.0 / 63) / std::sqrt(128.0);
+    const double cornerTolerance = 5 * std::sqrt(2.0 / 63) / 4;
+    for (int k : {0, 1, 2, 3, size.width - 4, size.width - 3, size.width - 2, size.width - 1}) {
+        EXPECT_NEAR(cv::mean(var.col(k))[0] / truth, 1.0, lineTolerance) << "column " << k;
+        EXPECT_NEAR(cv::mean(var.row(k))[0] / truth, 1.0, lineTolerance) << "row " << k;
+    }
+    for (Point corner : {Point(0, 0), Point(size.width - 4, 0), Point(0, size.height - 4),
+                         Point(size.width - 4, size.height - 4)})
+        EXPECT_NEAR(cv::mean(var(Rect(corner, Size(4, 4))))[0] / truth, 1.0, cornerTolerance)
+            << "corner " << corner;
+}
+
+TEST(Augment, scaleKeepsTheModelVarianceAtEveryInterpolationPosition)
+{
+    const Size size(128, 128);
+    const SensorSimulator sensor(test::referenceSensorParams(), size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(kGain);
+    const NoiseLine line = model.lineAtGain(kGain);
+    // A horizontal ramp: the model variance is linear in the mean, so a bilinear mix of truly noisy
+    // pixels must have exactly the model variance at the mixed mean (Eq. 15 with interpolation weights).
+    Mat scene(size, CV_32FC1);
+    for (int c = 0; c < size.width; ++c)
+        scene.col(c).setTo(50.0 + 12.0 * c);
+    const std::vector<Mat> burst = floatBurst(sensor, scene, 21);
+    for (double scale : {1.03, 0.97}) {
+        double worstNone = 1;
+        for (NoiseAlignment mode : kAllAlignments) {
+            Mat mean, var;
+            statsAfterStep(
+                burst, fmt,
+                [&](const Mat& frame, int t, Mat& out) {
+                    scaleMosaic(frame, fmt, model, scale, mode, 900 + t, out);
+                },
+                mean, var);
+            const Mat expected = line.a * mean + line.b;
+            double total = 0;
+            // Columns away from the left/right edges, where replication makes constant patches.
+            for (int c = 8; c < size.width - 8; ++c) {
+                const double ratio = cv::mean(var.col(c))[0] / cv::mean(expected.col(c))[0];
+                total += ratio;
+                if (mode == NoiseAlignment::NONE)
+                    worstNone = std::min(worstNone, ratio);
+                // A column averages 128 variances of 64 frames (relative standard error sqrt(2/63) =
+                // 17.8% each); neighbouring rows share source rows, so count 64 independent ones:
+                // 2.2%, and 5 of them is 11%.
+                if (mode == NoiseAlignment::ACCOUNT_PRIOR) {
+                    EXPECT_NEAR(ratio, 1.0, 0.11) << "scale " << scale << ", column " << c;
+                }
+            }
+            const double average = total / (size.width - 16);
+            std::cout << "scale " << scale << ", mode " << static_cast<int>(mode)
+                      << ": variance / model, average over columns " << average << "\n";
+            if (mode == NoiseAlignment::ACCOUNT_PRIOR) { // ~14,000 pixels, half independent: 0.8% s.e.
+                EXPECT_NEAR(average, 1.0, 0.04);
+            }
+            if (mode == NoiseAlignment::IGNORE_PRIOR) { // the prior noise is counted twice
+                EXPECT_GT(average, 1.1);
+            }
+        }
+        // Halfway between two pixels in both directions a bilinear mix keeps a quarter of the
+        // variance; columns at x fraction 0.5 keep at most half: plain resampling is far too clean.
+        EXPECT_LT(worstNone, 0.75) << "scale " << scale;
+    }
+}
+
+TEST(Augment, blurNoiseFromTheBlurredMeanIsExactWhereTheTapsAgree)
+{
+    // A noiseless float mosaic with a vertical edge: the added noise of the same seed differs between
+    // the two sums only through sqrt(v), so (out - plain blur) compares the variances pixel by pixel.
+    const Size size(64, 16);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d::all(64);
+    fmt.whiteLevel = 65535;
+    fmt.gain = 2;
+    Mat src(size, CV_32FC1);
+    for (int c = 0; c < size.width; ++c)
+        src.col(c).setTo(c < size.width / 2 ? 64 + 50 : 64 + 2000);
+    const auto noiseOf = [&](const Mat& kernel, BlurNoiseSum sum) {
+        NoiseOptions noise;
+        noise.blurNoiseSum = sum;
+        Mat plain, noisy;
+        motionBlur(src, fmt, model, kernel, NoiseAlignment::NONE, 3, plain);
+        motionBlur(src, fmt, model, kernel, noise, 3, noisy);
+        return Mat(noisy - plain);
+    };
+    const Mat uniform = Mat::ones(1, 5, CV_32F);
+    Mat exact = noiseOf(uniform, BlurNoiseSum::EXACT),
+        approx = noiseOf(uniform, BlurNoiseSum::FROM_BLURRED_MEAN);
+    // Equal weights: sum w (1 - w) x = (1 - sum w^2) mean, the approximation is exact (to float rounding).
+    EXPECT_LT(norm(exact, approx, NORM_INF), 1e-3);
+    const Mat skewed = (Mat_<float>(1, 3) << 0.7f, 0.2f, 0.1f);
+    exact = noiseOf(skewed, BlurNoiseSum::EXACT);
+    approx = noiseOf(skewed, BlurNoiseSum::FROM_BLURRED_MEAN);
+    // Flat away from the edge: the same. At the edge (plane column 15 sees both levels): the ratio of
+    // standard deviations the two formulas give there.
+    EXPECT_LT(norm(exact.colRange(0, 24), approx.colRange(0, 24), NORM_INF), 1e-3);
+    EXPECT_LT(norm(exact.colRange(40, 64), approx.colRange(40, 64), NORM_INF), 1e-3);
+    const NoiseLine line = model.lineAtGain(fmt.gain);
+    const double w[3] = {0.7, 0.2, 0.1}, level[3] = {50, 2000, 2000}; // plane columns 15, 16, 17
+    double exactShot = 0, blurred = 0, sumW2 = 0;
+    for (int t = 0; t < 3; ++t) {
+        exactShot += w[t] * (1 - w[t]) * level[t];
+        blurred += w[t] * level[t];
+        sumW2 += w[t] * w[t];
+    }
+    const double vExact = line.a * exactShot + (1 - sumW2) * line.b;
+    const double vApprox = line.a * (1 - sumW2) * blurred + (1 - sumW2) * line.b;
+    for (int r = 0; r < size.height; ++r) {
+        const int c = 2 * 15 + r % 2; // both sites of the row
+        const float e = exact.at<float>(r, c), a = approx.at<float>(r, c);
+        if (std::abs(e) > 1) { // far from zero, so the ratio is well conditioned
+            EXPECT_NEAR(a / e, std::sqrt(vApprox / vExact), 1e-3);
+        }
+    }
+}
+
+TEST(Augment, poissonSamplingKeepsTheVarianceOfBlurAndScale)
+{
+    // A noiseless flat frame of 20 DN above black: the added variance is all there is to measure.
+    const Size size(256, 256);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d::all(64);
+    fmt.whiteLevel = 65535;
+    fmt.gain = 4;
+    const Mat src(size, CV_32FC1, Scalar(64 + 20));
+    const Mat kernel = linearMotionKernel(9, 30);
+    for (int step = 0; step < 2; ++step) {
+        double var[2] = {0, 0};
+        for (ShotNoiseSampling sampling : {ShotNoiseSampling::GAUSSIAN, ShotNoiseSampling::POISSON}) {
+            NoiseOptions noise;
+            noise.shotSampling = sampling;
+            Mat out;
+            if (step == 0)
+                motionBlur(src, fmt, model, kernel, noise, 5, out);
+            else
+                scaleMosaic(src, fmt, model, 1.01, noise, 5, out);
+            double mean = 0;
+            spatialStats(out, fmt, mean, var[static_cast<int>(sampling)]);
+            EXPECT_NEAR(mean, 20, 0.1);
+        }
+        // Neighbouring outputs are independent draws; the variance differs between pixels (scale)
+        // but the frame averages are comparable: 5 x sqrt(2) x sqrt(3 / N) (kurtosis of a few-electron
+        // Poisson below 1) = 4.8%.
+        EXPECT_NEAR(var[1] / var[0], 1.0,
+                    5 * std::sqrt(2.0) * std::sqrt(3.0 / static_cast<double>(size.area())))
+            << (step == 0 ? "blur" : "scale");
+    }
+}
+
+TEST(Augment, blurAndScaleRestoreTheDarkFrameComponentsTheyAverageAway)
+{
+    // A dark flat scene at a high gain, where the components are a large part of the noise: the target
+    // of a blur or a scale of a flat scene is a plain capture (captureBlurred of a flat scene is one).
+    const Size size(256, 256);
+    const int T = 32;
+    const double gain = 8;
+    const SensorSimulator sensor(darkComponentSensor(size), size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(gain);
+    const double black = fmt.blackLevel[0];
+    const Mat scene(size, CV_32FC1, Scalar(2)); // 16 DN at gain 8: 5 electrons
+    std::vector<Mat> input, target;
+    sensor.captureBurst(scene, gain, 1.0, T, 9, input);
+    sensor.captureBurst(scene, gain, 1.0, T, 10, target);
+    const DarkStats truth = darkStats(target, black);
+    const Mat kernel = linearMotionKernel(9, 30);
+    typedef std::function<void(const Mat&, const NoiseOptions&, uint64, Mat&)> Step;
+    const std::pair<const char*, Step> steps[] = {
+        {"motionBlur", [&](const Mat& in, const NoiseOptions& o, uint64 seed,
+                           Mat& out) { motionBlur(in, fmt, model, kernel, o, seed, out); }},
+        {"scale 1.3", [&](const Mat& in, const NoiseOptions& o, uint64 seed, Mat& out) {
+             scaleMosaic(in, fmt, model, 1.3, o, seed, out);
+         }}};
+    // Tolerances as in darkeningAddsTheDarkFrameComponentsATargetCaptureHas.
+    const double rowTol = 5 * std::sqrt(2.0) * std::sqrt(2.0 / truth.dof);
+    const double pixTol = 5 * std::sqrt(2.0) *
+                          std::sqrt((2 + std::max(truth.kurtosis, 0.0)) / (truth.dof * (size.width - 1.0)));
+    const double patternTol = 5 * std::sqrt(2.0 / size.area());
+    for (const auto& step : steps) {
+        SCOPED_TRACE(step.first);
+        auto stats = [&](const NoiseOptions& o) {
+            std::vector<Mat> out(T);
+            for (int t = 0; t < T; ++t)
+                step.second(input[t], o, 300 + t, out[t]);
+            return darkStats(out, black);
+        };
+        NoiseOptions poisson;
+        poisson.shotSampling = ShotNoiseSampling::POISSON;
+        const DarkStats account = stats(poisson), none = stats(NoiseAlignment::NONE),
+                        ignore = stats(NoiseAlignment::IGNORE_PRIOR);
+        EXPECT_NEAR(account.rowMeanVar / truth.rowMeanVar, 1, rowTol) << "row-mean variance";
+        EXPECT_NEAR(account.pixelVar / truth.pixelVar, 1, pixTol) << "per-pixel variance";
+        EXPECT_NEAR(fixedPatternExcess(account, truth, T, size.width), 0, patternTol) << "fixed pattern";
+        // The added read part's shape matches the kurtosis of the step's typical weights: exact inside a
+        // blur, on average along a scaled row; the tolerance is statistical only, which the measured
+        // error (printed) stays within.
+        EXPECT_NEAR(account.kurtosis, truth.kurtosis, 5 * std::hypot(account.kurtosisSE, truth.kurtosisSE))
+            << "excess kurtosis";
+        EXPECT_LT(none.rowMeanVar / truth.rowMeanVar, 1 - rowTol) << "NONE averages the rows away";
+        EXPECT_LT(none.pixelVar / truth.pixelVar, 1 - pixTol) << "NONE averages the noise away";
+        EXPECT_GT(fixedPatternExcess(none, truth, T, size.width), patternTol) << "NONE blurs the pattern";
+        EXPECT_GT(ignore.rowMeanVar / truth.rowMeanVar, 1 + rowTol) << "IGNORE_PRIOR adds rows on top";
+        EXPECT_GT(ignore.pixelVar / truth.pixelVar, 1 + pixTol) << "IGNORE_PRIOR adds noise on top";
+        EXPECT_GT(fixedPatternExcess(ignore, truth, T, size.width), patternTol) << "IGNORE_PRIOR doubles it";
+        std::cout << step.first << ": row-mean var (capture " << truth.rowMeanVar << ") NONE "
+                  << none.rowMeanVar << ", IGNORE " << ignore.rowMeanVar << ", ACCOUNT " << account.rowMeanVar
+                  << "; pixel var (" << truth.pixelVar << ") " << none.pixelVar << ", " << ignore.pixelVar
+                  << ", " << account.pixelVar << "; kurtosis (" << truth.kurtosis << " +- "
+                  << truth.kurtosisSE << ") ACCOUNT " << account.kurtosis << "; pattern excess "
+                  << fixedPatternExcess(none, truth, T, size.width) << ", "
+                  << fixedPatternExcess(ignore, truth, T, size.width) << ", "
+                  << fixedPatternExcess(account, truth, T, size.width) << "\n";
+    }
+}
+
+} // namespace
+} // namespace rawgment
+} // namespace cv
