@@ -31,6 +31,11 @@ struct Target
 //! The bytes of a file; throws std::runtime_error naming it when it cannot be read.
 std::string readBytes(const std::string& path);
 
+/** Every file reader of the module and the apps (models, reports, scenes, policies, sidecars, manifests,
+ * camera profiles, .npy, RAW files, and emva1288Targets()), plus the canary: a reader with a planted bug
+ * (targets_readers.cpp). `dataDir` holds the shared test data (real RAW files as seeds). */
+std::vector<Target> readerTargets(const std::string& dataDir);
+
 //! The EMVA 1288 descriptor (with its figures) and one image of a series (targets_emva1288.cpp).
 std::vector<Target> emva1288Targets();
 

@@ -1,0 +1,164 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The apps in a row (simulate, calibrate, validate, augment) on small inputs, and validate's refusals.
+#include "app_runs.hpp"
+
+#include <gtest/gtest.h>
+#include <opencv2/rawgment.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+using namespace rawgment_app_tests;
+
+TEST(Apps, validateRefusesFramesOfAnotherSizeNamingTheFiles)
+{
+    // Target frames smaller than the bright ones were read out of bounds (ASan: heap-buffer-overflow).
+    const std::string dir = freshDir("validate_sizes");
+    for (const char* run : {"big --patch=40", "small --patch=20"}) {
+        const std::string name(run, std::string(run).find(' '));
+        const AppRun r =
+            runApp("rawgment_simulate", "--out='" + dir + "/" + name + "' --frames=3 --gains=12 " +
+                                            "--levels=0.5 --format=png " + (std::strchr(run, ' ') + 1));
+        ASSERT_EQ(0, r.status) << r.output;
+    }
+    std::ofstream(dir + "/mixed.yml")
+        << "%YAML:1.0\nvalidation_manifest:\n  gain_db: 12\n"
+        << "  bright: [big/validation/bright/frame_000.png, "
+           "big/validation/bright/frame_001.png]\n"
+        << "  targets:\n    - { factor: 0.5, files: [small/validation/x0.50/frame_000.png, "
+           "small/validation/x0.50/frame_001.png] }\n";
+    const AppRun r =
+        runApp("rawgment_validate", "'" + dir + "/mixed.yml' --model='" + dir +
+                                        "/big/truth_noise_model.yml' --out='" + dir + "/val' --plots=false");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("small/validation/x0.50/frame_000.png")) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("one size and type")) << r.output;
+}
+
+TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
+{
+    const std::string dir = freshDir("pipeline");
+    // 1. Simulate. 32 frames keep the test short and still pin the model (tolerances below).
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=32 --seed=5");
+    ASSERT_EQ(0, r.status) << r.output;
+    ASSERT_TRUE(exists(dir + "/sim/manifest.yml"));
+    ASSERT_TRUE(exists(dir + "/sim/validation_manifest.yml"));
+    r = runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=32 --seed=5");
+    EXPECT_EQ(1, r.status) << "a second run must not overwrite the first";
+    EXPECT_NE(std::string::npos, r.output.find("already exists")) << r.output;
+
+    // 2. Calibrate.
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + dir + "/cal'");
+    ASSERT_EQ(0, r.status) << r.output;
+    const cv::rawgment::NoiseModel truth = cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
+    const cv::rawgment::NoiseModel fitted = cv::rawgment::NoiseModel::load(dir + "/cal/noise_model.yml");
+    // The joint fit's spread over seeds at 100 frames is 0.08% / 0.45% / 1.7% (docs/performance.md,
+    // study_calibration); a variance of 32 frames is sqrt(99/31) = 1.8x noisier. The bounds are about 5 of
+    // those spreads.
+    EXPECT_NEAR(truth.alpha, fitted.alpha, 0.01 * truth.alpha);
+    EXPECT_NEAR(truth.sigmaD2, fitted.sigmaD2, 0.04 * truth.sigmaD2);
+    EXPECT_NEAR(truth.sigmaR2, fitted.sigmaR2, 0.15 * truth.sigmaR2);
+    for (const char* f : {"calibration_report.yml", "samples.csv", "lines.csv", "shapiro.csv"})
+        EXPECT_TRUE(exists(dir + "/cal/" + f)) << f;
+    for (const char* png :
+         {"calib_mean_variance.png", "calib_histograms.png", "calib_cross_gain.png", "shapiro_pvalue.png"})
+        expectPngDecodes(dir + "/cal/" + png);
+    const std::string modelBefore = readText(dir + "/cal/noise_model.yml");
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + dir + "/cal'");
+    EXPECT_EQ(1, r.status);
+    EXPECT_EQ(modelBefore, readText(dir + "/cal/noise_model.yml"))
+        << "an existing output is never overwritten";
+    // A run that died before its plots and its last table is completed by the same command.
+    std::remove((dir + "/cal/shapiro_pvalue.png").c_str());
+    std::remove((dir + "/cal/variance_ratio_histogram.csv").c_str());
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + dir + "/cal'");
+    EXPECT_EQ(0, r.status) << r.output;
+    expectPngDecodes(dir + "/cal/shapiro_pvalue.png");
+    EXPECT_TRUE(exists(dir + "/cal/variance_ratio_histogram.csv"));
+    EXPECT_EQ(modelBefore, readText(dir + "/cal/noise_model.yml"));
+    // ...but never over an output that is not what it computes.
+    std::remove((dir + "/cal/shapiro_pvalue.png").c_str());
+    std::ofstream(dir + "/cal/lines.csv") << "not these lines\n";
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + dir + "/cal'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_EQ("not these lines\n", readText(dir + "/cal/lines.csv"));
+
+    // 2b. The same bursts with the patches detected by cv::mcc (the sample's method) instead of given.
+    std::string manifest = readText(dir + "/sim/manifest.yml");
+    const size_t at = manifest.find("patches.yml");
+    ASSERT_NE(std::string::npos, at);
+    manifest.replace(at - 1, std::string("\"patches.yml\"").size(), "detect");
+    {
+        std::ofstream f(dir + "/sim/manifest_detect.yml");
+        f << manifest;
+    }
+    r = runApp("rawgment_calibrate",
+               "'" + dir + "/sim/manifest_detect.yml' --side=12 --plots=false --out='" + dir + "/cal_detect'",
+               AllocationStacks::FULL);
+    ASSERT_EQ(0, r.status) << r.output << manifest;
+    EXPECT_NE(std::string::npos, r.output.find("patches detected with cv::mcc")) << r.output;
+    // A quarter of the pixels of the given squares: alpha still within 2% (about 5 of its spreads).
+    EXPECT_NEAR(truth.alpha, cv::rawgment::NoiseModel::load(dir + "/cal_detect/noise_model.yml").alpha,
+                0.02 * truth.alpha);
+
+    // 3. Validate: ACCOUNT_PRIOR matches the real darker bursts, IGNORE_PRIOR overshoots, NONE undershoots.
+    r = runApp("rawgment_validate", "'" + dir + "/sim/validation_manifest.yml' --model='" + dir +
+                                        "/cal/noise_model.yml' --out='" + dir + "/val'");
+    ASSERT_EQ(0, r.status) << r.output;
+    expectPngDecodes(dir + "/val/validation.png");
+    std::istringstream csv(readText(dir + "/val/validation.csv"));
+    std::string line;
+    std::getline(csv, line);
+    double real = 0, none = 0, ignore = 0, account = 0;
+    int rows = 0;
+    while (std::getline(csv, line)) {
+        std::vector<double> v;
+        std::stringstream cells(line);
+        std::string cell;
+        while (std::getline(cells, cell, ','))
+            v.push_back(std::stod(cell));
+        ASSERT_EQ(11u, v.size()) << line;
+        if (v[0] != 0.5)
+            continue;
+        real += v[5];
+        none += v[6];
+        ignore += v[7];
+        account += v[8];
+        ++rows;
+    }
+    ASSERT_GT(rows, 3);
+    // Pooled over ~10k pixels x 31 degrees of freedom the ratio's noise is far below 1%; 3% allows for the
+    // model error of a 32-frame calibration. The prior noise of the x0.5 conversion is half the target's
+    // signal noise, so IGNORE_PRIOR lands ~1.5x high and NONE ~0.5x low.
+    EXPECT_NEAR(1.0, account / real, 0.03);
+    EXPECT_GT(ignore / real, 1.3);
+    EXPECT_LT(none / real, 0.7);
+
+    // 4. Augment two inputs twice each with a fixed scene; a second run resumes (skips everything).
+    writeExposureScene(dir + "/scene.yml", 0.25, 2.0);
+    const std::string in0 = dir + "/sim/g06dB_level0.90/frame_000.dng",
+                      in1 = dir + "/sim/g06dB_level0.90/frame_001.dng";
+    const std::string inputBytes = readText(in0);
+    const std::string args = "--model='" + dir + "/cal/noise_model.yml' --scene='" + dir +
+                             "/scene.yml' --out='" + dir + "/aug' --variants=2 --preview=true '" + in0 +
+                             "' '" + in1 + "'";
+    r = runApp("rawgment_augment", args);
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("wrote 4 outputs")) << r.output;
+    cv::Mat out;
+    const cv::rawgment::MosaicMetadata meta = cv::rawgment::readMosaic(dir + "/aug/frame_000_v01.dng", out);
+    EXPECT_NEAR(2.0 * cv::rawgment::dbToLinearGain(6), meta.format.gain, 1e-9)
+        << "the new gain is in the sidecar";
+    EXPECT_TRUE(meta.hasScene);
+    expectPngDecodes(dir + "/aug/frame_001_v00_preview.png");
+    r = runApp("rawgment_augment", args);
+    ASSERT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("skipped 4")) << r.output;
+    EXPECT_EQ(inputBytes, readText(in0)) << "inputs are never modified";
+}
+
+} // namespace
