@@ -5,14 +5,11 @@
 // reader's documented one, an accepted file that breaks the reader's promises, or an input that takes
 // longer than a stated time. The allocation cap is the sanitizer's (max_allocation_size_mb, set by the
 // test). Deterministic: a seed and an iteration number name an input; --replay reads one file.
-#include "chart_patches.hpp"
 #include "differential.hpp"
-#include "flow_common.hpp"
 #include "fuzz_target.hpp"
-#include "pipeline.hpp"
 
+#include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
-#include <opencv2/rawgment.hpp>
 
 #include <cxxabi.h>
 #include <signal.h>
@@ -20,14 +17,11 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <iostream>
-#include <map>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -53,7 +47,6 @@ std::string readBytes(const std::string& path)
 
 namespace {
 
-using namespace cv::rawgment;
 namespace fs = std::filesystem;
 
 // ---------------------------------------------------------------------------------------------------
@@ -81,7 +74,6 @@ bool checkedDifferentially(const Target& t)
     const std::string ext = dot == std::string::npos ? std::string() : t.inputName.substr(dot);
     return ext == ".yml" || ext == ".yaml" || ext == ".json";
 }
-
 
 // ---------------------------------------------------------------------------------------------------
 // Mutations.
