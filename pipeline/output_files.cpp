@@ -96,11 +96,6 @@ pid_t temporaryOwner(const std::string& name)
 
 } // namespace
 
-bool pathExists(const std::string& path)
-{
-    return ::access(path.c_str(), F_OK) == 0;
-}
-
 void prepareOutputDirectory(const std::string& dir)
 {
     makeDirectories(dir);
@@ -125,12 +120,6 @@ void prepareOutputDirectory(const std::string& dir)
         throw std::runtime_error("the output folder '" + dir + "' cannot be written: " + e.err);
     }
     std::remove(probe.c_str());
-}
-
-bool isRegularFile(const std::string& path)
-{
-    struct stat st;
-    return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
 std::string canonicalPath(const std::string& path)

@@ -1,19 +1,21 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// The pipeline layer's files: paths, output folders, and writes that are atomic and never replace a
-// file, shared by the apps and the Python module. Errors are std::runtime_error naming the path.
+// The pipeline layer's file policy: output folders, and writes that never replace a file (through the
+// library's atomic writer), shared by the apps and the Python module. Errors are std::runtime_error naming
+// the path.
 #ifndef RAWGMENT_PIPELINE_OUTPUT_FILES_HPP
 #define RAWGMENT_PIPELINE_OUTPUT_FILES_HPP
 
 #include <opencv2/core.hpp>
+#include <opencv2/rawgment/files.hpp>
 
 #include <string>
 
 namespace rawgment_pipeline {
 
-//! Whether a file or directory exists.
-bool pathExists(const std::string& path);
-//! Whether `path` is a regular file (or a link to one).
-bool isRegularFile(const std::string& path);
+// The checks are the library's (files.hpp); this layer keeps only the policy: outputs that are never
+// replaced, output folders.
+using cv::rawgment::isRegularFile;
+using cv::rawgment::pathExists;
 //! `path` with '.', '..' and links resolved (as far as it exists): two names of one file compare equal.
 std::string canonicalPath(const std::string& path);
 /** Makes `dir` (and its parents), removes the temporaries that interrupted runs left in it (files

@@ -482,7 +482,7 @@ void writeModelAndExports(const CalibrateOptions& o, const std::vector<Calibrati
         writeNewImage(o.outDir + "/" + shadingImages[0], report.model.darkShadingPerGain);
         writeNewImage(o.outDir + "/" + shadingImages[1], report.model.darkShadingOffset);
     }
-    writeNewText(o.outDir + "/noise_model.yml", yamlToString([&](cv::FileStorage& fs) {
+    writeNewText(o.outDir + "/noise_model.yml", fileStorageText("noise_model.yml", [&](cv::FileStorage& fs) {
                      report.model.write(fs, "noise_model",
                                         std::vector<cv::String>(shadingImages.begin(), shadingImages.end()));
                  }));
@@ -599,14 +599,16 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     // The per-gain fits travel with the model as its measured lines, which the augmentation follows; the
     // verdict above judged Eq. 5, which stays the model's summary and its trend beyond the gains.
     result.report.model.measuredLines = measuredLinesOf(report.perGain, specs, gains);
-    writeNewText(reportPath,
-                 yamlToString([&](cv::FileStorage& fs) { report.write(fs, "calibration_report"); }));
+    writeNewText(reportPath, fileStorageText(reportPath, [&](cv::FileStorage& fs) {
+                     report.write(fs, "calibration_report");
+                 }));
     writeModelAndExports(o, specs, gains, firstFormat, result);
 
     const size_t histogramGains =
         writeSampleTables(samples, report, in.shapiro, samplesCsv, linesCsv, shapiroCsv, histCsv);
+    PlotsWritten plots;
     if (result.haveDark)
-        writeDarkOutputs(o, result);
+        plots += writeDarkOutputs(o, result);
     if (o.plots) {
         std::vector<double> distinctGainsDb;
         for (double g : gainsDb)
@@ -614,10 +616,12 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                              [&](double d) { return std::abs(g - d) < 1e-9; }))
                 distinctGainsDb.push_back(g);
         CalibrationPlotFiles files{samplesCsv, linesCsv, histCsv, shapiroCsv};
-        plotCalibration(o.outDir, report, files, histogramGains, distinctGainsDb, result.shapiroTested > 0,
-                        result.pngs, result.notes);
+        plots += plotCalibration(o.outDir, report, files, histogramGains, distinctGainsDb,
+                                 result.shapiroTested > 0);
     }
-    writeNewText(o.outDir + "/report.md", calibrationReportMarkdown(result, o.outDir));
+    writeNewText(o.outDir + "/report.md", calibrationReportMarkdown(result, plots, o.outDir));
+    result.pngs = plots.pngs;
+    result.notes.insert(result.notes.end(), plots.notes.begin(), plots.notes.end());
     return result;
 }
 

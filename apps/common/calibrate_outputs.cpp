@@ -15,7 +15,8 @@ namespace rawgment_apps {
 using namespace cv::rawgment;
 
 //! report.md: the verdict first, with its checks, then the model, the per-gain lines, the plots, the notes.
-std::string calibrationReportMarkdown(const CalibrateResult& r, const std::string& outDir)
+std::string calibrationReportMarkdown(const CalibrateResult& r, const PlotsWritten& plots,
+                                      const std::string& outDir)
 {
     std::string md = "# Calibration report\n\n";
     md += std::string("**Verdict: ") + (r.verdict.pass ? "PASS" : "FAIL") + "**\n\n";
@@ -107,18 +108,20 @@ std::string calibrationReportMarkdown(const CalibrateResult& r, const std::strin
               ? cv::format("\nShapiro-Wilk: %.1f%% of %d tested pixels have p > 0.05.\n",
                            100 * r.gaussianFraction, r.shapiroTested)
               : std::string("\nShapiro-Wilk: no pixel tested (it needs bursts of 3 or more frames).\n");
-    if (!r.pngs.empty()) {
+    if (!plots.pngs.empty()) {
         md += "\n## Plots\n\n";
-        for (const std::string& png : r.pngs) {
+        for (const std::string& png : plots.pngs) {
             const std::string name = png.rfind(outDir + "/", 0) == 0 ? png.substr(outDir.size() + 1) : png;
             md += "![" + name + "](" + name + ")\n\n";
         }
     }
-    if (!rep.notes.empty() || !r.notes.empty()) {
+    if (!rep.notes.empty() || !r.notes.empty() || !plots.notes.empty()) {
         md += "\n## Notes\n\n";
         for (const std::string& n : rep.notes)
             md += "- " + n + "\n";
         for (const std::string& n : r.notes)
+            md += "- " + n + "\n";
+        for (const std::string& n : plots.notes)
             md += "- " + n + "\n";
     }
     return md;
@@ -145,7 +148,8 @@ void writeProfileExports(const std::string& outDir, const std::vector<Calibratio
         outDir + "/darktable_noiseprofiles.json",
         darktableNoiseProfiles(report.model, firstFormat, result.baseIso, profileIsos, maker, model));
     const AndroidNoiseProfile android = androidNoiseProfile(report.model, firstFormat, result.baseIso);
-    writeNewText(outDir + "/android_noise_profile.yml", yamlToString([&](cv::FileStorage& fs) {
+    writeNewText(outDir + "/android_noise_profile.yml",
+                 fileStorageText("android_noise_profile.yml", [&](cv::FileStorage& fs) {
                      fs << "android_noise_profile"
                         << "{"
                         << "comment"
@@ -209,12 +213,12 @@ size_t writeSampleTables(const std::vector<NoiseSample>& samples, const Calibrat
     return counts.size();
 }
 
-// dark_calibration.yml, dark_rows.csv, dark_ppcc.csv and their plots.
-void writeDarkOutputs(const CalibrateOptions& o, CalibrateResult& result)
+PlotsWritten writeDarkOutputs(const CalibrateOptions& o, const CalibrateResult& result)
 {
     const CalibrationReport& report = result.report;
     writeNewText(o.outDir + "/dark_calibration.yml",
-                 yamlToString([&](cv::FileStorage& fs) { result.dark.write(fs, "dark_calibration"); }));
+                 fileStorageText("dark_calibration.yml",
+                                 [&](cv::FileStorage& fs) { result.dark.write(fs, "dark_calibration"); }));
     CsvTable rows({"gain_db", "gain", "row_variance", "row_variance_se", "model_row_variance",
                    "pixel_variance", "excess_kurtosis", "sw_p_with_rows", "sw_p_without_rows"});
     for (const DarkGainStatistics& g : result.dark.gains)
@@ -226,9 +230,10 @@ void writeDarkOutputs(const CalibrateOptions& o, CalibrateResult& result)
     for (const cv::Vec2d& p : result.dark.ppcc)
         ppcc.addRow(std::vector<double>{p[0], p[1]});
     ppcc.write(o.outDir + "/dark_ppcc.csv");
-    if (o.plots)
-        plotDarkComponents(o.outDir, result.dark, o.outDir + "/dark_rows.csv", o.outDir + "/dark_ppcc.csv",
-                           result.pngs, result.notes);
+    if (!o.plots)
+        return PlotsWritten();
+    return plotDarkComponents(o.outDir, result.dark, o.outDir + "/dark_rows.csv",
+                              o.outDir + "/dark_ppcc.csv");
 }
 
 } // namespace rawgment_apps

@@ -6,14 +6,17 @@
 
 #include "app_tools.hpp"
 #include "pipeline.hpp"
+#include "plots.hpp"
 
 #include <string>
 #include <vector>
 
 namespace rawgment_apps {
 
-//! report.md: the verdict first, with its checks, then the model, the per-gain lines, the plots, the notes.
-std::string calibrationReportMarkdown(const CalibrateResult& r, const std::string& outDir);
+//! report.md: the verdict first, with its checks, then the model, the per-gain lines, the plots that were
+//! written (`plots`), the notes (the run's, then the plots').
+std::string calibrationReportMarkdown(const CalibrateResult& r, const PlotsWritten& plots,
+                                      const std::string& outDir);
 /* darktable's noise-profile file and Android's form of the model, at the ISOs of the bursts (a file's ISO
  * as it says it; a gain_db burst's from its gain, as dB are not exact). */
 void writeProfileExports(const std::string& outDir, const std::vector<CalibrationManifest::Burst>& specs,
@@ -26,8 +29,8 @@ size_t writeSampleTables(const std::vector<cv::rawgment::NoiseSample>& samples,
                          const cv::rawgment::CalibrationReport& report, const CsvTable& shapiro,
                          const std::string& samplesCsv, const std::string& linesCsv,
                          const std::string& shapiroCsv, const std::string& histCsv);
-// dark_calibration.yml, dark_rows.csv, dark_ppcc.csv and their plots.
-void writeDarkOutputs(const CalibrateOptions& o, CalibrateResult& result);
+//! dark_calibration.yml, dark_rows.csv, dark_ppcc.csv and their plots (returned).
+PlotsWritten writeDarkOutputs(const CalibrateOptions& o, const CalibrateResult& result);
 
 } // namespace rawgment_apps
 

@@ -4,6 +4,7 @@
 #include "pipeline.hpp"
 
 #include "app_tools.hpp"
+#include "plots.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -320,8 +321,9 @@ void writeReportTables(const std::string& dir, const std::vector<CameraNoiseProf
     cameras.write(dir + "/cameras.csv");
 }
 
-void plotReport(const std::string& dir, std::vector<std::string>& pngs, std::vector<std::string>& notes)
+PlotsWritten plotReport(const std::string& dir)
 {
+    PlotsWritten out;
     std::string message;
     const std::string slope = dir + "/real_cameras_slope.png";
     if (plotWithGnuplot(
@@ -334,9 +336,9 @@ void plotReport(const std::string& dir, std::vector<std::string>& pngs, std::vec
                 "/iso_points.csv' every ::1 using 1:2 with points pt 7 ps 0.4 lc rgb '#3060a0', 1 "
                 "with lines lw 2 lc rgb 'black'\n",
             message))
-        pngs.push_back(slope);
+        out.pngs.push_back(slope);
     else
-        notes.push_back(message);
+        out.notes.push_back(message);
     const std::string params = dir + "/real_cameras_parameters.png";
     if (plotWithGnuplot(
             params,
@@ -353,9 +355,10 @@ void plotReport(const std::string& dir, std::vector<std::string>& pngs, std::vec
                 "/cameras.csv' every ::1 using (bin($11)):(1) smooth frequency with boxes lc rgb "
                 "'#30a060'\nunset multiplot\n",
             message, 1400, 600))
-        pngs.push_back(params);
+        out.pngs.push_back(params);
     else
-        notes.push_back(message);
+        out.notes.push_back(message);
+    return out;
 }
 
 } // namespace
@@ -380,8 +383,10 @@ CamerasResult runCameras(const CamerasOptions& o)
     if (!o.reportDir.empty()) {
         prepareOutputDirectory(o.reportDir);
         writeReportTables(o.reportDir, cams);
-        plotReport(o.reportDir, r.pngs, r.notes);
-        const std::string report = reportText(cams, path, seconds, r.pngs);
+        const PlotsWritten plots = plotReport(o.reportDir);
+        r.pngs = plots.pngs;
+        r.notes = plots.notes;
+        const std::string report = reportText(cams, path, seconds, plots.pngs);
         writeNewText(o.reportDir + "/report.md",
                      "# What darktable's measured cameras say about Eq. 5\n\n" + report);
         r.text = report;

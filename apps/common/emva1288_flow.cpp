@@ -4,6 +4,7 @@
 #include "app_tools.hpp"
 #include "flow_common.hpp"
 #include "pipeline.hpp"
+#include "plots.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -80,7 +81,7 @@ std::vector<Emva1288Input> readManifest(const std::string& path)
 std::string emvaFiguresYaml(const std::vector<Emva1288Input>& inputs,
                             const std::vector<Emva1288Results>& results)
 {
-    return yamlToString([&](cv::FileStorage& fs) {
+    return fileStorageText("emva1288.yml", [&](cv::FileStorage& fs) {
         fs << "emva1288"
            << "[";
         for (size_t k = 0; k < results.size(); ++k) {
@@ -101,11 +102,12 @@ std::string emvaFiguresYaml(const std::vector<Emva1288Input>& inputs,
     });
 }
 
-void plotSeries(const std::string& outDir, const std::string& pointsCsv, const std::string& validationCsv,
-                const std::string& histogramCsv, const std::vector<Emva1288Results>& results, double gain,
-                const CalibrationReport& report, const Emva1288CalibrationParams& params,
-                Emva1288FlowResult& out)
+PlotsWritten plotSeries(const std::string& outDir, const std::string& pointsCsv,
+                        const std::string& validationCsv, const std::string& histogramCsv,
+                        const std::vector<Emva1288Results>& results, double gain,
+                        const CalibrationReport& report, const Emva1288CalibrationParams& params)
 {
+    PlotsWritten out;
     const Emva1288Results& r = results.front();
     const NoiseLineFit& line = emva1288LineAtGain(report, gain);
     const double saturated = r.mean[r.saturationIndex] - r.darkMean[r.saturationIndex];
@@ -174,6 +176,7 @@ void plotSeries(const std::string& outDir, const std::string& pointsCsv, const s
                             a ? ", " : "", histogramCsv.c_str(), a + 3, kColours[a], names[a]);
         plot(outDir + "/emva_validation_histograms.png", s + "\n");
     }
+    return out;
 }
 
 } // namespace
@@ -320,10 +323,12 @@ Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
                 failed += (failed.empty() ? "" : ", ") + c.name;
         model.failedCalibration = failed;
     }
-    writeNewText(o.outDir + "/noise_model.yml",
-                 yamlToString([&](cv::FileStorage& fs) { model.write(fs, "noise_model"); }));
+    writeNewText(o.outDir + "/noise_model.yml", fileStorageText("noise_model.yml", [&](cv::FileStorage& fs) {
+                     model.write(fs, "noise_model");
+                 }));
     writeNewText(o.outDir + "/calibration_report.yml",
-                 yamlToString([&](cv::FileStorage& fs) { out.report.write(fs, "calibration_report"); }));
+                 fileStorageText("calibration_report.yml",
+                                 [&](cv::FileStorage& fs) { out.report.write(fs, "calibration_report"); }));
     writeNewText(o.outDir + "/emva1288.yml", emvaFiguresYaml(inputs, results));
     CsvTable points({"series", "photons", "mean", "variance", "variance_std_error", "dark_mean",
                      "dark_variance", "exposure", "linearity_deviation_percent"});
@@ -359,9 +364,12 @@ Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
             cv::format("the histograms are those of point %d taken to point %d (photon ratio %.3f)",
                        d[0].brightPoint, d[0].darkPoint, d[0].photonRatio));
     }
-    if (o.plots)
-        plotSeries(o.outDir, pointsCsv, validationCsv, histogramCsv, results, gains.front(), out.report,
-                   params, out);
+    if (o.plots) {
+        const PlotsWritten plots = plotSeries(o.outDir, pointsCsv, validationCsv, histogramCsv, results,
+                                              gains.front(), out.report, params);
+        out.pngs = plots.pngs;
+        out.notes.insert(out.notes.end(), plots.notes.begin(), plots.notes.end());
+    }
     writeNewText(o.outDir + "/report.md", emva1288ReportMarkdown(out, o));
     return out;
 }

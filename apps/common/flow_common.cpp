@@ -15,14 +15,6 @@ namespace rawgment_apps {
 
 using namespace cv::rawgment;
 
-std::string yamlToString(const std::function<void(cv::FileStorage&)>& body)
-{
-    cv::FileStorage fs(".yml",
-                       cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-    body(fs);
-    return fs.releaseAndGetString();
-}
-
 std::vector<std::string> readFileList(const cv::FileNode& node, const std::string& base,
                                       const std::string& where)
 {

@@ -13,8 +13,6 @@
 
 namespace rawgment_apps {
 
-//! A YAML document built with a FileStorage, as text.
-std::string yamlToString(const std::function<void(cv::FileStorage&)>& body);
 //! A manifest's non-empty list of files, resolved against `base`; errors name `where`.
 std::vector<std::string> readFileList(const cv::FileNode& node, const std::string& base,
                                       const std::string& where);

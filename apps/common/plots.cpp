@@ -16,28 +16,27 @@ namespace {
 const char* const kSeriesColours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
                                       "#ff7f0e", "#8c564b", "#17becf"};
 
-void plotOrNote(const std::string& png, const std::string& script, std::vector<std::string>& pngs,
-                std::vector<std::string>& notes)
+void plotOrNote(const std::string& png, const std::string& script, PlotsWritten& out)
 {
     // A plot an interrupted run of the same job already made is kept, never redrawn over.
     if (pathExists(png)) {
-        pngs.push_back(png);
+        out.pngs.push_back(png);
         return;
     }
     std::string message;
     if (plotWithGnuplot(png, script, message))
-        pngs.push_back(png);
+        out.pngs.push_back(png);
     else
-        notes.push_back(message);
+        out.notes.push_back(message);
 }
 
 } // namespace
 
-void plotCalibration(const std::string& outDir, const CalibrationReport& report,
-                     const CalibrationPlotFiles& files, size_t histogramSeries,
-                     const std::vector<double>& gainsDb, bool haveShapiro, std::vector<std::string>& pngs,
-                     std::vector<std::string>& notes)
+PlotsWritten plotCalibration(const std::string& outDir, const CalibrationReport& report,
+                             const CalibrationPlotFiles& files, size_t histogramSeries,
+                             const std::vector<double>& gainsDb, bool haveShapiro)
 {
+    PlotsWritten out;
     const NoiseModel& model = report.model;
     std::string s;
     s += "set title 'Noise calibration: variance against mean at each gain'\n";
@@ -62,20 +61,20 @@ void plotCalibration(const std::string& outDir, const CalibrationReport& report,
              : cv::format("1/0 title 'model: {/Symbol a} %.4f ({/Symbol s}_d^2, {/Symbol s}_r^2 not "
                           "separable)'\n",
                           model.alpha);
-    plotOrNote(outDir + "/calib_mean_variance.png", s, pngs, notes);
+    plotOrNote(outDir + "/calib_mean_variance.png", s, out);
 
     s = "set title 'Sample variance over fitted variance, per gain (ideal: centred on 1)'\n";
     s += "set xlabel 'variance / fitted variance'\nset ylabel 'samples'\nset key right top\nset grid\nplot ";
     for (size_t i = 0; i < histogramSeries; ++i)
         s += cv::format("%s'%s' every ::1 using 1:%zu with steps lw 2 lc rgb '%s' title columnhead(%zu)",
                         i ? ", " : "", files.histogramCsv.c_str(), i + 2, kSeriesColours[i % 7], i + 2);
-    plotOrNote(outDir + "/calib_histograms.png", s, pngs, notes);
+    plotOrNote(outDir + "/calib_histograms.png", s, out);
 
     // A cross-gain fit needs two gains, a Shapiro-Wilk plot tested pixels (bursts of >= 3 frames).
     if (report.perGain.size() < 2)
-        notes.push_back("one gain: no cross-gain plot");
+        out.notes.push_back("one gain: no cross-gain plot");
     if (!haveShapiro)
-        notes.push_back("no burst of 3 or more frames: no Shapiro-Wilk plot");
+        out.notes.push_back("no burst of 3 or more frames: no Shapiro-Wilk plot");
     if (report.perGain.size() >= 2) {
         s = "set multiplot layout 1,2 title 'Cross-gain fit of the per-gain lines'\nset grid\nset key left "
             "top\n";
@@ -93,10 +92,10 @@ void plotCalibration(const std::string& outDir, const CalibrationReport& report,
                         "%.10g*x + %.10g with lines lw 2 title 'g^2 {/Symbol s}_d^2 + {/Symbol "
                         "s}_r^2'\nunset multiplot\n",
                         files.linesCsv.c_str(), model.sigmaD2, model.sigmaR2);
-        plotOrNote(outDir + "/calib_cross_gain.png", s, pngs, notes);
+        plotOrNote(outDir + "/calib_cross_gain.png", s, out);
     }
     if (!haveShapiro)
-        return;
+        return out;
 
     s = "set title 'Shapiro-Wilk test of each pixel''s temporal series (Gaussian noise: p spread evenly on "
         "[0, 1])'\n";
@@ -110,13 +109,14 @@ void plotCalibration(const std::string& outDir, const CalibrationReport& report,
             files.shapiroCsv.c_str(), gainsDb[i] - 0.01, gainsDb[i] + 0.01, kSeriesColours[i % 7],
             gainsDb[i]);
     s += "0.05 with lines lw 2 lc rgb 'black' dt 2 title 'p = 0.05'\n";
-    plotOrNote(outDir + "/shapiro_pvalue.png", s, pngs, notes);
+    plotOrNote(outDir + "/shapiro_pvalue.png", s, out);
+    return out;
 }
 
-void plotDarkComponents(const std::string& outDir, const DarkCalibrationReport& dark,
-                        const std::string& rowsCsv, const std::string& ppccCsv,
-                        std::vector<std::string>& pngs, std::vector<std::string>& notes)
+PlotsWritten plotDarkComponents(const std::string& outDir, const DarkCalibrationReport& dark,
+                                const std::string& rowsCsv, const std::string& ppccCsv)
 {
+    PlotsWritten out;
     const NoiseModel& m = dark.model;
     std::string rows = "set title 'Row noise: variance of a row offset against gain'\n";
     rows += "set xlabel 'linear gain'\nset ylabel 'row variance (DN^2)'\nset logscale xy\nset grid\n";
@@ -126,7 +126,7 @@ void plotDarkComponents(const std::string& outDir, const DarkCalibrationReport& 
         "standard error)', x*x*%.10g + %.10g with lines lw 2 lc rgb '%s' title 'fit: g^2 %.4g + %.4g'\n",
         rowsCsv.c_str(), kSeriesColours[0], m.rowSigmaD2, m.rowSigmaR2, kSeriesColours[1], m.rowSigmaD2,
         m.rowSigmaR2);
-    plotOrNote(outDir + "/dark_rows.png", rows, pngs, notes);
+    plotOrNote(outDir + "/dark_rows.png", rows, out);
     std::string ppcc = "set title 'Read-noise shape: probability-plot correlation against Tukey lambda'\n";
     ppcc += "set xlabel 'lambda (0.14: Gaussian, smaller: heavier tails)'\nset ylabel 'PPCC'\nset grid\n";
     ppcc += "set datafile separator ','\nset key left bottom box opaque\n";
@@ -136,13 +136,13 @@ void plotDarkComponents(const std::string& outDir, const DarkCalibrationReport& 
         "plot '%s' every ::1 using 1:2 with linespoints pt 7 ps 0.5 lc rgb '%s' title "
         "'residuals (best %.3f; Gaussian plot %.5f); model lambda %.3f after the correction'\n",
         ppccCsv.c_str(), kSeriesColours[0], dark.lambdaOfResiduals, dark.ppccGaussian, m.tukeyLambda);
-    plotOrNote(outDir + "/dark_ppcc.png", ppcc, pngs, notes);
+    plotOrNote(outDir + "/dark_ppcc.png", ppcc, out);
     if (!m.hasDarkShading())
-        return;
+        return out;
     const std::string shading = outDir + "/dark_shading.png";
     if (pathExists(shading)) {
-        pngs.push_back(shading);
-        return;
+        out.pngs.push_back(shading);
+        return out;
     }
     // Each map in false colour over its 1st to 99th percentile, side by side, with its range as text.
     std::vector<cv::Mat> panels;
@@ -168,13 +168,14 @@ void plotDarkComponents(const std::string& outDir, const DarkCalibrationReport& 
     cv::Mat both;
     cv::hconcat(panels, both);
     writeNewImage(shading, both);
-    pngs.push_back(shading);
+    out.pngs.push_back(shading);
+    return out;
 }
 
-void plotValidation(const std::string& outDir, const std::string& csvPath,
-                    const std::vector<ValidationPanel>& panels, std::vector<std::string>& pngs,
-                    std::vector<std::string>& notes)
+PlotsWritten plotValidation(const std::string& outDir, const std::string& csvPath,
+                            const std::vector<ValidationPanel>& panels)
 {
+    PlotsWritten out;
     std::string s =
         cv::format("set multiplot layout 1,%zu title 'Bright burst converted to darker exposures against "
                    "real darker bursts (per-pixel temporal variance, averaged per mean bin)'\n",
@@ -205,7 +206,8 @@ void plotValidation(const std::string& outDir, const std::string& csvPath,
             f - 1e-6, f + 1e-6);
     }
     s += "unset multiplot\n";
-    plotOrNote(outDir + "/validation.png", s, pngs, notes);
+    plotOrNote(outDir + "/validation.png", s, out);
+    return out;
 }
 
 } // namespace rawgment_apps

@@ -10,6 +10,20 @@
 
 namespace rawgment_apps {
 
+/** What a plotting call wrote: each PNG made (or kept from an interrupted run of the same job), and for each
+ * plot that could not be made, or was not, its reason. A report lists what it is given of these, so the
+ * plots it shows are those returned, never those some earlier call left in a shared list. */
+struct PlotsWritten
+{
+    std::vector<std::string> pngs, notes;
+    PlotsWritten& operator+=(const PlotsWritten& other)
+    {
+        pngs.insert(pngs.end(), other.pngs.begin(), other.pngs.end());
+        notes.insert(notes.end(), other.notes.begin(), other.notes.end());
+        return *this;
+    }
+};
+
 //! The CSV tables that rawgment_calibrate writes and its plots read.
 struct CalibrationPlotFiles
 {
@@ -18,19 +32,16 @@ struct CalibrationPlotFiles
 
 /** calib_mean_variance.png, calib_histograms.png (histogramSeries columns after the first),
  * calib_cross_gain.png (with two gains or more) and shapiro_pvalue.png (when `haveShapiro`; one series
- * per gain in gainsDb) in outDir. Each PNG written goes to `pngs`; a plot that could not be made, or
- * was not, leaves its reason in `notes`. */
-void plotCalibration(const std::string& outDir, const cv::rawgment::CalibrationReport& report,
-                     const CalibrationPlotFiles& files, size_t histogramSeries,
-                     const std::vector<double>& gainsDb, bool haveShapiro, std::vector<std::string>& pngs,
-                     std::vector<std::string>& notes);
+ * per gain in gainsDb) in outDir. */
+PlotsWritten plotCalibration(const std::string& outDir, const cv::rawgment::CalibrationReport& report,
+                             const CalibrationPlotFiles& files, size_t histogramSeries,
+                             const std::vector<double>& gainsDb, bool haveShapiro);
 
 /** The dark-frame components' plots in outDir: dark_rows.png (row variance against gain with the fitted
  * g^2 sigma_row_d^2 + sigma_row_r^2), dark_ppcc.png (probability-plot correlation against lambda) and
  * dark_shading.png (the two maps in false colour, without gnuplot). */
-void plotDarkComponents(const std::string& outDir, const cv::rawgment::DarkCalibrationReport& dark,
-                        const std::string& rowsCsv, const std::string& ppccCsv,
-                        std::vector<std::string>& pngs, std::vector<std::string>& notes);
+PlotsWritten plotDarkComponents(const std::string& outDir, const cv::rawgment::DarkCalibrationReport& dark,
+                                const std::string& rowsCsv, const std::string& ppccCsv);
 
 //! One panel of the validation plot: an exposure factor and the largest mean of its bins.
 struct ValidationPanel
@@ -39,10 +50,9 @@ struct ValidationPanel
     double largestMean;
 };
 
-//! validation.png in outDir from the validation CSV, one panel per target (see plotCalibration()).
-void plotValidation(const std::string& outDir, const std::string& csvPath,
-                    const std::vector<ValidationPanel>& panels, std::vector<std::string>& pngs,
-                    std::vector<std::string>& notes);
+//! validation.png in outDir from the validation CSV, one panel per target.
+PlotsWritten plotValidation(const std::string& outDir, const std::string& csvPath,
+                            const std::vector<ValidationPanel>& panels);
 
 } // namespace rawgment_apps
 

@@ -32,7 +32,7 @@ std::string burstFolder(double gainDb, double level)
  * its folder refuses, so an interrupted run is only ever resumed by the same job. */
 std::string jobDescription(const SimulateOptions& o)
 {
-    return yamlToString([&](cv::FileStorage& fs) {
+    return fileStorageText("simulation_job.yml", [&](cv::FileStorage& fs) {
         fs << "simulation_job"
            << "{";
         fs << "gains_db" << o.gainsDb << "levels" << o.levels << "frames" << o.frames << "patch_size"
@@ -207,7 +207,7 @@ std::string validationManifestText(const SimulateOptions& o,
                                    const std::vector<std::vector<std::string>>& files,
                                    size_t calibrationBursts)
 {
-    return yamlToString([&](cv::FileStorage& fs) {
+    return fileStorageText("validation_manifest.yml", [&](cv::FileStorage& fs) {
         fs << "validation_manifest"
            << "{";
         fs << "patches"
@@ -230,7 +230,7 @@ std::string calibrationManifestText(const std::vector<PlannedBurst>& bursts,
                                     const std::vector<std::vector<std::string>>& files,
                                     size_t calibrationBursts)
 {
-    return yamlToString([&](cv::FileStorage& fs) {
+    return fileStorageText("calibration_manifest.yml", [&](cv::FileStorage& fs) {
         fs << "calibration_manifest"
            << "{";
         fs << "patches"

@@ -233,8 +233,11 @@ ValidateResult validateConversion(const ValidateOptions& o)
     csv.write(csvPath);
     result.table = validationTable(result.rows);
     writeTextAtomically(mdPath, result.table);
-    if (o.plots)
-        plotValidation(o.outDir, csvPath, panels, result.pngs, result.notes);
+    if (o.plots) {
+        const PlotsWritten plots = plotValidation(o.outDir, csvPath, panels);
+        result.pngs = plots.pngs;
+        result.notes.insert(result.notes.end(), plots.notes.begin(), plots.notes.end());
+    }
     return result;
 }
 

@@ -603,9 +603,9 @@ String darktableProfilesPath()
                           : xdg && *xdg   ? String(xdg) + "/rawgment"
                           : home && *home ? String(home) + "/.cache/rawgment"
                                           : String();
-    if (!folder.empty() && detail::fileExists(folder + "/darktable/noiseprofiles.json"))
+    if (!folder.empty() && pathExists(folder + "/darktable/noiseprofiles.json"))
         return folder + "/darktable/noiseprofiles.json";
-    if (detail::fileExists("/usr/share/darktable/noiseprofiles.json"))
+    if (pathExists("/usr/share/darktable/noiseprofiles.json"))
         return "/usr/share/darktable/noiseprofiles.json";
     return String();
 }

@@ -384,7 +384,7 @@ std::vector<uint8_t> dngFileBytes(const String& path, const RawImage& image)
 void writeDng(const String& path, const RawImage& image)
 {
     const std::vector<uint8_t> bytes = detail::dngFileBytes(path, image);
-    if (detail::fileExists(path))
+    if (pathExists(path))
         CV_Error(Error::StsError, "writeDng: '" + path + "' already exists; it is never overwritten");
     writeFileAtomically(path, bytes.data(), bytes.size(), false);
 }

@@ -190,7 +190,7 @@ Emva1288Series readEmva1288(const String& path)
                         cv::format("more than %d images; a descriptor may list at most that many",
                                    MAX_EMVA1288_IMAGES));
             const String image = resolvedImagePath(folder, name);
-            if (!detail::fileExists(image))
+            if (!pathExists(image))
                 badLine(path, lineNumber, "image '" + image + "' does not exist");
             detail::checkRegularFile(image, "EMVA 1288 image (descriptor '" + path +
                                                 cv::format("', line %d)", lineNumber));

@@ -29,11 +29,6 @@ int fileStorageFormatOf(const String& path)
     CV_Error(Error::StsBadArg, "'" + path + "': unsupported extension; expected .yml, .yaml or .json");
 }
 
-bool fileExists(const String& path)
-{
-    return ::access(path.c_str(), F_OK) == 0;
-}
-
 std::string readTextFile(const String& path)
 {
     return readFileBounded(path, MAX_TEXT_FILE_BYTES, "file");
@@ -94,6 +89,26 @@ const char* notRegularReason(unsigned mode)
 }
 
 } // namespace detail
+
+bool pathExists(const String& path)
+{
+    return ::access(path.c_str(), F_OK) == 0;
+}
+
+bool isRegularFile(const String& path)
+{
+    struct stat status;
+    return ::stat(path.c_str(), &status) == 0 && S_ISREG(status.st_mode);
+}
+
+std::string fileStorageText(const String& path, const std::function<void(FileStorage&)>& writeBody)
+{
+    const int format = detail::fileStorageFormatOf(path);
+    FileStorage fs(format == FileStorage::FORMAT_JSON ? ".json" : ".yml",
+                   FileStorage::WRITE | FileStorage::MEMORY | format);
+    writeBody(fs);
+    return fs.releaseAndGetString();
+}
 
 std::string readFileBounded(const String& path, long long maxBytes, const String& what)
 {

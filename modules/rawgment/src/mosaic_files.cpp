@@ -166,13 +166,13 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
     meta.type = mosaic.type();
     const String sidecar = sidecarPathOf(path);
     const std::string text =
-        detail::fileStorageText(sidecar, [&](FileStorage& fs) { meta.write(fs, "mosaic_metadata"); });
+        fileStorageText(sidecar, [&](FileStorage& fs) { meta.write(fs, "mosaic_metadata"); });
     const std::vector<uchar> bytes = containerBytes(path, ext, mosaic, meta);
     // Another writer of the same job (a second run into the same folder, started at once) may make the same
     // files at the same time: its image and sidecar, byte for byte ours, are this call's output too.
     const auto holds = [](const String& file, const void* data, size_t size) {
         try {
-            return detail::fileExists(file) && readFileBounded(file, static_cast<long long>(size), "file") ==
+            return pathExists(file) && readFileBounded(file, static_cast<long long>(size), "file") ==
                                                    std::string(static_cast<const char*>(data), size);
         } catch (const Exception&) {
             return false; // larger than ours, or unreadable: not this call's output
@@ -180,7 +180,7 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
     };
     const auto sameSidecar = [&] { return holds(sidecar, text.data(), text.size()); };
     const auto sameImage = [&] { return holds(path, bytes.data(), bytes.size()); };
-    if (detail::fileExists(path)) {
+    if (pathExists(path)) {
         if (sameSidecar() && sameImage())
             return;
         CV_Error(Error::StsError, "writeMosaic: '" + path + "' already exists; it is never overwritten");
@@ -188,7 +188,7 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
     // The sidecar is never replaced either. One left by an interrupted run of the same job (the image
     // missing, the same text) is kept; any other is another mosaic's and stops the write.
     bool createdSidecar = false;
-    if (detail::fileExists(sidecar)) {
+    if (pathExists(sidecar)) {
         if (!sameSidecar())
             CV_Error(Error::StsError, "writeMosaic: '" + sidecar +
                                           "' exists and describes another mosaic; it is never overwritten "
@@ -209,7 +209,7 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
             return;
         // No sidecar without its image: a sidecar this call made goes with the failed image, unless an
         // image that another writer made in the meantime now depends on it.
-        if (createdSidecar && !detail::fileExists(path))
+        if (createdSidecar && !pathExists(path))
             std::remove(sidecar.c_str());
         throw;
     }
@@ -218,7 +218,7 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
 MosaicMetadata readMosaic(const String& path, OutputArray _mosaic)
 {
     const String sidecar = sidecarPathOf(path);
-    if (!detail::fileExists(path))
+    if (!pathExists(path))
         CV_Error(Error::StsError, "readMosaic: '" + path + "': no such file");
     detail::checkRegularFile(path, "mosaic");
     const MosaicMetadata meta =

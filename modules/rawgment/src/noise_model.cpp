@@ -454,7 +454,7 @@ void NoiseModel::save(const String& path) const
         for (int i = 0; i < 2; ++i)
             images.push_back(shadingImageName(path, i, *maps[i]));
     const std::string text =
-        detail::fileStorageText(path, [&](FileStorage& fs) { write(fs, kTopLevelName, images); });
+        fileStorageText(path, [&](FileStorage& fs) { write(fs, kTopLevelName, images); });
     const String folder = detail::folderOf(path);
     std::vector<String> created;
     try {
@@ -462,7 +462,7 @@ void NoiseModel::save(const String& path) const
             const String image = folder + images[i];
             // Same name, same checksum: a map an earlier save left is this one already (when its pixels
             // say so; a damaged one is replaced, as nothing can load it).
-            const bool present = detail::fileExists(image);
+            const bool present = pathExists(image);
             if (present && mapChecksum(imread(image, IMREAD_UNCHANGED)) == mapChecksum(*maps[i]))
                 continue;
             std::vector<uchar> bytes;

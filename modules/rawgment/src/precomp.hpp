@@ -67,8 +67,6 @@ int fileStorageFormatOf(const String& path);
 //! Throws StsBadArg naming `what` unless baseIso lies in [NoiseModel::MIN_BASE_ISO, MAX_BASE_ISO] (or is 0,
 //! for unknown, when zeroIsUnknown).
 CV_RAWGMENT_EXPORTS void checkBaseIso(double baseIso, const char* what, bool zeroIsUnknown);
-//! Whether anything exists at `path`.
-bool fileExists(const String& path);
 //! The whole content of a regular file of at most MAX_TEXT_FILE_BYTES; throws StsError naming it.
 std::string readTextFile(const String& path);
 //! Throws StsError naming `path` (as `what`) unless it exists and is a regular file: a reader handed a
@@ -114,16 +112,6 @@ constexpr int MAX_NESTING_DEPTH = 64;
  * aliases, a repeated key in any map, a key OpenCV's files cannot hold, an integer beyond 32 bits, a plain
  * value OpenCV's own reader would read as another type or value, and UTF-16 or UTF-32 text. */
 CV_RAWGMENT_EXPORTS std::string textForOpenCv(const String& path, std::string text);
-
-//! The text that writeFileStorageAtomically() would write to `path`.
-template <typename Writer> std::string fileStorageText(const String& path, Writer&& writeBody)
-{
-    const int format = fileStorageFormatOf(path);
-    FileStorage fs(format == FileStorage::FORMAT_JSON ? ".json" : ".yml",
-                   FileStorage::WRITE | FileStorage::MEMORY | format);
-    writeBody(fs);
-    return fs.releaseAndGetString();
-}
 
 template <typename Writer> void writeFileStorageAtomically(const String& path, Writer&& writeBody)
 {

@@ -111,7 +111,7 @@ RawImage readRaw(const String& path)
 {
     if (path.empty())
         CV_Error(Error::StsBadArg, "readRaw: the path is empty");
-    if (!detail::fileExists(path))
+    if (!pathExists(path))
         failOn(path, "no such file");
     struct stat status;
     // LibRaw would block on a FIFO's open and read a device until its own allocation limit.

@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/rawgment/export.hpp>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,23 @@ CV_RAWGMENT_EXPORTS void writeFileAtomically(const String& path, const void* dat
  * with SIGKILL leaves its own, which a later run may remove once that pid is gone.
  */
 CV_RAWGMENT_EXPORTS void removeTemporaryFilesInProgress();
+
+/** @brief Whether anything (a file, a folder, or a link to one) exists at `path`: the one existence check of
+ * the library, its pipeline and its apps. */
+CV_RAWGMENT_EXPORTS bool pathExists(const String& path);
+
+/** @brief Whether `path` is a regular file, or a link to one: what every reader of this module opens (a FIFO,
+ * a device or a folder never is). */
+CV_RAWGMENT_EXPORTS bool isRegularFile(const String& path);
+
+/** @brief The text of the YAML or JSON file that `writeBody` writes into a cv::FileStorage, built in memory:
+ * what the library's own writers give writeFileAtomically().
+ * @param path the file the text is for: its extension decides the format (.yml or .yaml: YAML; .json: JSON)
+ * @param writeBody writes the file's content into the storage it is given
+ * @throws cv::Exception StsBadArg for another extension, and whatever `writeBody` throws.
+ */
+CV_RAWGMENT_EXPORTS std::string fileStorageText(const String& path,
+                                                const std::function<void(FileStorage&)>& writeBody);
 
 //! The largest YAML or JSON file openFileStorageForReading() (and so every reader of this module) opens.
 static constexpr long long MAX_TEXT_FILE_BYTES = 64LL << 20;
