@@ -114,7 +114,34 @@ if [ "${#explicit[@]}" -eq 0 ]; then
   done
 fi
 
+# Tests are organised like the code: no test file over 800 lines (a topic's tests split along its seams).
+# Private functions are never exported: tests reach them by linking rawgment_internal, so no header of src/
+# carries an export macro. precomp.hpp holds includes only: a declaration belongs to its topic's header.
+if [ "${#explicit[@]}" -eq 0 ]; then
+  for f in "${files[@]}"; do
+    [ -f "$f" ] || continue
+    case "$f" in
+      modules/rawgment/test/*.cpp|modules/rawgment/test/*.hpp|test/*.cpp|test/*.hpp|test/fuzz/*.cpp|python/tests/*.py|python/tests_opencv/*.py)
+        lines=$(wc -l < "$f")
+        if [ "$lines" -gt 800 ]; then
+          echo "$f: $lines lines; split the tests along the seams of what they test (at most 800)"
+          status=1
+        fi ;;
+      modules/rawgment/src/*.hpp)
+        if grep -nE 'CV_RAWGMENT_EXPORTS|CV_EXPORTS' "$f" >/dev/null; then
+          grep -nE 'CV_RAWGMENT_EXPORTS|CV_EXPORTS' "$f" | sed "s|^|$f: a private function exported (tests link rawgment_internal): |"
+          status=1
+        fi ;;
+    esac
+  done
+  precomp=modules/rawgment/src/precomp.hpp
+  if grep -nvE '^(#include |#ifndef |#define |#endif|//|$)' "$precomp" >/dev/null; then
+    grep -nvE '^(#include |#ifndef |#define |#endif|//|$)' "$precomp" | sed "s|^|$precomp: declares something (put it in its topic's header): |" | head -5
+    status=1
+  fi
+fi
+
 if [ "$status" -eq 0 ]; then
-  echo "check-sources: ${#files[@]} files, no control characters, no copy of Eq. 5, layers kept, no file over 750 lines, noise steps prepared once"
+  echo "check-sources: ${#files[@]} files, no control characters, no copy of Eq. 5, layers kept, no file over 750 lines (tests 800), noise steps prepared once, no exported private function, precomp.hpp only includes"
 fi
 exit "$status"

@@ -40,8 +40,7 @@ def snapshot(module):
     for name in sorted(n for n in dir(module) if not n.startswith("__")):
         obj = getattr(module, name)
         if inspect.ismodule(obj):
-            lines.append("%s: module" % name)
-            continue
+            continue  # a submodule is an attribute only once something imported it
         lines += documented(name, obj, "")
         if inspect.isclass(obj):
             for member in sorted(n for n in vars(obj) if not n.startswith("__")):

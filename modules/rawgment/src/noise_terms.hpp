@@ -59,7 +59,7 @@ private:
 
 /** The terms of a model at linear gain g, after checking both (ValidatedNoiseModel::termsAt() of a model
  * validated for this call). NoiseModel::lineAtGain() is built from it. */
-CV_RAWGMENT_EXPORTS NoiseTerms<double> checkedNoiseTerms(const NoiseModel& model, double gain);
+NoiseTerms<double> checkedNoiseTerms(const NoiseModel& model, double gain);
 
 /** The terms of a model with measured lines (NoiseModel::measuredLines, which says how they are
  * interpolated and extrapolated) at linear gain g > 0; the offset split before and after the gain as
@@ -79,17 +79,17 @@ std::vector<MeasuredNoiseLine> readMeasuredLines(const FileNode& list);
 /** @name The Tukey-lambda shape of the read noise (NoiseModel::tukeyRead)
  * X = (U^lambda - (1 - U)^lambda) / lambda for U uniform in (0, 1); lambda = 0 is the logistic
  * log(U / (1 - U)). Moments from the Beta function (docs/mathematics.md, "Dark-frame noise").
- * Exported for the tests, which check them against SciPy; not installed. */
+ * The tests check them against SciPy (they link the library's objects statically: rawgment_internal). */
 //! @{
 //! The variance of X (finite for lambda > -1/2).
-CV_RAWGMENT_EXPORTS double tukeyLambdaVariance(double lambda);
+double tukeyLambdaVariance(double lambda);
 //! The excess kurtosis of X (finite for lambda > -1/4): 0 near lambda = 0.1349, 1.2 at 0, -1.2 at 1.
-CV_RAWGMENT_EXPORTS double tukeyLambdaExcessKurtosis(double lambda);
+double tukeyLambdaExcessKurtosis(double lambda);
 /** The lambda in [kTukeyLambdaMin, 1] whose excess kurtosis is `kurtosis`, clamped to the kurtosis range
  * of that interval (bisection: the kurtosis falls monotonically as lambda grows there). */
-CV_RAWGMENT_EXPORTS double tukeyLambdaOfExcessKurtosis(double kurtosis);
+double tukeyLambdaOfExcessKurtosis(double kurtosis);
 //! The quantile X(u) (expm1 keeps it exact for lambda near 0).
-CV_RAWGMENT_EXPORTS double tukeyLambdaQuantile(double u, double lambda);
+double tukeyLambdaQuantile(double u, double lambda);
 //! The smallest lambda the library draws or accounts for: excess kurtosis 95, far past any sensor's.
 constexpr double kTukeyLambdaMin = -0.2;
 
@@ -112,8 +112,7 @@ struct TukeyUnitSampler
  * and `added` = b_t - (the prior's read variance). Two shapes summed are not a Tukey-lambda shape:
  * this matches variance and kurtosis only (docs/mathematics.md measures the error). Returns `lambda`
  * itself when nothing is added. */
-CV_RAWGMENT_EXPORTS double addedReadLambda(double lambda, double targetRead, double priorFourthMoment,
-                                           double added);
+double addedReadLambda(double lambda, double targetRead, double priorFourthMoment, double added);
 //! @}
 
 /** Throws StsBadArg naming the map when a dark-shading map holds NaN or Inf: a pass over both maps, so

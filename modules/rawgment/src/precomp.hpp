@@ -1,8 +1,14 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// Private helpers shared by the module's sources; never installed. The rules they carry out (errors,
-// files, atomic writes) are in docs/conventions.md.
+// What every source of the module includes first: OpenCV's core and the module's private headers that
+// most sources share (one per topic). Includes only: a declaration belongs to its topic's header.
 #ifndef OPENCV_RAWGMENT_SRC_PRECOMP_HPP
 #define OPENCV_RAWGMENT_SRC_PRECOMP_HPP
+
+#include "argument_checks.hpp"
+#include "file_access.hpp"
+#include "huge_pages.hpp"
+#include "normal_quantile.hpp"
+#include "npy_format.hpp"
 
 #include <opencv2/core.hpp>
 #include <opencv2/core/utility.hpp>
@@ -12,133 +18,5 @@
 #include <string>
 #include <utility>
 #include <vector>
-
-namespace cv {
-namespace rawgment {
-namespace detail {
-
-//! Throws StsBadArg "<what> must be finite and > 0 (got <value>)" unless value is finite and positive.
-void checkFinitePositive(double value, const char* what);
-//! Throws StsBadArg "<what> must be finite and >= 0 (got <value>)" unless value is finite and >= 0.
-void checkFiniteNonNegative(double value, const char* what);
-
-/** A blur kernel as float64 normalised to sum 1: the one check of motion blur and the simulator's
- * blurred captures. Throws StsBadArg naming `who` unless it is non-empty, finite, non-negative and of
- * positive sum. */
-Mat normalisedKernel(InputArray kernel, const char* who);
-/** The Mat of an array argument, refused with StsBadArg naming `what` ("colorJitter: src") unless it has at
- * most two dimensions: an N-D array (numpy's (1, 1, H, W) through cv2) would otherwise be read as 1x1. The
- * check every entry point makes, so that every binding gets it. */
-Mat twoDimensional(InputArray array, const char* what);
-
-/** The border rule of every blur: BORDER_REPLICATE, the nearest visible pixel stands for the light just
- * outside the frame. A motion blur at the edge integrates light the sensor never saw; the nearest
- * recorded value is the estimate of it that assumes least (a reflection would invent structure that
- * moves the wrong way), and it is the rule the augmentation's noise accounting implements exactly
- * (taps that replicate one pixel are merged, resample.cpp). The simulator uses it too, so a blurred
- * capture and a blurred augmentation agree up to the frame's edge. */
-constexpr int kBlurBorder = BORDER_REPLICATE;
-
-/** Standard normal quantile for p in (0, 0.5] (negative), to the precision of erfc (normality.cpp). */
-double lowerNormalQuantile(double p);
-
-/* The one reader of numeric fields in YAML/JSON files: a field is a number or an error naming it. */
-//! A required real field of a FileStorage map, named in the error when it is missing or not a number.
-double readRealField(const FileNode& node, const char* field);
-//! An optional real field: `fallback` when absent (or null), an error naming it when not a number.
-double readOptionalRealField(const FileNode& node, const char* field, double fallback);
-//! An optional integer field: as readOptionalRealField(), and an error when it has a fraction or does
-//! not fit an int.
-int readOptionalIntField(const FileNode& node, const char* field, int fallback);
-//! A required list of exactly `n` numbers, named (and the element) in the error.
-std::vector<double> readRealList(const FileNode& node, const char* field, int n);
-
-//! The extension of a path's file name, with its dot, in lower case ("" when it has none).
-String lowerExtensionOf(const String& path);
-//! The folder of a path with its trailing '/' ("" for a bare file name): what relative names inside a file
-//! are resolved against.
-String folderOf(const String& path);
-
-/** Writes `path` with a FileStorage, replacing it: the text is built in memory, then written by
- * writeFileAtomically() (checked, synced, atomic). The format follows the extension of `path`
- * (.yml/.yaml or .json); other extensions are rejected. */
-template <typename Writer> void writeFileStorageAtomically(const String& path, Writer&& writeBody);
-int fileStorageFormatOf(const String& path);
-//! Throws StsBadArg naming `what` unless baseIso lies in [NoiseModel::MIN_BASE_ISO, MAX_BASE_ISO] (or is 0,
-//! for unknown, when zeroIsUnknown).
-CV_RAWGMENT_EXPORTS void checkBaseIso(double baseIso, const char* what, bool zeroIsUnknown);
-//! The whole content of a regular file of at most MAX_TEXT_FILE_BYTES; throws StsError naming it.
-std::string readTextFile(const String& path);
-//! Throws StsError naming `path` (as `what`) unless it exists and is a regular file: a reader handed a
-//! FIFO or a device would block or read forever.
-void checkRegularFile(const String& path, const String& what);
-//! Why a file of this st_mode is not read ("it is a FIFO ...").
-const char* notRegularReason(unsigned mode);
-/** A regular file opened for reading, closed with the object. A FIFO (opened without waiting for a
- * writer), a device, a socket or a directory is refused with StsError naming `what` and `path`, decided on
- * the opened file itself, so nothing can be swapped in between. */
-class RegularFileForReading
-{
-public:
-    RegularFileForReading(const String& path, const String& what);
-    ~RegularFileForReading();
-    RegularFileForReading(const RegularFileForReading&) = delete;
-    RegularFileForReading& operator=(const RegularFileForReading&) = delete;
-    int fd() const { return fd_; }
-    long long size() const { return size_; } //!< at the time it was opened
-
-private:
-    int fd_;
-    long long size_ = 0;
-};
-/** Asks for transparent huge pages over a large buffer (4 MiB or more) that is about to be written for the
- * first time: on a virtual machine each 4 KiB page fault costs microseconds, so a new 12 MP float mosaic
- * (48 MB) spends more time faulting than being written. Advice only: nothing changes without THP, on
- * memory already touched, or off Linux. */
-void adviseHugePages(const Mat& m);
-//! The bytes of a .npy file (format 1.0, little-endian, C order) holding `mosaic`, CV_16UC1 or CV_32FC1.
-std::vector<uchar> npyFileBytes(const Mat& mosaic);
-/** The mosaic of a .npy file as npyFileBytes() writes it (format 1.0 to 3.0, a 2-D '<u2' or '<f4' array
- * in C order, the file exactly that long); throws naming the file otherwise, before allocating. */
-Mat readNpyMosaic(const String& path);
-//! The deepest nesting of maps and lists openFileStorageForReading() accepts; this module's files nest
-//! at most five levels, and OpenCV's readers recurse once per level.
-constexpr int MAX_NESTING_DEPTH = 64;
-/** The text OpenCV's reader is given for a file's whole content `text` (YAML, OpenCV's "%YAML:1.0" line
- * allowed, or JSON when it starts with a brace): parsed by libyaml or nlohmann-json, iteratively, scalars
- * typed by YAML 1.2's core schema, and the values written anew by OpenCV's own JSON writer. Throws
- * StsParseError naming the file (`path`), the line where it is known and what is wrong for text that is not
- * one YAML document or JSON value whose root is a map, nesting deeper than MAX_NESTING_DEPTH, anchors or
- * aliases, a repeated key in any map, a key OpenCV's files cannot hold, an integer beyond 32 bits, a plain
- * value OpenCV's own reader would read as another type or value, and UTF-16 or UTF-32 text. */
-CV_RAWGMENT_EXPORTS std::string textForOpenCv(const String& path, std::string text);
-
-template <typename Writer> void writeFileStorageAtomically(const String& path, Writer&& writeBody)
-{
-    const std::string text = fileStorageText(path, std::forward<Writer>(writeBody));
-    writeFileAtomically(path, text.data(), text.size(), true);
-}
-
-/** Reads the map `topLevel` of a YAML/JSON file with `read(node)`. Errors name the file: a missing or
- * unreadable file ("cannot open <what> '<path>'"), text that is not YAML/JSON, or whatever `read`
- * rejects. */
-template <typename Reader>
-auto loadFileStorage(const String& path, const char* topLevel, const char* what, Reader&& read)
-    -> decltype(read(FileNode()))
-{
-    FileStorage fs = openFileStorageForReading(path, what);
-    try {
-        return read(fs[topLevel]);
-    } catch (const Exception& e) {
-        CV_Error(e.code, "'" + path + "': " + e.err);
-    } catch (const std::exception& e) {
-        // OpenCV's reader throws std::length_error and friends on some malformed files.
-        CV_Error(Error::StsParseError, "'" + path + "' is not a valid YAML or JSON file: " + e.what());
-    }
-}
-
-} // namespace detail
-} // namespace rawgment
-} // namespace cv
 
 #endif // OPENCV_RAWGMENT_SRC_PRECOMP_HPP

@@ -483,7 +483,7 @@ public:
      * approximation, which matters at the few-electron counts of dark pixels. lambda must not exceed
      * kMaxPoissonMean (callers check before their loops: above it, a count no longer fits the integers
      * that a double holds exactly, and a Gaussian is exact to double precision anyway). */
-    CV_RAWGMENT_EXPORTS int64_t poisson(double lambda);
+    int64_t poisson(double lambda);
 
 private:
     std::array<uint32_t, 2> key_;
@@ -519,7 +519,7 @@ void fillGaussian(uint64_t seed, uint64_t stream, float* out, int n);
  * multiply-adds decide: 2e-7 relative at most, measured at lambda -0.2 to 1. Built once per step (two
  * exponentials at each of 896 nodes and site, about 70 microseconds); a lookup and the cubic cost a
  * fraction of the logarithms and exponentials the quantile needs otherwise. */
-class CV_RAWGMENT_EXPORTS TukeyQuantileTable
+class TukeyQuantileTable
 {
 public:
     static constexpr int kCellsPerOctave = 32;
@@ -553,8 +553,7 @@ private:
  * from the logarithms and exponentials as polynomials (no library calls). Accuracy: within 2e-6 relative
  * (or 1e-6 absolute near 0) of the double quantile of the same uniform
  * (Simulate.fillTukeyUnitIsTheQuantileOfItsWordsOnEveryPath). */
-CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, const TukeyQuantileTable& table,
-                                       float* out, int n);
+void fillTukeyUnit(uint64_t seed, uint64_t stream, const TukeyQuantileTable& table, float* out, int n);
 
 /** Fills counts[0..n) with exact Poisson variates of means[0..n) from the stream (seed, stream), the
  * vector sampler that ShotNoiseSampling::POISSON draws with. Every mean must lie in [0, kMaxPoissonMean]
@@ -577,13 +576,12 @@ CV_RAWGMENT_EXPORTS void fillTukeyUnit(uint64_t seed, uint64_t stream, const Tuk
  * the normal's radius and angle are on grids of 2^-32 (|T| <= 6.7), so each count's probability is exact to
  * about 2^-31 absolute. Same bits on every path (Simulate.fillPoissonIsExactAndTheSameOnEveryPath, which also
  * checks each value against a reference written with the C library). counts must not overlap means. */
-CV_RAWGMENT_EXPORTS void fillPoisson(uint64_t seed, uint64_t stream, const double* means, double* counts,
-                                     int n);
+void fillPoisson(uint64_t seed, uint64_t stream, const double* means, double* counts, int n);
 
 /** out[i] = ln P(K = ks[i]) for K ~ Poisson(mus[i]), as fillPoisson()'s steps Q and E compute it in lanes
  * (k (ln(1 + v) - v) - ln(2 pi k) / 2 - Stirling's remainder, v = (mu - k) / k; -mu at k = 0), for ks[i] >= 0
  * and mus[i] >= 1: exposed for the test of its accuracy (Simulate.poissonProbabilitiesOfTheLanesAreExact). */
-CV_RAWGMENT_EXPORTS void logPoissonProbabilities(const double* ks, const double* mus, double* out, int n);
+void logPoissonProbabilities(const double* ks, const double* mus, double* out, int n);
 
 //! The key of fillPoisson()'s scalar steps for the stream (seed, stream); such a value i draws from (key, i).
 inline uint64_t poissonRetryKey(uint64_t seed, uint64_t stream)

@@ -3,8 +3,6 @@
 // and the guarded YAML/JSON reader.
 #include "test_common.hpp"
 
-#include "../src/precomp.hpp"
-
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/camera_profiles.hpp>
@@ -88,6 +86,13 @@ std::string textFile(const std::string& dir, const std::string& name, const std:
     const std::string path = dir + "/" + name;
     std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
     return path;
+}
+
+//! A file `name` holding `text`, read as every reader of the module reads it (openFileStorageForReading()).
+FileStorage readText(const std::string& name, const std::string& text)
+{
+    static const std::string dir = makeTempDir("files_read_text");
+    return openFileStorageForReading(textFile(dir, name, text), "test file");
 }
 
 //! `depth` nested lists, as YAML's block lists ("- - - 1") or flow lists ("[[[1]]]").
@@ -251,24 +256,23 @@ TEST(Files, aYamlTextOnWhichOpenCvNeverFinishesIsAnErrorNotAHang)
     EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(textFile(dir, "hang.yml", hang), "sidecar"),
                              "hang.yml' line 2: the root is a single value");
     for (const char* text : {"%YAML:1.0\n---[][  -\n", "%YAML:1.0\n---%:1\n-\n-", "%YAML:1.0\n s:0\n:  -\n"})
-        EXPECT_THROW(detail::textForOpenCv("loop.yml", text), Exception) << text;
-    EXPECT_NO_THROW(detail::textForOpenCv("ok.yml", "%YAML:1.0\n---\nm:\n   a: 1\n"));
+        EXPECT_THROW(readText("loop.yml", text), Exception) << text;
+    EXPECT_NO_THROW(readText("ok.yml", "%YAML:1.0\n---\nm:\n   a: 1\n"));
 }
 
 TEST(Files, theYamlReaderNamesTheLineAndWhatIsWrong)
 {
-    const auto read = [](const std::string& text) { return detail::textForOpenCv("a.yml", text); };
-    EXPECT_CV_ERROR_CONTAINS(read("%YAML:1.0\n---\nm:\n   a: [ 1, 2\n"), "'a.yml' line 5: not valid YAML");
+    const auto read = [](const std::string& text) { return readText("a.yml", text); };
+    EXPECT_CV_ERROR_CONTAINS(read("%YAML:1.0\n---\nm:\n   a: [ 1, 2\n"), "/a.yml' line 5: not valid YAML");
     EXPECT_CV_ERROR_CONTAINS(read("m: &x 1\nn: *x\n"), "line 1: an anchor");
     EXPECT_CV_ERROR_CONTAINS(read("m: 1\n---\nn: 2\n"), "line 2: a second document");
     EXPECT_CV_ERROR_CONTAINS(read("just a value\n"), "the root is a single value");
     EXPECT_CV_ERROR_CONTAINS(read("# only a comment\n"), "holds no map");
     EXPECT_CV_ERROR_CONTAINS(read("- 1\n- 2\n"), "line 1: the root is a list, not a map");
     EXPECT_CV_ERROR_CONTAINS(read("m:\n   - [ 1, 4294967297 ]\n"),
-                             "'a.yml' line 2: the integer 4294967297 does not fit 32 bits");
+                             "/a.yml' line 2: the integer 4294967297 does not fit 32 bits");
     // Quoted, it is a string, and a real is a real.
-    const FileStorage fs(read("m: \"4294967297\"\nn: 4294967297.0\nk: -2147483648\n"),
-                         FileStorage::READ | FileStorage::MEMORY);
+    const FileStorage fs = read("m: \"4294967297\"\nn: 4294967297.0\nk: -2147483648\n");
     EXPECT_TRUE(fs["m"].isString());
     EXPECT_EQ("4294967297", std::string(fs["m"]));
     EXPECT_EQ(4294967297.0, double(fs["n"]));
@@ -280,7 +284,7 @@ TEST(Files, theYamlReaderNamesTheLineAndWhatIsWrong)
 //! The one value `value` of a map read from "v: <value>" (YAML) by the module's reader.
 FileNode readOneValue(FileStorage& fs, const std::string& value)
 {
-    fs.open(detail::textForOpenCv("v.yml", "v: " + value + "\n"), FileStorage::READ | FileStorage::MEMORY);
+    fs = readText("v.yml", "v: " + value + "\n");
     return fs["v"];
 }
 
@@ -318,7 +322,7 @@ TEST(Files, scalarsAreTypedByYamlsCoreSchemaAndWhatOpenCvReadsOtherwiseIsRefused
     };
     for (const auto& c : refused) {
         SCOPED_TRACE(c.spelling);
-        EXPECT_CV_ERROR_CONTAINS(readOneValue(fs, c.spelling), "'v.yml' line 1: ");
+        EXPECT_CV_ERROR_CONTAINS(readOneValue(fs, c.spelling), "/v.yml' line 1: ");
         EXPECT_CV_ERROR_CONTAINS(readOneValue(fs, c.spelling), c.refusal);
     }
     // What both read alike, and what YAML reads unambiguously, is read as the value written.
@@ -347,7 +351,7 @@ TEST(Files, scalarsAreTypedByYamlsCoreSchemaAndWhatOpenCvReadsOtherwiseIsRefused
     EXPECT_EQ("trailing ", std::string(readOneValue(fs, "\"trailing \"")));
     EXPECT_EQ("1", std::string(readOneValue(fs, "'1'")));
     // A tab after the colon (OpenCV's "skipSpaces" refused it) is YAML's separator.
-    fs.open(detail::textForOpenCv("t.yml", "v:\t3\n"), FileStorage::READ | FileStorage::MEMORY);
+    fs = readText("t.yml", "v:\t3\n");
     EXPECT_EQ(3, int(fs["v"]));
 }
 
@@ -485,14 +489,14 @@ TEST(Files, theJsonReaderReadsEveryEscapeAndNamesTheLine)
     // reads every escape, and OpenCV's writer writes the value anew.
     const std::string escaped =
         "{\n \"a\": \"Sj\\u00f8str\\u00f8m \\/ \\ud83d\\ude00 \\u0022q\\u0022 \\\\ \\n\"\n}";
-    const FileStorage fs(detail::textForOpenCv("a.json", escaped), FileStorage::READ | FileStorage::MEMORY);
+    const FileStorage fs = readText("a.json", escaped);
     EXPECT_EQ("Sj\xc3\xb8str\xc3\xb8m / \xf0\x9f\x98\x80 \"q\" \\ \n", std::string(fs["a"]));
-    const auto read = [](const std::string& text) { return detail::textForOpenCv("a.json", text); };
+    const auto read = [](const std::string& text) { return readText("a.json", text); };
     EXPECT_CV_ERROR_CONTAINS(read("{\n\"a\": \"x\\u0000\"}"), "a NUL character in a string");
     EXPECT_CV_ERROR_CONTAINS(read("{\n \"a\": [ 1, 2 }\n"),
-                             "'a.json' is not valid JSON: parse error at line 2");
+                             "/a.json' is not valid JSON: parse error at line 2");
     EXPECT_CV_ERROR_CONTAINS(read("{\n \"a\": [ 14294967297.5,\n 4294967297 ]\n}"),
-                             "'a.json' line 3: the integer 4294967297 does not fit 32 bits");
+                             "/a.json' line 3: the integer 4294967297 does not fit 32 bits");
     EXPECT_CV_ERROR_CONTAINS(read("{\n \"a\": -9999999999 }"), "line 2: the integer -9999999999");
     EXPECT_CV_ERROR_CONTAINS(read("{ \"a\": 1 } x"), "is not valid JSON");
 }
