@@ -14,7 +14,7 @@ import rawgment as rg
 
 APPS = ("rawgment_augment", "rawgment_calibrate", "rawgment_cameras", "rawgment_demo", "rawgment_simulate",
         "rawgment_tradeoffs", "rawgment_validate")
-MODULES = ("rawgment.batch", "rawgment.ablation")
+MODULES = ("rawgment.batch", "rawgment_ablation")
 
 
 def documents():

@@ -40,11 +40,11 @@ def test_the_ablation_study_runs_from_the_installed_prefix(tmp_path):
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "LD_LIBRARY_PATH")}
     env.update(PYTHONPATH=str(site), OMP_NUM_THREADS="1")
     out = tmp_path / "study"
-    run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--quick", "--per-condition", "--networks", "blind",
+    run = subprocess.run([sys.executable, "-m", "rawgment_ablation", "--quick", "--per-condition", "--networks", "blind",
                           "--arms", "IGNORE_PRIOR,ACCOUNT_PRIOR,IGNORE_RESCALED,NOISY", "--seeds", "2", "--iterations",
                           "1", "--out", str(out)], env=env, cwd=str(tmp_path), capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     assert (out / "report.md").exists() and (out / "blind-per-condition" / "results.json").exists()
-    where = subprocess.run([sys.executable, "-c", "import rawgment.ablation_controls as c; print(c.__file__)"],
+    where = subprocess.run([sys.executable, "-c", "import rawgment_ablation.controls as c; print(c.__file__)"],
                            env=env, cwd=str(tmp_path), check=True, capture_output=True, text=True)
     assert where.stdout.strip().startswith(str(site))

@@ -29,7 +29,7 @@ enum SeedPurpose: int
     SEED_STUDY = 21,                      //!< accuracy studies (rawgment_tradeoffs); index: the measurement
     SEED_TRAINING_EPOCH = 22,             //!< a training epoch (Python's rawgment.torch); index: the epoch
     SEED_TRAINING_SAMPLE = 23,            //!< a sample of an epoch's seed; index: the sample's index
-    SEED_ABLATION = 24 //!< the ablation study (rawgment.ablation); index: a role, then an item
+    SEED_ABLATION = 24 //!< the ablation study (rawgment_ablation); index: a role, then an item
 };
 
 /** @brief A seed for one use of a user's seed: a well-mixed (SplitMix64) function of (seed, purpose,

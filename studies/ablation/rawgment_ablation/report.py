@@ -1,6 +1,6 @@
-"""The report of rawgment.ablation: paired significance (bootstrap interval, sign-flip test) with Holm's
+"""The report of the ablation study (rawgment_ablation): paired significance (bootstrap interval, sign-flip test) with Holm's
 correction over a report's tests, the summary rows, the PSNR plot, report.md, results.json and results.csv,
-for one study or several side by side. Use it through rawgment.ablation."""
+for one study or several side by side. Use it through rawgment_ablation.study."""
 import json
 import math
 import os
@@ -10,8 +10,8 @@ from statistics import NormalDist
 import numpy as np
 
 import rawgment as _rg
-from rawgment._ablation_common import ARMS, BLIND_STEP, TRAINED_ARMS, _ROLE_BOOTSTRAP, _seed
-from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS, predictionOutcome
+from rawgment_ablation.common import ARMS, BLIND_STEP, TRAINED_ARMS, _ROLE_BOOTSTRAP, _seed
+from rawgment_ablation.controls import CONTROL_CONTRASTS, PREDICTIONS, predictionOutcome
 
 __all__ = ["pairedSignificance", "summarize", "writeOutputs", "writeStudiesOutputs", "writeCombinedReport", "mergeReplicates", "loadStudy",
            "studyName", "holmAdjusted", "seedsForFamily", "seedsToConfirm", "contrastRows", "correctFamily", "NETWORKS",
@@ -103,7 +103,7 @@ def seedsToConfirm(mean, sd, tests, alpha=SIGNIFICANCE):
 
 def contrastPairs(arms):
     """The paired tests a study's report makes, (a, b, metric) for a minus b: ACCOUNT_PRIOR against NONE,
-    IGNORE_PRIOR and ORACLE (the paper's question), then the control contrasts (ablation_controls), each
+    IGNORE_PRIOR and ORACLE (the paper's question), then the control contrasts (controls.py), each
     where both arms ran."""
     pairs = [("ACCOUNT_PRIOR", b, "psnr") for b in ("NONE", "IGNORE_PRIOR", "ORACLE")
              if "ACCOUNT_PRIOR" in arms and b in arms]
@@ -379,7 +379,7 @@ def _testsTable(contrasts):
 
 
 def _predictionsSection(contrasts):
-    """The control arms' predictions (ablation_controls.PREDICTIONS, stated before the runs) whose arms,
+    """The control arms' predictions (controls.PREDICTIONS, stated before the runs) whose arms,
     network, design and conditions the contrasts hold, each with its outcome after the family's correction."""
     out = []
     for prediction in PREDICTIONS:
@@ -390,7 +390,7 @@ def _predictionsSection(contrasts):
         state, rows = outcome
         if not out:
             out = ["", "## The controls: predictions stated before the run, and outcomes", "",
-                   "Each prediction was written into rawgment/ablation_controls.py before the runs that test it; "
+                   "Each prediction was written into studies/ablation/rawgment_ablation/controls.py before the runs that test it; "
                    "the outcome is read from the Holm-corrected tests above: a direction holds when every "
                    "condition in its scope has that corrected verdict and is contradicted when any has the "
                    "other; a tie holds when none has a corrected verdict.", ""]
@@ -483,9 +483,9 @@ def loadStudy(folder):
     except ValueError as e:
         if str(e).startswith("'%s': condition" % path):
             raise
-        raise ValueError("'%s' is not the results.json of a rawgment.ablation study (%s)" % (path, e)) from None
+        raise ValueError("'%s' is not the results.json of a rawgment_ablation study (%s)" % (path, e)) from None
     except (KeyError, TypeError) as e:
-        raise ValueError("'%s' is not the results.json of a rawgment.ablation study (%s)" % (path, e)) from None
+        raise ValueError("'%s' is not the results.json of a rawgment_ablation study (%s)" % (path, e)) from None
     return results
 
 

@@ -4,7 +4,7 @@ ACCOUNT_PRIOR and ORACLE inputs, through the study's own trainingInputs (12 crop
 condition and grey level; the relative standard error of a variance ratio is about 0.3%).
 docs/results.md cites it for why blind networks trained on ACCOUNT_PRIOR trail the oracle.
 
-Usage: PYTHONPATH=build/release/python /usr/bin/python3 python/tools/ablation_input_moments.py [POISSON]
+Usage: PYTHONPATH=build/release/python /usr/bin/python3 studies/ablation/input_moments.py [POISSON]
 (the argument: the augmented arms' ShotNoiseSampling, GAUSSIAN by default)
 
 Output on host H2, 2026-11-25 (condition, grey level, then per arm the variance over the oracle's and
@@ -44,7 +44,7 @@ import sys
 import numpy as np
 import torch
 
-import rawgment.ablation as ab
+import rawgment_ablation.study as ab
 
 ARMS = ("IGNORE_PRIOR", "ACCOUNT_PRIOR", "ORACLE")
 

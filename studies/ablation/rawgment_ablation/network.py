@@ -1,11 +1,11 @@
-"""The ablation study's network and measures (rawgment.ablation): a compact U-Net denoiser on packed CFA
+"""The ablation study's network and measures (rawgment_ablation): a compact U-Net denoiser on packed CFA
 planes, told the noise or blind, and PSNR and SSIM."""
 import math
 
 import torch
 import torch.nn.functional as F
 
-from rawgment._ablation_common import BLIND_STEP
+from rawgment_ablation.common import BLIND_STEP
 
 __all__ = ["Denoiser", "psnr", "ssim"]
 

@@ -2,7 +2,7 @@
 (docs/ablation.md#the-control-arms): why blind networks trained on IGNORE_PRIOR's inputs did better than
 those trained on ACCOUNT_PRIOR's. Each prediction names a paired contrast, the conditions it is about and
 the direction expected; the report sets the Holm-corrected outcome beside it. Use it through
-rawgment.ablation."""
+rawgment_ablation.study."""
 import dataclasses
 
 __all__ = ["Prediction", "PREDICTIONS", "CONTROL_CONTRASTS", "predictionOutcome"]
@@ -73,7 +73,7 @@ PREDICTIONS = (
 
 
 def predictionOutcome(prediction, contrasts):
-    """The outcome of a prediction on a study's contrast rows (ablation_report.contrastRows, corrected):
+    """The outcome of a prediction on a study's contrast rows (report.contrastRows, corrected):
     None when the study lacks its arms, design or conditions; else (state, rows) with state "held",
     "contradicted" or "undecided" and the rows it was read from. A direction held when every condition in
     scope has that corrected verdict, is contradicted when any has the other; a tie held when none has a

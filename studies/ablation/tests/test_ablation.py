@@ -1,4 +1,4 @@
-"""rawgment.ablation: the quick study runs end to end and the oracle beats the noisy input; the arms are
+"""rawgment_ablation: the quick study runs end to end and the oracle beats the noisy input; the arms are
 fed what they claim (noise variances on a flat scene); the same seeds give the same numbers; the
 command refuses what it does not understand."""
 import dataclasses
@@ -13,7 +13,7 @@ import pytest
 import torch
 
 import rawgment as rg
-import rawgment.ablation as ab
+import rawgment_ablation.study as ab
 
 
 def tiny_config(**changes):
@@ -26,7 +26,7 @@ def tiny_config(**changes):
 
 def test_quick_run_writes_the_report_and_the_oracle_beats_the_noisy_input(tmp_path):
     out = tmp_path / "quick"
-    run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--quick", "--out", str(out)],
+    run = subprocess.run([sys.executable, "-m", "rawgment_ablation", "--quick", "--out", str(out)],
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     # By default both kinds of network, each a full study in its own folder.
@@ -80,7 +80,7 @@ def test_per_condition_and_the_control_arms_from_the_command(tmp_path):
     # Two seeds cannot reach any corrected verdict: every prediction is undecided, none held by default.
     assert page.count("**Outcome: undecided (too few seeds") == len(ab.PREDICTIONS)
     assert "| condition | prior share | blind: IGNORE_PRIOR minus IGNORE_RESCALED | blind-per-condition:" in page
-    run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--designs", "pooled,shuffled",
+    run = subprocess.run([sys.executable, "-m", "rawgment_ablation", "--designs", "pooled,shuffled",
                           "--out", str(tmp_path / "x")], capture_output=True, text=True)
     assert run.returncode == 2 and "--designs must be pooled, per-condition or pooled,per-condition" in run.stderr
 
@@ -146,7 +146,7 @@ def test_studies_of_separate_runs_are_combined_into_one_corrected_page(tmp_path)
     assert "| condition | prior share | told: minus IGNORE_PRIOR | blind-per-condition: minus IGNORE_PRIOR |" in report
 
     def refused(argv, message):
-        run = subprocess.run([sys.executable, "-m", "rawgment.ablation", *argv], capture_output=True, text=True)
+        run = subprocess.run([sys.executable, "-m", "rawgment_ablation", *argv], capture_output=True, text=True)
         assert run.returncode == 2 and message in run.stderr and "Traceback" not in run.stderr, run.stderr
 
     refused(["--combine", *folders, "--out", str(page)], "exists: outputs are never replaced")
@@ -169,7 +169,7 @@ def test_a_study_extended_with_later_replicates_merges_into_the_study_of_all_of_
     whole = ab.runAblation(tiny_config(seeds=2))
     for first in (1, 0):
         ab.writeOutputs(ab.runAblation(tiny_config(seeds=1, firstReplicate=first)), str(tmp_path / ("r%d" % first)))
-    from rawgment.ablation_report import loadStudy
+    from rawgment_ablation.report import loadStudy
     merged = ab.mergeReplicates([loadStudy(str(tmp_path / "r1")), loadStudy(str(tmp_path / "r0"))])
     assert [e["arms"] for e in merged["conditions"]] == [e["arms"] for e in whole["conditions"]]
     assert merged["config"]["seeds"] == 2 and merged["config"]["replicates"] == [[0, 0], [1, 1]]
@@ -193,7 +193,7 @@ def test_runs_of_other_conditions_or_short_result_lists_are_never_merged(tmp_pat
     base = run("bright0", bright, 0)
     for name, conditions in (("dark", dark), ("reordered", bright[::-1]), ("one", bright[:1])):
         other = run(name, conditions, 1)
-        proc = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--combine", base, other, "--out",
+        proc = subprocess.run([sys.executable, "-m", "rawgment_ablation", "--combine", base, other, "--out",
                                str(tmp_path / ("page-" + name))], capture_output=True, text=True)
         assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
         assert "differ in their conditions (x0.5, x0.2 against %s)" % ", ".join(
@@ -204,7 +204,7 @@ def test_runs_of_other_conditions_or_short_result_lists_are_never_merged(tmp_pat
     results["config"]["seeds"] = 4
     (tmp_path / "short").mkdir()
     (tmp_path / "short" / "results.json").write_text(json.dumps(results))
-    proc = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--combine", str(tmp_path / "short"),
+    proc = subprocess.run([sys.executable, "-m", "rawgment_ablation", "--combine", str(tmp_path / "short"),
                            "--out", str(tmp_path / "page-short")], capture_output=True, text=True)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
     assert "short/results.json': condition x0.5, arm " in proc.stderr and "holds 1 psnr value(s) for its 4 seed(s)" \
@@ -396,7 +396,7 @@ def test_a_prediction_holds_only_when_every_condition_in_its_scope_agrees():
                 "metric": "psnr", "network": "blind", "design": "pooled", "directionHolm": direction, "n": 12,
                 "seedsForFamily": 11}
 
-    from rawgment.ablation_controls import predictionOutcome
+    from rawgment_ablation.controls import predictionOutcome
     # The small-share condition is out of its scope, whatever it shows.
     rows = [row("x0.5", 0.48, "a"), row("x0.2", 0.17, "a"), row("x0.01", 0.002, "b")]
     assert predictionOutcome(prediction, rows)[0] == "held"
@@ -506,7 +506,7 @@ def test_a_real_camera_from_darktables_profiles_is_the_one_simulated(tmp_path):
     (["--base-gain-db=nan"], "--base-gain-db must be finite, got nan"),
 ])
 def test_the_command_refuses_what_it_does_not_understand(argv, message, tmp_path):
-    run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--out", str(tmp_path / "x"), *argv],
+    run = subprocess.run([sys.executable, "-m", "rawgment_ablation", "--out", str(tmp_path / "x"), *argv],
                          capture_output=True, text=True)
     assert run.returncode == 2
     assert message in run.stderr
@@ -528,7 +528,7 @@ def test_an_out_that_cannot_take_the_outputs_is_refused_before_any_training(tmp_
                                 (previous, [], "holds a previous run's '%s'" % (previous / "report.md")),
                                 (both, ["--networks", "told,blind"], str(both / "blind" / "results.json")),
                                 (tmp_path / "afile" / "sub", [], "is not a writable folder")):
-        run = subprocess.run([sys.executable, "-m", "rawgment.ablation", *quick, *extra, "--out", str(out)],
+        run = subprocess.run([sys.executable, "-m", "rawgment_ablation", *quick, *extra, "--out", str(out)],
                              capture_output=True, text=True)
         assert run.returncode == 2, run.stderr
         assert message in run.stderr
@@ -539,19 +539,19 @@ def test_an_out_that_cannot_take_the_outputs_is_refused_before_any_training(tmp_
 
 
 def test_help_names_the_options():
-    run = subprocess.run([sys.executable, "-m", "rawgment.ablation", "--help"], capture_output=True, text=True)
+    run = subprocess.run([sys.executable, "-m", "rawgment_ablation", "--help"], capture_output=True, text=True)
     assert run.returncode == 0
     for option in ("--model", "--quick", "--out", "--seeds", "--arms"):
         assert option in run.stdout
 
 
-def test_the_dark_components_model_of_the_results_page_serves_the_default_study(tmp_path, source_dir):
-    # python/tools/dark_components_model.py writes the model of docs/results.md's run with every
+def test_the_dark_components_model_of_the_results_page_serves_the_default_study(tmp_path):
+    # studies/ablation/dark_components_model.py writes the model of docs/results.md's run with every
     # dark-frame component: the file it writes must load with all of them, and its maps must cover the
     # default study's largest capture (or that run would be refused).
     path = tmp_path / "dark.yml"
-    run = subprocess.run([sys.executable, os.path.join(source_dir, "python", "tools", "dark_components_model.py"),
-                          str(path)], capture_output=True, text=True)
+    tool = os.path.join(os.path.dirname(__file__), "..", "dark_components_model.py")
+    run = subprocess.run([sys.executable, tool, str(path)], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     model = rg.NoiseModel.load(str(path))
     assert model.rowSigmaD2 > 0 and model.rowSigmaR2 > 0 and model.tukeyRead and model.hasDarkShading()

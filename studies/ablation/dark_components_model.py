@@ -10,7 +10,7 @@ run on such a sensor (docs/results.md): the simulator's default sensor (alpha 0.
   gain) and an offset map (a gentle gradient and fixed column offsets, up to 2 DN), 512x512, larger
   than every capture of the study (maps are read from their top-left corner).
 
-Usage: PYTHONPATH=build/release/python /usr/bin/python3 python/tools/dark_components_model.py OUT.yml
+Usage: PYTHONPATH=build/release/python /usr/bin/python3 studies/ablation/dark_components_model.py OUT.yml
 """
 import sys
 

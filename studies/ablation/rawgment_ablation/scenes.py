@@ -1,4 +1,4 @@
-"""The ablation study's scenes (rawgment.ablation): synthetic reflectance scenes with edges, gratings and
+"""The ablation study's scenes (rawgment_ablation): synthetic reflectance scenes with edges, gratings and
 smooth textures, and their expected mosaic under the study's illuminant."""
 import math
 

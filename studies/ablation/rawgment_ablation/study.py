@@ -1,7 +1,7 @@
 """The ablation study of the paper's claim, on your sensor: a small RAW denoiser trained on darkened
 captures made with each noise alignment, tested on captures simulated directly in the dark.
 
-Run it as ``python3 -m rawgment.ablation [--model camera.yml] [--quick] [--out DIR]``; ``--help`` lists
+Run it as ``python3 -m rawgment_ablation [--model camera.yml] [--quick] [--out DIR]``; ``--help`` lists
 every option and docs/ablation.md explains the design and how to read the report.
 
 Arms (each trains the same network with the same budget, seed and data order; only the training
@@ -29,16 +29,16 @@ import numpy as np
 import torch
 
 import rawgment as _rg
-from rawgment._ablation_common import (ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_ARMS, DESIGNS, TRAINED_ARMS,
+from rawgment_ablation.common import (ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_ARMS, DESIGNS, TRAINED_ARMS,
                                        _ROLE_BATCH, _ROLE_NETWORK, _ROLE_SAMPLE, _ROLE_TEST_CAPTURE, _ROLE_TEST_SCENES,
                                        _ROLE_TRAIN_SCENES, _seed)
-from rawgment.ablation_report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, contrastPairs, contrastRows,
+from rawgment_ablation.report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, contrastPairs, contrastRows,
                                       correctFamily, holmAdjusted, pairedSignificance, seedsForFamily, seedsToConfirm,
                                       mergeReplicates, studyName, summarize, writeCombinedReport, writeOutputs,
                                       writeStudiesOutputs)
-from rawgment.ablation_controls import CONTROL_CONTRASTS, PREDICTIONS
-from rawgment.ablation_network import Denoiser, psnr, ssim
-from rawgment.ablation_scenes import mosaicOfScene, renderScene
+from rawgment_ablation.controls import CONTROL_CONTRASTS, PREDICTIONS
+from rawgment_ablation.network import Denoiser, psnr, ssim
+from rawgment_ablation.scenes import mosaicOfScene, renderScene
 from rawgment.torch import packCfaPlanes
 
 __all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "CONTROL_ARMS", "DESIGNS",
@@ -512,7 +512,7 @@ def runAblation(config, log=None):
 
 def _parser():
     parser = argparse.ArgumentParser(
-        prog="python3 -m rawgment.ablation",
+        prog="python3 -m rawgment_ablation",
         description="Trains a small RAW denoiser on darkened captures made with each noise alignment (NONE, "
                     "IGNORE_PRIOR, ACCOUNT_PRIOR), an oracle trained on captures simulated at the target, and "
                     "the noisy input as the floor; tests all on captures simulated at the target; writes "
@@ -638,19 +638,19 @@ def main(argv=None):
     errors = _argumentErrors(args)
     if errors:
         for e in errors:
-            print("rawgment.ablation: %s" % e, file=sys.stderr)
+            print("rawgment_ablation: %s" % e, file=sys.stderr)
         return 2
     if args.combine:
         unused = ["--" + a.dest.replace("_", "-") for a in parser._actions
                   if a.dest not in ("help", "combine", "out") and getattr(args, a.dest) != a.default]
         if unused:
-            print("rawgment.ablation: --combine trains nothing, so %s would be ignored" % ", ".join(unused),
+            print("rawgment_ablation: --combine trains nothing, so %s would be ignored" % ", ".join(unused),
                   file=sys.stderr)
             return 2
         try:
             print(writeCombinedReport(args.combine, args.out))
         except ValueError as e:
-            print("rawgment.ablation: %s" % e, file=sys.stderr)
+            print("rawgment_ablation: %s" % e, file=sys.stderr)
             return 2
         return 0
     config = AblationConfig()
@@ -660,30 +660,30 @@ def main(argv=None):
     config.bitDepth, config.blackLevel = args.bit_depth, args.black_level
     if args.model is not None:
         if not os.path.isfile(args.model):
-            print("rawgment.ablation: --model '%s' is not a file" % args.model, file=sys.stderr)
+            print("rawgment_ablation: --model '%s' is not a file" % args.model, file=sys.stderr)
             return 2
         # A darktable camera's and an Android profile's model is made at the study's levels.
         fmt = _rg.RawFormat(blackLevel=(float(args.black_level),) * 4, whiteLevel=2 ** int(args.bit_depth) - 1)
         try:
             config.model = _rg.loadAnyNoiseModel(args.model, args.camera or "", fmt)
         except _rg.error as e:
-            print("rawgment.ablation: %s" % e, file=sys.stderr)
+            print("rawgment_ablation: %s" % e, file=sys.stderr)
             return 2
         config.camera = args.camera or ""
     elif args.camera is not None:
-        print("rawgment.ablation: --camera needs --model (a darktable profile file)", file=sys.stderr)
+        print("rawgment_ablation: --camera needs --model (a darktable profile file)", file=sys.stderr)
         return 2
     config.baseGain = _rg.dbToLinearGain(args.base_gain_db)
     config.seed, config.threads, config.firstReplicate = args.seed, args.threads, args.first_replicate
     networks = ["blind"] if args.blind else [n.strip() for n in args.networks.split(",") if n.strip()]
     if not networks or any(n not in NETWORKS for n in networks) or len(set(networks)) != len(networks):
-        print("rawgment.ablation: --networks must be told, blind or told,blind, got '%s'" % args.networks,
+        print("rawgment_ablation: --networks must be told, blind or told,blind, got '%s'" % args.networks,
               file=sys.stderr)
         return 2
     designs = ["pooled", "per-condition"] if args.per_condition else \
         [d.strip() for d in args.designs.split(",") if d.strip()]
     if not designs or any(d not in DESIGNS for d in designs) or len(set(designs)) != len(designs):
-        print("rawgment.ablation: --designs must be pooled, per-condition or pooled,per-condition, got '%s'"
+        print("rawgment_ablation: --designs must be pooled, per-condition or pooled,per-condition, got '%s'"
               % args.designs, file=sys.stderr)
         return 2
     config.blindStep = args.blind_step
@@ -699,21 +699,21 @@ def main(argv=None):
         names = [n.strip() for n in args.conditions.split(",") if n.strip()]
         unknown = [n for n in names if n not in known]
         if unknown:
-            print("rawgment.ablation: unknown condition(s) %s; the conditions are %s"
+            print("rawgment_ablation: unknown condition(s) %s; the conditions are %s"
                   % (", ".join(unknown), ", ".join(known)), file=sys.stderr)
             return 2
         config.conditions = [known[n] for n in names]
     try:
         config.validate()
     except (ValueError, _rg.error) as e:
-        print("rawgment.ablation: %s" % e, file=sys.stderr)
+        print("rawgment_ablation: %s" % e, file=sys.stderr)
         return 2
     studies = [(n, d) for n in networks for d in designs]
     if not config.seeds:
         config.seeds = seedsNeeded(config, len(studies))
     conflict = _outputConflicts(args.out, [studyName(n, d) for n, d in studies])
     if conflict is not None:
-        print("rawgment.ablation: %s" % conflict, file=sys.stderr)
+        print("rawgment_ablation: %s" % conflict, file=sys.stderr)
         return 2
 
     def log(line):
@@ -722,7 +722,7 @@ def main(argv=None):
     byStudy = {}
     for network, design in studies:
         if len(studies) > 1:
-            log("rawgment.ablation: %s networks, %s design" % (network, design))
+            log("rawgment_ablation: %s networks, %s design" % (network, design))
         byStudy[studyName(network, design)] = runAblation(
             dataclasses.replace(config, noiseMaps=network == "told", design=design), log)
     if len(studies) == 1:
@@ -730,7 +730,7 @@ def main(argv=None):
     else:
         written, notes = writeStudiesOutputs(byStudy, args.out)
     for note in notes:
-        log("rawgment.ablation: " + note)
+        log("rawgment_ablation: " + note)
     for path in written:
         print(path)
     return 0

@@ -1,5 +1,5 @@
-"""What rawgment.ablation and its report share: the arms, the seed roles and the blind network's step.
-Private: import them from rawgment.ablation."""
+"""What the ablation study (rawgment_ablation) and its report share: the arms, the seed roles and the blind network's step.
+Private: import them from rawgment_ablation.study."""
 import rawgment as _rg
 
 #: The study's arms: the paper's three alignments, the oracle and the noisy floor, then the control arms that
