@@ -4,6 +4,8 @@
 // averaged over several seeds, with the time of the statistics and of the fit. Prints a Markdown table.
 //
 //   build/release/bin/study_calibration [seeds=4]
+#include "calibration_bench.hpp"
+
 #include <opencv2/core/utility.hpp>
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/simulate.hpp>
@@ -48,10 +50,9 @@ int main(int argc, char** argv)
     chart.patchSize = 32;
     chart.border = 8;
     chart.illumination = 1000;
-    const ColorCheckerScene scene = makeColorCheckerScene(chart);
-    const SensorSimulator sensor(p, scene.meanAtUnitGain.size());
-    const NoiseModel truth = sensor.effectiveModel();
-    const std::vector<Rect> squares = cfaAlignedSquares(scene.patches, 24);
+    const rawgment_studies::CalibrationBench bench(chart, p);
+    const NoiseModel& truth = bench.truth;
+    const std::vector<Rect> squares = cfaAlignedSquares(bench.scene.patches, 24);
     const std::vector<int> frameCounts = {8, 16, 32, 64, 100};
     const std::vector<int> patchCounts = {6, 12, 24};
     std::map<std::pair<int, int>, Cell> cells;
@@ -63,24 +64,17 @@ int main(int argc, char** argv)
         uint64 streamSeed = 1000 * (seed + 1);
         for (double db : {6.0, 12.0, 24.0}) {
             const double g = dbToLinearGain(db);
-            const RawFormat fmt = sensor.rawFormat(g);
             for (double level : {0.2, 0.65}) {
-                BurstStatistics stats(fmt);
-                for (int t = 0; t < frameCounts.back(); ++t) {
-                    Mat raw;
-                    sensor.capture(scene.meanAtUnitGain, g, level * 3839 / (g * 1000), streamSeed, t, raw);
-                    const double t0 = now();
-                    stats.add(raw);
-                    statsMs += now() - t0;
-                    if (std::find(frameCounts.begin(), frameCounts.end(), t + 1) != frameCounts.end()) {
-                        auto& perPatch = samples[t + 1];
+                statsMs += rawgment_studies::simulateLightBurst(
+                    bench, g, level, streamSeed, frameCounts.back(), frameCounts,
+                    [&](int frames, const BurstStatistics& stats) {
+                        auto& perPatch = samples[frames];
                         perPatch.resize(squares.size());
                         for (size_t k = 0; k < squares.size(); ++k) {
                             const std::vector<NoiseSample> s = sampleBurstPatches(stats, {squares[k]}, g);
                             perPatch[k].insert(perPatch[k].end(), s.begin(), s.end());
                         }
-                    }
-                }
+                    });
                 ++streamSeed;
             }
         }

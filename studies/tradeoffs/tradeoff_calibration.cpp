@@ -1,8 +1,10 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // The trade-off studies of calibration (rawgment_tradeoffs): each knob's time and accuracy over simulated
-// campaigns, and the errors a calibration states against those it makes; and the studies' shared seeds and
-// timers (tradeoff_study.hpp).
+// campaigns (the chart, sensor and light bursts of studies/calibration/calibration_bench.hpp), and the errors
+// a calibration states against those it makes; and the studies' shared seeds and timers (tradeoff_study.hpp).
 #include "tradeoff_study.hpp"
+
+#include "calibration_bench.hpp"
 
 #include "flow_common.hpp"
 
@@ -117,29 +119,6 @@ std::vector<PrecisionSetup> precisionSetups(const TradeoffSettings& set)
     return setups;
 }
 
-//! The simulated chart and sensor of the calibration campaigns.
-struct CalibrationBench
-{
-    ColorCheckerOptions chart;
-    ColorCheckerScene scene;
-    SensorSimulator sensor;
-    NoiseModel truth;
-
-    CalibrationBench(const ColorCheckerOptions& chartOptions, const SensorParams& params)
-        : chart(chartOptions), scene(makeColorCheckerScene(chartOptions)),
-          sensor(params, scene.meanAtUnitGain.size()), truth(sensor.effectiveModel())
-    {
-    }
-
-    /** The exposure of a burst at light `level`: a perfect white reflector at that fraction of the DN
-     * range above black (4095 - 256 = 3839 DN), level x range / (gain x the chart's illumination). */
-    double exposureFor(double level, double gain) const
-    {
-        const RawFormat unitFormat = sensor.rawFormat(1);
-        return level * (unitFormat.whiteLevel - unitFormat.blackLevel[0]) / (gain * chart.illumination);
-    }
-};
-
 //! One campaign's samples after each burst length, for every square side.
 struct CampaignSamples
 {
@@ -150,8 +129,8 @@ struct CampaignSamples
 
 /** Simulates one campaign (3 gains x (2 light levels + 1 dark)) and samples each burst's statistics after
  * every burst length of the study; `statsMs` gains the time of every BurstStatistics::add. */
-CampaignSamples sampleCampaign(const TradeoffSettings& set, const CalibrationBench& bench, int campaign,
-                               double& statsMs, rawgment_apps::ProgressBar& progress)
+CampaignSamples sampleCampaign(const TradeoffSettings& set, const rawgment_studies::CalibrationBench& bench,
+                               int campaign, double& statsMs, rawgment_apps::ProgressBar& progress)
 {
     const int maxFrames = set.burstLengths.back();
     const auto isBurstLength = [&](int frames) {
@@ -168,23 +147,18 @@ CampaignSamples sampleCampaign(const TradeoffSettings& set, const CalibrationBen
         const double g = dbToLinearGain(db);
         const RawFormat fmt = bench.sensor.rawFormat(g);
         for (double level : {0.2, 0.65}) {
-            BurstStatistics stats(fmt);
-            for (int t = 0; t < maxFrames; ++t) {
-                Mat raw;
-                bench.sensor.capture(bench.scene.meanAtUnitGain, g, bench.exposureFor(level, g),
-                                     nextBurstSeed(), t, raw);
-                statsMs += fastestMs(1, [&] { stats.add(raw); });
-                if (!isBurstLength(t + 1))
-                    continue;
-                for (int side : {8, 16, 24}) {
-                    std::vector<NoiseSample>& samples = out.light[{t + 1, side}];
-                    out.samplingMs[{t + 1, side}] += fastestMs(1, [&] {
-                        const std::vector<NoiseSample> s =
-                            sampleBurstPatches(stats, cfaAlignedSquares(bench.scene.patches, side), g);
-                        samples.insert(samples.end(), s.begin(), s.end());
-                    });
-                }
-            }
+            statsMs += rawgment_studies::simulateLightBurst(
+                bench, g, level, nextBurstSeed(), maxFrames, set.burstLengths,
+                [&](int frames, const BurstStatistics& stats) {
+                    for (int side : {8, 16, 24}) {
+                        std::vector<NoiseSample>& samples = out.light[{frames, side}];
+                        out.samplingMs[{frames, side}] += fastestMs(1, [&] {
+                            const std::vector<NoiseSample> s =
+                                sampleBurstPatches(stats, cfaAlignedSquares(bench.scene.patches, side), g);
+                            samples.insert(samples.end(), s.begin(), s.end());
+                        });
+                    }
+                });
             ++burstIndex;
             progress.advance();
         }
@@ -293,7 +267,7 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
     chart.illumination = 1000;
     SensorParams params;
     params.noise = NoiseModel(0.4, 0.5, 2.0);
-    const CalibrationBench bench(chart, params);
+    const rawgment_studies::CalibrationBench bench(chart, params);
     const int maxFrames = set.burstLengths.back();
     const double frameMp = megapixels(bench.scene.meanAtUnitGain.size());
     const std::vector<CalibrationKnobSetting> settings = calibrationKnobSettings(set);
