@@ -173,7 +173,7 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
     const auto holds = [](const String& file, const void* data, size_t size) {
         try {
             return pathExists(file) && readFileBounded(file, static_cast<long long>(size), "file") ==
-                                                   std::string(static_cast<const char*>(data), size);
+                                           std::string(static_cast<const char*>(data), size);
         } catch (const Exception&) {
             return false; // larger than ours, or unreadable: not this call's output
         }
