@@ -283,18 +283,19 @@ Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
         // The same steps with the standard's K and sigma_y.dark as the model: the evidence of which slope
         // predicts the sensor's own darker steps when the two differ (a photon transfer curve that bends).
         const NoiseModel standard(results[k].K, 0.0, results[k].sigmaYDark * results[k].sigmaYDark);
-        double modelMean = 0, standardMean = 0;
-        int pairs = 0;
-        for (const Emva1288Darkening& e : emva1288Darkening(series[k], results[k], standard, steps, o.seed))
-            if (e.alignment == NoiseAlignment::ACCOUNT_PRIOR)
-                standardMean += e.ratio;
-        for (const Emva1288Darkening& e : d)
-            if (e.alignment == NoiseAlignment::ACCOUNT_PRIOR) {
-                modelMean += e.ratio;
-                ++pairs;
-            }
-        modelMean /= pairs;
-        standardMean /= pairs;
+        const auto meanAccountRatio = [](const std::vector<Emva1288Darkening>& darkening) {
+            double sum = 0;
+            int pairs = 0;
+            for (const Emva1288Darkening& e : darkening)
+                if (e.alignment == NoiseAlignment::ACCOUNT_PRIOR) {
+                    sum += e.ratio;
+                    ++pairs;
+                }
+            return sum / pairs;
+        };
+        const double modelMean = meanAccountRatio(d);
+        const double standardMean =
+            meanAccountRatio(emva1288Darkening(series[k], results[k], standard, steps, o.seed));
         const bool modelCloser = std::abs(modelMean - 1) <= std::abs(standardMean - 1);
         out.notes.push_back(cv::format("%s: darkened with ACCOUNT_PRIOR, the model's line (slope %.5f, to "
                                        "%.0f%% of saturation) gives %.4f of "

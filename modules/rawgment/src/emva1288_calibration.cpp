@@ -4,6 +4,7 @@
 // degree of freedom and is 0 whenever the two integer readings tie; fitNoiseLine()'s inlier band dropped
 // every tie until its lower edge took a continuity correction (docs/emva1288.md). The pooled pair statistic
 // selects nothing, and its standard error is measured from the pixels' own fourth moment (or the rows).
+#include "noise_terms.hpp"
 #include "precomp.hpp"
 
 #include <opencv2/rawgment/emva1288.hpp>
@@ -248,10 +249,9 @@ CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurem
         double ssTot = 0, ssRes = 0, mean = 0;
         for (double v : b)
             mean += v / double(b.size());
-        const NoiseModel readOnly(0.0, sigmaD2, sigmaR2);
         for (size_t i = 0; i < g.size(); ++i) {
             ssTot += (b[i] - mean) * (b[i] - mean);
-            ssRes += std::pow(b[i] - readOnly.lineAtGain(g[i]).b, 2);
+            ssRes += std::pow(b[i] - detail::noiseTermsAt(g[i], 0.0, sigmaD2, sigmaR2).read(), 2);
         }
         report.rSquaredOffset = ssTot > 0 ? 1 - ssRes / ssTot : 1;
     } else {
@@ -318,7 +318,7 @@ CalibrationVerdict judgeEmva1288(const std::vector<Emva1288Results>& results,
                 continue;
             ++steps;
             worstRelativeError = std::max(worstRelativeError, r.varianceStdError[i] / r.variance[i]);
-            const double fitted = line.line.a * signal + line.line.b;
+            const double fitted = detail::lineVariance(line.line.a, line.line.b, signal);
             worstResidual = std::max(worstResidual, std::abs(r.variance[i] / fitted - 1));
         }
         // Effective degrees of freedom: each step's variance to 2% (a Gaussian pair of P pixels gives
