@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages that cv::rawgment needs to build, test and run its demo.
-# Idempotent: packages already present are not reinstalled. Runs as root or through sudo.
+# Installs the Debian 12 packages that cv::rawgment needs to build, test and run its demo; with --packaging
+# also what scripts/package-deb.sh needs. Idempotent: packages already present are not reinstalled. Runs as
+# root or through sudo.
 set -euo pipefail
 
 packages=(
@@ -30,6 +31,14 @@ packages=(
   python3-dask      # rawgment.batch on a cluster
   python3-distributed  # Dask's scheduler, workers and LocalCluster
 )
+
+# scripts/package-deb.sh also writes the apps' manual pages and checks its package with lintian.
+if [ "${1:-}" = "--packaging" ]; then
+  packages+=(help2man lintian)
+elif [ $# -gt 0 ]; then
+  echo "install-deps: unknown argument '$1' (expected nothing or --packaging)" >&2
+  exit 2
+fi
 
 missing=()
 for p in "${packages[@]}"; do
