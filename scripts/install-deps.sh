@@ -32,9 +32,10 @@ packages=(
   python3-distributed  # Dask's scheduler, workers and LocalCluster
 )
 
-# scripts/package-deb.sh also writes the apps' manual pages and checks its package with lintian.
+# scripts/package-deb.sh also writes the apps' manual pages and checks its package with lintian;
+# scripts/test-pip.sh builds with pip in a virtual environment (setuptools 66 and wheel as the backend).
 if [ "${1:-}" = "--packaging" ]; then
-  packages+=(help2man lintian)
+  packages+=(help2man lintian python3-pip python3-venv python3-setuptools python3-wheel)
 elif [ $# -gt 0 ]; then
   echo "install-deps: unknown argument '$1' (expected nothing or --packaging)" >&2
   exit 2

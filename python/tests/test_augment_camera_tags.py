@@ -8,6 +8,7 @@ import subprocess
 import pytest
 
 import rawgment as rg
+from conftest import env_path
 
 PHOTON_RATIO, GAIN_RATIO = 0.125, 4.0
 
@@ -56,7 +57,7 @@ def test_augmented_dng_keeps_the_camera_and_states_the_simulated_capture(tmp_pat
     contrast = PHOTON_RATIO * GAIN_RATIO
     (tmp_path / "scene.yml").write_text("%%YAML:1.0\nscene: {contrast: [%g, %g, %g, %g], brightness: 0, "
                                         "gain_ratio: %g}\n" % (contrast, contrast, contrast, contrast, GAIN_RATIO))
-    app = os.path.join(os.environ["RAWGMENT_APP_DIR"], "rawgment_augment")
+    app = os.path.join(env_path("RAWGMENT_APP_DIR"), "rawgment_augment")
     subprocess.run([app, "--model=%s" % (tmp_path / "model.yml"), "--scene=%s" % (tmp_path / "scene.yml"),
                     "--out=%s" % (tmp_path / "out"), "--preview", source], check=True, capture_output=True)
     stem = os.path.splitext(name)[0]

@@ -7,10 +7,20 @@ import sys
 import numpy as np
 
 import rawgment as rg
+from conftest import env_path
+
+
+def test_the_package_under_test_is_the_one_meant():
+    # Under ctest the build tree's package, under scripts/test-pip.sh the one pip installed in the venv: a
+    # stray PYTHONPATH or an older install must not stand in for either.
+    from conftest import INSTALLED_PACKAGE_DIR
+    expected = INSTALLED_PACKAGE_DIR or os.path.join(env_path("RAWGMENT_BUILD_DIR"), "python")
+    for module in (rg, rg._rawgment):
+        assert os.path.realpath(module.__file__).startswith(os.path.realpath(expected) + os.sep), module.__file__
 
 
 def test_installed_package_imports_and_runs(tmp_path):
-    build = os.environ["RAWGMENT_BUILD_DIR"]
+    build = env_path("RAWGMENT_BUILD_DIR")
     prefix = tmp_path / "prefix"
     subprocess.run(["cmake", "--install", build, "--prefix", str(prefix)], check=True, capture_output=True)
     site = prefix / "lib" / ("python%d.%d" % sys.version_info[:2]) / "dist-packages"
@@ -33,7 +43,7 @@ def test_installed_package_imports_and_runs(tmp_path):
 def test_the_ablation_study_runs_from_the_installed_prefix(tmp_path):
     # Every module the study imports (the report, the controls, the network, the scenes) must be installed:
     # a module missing from the install list would only show here, the build tree having them all.
-    build = os.environ["RAWGMENT_BUILD_DIR"]
+    build = env_path("RAWGMENT_BUILD_DIR")
     prefix = tmp_path / "prefix"
     subprocess.run(["cmake", "--install", build, "--prefix", str(prefix)], check=True, capture_output=True)
     site = prefix / "lib" / ("python%d.%d" % sys.version_info[:2]) / "dist-packages"

@@ -9,6 +9,7 @@ import torch
 
 import rawgment as rg
 import rawgment.torch as rgt
+from conftest import env_path
 
 
 @pytest.fixture(scope="module")
@@ -202,7 +203,7 @@ def test_npy_mosaics_are_numpys_own_files_and_the_dataset_reads_them(folder, tmp
     assert back.dtype == np.float32 and np.array_equal(back, floats)
     # Conversions of the folder's camera files, as rawgment_convert writes them: the same samples.
     converted = tmp_path / "converted"
-    run = subprocess.run([os.path.join(os.environ["RAWGMENT_APP_DIR"], "rawgment_convert"), "--out=%s" % converted]
+    run = subprocess.run([os.path.join(env_path("RAWGMENT_APP_DIR"), "rawgment_convert"), "--out=%s" % converted]
                          + [str(folder / name) for name in sorted(os.listdir(folder)) if name.endswith(".dng")],
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stdout + run.stderr
