@@ -18,9 +18,10 @@ build="$root/build/deb"
 generator=()
 command -v ninja >/dev/null 2>&1 && generator=(-G Ninja)
 echo "=== package-deb.sh: build ($build)"
+mkdir -p "$build"
 cmake -S "$root" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=/usr \
   -DRAWGMENT_DEBIAN_PACKAGE=ON -DRAWGMENT_BUILD_PYTHON=ON -DRAWGMENT_BUILD_TESTS=OFF -DRAWGMENT_BUILD_PERF=OFF \
-  -DRAWGMENT_BUILD_SAMPLES=OFF > "$build.configure.log" || { cat "$build.configure.log"; exit 1; }
+  -DRAWGMENT_BUILD_SAMPLES=OFF > "$build/configure.log" || { cat "$build/configure.log"; exit 1; }
 cmake --build "$build" --parallel "$jobs"
 rm -f "$build"/rawgment_*.deb
 (cd "$build" && cpack > cpack.log) || { cat "$build/cpack.log"; exit 1; }
