@@ -134,10 +134,10 @@ void bindNoiseSteps(py::module_& m)
     m.attr("MAX_MOTION_LENGTH") = MAX_MOTION_LENGTH;
     m.def(
         "linearMotionKernel",
-        [](double length, double angleDegrees) {
-            return arrayFromMat(linearMotionKernel(length, angleDegrees));
+        [](double length, double angleDegrees, CfaPattern pattern) {
+            return arrayFromMat(linearMotionKernel(length, angleDegrees, pattern));
         },
-        py::arg("length"), py::arg("angleDegrees"),
+        py::arg("length"), py::arg("angleDegrees"), py::arg("pattern") = CFA_RGGB,
         doc("linearMotionKernel", "Python: returns the float32 kernel."));
     m.def(
         "motionBlur",

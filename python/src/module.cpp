@@ -251,12 +251,14 @@ void bindBayer(py::module_& m)
         .value("CFA_BGGR", CFA_BGGR, doc("CfaPattern::CFA_BGGR"))
         .value("CFA_GRBG", CFA_GRBG, doc("CfaPattern::CFA_GRBG"))
         .value("CFA_GBRG", CFA_GBRG, doc("CfaPattern::CFA_GBRG"))
+        .value("CFA_MONO", CFA_MONO, doc("CfaPattern::CFA_MONO"))
         .export_values();
     py::enum_<CfaChannel>(m, "CfaChannel", doc("CfaChannel"))
         .value("CFA_R", CFA_R, doc("CfaChannel::CFA_R"))
         .value("CFA_G1", CFA_G1, doc("CfaChannel::CFA_G1"))
         .value("CFA_G2", CFA_G2, doc("CfaChannel::CFA_G2"))
         .value("CFA_B", CFA_B, doc("CfaChannel::CFA_B"))
+        .value("CFA_W", CFA_W, doc("CfaChannel::CFA_W"))
         .export_values();
     m.def("cfaSite", &cfaSite, py::arg("row"), py::arg("col"), doc("cfaSite"));
     m.def("cfaChannelAt", &cfaChannelAt, py::arg("pattern"), py::arg("row"), py::arg("col"),
@@ -280,6 +282,7 @@ void bindBayer(py::module_& m)
                        doc("RawFormat::sensorOrigin", "Python: a tuple (x, y)."))
         .def("validate", &RawFormat::validate, doc("RawFormat::validate"))
         .def("blackAt", &RawFormat::blackAt, py::arg("row"), py::arg("col"), doc("RawFormat::blackAt"))
+        .def("isMonochrome", &RawFormat::isMonochrome, doc("RawFormat::isMonochrome"))
         .def("cropped", &RawFormat::cropped, py::arg("rowOffset"), py::arg("colOffset"),
              doc("RawFormat::cropped"));
 

@@ -18,7 +18,7 @@ void checkFiniteNonNegative(double value, const char* what);
 /** A blur kernel as float64 normalised to sum 1: the one check of motion blur and the simulator's
  * blurred captures. Throws StsBadArg naming `who` unless it is non-empty, finite, non-negative and of
  * positive sum. */
-Mat normalisedKernel(InputArray kernel, const char* who);
+Mat normalisedKernel(InputArray kernel, const char* who, int maxSide);
 /** The Mat of an array argument, refused with StsBadArg naming `what` ("colorJitter: src") unless it has at
  * most two dimensions: an N-D array (numpy's (1, 1, H, W) through cv2) would otherwise be read as 1x1. The
  * check every entry point makes, so that every binding gets it. */

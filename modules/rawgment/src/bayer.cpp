@@ -12,19 +12,20 @@ namespace rawgment {
 namespace {
 
 // Channels of the four sites, per pattern (row-major 2x2 block).
-constexpr std::array<std::array<CfaChannel, 4>, 4> kChannelsOfPattern = {{
+constexpr std::array<std::array<CfaChannel, 4>, 5> kChannelsOfPattern = {{
     {{CFA_R, CFA_G1, CFA_G2, CFA_B}}, // RGGB
     {{CFA_B, CFA_G2, CFA_G1, CFA_R}}, // BGGR
     {{CFA_G1, CFA_R, CFA_B, CFA_G2}}, // GRBG
     {{CFA_G2, CFA_B, CFA_R, CFA_G1}}, // GBRG
+    {{CFA_W, CFA_W, CFA_W, CFA_W}},   // MONO
 }};
-constexpr std::array<const char*, 4> kPatternNames = {{"RGGB", "BGGR", "GRBG", "GBRG"}};
+constexpr std::array<const char*, 5> kPatternNames = {{"RGGB", "BGGR", "GRBG", "GBRG", "MONO"}};
 
 void checkPattern(CfaPattern pattern)
 {
-    if (pattern < CFA_RGGB || pattern > CFA_GBRG)
+    if (pattern < CFA_RGGB || pattern > CFA_MONO)
         CV_Error(Error::StsBadArg,
-                 format("CFA pattern %d is not one of CFA_RGGB, CFA_BGGR, CFA_GRBG, CFA_GBRG",
+                 format("CFA pattern %d is not one of CFA_RGGB, CFA_BGGR, CFA_GRBG, CFA_GBRG, CFA_MONO",
                         static_cast<int>(pattern)));
 }
 
@@ -100,16 +101,25 @@ CfaChannel cfaChannelAt(CfaPattern pattern, int row, int col)
 int cfaSiteOfChannel(CfaPattern pattern, CfaChannel channel)
 {
     checkPattern(pattern);
-    if (channel < CFA_R || channel > CFA_B)
-        CV_Error(Error::StsBadArg, format("CFA channel %d is not one of CFA_R, CFA_G1, CFA_G2, CFA_B",
+    if (channel < CFA_R || channel > CFA_W)
+        CV_Error(Error::StsBadArg, format("CFA channel %d is not one of CFA_R, CFA_G1, CFA_G2, CFA_B, CFA_W",
                                           static_cast<int>(channel)));
     const auto& sites = kChannelsOfPattern[pattern];
-    return static_cast<int>(std::find(sites.begin(), sites.end(), channel) - sites.begin());
+    const auto site = std::find(sites.begin(), sites.end(), channel);
+    if (site == sites.end())
+        CV_Error(Error::StsBadArg,
+                 format("a %s frame has no CFA channel %d (%s)", kPatternNames[pattern],
+                        static_cast<int>(channel),
+                        pattern == CFA_MONO ? "a monochrome frame has only CFA_W"
+                                            : "CFA_W is the channel of a monochrome frame"));
+    return static_cast<int>(site - sites.begin());
 }
 
 CfaPattern cfaPatternOfCrop(CfaPattern pattern, int rowOffset, int colOffset)
 {
     checkPattern(pattern);
+    if (pattern == CFA_MONO)
+        return CFA_MONO;
     // The crop's site s lies at the original's site s XOR the offset's phase.
     const int shift = cfaSite(rowOffset, colOffset);
     const auto& original = kChannelsOfPattern[pattern];
@@ -134,10 +144,11 @@ CfaPattern cfaPatternFromName(const String& name)
     String upper = name;
     std::transform(upper.begin(), upper.end(), upper.begin(),
                    [](unsigned char ch) { return static_cast<char>(std::toupper(ch)); });
-    for (int p = 0; p < 4; ++p)
+    for (size_t p = 0; p < kPatternNames.size(); ++p)
         if (upper == kPatternNames[p])
             return static_cast<CfaPattern>(p);
-    CV_Error(Error::StsBadArg, "unknown CFA pattern '" + name + "'; expected one of RGGB, BGGR, GRBG, GBRG");
+    CV_Error(Error::StsBadArg,
+             "unknown CFA pattern '" + name + "'; expected one of RGGB, BGGR, GRBG, GBRG, MONO");
 }
 
 void RawFormat::validate() const
@@ -155,6 +166,11 @@ void RawFormat::validate() const
                             "(blackLevel[%d] = %g)",
                             whiteLevel, s, blackLevel[s]));
     }
+    if (pattern == CFA_MONO && blackLevel != Vec4d::all(blackLevel[0]))
+        CV_Error(Error::StsBadArg,
+                 format("RawFormat.blackLevel must be one value on all four sites for a CFA_MONO format (got "
+                        "%g, %g, %g, %g): a sensor without a colour filter has no 2x2 structure",
+                        blackLevel[0], blackLevel[1], blackLevel[2], blackLevel[3]));
     detail::checkFinitePositive(gain, "RawFormat.gain");
     if (sensorOrigin.x < 0 || sensorOrigin.y < 0)
         CV_Error(Error::StsBadArg, format("RawFormat.sensorOrigin must be >= 0 (got (%d, %d))",
@@ -347,10 +363,11 @@ void packCfaPlanes(InputArray _mosaic, const RawFormat& format, OutputArray _pla
     if (normalize)
         for (int s = 0; s < 4; ++s)
             scale[s] = 1.0 / (format.whiteLevel - format.blackLevel[s]);
-    int planeOfSite[4];
+    int planeOfSite[4] = {0, 1, 2, 3};
     const CfaChannel order[4] = {CFA_R, CFA_G1, CFA_G2, CFA_B};
-    for (int k = 0; k < 4; ++k)
-        planeOfSite[cfaSiteOfChannel(format.pattern, order[k])] = k;
+    if (!format.isMonochrome())
+        for (int k = 0; k < 4; ++k)
+            planeOfSite[cfaSiteOfChannel(format.pattern, order[k])] = k;
     _planes.create(2 * src.rows, src.cols / 2, CV_32FC1);
     Mat dst = _planes.getMat();
     // Often a tensor's new memory, first touched here.

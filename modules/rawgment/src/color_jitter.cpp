@@ -378,6 +378,14 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     format.validate();
     for (int s = 0; s < 4; ++s)
         checkFinitePositive(jitter.contrast[s], "colorJitter: contrast");
+    // Different contrasts per site would print a 2x2 checkerboard on a frame whose pixels all see the same
+    // light: no capture makes that.
+    if (format.isMonochrome() && jitter.contrast != Vec4d::all(jitter.contrast[0]))
+        CV_Error(
+            Error::StsBadArg,
+            cv::format("colorJitter: a CFA_MONO frame has one contrast for all four sites (got %g, %g, %g, "
+                       "%g): a monochrome sensor has no hue",
+                       jitter.contrast[0], jitter.contrast[1], jitter.contrast[2], jitter.contrast[3]));
     if (!std::isfinite(jitter.brightness))
         CV_Error(Error::StsBadArg, "colorJitter: brightness must be finite");
     checkFinitePositive(jitter.gainRatio, "colorJitter: gainRatio");

@@ -67,14 +67,14 @@ Mat twoDimensional(InputArray array, const char* what)
     return m;
 }
 
-Mat normalisedKernel(InputArray _kernel, const char* who)
+Mat normalisedKernel(InputArray _kernel, const char* who, int maxSide)
 {
     const Mat given = twoDimensional(_kernel, format("%s: kernel", who).c_str());
-    if (given.rows > MAX_MOTION_KERNEL_SIDE || given.cols > MAX_MOTION_KERNEL_SIDE)
+    if (given.rows > maxSide || given.cols > maxSide)
         CV_Error(Error::StsBadArg,
                  format("%s: the kernel is %dx%d; a blur kernel is at most %d plane pixels on a "
                         "side (a motion of MAX_MOTION_LENGTH), and its cost grows with its area",
-                        who, given.cols, given.rows, MAX_MOTION_KERNEL_SIDE));
+                        who, given.cols, given.rows, maxSide));
     // A kernel of several channels would be read interleaved, its channels taken for taps.
     if (given.channels() != 1)
         CV_Error(Error::StsBadArg, format("%s: kernel has %d channels; expected a single-channel 2-D kernel",

@@ -325,7 +325,8 @@ std::vector<uint8_t> dngFileBytes(const String& path, const RawImage& image)
     t.longs(257, {uint32_t(m.rows)});
     t.shorts(258, {16});
     t.shorts(259, {1});
-    t.shorts(262, {32803}); // CFA
+    const bool mono = image.format.isMonochrome();
+    t.shorts(262, {static_cast<uint16_t>(mono ? 34892 : 32803)}); // LinearRaw or CFA
     if (!image.make.empty())
         t.ascii(271, image.make);
     if (!image.model.empty())
@@ -335,10 +336,12 @@ std::vector<uint8_t> dngFileBytes(const String& path, const RawImage& image)
     t.longs(278, {uint32_t(m.rows)});
     t.shorts(284, {1});
     t.ascii(305, "cv::rawgment");
-    t.shorts(33421, {2, 2});
-    const CfaPattern p = image.format.pattern;
-    t.bytes(33422, {dngColourOf(cfaChannelAt(p, 0, 0)), dngColourOf(cfaChannelAt(p, 0, 1)),
-                    dngColourOf(cfaChannelAt(p, 1, 0)), dngColourOf(cfaChannelAt(p, 1, 1))});
+    if (!mono) {
+        t.shorts(33421, {2, 2});
+        const CfaPattern p = image.format.pattern;
+        t.bytes(33422, {dngColourOf(cfaChannelAt(p, 0, 0)), dngColourOf(cfaChannelAt(p, 0, 1)),
+                        dngColourOf(cfaChannelAt(p, 1, 0)), dngColourOf(cfaChannelAt(p, 1, 1))});
+    }
     if (image.exposureTime > 0)
         t.rationals(33434, {image.exposureTime}, false);
     if (image.iso > 0) {
@@ -355,18 +358,20 @@ std::vector<uint8_t> dngFileBytes(const String& path, const RawImage& image)
     t.bytes(50707, {1, 1, 0, 0});
     t.ascii(50708, image.make.empty() && image.model.empty() ? String("cv::rawgment")
                                                              : image.make + " " + image.model);
-    t.bytes(50710, {0, 1, 2}); // CFAPlaneColor
-    t.shorts(50711, {1});      // CFALayout: rectangular
-    t.shorts(50713, {2, 2});
-    {
-        std::vector<uint8_t> b;
-        for (uint32_t v : blacks)
-            for (int k = 0; k < 4; ++k)
-                b.push_back(uint8_t(v >> (8 * k)));
-        t.add(50714, TIFF_LONG, 4, b);
+    if (mono) {
+        // A monochrome DNG has one sample per pixel and one black level (RawFormat::validate() makes
+        // the four sites' equal); DNG requires colour tags only of files with colour.
+        t.shorts(50713, {1, 1});
+        t.longs(50714, {blacks[0]});
+    } else {
+        t.bytes(50710, {0, 1, 2}); // CFAPlaneColor
+        t.shorts(50711, {1});      // CFALayout: rectangular
+        t.shorts(50713, {2, 2});
+        t.longs(50714, {blacks[0], blacks[1], blacks[2], blacks[3]});
     }
     t.longs(50717, {static_cast<uint32_t>(std::llround(image.format.whiteLevel))});
-    addColourTags(t, image);
+    if (!mono)
+        addColourTags(t, image);
     if (!image.noiseProfile.empty()) {
         std::vector<double> pairs;
         for (const Vec2d& so : image.noiseProfile) {

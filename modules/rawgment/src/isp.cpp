@@ -164,6 +164,8 @@ int bayerToBgrCode(CfaPattern pattern, bool edgeAware)
         return edgeAware ? COLOR_BayerGB2BGR_EA : COLOR_BayerGB2BGR;
     case CFA_GBRG:
         return edgeAware ? COLOR_BayerGR2BGR_EA : COLOR_BayerGR2BGR;
+    case CFA_MONO:
+        break;
     }
     CV_Error(Error::StsBadArg, "renderSimpleIsp: invalid CFA pattern");
 }
@@ -268,11 +270,12 @@ void renderSimpleIsp(InputArray _mosaic, const RawFormat& format, OutputArray _b
         CV_Error(Error::StsBadArg, cv::format("renderSimpleIsp: mosaic is %dx%d; both sides must be even and "
                                               "at least 2 (crop it by one row or column)",
                                               mosaic.cols, mosaic.rows));
+    const bool mono = format.isMonochrome();
     Vec4f siteGain;
     for (int s = 0; s < 4; ++s) {
         const CfaChannel ch = cfaChannelAt(format.pattern, s / 2, s % 2);
         const int rgb = ch == CFA_R ? 0 : (ch == CFA_B ? 2 : 1);
-        siteGain[s] = static_cast<float>(params.whiteBalance[rgb] * params.exposure);
+        siteGain[s] = static_cast<float>((mono ? 1.0 : params.whiteBalance[rgb]) * params.exposure);
     }
     Mat codes(mosaic.size(), CV_16UC1);
     if (mosaic.depth() == CV_16U)
@@ -281,7 +284,14 @@ void renderSimpleIsp(InputArray _mosaic, const RawFormat& format, OutputArray _b
         normaliseMosaic<float>(mosaic, format, siteGain, codes);
 
     Mat bgr16;
-    if (params.demosaic == DEMOSAIC_HALF_SIZE) {
+    if (mono) {
+        Mat grey;
+        if (params.demosaic == DEMOSAIC_HALF_SIZE)
+            resize(codes, grey, Size(codes.cols / 2, codes.rows / 2), 0, 0, INTER_AREA);
+        else
+            grey = codes;
+        cvtColor(grey, bgr16, COLOR_GRAY2BGR);
+    } else if (params.demosaic == DEMOSAIC_HALF_SIZE) {
         halfSizeBgr(codes, format.pattern, bgr16);
     } else if (codes.rows < 4 || codes.cols < 4) {
         // OpenCV's Bayer conversions return black below 3 pixels on a side: each 2x2 block then gets its
@@ -295,10 +305,11 @@ void renderSimpleIsp(InputArray _mosaic, const RawFormat& format, OutputArray _b
     codes.release();
 
     Mat dst(bgr16.size(), CV_MAKETYPE(params.outputDepth, 3));
+    const Matx33d colorMatrix = mono ? Matx33d::eye() : params.colorMatrix;
     if (params.outputDepth == CV_8U)
-        toneMapBgr(bgr16, params.colorMatrix, toneTable<uchar>(params.tone, 255.0), dst);
+        toneMapBgr(bgr16, colorMatrix, toneTable<uchar>(params.tone, 255.0), dst);
     else
-        toneMapBgr(bgr16, params.colorMatrix, toneTable<float>(params.tone, 1.0), dst);
+        toneMapBgr(bgr16, colorMatrix, toneTable<float>(params.tone, 1.0), dst);
     _bgr.assign(dst);
 }
 

@@ -10,7 +10,7 @@
 namespace cv {
 namespace rawgment {
 
-Mat linearMotionKernel(double length, double angleDegrees)
+Mat linearMotionKernel(double length, double angleDegrees, CfaPattern pattern)
 {
     if (!(length >= 0 && length <= MAX_MOTION_LENGTH))
         CV_Error(Error::StsBadArg,
@@ -18,7 +18,8 @@ Mat linearMotionKernel(double length, double angleDegrees)
                         MAX_MOTION_LENGTH, length));
     if (!std::isfinite(angleDegrees))
         CV_Error(Error::StsBadArg, "linearMotionKernel: angle must be finite");
-    const double planeLength = length / 2; // the CFA planes have half the resolution
+    // The CFA planes have half the resolution; a monochrome frame is blurred on its own pixels.
+    const double planeLength = cfaPatternName(pattern) == "MONO" ? length : length / 2;
     if (planeLength <= 1)
         return Mat::ones(1, 1, CV_32FC1);
     const int radius = static_cast<int>(std::ceil(planeLength / 2));
@@ -49,6 +50,7 @@ namespace {
 
 using detail::finishPlaneRow;
 using detail::loadPlaneRow;
+using detail::PlaneGrid;
 using detail::ResampleConstants;
 using detail::RowScratch;
 using detail::storeMosaicRow;
@@ -140,7 +142,9 @@ template <typename T>
 void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps, Size ksize, float readFactor,
                    bool shotFromMean, const ResampleConstants& k, const Range& range)
 {
-    const int pw = src.cols / 2, ph = src.rows / 2, rx = ksize.width / 2, ry = ksize.height / 2;
+    const PlaneGrid& grid = k.grid;
+    const int pw = src.cols / grid.step, ph = src.rows / grid.step, rx = ksize.width / 2,
+              ry = ksize.height / 2;
     const Size plane(pw, ph), radius(rx, ry);
     // A ring row holds the plane row with rx columns of edge on each side, and one widest block more,
     // which addTapRow's last block reads past the row (detail::wholeBlocks()).
@@ -148,8 +152,8 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
     // A ring per site: a task makes whole plane rows i, the four sites in turn, so that it writes both
     // mosaic rows 2 i and 2 i + 1 whole (storeMosaicRow()).
     const size_t ringRows = static_cast<size_t>(ksize.height);
-    std::vector<float> ring(4 * ringRows * stride);
-    std::vector<int> ringRow(4 * ringRows, -1);
+    std::vector<float> ring(static_cast<size_t>(grid.sites) * ringRows * stride);
+    std::vector<int> ringRow(static_cast<size_t>(grid.sites) * ringRows, -1);
     std::vector<float> means[2] = {std::vector<float>(detail::wholeBlocks(pw)),
                                    std::vector<float>(detail::wholeBlocks(pw))};
     std::vector<float> shotSum(detail::wholeBlocks(pw)), readFactors(detail::wholeBlocks(pw));
@@ -186,7 +190,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
         }
         const float rowReadFactor =
             edgeRow ? mergeClampedTaps(taps, i, 0, plane, radius, true, false, rowTaps) : readFactor;
-        for (int site = 0; site < 4; ++site) {
+        for (int site = 0; site < grid.sites; ++site) {
             std::vector<float>& mean = means[site % 2];
             float* const siteRing = ring.data() + static_cast<size_t>(site) * ringRows * stride;
             int* const siteRingRow = ringRow.data() + static_cast<size_t>(site) * ringRows;
@@ -200,7 +204,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
                 const size_t slot = static_cast<size_t>(si) % ringRows;
                 float* row = siteRing + slot * stride;
                 if (siteRingRow[slot] != si) {
-                    loadPlaneRow<T>(src, site, si, rx, k.black[site], row, k.inputShading);
+                    loadPlaneRow<T>(src, grid, site, si, rx, k.black[site], row, k.inputShading);
                     siteRingRow[slot] = si;
                 }
                 tapRows.push_back(row + t.dx);
@@ -233,7 +237,9 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
                                                           std::max(mean[static_cast<size_t>(j)], 0.0f);
             }
             finishPlaneRow(mean, shotSum.data(), readFactors.data(), scratch, k, pw, site, i, rowKeep);
-            if (site % 2 == 1)
+            if (grid.sites == 1)
+                detail::storeFrameRow(mean.data(), dst.ptr<T>(i), pw);
+            else if (site % 2 == 1)
                 storeMosaicRow(means[0].data(), means[1].data(), dst.ptr<T>(2 * i + site / 2), pw);
         }
     }
@@ -250,7 +256,9 @@ void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNois
     const auto start = std::chrono::steady_clock::now();
     checkResampleInput(src, format, "motionBlur");
     const StepNoise step(model, format, noise, 1, src.size(), "motionBlur");
-    const Mat w = normalisedKernel(_kernel, "motionBlur");
+    const Mat w =
+        normalisedKernel(_kernel, "motionBlur",
+                         format.isMonochrome() ? 2 * MAX_MOTION_KERNEL_SIDE - 1 : MAX_MOTION_KERNEL_SIDE);
     if (w.total() == 1) {
         _dst.assign(src);
         return;
@@ -275,7 +283,7 @@ void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNois
     }
     const bool shotFromMean = noise.blurNoiseSum == BlurNoiseSum::FROM_BLURRED_MEAN;
     Mat dst = stepOutput(src, _dst);
-    parallel_for_(Range(0, src.rows / 2), [&](const Range& range) {
+    parallel_for_(Range(0, src.rows / k.grid.step), [&](const Range& range) {
         if (src.depth() == CV_16U)
             blurPlaneRows<ushort>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
         else

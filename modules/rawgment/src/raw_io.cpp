@@ -125,19 +125,22 @@ RawImage readRaw(const String& path)
     if (rc != LIBRAW_SUCCESS)
         failOn(path, "LibRaw cannot open it: " + libRawError(rc));
     const libraw_data_t& d = raw->imgdata;
-    if (d.idata.filters == 0)
-        failOn(path, "LibRaw reports no colour filter array: a linear or demosaiced DNG, a Foveon or a "
-                     "monochrome sensor, not a Bayer mosaic");
+    // One colour and no filter array: a monochrome sensor (a LinearRaw DNG with one sample per pixel).
+    const bool mono = d.idata.filters == 0 && d.idata.colors == 1;
+    if (d.idata.filters == 0 && !mono)
+        failOn(path, format("LibRaw reports no colour filter array and %d colours: a linear or demosaiced "
+                            "DNG or a Foveon, neither a Bayer mosaic nor a monochrome frame",
+                            d.idata.colors));
     if (d.idata.filters == 9)
         failOn(path, "the sensor has a 6x6 X-Trans colour filter array, not a 2x2 Bayer mosaic");
-    if (d.idata.filters < 1000)
+    if (!mono && d.idata.filters < 1000)
         failOn(path, "the colour filter array is not a 2x2 Bayer layout");
-    if (d.idata.colors != 3)
+    if (!mono && d.idata.colors != 3)
         failOn(path, format("the sensor has %d colours (for example CMYG), not red, green and blue",
                             d.idata.colors));
     if (raw->is_floating_point())
         failOn(path, "the mosaic is stored as floating point, which readRaw does not support");
-    const CfaPattern pattern = patternOf(*raw, path);
+    const CfaPattern pattern = mono ? CFA_MONO : patternOf(*raw, path);
     rc = raw->unpack();
     if (rc != LIBRAW_SUCCESS)
         failOn(path, "LibRaw cannot decode the image data (truncated or corrupt?): " + libRawError(rc));
@@ -147,7 +150,7 @@ RawImage readRaw(const String& path)
                                                 "offset %d)",
                                                 errors.offset));
     if (!d.rawdata.raw_image)
-        failOn(path, "LibRaw decoded no single-channel Bayer data for it");
+        failOn(path, "LibRaw decoded no single-channel data for it");
 
     const libraw_image_sizes_t& s = d.sizes;
     // Our mosaic functions need even sides; an odd visible size loses its last row or column.
@@ -165,7 +168,8 @@ RawImage readRaw(const String& path)
     out.format.pattern = pattern;
     for (int site = 0; site < 4; ++site) {
         const int r = site / 2, col = site % 2;
-        double black = double(c.black) + double(c.cblack[raw->COLOR(r, col)]);
+        // LibRaw's COLOR() has no colour index for a frame without a filter; its one colour is index 0.
+        double black = double(c.black) + double(c.cblack[mono ? 0 : raw->COLOR(r, col)]);
         if (c.cblack[4] > 0 && c.cblack[5] > 0) {
             const unsigned idx = 6 + (r % c.cblack[4]) * c.cblack[5] + (col % c.cblack[5]);
             if (idx < LIBRAW_CBLACK_SIZE)
@@ -190,13 +194,14 @@ RawImage readRaw(const String& path)
     out.exposureTime = d.other.shutter > 0 ? shortestDecimal(d.other.shutter) : 0.0;
     out.make = d.idata.make;
     out.model = d.idata.model;
-    if (c.cam_mul[0] > 0 && c.cam_mul[1] > 0 && c.cam_mul[2] > 0)
+    // A monochrome frame has no colour to balance or convert: the identity balance and matrix.
+    if (!mono && c.cam_mul[0] > 0 && c.cam_mul[1] > 0 && c.cam_mul[2] > 0)
         out.whiteBalance = Vec3d(c.cam_mul[0] / c.cam_mul[1], 1.0, c.cam_mul[2] / c.cam_mul[1]);
     bool haveMatrix = false;
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) {
             out.cameraToSrgb(i, j) = c.rgb_cam[i][j];
-            haveMatrix = haveMatrix || (i != j && c.rgb_cam[i][j] != 0);
+            haveMatrix = haveMatrix || (!mono && i != j && c.rgb_cam[i][j] != 0);
         }
     if (!haveMatrix)
         out.cameraToSrgb = Matx33d::eye();
@@ -207,7 +212,7 @@ RawImage readRaw(const String& path)
     bool haveXyz = false;
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
-            haveXyz = haveXyz || c.cam_xyz[i][j] != 0;
+            haveXyz = haveXyz || (!mono && c.cam_xyz[i][j] != 0);
     if (out.colorTags.empty() && haveXyz) {
         DngTag colorMatrix;
         colorMatrix.tag = 50721;

@@ -110,7 +110,7 @@ void finishResampledRowScalar(float* mean, const float* shotSum, const float* re
 // kept), drawn once per mosaic row so both sites of a row share it, plus the dark shading to restore.
 bool resampledDarkRow(const ResampleConstants& k, int site, int planeRow, float rowKeep, float* extra, int n)
 {
-    const int r = 2 * planeRow + site / 2;
+    const int r = k.grid.mosaicRow(site, planeRow);
     float amp = 0;
     if (k.dark.row) {
         const double added =
@@ -125,9 +125,10 @@ bool resampledDarkRow(const ResampleConstants& k, int site, int planeRow, float 
     }
     const float *bd = shading.perGainRow(r) + site % 2, *br = shading.offsetRow(r) + site % 2;
     float check = 0; // as in detail::darkRowExtra(): NaN when a map value is not finite
+    const int step = k.grid.step;
     for (int j = 0; j < n; ++j) {
-        extra[j] = amp + shading.at(bd, br, 2 * j);
-        check += (bd[2 * j] - bd[2 * j]) + (br[2 * j] - br[2 * j]);
+        extra[j] = amp + shading.at(bd, br, step * j);
+        check += (bd[step * j] - bd[step * j]) + (br[step * j] - br[step * j]);
     }
     return check == 0;
 }
@@ -203,6 +204,17 @@ void storeMosaicRow(const float* even, const float* odd, float* d, int width)
     }
 }
 
+void storeFrameRow(const float* values, ushort* d, int width)
+{
+    for (int j = 0; j < width; ++j)
+        d[j] = static_cast<ushort>(static_cast<int>(detail::roundHalfToEven(values[j])));
+}
+
+void storeFrameRow(const float* values, float* d, int width)
+{
+    std::memcpy(d, values, static_cast<size_t>(width) * sizeof(float));
+}
+
 void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float* readFactor,
                     RowScratch& scratch, const ResampleConstants& k, int n, int site, int planeRow,
                     float rowKeep)
@@ -229,6 +241,7 @@ ResampleConstants resampleConstants(int depth, const RawFormat& format, const St
                                     detail::RandomStream gaussian, detail::RandomStream poisson)
 {
     ResampleConstants k;
+    k.grid = PlaneGrid(format);
     for (int s = 0; s < 4; ++s)
         k.black[s] = static_cast<float>(format.blackLevel[s]);
     k.white = detail::outputWhite(format, depth); // storeMosaicRow() converts through int32
@@ -273,27 +286,29 @@ namespace {
 
 using detail::finishPlaneRow;
 using detail::loadPlaneRow;
+using detail::PlaneGrid;
 using detail::storeMosaicRow;
 
 // Source position on the plane grid of each output plane pixel for a scale about the mosaic centre:
-// plane index j of site column px sits at mosaic x = 2 j + px; its source is C + (x - C) / scale.
+// plane index j of site column px sits at mosaic x = step j + px (PlaneGrid); its source is
+// C + (x - C) / scale.
 struct BilinearAxis
 {
     std::vector<int> i0, i1;
     std::vector<float> f; // weight of i1; 0 when the two clamp onto the same pixel
 };
 
-BilinearAxis bilinearAxis(int planeSize, int phase, double scale)
+BilinearAxis bilinearAxis(int planeSize, int phase, double scale, int step)
 {
     // Whole blocks for bilinearRow(): the extra entries read pixel 0 with weight 0.
     BilinearAxis a;
     a.i0.assign(detail::wholeBlocks(planeSize), 0);
     a.i1.assign(detail::wholeBlocks(planeSize), 0);
     a.f.assign(detail::wholeBlocks(planeSize), 0.0f);
-    const double centre = (2.0 * planeSize - 1) / 2;
+    const double centre = (static_cast<double>(step) * planeSize - 1) / 2;
     for (int j = 0; j < planeSize; ++j) {
-        const double x = centre + (2.0 * j + phase - centre) / scale;
-        const double planeX = (x - phase) / 2;
+        const double x = centre + (static_cast<double>(step) * j + phase - centre) / scale;
+        const double planeX = (x - phase) / step;
         const double lo = std::floor(planeX);
         const int i0 = static_cast<int>(std::min(std::max(lo, 0.0), planeSize - 1.0));
         const int i1 = static_cast<int>(std::min(std::max(lo + 1, 0.0), planeSize - 1.0));
@@ -351,7 +366,8 @@ template <typename T>
 void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const BilinearAxis* rows,
                     const ResampleConstants& k, const Range& range)
 {
-    const int pw = src.cols / 2;
+    const PlaneGrid& grid = k.grid;
+    const int pw = src.cols / grid.step;
     std::vector<float> row0(static_cast<size_t>(pw)), row1(static_cast<size_t>(pw));
     std::vector<float> means[2] = {std::vector<float>(detail::wholeBlocks(pw)),
                                    std::vector<float>(detail::wholeBlocks(pw))};
@@ -360,20 +376,22 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
     // Whole plane rows i, the four sites in turn, so that a task writes mosaic rows 2 i and 2 i + 1
     // whole (storeMosaicRow()).
     for (int i = range.start; i < range.end; ++i)
-        for (int site = 0; site < 4; ++site) {
+        for (int site = 0; site < grid.sites; ++site) {
             std::vector<float>& mean = means[site % 2];
             const BilinearAxis& ax = cols[site % 2];
             const BilinearAxis& ay = rows[site / 2];
-            loadPlaneRow<T>(src, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site], row0.data(),
+            loadPlaneRow<T>(src, grid, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site], row0.data(),
                             k.inputShading);
-            loadPlaneRow<T>(src, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data(),
+            loadPlaneRow<T>(src, grid, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data(),
                             k.inputShading);
             bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
                         ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
             const float fy = ay.f[static_cast<size_t>(i)];
             finishPlaneRow(mean, shot.data(), readFactor.data(), scratch, k, pw, site, i,
                            (1 - fy) * (1 - fy) + fy * fy);
-            if (site % 2 == 1)
+            if (grid.sites == 1)
+                detail::storeFrameRow(mean.data(), dst.ptr<T>(i), pw);
+            else if (site % 2 == 1)
                 storeMosaicRow(means[0].data(), means[1].data(), dst.ptr<T>(2 * i + site / 2), pw);
         }
 }
@@ -394,8 +412,13 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
         _dst.assign(src);
         return;
     }
-    const BilinearAxis cols[2] = {bilinearAxis(src.cols / 2, 0, scale), bilinearAxis(src.cols / 2, 1, scale)};
-    const BilinearAxis rows[2] = {bilinearAxis(src.rows / 2, 0, scale), bilinearAxis(src.rows / 2, 1, scale)};
+    const PlaneGrid grid(format);
+    const Size plane = grid.plane(src.size());
+    const int phases = grid.step; // the site columns (rows) of the grid: 2, or 1 for a monochrome frame
+    const BilinearAxis cols[2] = {bilinearAxis(plane.width, 0, scale, grid.step),
+                                  bilinearAxis(plane.width, phases - 1, scale, grid.step)};
+    const BilinearAxis rows[2] = {bilinearAxis(plane.height, 0, scale, grid.step),
+                                  bilinearAxis(plane.height, phases - 1, scale, grid.step)};
     std::atomic<bool> nonFinite{false};
     ResampleConstants k = resampleConstants(src.depth(), format, step, seed, RandomStream::SCALE_GAUSSIAN,
                                             RandomStream::SCALE_POISSON);
@@ -406,19 +429,19 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
         double axis2[2] = {0, 0}, axis4[2] = {0, 0};
         for (int a = 0; a < 2; ++a) {
             const BilinearAxis* axis = a == 0 ? cols : rows;
-            const int n = a == 0 ? src.cols / 2 : src.rows / 2;
-            for (int p = 0; p < 2; ++p)
+            const int n = a == 0 ? plane.width : plane.height;
+            for (int p = 0; p < phases; ++p)
                 for (int j = 0; j < n; ++j) {
                     const double f = axis[p].f[static_cast<size_t>(j)];
-                    axis2[a] += (f * f + (1 - f) * (1 - f)) / (2.0 * n);
-                    axis4[a] += (std::pow(f, 4) + std::pow(1 - f, 4)) / (2.0 * n);
+                    axis2[a] += (f * f + (1 - f) * (1 - f)) / (static_cast<double>(phases) * n);
+                    axis4[a] += (std::pow(f, 4) + std::pow(1 - f, 4)) / (static_cast<double>(phases) * n);
                 }
         }
         resampleDarkTerms(k, step, axis2[0] * axis2[1], axis4[0] * axis4[1], seed, RandomStream::SCALE_ROW,
                           RandomStream::SCALE_TUKEY);
     }
     Mat dst = stepOutput(src, _dst);
-    parallel_for_(Range(0, src.rows / 2), [&](const Range& range) {
+    parallel_for_(Range(0, plane.height), [&](const Range& range) {
         if (src.depth() == CV_16U)
             scalePlaneRows<ushort>(src, dst, cols, rows, k, range);
         else

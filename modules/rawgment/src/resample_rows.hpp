@@ -14,9 +14,26 @@ namespace cv {
 namespace rawgment {
 namespace detail {
 
+/* The grid a resampling step works on. A Bayer mosaic is four half-resolution CFA planes, one per site,
+ * each resampled on its own (plane pixel j of site s is mosaic column 2 j + s % 2, plane row i mosaic row
+ * 2 i + s / 2). A monochrome frame (CFA_MONO) is one plane, site 0, at full resolution: its neighbours
+ * see the same light, so a blur or a scale reads them all. */
+struct PlaneGrid
+{
+    int step;  // mosaic pixels per plane pixel: 2, or 1 for a monochrome frame
+    int sites; // planes: 4, or 1
+    explicit PlaneGrid(const RawFormat& format)
+        : step(format.isMonochrome() ? 1 : 2), sites(format.isMonochrome() ? 1 : 4)
+    {
+    }
+    Size plane(Size mosaic) const { return Size(mosaic.width / step, mosaic.height / step); }
+    int mosaicRow(int site, int planeRow) const { return step * planeRow + site / 2; }
+};
+
 // Constants of a resampling step (blur or scale) on one mosaic: Eq. 15 with the step's weights.
 struct ResampleConstants
 {
+    PlaneGrid grid{RawFormat()};
     float black[4];
     float white;
     float shot;     // g alpha
@@ -55,20 +72,30 @@ void siteColumns(const float* row, int column, int width, float black, float* ou
 void storeMosaicRow(const float* even, const float* odd, ushort* d, int width);
 void storeMosaicRow(const float* even, const float* odd, float* d, int width);
 
+//! A monochrome frame's row (PlaneGrid with step 1): the plane row is the frame's row.
+void storeFrameRow(const float* values, ushort* d, int width);
+void storeFrameRow(const float* values, float* d, int width);
+
 // Plane row `planeRow` of site `site`, black-subtracted (and without the input's dark shading when
 // `shading` is not empty), into out[0..pad + width + pad) with the plane's edge replicated `pad` columns
 // on each side.
 template <typename T>
-void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, float* out,
-                  const DarkShading& shading = DarkShading())
+void loadPlaneRow(const Mat& src, const PlaneGrid& grid, int site, int planeRow, int pad, float black,
+                  float* out, const DarkShading& shading = DarkShading())
 {
-    const int width = src.cols / 2;
-    siteColumns(src.ptr<T>(2 * planeRow + site / 2), site % 2, width, black, out + pad);
+    const int width = src.cols / grid.step;
+    const int r = grid.mosaicRow(site, planeRow);
+    if (grid.step == 2) {
+        siteColumns(src.ptr<T>(r), site % 2, width, black, out + pad);
+    } else {
+        const T* in = src.ptr<T>(r);
+        for (int j = 0; j < width; ++j)
+            out[pad + j] = static_cast<float>(in[j]) - black;
+    }
     if (!shading.empty()) {
-        const int r = 2 * planeRow + site / 2;
         const float *bd = shading.perGainRow(r) + site % 2, *br = shading.offsetRow(r) + site % 2;
         for (int j = 0; j < width; ++j)
-            out[pad + j] -= shading.at(bd, br, 2 * j);
+            out[pad + j] -= shading.at(bd, br, grid.step * j);
     }
     for (int j = 0; j < pad; ++j) {
         out[j] = out[pad];
@@ -77,7 +104,7 @@ void loadPlaneRow(const Mat& src, int site, int planeRow, int pad, float black, 
 }
 
 // The end of every resampled row: its noise streams (site, row), the noise, the dark terms, the black
-// level, in `mean`; storeMosaicRow() stores it with the row's other site.
+// level, in `mean`; storeMosaicRow() stores it with the row's other site (storeFrameRow() alone).
 void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float* readFactor,
                     RowScratch& scratch, const ResampleConstants& k, int n, int site, int planeRow,
                     float rowKeep = 1);

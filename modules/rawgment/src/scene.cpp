@@ -102,36 +102,39 @@ Scene Scene::read(const FileNode& node)
 
 namespace {
 
-/* Where each output pixel of a shift reads: each CFA plane moved by half the (even) shift, vacated pixels
- * replicating the plane's edge. Output pixel (r, c) is source pixel (2 clamp(r/2 - shift.y/2) + r%2,
- * 2 clamp(c/2 - shift.x/2) + c%2), the clamps to the plane's rows and columns; output columns
- * [first, last) read source column c - shift.x, those left of them the first pair of source columns,
- * those right of them the last pair. */
+/* Where each output pixel of a shift reads: each CFA plane (of step 2; a monochrome frame is one plane of
+ * step 1, PlaneGrid) moved by shift / step, vacated pixels replicating the plane's edge. Output pixel
+ * (r, c) is source pixel (step clamp(r/step - shift.y/step) + r%step, step clamp(c/step - shift.x/step) +
+ * c%step), the clamps to the plane's rows and columns; output columns [first, last) read source column
+ * c - shift.x, those left of them the first step of source columns, those right of them the last. */
 struct ShiftSource
 {
-    int planeRows, planeCols, halfShiftY, shiftX, first, last;
+    int step, planeRows, planeCols, planeShiftY, shiftX, first, last;
 
-    ShiftSource(Size size, Point shift)
-        : planeRows(size.height / 2), planeCols(size.width / 2), halfShiftY(shift.y / 2), shiftX(shift.x),
-          first(std::min(std::max(shift.x, 0), size.width)),
+    ShiftSource(Size size, Point shift, int gridStep)
+        : step(gridStep), planeRows(size.height / gridStep), planeCols(size.width / gridStep),
+          planeShiftY(shift.y / gridStep), shiftX(shift.x), first(std::min(std::max(shift.x, 0), size.width)),
           last(std::max(std::min(size.width + shift.x, size.width), 0))
     {
     }
-    int row(int r) const { return 2 * std::min(std::max(r / 2 - halfShiftY, 0), planeRows - 1) + (r & 1); }
+    int row(int r) const
+    {
+        return step * std::min(std::max(r / step - planeShiftY, 0), planeRows - 1) + r % step;
+    }
     int column(int c) const
     {
-        return c < first ? (c & 1) : c < last ? c - shiftX : 2 * (planeCols - 1) + (c & 1);
+        return c < first ? c % step : c < last ? c - shiftX : step * (planeCols - 1) + c % step;
     }
 };
 
 /* The shift in one pass (ShiftSource): the same values as splitting the planes, moving each with
  * warpAffine (INTER_NEAREST, BORDER_REPLICATE) and merging them (Augment.shiftMatchesThePlaneWise
  * Composition), at the cost of a copy: the inner columns of a row are one memcpy. */
-void shiftMosaic(const Mat& src, Point shift, Mat& dst)
+void shiftMosaic(const Mat& src, Point shift, int gridStep, Mat& dst)
 {
-    CV_Assert(shift.x % 2 == 0 && shift.y % 2 == 0 && src.rows % 2 == 0 && src.cols % 2 == 0);
+    CV_Assert(shift.x % gridStep == 0 && shift.y % gridStep == 0 && src.rows % 2 == 0 && src.cols % 2 == 0);
     dst.create(src.size(), src.type());
-    const ShiftSource from(src.size(), shift);
+    const ShiftSource from(src.size(), shift, gridStep);
     const size_t esz = src.elemSize();
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         for (int r = rows.start; r < rows.end; ++r) {
@@ -155,9 +158,9 @@ void shiftMosaic(const Mat& src, Point shift, Mat& dst)
  * them. */
 template <typename T>
 void swapShiftedShading(const Mat& src, const RawFormat& format, const detail::DarkShading& shading,
-                        Point shift, Mat& dst)
+                        Point shift, int gridStep, Mat& dst)
 {
-    const ShiftSource from(src.size(), shift);
+    const ShiftSource from(src.size(), shift, gridStep);
     const float white = static_cast<float>(format.whiteLevel);
     const float highest = src.depth() == CV_16U ? 65535.f : std::numeric_limits<float>::max();
     const float lowest = src.depth() == CV_16U ? 0.f : -std::numeric_limits<float>::max();
@@ -214,19 +217,23 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
                                     b.width, b.height));
             b &= Rect(0, 0, current.cols, current.rows);
         }
-    const Point shift(2 * cvRound(scene.shift.x / 2.0), 2 * cvRound(scene.shift.y / 2.0));
+    // A Bayer mosaic moves by whole 2x2 blocks so that its CFA phase stays; a monochrome frame has none.
+    const int gridStep = fmt.isMonochrome() ? 1 : 2;
+    const Point shift = gridStep == 1
+                            ? scene.shift
+                            : Point(2 * cvRound(scene.shift.x / 2.0), 2 * cvRound(scene.shift.y / 2.0));
     if (shift != Point(0, 0)) {
         const auto start = std::chrono::steady_clock::now();
         // Into a new Mat: `current` still shares the caller's data, which must never be written.
         Mat shifted;
-        shiftMosaic(current, shift, shifted);
+        shiftMosaic(current, shift, gridStep, shifted);
         // The dark shading belongs to the sensor, not to the content: it must not move with the shift.
         const detail::StepNoise step(valid, fmt, scene.noise, 1, current.size(), "applyScene");
         if (!step.shading.empty()) {
             if (current.depth() == CV_16U)
-                swapShiftedShading<ushort>(current, fmt, step.shading, shift, shifted);
+                swapShiftedShading<ushort>(current, fmt, step.shading, shift, gridStep, shifted);
             else
-                swapShiftedShading<float>(current, fmt, step.shading, shift, shifted);
+                swapShiftedShading<float>(current, fmt, step.shading, shift, gridStep, shifted);
         }
         current = shifted;
         if (boxes)
@@ -360,6 +367,7 @@ void RandomScenePolicy::validate() const
 Scene RandomScenePolicy::draw(InputArray _src, const RawFormat& format, uint64 seed) const
 {
     validate();
+    format.validate();
     const Mat src = detail::twoDimensional(_src, "RandomScenePolicy::draw: src");
     detail::checkMosaicInput(src, "RandomScenePolicy::draw");
     const double minX = minimumAboveBlack(src, format);
@@ -374,13 +382,13 @@ Scene RandomScenePolicy::draw(InputArray _src, const RawFormat& format, uint64 s
     }
     const double contrast = std::exp(uniform(std::log(contrastMin), std::log(contrastMax)));
     s.jitter.contrast = Vec4d::all(contrast);
-    if (rng.uniform() < hueProbability)
+    if (rng.uniform() < hueProbability && !format.isMonochrome())
         for (int i = 0; i < 4; ++i)
             s.jitter.contrast[i] *= uniform(hueMin, hueMax);
     s.jitter.brightness = uniform(brightnessMin, brightnessMax) * minX;
     s.jitter.gainRatio = dbToLinearGain(uniform(gainDbMin, gainDbMax));
     if (rng.uniform() < blurProbability)
-        s.motionKernel = linearMotionKernel(uniform(0, blurLengthMax), uniform(0, 180));
+        s.motionKernel = linearMotionKernel(uniform(0, blurLengthMax), uniform(0, 180), format.pattern);
     return s;
 }
 

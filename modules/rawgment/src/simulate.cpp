@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "opencv2/rawgment/simulate.hpp"
 #include "noise_terms.hpp"
+#include "opencv2/rawgment/augment.hpp"
 #include "precomp.hpp"
 #include "random.hpp"
 
@@ -36,9 +37,12 @@ double srgbToLinear(double v8)
 void SensorParams::validate() const
 {
     noise.validate();
-    if (pattern < CFA_RGGB || pattern > CFA_GBRG)
+    if (pattern < CFA_RGGB || pattern > CFA_MONO)
         CV_Error(Error::StsBadArg,
                  format("SensorParams.pattern %d is not a CFA pattern", static_cast<int>(pattern)));
+    if (pattern == CFA_MONO && blackLevel != Vec4d::all(blackLevel[0]))
+        CV_Error(Error::StsBadArg,
+                 "SensorParams.blackLevel must be one value on all four sites for CFA_MONO");
     if (bitDepth < 1 || bitDepth > 16)
         CV_Error(Error::StsBadArg, format("SensorParams.bitDepth must lie in [1, 16] (got %d)", bitDepth));
     const double white = std::ldexp(1.0, bitDepth) - 1;
@@ -235,13 +239,21 @@ void SensorSimulator::captureBurst(InputArray mean, double gain, double exposure
 void SensorSimulator::captureBlurred(InputArray _mean, InputArray _kernel, double gain, double exposure,
                                      uint64 seed, int frameIndex, OutputArray raw) const
 {
-    const Mat kernel = detail::normalisedKernel(_kernel, "SensorSimulator::captureBlurred");
-    std::vector<Mat> planes;
-    splitCfaPlanes(_mean, planes);
-    for (Mat& plane : planes)
-        filter2D(plane, plane, CV_32F, kernel, Point(-1, -1), 0, detail::kBlurBorder);
+    const bool mono = params_.pattern == CFA_MONO;
+    const Mat kernel =
+        detail::normalisedKernel(_kernel, "SensorSimulator::captureBlurred",
+                                 mono ? 2 * MAX_MOTION_KERNEL_SIDE - 1 : MAX_MOTION_KERNEL_SIDE);
     Mat blurred;
-    mergeCfaPlanes(planes, blurred);
+    // The kernel lies on the grid motionBlur() uses: the CFA planes, or a monochrome frame's own pixels.
+    if (mono) {
+        filter2D(_mean, blurred, CV_32F, kernel, Point(-1, -1), 0, detail::kBlurBorder);
+    } else {
+        std::vector<Mat> planes;
+        splitCfaPlanes(_mean, planes);
+        for (Mat& plane : planes)
+            filter2D(plane, plane, CV_32F, kernel, Point(-1, -1), 0, detail::kBlurBorder);
+        mergeCfaPlanes(planes, blurred);
+    }
     capture(blurred, gain, exposure, seed, frameIndex, raw);
 }
 
@@ -317,11 +329,17 @@ ColorCheckerScene makeColorCheckerScene(const ColorCheckerOptions& o)
     for (int r = 0; r < size.height; ++r)
         for (int c = 0; c < size.width; ++c) {
             const CfaChannel ch = cfaChannelAt(o.pattern, r, c);
-            const int rgbIndex = ch == CFA_R ? 0 : ch == CFA_B ? 2 : 1;
+            const Vec3d& reflectance = rgb.at<Vec3d>(r, c);
+            // A sensor without a filter sees all three bands; their Rec. 709 luminance weights stand in
+            // for its spectral response.
+            const double response =
+                ch == CFA_W ? 0.2126 * reflectance[0] + 0.7152 * reflectance[1] + 0.0722 * reflectance[2]
+                            : reflectance[ch == CFA_R   ? 0
+                                          : ch == CFA_B ? 2
+                                                        : 1];
             const double dx = (c - cx) / cx, dy = (r - cy) / cy;
             const double shading = 1.0 - o.vignetting * 0.5 * (dx * dx + dy * dy);
-            scene.meanAtUnitGain.at<float>(r, c) =
-                static_cast<float>(o.illumination * shading * rgb.at<Vec3d>(r, c)[rgbIndex]);
+            scene.meanAtUnitGain.at<float>(r, c) = static_cast<float>(o.illumination * shading * response);
         }
     return scene;
 }

@@ -86,10 +86,67 @@ TEST(Bayer, patternNamesRoundTrip)
     for (CfaPattern p : kAllPatterns)
         EXPECT_EQ(cfaPatternFromName(cfaPatternName(p)), p);
     EXPECT_EQ(cfaPatternFromName("gbrg"), CFA_GBRG);
-    EXPECT_CV_ERROR_CONTAINS(cfaPatternFromName("RGBG"), "expected one of RGGB, BGGR, GRBG, GBRG");
+    EXPECT_CV_ERROR_CONTAINS(cfaPatternFromName("RGBG"), "expected one of RGGB, BGGR, GRBG, GBRG, MONO");
     EXPECT_CV_ERROR_CONTAINS(cfaPatternName(static_cast<CfaPattern>(7)), "CFA pattern 7");
     EXPECT_CV_ERROR_CONTAINS(cfaChannelAt(static_cast<CfaPattern>(-1), 0, 0), "CFA pattern -1");
-    EXPECT_CV_ERROR_CONTAINS(cfaSiteOfChannel(CFA_RGGB, static_cast<CfaChannel>(4)), "CFA channel 4");
+    EXPECT_CV_ERROR_CONTAINS(cfaSiteOfChannel(CFA_RGGB, static_cast<CfaChannel>(5)), "CFA channel 5");
+}
+
+TEST(Bayer, monochromeIsAPatternWithOneChannelOnEverySite)
+{
+    EXPECT_EQ(cfaPatternFromName("mono"), CFA_MONO);
+    EXPECT_EQ(cfaPatternName(CFA_MONO), "MONO");
+    for (int r = -2; r < 3; ++r)
+        for (int c = -2; c < 3; ++c) {
+            EXPECT_EQ(cfaChannelAt(CFA_MONO, r, c), CFA_W);
+            EXPECT_EQ(cfaPatternOfCrop(CFA_MONO, r, c), CFA_MONO);
+        }
+    EXPECT_EQ(cfaSiteOfChannel(CFA_MONO, CFA_W), 0);
+    EXPECT_CV_ERROR_CONTAINS(cfaSiteOfChannel(CFA_MONO, CFA_R), "a monochrome frame has only CFA_W");
+    EXPECT_CV_ERROR_CONTAINS(cfaSiteOfChannel(CFA_RGGB, CFA_W), "CFA_W is the channel of a monochrome frame");
+
+    RawFormat f;
+    f.pattern = CFA_MONO;
+    f.blackLevel = Vec4d::all(100);
+    f.whiteLevel = 4095;
+    EXPECT_TRUE(f.isMonochrome());
+    EXPECT_FALSE(RawFormat().isMonochrome());
+    EXPECT_NO_THROW(f.validate());
+    const RawFormat crop = f.cropped(1, 3);
+    EXPECT_EQ(crop.pattern, CFA_MONO);
+    EXPECT_EQ(crop.blackLevel, f.blackLevel);
+    EXPECT_EQ(crop.sensorOrigin, Point(3, 1));
+    FileStorage out("", FileStorage::WRITE | FileStorage::MEMORY | FileStorage::FORMAT_YAML);
+    f.write(out, "raw_format");
+    const std::string text = out.releaseAndGetString();
+    EXPECT_NE(text.find("MONO"), std::string::npos) << text;
+    FileStorage in(text, FileStorage::READ | FileStorage::MEMORY);
+    const RawFormat g = RawFormat::read(in["raw_format"]);
+    EXPECT_EQ(g.pattern, CFA_MONO);
+    EXPECT_EQ(g.blackLevel, f.blackLevel);
+    // A sensor without a colour filter has no 2x2 structure to give four black levels.
+    f.blackLevel[3] = 101;
+    EXPECT_CV_ERROR_CONTAINS(f.validate(), "one value on all four sites for a CFA_MONO format");
+}
+
+TEST(Bayer, packCfaPlanesOfAMonochromeFrameIsSpaceToDepthInSiteOrder)
+{
+    RawFormat format;
+    format.pattern = CFA_MONO;
+    format.blackLevel = Vec4d::all(64);
+    format.whiteLevel = 1023;
+    for (int type : {CV_16UC1, CV_32FC1}) {
+        Mat frame(20, 30, type);
+        randu(frame, 0, 1024);
+        Mat signal, packed;
+        std::vector<Mat> planes;
+        subtractBlackLevel(frame, format, signal, true);
+        splitCfaPlanes(signal, planes);
+        packCfaPlanes(frame, format, packed, true);
+        ASSERT_EQ(Size(15, 40), packed.size());
+        for (int site = 0; site < 4; ++site)
+            EXPECT_EQ(0, norm(packed.rowRange(10 * site, 10 * (site + 1)), planes[site], NORM_INF)) << site;
+    }
 }
 
 RawFormat makeFormat(CfaPattern pattern = CFA_RGGB)

@@ -512,7 +512,7 @@ TEST(RawIo, truncatedFileIsAnError)
     EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/half.dng"), "truncated");
 }
 
-TEST(RawIo, linearDngIsNotABayerMosaic)
+TEST(RawIo, aThreeSampleLinearDngIsNeitherBayerNorMonochrome)
 {
     const std::string dir = makeTempDir("raw_io_linear");
     RawImage img;
@@ -535,7 +535,50 @@ TEST(RawIo, linearDngIsNotABayerMosaic)
     const bool patched = patchEntry(262, 34892) && patchEntry(277, 3) && patchEntry(256, 22);
     ASSERT_TRUE(patched);
     writeBytes(dir + "/linear.dng", bytes);
-    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/linear.dng"), "not a Bayer mosaic");
+    EXPECT_CV_ERROR_CONTAINS(readRaw(dir + "/linear.dng"), "neither a Bayer mosaic nor a monochrome frame");
+}
+
+TEST(RawIo, aMonochromeFrameRoundTripsThroughALinearRawDng)
+{
+    const std::string dir = makeTempDir("raw_io_mono");
+    RawImage img;
+    img.mosaic.create(48, 70, CV_16UC1);
+    randu(img.mosaic, 0, 4096);
+    img.format.pattern = CFA_MONO;
+    img.format.blackLevel = Vec4d::all(200);
+    img.format.whiteLevel = 4095;
+    img.iso = 400;
+    img.exposureTime = 0.02;
+    img.make = "Basler";
+    img.model = "mono test";
+    img.noiseProfile = {Vec2d(1e-4, 2e-6)};
+    writeDng(dir + "/mono.dng", img);
+    const std::vector<char> bytes = readBytes(dir + "/mono.dng");
+    // PhotometricInterpretation LinearRaw (34892), SamplesPerPixel 1, and no CFA tags.
+    const auto entry = [&](uint16_t tag) -> int {
+        for (size_t i = 10; i + 12 <= bytes.size(); i += 12)
+            if (uint8_t(bytes[i]) == (tag & 0xff) && uint8_t(bytes[i + 1]) == (tag >> 8))
+                return uint8_t(bytes[i + 8]) | (uint8_t(bytes[i + 9]) << 8);
+        return -1;
+    };
+    EXPECT_EQ(entry(262), 34892);
+    EXPECT_EQ(entry(277), 1);
+    EXPECT_EQ(entry(33421), -1);
+    EXPECT_EQ(entry(33422), -1);
+    const RawImage back = readRaw(dir + "/mono.dng");
+    EXPECT_EQ(back.format.pattern, CFA_MONO);
+    EXPECT_EQ(back.format.blackLevel, img.format.blackLevel);
+    EXPECT_EQ(back.format.whiteLevel, img.format.whiteLevel);
+    EXPECT_EQ(0, norm(back.mosaic, img.mosaic, NORM_INF));
+    EXPECT_EQ(back.iso, 400);
+    EXPECT_EQ(back.exposureTime, 0.02);
+    EXPECT_EQ(back.make, "Basler");
+    ASSERT_EQ(back.noiseProfile.size(), 1u);
+    EXPECT_EQ(back.noiseProfile[0], img.noiseProfile[0]);
+    // No colour: the identity balance and matrix, and no colour tags.
+    EXPECT_EQ(back.whiteBalance, Vec3d(1, 1, 1));
+    EXPECT_EQ(back.cameraToSrgb, Matx33d::eye());
+    EXPECT_TRUE(back.colorTags.empty());
 }
 
 } // namespace

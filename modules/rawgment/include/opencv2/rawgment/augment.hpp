@@ -119,7 +119,7 @@ struct CV_EXPORTS_W_SIMPLE ColorJitter
 {
     //! The identity.
     CV_WRAP ColorJitter() : contrast(Vec4d::all(1)), brightness(0), gainRatio(1) {}
-    CV_PROP_RW Vec4d contrast;    //!< p_c per CFA site (index = cfaSite()), > 0
+    CV_PROP_RW Vec4d contrast;    //!< p_c per CFA site (index = cfaSite()), > 0; one value for CFA_MONO
     CV_PROP_RW double brightness; //!< p_b in DN
     CV_PROP_RW double gainRatio;  //!< p_g: target gain / input gain, > 0
 
@@ -171,19 +171,21 @@ CV_EXPORTS_W void colorJitter(InputArray src, const RawFormat& format, const Noi
 //! up to 513 x 513 plane pixels (the paper's longest is 13).
 constexpr double MAX_MOTION_LENGTH = 1024;
 
-/** @brief A linear motion-blur kernel on the CFA-plane grid (half the mosaic's resolution).
+/** @brief A linear motion-blur kernel on the grid motionBlur() works on: the CFA-plane grid (half the
+ * mosaic's resolution) of a Bayer pattern, the pixel grid of a CFA_MONO frame.
  * @param length length of the motion in full-resolution mosaic pixels, in [0, MAX_MOTION_LENGTH]; up
- *        to 2 pixels (one plane pixel) the kernel is the identity 1x1
+ *        to one grid pixel (2 mosaic pixels on the plane grid) the kernel is the identity 1x1
  * @param angleDegrees direction of the motion, counter-clockwise from the x axis
+ * @param pattern the pattern of the mosaic it will blur (its grid)
  * @return CV_32FC1 kernel, odd size, sum 1
  */
-CV_EXPORTS_W Mat linearMotionKernel(double length, double angleDegrees);
+CV_EXPORTS_W Mat linearMotionKernel(double length, double angleDegrees, CfaPattern pattern = CFA_RGGB);
 
 /** @brief The largest side of a blur kernel, in plane pixels: that of a motion of MAX_MOTION_LENGTH. A blur's
  * cost grows with the kernel's area (a hand-made 2001x2001 kernel took over 30 s on a 64x96 mosaic). */
 constexpr int MAX_MOTION_KERNEL_SIDE = static_cast<int>(MAX_MOTION_LENGTH / 2) + 1;
 
-/** @brief Noise-accounted blur (paper Eq. 15) on each CFA plane.
+/** @brief Noise-accounted blur (paper Eq. 15) on each CFA plane (on the whole frame for CFA_MONO).
  *
  * \f[ x_{new} = \sum_k w_k x_k + \mathcal{N}\Big(0,\; g\alpha\sum_k (1-w_k)w_k\max(x_k,0)
  *     + \big(1 - \sum_k w_k^2\big)(g^2\sigma_d^2 + \sigma_r^2)\Big) \f]
@@ -193,8 +195,10 @@ constexpr int MAX_MOTION_KERNEL_SIDE = static_cast<int>(MAX_MOTION_LENGTH / 2) +
  * @param src CV_16UC1 or CV_32FC1 mosaic with black level, even sides
  * @param format its format (the gain stays)
  * @param model the noise model
- * @param kernel non-negative CV_32FC1/CV_64FC1 kernel on the plane grid, normalised here, at most
- *        MAX_MOTION_KERNEL_SIDE on a side; a 1x1 kernel is the identity and the step is skipped
+ * @param kernel non-negative CV_32FC1/CV_64FC1 kernel on the plane grid (the pixel grid for CFA_MONO; see
+ *        linearMotionKernel()), normalised here, at most MAX_MOTION_KERNEL_SIDE on a side (2
+ *        MAX_MOTION_KERNEL_SIDE - 1 on the pixel grid: the same extent); a 1x1 kernel is the identity and
+ *        the step is skipped
  * @param noise how the prior noise is treated (alignment), how the noise is drawn
  * @param seed noise seed
  * @param dst output, same type; reused as colorJitter()'s dst is
@@ -210,7 +214,8 @@ CV_EXPORTS_W void motionBlur(InputArray src, const RawFormat& format, const Nois
                              InputArray kernel, const NoiseOptions& noise, uint64 seed, OutputArray dst,
                              CV_OUT AugmentReport& report);
 
-/** @brief Noise-accounted scaling about the mosaic centre, each CFA plane resampled bilinearly.
+/** @brief Noise-accounted scaling about the mosaic centre, each CFA plane resampled bilinearly (the whole
+ * frame for CFA_MONO).
  *
  * Output pixel of site s at mosaic position X takes its value from \f$ C + (X - C)/\text{scale} \f$ in
  * the same site's plane (C the centre), so the CFA phase is kept and every site is sampled at its own
@@ -255,7 +260,8 @@ struct CV_EXPORTS_W_SIMPLE Scene
 {
     //! The identity scene.
     CV_WRAP Scene() : shift(Point(0, 0)), scale(1) {}
-    CV_PROP_RW Point shift;  //!< translation in mosaic pixels; each component rounded to even (CFA phase)
+    CV_PROP_RW Point shift;  //!< translation in mosaic pixels; each component rounded to even (CFA phase;
+                             //!< a CFA_MONO frame moves by any whole number)
     CV_PROP_RW double scale; //!< magnification about the centre (see scaleMosaic()); 1: none
     CV_PROP_RW ColorJitter jitter; //!< exposure, gain, contrast, brightness, hue
     CV_PROP_RW Mat motionKernel;   //!< blur on the plane grid (empty or 1x1: none)
@@ -305,6 +311,7 @@ CV_EXPORTS_W uint64 augmentedOutputSeed(uint64 seed, const String& inputName, in
  * is uniform in dB; with probability blurProbability a linear motion kernel of uniform length in
  * [0, blurLengthMax] and uniform angle; with probability geometryProbability a shift of up to maxShift
  * of each side and a scale within 1 +- maxScale. File keys are the snake_case names (contrast_min, ...).
+ * A CFA_MONO frame has no hue: its four sites keep one contrast, and its kernel lies on its pixel grid.
  */
 struct CV_EXPORTS_W_SIMPLE RandomScenePolicy
 {

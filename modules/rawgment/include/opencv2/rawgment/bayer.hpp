@@ -12,7 +12,11 @@ namespace rawgment {
 //! @{
 
 /** @brief The colour filter array (CFA) layout of a Bayer mosaic, named by its top-left 2x2 block
- * read row by row.
+ * read row by row, or CFA_MONO for a sensor without a colour filter.
+ *
+ * A monochrome frame is handled as a "mosaic" whose four sites all see the same light (channel CFA_W):
+ * per-site quantities (black levels, contrasts) must then be equal, and resampling steps work on the
+ * full pixel grid rather than on half-resolution CFA planes.
  *
  * The underlying type is fixed so that any int cast to it is a valid value that the functions can
  * reject with a clear error.
@@ -25,7 +29,8 @@ enum CfaPattern: int
     CFA_RGGB = 0, //!< R G / G B
     CFA_BGGR = 1, //!< B G / G R
     CFA_GRBG = 2, //!< G R / B G
-    CFA_GBRG = 3  //!< G B / R G
+    CFA_GBRG = 3, //!< G B / R G
+    CFA_MONO = 4  //!< no colour filter (a monochrome sensor): every pixel is CFA_W
 };
 
 /** @brief The four colour channels of a Bayer mosaic.
@@ -41,7 +46,8 @@ enum CfaChannel: int
     CFA_R = 0,  //!< red
     CFA_G1 = 1, //!< green on the red rows (Gr)
     CFA_G2 = 2, //!< green on the blue rows (Gb)
-    CFA_B = 3   //!< blue
+    CFA_B = 3,  //!< blue
+    CFA_W = 4   //!< unfiltered (panchromatic): the only channel of a CFA_MONO frame
 };
 
 /** @brief The site of a pixel inside its 2x2 CFA block: \f$ s = 2\,(row \bmod 2) + (col \bmod 2) \f$.
@@ -60,7 +66,10 @@ CV_EXPORTS_W int cfaSite(int row, int col);
  */
 CV_EXPORTS_W CfaChannel cfaChannelAt(CfaPattern pattern, int row, int col);
 
-/** @brief The site (0..3, see cfaSite()) where a channel lies in the 2x2 block of a pattern. */
+/** @brief The site (0..3, see cfaSite()) where a channel lies in the 2x2 block of a pattern; 0 for CFA_W in a
+ * CFA_MONO frame (every site holds it).
+ * @throws cv::Exception (StsBadArg) for a channel the pattern does not have (CFA_R of CFA_MONO, CFA_W of a
+ * Bayer pattern). */
 CV_EXPORTS_W int cfaSiteOfChannel(CfaPattern pattern, CfaChannel channel);
 
 /** @brief The pattern of a crop of a mosaic whose top-left corner is at (rowOffset, colOffset).
@@ -70,16 +79,16 @@ CV_EXPORTS_W int cfaSiteOfChannel(CfaPattern pattern, CfaChannel channel);
  */
 CV_EXPORTS_W CfaPattern cfaPatternOfCrop(CfaPattern pattern, int rowOffset, int colOffset);
 
-/** @brief The pattern's name ("RGGB", ...). Throws on a value outside the enumeration. */
+/** @brief The pattern's name ("RGGB", ..., "MONO"). Throws on a value outside the enumeration. */
 CV_EXPORTS_W String cfaPatternName(CfaPattern pattern);
 
-/** @brief The pattern with the given name, case-insensitive ("rggb", "BGGR", ...).
+/** @brief The pattern with the given name, case-insensitive ("rggb", "BGGR", ..., "mono").
  * @throws cv::Exception (StsBadArg) naming the valid names when the name is unknown.
  */
 CV_EXPORTS_W CfaPattern cfaPatternFromName(const String& name);
 
-/** @brief How a Bayer mosaic encodes light: CFA layout, black and white levels, and the analog gain at
- * which it was captured.
+/** @brief How a Bayer mosaic (or a monochrome frame, CFA_MONO) encodes light: CFA layout, black and white
+ * levels, and the analog gain at which it was captured.
  *
  * All values are in DN (digital numbers) of the stored mosaic. The black level is given per 2x2 site
  * (see cfaSite()) because many sensors have a different offset per colour; a pixel's signal is
@@ -105,9 +114,13 @@ struct CV_EXPORTS_W_SIMPLE RawFormat
 
     /** @brief Throws cv::Exception (StsBadArg) naming the field when the format is not usable: pattern
      * outside the enumeration, non-finite or negative black level, white level not above every black
-     * level, gain not finite and positive, a negative sensorOrigin.
+     * level, gain not finite and positive, a negative sensorOrigin, or a CFA_MONO format whose four black
+     * levels differ (a sensor without a colour filter has no 2x2 structure to give them).
      */
     CV_WRAP void validate() const;
+
+    /** @brief True for a sensor without a colour filter (CFA_MONO). */
+    CV_WRAP bool isMonochrome() const { return pattern == CFA_MONO; }
 
     /** @brief Black level of the pixel at (row, col). */
     CV_WRAP double blackAt(int row, int col) const { return blackLevel[cfaSite(row, col)]; }
@@ -159,6 +172,7 @@ CV_EXPORTS_W void subtractBlackLevel(InputArray src, const RawFormat& format, Ou
 
 /** @brief subtractBlackLevel() and splitCfaPlanes() in one pass, in the R, G1, G2, B order whatever the
  * pattern: the input layout of most RAW networks, written straight into the memory it will be used from.
+ * A CFA_MONO frame is packed in site order (a 2x2 space-to-depth).
  *
  * Plane k of the output is rows [k h, (k + 1) h) with h = rows / 2: the planes of channel CFA_R, CFA_G1,
  * CFA_G2, CFA_B (cfaSiteOfChannel()), each black-subtracted per site and, with `normalize`, divided by

@@ -103,8 +103,11 @@ struct CV_RAWGMENT_EXPORTS IspParams
  * with \f$ e \f$ the exposure and \f$ w_c \f$ the white-balance gain of the pixel's colour. The clipped
  * linear signal is quantised to 16 bits for OpenCV's demosaicing (a step of 1/65535 of the range, finer
  * than any sensor's ADC), then the colour matrix and the tone curve are applied through a 65536-entry
- * table. Runs in parallel over rows.
- * @param mosaic Bayer mosaic, CV_16UC1 or CV_32FC1 (black included, as stored), even sides
+ * table. Runs in parallel over rows. A CFA_MONO frame has no colours to balance, interpolate or mix: white
+ * balance and colour matrix are not applied, and the grey value fills the three channels (averaged over
+ * each 2x2 block with DEMOSAIC_HALF_SIZE).
+ * @param mosaic Bayer mosaic or monochrome frame, CV_16UC1 or CV_32FC1 (black included, as stored), even
+ * sides
  * @param format its format (pattern, black and white levels; the gain is not used)
  * @param bgr output: CV_8UC3 or CV_32FC3, the mosaic's size (half of it with DEMOSAIC_HALF_SIZE)
  * @param params the ISP settings (validated)

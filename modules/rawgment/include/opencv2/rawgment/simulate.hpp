@@ -95,7 +95,8 @@ public:
      * Beyond the frame, the border rule of every blur of the library applies: the nearest pixel
      * (BORDER_REPLICATE), as in motionBlur().
      * @param meanAtUnitGain as in capture()
-     * @param kernel CV_32FC1 or CV_64FC1 kernel on the CFA-plane grid; normalised to sum 1 here
+     * @param kernel CV_32FC1 or CV_64FC1 kernel on the CFA-plane grid (on the pixel grid for a CFA_MONO
+     *        sensor, as in motionBlur()); normalised to sum 1 here
      * @param gain as in capture()
      * @param exposure as in capture()
      * @param seed as in capture()
