@@ -67,6 +67,44 @@ TEST(Augment, exposureChangeMatchesTheModelOnlyWhenThePriorIsAccounted)
     }
 }
 
+// A monochrome sensor, flat input: an exposure and gain change gives Eq. 5's variance at the new mean and
+// gain, the same on all four sites (one contrast, one black level, one noise line).
+TEST(Augment, aMonochromeFlatFrameTakesEq5sVarianceAtTheNewExposureAndGain)
+{
+    const Size size(64, 32);
+    SensorParams params = test::referenceSensorParams();
+    params.pattern = CFA_MONO;
+    const SensorSimulator sensor(params, size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(kGain);
+    const std::vector<Mat> flat = floatBurst(sensor, Mat(size, CV_32FC1, Scalar(800)), 17);
+    for (double photons : {0.5, 0.1}) {
+        RawFormat outFmt;
+        Mat mean, var;
+        statsAfterStep(
+            flat, fmt,
+            [&](const Mat& frame, int t, Mat& out) {
+                colorJitter(frame, fmt, model, ColorJitter::exposureChange(photons, 2.0),
+                            NoiseAlignment::ACCOUNT_PRIOR, 40 + t, out, outFmt);
+            },
+            mean, var);
+        EXPECT_TRUE(outFmt.isMonochrome());
+        EXPECT_EQ(outFmt.gain, 2 * kGain);
+        // Per site, 512 variances of 64 frames: relative standard error sqrt(2 / 63) / sqrt(512) = 0.79%;
+        // 5 of them = 3.9%.
+        for (int site = 0; site < 4; ++site) {
+            double m = 0, v = 0;
+            for (int r = site / 2; r < size.height; r += 2)
+                for (int c = site % 2; c < size.width; c += 2) {
+                    m += mean.at<double>(r, c) / 512;
+                    v += var.at<double>(r, c) / 512;
+                }
+            EXPECT_NEAR(m, 800 * kGain * photons * 2.0, 0.01 * 800 * kGain * photons * 2.0) << site;
+            EXPECT_NEAR(v / model.variance(m, 2 * kGain), 1.0, 0.039) << "x" << photons << ", site " << site;
+        }
+    }
+}
+
 /* A sensor whose measured lines leave Eq. 5 (0.4, 0.5, 2.0) by 15-30% at gains 2 and 4 (a digitally
  * scaled setting does that): the simulator draws the lines, and an exposure change to another gain adds
  * what the target gain's own line lacks, not what Eq. 5 would. */

@@ -71,6 +71,96 @@ TEST(Augment, motionBlurMatchesACaptureBlurredBeforeTheNoise)
     EXPECT_GT(ratio[1], 1.03);
 }
 
+// A monochrome frame has no CFA planes: its neighbours see the same light, so blur and scale resample the
+// whole pixel grid. Their means are a plain full-resolution filter (checked against OpenCV's filter2D and a
+// bilinear reference computed here), and ACCOUNT_PRIOR keeps Eq. 5's variance (against a capture blurred
+// before the noise, and the model line).
+TEST(Augment, monochromeBlurAndScaleResampleThePixelGridWithTheModelVariance)
+{
+    const Size size(128, 128);
+    SensorParams params = test::referenceSensorParams();
+    params.pattern = CFA_MONO;
+    const SensorSimulator sensor(params, size);
+    const NoiseModel model = sensor.effectiveModel();
+    const RawFormat fmt = sensor.rawFormat(kGain);
+    ASSERT_TRUE(fmt.isMonochrome());
+    Mat scene(size, CV_32FC1);
+    for (int c = 0; c < size.width; ++c)
+        scene.col(c).setTo((c / 16) % 2 ? 1500.0 : 60.0);
+    // 13 mosaic pixels on the pixel grid: 13 taps wide, not the 7 of a CFA plane's kernel.
+    const Mat kernel = linearMotionKernel(13, 0, CFA_MONO);
+    EXPECT_EQ(kernel.cols, 15);
+    EXPECT_EQ(linearMotionKernel(13, 0).cols, 9);
+    const std::vector<Mat> sharp = floatBurst(sensor, scene, 9);
+
+    // NONE is the plain filter, on the full grid (float sums in another order: 1e-3 DN on 4000 DN).
+    Mat plain, signal, reference;
+    motionBlur(sharp[0], fmt, model, kernel, NoiseAlignment::NONE, 1, plain);
+    subtractBlackLevel(sharp[0], fmt, signal);
+    filter2D(signal, reference, CV_32F, kernel, Point(-1, -1), 0, BORDER_REPLICATE);
+    reference += fmt.blackLevel[0];
+    EXPECT_LT(norm(plain, reference, NORM_INF), 1e-3);
+
+    std::vector<Mat> truth(kFrames);
+    for (int t = 0; t < kFrames; ++t) {
+        sensor.captureBlurred(scene, kernel, kGain, 1.0, 77, t, truth[t]);
+        truth[t].convertTo(truth[t], CV_32F);
+    }
+    Mat truthMean, truthVar, mean, var;
+    temporalStats(truth, fmt, truthMean, truthVar);
+    statsAfterStep(
+        sharp, fmt,
+        [&](const Mat& frame, int t, Mat& out) {
+            motionBlur(frame, fmt, model, kernel, NoiseAlignment::ACCOUNT_PRIOR, 500 + t, out);
+        },
+        mean, var);
+    // As motionBlurMatchesACaptureBlurredBeforeTheNoise: 16,384 pixels, a standard error of 0.55%; 3% is
+    // more than 5 of them.
+    const double blurRatio = cv::mean(var)[0] / cv::mean(truthVar)[0];
+    std::cout << "monochrome blur variance / true blurred capture (ACCOUNT_PRIOR): " << blurRatio << "\n";
+    EXPECT_NEAR(blurRatio, 1.0, 0.03);
+
+    // Scaling: output pixel x reads C + (x - C) / scale of the same grid, C = (W - 1) / 2.
+    const double scale = 1.07;
+    Mat scaled;
+    scaleMosaic(sharp[0], fmt, model, scale, NoiseAlignment::NONE, 1, scaled);
+    const auto source = [&](int x, int n, int& i0, int& i1, double& f) {
+        const double centre = (n - 1) / 2.0, at = centre + (x - centre) / scale, lo = std::floor(at);
+        i0 = static_cast<int>(std::min(std::max(lo, 0.0), n - 1.0));
+        i1 = static_cast<int>(std::min(std::max(lo + 1, 0.0), n - 1.0));
+        f = i0 == i1 ? 0 : at - lo;
+    };
+    double worst = 0;
+    for (int r = 0; r < size.height; ++r)
+        for (int c = 0; c < size.width; ++c) {
+            int r0, r1, c0, c1;
+            double fy, fx;
+            source(r, size.height, r0, r1, fy);
+            source(c, size.width, c0, c1, fx);
+            const auto at = [&](int rr, int cc) { return static_cast<double>(signal.at<float>(rr, cc)); };
+            const double want = (1 - fy) * ((1 - fx) * at(r0, c0) + fx * at(r0, c1)) +
+                                fy * ((1 - fx) * at(r1, c0) + fx * at(r1, c1)) + fmt.blackLevel[0];
+            worst = std::max(worst, std::abs(scaled.at<float>(r, c) - want));
+        }
+    EXPECT_LT(worst, 1e-3);
+    const NoiseLine line = model.lineAtGain(kGain);
+    statsAfterStep(
+        sharp, fmt,
+        [&](const Mat& frame, int t, Mat& out) {
+            scaleMosaic(frame, fmt, model, scale, NoiseAlignment::ACCOUNT_PRIOR, 900 + t, out);
+        },
+        mean, var);
+    const Mat expected = line.a * mean + line.b;
+    // The model variance is linear in the mean, so a bilinear mix of noisy pixels, bars' edges included,
+    // has it at the mixed mean. As in scaleKeepsTheModelVarianceAtEveryInterpolationPosition, 4% is 5
+    // standard errors of the average over columns.
+    double total = 0;
+    for (int c = 0; c < size.width; ++c)
+        total += cv::mean(var.col(c))[0] / cv::mean(expected.col(c))[0];
+    std::cout << "monochrome scale variance / model (ACCOUNT_PRIOR): " << total / size.width << "\n";
+    EXPECT_NEAR(total / size.width, 1.0, 0.04);
+}
+
 TEST(Augment, motionBlurMergesTapsThatReplicateOneEdgePixel)
 {
     // A flat burst blurred with a peaked 5x5 kernel: at the frame's edges several taps replicate one

@@ -585,6 +585,65 @@ TEST(Augment, shiftMatchesThePlaneWiseComposition)
             }
 }
 
+// A monochrome frame through every step: each at identity returns the input itself, a shift moves it by any
+// whole number of pixels (it has no CFA phase to keep), a random scene gives it one contrast and a kernel on
+// its pixel grid, and per-site contrasts are an error.
+TEST(Augment, aMonochromeFrameGoesThroughEveryStepOnItsPixelGrid)
+{
+    SensorParams params = test::referenceSensorParams();
+    params.pattern = CFA_MONO;
+    const RawFormat fmt = SensorSimulator(params, Size(2, 2)).rawFormat(kGain);
+    const NoiseModel model(0.4, 0.5, 2.0);
+    Mat src(22, 40, CV_16UC1);
+    randu(src, 300, 4000);
+    for (int depth : {CV_16U, CV_32F}) {
+        Mat typed, out;
+        src.convertTo(typed, depth);
+        RawFormat f;
+        AugmentReport report;
+        applyScene(typed, fmt, model, Scene(), 1, out, f, &report);
+        EXPECT_EQ(out.data, typed.data);
+        EXPECT_TRUE(report.steps.empty());
+        colorJitter(typed, fmt, model, ColorJitter(), NoiseOptions(), 1, out, f);
+        EXPECT_EQ(out.data, typed.data);
+        motionBlur(typed, fmt, model, linearMotionKernel(1, 0, CFA_MONO), NoiseOptions(), 1, out);
+        EXPECT_EQ(out.data, typed.data);
+        scaleMosaic(typed, fmt, model, 1.0, NoiseOptions(), 1, out);
+        EXPECT_EQ(out.data, typed.data);
+        for (const Point shift : {Point(1, 0), Point(0, -3), Point(5, 7), Point(-13, 9), Point(40, -22)}) {
+            Mat expected;
+            warpAffine(typed, expected, Matx23d(1, 0, shift.x, 0, 1, shift.y), typed.size(), INTER_NEAREST,
+                       BORDER_REPLICATE);
+            Scene scene;
+            scene.shift = shift;
+            std::vector<Rect> boxes = {Rect(2, 2, 4, 4)};
+            applyScene(typed, fmt, model, scene, 0, out, f, nullptr, &boxes);
+            EXPECT_EQ(0, norm(out, expected, NORM_INF)) << "shift " << shift << ", depth " << depth;
+            EXPECT_EQ(boxes[0], (Rect(2, 2, 4, 4) + shift) & Rect(0, 0, 40, 22)) << "shift " << shift;
+        }
+    }
+    RandomScenePolicy policy;
+    policy.hueProbability = 1;
+    policy.blurProbability = 1;
+    for (uint64 seed = 0; seed < 50; ++seed) {
+        const Scene s = policy.draw(src, fmt, seed);
+        EXPECT_EQ(s.jitter.contrast, Vec4d::all(s.jitter.contrast[0])) << "seed " << seed;
+        // A kernel on the pixel grid is as wide as the motion in pixels (one more for the centre tap).
+        const Mat plane = linearMotionKernel(policy.blurLengthMax, 0), pixel = linearMotionKernel(policy.blurLengthMax, 0, CFA_MONO);
+        EXPECT_GT(pixel.cols, plane.cols);
+        Mat out;
+        RawFormat f;
+        applyScene(src, fmt, model, s, seed, out, f);
+        EXPECT_EQ(out.size(), src.size());
+    }
+    ColorJitter hue;
+    hue.contrast = Vec4d(0.5, 0.5, 0.5, 0.6);
+    Mat out;
+    RawFormat f;
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(src, fmt, model, hue, NoiseOptions(), 1, out, f),
+                             "a CFA_MONO frame has one contrast for all four sites");
+}
+
 TEST(Augment, randomPolicyDrawsInItsRangesAndRoundTrips)
 {
     const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
