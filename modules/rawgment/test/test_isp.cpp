@@ -175,6 +175,47 @@ TEST(Isp, whiteBalanceExposureAndColourMatrixActOnTheLinearSignal)
     EXPECT_NEAR(b0[2], sw[0], q);
 }
 
+// A monochrome frame has no colour to balance, interpolate or mix: its grey fills the three channels.
+TEST(Isp, aMonochromeFrameIsGreyWhateverTheColourSettings)
+{
+    RawFormat f;
+    f.pattern = CFA_MONO;
+    f.blackLevel = cv::Vec4d::all(100);
+    f.whiteLevel = 4095;
+    cv::Mat m(8, 12, CV_16UC1);
+    for (int r = 0; r < m.rows; ++r)
+        for (int c = 0; c < m.cols; ++c)
+            m.at<ushort>(r, c) = static_cast<ushort>(500 + 100 * r + 10 * c);
+    IspParams p;
+    p.outputDepth = CV_32F;
+    p.tone = ToneCurve::simpleGamma(1.0);
+    p.whiteBalance = cv::Vec3d(2.0, 1.0, 0.5);
+    p.colorMatrix = cv::Matx33d(0, 0, 1, 0, 1, 0, 1, 0, 0);
+    p.exposure = 1.5;
+    // The linear signal is quantised to 16-bit codes (half a step), and at half size their 2x2 average is
+    // rounded again (half a step): one step, and a little for float32 output.
+    const double q = 1.001 / 65535;
+    for (DemosaicMethod method : {DEMOSAIC_BILINEAR, DEMOSAIC_EDGE_AWARE, DEMOSAIC_HALF_SIZE}) {
+        p.demosaic = method;
+        cv::Mat bgr;
+        renderSimpleIsp(m, f, bgr, p);
+        const int k = method == DEMOSAIC_HALF_SIZE ? 2 : 1;
+        ASSERT_EQ(bgr.size(), cv::Size(m.cols / k, m.rows / k));
+        for (int r = 0; r < bgr.rows; ++r)
+            for (int c = 0; c < bgr.cols; ++c) {
+                double raw = 0;
+                for (int dy = 0; dy < k; ++dy)
+                    for (int dx = 0; dx < k; ++dx)
+                        raw += m.at<ushort>(k * r + dy, k * c + dx) / double(k * k);
+                const double want = 1.5 * (raw - 100) / (4095 - 100);
+                const cv::Vec3f v = bgr.at<cv::Vec3f>(r, c);
+                EXPECT_NEAR(v[0], want, q) << method << " at " << r << ", " << c;
+                EXPECT_EQ(v[0], v[1]);
+                EXPECT_EQ(v[1], v[2]);
+            }
+    }
+}
+
 TEST(Isp, clippingBelowBlackAboveWhiteAndNan)
 {
     RawFormat f;

@@ -184,6 +184,42 @@ TEST(MosaicFiles, mosaicRoundTripsWithItsSidecarInEveryContainer)
     EXPECT_EQ(expected, filesIn(dir)) << "no temporary files are left behind";
 }
 
+TEST(MosaicFiles, aMonochromeFrameRoundTripsWithItsSidecarInEveryContainer)
+{
+    const std::string dir = makeTempDir("mosaic_files_mono");
+    Mat frame(40, 60, CV_16UC1);
+    randu(frame, 0, 4096);
+    MosaicMetadata meta;
+    meta.format.pattern = CFA_MONO;
+    meta.format.blackLevel = Vec4d::all(100);
+    meta.format.whiteLevel = 4095;
+    meta.format.gain = 2.5;
+    meta.seed = 7;
+    for (const char* ext : {".png", ".tif", ".dng", ".npy"}) {
+        SCOPED_TRACE(ext);
+        const std::string path = dir + "/mono" + ext;
+        writeMosaic(path, frame, meta);
+        Mat back;
+        const MosaicMetadata r = readMosaic(path, back);
+        EXPECT_EQ(0, norm(frame, back, NORM_INF));
+        EXPECT_EQ(r.format.pattern, CFA_MONO);
+        EXPECT_EQ(r.format.blackLevel, meta.format.blackLevel);
+        EXPECT_EQ(r.format.gain, 2.5);
+        EXPECT_NE(std::string(test::readBytes(path + ".yml").data(), test::readBytes(path + ".yml").size())
+                      .find("pattern: MONO"),
+                  std::string::npos);
+    }
+    // The DNG states the same format as the sidecar, so readMosaic() compares them: a Bayer sidecar beside
+    // a monochrome DNG contradicts it.
+    const std::string dng = dir + "/mono.dng";
+    std::vector<char> sidecar = test::readBytes(dng + ".yml");
+    std::string text(sidecar.begin(), sidecar.end());
+    text.replace(text.find("pattern: MONO"), 13, "pattern: RGGB");
+    test::writeBytes(dng + ".yml", std::vector<char>(text.begin(), text.end()));
+    Mat back;
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dng, back), "MONO");
+}
+
 /* The .npy container as numpy writes it: a 64-byte-aligned header, and the data right after; and every
  * malformed file an error naming it, decided before the array is allocated. */
 TEST(MosaicFiles, npyMosaicsAreNumpysFormatAndMalformedOnesAreErrors)

@@ -372,6 +372,23 @@ TEST(Simulate, colorCheckerLayoutAndValues)
     EXPECT_LT(shaded.meanAtUnitGain.at<float>(0, 0), scene.meanAtUnitGain.at<float>(0, 0) * 0.65);
     EXPECT_CV_ERROR_CONTAINS(makeColorCheckerScene(ColorCheckerOptions{CFA_RGGB, 5}),
                              "patchSize must be even");
+    // A sensor without a filter sees the luminance of the three bands (Rec. 709 weights) on every site.
+    o.pattern = CFA_MONO;
+    o.vignetting = 0;
+    const ColorCheckerScene mono = makeColorCheckerScene(o);
+    for (size_t i = 0; i < 24; ++i) {
+        const Vec3d& rho = scene.reflectance[i];
+        const double luminance = 0.2126 * rho[0] + 0.7152 * rho[1] + 0.0722 * rho[2];
+        for (int s = 0; s < 4; ++s)
+            EXPECT_NEAR(mono.meanAtUnitGain.at<float>(mono.patches[i].y + s / 2, mono.patches[i].x + s % 2),
+                        1000 * luminance, 1e-3)
+                << "patch " << i << ", site " << s;
+    }
+    SensorParams unequal;
+    unequal.pattern = CFA_MONO;
+    unequal.blackLevel = Vec4d(256, 256, 256, 250);
+    EXPECT_CV_ERROR_CONTAINS(SensorSimulator(unequal, Size(8, 8)),
+                             "one value on all four sites for CFA_MONO");
 }
 
 TEST(Simulate, fillGaussianIsBoxMullerOfItsPhiloxWordsOnEveryPath)
