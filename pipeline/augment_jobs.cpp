@@ -255,7 +255,8 @@ void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe)
     // The output is the camera's capture of the darker or brighter scene: the input's camera tags, with
     // the ISO scaled by the gain ratio, the exposure time by the photon ratio (of green, which hue leaves
     // alone) and the noise profile of the model at the output's gain.
-    const double signalRatio = scene.jitter.contrast[cfaSiteOfChannel(m.format.pattern, CFA_G1)];
+    const double signalRatio =
+        scene.jitter.contrast[m.format.isMonochrome() ? 0 : cfaSiteOfChannel(m.format.pattern, CFA_G1)];
     meta.hasCamera = true;
     meta.camera = m.camera;
     meta.camera.iso = m.camera.iso * outFormat.gain / m.format.gain;

@@ -203,9 +203,13 @@ class RandomNoiseScene:
 
 def packCfaPlanes(signal, format):
     """A 4 x H/2 x W/2 float32 tensor of the CFA planes of a black-subtracted mosaic, in the order
-    R, G1, G2, B (whatever the pattern): the input layout of most RAW networks."""
+    R, G1, G2, B (whatever the pattern): the input layout of most RAW networks. A monochrome frame
+    (CFA_MONO) is packed in site order, as rawgment.packCfaPlanes does."""
     planes = _rg.splitCfaPlanes(np.ascontiguousarray(signal, dtype=np.float32))
-    order = [_rg.cfaSiteOfChannel(format.pattern, c) for c in (_rg.CFA_R, _rg.CFA_G1, _rg.CFA_G2, _rg.CFA_B)]
+    if format.pattern == _rg.CFA_MONO:
+        order = [0, 1, 2, 3]
+    else:
+        order = [_rg.cfaSiteOfChannel(format.pattern, c) for c in (_rg.CFA_R, _rg.CFA_G1, _rg.CFA_G2, _rg.CFA_B)]
     return torch.from_numpy(np.stack([planes[s] for s in order]))
 
 

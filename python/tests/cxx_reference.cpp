@@ -136,6 +136,26 @@ int main(int argc, char** argv)
             numbers << "scene_box" << i << " " << boxes[i].x << " " << boxes[i].y << " " << boxes[i].width
                     << " " << boxes[i].height << "\n";
 
+        // A monochrome frame (the capture's values, one black level): a random scene with hue, blur and
+        // geometry asked for, which it takes on its pixel grid with one contrast, and its grey preview.
+        RawFormat monoFormat = format;
+        monoFormat.pattern = CFA_MONO;
+        monoFormat.blackLevel = Vec4d::all(64);
+        RandomScenePolicy monoPolicy;
+        monoPolicy.blurProbability = 1;
+        monoPolicy.geometryProbability = 1;
+        monoPolicy.hueProbability = 1;
+        const uint64 monoSeed = augmentedOutputSeed(1, "mono", 0);
+        const Scene monoScene = monoPolicy.draw(capture, monoFormat, monoSeed);
+        Mat monoAugmented, monoPreview;
+        RawFormat monoAugmentedFormat;
+        applyScene(capture, monoFormat, model, monoScene, monoSeed, monoAugmented, monoAugmentedFormat);
+        saveNpy("mono_scene", monoAugmented);
+        saveNpy("mono_kernel", monoScene.motionKernel);
+        numbers << "mono_scene_gain " << monoAugmentedFormat.gain << "\n";
+        renderSimpleIsp(monoAugmented, monoAugmentedFormat, monoPreview);
+        saveNpy("mono_isp", monoPreview);
+
         Mat normals;
         fillStandardNormal(normals, Size(33, 17), 9);
         saveNpy("normal", normals);

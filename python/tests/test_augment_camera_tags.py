@@ -173,3 +173,56 @@ def test_an_iso_1600_file_is_at_gain_16_through_the_app_the_library_and_the_data
     # A file that states no ISO stays at its format's gain.
     rg.writeDng(str(tmp_path / "noiso.dng"), rg.RawImage(mosaic=mosaic, format=fmt))
     assert rg.readRaw(str(tmp_path / "noiso.dng")).formatFor(noBase).gain == 1
+
+
+def test_a_monochrome_dng_stays_monochrome_through_the_app_and_the_dataset(tmp_path, app_dir):
+    """A monochrome sensor's frame (CFA_MONO) is a LinearRaw DNG with one sample per pixel, which exiftool and
+    LibRaw read; the app and the dataset augment it with one contrast and write it back the same way, its
+    NoiseProfile one (S, O) pair."""
+    import numpy as np
+    import torch  # noqa: F401 (rawgment.torch needs it)
+    import rawgment.torch as rgt
+
+    folder = tmp_path / "raws"
+    folder.mkdir()
+    rng = np.random.default_rng(3)
+    mosaic = (rng.poisson(900, size=(64, 96)) + 100).astype(np.uint16)
+    fmt = rg.RawFormat(pattern=rg.CFA_MONO, blackLevel=(100, 100, 100, 100), whiteLevel=4095)
+    model = rg.NoiseModel(alpha=0.3, sigmaD2=1.5, sigmaR2=4.0)
+    model.baseIso = 100
+    rg.writeDng(str(folder / "mono.dng"), rg.RawImage(mosaic=mosaic, format=fmt, iso=100, make="Basler",
+                                                      noiseProfile=rg.dngNoiseProfile(model, fmt)))
+    tags = exiftool_values(str(folder / "mono.dng"), "PhotometricInterpretation", "SamplesPerPixel", "BlackLevel",
+                           "WhiteLevel", "CFAPattern2", "NoiseProfile")
+    assert tags["PhotometricInterpretation"] == "34892" and tags["SamplesPerPixel"] == "1"
+    assert tags["BlackLevel"] == "100" and tags["WhiteLevel"] == "4095" and "CFAPattern2" not in tags
+    assert len(tags["NoiseProfile"].split()) == 2
+    image = rg.readRaw(str(folder / "mono.dng"))
+    assert image.format.pattern == rg.CFA_MONO and np.array_equal(image.mosaic, mosaic)
+    assert rg.withDngNoiseProfileLine(model, image).lineAtGain(1).a == pytest.approx(model.alpha, rel=1e-12)
+
+    model.save(str(tmp_path / "model.yml"))
+    policy = rg.RandomScenePolicy(hueProbability=1, blurProbability=1, geometryProbability=1)
+    policy.save(str(tmp_path / "policy.yml"))
+    subprocess.run([os.path.join(app_dir, "rawgment_augment"), "--model=%s" % (tmp_path / "model.yml"),
+                    "--policy=%s" % (tmp_path / "policy.yml"), "--out=%s" % (tmp_path / "out"), "--variants=2",
+                    "--preview", str(folder / "mono.dng")], check=True, capture_output=True)
+    for v in range(2):
+        out = str(tmp_path / "out" / ("mono_v%02d.dng" % v))
+        tags = exiftool_values(out, "PhotometricInterpretation", "SamplesPerPixel", "NoiseProfile", "ISO")
+        assert tags["PhotometricInterpretation"] == "34892" and tags["SamplesPerPixel"] == "1"
+        after = rg.readRaw(out)
+        assert after.format.pattern == rg.CFA_MONO
+        meta = rg.readMosaic(out)[1]
+        assert len(set(meta.scene.jitter.contrast)) == 1
+        # The DNG's ISO is rounded to an integer; the sidecar keeps the exact gain.
+        assert after.iso == round(100 * meta.format.gain)
+        assert after.noiseProfile == [tuple(so) for so in rg.dngNoiseProfile(model, meta.format)]
+
+    for pack, shape in ((False, (1, 64, 96)), (True, (4, 32, 48))):
+        sample = rgt.RawFolderDataset(folder, model, policy=policy, pack=pack)[0]
+        assert tuple(sample["raw"].shape) == shape and sample["gain"] >= 1
+    # The site order of packCfaPlanes, in rawgment.torch's own packing too.
+    signal = rg.subtractBlackLevel(mosaic, fmt)
+    assert np.array_equal(rgt.packCfaPlanes(signal, fmt).numpy(),
+                          np.stack([signal[0::2, 0::2], signal[0::2, 1::2], signal[1::2, 0::2], signal[1::2, 1::2]]))

@@ -59,6 +59,21 @@ def test_scene_policy_and_boxes(cxx_reference, sensor, capture):
     assert boxes == [tuple(int(v) for v in ref["scene_box%d" % i]) for i in range(2)]
 
 
+def test_a_monochrome_frames_scene_and_preview(cxx_reference, sensor, capture):
+    ref = numbers(cxx_reference)
+    fmt = rg.RawFormat(pattern=rg.CFA_MONO, blackLevel=(64, 64, 64, 64), whiteLevel=4095, gain=2.0)
+    assert fmt.isMonochrome()
+    policy = rg.RandomScenePolicy(blurProbability=1, geometryProbability=1, hueProbability=1)
+    seed = rg.augmentedOutputSeed(1, "mono", 0)
+    scene = policy.draw(capture, fmt, seed)
+    assert len(set(scene.jitter.contrast)) == 1  # no hue on a monochrome frame
+    same(cxx_reference, "mono_kernel", np.asarray(scene.motionKernel))
+    out, outFormat, _, _ = rg.applyScene(capture, fmt, sensor.effectiveModel(), scene, seed=seed)
+    same(cxx_reference, "mono_scene", out)
+    assert outFormat.pattern == rg.CFA_MONO and outFormat.gain == float(ref["mono_scene_gain"][0])
+    same(cxx_reference, "mono_isp", rg.renderSimpleIsp(out, outFormat))
+
+
 def test_normals_shapiro_wilk_and_isp(cxx_reference, sensor, capture):
     ref = numbers(cxx_reference)
     z = rg.fillStandardNormal((33, 17), 9)

@@ -122,6 +122,27 @@ def test_scene_policy_and_boxes(reference):
     assert report.steps and len(report.stepSeconds) == len(report.steps)
 
 
+def test_a_monochrome_frames_scene_and_preview(reference):
+    folder, numbers = reference
+    fmt, model = inputs(numbers)
+    fmt.pattern = rg.CFA_MONO
+    fmt.blackLevel = (64, 64, 64, 64)
+    assert fmt.isMonochrome()
+    capture = np.load(folder / "capture.npy")
+    policy = rg.RandomScenePolicy()
+    policy.blurProbability = 1
+    policy.geometryProbability = 1
+    policy.hueProbability = 1
+    seed = rg.augmentedOutputSeed(1, "mono", 0)
+    scene = policy.draw(capture, fmt, seed)
+    same(folder, "mono_kernel", scene.motionKernel)
+    out, outFormat, _, _ = rg.applyScene(capture, fmt, model, scene, seed, boxes=[])
+    same(folder, "mono_scene", out)
+    assert outFormat.pattern == rg.CFA_MONO and outFormat.gain == number(numbers, "mono_scene_gain")
+    same(folder, "mono_isp", rg.renderSimpleIsp(out, outFormat))
+    assert rg.cfaChannelAt(rg.CFA_MONO, 1, 1) == rg.CFA_W
+
+
 def test_shapiro_wilk(reference):
     folder, numbers = reference
     normals = np.load(folder / "normal.npy")

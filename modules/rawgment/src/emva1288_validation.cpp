@@ -121,7 +121,8 @@ std::vector<Emva1288Darkening> emva1288Darkening(const Emva1288Series& series, c
             readEmva1288Image(series, bright.images[f], bright.line).convertTo(frames[f], CV_32F);
             real[f] = readEmva1288Image(series, dark.images[f], dark.line);
         }
-        RawFormat format;
+        RawFormat format; // the standard's frames are a monochrome sensor's, or one channel's
+        format.pattern = CFA_MONO;
         format.blackLevel = Vec4d::all(results.darkMean[i]);
         format.whiteLevel = std::ldexp(1.0, series.bits) - 1;
         const double ratio = results.photons[j] / results.photons[i];

@@ -344,10 +344,11 @@ std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, const RawFormat& for
     format.validate();
     model.validate();
     const NoiseLine line = model.lineAtGain(format.gain);
-    std::vector<Vec2d> profile(3);
-    for (int plane = 0; plane < 3; ++plane) {
-        const double r = detail::rangeOfColourPlane(format, plane);
-        profile[plane] = Vec2d(line.a / r, line.b / (r * r));
+    // A monochrome DNG has one colour plane, so one (S, O) pair: its colour plane is green's (CFA_W).
+    std::vector<Vec2d> profile(format.isMonochrome() ? 1 : 3);
+    for (size_t k = 0; k < profile.size(); ++k) {
+        const double r = detail::rangeOfColourPlane(format, format.isMonochrome() ? 1 : static_cast<int>(k));
+        profile[k] = Vec2d(line.a / r, line.b / (r * r));
     }
     detail::checkDngNoiseProfile(profile, "dngNoiseProfile");
     return profile;
@@ -358,6 +359,15 @@ NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& profile, const RawFo
 {
     detail::checkDngNoiseProfile(profile, "noiseLineFromDngProfile");
     format.validate();
+    if (format.isMonochrome() != (channel == CFA_W))
+        CV_Error(Error::StsBadArg, cv::format("noiseLineFromDngProfile: channel %d of a %s format (CFA_W is the "
+                                              "only channel of a monochrome frame, and only of one)",
+                                              static_cast<int>(channel), cfaPatternName(format.pattern).c_str()));
+    if (format.isMonochrome() && profile.size() != 1)
+        CV_Error(Error::StsBadArg,
+                 cv::format("noiseLineFromDngProfile: %d (S, O) pairs for a monochrome frame, which has one "
+                            "colour plane and so one pair",
+                            static_cast<int>(profile.size())));
     const int plane = colourPlaneOf(channel);
     const Vec2d so = profile.size() == 1 ? profile[0] : profile[static_cast<size_t>(plane)];
     const double r = detail::rangeOfColourPlane(format, plane);
@@ -388,7 +398,8 @@ NoiseModel withDngNoiseProfileLine(const NoiseModel& model, const RawImage& imag
     measured.gain = image.iso / model.baseIso;
     measured.iso = image.iso;
     // Green's line: the augmentation's one line per gain, as darktable's catalogue takes it.
-    measured.line = noiseLineFromDngProfile(image.noiseProfile, image.format, CFA_G1);
+    measured.line =
+        noiseLineFromDngProfile(image.noiseProfile, image.format, image.format.isMonochrome() ? CFA_W : CFA_G1);
     NoiseModel out = model;
     std::vector<MeasuredNoiseLine>& lines = out.measuredLines;
     const auto at = std::lower_bound(lines.begin(), lines.end(), measured.gain,
