@@ -374,8 +374,10 @@ std::vector<Target> readerTargets(const std::string& dataDir)
     t.push_back({"raw", "input.dng", true, Errors::LIBRARY,
                  [dataDir](const std::string& work) {
                      std::vector<std::string> seeds;
-                     const CfaPattern patterns[] = {CFA_RGGB, CFA_GBRG};
-                     for (int k = 0; k < 2; ++k) {
+                     // Two Bayer layouts and a monochrome LinearRaw file, whose reading takes LibRaw's other
+                     // path.
+                     const CfaPattern patterns[] = {CFA_RGGB, CFA_GBRG, CFA_MONO};
+                     for (int k = 0; k < 3; ++k) {
                          RawImage image;
                          image.format.pattern = patterns[k];
                          image.format.whiteLevel = k == 0 ? 65535 : 4095;
@@ -387,7 +389,7 @@ std::vector<Target> readerTargets(const std::string& dataDir)
                          image.make = "Rawgment";
                          image.model = "Fuzz seed";
                          // A NoiseProfile in both layouts, so mutations reach the tag reader.
-                         if (k == 0)
+                         if (k != 1)
                              image.noiseProfile = {cv::Vec2d(2e-5, 1e-8)};
                          else
                              image.noiseProfile = {cv::Vec2d(1e-4, 1e-7), cv::Vec2d(2e-4, 2e-7),
@@ -416,6 +418,8 @@ std::vector<Target> readerTargets(const std::string& dataDir)
                      if (!image.noiseProfile.empty() && image.noiseProfile.size() != 1 &&
                          image.noiseProfile.size() != 3)
                          return std::string("accepted a NoiseProfile of neither 1 nor 3 pairs");
+                     if (image.format.isMonochrome() && image.noiseProfile.size() > 1)
+                         return std::string("accepted a NoiseProfile of 3 pairs for one colour plane");
                      return checkFormat(image.format);
                  }});
     // A reader with a planted bug, so that a test proves the fuzzer reports what it must: it throws a

@@ -206,6 +206,9 @@ RawImage readRaw(const String& path)
     if (!haveMatrix)
         out.cameraToSrgb = Matx33d::eye();
     out.noiseProfile = detail::readDngNoiseProfile(path);
+    if (mono && out.noiseProfile.size() > 1)
+        failOn(path, format("its NoiseProfile has %d (S, O) pairs for its one colour plane; DNG allows one",
+                            static_cast<int>(out.noiseProfile.size())));
     out.colorTags = detail::readDngColorTags(path);
     // Another RAW format: LibRaw's XYZ-to-camera matrix is Adobe's coefficients for the camera (integers
     // over 10000, given for D65), which is the DNG's ColorMatrix with CalibrationIlluminant D65 (21).
