@@ -23,6 +23,8 @@ int main(int argc, char** argv)
         "{sigma_d2       | 1.5      | sensor: read-noise variance before the gain (DN^2) }"
         "{sigma_r2       | 0.8      | sensor: noise variance after the gain (DN^2) }"
         "{bits           | 12       | sensor: ADC bits }"
+        "{pattern        | RGGB     | sensor: colour filter RGGB, BGGR, GRBG or GBRG, or MONO for none "
+        "(monochrome) }"
         "{outliers       | 0        | sensor: fraction of hot + dead + noisy pixels }"
         "{seed           | 1        | noise seed }"
         "{format         | dng      | frame container: dng, png or tif }"
@@ -51,6 +53,12 @@ int main(int argc, char** argv)
         o.sensor.noise = cv::rawgment::NoiseModel(parser.get<double>("alpha"), parser.get<double>("sigma_d2"),
                                                   parser.get<double>("sigma_r2"));
         o.sensor.bitDepth = parser.get<int>("bits");
+        try {
+            o.sensor.pattern = cv::rawgment::cfaPatternFromName(parser.get<std::string>("pattern"));
+        } catch (const cv::Exception& e) {
+            std::cerr << "rawgment_simulate: --pattern: " << e.err << "\n";
+            return 2;
+        }
         const double outliers = parser.get<double>("outliers");
         o.sensor.hotPixelFraction = o.sensor.deadPixelFraction = o.sensor.noisyPixelFraction = outliers / 3;
         o.seed = rawgment_apps::seedOption(parser, "rawgment_simulate");

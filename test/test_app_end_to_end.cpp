@@ -161,4 +161,72 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
     EXPECT_EQ(inputBytes, readText(in0)) << "inputs are never modified";
 }
 
+// A monochrome sensor through the same apps: its frames are LinearRaw DNGs, its calibration finds the sensor,
+// its validation matches the darker captures with ACCOUNT_PRIOR only, and its augmented frames stay
+// monochrome. The library's tests hold the accuracy
+// (Calibration.aMonochromeSensorCalibratesOnTheSameProtocol); 16 frames keep this one short.
+TEST(Apps, aMonochromeSensorGoesFromSimulationToAugmentation)
+{
+    const std::string dir = freshDir("mono_pipeline");
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir + "/sim' --pattern=MONO --frames=16 --seed=3");
+    ASSERT_EQ(0, r.status) << r.output;
+    const cv::rawgment::RawImage frame = cv::rawgment::readRaw(dir + "/sim/g06dB_level0.90/frame_000.dng");
+    EXPECT_EQ(cv::rawgment::CFA_MONO, frame.format.pattern);
+    r = runApp("rawgment_simulate", "--out='" + dir + "/bad' --pattern=RGBW");
+    EXPECT_EQ(2, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("expected one of RGGB, BGGR, GRBG, GBRG, MONO")) << r.output;
+
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --plots=false --out='" + dir + "/cal'");
+    ASSERT_EQ(0, r.status) << r.output;
+    const cv::rawgment::NoiseModel truth = cv::rawgment::NoiseModel::load(dir + "/sim/truth_noise_model.yml");
+    const cv::rawgment::NoiseModel fitted = cv::rawgment::NoiseModel::load(dir + "/cal/noise_model.yml");
+    // At 100 frames the joint fit's alpha spreads by 0.08% over seeds; 16 frames are sqrt(99 / 15) = 2.6x
+    // noisier: 2% is more than 9 of those spreads.
+    EXPECT_NEAR(truth.alpha, fitted.alpha, 0.02 * truth.alpha);
+
+    r = runApp("rawgment_validate", "'" + dir + "/sim/validation_manifest.yml' --model='" + dir +
+                                        "/cal/noise_model.yml' --plots=false --out='" + dir + "/val'");
+    ASSERT_EQ(0, r.status) << r.output;
+    std::istringstream csv(readText(dir + "/val/validation.csv"));
+    std::string line;
+    std::getline(csv, line);
+    double real = 0, none = 0, ignore = 0, account = 0;
+    while (std::getline(csv, line)) {
+        std::vector<double> v;
+        std::stringstream cells(line);
+        std::string cell;
+        while (std::getline(cells, cell, ','))
+            v.push_back(std::stod(cell));
+        ASSERT_EQ(11u, v.size()) << line;
+        real += v[5];
+        none += v[6];
+        ignore += v[7];
+        account += v[8];
+    }
+    // As in simulateCalibrateValidateAugmentEndToEnd, with half the frames: 5% for the ratio pooled over the
+    // validation bins (both factors), while IGNORE_PRIOR and NONE miss by far more.
+    EXPECT_NEAR(1.0, account / real, 0.05);
+    EXPECT_GT(ignore / real, 1.2);
+    EXPECT_LT(none / real, 0.8);
+
+    cv::rawgment::RandomScenePolicy policy;
+    policy.hueProbability = 1;
+    policy.blurProbability = 1;
+    policy.geometryProbability = 1;
+    policy.save(dir + "/policy.yml");
+    r = runApp("rawgment_augment", "--model='" + dir + "/cal/noise_model.yml' --policy='" + dir +
+                                       "/policy.yml' --out='" + dir + "/aug' --variants=2 --preview=true '" +
+                                       dir + "/sim/g06dB_level0.90/frame_000.dng'");
+    ASSERT_EQ(0, r.status) << r.output;
+    for (int v = 0; v < 2; ++v) {
+        const std::string out = dir + cv::format("/aug/frame_000_v%02d.dng", v);
+        EXPECT_EQ(cv::rawgment::CFA_MONO, cv::rawgment::readRaw(out).format.pattern);
+        cv::Mat mosaic;
+        const cv::rawgment::MosaicMetadata meta = cv::rawgment::readMosaic(out, mosaic);
+        EXPECT_EQ(cv::rawgment::CFA_MONO, meta.format.pattern);
+        EXPECT_EQ(cv::Vec4d::all(meta.scene.jitter.contrast[0]), meta.scene.jitter.contrast);
+        expectPngDecodes(dir + cv::format("/aug/frame_000_v%02d_preview.png", v));
+    }
+}
+
 } // namespace
