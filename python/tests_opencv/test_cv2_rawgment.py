@@ -139,7 +139,6 @@ def test_a_monochrome_frames_scene_and_preview(reference):
     out, outFormat, _, _ = rg.applyScene(capture, fmt, model, scene, seed, boxes=[])
     same(folder, "mono_scene", out)
     assert outFormat.pattern == rg.CFA_MONO and outFormat.gain == number(numbers, "mono_scene_gain")
-    same(folder, "mono_isp", rg.renderSimpleIsp(out, outFormat))
     assert rg.cfaChannelAt(rg.CFA_MONO, 1, 1) == rg.CFA_W
 
 
