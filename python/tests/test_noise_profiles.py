@@ -55,6 +55,33 @@ def test_exiftool_reads_the_models_noise_profile(tmp_path, pattern):
         assert (line.a, line.b) == pytest.approx((truth.a, truth.b), rel=1e-13)
 
 
+def test_a_monochrome_dngs_profile_is_one_pair_that_exiftool_validates(tmp_path):
+    model = rg.NoiseModel(alpha=0.3, sigmaD2=1.2, sigmaR2=2.5)
+    fmt = rg.RawFormat(pattern=rg.CFA_MONO, blackLevel=(100, 100, 100, 100), whiteLevel=4000, gain=4.0)
+    image = rg.RawImage(mosaic=np.full((48, 64), 600, np.uint16), format=fmt)
+    image.noiseProfile = rg.dngNoiseProfile(model, fmt)
+    assert len(image.noiseProfile) == 1
+    path = str(tmp_path / "mono.dng")
+    rg.writeDng(path, image)
+    run = subprocess.run([exiftool(), "-n", "-s3", "-NoiseProfile", path], capture_output=True, text=True, check=True)
+    values = [float(v) for v in run.stdout.split()]
+    assert values == pytest.approx([4.0 * model.alpha / 3900, (16.0 * model.sigmaD2 + model.sigmaR2) / 3900 ** 2],
+                                   rel=1e-13)
+    # exiftool checks the file against the DNG and TIFF rules (tag counts for one colour plane among them).
+    valid = subprocess.run([exiftool(), "-validate", "-warning", "-s3", path], capture_output=True, text=True,
+                           check=True)
+    assert valid.stdout.strip() == "OK", valid.stdout
+    back = rg.readRaw(path)
+    back.format.gain = 4.0
+    line, truth = rg.noiseLineFromDngProfile(back.noiseProfile, back.format, rg.CFA_W), model.lineAtGain(4.0)
+    assert (line.a, line.b) == pytest.approx((truth.a, truth.b), rel=1e-13)
+    with pytest.raises(rg.error, match="CFA_W is the only channel of a monochrome frame"):
+        rg.noiseLineFromDngProfile(back.noiseProfile, back.format, rg.CFA_G1)
+    image.noiseProfile = [(1e-4, 1e-6)] * 3
+    with pytest.raises(rg.error, match="one \\(S, O\\) pair"):
+        rg.writeDng(str(tmp_path / "three.dng"), image)
+
+
 def test_a_profile_dng_cannot_hold_is_refused(tmp_path):
     image = rg.RawImage(mosaic=np.full((48, 64), 600, np.uint16))
     image.noiseProfile = [(1e-4, 1e-6), (1e-4, 1e-6)]

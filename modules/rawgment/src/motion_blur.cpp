@@ -18,8 +18,11 @@ Mat linearMotionKernel(double length, double angleDegrees, CfaPattern pattern)
                         MAX_MOTION_LENGTH, length));
     if (!std::isfinite(angleDegrees))
         CV_Error(Error::StsBadArg, "linearMotionKernel: angle must be finite");
+    if (pattern < CFA_RGGB || pattern > CFA_MONO)
+        CV_Error(Error::StsBadArg,
+                 format("linearMotionKernel: pattern %d is not a CfaPattern", static_cast<int>(pattern)));
     // The CFA planes have half the resolution; a monochrome frame is blurred on its own pixels.
-    const double planeLength = cfaPatternName(pattern) == "MONO" ? length : length / 2;
+    const double planeLength = pattern == CFA_MONO ? length : length / 2;
     if (planeLength <= 1)
         return Mat::ones(1, 1, CV_32FC1);
     const int radius = static_cast<int>(std::ceil(planeLength / 2));

@@ -179,6 +179,9 @@ namespace detail {
 
 double rangeOfColourPlane(const RawFormat& format, int plane)
 {
+    // A monochrome frame's one plane stands for every colour a profile names (darktable's hold three).
+    if (format.isMonochrome())
+        return format.whiteLevel - format.blackLevel[0];
     double black = 0;
     int sites = 0;
     for (int site = 0; site < 4; ++site)
@@ -347,7 +350,7 @@ std::vector<Vec2d> dngNoiseProfile(const NoiseModel& model, const RawFormat& for
     // A monochrome DNG has one colour plane, so one (S, O) pair: its colour plane is green's (CFA_W).
     std::vector<Vec2d> profile(format.isMonochrome() ? 1 : 3);
     for (size_t k = 0; k < profile.size(); ++k) {
-        const double r = detail::rangeOfColourPlane(format, format.isMonochrome() ? 1 : static_cast<int>(k));
+        const double r = detail::rangeOfColourPlane(format, static_cast<int>(k));
         profile[k] = Vec2d(line.a / r, line.b / (r * r));
     }
     detail::checkDngNoiseProfile(profile, "dngNoiseProfile");
@@ -360,9 +363,10 @@ NoiseLine noiseLineFromDngProfile(const std::vector<Vec2d>& profile, const RawFo
     detail::checkDngNoiseProfile(profile, "noiseLineFromDngProfile");
     format.validate();
     if (format.isMonochrome() != (channel == CFA_W))
-        CV_Error(Error::StsBadArg, cv::format("noiseLineFromDngProfile: channel %d of a %s format (CFA_W is the "
-                                              "only channel of a monochrome frame, and only of one)",
-                                              static_cast<int>(channel), cfaPatternName(format.pattern).c_str()));
+        CV_Error(Error::StsBadArg,
+                 cv::format("noiseLineFromDngProfile: channel %d of a %s format (CFA_W is the "
+                            "only channel of a monochrome frame, and only of one)",
+                            static_cast<int>(channel), cfaPatternName(format.pattern).c_str()));
     if (format.isMonochrome() && profile.size() != 1)
         CV_Error(Error::StsBadArg,
                  cv::format("noiseLineFromDngProfile: %d (S, O) pairs for a monochrome frame, which has one "
@@ -398,8 +402,8 @@ NoiseModel withDngNoiseProfileLine(const NoiseModel& model, const RawImage& imag
     measured.gain = image.iso / model.baseIso;
     measured.iso = image.iso;
     // Green's line: the augmentation's one line per gain, as darktable's catalogue takes it.
-    measured.line =
-        noiseLineFromDngProfile(image.noiseProfile, image.format, image.format.isMonochrome() ? CFA_W : CFA_G1);
+    measured.line = noiseLineFromDngProfile(image.noiseProfile, image.format,
+                                            image.format.isMonochrome() ? CFA_W : CFA_G1);
     NoiseModel out = model;
     std::vector<MeasuredNoiseLine>& lines = out.measuredLines;
     const auto at = std::lower_bound(lines.begin(), lines.end(), measured.gain,

@@ -163,6 +163,20 @@ inline double fixedPatternExcess(const DarkStats& a, const DarkStats& b, int T, 
     return d.dot(d) / d.total() / noise - 1;
 }
 
+//! A small 12-bit mosaic (black 256) with a pixel far below black, one saturated and one exactly at black.
+inline Mat smallMosaic(int type = CV_16UC1)
+{
+    Mat m(16, 24, CV_16UC1);
+    RNG rng(3);
+    rng.fill(m, RNG::UNIFORM, 200, 3000);
+    m.at<ushort>(0, 0) = 0;    // far below black
+    m.at<ushort>(1, 1) = 4095; // saturated
+    m.at<ushort>(2, 2) = 256;  // exactly black
+    Mat out;
+    m.convertTo(out, type);
+    return out;
+}
+
 } // namespace augment_test
 } // namespace rawgment
 } // namespace cv

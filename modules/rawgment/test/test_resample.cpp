@@ -336,14 +336,15 @@ TEST(Augment, poissonSamplingKeepsTheVarianceOfBlurAndScale)
     }
 }
 
-TEST(Augment, blurAndScaleRestoreTheDarkFrameComponentsTheyAverageAway)
+// A dark flat scene at a high gain, where the components are a large part of the noise: the target of a blur
+// or a scale of a flat scene is a plain capture (captureBlurred of a flat scene is one).
+void expectBlurAndScaleRestoreTheDarkFrameComponents(CfaPattern pattern, Size size)
 {
-    // A dark flat scene at a high gain, where the components are a large part of the noise: the target
-    // of a blur or a scale of a flat scene is a plain capture (captureBlurred of a flat scene is one).
-    const Size size(256, 256);
     const int T = 32;
     const double gain = 8;
-    const SensorSimulator sensor(darkComponentSensor(size), size);
+    SensorParams params = darkComponentSensor(size);
+    params.pattern = pattern;
+    const SensorSimulator sensor(params, size);
     const NoiseModel model = sensor.effectiveModel();
     const RawFormat fmt = sensor.rawFormat(gain);
     const double black = fmt.blackLevel[0];
@@ -352,7 +353,7 @@ TEST(Augment, blurAndScaleRestoreTheDarkFrameComponentsTheyAverageAway)
     sensor.captureBurst(scene, gain, 1.0, T, 9, input);
     sensor.captureBurst(scene, gain, 1.0, T, 10, target);
     const DarkStats truth = darkStats(target, black);
-    const Mat kernel = linearMotionKernel(9, 30);
+    const Mat kernel = linearMotionKernel(9, 30, pattern);
     typedef std::function<void(const Mat&, const NoiseOptions&, uint64, Mat&)> Step;
     const std::pair<const char*, Step> steps[] = {
         {"motionBlur", [&](const Mat& in, const NoiseOptions& o, uint64 seed,
@@ -366,7 +367,7 @@ TEST(Augment, blurAndScaleRestoreTheDarkFrameComponentsTheyAverageAway)
                           std::sqrt((2 + std::max(truth.kurtosis, 0.0)) / (truth.dof * (size.width - 1.0)));
     const double patternTol = 5 * std::sqrt(2.0 / size.area());
     for (const auto& step : steps) {
-        SCOPED_TRACE(step.first);
+        SCOPED_TRACE(cfaPatternName(pattern) + ", " + step.first);
         auto stats = [&](const NoiseOptions& o) {
             std::vector<Mat> out(T);
             for (int t = 0; t < T; ++t)
@@ -391,15 +392,22 @@ TEST(Augment, blurAndScaleRestoreTheDarkFrameComponentsTheyAverageAway)
         EXPECT_GT(ignore.rowMeanVar / truth.rowMeanVar, 1 + rowTol) << "IGNORE_PRIOR adds rows on top";
         EXPECT_GT(ignore.pixelVar / truth.pixelVar, 1 + pixTol) << "IGNORE_PRIOR adds noise on top";
         EXPECT_GT(fixedPatternExcess(ignore, truth, T, size.width), patternTol) << "IGNORE_PRIOR doubles it";
-        std::cout << step.first << ": row-mean var (capture " << truth.rowMeanVar << ") NONE "
-                  << none.rowMeanVar << ", IGNORE " << ignore.rowMeanVar << ", ACCOUNT " << account.rowMeanVar
-                  << "; pixel var (" << truth.pixelVar << ") " << none.pixelVar << ", " << ignore.pixelVar
-                  << ", " << account.pixelVar << "; kurtosis (" << truth.kurtosis << " +- "
-                  << truth.kurtosisSE << ") ACCOUNT " << account.kurtosis << "; pattern excess "
-                  << fixedPatternExcess(none, truth, T, size.width) << ", "
+        std::cout << cfaPatternName(pattern) << ", " << step.first << ": row-mean var (capture "
+                  << truth.rowMeanVar << ") NONE " << none.rowMeanVar << ", IGNORE " << ignore.rowMeanVar
+                  << ", ACCOUNT " << account.rowMeanVar << "; pixel var (" << truth.pixelVar << ") "
+                  << none.pixelVar << ", " << ignore.pixelVar << ", " << account.pixelVar << "; kurtosis ("
+                  << truth.kurtosis << " +- " << truth.kurtosisSE << ") ACCOUNT " << account.kurtosis
+                  << "; pattern excess " << fixedPatternExcess(none, truth, T, size.width) << ", "
                   << fixedPatternExcess(ignore, truth, T, size.width) << ", "
                   << fixedPatternExcess(account, truth, T, size.width) << "\n";
     }
+}
+
+TEST(Augment, blurAndScaleRestoreTheDarkFrameComponentsTheyAverageAway)
+{
+    expectBlurAndScaleRestoreTheDarkFrameComponents(CFA_RGGB, Size(256, 256));
+    // A monochrome frame's rows and shading, read on its full pixel grid.
+    expectBlurAndScaleRestoreTheDarkFrameComponents(CFA_MONO, Size(256, 256));
 }
 
 } // namespace
