@@ -1,5 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// Augmentation of a 4000x3000 CV_16UC1 mosaic, all in one run:
+// Augmentation of a 4000x3000 CV_16UC1 mosaic, and of the same mosaic as CV_32FC1 (the *F32 benchmarks), all
+// in one run:
 //   colour jitter (ACCOUNT_PRIOR; also with Tukey-lambda read noise and with Poisson shot draws), motion
 //   blur (length 13), scaling by 3%, a full random scene,
 //   the same colour jitter composed naively with OpenCV calls (convertTo, RNG::fill NORMAL, Mat
@@ -38,24 +39,41 @@ const Mat& frame()
     return perf::perfFrame();
 }
 
+//! The same frame as CV_32FC1: the *F32 benchmarks time every step on float input beside the uint16 one.
+const Mat& floatFrame()
+{
+    static const Mat f = [] {
+        Mat m;
+        perf::perfFrame().convertTo(m, CV_32F);
+        return m;
+    }();
+    return f;
+}
+
 const ColorJitter kJitter = ColorJitter::exposureChange(0.2, 2.0);
 
 //! The jitter of kJitter with `model` and `noise`, a new seed per iteration, into one reused output.
-void timeColorJitter(benchmark::State& state, const NoiseModel& model, const NoiseOptions& noise)
+void timeColorJitter(benchmark::State& state, const NoiseModel& model, const NoiseOptions& noise,
+                     const Mat& input = frame())
 {
     Mat out;
     RawFormat f;
     uint64 seed = 0;
     for (auto _ : state) {
-        colorJitter(frame(), frameFormat(), model, kJitter, noise, ++seed, out, f);
+        colorJitter(input, frameFormat(), model, kJitter, noise, ++seed, out, f);
         benchmark::DoNotOptimize(out.data);
     }
-    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(input.total()));
 }
 
 void BM_Augment_colorJitter(benchmark::State& state)
 {
     timeColorJitter(state, kModel, NoiseAlignment::ACCOUNT_PRIOR);
+}
+
+void BM_Augment_colorJitterF32(benchmark::State& state)
+{
+    timeColorJitter(state, kModel, NoiseAlignment::ACCOUNT_PRIOR, floatFrame());
 }
 
 void BM_Augment_colorJitterTukeyRead(benchmark::State& state)
@@ -67,11 +85,21 @@ void BM_Augment_colorJitterTukeyRead(benchmark::State& state)
     timeColorJitter(state, model, NoiseAlignment::ACCOUNT_PRIOR);
 }
 
-void BM_Augment_colorJitterPoisson(benchmark::State& state)
+NoiseOptions poissonNoise()
 {
     NoiseOptions noise(NoiseAlignment::ACCOUNT_PRIOR);
     noise.shotSampling = ShotNoiseSampling::POISSON;
-    timeColorJitter(state, kModel, noise);
+    return noise;
+}
+
+void BM_Augment_colorJitterPoisson(benchmark::State& state)
+{
+    timeColorJitter(state, kModel, poissonNoise());
+}
+
+void BM_Augment_colorJitterPoissonF32(benchmark::State& state)
+{
+    timeColorJitter(state, kModel, poissonNoise(), floatFrame());
 }
 
 void BM_Augment_colorJitterNaiveOpenCV(benchmark::State& state)
@@ -98,30 +126,50 @@ void BM_Augment_colorJitterNaiveOpenCV(benchmark::State& state)
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
 }
 
-void BM_Augment_motionBlur13(benchmark::State& state)
+void timeMotionBlur13(benchmark::State& state, const Mat& input)
 {
     const Mat kernel = linearMotionKernel(13, 30);
     Mat out;
     uint64 seed = 0;
     for (auto _ : state) {
-        motionBlur(frame(), frameFormat(), kModel, kernel, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out);
+        motionBlur(input, frameFormat(), kModel, kernel, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out);
         benchmark::DoNotOptimize(out.data);
     }
-    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(input.total()));
 }
 
-void BM_Augment_scale103(benchmark::State& state)
+void BM_Augment_motionBlur13(benchmark::State& state)
+{
+    timeMotionBlur13(state, frame());
+}
+
+void BM_Augment_motionBlur13F32(benchmark::State& state)
+{
+    timeMotionBlur13(state, floatFrame());
+}
+
+void timeScale103(benchmark::State& state, const Mat& input)
 {
     Mat out;
     uint64 seed = 0;
     for (auto _ : state) {
-        scaleMosaic(frame(), frameFormat(), kModel, 1.03, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out);
+        scaleMosaic(input, frameFormat(), kModel, 1.03, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out);
         benchmark::DoNotOptimize(out.data);
     }
-    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(input.total()));
 }
 
-void BM_Augment_randomScene(benchmark::State& state)
+void BM_Augment_scale103(benchmark::State& state)
+{
+    timeScale103(state, frame());
+}
+
+void BM_Augment_scale103F32(benchmark::State& state)
+{
+    timeScale103(state, floatFrame());
+}
+
+void timeRandomScene(benchmark::State& state, const Mat& input)
 {
     RandomScenePolicy policy;
     policy.blurProbability = 1; // the expensive case: every scene blurs
@@ -129,11 +177,21 @@ void BM_Augment_randomScene(benchmark::State& state)
     RawFormat f;
     uint64 seed = 0;
     for (auto _ : state) {
-        const Scene s = policy.draw(frame(), frameFormat(), ++seed);
-        applyScene(frame(), frameFormat(), kModel, s, seed, out, f);
+        const Scene s = policy.draw(input, frameFormat(), ++seed);
+        applyScene(input, frameFormat(), kModel, s, seed, out, f);
         benchmark::DoNotOptimize(out.data);
     }
-    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
+    state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(input.total()));
+}
+
+void BM_Augment_randomScene(benchmark::State& state)
+{
+    timeRandomScene(state, frame());
+}
+
+void BM_Augment_randomSceneF32(benchmark::State& state)
+{
+    timeRandomScene(state, floatFrame());
 }
 
 void BM_Augment_standardNormals(benchmark::State& state)
@@ -285,12 +343,17 @@ int main(int argc, char** argv)
     const std::pair<const char*, void (*)(benchmark::State&)> library[] = {
         {"BM_Augment_standardNormals", BM_Augment_standardNormals},
         {"BM_Augment_colorJitter", BM_Augment_colorJitter},
+        {"BM_Augment_colorJitterF32", BM_Augment_colorJitterF32},
         {"BM_Augment_colorJitterTukeyRead", BM_Augment_colorJitterTukeyRead},
         {"BM_Augment_colorJitterPoisson", BM_Augment_colorJitterPoisson},
+        {"BM_Augment_colorJitterPoissonF32", BM_Augment_colorJitterPoissonF32},
         {"BM_Augment_poissonDraws", BM_Augment_poissonDraws},
         {"BM_Augment_motionBlur13", BM_Augment_motionBlur13},
+        {"BM_Augment_motionBlur13F32", BM_Augment_motionBlur13F32},
         {"BM_Augment_scale103", BM_Augment_scale103},
-        {"BM_Augment_randomScene", BM_Augment_randomScene}};
+        {"BM_Augment_scale103F32", BM_Augment_scale103F32},
+        {"BM_Augment_randomScene", BM_Augment_randomScene},
+        {"BM_Augment_randomSceneF32", BM_Augment_randomSceneF32}};
     for (const auto& b : library)
         perf::registerOnEveryCpuPath(b.first, b.second);
     return perf::runRegisteredBenchmarks(argc, argv);

@@ -2,24 +2,44 @@
 // Noise options and the checks that every noise step of the augment topic shares.
 #include "augment_steps.hpp"
 
+#include <atomic>
+
 namespace cv {
 namespace rawgment {
 namespace detail {
 
-void checkMosaicInput(const Mat& src, const char* who)
+void checkMosaicType(const Mat& src, const char* who)
 {
     if (src.empty())
         CV_Error(Error::StsBadArg, format("%s: src is empty", who));
     if (src.type() != CV_16UC1 && src.type() != CV_32FC1)
         CV_Error(Error::StsBadArg, format("%s: src type %s is not supported; expected CV_16UC1 or CV_32FC1",
                                           who, typeToString(src.type()).c_str()));
-    if (src.type() == CV_32FC1 && !checkRange(src, true))
-        CV_Error(Error::StsBadArg, format("%s: src contains NaN or Inf", who));
+}
+
+void checkMosaicInput(const Mat& src, const char* who)
+{
+    checkMosaicType(src, who);
+    if (src.type() != CV_32FC1)
+        return;
+    std::atomic<bool> nonFinite{false};
+    parallel_for_(Range(0, src.rows), [&](const Range& rows) {
+        for (int r = rows.start; r < rows.end; ++r)
+            if (!rowIsFinite(src.ptr<float>(r), src.cols))
+                nonFinite = true;
+    });
+    if (nonFinite)
+        throwNonFiniteInput(who);
+}
+
+void throwNonFiniteInput(const char* who)
+{
+    CV_Error(Error::StsBadArg, format("%s: src contains NaN or Inf", who));
 }
 
 void checkResampleInput(const Mat& src, const RawFormat& format, const char* who)
 {
-    checkMosaicInput(src, who);
+    checkMosaicType(src, who);
     format.validate();
     if (src.rows % 2 || src.cols % 2)
         CV_Error(Error::StsBadArg,

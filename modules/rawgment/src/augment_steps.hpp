@@ -11,16 +11,41 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 namespace cv {
 namespace rawgment {
 namespace detail {
 
-//! Throws StsBadArg naming `who` unless src is a non-empty CV_16UC1 or finite CV_32FC1 mosaic.
+/* A float mosaic's values are checked where a step reads them anyway, row by row while the row is in cache
+ * (checkMosaicType() up front, rowIsFinite() in the rows, throwNonFiniteInput() after them): a separate pass
+ * over a 48 MB frame cost a float step more than its extra memory traffic. A path that reads no row whole (an
+ * identity step, a scene that only moves) checks with checkMosaicInput(). */
+
+//! Throws StsBadArg naming `who` unless src is a non-empty CV_16UC1 or CV_32FC1 mosaic; its values unread.
+void checkMosaicType(const Mat& src, const char* who);
+
+//! checkMosaicType(), then every value of a CV_32FC1 mosaic finite (rows in parallel).
 void checkMosaicInput(const Mat& src, const char* who);
 
-//! checkMosaicInput() plus the format and even sides: blur and scale resample each CFA plane, so they
+//! Whether n floats are all finite: one pass without an early exit, which the compiler vectorises.
+inline bool rowIsFinite(const float* p, int n)
+{
+    uint32_t nonFinite = 0;
+    for (int i = 0; i < n; ++i) {
+        uint32_t bits;
+        std::memcpy(&bits, p + i, sizeof(bits));
+        nonFinite |= static_cast<uint32_t>((bits & 0x7f800000u) == 0x7f800000u); // exponent all ones
+    }
+    return nonFinite == 0;
+}
+
+//! The error of a step whose float input held NaN or Inf (found by rowIsFinite()).
+[[noreturn]] void throwNonFiniteInput(const char* who);
+
+//! checkMosaicType() plus the format and even sides: blur and scale resample each CFA plane, so they
 //! need whole 2x2 blocks.
 void checkResampleInput(const Mat& src, const RawFormat& format, const char* who);
 
@@ -29,9 +54,11 @@ void checkResampleInput(const Mat& src, const RawFormat& format, const char* who
  * validating their model; applyScene() runs them all on one validated model. Same arguments and errors
  * as the public functions. */
 //! @{
+//! `valuesCheckedElsewhere`: a scene's other step checks the values, so an identity jitter need not.
 void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
                      const ColorJitter& jitter, const NoiseOptions& noise, uint64 seed, OutputArray dst,
-                     RawFormat& dstFormat, AugmentReport* report, OutputArray saturatedMask);
+                     RawFormat& dstFormat, AugmentReport* report, OutputArray saturatedMask,
+                     bool valuesCheckedElsewhere = false);
 void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
                     InputArray kernel, const NoiseOptions& noise, uint64 seed, OutputArray dst,
                     AugmentReport* report);

@@ -244,7 +244,7 @@ template <typename T>
 void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstants& k,
                 const JitterColumnTables& tables, const JitterKeys& keys,
                 const detail::DarkShading& inputShading, const Range& rows, std::atomic<int64>& brightening,
-                std::atomic<bool>& nonFinite)
+                std::atomic<bool>& nonFinite, std::atomic<bool>& nonFiniteInput)
 {
     const int cols = src.cols;
     const bool noise = k.alignment != NoiseAlignment::NONE;
@@ -255,6 +255,11 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstant
     PoissonRowBuffers poissonRows;
     int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
+        if (std::is_same<T, float>::value &&
+            !detail::rowIsFinite(reinterpret_cast<const float*>(src.ptr<T>(r)), cols)) {
+            nonFiniteInput = true;
+            continue;
+        }
         if (noise)
             detail::fillGaussian(keys.gaussian, static_cast<uint64_t>(r), z.data(), cols);
         if (tails) {
@@ -371,10 +376,11 @@ namespace detail {
 
 void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
                      const ColorJitter& jitter, const NoiseOptions& noise, uint64 seed, OutputArray _dst,
-                     RawFormat& dstFormat, AugmentReport* report, OutputArray saturatedMask)
+                     RawFormat& dstFormat, AugmentReport* report, OutputArray saturatedMask,
+                     bool valuesCheckedElsewhere)
 {
     const auto start = std::chrono::steady_clock::now();
-    checkMosaicInput(src, "colorJitter");
+    checkMosaicType(src, "colorJitter");
     format.validate();
     for (int s = 0; s < 4; ++s)
         checkFinitePositive(jitter.contrast[s], "colorJitter: contrast");
@@ -415,7 +421,9 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     }
 
     if (jitter.isIdentity()) {
-        // Skipped entirely: no copy, no random draw.
+        // Skipped entirely: no copy, no random draw; the values are checked, since no row reads them.
+        if (!valuesCheckedElsewhere)
+            checkMosaicInput(src, "colorJitter");
         reportSaturation(src, format, report, saturatedMask);
         _dst.assign(src);
         dstFormat = format;
@@ -464,17 +472,21 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     k.dark = jitterDarkTerms(step, jitter);
     Mat dst = stepOutput(src, _dst);
     std::atomic<int64> brightening{0};
-    std::atomic<bool> nonFinite{false};
+    std::atomic<bool> nonFinite{false}, nonFiniteInput{false};
     const JitterKeys keys = {
         stepKey(seed, RandomStream::JITTER_GAUSSIAN), stepKey(seed, RandomStream::JITTER_POISSON),
         stepKey(seed, RandomStream::JITTER_ROW), stepKey(seed, RandomStream::JITTER_TUKEY)};
     const JitterColumnTables tables(k, src.cols);
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
-            jitterRows<ushort>(src, prior, dst, k, tables, keys, inputShading, rows, brightening, nonFinite);
+            jitterRows<ushort>(src, prior, dst, k, tables, keys, inputShading, rows, brightening, nonFinite,
+                               nonFiniteInput);
         else
-            jitterRows<float>(src, prior, dst, k, tables, keys, inputShading, rows, brightening, nonFinite);
+            jitterRows<float>(src, prior, dst, k, tables, keys, inputShading, rows, brightening, nonFinite,
+                              nonFiniteInput);
     });
+    if (nonFiniteInput)
+        throwNonFiniteInput("colorJitter");
     if (nonFinite)
         throwNonFiniteShading("colorJitter");
     reportSaturation(src, format, report, saturatedMask);

@@ -207,7 +207,8 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
                 const size_t slot = static_cast<size_t>(si) % ringRows;
                 float* row = siteRing + slot * stride;
                 if (siteRingRow[slot] != si) {
-                    loadPlaneRow<T>(src, grid, site, si, rx, k.black[site], row, k.inputShading);
+                    if (!loadPlaneRow<T>(src, grid, site, si, rx, k.black[site], row, k.inputShading))
+                        *k.nonFiniteInput = true;
                     siteRingRow[slot] = si;
                 }
                 tapRows.push_back(row + t.dx);
@@ -263,6 +264,7 @@ void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNois
         normalisedKernel(_kernel, "motionBlur",
                          format.isMonochrome() ? 2 * MAX_MOTION_KERNEL_SIDE - 1 : MAX_MOTION_KERNEL_SIDE);
     if (w.total() == 1) {
+        checkMosaicInput(src, "motionBlur");
         _dst.assign(src);
         return;
     }
@@ -274,11 +276,14 @@ void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNois
             if (wk > 0)
                 taps.push_back({y, x, static_cast<float>(wk), static_cast<float>(wk * (1 - wk))});
         }
-    std::atomic<bool> nonFinite{false};
+    // Every source row is loaded whole: with any tap offset d, the clamped rows i + d of all output rows i
+    // are all the rows.
+    std::atomic<bool> nonFinite{false}, nonFiniteInput{false};
     ResampleConstants k = resampleConstants(src.depth(), format, step, seed, RandomStream::BLUR_GAUSSIAN,
                                             RandomStream::BLUR_POISSON);
     const float readFactor = static_cast<float>(1 - w.dot(w));
     k.nonFiniteShading = &nonFinite;
+    k.nonFiniteInput = &nonFiniteInput;
     if (step.hasDarkComponents()) {
         Mat w2 = w.mul(w);
         resampleDarkTerms(k, step, sum(w2)[0], w2.dot(w2), seed, RandomStream::BLUR_ROW,
@@ -292,6 +297,8 @@ void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNois
         else
             blurPlaneRows<float>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
     });
+    if (nonFiniteInput)
+        throwNonFiniteInput("motionBlur");
     if (nonFinite)
         throwNonFiniteShading("motionBlur");
     _dst.assign(dst);

@@ -380,10 +380,11 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
             std::vector<float>& mean = means[site % 2];
             const BilinearAxis& ax = cols[site % 2];
             const BilinearAxis& ay = rows[site / 2];
-            loadPlaneRow<T>(src, grid, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site], row0.data(),
-                            k.inputShading);
-            loadPlaneRow<T>(src, grid, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site], row1.data(),
-                            k.inputShading);
+            if (!loadPlaneRow<T>(src, grid, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site],
+                                 row0.data(), k.inputShading) ||
+                !loadPlaneRow<T>(src, grid, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site],
+                                 row1.data(), k.inputShading))
+                *k.nonFiniteInput = true;
             bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
                         ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
             const float fy = ay.f[static_cast<size_t>(i)];
@@ -409,6 +410,7 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     if (!std::isfinite(scale) || !(scale > 0))
         CV_Error(Error::StsBadArg, cv::format("scaleMosaic: scale must be finite and > 0 (got %g)", scale));
     if (scale == 1) {
+        checkMosaicInput(src, "scaleMosaic");
         _dst.assign(src);
         return;
     }
@@ -419,10 +421,11 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
                                   bilinearAxis(plane.width, phases - 1, scale, grid.step)};
     const BilinearAxis rows[2] = {bilinearAxis(plane.height, 0, scale, grid.step),
                                   bilinearAxis(plane.height, phases - 1, scale, grid.step)};
-    std::atomic<bool> nonFinite{false};
+    std::atomic<bool> nonFinite{false}, nonFiniteInput{false};
     ResampleConstants k = resampleConstants(src.depth(), format, step, seed, RandomStream::SCALE_GAUSSIAN,
                                             RandomStream::SCALE_POISSON);
     k.nonFiniteShading = &nonFinite;
+    k.nonFiniteInput = &nonFiniteInput;
     if (step.hasDarkComponents()) {
         // The typical weights: sum w^2 and sum w^4 of the bilinear taps averaged over the output pixels
         // (a product of the two axes' averages).
@@ -447,6 +450,20 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
         else
             scalePlaneRows<float>(src, dst, cols, rows, k, range);
     });
+    if (src.depth() == CV_32F) {
+        // A magnification reads no row near the top and bottom edges: those are checked here.
+        std::vector<uchar> loaded(static_cast<size_t>(src.rows), 0);
+        for (int p = 0; p < phases; ++p)
+            for (int i = 0; i < plane.height; ++i)
+                for (const int planeRow :
+                     {rows[p].i0[static_cast<size_t>(i)], rows[p].i1[static_cast<size_t>(i)]})
+                    loaded[static_cast<size_t>(grid.step * planeRow + p)] = 1;
+        for (int r = 0; r < src.rows; ++r)
+            if (!loaded[static_cast<size_t>(r)] && !rowIsFinite(src.ptr<float>(r), src.cols))
+                nonFiniteInput = true;
+    }
+    if (nonFiniteInput)
+        throwNonFiniteInput("scaleMosaic");
     if (nonFinite)
         throwNonFiniteShading("scaleMosaic");
     _dst.assign(dst);

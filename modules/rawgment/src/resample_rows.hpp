@@ -48,6 +48,7 @@ struct ResampleConstants
     DarkShading inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out before the step
     uint64_t rowKey = 0, tukeyKey = 0;
     std::atomic<bool>* nonFiniteShading = nullptr; // set when a shading row held NaN or Inf
+    std::atomic<bool>* nonFiniteInput = nullptr;   // set when a float input row held NaN or Inf
 };
 
 // The buffers of a task's rows, sized once per task for plane rows of n pixels (whole blocks where a
@@ -78,9 +79,10 @@ void storeFrameRow(const float* values, float* d, int width);
 
 // Plane row `planeRow` of site `site`, black-subtracted (and without the input's dark shading when
 // `shading` is not empty), into out[0..pad + width + pad) with the plane's edge replicated `pad` columns
-// on each side.
+// on each side. Returns false when a float mosaic's values there are not all finite (the step's check of
+// its input: every step loads each site of each row it reads).
 template <typename T>
-void loadPlaneRow(const Mat& src, const PlaneGrid& grid, int site, int planeRow, int pad, float black,
+bool loadPlaneRow(const Mat& src, const PlaneGrid& grid, int site, int planeRow, int pad, float black,
                   float* out, const DarkShading& shading = DarkShading())
 {
     const int width = src.cols / grid.step;
@@ -92,6 +94,8 @@ void loadPlaneRow(const Mat& src, const PlaneGrid& grid, int site, int planeRow,
         for (int j = 0; j < width; ++j)
             out[pad + j] = static_cast<float>(in[j]) - black;
     }
+    // The black level is finite, so the values less it are finite exactly where the values are.
+    const bool finite = !std::is_same<T, float>::value || rowIsFinite(out + pad, width);
     if (!shading.empty()) {
         const float *bd = shading.perGainRow(r) + site % 2, *br = shading.offsetRow(r) + site % 2;
         for (int j = 0; j < width; ++j)
@@ -101,6 +105,7 @@ void loadPlaneRow(const Mat& src, const PlaneGrid& grid, int site, int planeRow,
         out[j] = out[pad];
         out[pad + width + j] = out[pad + width - 1];
     }
+    return finite;
 }
 
 // The end of every resampled row: its noise streams (site, row), the noise, the dark terms, the black

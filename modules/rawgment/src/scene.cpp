@@ -136,9 +136,14 @@ void shiftMosaic(const Mat& src, Point shift, int gridStep, Mat& dst)
     dst.create(src.size(), src.type());
     const ShiftSource from(src.size(), shift, gridStep);
     const size_t esz = src.elemSize();
+    const bool checkValues = src.depth() == CV_32F;
+    std::atomic<bool> nonFinite{false};
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         for (int r = rows.start; r < rows.end; ++r) {
             const uchar* s = src.ptr(from.row(r));
+            // The shift is the scene's first step: it checks each source row whole, while it is in cache.
+            if (checkValues && !detail::rowIsFinite(reinterpret_cast<const float*>(s), src.cols))
+                nonFinite = true;
             uchar* d = dst.ptr(r);
             for (int c = 0; c < from.first; ++c)
                 std::memcpy(d + c * esz, s + from.column(c) * esz, esz);
@@ -149,6 +154,17 @@ void shiftMosaic(const Mat& src, Point shift, int gridStep, Mat& dst)
                 std::memcpy(d + c * esz, s + from.column(c) * esz, esz);
         }
     });
+    if (checkValues) {
+        // The rows the shift moved out of the frame, which no output row read.
+        std::vector<uchar> read(static_cast<size_t>(src.rows), 0);
+        for (int r = 0; r < src.rows; ++r)
+            read[static_cast<size_t>(from.row(r))] = 1;
+        for (int r = 0; r < src.rows; ++r)
+            if (!read[static_cast<size_t>(r)] && !detail::rowIsFinite(src.ptr<float>(r), src.cols))
+                nonFinite = true;
+    }
+    if (nonFinite)
+        detail::throwNonFiniteInput("applyScene");
 }
 
 /* The sensor's dark shading S stays where the sensor has it: the shifted content carries the input's S
@@ -197,7 +213,8 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
                 std::vector<Rect>* boxes)
 {
     Mat current = detail::twoDimensional(_src, "applyScene: src");
-    detail::checkMosaicInput(current, "applyScene");
+    // Its first step checks a float mosaic's values as it reads them (augment_steps.hpp).
+    detail::checkMosaicType(current, "applyScene");
     format.validate();
     const detail::ValidatedNoiseModel valid(model); // once for every step of the scene
     if (current.rows % 2 || current.cols % 2)
@@ -247,8 +264,10 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
             for (Rect& b : *boxes)
                 b = scaleBox(b, current.size(), scene.scale);
     }
-    detail::colorJitterStep(current, fmt, valid, scene.jitter, scene.noise, seed, current, fmt, report,
-                            noArray());
+    // The shift, the scale or the blur reads every value: an identity jitter then need not check them.
+    detail::colorJitterStep(
+        current, fmt, valid, scene.jitter, scene.noise, seed, current, fmt, report, noArray(),
+        shift != Point(0, 0) || scene.scale != 1 || !isIdentityKernel(scene.motionKernel));
     if (!isIdentityKernel(scene.motionKernel))
         detail::motionBlurStep(current, fmt, valid, scene.motionKernel, scene.noise, seed, current, report);
     _dst.assign(current);
@@ -288,14 +307,23 @@ template <typename T> double minimumAboveBlackOf(const Mat& src, const RawFormat
     std::mutex mutex;
     T lowest[4];
     std::fill(lowest, lowest + 4, std::numeric_limits<T>::max());
+    std::atomic<bool> nonFinite{false};
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         T local[4];
         std::fill(local, local + 4, std::numeric_limits<T>::max());
-        siteMinima(src, rows, local);
+        for (int r = rows.start; r < rows.end; ++r) {
+            siteMinima(src, Range(r, r + 1), local);
+            // The values' check, on the row this pass has just read (in cache, a second look costs little).
+            if (std::is_same<T, float>::value &&
+                !detail::rowIsFinite(reinterpret_cast<const float*>(src.ptr<T>(r)), src.cols))
+                nonFinite = true;
+        }
         const std::lock_guard<std::mutex> lock(mutex);
         for (int i = 0; i < 4; ++i)
             lowest[i] = std::min(lowest[i], local[i]);
     });
+    if (nonFinite)
+        detail::throwNonFiniteInput("RandomScenePolicy::draw");
     double result = std::numeric_limits<double>::infinity();
     for (int i = 0; i < 4; ++i)
         if (i / 2 < src.rows && i % 2 < src.cols) // a site the frame has
@@ -369,7 +397,7 @@ Scene RandomScenePolicy::draw(InputArray _src, const RawFormat& format, uint64 s
     validate();
     format.validate();
     const Mat src = detail::twoDimensional(_src, "RandomScenePolicy::draw: src");
-    detail::checkMosaicInput(src, "RandomScenePolicy::draw");
+    detail::checkMosaicType(src, "RandomScenePolicy::draw"); // the values: minimumAboveBlack()
     const double minX = minimumAboveBlack(src, format);
     detail::CounterRng rng(detail::stepKey(seed, detail::RandomStream::POLICY_DRAW), 0);
     const auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * rng.uniform(); };

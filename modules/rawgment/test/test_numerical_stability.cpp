@@ -216,6 +216,58 @@ Vec2d burstStatisticsErrorsAtLargeMean(const RawFormat& fmt, int depth, int grou
     return worst;
 }
 
+// A float mosaic's values are checked where the steps read them (augment_steps.hpp): one NaN or Inf anywhere
+// must still be an error on every path, at the corners and in the rows a magnification or a shift reads
+// no longer, on Bayer and monochrome frames alike.
+TEST(NumericalStability, oneNonFiniteValueAnywhereIsAnErrorOfEveryStep)
+{
+    const NoiseModel model(0.4, 0.5, 2.0);
+    NoiseOptions poisson;
+    poisson.shotSampling = ShotNoiseSampling::POISSON;
+    const Size size(40, 32);
+    const Point places[] = {Point(0, 0), Point(39, 31), Point(17, 0), Point(3, 31), Point(21, 15)};
+    for (CfaPattern pattern : {CFA_RGGB, CFA_MONO}) {
+        RawFormat fmt;
+        fmt.pattern = pattern;
+        fmt.blackLevel = Vec4d::all(64);
+        fmt.whiteLevel = 4095;
+        for (float bad : {std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::infinity()})
+            for (const Point at : places) {
+                Mat src(size, CV_32FC1, Scalar(900));
+                src.at<float>(at) = bad;
+                SCOPED_TRACE(
+                    cv::format("%s, %g at (%d, %d)", cfaPatternName(pattern).c_str(), bad, at.x, at.y));
+                Mat out;
+                RawFormat f;
+                const ColorJitter darker = ColorJitter::exposureChange(0.5, 2);
+                EXPECT_CV_ERROR_CONTAINS(colorJitter(src, fmt, model, darker, NoiseOptions(), 1, out, f),
+                                         "NaN or Inf");
+                EXPECT_CV_ERROR_CONTAINS(colorJitter(src, fmt, model, darker, poisson, 1, out, f),
+                                         "NaN or Inf");
+                EXPECT_CV_ERROR_CONTAINS(
+                    colorJitter(src, fmt, model, ColorJitter(), NoiseOptions(), 1, out, f), "NaN or Inf");
+                EXPECT_CV_ERROR_CONTAINS(
+                    motionBlur(src, fmt, model, linearMotionKernel(9, 30, pattern), NoiseOptions(), 1, out),
+                    "NaN or Inf");
+                EXPECT_CV_ERROR_CONTAINS(
+                    motionBlur(src, fmt, model, Mat::ones(1, 1, CV_32F), NoiseOptions(), 1, out),
+                    "NaN or Inf");
+                for (double scale : {1.3, 0.8, 1.0}) {
+                    SCOPED_TRACE(cv::format("scale %g", scale));
+                    EXPECT_CV_ERROR_CONTAINS(scaleMosaic(src, fmt, model, scale, NoiseOptions(), 1, out),
+                                             "NaN or Inf");
+                }
+                Scene moved;
+                moved.shift = Point(12, -10);
+                Scene blurred;
+                blurred.motionKernel = linearMotionKernel(9, 0, pattern);
+                for (const Scene& scene : {Scene(), moved, blurred})
+                    EXPECT_CV_ERROR_CONTAINS(applyScene(src, fmt, model, scene, 1, out, f), "NaN or Inf");
+                EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy().draw(src, fmt, 1), "NaN or Inf");
+            }
+    }
+}
+
 TEST(NumericalStability, burstStatisticsAreExactForLargeMeansAndAnyFrameCount)
 {
     RawFormat fmt;
