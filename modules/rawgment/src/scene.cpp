@@ -134,6 +134,7 @@ void shiftMosaic(const Mat& src, Point shift, int gridStep, Mat& dst)
 {
     CV_Assert(shift.x % gridStep == 0 && shift.y % gridStep == 0 && src.rows % 2 == 0 && src.cols % 2 == 0);
     dst.create(src.size(), src.type());
+    detail::adviseHugePages(dst);
     const ShiftSource from(src.size(), shift, gridStep);
     const size_t esz = src.elemSize();
     const bool checkValues = src.depth() == CV_32F;
@@ -239,10 +240,22 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
     const Point shift = gridStep == 1
                             ? scene.shift
                             : Point(2 * cvRound(scene.shift.x / 2.0), 2 * cvRound(scene.shift.y / 2.0));
+    // The steps write into two buffers in turn, the last into the caller's dst when it is a Mat to reuse (as
+    // a single step's dst is): a new 48 MB float frame per step cost more in page faults than the step itself
+    // (glibc maps blocks over 32 MB afresh on every allocation). The first step reads the caller's src, which
+    // no step writes (stepOutput() gives a new Mat for a dst that overlaps it).
+    const bool jitters = !scene.jitter.isIdentity(), blurs = !isIdentityKernel(scene.motionKernel);
+    int stepsLeft = (shift != Point(0, 0)) + (scene.scale != 1) + jitters + blurs;
+    Mat buffers[2];
+    if (_dst.kind() == _InputArray::MAT)
+        buffers[0] = _dst.getMat();
+    const auto nextBuffer = [&]() -> Mat& { return buffers[--stepsLeft % 2]; };
     if (shift != Point(0, 0)) {
         const auto start = std::chrono::steady_clock::now();
-        // Into a new Mat: `current` still shares the caller's data, which must never be written.
-        Mat shifted;
+        Mat& shifted = nextBuffer();
+        const bool overlaps = shifted.datastart < current.dataend && current.datastart < shifted.dataend;
+        if (overlaps || shifted.size() != current.size() || shifted.type() != current.type())
+            shifted = Mat(); // never into the caller's src
         shiftMosaic(current, shift, gridStep, shifted);
         // The dark shading belongs to the sensor, not to the content: it must not move with the shift.
         const detail::StepNoise step(valid, fmt, scene.noise, 1, current.size(), "applyScene");
@@ -259,17 +272,24 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
         detail::recordStep(report, "shift", start);
     }
     if (scene.scale != 1) {
-        detail::scaleMosaicStep(current, fmt, valid, scene.scale, scene.noise, seed, current, report);
+        Mat& scaled = nextBuffer();
+        detail::scaleMosaicStep(current, fmt, valid, scene.scale, scene.noise, seed, scaled, report);
+        current = scaled;
         if (boxes)
             for (Rect& b : *boxes)
                 b = scaleBox(b, current.size(), scene.scale);
     }
     // The shift, the scale or the blur reads every value: an identity jitter then need not check them.
-    detail::colorJitterStep(
-        current, fmt, valid, scene.jitter, scene.noise, seed, current, fmt, report, noArray(),
-        shift != Point(0, 0) || scene.scale != 1 || !isIdentityKernel(scene.motionKernel));
-    if (!isIdentityKernel(scene.motionKernel))
-        detail::motionBlurStep(current, fmt, valid, scene.motionKernel, scene.noise, seed, current, report);
+    Mat unchanged;
+    Mat& jittered = jitters ? nextBuffer() : unchanged;
+    detail::colorJitterStep(current, fmt, valid, scene.jitter, scene.noise, seed, jittered, fmt, report,
+                            noArray(), shift != Point(0, 0) || scene.scale != 1 || blurs);
+    current = jittered;
+    if (blurs) {
+        Mat& blurred = nextBuffer();
+        detail::motionBlurStep(current, fmt, valid, scene.motionKernel, scene.noise, seed, blurred, report);
+        current = blurred;
+    }
     _dst.assign(current);
     dstFormat = fmt;
 }
@@ -277,23 +297,21 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
 namespace {
 
 // The smallest value of each CFA site (index cfaSite(row, col) of a 2x2 block), rows split among
-// threads. A row is read in blocks of 16 values whose lane i always holds column parity i % 2, so the
-// lane-wise minima vectorise on every path; the row's tail, fewer than 16 values, goes one by one.
+// threads. A row is read in blocks of 16 values whose element i always holds column parity i % 2: a plain
+// array the compiler vectorises (pminuw, minps). A vector type of 32 bytes in this baseline-compiled file was
+// taken apart lane by lane through the stack, at 2 GB/s. The row's tail, fewer than 16 values, goes one by
+// one.
 template <typename T> void siteMinima(const Mat& src, const Range& rows, T lowest[4])
 {
-    typedef RAWGMENT_VECTOR(T, 16 * sizeof(T)) Block;
     for (int r = rows.start; r < rows.end; ++r) {
         const T* p = src.ptr<T>(r);
         T* lo = lowest + 2 * (r & 1);
-        Block acc;
-        for (int i = 0; i < 16; ++i)
-            acc[i] = std::numeric_limits<T>::max();
+        T acc[16];
+        std::fill(acc, acc + 16, std::numeric_limits<T>::max());
         int c = 0;
-        for (; c + 16 <= src.cols; c += 16) {
-            Block v;
-            std::memcpy(&v, p + c, sizeof(v));
-            acc = detail::minLanes(acc, v);
-        }
+        for (; c + 16 <= src.cols; c += 16)
+            for (int i = 0; i < 16; ++i)
+                acc[i] = std::min(acc[i], p[c + i]);
         for (int i = 0; i < 16; ++i)
             lo[i & 1] = std::min(lo[i & 1], acc[i]);
         for (; c < src.cols; ++c)
