@@ -368,7 +368,27 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
 {
     const PlaneGrid& grid = k.grid;
     const int pw = src.cols / grid.step;
-    std::vector<float> row0(static_cast<size_t>(pw)), row1(static_cast<size_t>(pw));
+    // Two loaded plane rows per site, kept from one output row to the next: a scale near 1 reads the row
+    // the previous output row read as its second, so most rows are loaded (converted, checked) once.
+    struct LoadedRow
+    {
+        int planeRow = -1;
+        std::vector<float> values;
+    };
+    std::vector<LoadedRow> loaded(static_cast<size_t>(2 * grid.sites));
+    for (LoadedRow& l : loaded)
+        l.values.resize(static_cast<size_t>(pw));
+    const auto rowOf = [&](int site, int planeRow, int keep) -> const float* {
+        LoadedRow* pair = &loaded[static_cast<size_t>(2 * site)];
+        for (int slot = 0; slot < 2; ++slot)
+            if (pair[slot].planeRow == planeRow)
+                return pair[slot].values.data();
+        LoadedRow& slot = pair[0].planeRow == keep ? pair[1] : pair[0];
+        if (!loadPlaneRow<T>(src, grid, site, planeRow, 0, k.black[site], slot.values.data(), k.inputShading))
+            *k.nonFiniteInput = true;
+        slot.planeRow = planeRow;
+        return slot.values.data();
+    };
     std::vector<float> means[2] = {std::vector<float>(detail::wholeBlocks(pw)),
                                    std::vector<float>(detail::wholeBlocks(pw))};
     std::vector<float> shot(detail::wholeBlocks(pw)), readFactor(detail::wholeBlocks(pw));
@@ -380,13 +400,11 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
             std::vector<float>& mean = means[site % 2];
             const BilinearAxis& ax = cols[site % 2];
             const BilinearAxis& ay = rows[site / 2];
-            if (!loadPlaneRow<T>(src, grid, site, ay.i0[static_cast<size_t>(i)], 0, k.black[site],
-                                 row0.data(), k.inputShading) ||
-                !loadPlaneRow<T>(src, grid, site, ay.i1[static_cast<size_t>(i)], 0, k.black[site],
-                                 row1.data(), k.inputShading))
-                *k.nonFiniteInput = true;
-            bilinearRow(row0.data(), row1.data(), ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(),
-                        ax.f.data(), mean.data(), shot.data(), readFactor.data(), pw);
+            const int i0 = ay.i0[static_cast<size_t>(i)], i1 = ay.i1[static_cast<size_t>(i)];
+            const float* row0 = rowOf(site, i0, i1);
+            const float* row1 = rowOf(site, i1, i0);
+            bilinearRow(row0, row1, ay.f[static_cast<size_t>(i)], ax.i0.data(), ax.i1.data(), ax.f.data(),
+                        mean.data(), shot.data(), readFactor.data(), pw);
             const float fy = ay.f[static_cast<size_t>(i)];
             finishPlaneRow(mean, shot.data(), readFactor.data(), scratch, k, pw, site, i,
                            (1 - fy) * (1 - fy) + fy * fy);
