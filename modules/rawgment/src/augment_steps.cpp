@@ -1,12 +1,32 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Noise options and the checks that every noise step of the augment topic shares.
 #include "augment_steps.hpp"
+#include "cpu_dispatch.hpp"
 
 #include <atomic>
+#include <cstdint>
+#include <cstring>
 
 namespace cv {
 namespace rawgment {
 namespace detail {
+
+namespace {
+
+RAWGMENT_KERNEL bool rowIsFiniteKernel(const float* p, int n)
+{
+    uint32_t nonFinite = 0;
+    for (int i = 0; i < n; ++i) {
+        uint32_t bits;
+        std::memcpy(&bits, p + i, sizeof(bits));
+        nonFinite |= static_cast<uint32_t>((bits & 0x7f800000u) == 0x7f800000u); // exponent all ones
+    }
+    return nonFinite == 0;
+}
+
+} // namespace
+
+RAWGMENT_DISPATCHED(bool, rowIsFinite, (const float* p, int n), (p, n))
 
 void checkMosaicType(const Mat& src, const char* who)
 {
