@@ -45,16 +45,18 @@ void checkResampleInput(const Mat& src, const RawFormat& format, const char* who
  * validating their model; applyScene() runs them all on one validated model. Same arguments and errors
  * as the public functions. */
 //! @{
-//! `valuesCheckedElsewhere`: a scene's other step checks the values, so an identity jitter need not.
+//! `valuesChecked`: another step of a scene checks (or checked) src's values, so this one need not: the
+//! output of a step is finite, and a scene's first step reads every value of its input.
 void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
                      const ColorJitter& jitter, const NoiseOptions& noise, uint64 seed, OutputArray dst,
                      RawFormat& dstFormat, AugmentReport* report, OutputArray saturatedMask,
-                     bool valuesCheckedElsewhere = false);
+                     bool valuesChecked = false);
 void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
                     InputArray kernel, const NoiseOptions& noise, uint64 seed, OutputArray dst,
-                    AugmentReport* report);
+                    AugmentReport* report, bool valuesChecked = false);
 void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model, double scale,
-                     const NoiseOptions& noise, uint64 seed, OutputArray dst, AugmentReport* report);
+                     const NoiseOptions& noise, uint64 seed, OutputArray dst, AugmentReport* report,
+                     bool valuesChecked = false);
 //! @}
 
 //! Counts or masks saturated input pixels, only when the caller asks: the hot loops do not pay for it.

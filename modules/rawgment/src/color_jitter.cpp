@@ -244,7 +244,7 @@ template <typename T>
 void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstants& k,
                 const JitterColumnTables& tables, const JitterKeys& keys,
                 const detail::DarkShading& inputShading, const Range& rows, std::atomic<int64>& brightening,
-                std::atomic<bool>& nonFinite, std::atomic<bool>& nonFiniteInput)
+                std::atomic<bool>& nonFinite, std::atomic<bool>* nonFiniteInput)
 {
     const int cols = src.cols;
     const bool noise = k.alignment != NoiseAlignment::NONE;
@@ -255,9 +255,9 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstant
     PoissonRowBuffers poissonRows;
     int64 localBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
-        if (std::is_same<T, float>::value &&
+        if (std::is_same<T, float>::value && nonFiniteInput &&
             !detail::rowIsFinite(reinterpret_cast<const float*>(src.ptr<T>(r)), cols)) {
-            nonFiniteInput = true;
+            *nonFiniteInput = true;
             continue;
         }
         if (noise)
@@ -377,7 +377,7 @@ namespace detail {
 void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
                      const ColorJitter& jitter, const NoiseOptions& noise, uint64 seed, OutputArray _dst,
                      RawFormat& dstFormat, AugmentReport* report, OutputArray saturatedMask,
-                     bool valuesCheckedElsewhere)
+                     bool valuesChecked)
 {
     const auto start = std::chrono::steady_clock::now();
     checkMosaicType(src, "colorJitter");
@@ -422,7 +422,7 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
 
     if (jitter.isIdentity()) {
         // Skipped entirely: no copy, no random draw; the values are checked, since no row reads them.
-        if (!valuesCheckedElsewhere)
+        if (!valuesChecked)
             checkMosaicInput(src, "colorJitter");
         reportSaturation(src, format, report, saturatedMask);
         _dst.assign(src);
@@ -480,10 +480,10 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
             jitterRows<ushort>(src, prior, dst, k, tables, keys, inputShading, rows, brightening, nonFinite,
-                               nonFiniteInput);
+                               nullptr);
         else
             jitterRows<float>(src, prior, dst, k, tables, keys, inputShading, rows, brightening, nonFinite,
-                              nonFiniteInput);
+                              valuesChecked ? nullptr : &nonFiniteInput);
     });
     if (nonFiniteInput)
         throwNonFiniteInput("colorJitter");

@@ -252,10 +252,11 @@ std::vector<uint32_t> checkDngImage(const String& path, const RawImage& image)
     if (!image.noiseProfile.empty())
         detail::checkDngNoiseProfile(image.noiseProfile, ("writeDng: '" + path + "': noiseProfile").c_str());
     if (image.format.isMonochrome() && image.noiseProfile.size() > 1)
-        CV_Error(Error::StsBadArg,
-                 format("writeDng: '%s': %d noise profile pairs for a monochrome frame; its one colour plane has "
-                        "one (S, O) pair",
-                        path.c_str(), static_cast<int>(image.noiseProfile.size())));
+        CV_Error(
+            Error::StsBadArg,
+            format("writeDng: '%s': %d noise profile pairs for a monochrome frame; its one colour plane has "
+                   "one (S, O) pair",
+                   path.c_str(), static_cast<int>(image.noiseProfile.size())));
 
     return blacks;
 }

@@ -207,7 +207,8 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
                 const size_t slot = static_cast<size_t>(si) % ringRows;
                 float* row = siteRing + slot * stride;
                 if (siteRingRow[slot] != si) {
-                    if (!loadPlaneRow<T>(src, grid, site, si, rx, k.black[site], row, k.inputShading))
+                    if (!loadPlaneRow<T>(src, grid, site, si, rx, k.black[site], row, k.inputShading,
+                                         k.nonFiniteInput != nullptr))
                         *k.nonFiniteInput = true;
                     siteRingRow[slot] = si;
                 }
@@ -255,7 +256,7 @@ namespace detail {
 
 void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
                     InputArray _kernel, const NoiseOptions& noise, uint64 seed, OutputArray _dst,
-                    AugmentReport* report)
+                    AugmentReport* report, bool valuesChecked)
 {
     const auto start = std::chrono::steady_clock::now();
     checkResampleInput(src, format, "motionBlur");
@@ -264,7 +265,8 @@ void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNois
         normalisedKernel(_kernel, "motionBlur",
                          format.isMonochrome() ? 2 * MAX_MOTION_KERNEL_SIDE - 1 : MAX_MOTION_KERNEL_SIDE);
     if (w.total() == 1) {
-        checkMosaicInput(src, "motionBlur");
+        if (!valuesChecked)
+            checkMosaicInput(src, "motionBlur");
         _dst.assign(src);
         return;
     }
@@ -283,7 +285,7 @@ void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNois
                                             RandomStream::BLUR_POISSON);
     const float readFactor = static_cast<float>(1 - w.dot(w));
     k.nonFiniteShading = &nonFinite;
-    k.nonFiniteInput = &nonFiniteInput;
+    k.nonFiniteInput = valuesChecked ? nullptr : &nonFiniteInput;
     if (step.hasDarkComponents()) {
         Mat w2 = w.mul(w);
         resampleDarkTerms(k, step, sum(w2)[0], w2.dot(w2), seed, RandomStream::BLUR_ROW,

@@ -384,7 +384,8 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
             if (pair[slot].planeRow == planeRow)
                 return pair[slot].values.data();
         LoadedRow& slot = pair[0].planeRow == keep ? pair[1] : pair[0];
-        if (!loadPlaneRow<T>(src, grid, site, planeRow, 0, k.black[site], slot.values.data(), k.inputShading))
+        if (!loadPlaneRow<T>(src, grid, site, planeRow, 0, k.black[site], slot.values.data(), k.inputShading,
+                             k.nonFiniteInput != nullptr))
             *k.nonFiniteInput = true;
         slot.planeRow = planeRow;
         return slot.values.data();
@@ -420,7 +421,8 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
 namespace detail {
 
 void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model, double scale,
-                     const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report)
+                     const NoiseOptions& noise, uint64 seed, OutputArray _dst, AugmentReport* report,
+                     bool valuesChecked)
 {
     const auto start = std::chrono::steady_clock::now();
     checkResampleInput(src, format, "scaleMosaic");
@@ -428,7 +430,8 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     if (!std::isfinite(scale) || !(scale > 0))
         CV_Error(Error::StsBadArg, cv::format("scaleMosaic: scale must be finite and > 0 (got %g)", scale));
     if (scale == 1) {
-        checkMosaicInput(src, "scaleMosaic");
+        if (!valuesChecked)
+            checkMosaicInput(src, "scaleMosaic");
         _dst.assign(src);
         return;
     }
@@ -443,7 +446,7 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     ResampleConstants k = resampleConstants(src.depth(), format, step, seed, RandomStream::SCALE_GAUSSIAN,
                                             RandomStream::SCALE_POISSON);
     k.nonFiniteShading = &nonFinite;
-    k.nonFiniteInput = &nonFiniteInput;
+    k.nonFiniteInput = valuesChecked ? nullptr : &nonFiniteInput;
     if (step.hasDarkComponents()) {
         // The typical weights: sum w^2 and sum w^4 of the bilinear taps averaged over the output pixels
         // (a product of the two axes' averages).
@@ -468,7 +471,7 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
         else
             scalePlaneRows<float>(src, dst, cols, rows, k, range);
     });
-    if (src.depth() == CV_32F) {
+    if (src.depth() == CV_32F && !valuesChecked) {
         // A magnification reads no row near the top and bottom edges: those are checked here.
         std::vector<uchar> loaded(static_cast<size_t>(src.rows), 0);
         for (int p = 0; p < phases; ++p)

@@ -48,7 +48,8 @@ struct ResampleConstants
     DarkShading inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out before the step
     uint64_t rowKey = 0, tukeyKey = 0;
     std::atomic<bool>* nonFiniteShading = nullptr; // set when a shading row held NaN or Inf
-    std::atomic<bool>* nonFiniteInput = nullptr;   // set when a float input row held NaN or Inf
+    std::atomic<bool>* nonFiniteInput =
+        nullptr; // set when a float input row held NaN or Inf; null: unchecked
 };
 
 // The buffers of a task's rows, sized once per task for plane rows of n pixels (whole blocks where a
@@ -83,7 +84,7 @@ void storeFrameRow(const float* values, float* d, int width);
 // its input: every step loads each site of each row it reads).
 template <typename T>
 bool loadPlaneRow(const Mat& src, const PlaneGrid& grid, int site, int planeRow, int pad, float black,
-                  float* out, const DarkShading& shading = DarkShading())
+                  float* out, const DarkShading& shading, bool checkValues)
 {
     const int width = src.cols / grid.step;
     const int r = grid.mosaicRow(site, planeRow);
@@ -95,7 +96,7 @@ bool loadPlaneRow(const Mat& src, const PlaneGrid& grid, int site, int planeRow,
             out[pad + j] = static_cast<float>(in[j]) - black;
     }
     // The black level is finite, so the values less it are finite exactly where the values are.
-    const bool finite = !std::is_same<T, float>::value || rowIsFinite(out + pad, width);
+    const bool finite = !checkValues || !std::is_same<T, float>::value || rowIsFinite(out + pad, width);
     if (!shading.empty()) {
         const float *bd = shading.perGainRow(r) + site % 2, *br = shading.offsetRow(r) + site % 2;
         for (int j = 0; j < width; ++j)

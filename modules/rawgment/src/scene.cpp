@@ -271,23 +271,27 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
                 b = (b + shift) & Rect(0, 0, current.cols, current.rows);
         detail::recordStep(report, "shift", start);
     }
+    // The first step that runs checks the input's values as it reads them all; its output, finite, is what
+    // the later steps read, unchecked.
+    const bool shifted = shift != Point(0, 0);
     if (scene.scale != 1) {
         Mat& scaled = nextBuffer();
-        detail::scaleMosaicStep(current, fmt, valid, scene.scale, scene.noise, seed, scaled, report);
+        detail::scaleMosaicStep(current, fmt, valid, scene.scale, scene.noise, seed, scaled, report, shifted);
         current = scaled;
         if (boxes)
             for (Rect& b : *boxes)
                 b = scaleBox(b, current.size(), scene.scale);
     }
-    // The shift, the scale or the blur reads every value: an identity jitter then need not check them.
+    // An identity jitter reads nothing: the blur after it checks then.
     Mat unchanged;
     Mat& jittered = jitters ? nextBuffer() : unchanged;
     detail::colorJitterStep(current, fmt, valid, scene.jitter, scene.noise, seed, jittered, fmt, report,
-                            noArray(), shift != Point(0, 0) || scene.scale != 1 || blurs);
+                            noArray(), shifted || scene.scale != 1 || (!jitters && blurs));
     current = jittered;
     if (blurs) {
         Mat& blurred = nextBuffer();
-        detail::motionBlurStep(current, fmt, valid, scene.motionKernel, scene.noise, seed, blurred, report);
+        detail::motionBlurStep(current, fmt, valid, scene.motionKernel, scene.noise, seed, blurred, report,
+                               shifted || scene.scale != 1 || jitters);
         current = blurred;
     }
     _dst.assign(current);
