@@ -14,6 +14,27 @@ namespace {
 
 using namespace rawgment_app_tests;
 
+//! The rows of rawgment_validate's validation.csv after its header, each its 11 numbers (factor, mean bounds,
+//! mean, pixels, the real and the three augmented variances, the bright burst's mean and variance).
+std::vector<std::vector<double>> validationRows(const std::string& path)
+{
+    std::istringstream csv(readText(path));
+    std::string line;
+    std::getline(csv, line);
+    std::vector<std::vector<double>> rows;
+    while (std::getline(csv, line)) {
+        std::vector<double> v;
+        std::stringstream cells(line);
+        std::string cell;
+        while (std::getline(cells, cell, ','))
+            v.push_back(std::stod(cell));
+        EXPECT_EQ(11u, v.size()) << line;
+        v.resize(11);
+        rows.push_back(v);
+    }
+    return rows;
+}
+
 TEST(Apps, validateRefusesFramesOfAnotherSizeNamingTheFiles)
 {
     // Target frames smaller than the bright ones were read out of bounds (ASan: heap-buffer-overflow).
@@ -110,18 +131,9 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
                                         "/cal/noise_model.yml' --out='" + dir + "/val'");
     ASSERT_EQ(0, r.status) << r.output;
     expectPngDecodes(dir + "/val/validation.png");
-    std::istringstream csv(readText(dir + "/val/validation.csv"));
-    std::string line;
-    std::getline(csv, line);
     double real = 0, none = 0, ignore = 0, account = 0;
     int rows = 0;
-    while (std::getline(csv, line)) {
-        std::vector<double> v;
-        std::stringstream cells(line);
-        std::string cell;
-        while (std::getline(cells, cell, ','))
-            v.push_back(std::stod(cell));
-        ASSERT_EQ(11u, v.size()) << line;
+    for (const std::vector<double>& v : validationRows(dir + "/val/validation.csv")) {
         if (v[0] != 0.5)
             continue;
         real += v[5];
@@ -187,17 +199,8 @@ TEST(Apps, aMonochromeSensorGoesFromSimulationToAugmentation)
     r = runApp("rawgment_validate", "'" + dir + "/sim/validation_manifest.yml' --model='" + dir +
                                         "/cal/noise_model.yml' --plots=false --out='" + dir + "/val'");
     ASSERT_EQ(0, r.status) << r.output;
-    std::istringstream csv(readText(dir + "/val/validation.csv"));
-    std::string line;
-    std::getline(csv, line);
     double real = 0, none = 0, ignore = 0, account = 0;
-    while (std::getline(csv, line)) {
-        std::vector<double> v;
-        std::stringstream cells(line);
-        std::string cell;
-        while (std::getline(cells, cell, ','))
-            v.push_back(std::stod(cell));
-        ASSERT_EQ(11u, v.size()) << line;
+    for (const std::vector<double>& v : validationRows(dir + "/val/validation.csv")) {
         real += v[5];
         none += v[6];
         ignore += v[7];
