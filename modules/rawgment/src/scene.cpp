@@ -247,15 +247,17 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
     const bool jitters = !scene.jitter.isIdentity(), blurs = !isIdentityKernel(scene.motionKernel);
     int stepsLeft = (shift != Point(0, 0)) + (scene.scale != 1) + jitters + blurs;
     Mat buffers[2];
-    if (_dst.kind() == _InputArray::MAT)
-        buffers[0] = _dst.getMat();
+    if (_dst.kind() == _InputArray::MAT) {
+        const Mat given = _dst.getMat();
+        // Never the caller's src (an in-place call, dst = src): a later step would write into it.
+        const bool overlaps = given.datastart < current.dataend && current.datastart < given.dataend;
+        if (!overlaps && given.size() == current.size() && given.type() == current.type())
+            buffers[0] = given;
+    }
     const auto nextBuffer = [&]() -> Mat& { return buffers[--stepsLeft % 2]; };
     if (shift != Point(0, 0)) {
         const auto start = std::chrono::steady_clock::now();
         Mat& shifted = nextBuffer();
-        const bool overlaps = shifted.datastart < current.dataend && current.datastart < shifted.dataend;
-        if (overlaps || shifted.size() != current.size() || shifted.type() != current.type())
-            shifted = Mat(); // never into the caller's src
         shiftMosaic(current, shift, gridStep, shifted);
         // The dark shading belongs to the sensor, not to the content: it must not move with the shift.
         const detail::StepNoise step(valid, fmt, scene.noise, 1, current.size(), "applyScene");

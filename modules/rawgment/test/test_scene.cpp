@@ -388,7 +388,17 @@ TEST(Augment, stepsWriteIntoTheCallersBufferButNeverIntoTheirInput)
         {"motionBlur",
          [&](const Mat& in, Mat& out) { motionBlur(in, fmt, model, kernel, NoiseOptions(), 3, out); }},
         {"scaleMosaic",
-         [&](const Mat& in, Mat& out) { scaleMosaic(in, fmt, model, 1.1, NoiseOptions(), 3, out); }}};
+         [&](const Mat& in, Mat& out) { scaleMosaic(in, fmt, model, 1.1, NoiseOptions(), 3, out); }},
+        // Four steps through two buffers in turn, the last the caller's.
+        {"applyScene", [&](const Mat& in, Mat& out) {
+             Scene all;
+             all.shift = Point(2, -2);
+             all.scale = 1.1;
+             all.jitter = ColorJitter::exposureChange(0.5, 2);
+             all.motionKernel = kernel;
+             RawFormat f;
+             applyScene(in, fmt, model, all, 3, out, f);
+         }}};
     for (const auto& step : steps) {
         Mat big(40, 48, CV_16UC1);
         randu(big, 300, 3000);
