@@ -42,8 +42,8 @@ public:
      *         CV_32F, which halves the state's memory (8 instead of 16 bytes per pixel) and its traffic.
      *         Each group is still merged in float64, so float32 only rounds the stored state: about
      *         1e-7 relative on the mean, whose rounding at each merge then enters M2 through the
-     *         merge's delta: at mean 60000 and variance 1 the variance errs by up to ~2e-3 relative
-     *         (rawgment_tradeoffs measures it), at ordinary means far less. */
+     *         merge's delta: at mean 60000 and variance 1 the variance errs by 0.00247 relative
+     *         (rawgment_tradeoffs measures it, docs/performance.md), at ordinary means far less. */
     explicit BurstStatistics(const RawFormat& format, int groupFrames = 8, int stateDepth = CV_64F);
     /** @brief The constructor's object, held by a Ptr: the way bindings make one. OpenCV 4.6's generated
      * cv2 constructor cannot raise cv2.error (a refused argument came out as SystemError), a function can.
