@@ -64,14 +64,14 @@ def ssim(output, clean):
     taps = torch.arange(11, dtype=torch.float64) - 5
     g = torch.exp(-taps ** 2 / (2 * 1.5 ** 2))
     g = g / g.sum()
-    window = (g[:, None] * g[None, :]).expand(c, 1, 11, 11).contiguous()
-    x, y = output.double()[None], clean.double()[None]
-
-    def blur(v):
-        return F.conv2d(v, window, groups=c)
-
-    mx, my = blur(x), blur(y)
-    vx, vy, cxy = blur(x * x) - mx * mx, blur(y * y) - my * my, blur(x * y) - mx * my
+    x, y = output.double(), clean.double()
+    # The window is separable: a column then a row pass, on the five planes at once, is 22 taps a pixel
+    # instead of 121 (the 2-D convolution was most of a quick study's evaluation time).
+    planes = torch.cat([x, y, x * x, y * y, x * y])[None]
+    blurred = F.conv2d(F.conv2d(planes, g.view(1, 1, 11, 1).expand(5 * c, 1, 11, 1), groups=5 * c),
+                       g.view(1, 1, 1, 11).expand(5 * c, 1, 1, 11), groups=5 * c)
+    mx, my, xx, yy, xy = blurred[0].split(c)
+    vx, vy, cxy = xx - mx * mx, yy - my * my, xy - mx * my
     c1, c2 = 0.01 ** 2, 0.03 ** 2
     value = ((2 * mx * my + c1) * (2 * cxy + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2))
     return float(value.mean())
