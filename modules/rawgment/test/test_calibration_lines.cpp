@@ -31,6 +31,11 @@ const std::vector<NoiseSample>& outlierProtocol()
 
 TEST(Calibration, perGainRSquaredIsWhatTheBurstLengthAllows)
 {
+#ifdef RAWGMENT_SANITIZED_BUILD
+    // 600 simulated frames for one statistic; the line fit runs under the sanitizers in every calibration
+    // test.
+    GTEST_SKIP() << "R^2 against the burst length is measured in the Release build only";
+#endif
     const std::vector<NoiseSample>& samples = cleanProtocol();
     const CalibrationReport report = calibrateNoiseModel(samples);
     ASSERT_EQ(report.perGain.size(), 3u);
@@ -64,6 +69,11 @@ TEST(Calibration, perGainRSquaredIsWhatTheBurstLengthAllows)
 
 TEST(Calibration, robustFitsSurviveFivePercentOutliersAndPlainLeastSquaresDoesNot)
 {
+#ifdef RAWGMENT_SANITIZED_BUILD
+    // 600 simulated frames for two accuracy figures; both fits run under the sanitizers in
+    // reportRoundTripsThroughYamlAndJson, on data with hot pixels to set aside.
+    GTEST_SKIP() << "robustness to outliers is measured in the Release build only";
+#endif
     const std::vector<NoiseSample>& samples = outlierProtocol();
     const CalibrationReport robust = calibrateNoiseModel(samples);
     const Errors e = relativeErrors(robust.model, truthModel());
