@@ -43,8 +43,11 @@ std::string markdownTable(const std::vector<rawgment_apps::TradeoffRow>& rows)
         md << "---:|";
     md << "\n";
     for (const rawgment_apps::TradeoffRow& r : rows) {
-        char error[32], time[32];
-        std::snprintf(error, sizeof(error), "%.3g", r.error);
+        char error[64], time[32];
+        if (r.errorStdError > 0)
+            std::snprintf(error, sizeof(error), "%.3g ± %.2g", r.error, r.errorStdError);
+        else
+            std::snprintf(error, sizeof(error), "%.3g", r.error);
         std::snprintf(time, sizeof(time), "%.3g ms", r.msPerMp);
         md << "| " << r.knob << " | " << r.setting << " | " << markdownCell(r.measure) << " | " << error
            << " | " << time << " |";
@@ -197,7 +200,8 @@ std::string tradeoffPlotScript(const std::vector<rawgment_apps::TradeoffRow>& ro
 //! The table's rows as CSV cells, one time column per CPU path.
 rawgment_apps::CsvTable tradeoffTable(const std::vector<rawgment_apps::TradeoffRow>& rows)
 {
-    std::vector<std::string> header = {"knob", "setting", "measure", "error", "ms_per_mp"};
+    std::vector<std::string> header = {"knob",     "setting",         "measure",           "error",
+                                       "error_se", "frames_to_shoot", "s_per_calibration", "ms_per_mp"};
     for (CpuPath p : availableCpuPaths())
         header.push_back("ms_per_mp_" + cpuPathName(p));
     rawgment_apps::CsvTable table(header);
@@ -207,14 +211,58 @@ rawgment_apps::CsvTable tradeoffTable(const std::vector<rawgment_apps::TradeoffR
         return text;
     };
     for (const rawgment_apps::TradeoffRow& r : rows) {
-        std::vector<std::string> cells = {cell(r.knob), cell(r.setting), cell(r.measure),
-                                          formatNumber(r.error), formatNumber(r.msPerMp)};
+        // The calibration knobs' own columns stay empty for the other knobs.
+        const bool calibration = r.framesToShoot > 0;
+        std::vector<std::string> cells = {cell(r.knob),
+                                          cell(r.setting),
+                                          cell(r.measure),
+                                          formatNumber(r.error),
+                                          calibration ? formatNumber(r.errorStdError) : std::string(),
+                                          calibration ? std::to_string(r.framesToShoot) : std::string(),
+                                          calibration ? formatNumber(r.secondsPerCalibration) : std::string(),
+                                          formatNumber(r.msPerMp)};
         // Knobs whose loops are not dispatched have one time: the other cells stay empty.
         for (size_t k = 0; k < availableCpuPaths().size(); ++k)
             cells.push_back(k < r.msPerMpByPath.size() ? formatNumber(r.msPerMpByPath[k]) : std::string());
         table.addRow(cells);
     }
     return table;
+}
+
+/** The calibration knobs as a user meets them: the frames to shoot and the time of one calibration, beside
+ * the error and how far it falls from the setting before, in standard errors of that fall. */
+std::string calibrationMarkdown(const std::vector<rawgment_apps::TradeoffRow>& rows,
+                                const rawgment_apps::TradeoffSettings& set)
+{
+    std::ostringstream md;
+    md << "## A calibration: the frames to shoot, its time, its error\n\n"
+       << "One calibration of a " << set.timingSize.width << "x" << set.timingSize.height
+       << " camera (3 gains x 2 light levels of a chart): the burst statistics of every frame, the "
+          "sampling of the squares and the fit with its bootstrap, on "
+       << getNumThreads()
+       << " threads; reading the files is not included. The fall is that of the mean squared error from "
+          "the row above, over the same "
+       << set.seeds
+       << " campaigns, in standard errors of the per-campaign differences (the settings share their "
+          "frames).\n\n"
+       << "| Knob | Setting | Frames to shoot | Time per calibration | Error (RMS ± SE) | Fall from the row "
+          "above |\n|---|---|---:|---:|---:|---:|\n";
+    const rawgment_apps::TradeoffRow* previous = nullptr;
+    for (const rawgment_apps::TradeoffRow& r : rows) {
+        if (r.framesToShoot == 0)
+            continue;
+        std::string fall = "-";
+        if (previous && previous->knob == r.knob && r.knob != "Calibration RANSAC iterations") {
+            const rawgment_apps::ErrorFall f =
+                rawgment_apps::pairedFall(previous->campaignErrors, r.campaignErrors);
+            fall = f.stdError > 0 ? cv::format("%.1f SE", f.meanSquareFall / f.stdError) : std::string("-");
+        }
+        md << "| " << r.knob << " | " << r.setting << " | " << r.framesToShoot << " | "
+           << cv::format("%.2f s", r.secondsPerCalibration) << " | "
+           << cv::format("%.3g ± %.2g", r.error, r.errorStdError) << " | " << fall << " |\n";
+        previous = &r;
+    }
+    return md.str();
 }
 
 //! tradeoffs.md: the table, what each setting means, and what more calibration data buys.
@@ -232,8 +280,9 @@ std::string tradeoffMarkdown(const std::vector<rawgment_apps::TradeoffRow>& rows
             "(the same bits on each). Errors "
             "against "
             "the sensor simulator's truth; calibration errors are RMS over "
-         << set.seeds << " simulated campaigns.\n\n"
-         << markdownTable(rows) << "\n## What each setting means\n\n";
+         << set.seeds << " simulated campaigns, ± their standard error.\n\n"
+         << markdownTable(rows) << "\n"
+         << calibrationMarkdown(rows, set) << "\n## What each setting means\n\n";
     for (const rawgment_apps::TradeoffRow& r : rows)
         text << "- " << r.knob << ", " << r.setting << ": " << r.meaning << ".\n";
     text << "\n## Calibration precision: what more data buys\n\n"
@@ -267,7 +316,7 @@ int main(int argc, char** argv)
         "{help h usage ? |       | print this message }"
         "{out o          |       | output directory, created; existing outputs are never replaced }"
         "{quick          | false | a small timing frame and short bursts (a smoke run, seconds) }"
-        "{seeds          | 3     | simulated calibration campaigns averaged per setting }"
+        "{seeds          | 32    | simulated calibration campaigns averaged per setting }"
         "{repeats        | 3     | timings keep the fastest of this many runs }"
         "{seed           | 1     | seed of every simulated capture and noise draw }"
         "{plots          | true  | write tradeoffs.png with gnuplot }";
@@ -294,13 +343,13 @@ int main(int argc, char** argv)
     if (parser.get<bool>("quick")) {
         set.timingSize = Size(800, 600);
         set.burstLengths = {8, 16};
-        set.seeds = std::min(set.seeds, 1);
+        set.seeds = std::min(set.seeds, 2); // two, so that every error has a standard error
         set.repeats = 1;
         set.shapiroSeries = 5000;
     }
     if (!parser.check() || outDir.empty() || set.seeds < 1 || set.repeats < 1) {
         parser.printErrors();
-        std::cerr << "usage: rawgment_tradeoffs --out=<dir> [--quick] [--seeds=3] [--repeats=3]\n";
+        std::cerr << "usage: rawgment_tradeoffs --out=<dir> [--quick] [--seeds=32] [--repeats=3]\n";
         return 2;
     }
     try {

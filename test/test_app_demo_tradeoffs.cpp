@@ -67,6 +67,9 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
     for (const char* setup :
          {"24x24, 3 gains |", "8x8, 3 gains |", "2 gains (6 and 24 dB) |", "+ dark frames |"})
         EXPECT_NE(std::string::npos, md.find(setup, precision)) << setup;
+    const size_t perCalibration = md.find("## A calibration: the frames to shoot, its time, its error");
+    ASSERT_NE(std::string::npos, perCalibration);
+    EXPECT_NE(std::string::npos, md.find("| Calibration burst length | 16 frames | 96 |", perCalibration));
     expectPngDecodes(dir + "/t/tradeoffs.png");
     // The figure: one view of every knob relative to its reference setting, then a panel per knob whose
     // y axis names the knob's own measure (the axes once said only "error").
@@ -87,22 +90,34 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
     };
     std::string line;
     std::getline(csv, line);
-    // Five columns, then the time on each CPU path this machine has.
-    const size_t paths = cv::rawgment::availableCpuPaths().size();
-    ASSERT_EQ(split(line).size(), 5 + paths) << line;
+    // Eight columns (three of them the calibration knobs' own), then the time on each CPU path.
+    const size_t paths = cv::rawgment::availableCpuPaths().size(), fixed = 8;
+    ASSERT_EQ(split(line).size(), fixed + paths) << line;
+    EXPECT_EQ(split(line)[4], "error_se");
+    EXPECT_EQ(split(line)[6], "s_per_calibration");
     EXPECT_EQ(split(line).back(),
               "ms_per_mp_" + cv::rawgment::cpuPathName(cv::rawgment::availableCpuPaths().back()));
     int rows = 0;
     while (std::getline(csv, line)) {
         std::vector<std::string> cells = split(line);
-        ASSERT_LE(cells.size(), 5 + paths) << line;
-        cells.resize(5 + paths);
-        const double e = std::stod(cells[3]), t = std::stod(cells[4]);
+        ASSERT_LE(cells.size(), fixed + paths) << line;
+        cells.resize(fixed + paths);
+        const double e = std::stod(cells[3]), t = std::stod(cells[7]);
         EXPECT_TRUE(std::isfinite(e) && e >= 0) << line;
         EXPECT_TRUE(std::isfinite(t) && t > 0) << line;
+        const bool calibration = cells[0].rfind("Calibration", 0) == 0;
+        if (calibration) {
+            // --quick runs two campaigns: each error has a standard error, each calibration its frames (6
+            // bursts) and time.
+            EXPECT_GT(std::stod(cells[4]), 0) << line;
+            EXPECT_EQ(0, std::stoi(cells[5]) % 6) << line;
+            EXPECT_GT(std::stod(cells[6]), 0) << line;
+        } else {
+            EXPECT_TRUE(cells[4].empty() && cells[5].empty() && cells[6].empty()) << line;
+        }
         // The augmentation and burst-statistics knobs run dispatched loops: timed on every path.
-        const bool dispatched = cells[0].rfind("Calibration", 0) != 0 && cells[0] != "Shapiro-Wilk";
-        for (size_t k = 5; k < cells.size(); ++k)
+        const bool dispatched = !calibration && cells[0] != "Shapiro-Wilk";
+        for (size_t k = fixed; k < cells.size(); ++k)
             if (dispatched)
                 EXPECT_GT(std::stod(cells[k]), 0) << line;
             else

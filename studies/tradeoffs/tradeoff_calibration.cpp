@@ -87,7 +87,7 @@ std::vector<CalibrationKnobSetting> calibrationKnobSettings(const TradeoffSettin
         settings.push_back({"Calibration patch size", std::to_string(side) + "x" + std::to_string(side),
                             maxFrames, side, 500});
     settings.push_back({"Calibration patch size", "24x24 (paper)", maxFrames, 24, 500});
-    for (int it : {20, 100, 2000})
+    for (int it : set.ransacIterations)
         settings.push_back({"Calibration RANSAC iterations", std::to_string(it), maxFrames, 24, it});
     return settings;
 }
@@ -162,6 +162,11 @@ CampaignSamples sampleCampaign(const TradeoffSettings& set, const rawgment_studi
             ++burstIndex;
             progress.advance();
         }
+        progress.advance();   // counted whether or not the dark burst below is simulated
+        if (!set.precision) { // only the precision set-up "+ dark frames" uses it; its seed stays taken
+            ++burstIndex;
+            continue;
+        }
         // A burst of dark frames (sampleDarkBurst(), as rawgment_calibrate samples them).
         BurstStatistics dark(fmt);
         const Mat black = Mat::zeros(bench.scene.meanAtUnitGain.size(), CV_32FC1);
@@ -175,7 +180,6 @@ CampaignSamples sampleCampaign(const TradeoffSettings& set, const rawgment_studi
                     out.dark[t + 1].push_back(x);
         }
         ++burstIndex;
-        progress.advance();
     }
     return out;
 }
@@ -184,6 +188,14 @@ CampaignSamples sampleCampaign(const TradeoffSettings& set, const rawgment_studi
 struct PrecisionSums
 {
     std::vector<std::array<double, 3>> stated, made;
+};
+
+//! What one campaign gives: its precision terms and its knob settings' errors and times.
+struct CampaignResult
+{
+    PrecisionSums precision;
+    std::vector<double> knobErrors, knobMs;
+    double statsMs = 0;
 };
 
 void addCampaignPrecision(const std::vector<PrecisionSetup>& setups, CampaignSamples& campaign,
@@ -207,25 +219,51 @@ void addCampaignPrecision(const std::vector<PrecisionSetup>& setups, CampaignSam
     }
 }
 
-//! Adds each knob setting's fit and sampling time and its squared worst relative parameter error.
-void addCampaignKnobErrors(const std::vector<CalibrationKnobSetting>& settings, CampaignSamples& campaign,
-                           const NoiseModel& truth, std::vector<double>& ms,
-                           std::vector<double>& squaredError)
+/** Each knob setting's worst relative parameter error in this campaign, and its fit and sampling time. A
+ * timed campaign fits as a user's calibration does, its bootstrap included; the others fit without the
+ * bootstrap, which changes the errors a report states but not the model. Settings that are the same
+ * calibration (the longest bursts at 24x24 and 500 iterations) are fitted once. */
+void campaignKnobErrors(const std::vector<CalibrationKnobSetting>& settings, CampaignSamples& campaign,
+                        const NoiseModel& truth, bool timed, CampaignResult& out)
 {
-    for (size_t i = 0; i < settings.size(); ++i) {
-        const CalibrationKnobSetting& s = settings[i];
-        CalibrationParams p;
-        p.line.ransacIterations = s.ransac;
-        CalibrationReport r;
-        const double fitMs = fastestMs(1, [&] {
-            r = calibrateNoiseModel(campaign.light[{s.frames, s.side}], p);
-        });
-        ms[i] += fitMs + campaign.samplingMs[{s.frames, s.side}];
-        const double e = std::max({std::abs(r.model.alpha / truth.alpha - 1),
-                                   std::abs(r.model.sigmaD2 / truth.sigmaD2 - 1),
-                                   std::abs(r.model.sigmaR2 / truth.sigmaR2 - 1)});
-        squaredError[i] += e * e;
+    std::map<std::array<int, 3>, std::pair<double, double>> fitted; // (frames, side, ransac) -> error, ms
+    for (const CalibrationKnobSetting& s : settings) {
+        const std::array<int, 3> key = {s.frames, s.side, s.ransac};
+        if (!fitted.count(key)) {
+            CalibrationParams p;
+            p.line.ransacIterations = s.ransac;
+            if (!timed)
+                p.bootstrapReplicates = 0;
+            CalibrationReport r;
+            const double fitMs = fastestMs(1, [&] {
+                r = calibrateNoiseModel(campaign.light[{s.frames, s.side}], p);
+            });
+            fitted[key] = {std::max({std::abs(r.model.alpha / truth.alpha - 1),
+                                     std::abs(r.model.sigmaD2 / truth.sigmaD2 - 1),
+                                     std::abs(r.model.sigmaR2 / truth.sigmaR2 - 1)}),
+                           fitMs + campaign.samplingMs[{s.frames, s.side}]};
+        }
+        out.knobErrors.push_back(fitted[key].first);
+        out.knobMs.push_back(fitted[key].second);
     }
+}
+
+/** Fastest time of BurstStatistics::add() per frame of `size` (CV_16UC1), from bursts of 8 frames (one
+ * group of the default, so the group's flush is in it). */
+double statisticsMsPerFrame(const TradeoffSettings& set, const rawgment_studies::CalibrationBench& bench,
+                            Size size)
+{
+    Mat frame(size, CV_16UC1);
+    randu(frame, Scalar(256), Scalar(4095));
+    const RawFormat fmt = bench.sensor.rawFormat(1);
+    const int frames = 8;
+    return fastestMs(set.repeats,
+                     [&] {
+                         BurstStatistics stats(fmt);
+                         for (int t = 0; t < frames; ++t)
+                             stats.add(frame);
+                     }) /
+           frames;
 }
 
 /** The stated and made errors per set-up, and for more of the same data (no gain left out, no dark
@@ -272,33 +310,116 @@ void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRo
     const double frameMp = megapixels(bench.scene.meanAtUnitGain.size());
     const std::vector<CalibrationKnobSetting> settings = calibrationKnobSettings(set);
     const std::vector<PrecisionSetup> setups = precisionSetups(set);
-    std::vector<double> squaredError(settings.size(), 0), ms(settings.size(), 0);
+    // Times are the mean of the first campaigns' (as many as the timings' repeats), run one after another
+    // on a quiet machine; the other campaigns run side by side, one per thread. Every campaign counts in
+    // the errors, summed in campaign order whatever the threads.
+    const int timedCampaigns = std::min(set.seeds, set.repeats);
+    std::vector<CampaignResult> results(static_cast<size_t>(set.seeds));
+    const auto runCampaign = [&](int campaign) {
+        CampaignResult& out = results[static_cast<size_t>(campaign)];
+        out.precision = {std::vector<std::array<double, 3>>(setups.size(), {0, 0, 0}),
+                         std::vector<std::array<double, 3>>(setups.size(), {0, 0, 0})};
+        CampaignSamples samples = sampleCampaign(set, bench, campaign, out.statsMs, progress);
+        if (set.precision)
+            addCampaignPrecision(setups, samples, bench.truth, set.seeds, out.precision);
+        campaignKnobErrors(settings, samples, bench.truth, campaign < timedCampaigns, out);
+    };
+    for (int campaign = 0; campaign < timedCampaigns; ++campaign)
+        runCampaign(campaign);
+    parallel_for_(Range(timedCampaigns, set.seeds), [&](const Range& range) {
+        for (int campaign = range.start; campaign < range.end; ++campaign)
+            runCampaign(campaign);
+    });
+    std::vector<std::vector<double>> errors(settings.size());
+    std::vector<double> ms(settings.size(), 0);
     PrecisionSums sums{std::vector<std::array<double, 3>>(setups.size(), {0, 0, 0}),
                        std::vector<std::array<double, 3>>(setups.size(), {0, 0, 0})};
     double statsMsPerFrame = 0;
     for (int campaign = 0; campaign < set.seeds; ++campaign) {
-        CampaignSamples samples = sampleCampaign(set, bench, campaign, statsMsPerFrame, progress);
-        addCampaignPrecision(setups, samples, bench.truth, set.seeds, sums);
-        addCampaignKnobErrors(settings, samples, bench.truth, ms, squaredError);
+        const CampaignResult& r = results[static_cast<size_t>(campaign)];
+        for (size_t i = 0; i < settings.size(); ++i) {
+            errors[i].push_back(r.knobErrors[i]);
+            if (campaign < timedCampaigns)
+                ms[i] += r.knobMs[i];
+        }
+        for (size_t i = 0; i < setups.size(); ++i)
+            for (size_t k = 0; k < 3; ++k) {
+                sums.stated[i][k] += r.precision.stated[i][k];
+                sums.made[i][k] += r.precision.made[i][k];
+            }
+        if (campaign < timedCampaigns)
+            statsMsPerFrame += r.statsMs / (timedCampaigns * 6.0 * maxFrames);
     }
-    const std::vector<PrecisionRow> made = precisionRows(setups, sums, maxFrames);
-    precision.insert(precision.end(), made.begin(), made.end());
-    statsMsPerFrame /= set.seeds * 6.0 * maxFrames;
+    if (set.precision) {
+        const std::vector<PrecisionRow> made = precisionRows(setups, sums, maxFrames);
+        precision.insert(precision.end(), made.begin(), made.end());
+    }
+    // A user's calibration: the same bursts of a camera of timingSize (the statistics of every frame scale
+    // with its pixels; sampling and the fit with the squares', which are the study's).
+    const double cameraStatsMsPerFrame = statisticsMsPerFrame(set, bench, set.timingSize);
     for (size_t i = 0; i < settings.size(); ++i) {
         const CalibrationKnobSetting& s = settings[i];
-        // Time of the whole calibration (statistics of every frame, sampling, fit) per MP of burst input.
-        const double totalMs = 6 * s.frames * statsMsPerFrame + ms[i] / set.seeds;
-        rows.push_back({s.knob,
+        const int frames = 6 * s.frames; // 3 gains x 2 light levels
+        const double sampleAndFitMs = ms[i] / timedCampaigns;
+        TradeoffRow row{s.knob,
                         s.name,
                         "RMS over campaigns of the worst relative error of alpha, sigma_d^2, sigma_r^2",
-                        std::sqrt(squaredError[i] / set.seeds),
-                        totalMs / (6 * s.frames * frameMp),
+                        rmsOf(errors[i]),
+                        // Statistics of every frame, sampling and the fit, per MP of burst input.
+                        (frames * statsMsPerFrame + sampleAndFitMs) / (frames * frameMp),
                         s.knob == "Calibration RANSAC iterations" ? "the fit is a small part of the time"
                                                                   : "more data, smaller error, linear cost",
-                        {}});
+                        {}};
+        row.campaignErrors = errors[i];
+        row.errorStdError = rmsStandardError(errors[i]);
+        row.framesToShoot = frames;
+        row.secondsPerCalibration = (frames * cameraStatsMsPerFrame + sampleAndFitMs) / 1000;
+        rows.push_back(row);
     }
 }
 
-// Shapiro-Wilk, batched against one call per series: the same numbers, a different price.
 } // namespace tradeoff_study
+
+double rmsOf(const std::vector<double>& errors)
+{
+    double sum = 0;
+    for (double e : errors)
+        sum += e * e;
+    return errors.empty() ? 0.0 : std::sqrt(sum / errors.size());
+}
+
+double rmsStandardError(const std::vector<double>& errors)
+{
+    const size_t n = errors.size();
+    const double rms = rmsOf(errors);
+    if (n < 2 || rms == 0)
+        return 0;
+    double spread = 0;
+    for (double e : errors)
+        spread += (e * e - rms * rms) * (e * e - rms * rms);
+    // d sqrt(m) = dm / (2 sqrt(m)), m the mean square, whose standard error is sd(e^2) / sqrt(n).
+    return std::sqrt(spread / (n - 1) / n) / (2 * rms);
+}
+
+ErrorFall pairedFall(const std::vector<double>& before, const std::vector<double>& after)
+{
+    CV_Assert(before.size() == after.size());
+    const size_t n = before.size();
+    ErrorFall f;
+    if (n == 0)
+        return f;
+    std::vector<double> d(n);
+    for (size_t c = 0; c < n; ++c)
+        d[c] = before[c] * before[c] - after[c] * after[c];
+    for (double x : d)
+        f.meanSquareFall += x / n;
+    if (n < 2)
+        return f;
+    double spread = 0;
+    for (double x : d)
+        spread += (x - f.meanSquareFall) * (x - f.meanSquareFall);
+    f.stdError = std::sqrt(spread / (n - 1) / n);
+    return f;
+}
+
 } // namespace rawgment_apps

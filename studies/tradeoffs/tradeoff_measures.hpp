@@ -19,8 +19,14 @@ struct TradeoffSettings
 {
     cv::Size timingSize{4000, 3000}; // the frame every augmentation and statistics time is measured on
     int repeats = 3;                 // timings keep the fastest of this many runs
-    int seeds = 3;                   // calibration errors are RMS over this many simulated campaigns
+    /* Calibration errors are RMS over this many simulated campaigns. 32 give each RMS a standard error of
+     * about 12% of itself, which tells apart neighbouring burst lengths and patch sizes (their errors differ
+     * by 1.4-3x); 3 could not (16x16 patches came out worse than 8x8). */
+    int seeds = 32;
     std::vector<int> burstLengths{8, 16, 32, 100};
+    std::vector<int> ransacIterations{20, 100, 2000}; // the RANSAC knob's settings (500 is the library's)
+    // Also the stated against the made errors (PrecisionRow), each fit with its bootstrap, and dark bursts.
+    bool precision = true;
     int shapiroSeries = 100000; // series of 64 values in the Shapiro-Wilk timing
     uint64_t seed = 1;          // every simulated capture and noise draw derives from it
 };
@@ -35,7 +41,26 @@ struct TradeoffRow
     /** The time on each CPU path this machine has, in the order of availableCpuPaths(), for the knobs
      * whose loops are dispatched (cpu.hpp); empty for the others. msPerMp is the active path's. */
     std::vector<double> msPerMpByPath;
+    // Calibration knobs only (empty or 0 elsewhere):
+    std::vector<double> campaignErrors{}; // each campaign's error; `error` is their RMS
+    double errorStdError = 0;             // the standard error of that RMS
+    int framesToShoot = 0;                // every burst's frames, as a user shoots them
+    double secondsPerCalibration = 0;     // compute time of one calibration of a timingSize camera
 };
+
+/** rmsOf(errors) and its standard error over the campaigns (the delta method on the mean square); 0 for
+ * fewer than two campaigns. */
+double rmsOf(const std::vector<double>& errors);
+double rmsStandardError(const std::vector<double>& errors);
+
+/** How much the mean squared error falls from one setting to another over the same campaigns, and the
+ * standard error of that fall from the per-campaign differences (paired: the settings share each campaign's
+ * frames, which a comparison of two independent standard errors would ignore). */
+struct ErrorFall
+{
+    double meanSquareFall = 0, stdError = 0;
+};
+ErrorFall pairedFall(const std::vector<double>& before, const std::vector<double>& after);
 
 /** How exact one calibration set-up is: the relative standard errors the calibration states (mean over
  * campaigns), the relative errors it makes (RMS over campaigns, against the simulator's truth), and
