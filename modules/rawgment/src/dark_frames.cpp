@@ -1,0 +1,184 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The fixed pattern and the temporal noise of dark frames (dark_frames.hpp).
+#include "dark_frames.hpp"
+
+#include "normal_quantile.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace cv {
+namespace rawgment {
+namespace detail {
+
+double DarkFrameEstimate::fixedPatternRms() const
+{
+    return std::sqrt((patternVariance[0] + patternVariance[1] + patternVariance[2] + patternVariance[3]) / 4);
+}
+
+double chiSquareUpperQuantileOverDof(int k, double p)
+{
+    CV_Assert(k >= 1 && p > 0 && p < 0.5);
+    const double z = -lowerNormalQuantile(p), a = 2.0 / (9.0 * k);
+    const double root = 1.0 - a + z * std::sqrt(a);
+    return root * root * root;
+}
+
+namespace {
+
+// The median of chi2(k) / k (Wilson and Hilferty): a row's median variance over it is the row's variance,
+// whatever few noisy pixels the row holds.
+double chiSquareMedianOverDof(int k)
+{
+    const double root = 1.0 - 2.0 / (9.0 * k);
+    return root * root * root;
+}
+
+double medianOf(std::vector<double>& v)
+{
+    CV_Assert(!v.empty());
+    const size_t half = v.size() / 2;
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(half), v.end());
+    const double upper = v[half];
+    if (v.size() % 2)
+        return upper;
+    return 0.5 * (upper + *std::max_element(v.begin(), v.begin() + static_cast<long>(half)));
+}
+
+// The quartiles of chi2(k) / k (Wilson and Hilferty).
+double chiSquareInterquartileOverDof(int k)
+{
+    const double a = 2.0 / (9.0 * k), z = 0.6744897501960817;
+    return std::pow(1.0 - a + z * std::sqrt(a), 3) - std::pow(1.0 - a - z * std::sqrt(a), 3);
+}
+
+/* The degrees of freedom k <= most whose chi2(k) / k has the interquartile range of `ratios` (each variance
+ * over its row's typical one): most when they scatter no more than that. */
+int effectiveDegreesOfFreedom(std::vector<double>& ratios, int most)
+{
+    const size_t q1 = ratios.size() / 4, q3 = (3 * ratios.size()) / 4;
+    std::nth_element(ratios.begin(), ratios.begin() + static_cast<long>(q1), ratios.end());
+    const double lower = ratios[q1];
+    std::nth_element(ratios.begin(), ratios.begin() + static_cast<long>(q3), ratios.end());
+    const double iqr = ratios[q3] - lower;
+    int k = most;
+    while (k > 1 && chiSquareInterquartileOverDof(k) < iqr)
+        --k;
+    return k;
+}
+
+} // namespace
+
+DarkFrameEstimate estimateDarkFrames(const BurstStatistics& stats, double falseAlarm)
+{
+    const int M = stats.frames();
+    if (M < 2)
+        CV_Error(Error::StsBadArg,
+                 format("estimateDarkFrames: %d frame(s); temporal noise needs at least two", M));
+    if (!(falseAlarm > 0 && falseAlarm < 0.5))
+        CV_Error(Error::StsOutOfRange,
+                 format("estimateDarkFrames: falseAlarm %g must lie in (0, 0.5)", falseAlarm));
+    Mat mean, variance;
+    stats.mean(mean);
+    stats.variance(variance);
+    const int rows = mean.rows, cols = mean.cols;
+    DarkFrameEstimate e;
+    e.frames = M;
+    e.rowVariance.create(rows, 2, CV_64FC1);
+    if (rows * cols < 16)
+        CV_Error(Error::StsBadArg, format("estimateDarkFrames: %dx%d frames are too small to tell a pattern "
+                                          "from noise (at least 16 pixels)",
+                                          cols, rows));
+    // A row's typical variance: the median over its pixels of one column parity, over the median of chi2(k) /
+    // k.
+    const auto typicalVariance = [&](int r, int parity, int k, std::vector<double>& values) {
+        const double* v = variance.ptr<double>(r);
+        values.clear();
+        for (int c = parity; c < cols; c += 2)
+            values.push_back(v[c]);
+        return medianOf(values) / chiSquareMedianOverDof(k);
+    };
+    // Heavy-tailed read noise scatters the sample variances more than M - 1 degrees of freedom say (with
+    // Tukey lambda -0.1 and 25 frames, the chi-square threshold flagged 0.2% of ordinary pixels as noisy).
+    // The degrees of freedom they do scatter with come from the interquartile range of each variance over
+    // its row's, which the few noisy pixels leave alone.
+    std::vector<double> values, ratios;
+    ratios.reserve(variance.total());
+    for (int r = 0; r < rows; ++r)
+        for (int parity = 0; parity < 2; ++parity) {
+            const double typical = typicalVariance(r, parity, M - 1, values);
+            const double* v = variance.ptr<double>(r);
+            for (int c = parity; c < cols; c += 2)
+                ratios.push_back(typical > 0 ? v[c] / typical : 1.0);
+        }
+    const int dof = effectiveDegreesOfFreedom(ratios, M - 1);
+    e.degreesOfFreedom = dof;
+    const double threshold = chiSquareUpperQuantileOverDof(dof, falseAlarm);
+    Mat noisy(rows, cols, CV_8UC1, Scalar(0));
+    for (int r = 0; r < rows; ++r) {
+        const double* v = variance.ptr<double>(r);
+        for (int parity = 0; parity < 2; ++parity) {
+            const double typical = typicalVariance(r, parity, dof, values);
+            double sum = 0;
+            int n = 0;
+            for (int c = parity; c < cols; c += 2) {
+                if (v[c] > threshold * typical) {
+                    noisy.at<uchar>(r, c) = 1;
+                    e.noisyPixels.emplace_back(c, r);
+                    e.noisyVariance.push_back(v[c]);
+                } else {
+                    sum += v[c];
+                    ++n;
+                }
+            }
+            // A row whose every pixel is noisy keeps the typical figure: there is nothing else to pool.
+            e.rowVariance.at<double>(r, parity) = n > 0 ? sum / n : typical;
+        }
+    }
+    // Per site: the level, the spatial variance of the means and the temporal variance each mean holds.
+    double sum[4] = {0, 0, 0, 0}, sum2[4] = {0, 0, 0, 0}, own[4] = {0, 0, 0, 0}, pooled[4] = {0, 0, 0, 0};
+    double count[4] = {0, 0, 0, 0}, pooledCount[4] = {0, 0, 0, 0};
+    for (int r = 0; r < rows; ++r) {
+        const double* m = mean.ptr<double>(r);
+        const double* v = variance.ptr<double>(r);
+        const uchar* flagged = noisy.ptr<uchar>(r);
+        for (int c = 0; c < cols; ++c) {
+            const int s = cfaSite(r, c);
+            sum[s] += m[c];
+            sum2[s] += m[c] * m[c];
+            own[s] += v[c];
+            count[s] += 1;
+            if (!flagged[c]) {
+                pooled[s] += v[c];
+                pooledCount[s] += 1;
+            }
+        }
+    }
+    for (int s = 0; s < 4; ++s) {
+        const double n = count[s];
+        e.level[s] = sum[s] / n;
+        e.meanVariance[s] = n > 1 ? (sum2[s] - sum[s] * sum[s] / n) / (n - 1) : 0.0;
+        // E[Var(m)] = s_F^2 + mean(v) / M, each pixel's own variance unbiased for its own noise.
+        e.patternVariance[s] = std::max(0.0, e.meanVariance[s] - own[s] / n / M);
+        e.temporalVariance[s] = pooledCount[s] > 0 ? pooled[s] / pooledCount[s] : own[s] / n;
+    }
+    e.pattern.create(rows, cols, CV_32FC1);
+    for (int r = 0; r < rows; ++r) {
+        const double* m = mean.ptr<double>(r);
+        const double* v = variance.ptr<double>(r);
+        const uchar* flagged = noisy.ptr<uchar>(r);
+        float* out = e.pattern.ptr<float>(r);
+        for (int c = 0; c < cols; ++c) {
+            const int s = cfaSite(r, c);
+            const double frozen = (flagged[c] ? v[c] : e.rowVariance.at<double>(r, c & 1)) / M;
+            const double spread = e.patternVariance[s];
+            const double w = spread > 0 ? spread / (spread + frozen) : 0.0;
+            out[c] = static_cast<float>(e.level[s] + w * (m[c] - e.level[s]));
+        }
+    }
+    return e;
+}
+
+} // namespace detail
+} // namespace rawgment
+} // namespace cv

@@ -1,0 +1,58 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// What M dark frames of one gain tell apart: the fixed pattern and the temporal noise (issue #64, the
+// statistics of a dark-frame bank). Private until the bank itself is public.
+#ifndef OPENCV_RAWGMENT_SRC_DARK_FRAMES_HPP
+#define OPENCV_RAWGMENT_SRC_DARK_FRAMES_HPP
+
+#include <opencv2/rawgment/calibration_samples.hpp>
+
+#include <vector>
+
+namespace cv {
+namespace rawgment {
+namespace detail {
+
+/** The fixed pattern and the temporal noise of M dark frames of one gain (DN above the black level).
+ *
+ * A pixel's mean m over M frames is its fixed pattern F plus temporal noise of variance v/M, frozen into
+ * the mean: with v = 0.19 DN^2 over 50 frames... the mean of a mostly flat sensor is mostly noise. So the
+ * fixed pattern's variance per CFA site is Var(m) - mean(v)/M (the EMVA 1288 correction), and the pattern is
+ * the mean shrunk towards the site's level by w = s_F^2 / (s_F^2 + v/M): the best linear estimate of F given
+ * m when the pattern's values scatter by s_F^2 around the site's level (zero when the frames resolve no
+ * pattern at all). */
+struct DarkFrameEstimate
+{
+    int frames = 0;           //!< M
+    int degreesOfFreedom = 0; //!< those the variances scatter with: M - 1, fewer for heavy-tailed noise
+    Mat pattern;              //!< CV_32FC1: the fixed pattern, shrunk for its v/M
+    Mat rowVariance;          //!< CV_64FC1, rows x 2: row r's temporal variance at its columns' parities 0, 1
+    std::vector<Point> noisyPixels;    //!< pixels whose temporal variance the row's cannot explain
+    std::vector<double> noisyVariance; //!< their own temporal variance
+    Vec4d level;                       //!< each CFA site's mean level
+    Vec4d temporalVariance; //!< each site's temporal variance, pooled over its pixels that are not noisy
+    Vec4d meanVariance;     //!< each site's spatial variance of the means: what a plain mean holds
+    Vec4d patternVariance;  //!< each site's fixed-pattern variance, Var(m) - mean(v)/M, at least 0
+
+    /** The fixed-pattern RMS over the sites: sqrt of the mean of patternVariance (DN). */
+    double fixedPatternRms() const;
+};
+
+/** Estimates the dark frames' pattern and temporal noise from their burst statistics (every frame of one
+ * gain and exposure, M >= 2), black-subtracted with `stats`' format. A pixel is noisy when its variance
+ * exceeds its row's by more than a chi-square allows at a false-alarm rate of `falseAlarm` per pixel, with
+ * the degrees of freedom the variances scatter with (their interquartile range: M - 1 for Gaussian noise,
+ * fewer for heavy tails); its own variance then stands in the pattern's shrinkage, and it is left out of
+ * the pooled variances. Hot pixels (a high mean) belong to the pattern and count in its variance.
+ * @throws cv::Exception for fewer than two frames, frames of fewer than 16 pixels or a false-alarm rate
+ * outside (0, 0.5). */
+DarkFrameEstimate estimateDarkFrames(const BurstStatistics& stats, double falseAlarm = 1e-6);
+
+/** The upper chi-square quantile over its degrees of freedom, chi2_{1-p}(k) / k, to Wilson and Hilferty's
+ * approximation (a relative error below 1% for k >= 3 at p >= 1e-9). */
+double chiSquareUpperQuantileOverDof(int k, double p);
+
+} // namespace detail
+} // namespace rawgment
+} // namespace cv
+
+#endif // OPENCV_RAWGMENT_SRC_DARK_FRAMES_HPP
