@@ -15,7 +15,8 @@ namespace detail {
 /** The fixed pattern and the temporal noise of M dark frames of one gain (DN above the black level).
  *
  * A pixel's mean m over M frames is its fixed pattern F plus temporal noise of variance v/M, frozen into
- * the mean: with v = 0.19 DN^2 over 50 frames... the mean of a mostly flat sensor is mostly noise. So the
+ * the mean: on EMVA 1288 set 001 (a 12-bit CCD) the spatial variance of the mean of 50 dark frames is
+ * 0.214 DN^2, of which 0.190 is v/M and 0.024 the pattern. So the
  * fixed pattern's variance per CFA site is Var(m) - mean(v)/M (the EMVA 1288 correction), and the pattern is
  * the mean shrunk towards the site's level by w = s_F^2 / (s_F^2 + v/M): the best linear estimate of F given
  * m when the pattern's values scatter by s_F^2 around the site's level (zero when the frames resolve no
