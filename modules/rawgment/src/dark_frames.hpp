@@ -5,6 +5,7 @@
 #define OPENCV_RAWGMENT_SRC_DARK_FRAMES_HPP
 
 #include <opencv2/rawgment/calibration_samples.hpp>
+#include <opencv2/rawgment/noise_model.hpp>
 
 #include <vector>
 
@@ -47,6 +48,31 @@ struct DarkFrameEstimate
  * @throws cv::Exception for fewer than two frames, frames of fewer than 16 pixels or a false-alarm rate
  * outside (0, 0.5). */
 DarkFrameEstimate estimateDarkFrames(const BurstStatistics& stats, double falseAlarm = 1e-6);
+
+/** Dark frames of one gain and exposure time (dark current grows with it), and what they tell apart. */
+struct DarkFrameGroup
+{
+    double gain = 1;           //!< the linear gain the frames were taken at
+    double exposureTime = 0;   //!< seconds; 0 when the frames do not state it
+    std::vector<String> files; //!< the frames, in the order given: read on demand, never all held
+    DarkFrameEstimate estimate;
+};
+
+/** Dark frames of one sensor (one size, CFA pattern, black and white level), grouped by gain and exposure. */
+struct DarkFrameCollection
+{
+    RawFormat format; //!< the frames' format, at gain 1
+    Size size;
+    std::vector<DarkFrameGroup> groups; //!< by gain, then exposure time
+};
+
+/** Reads each file once, one at a time, and groups the frames by gain and exposure time: a mosaic with a
+ * sidecar (readMosaic(): the sidecar's gain, or its camera's ISO through `model` when it says gainFromIso)
+ * or a DNG or camera RAW file without one (readRaw(): its ISO through formatAtIso() with `model`, the
+ * library's one ISO-to-gain rule). A single gain is a valid collection.
+ * @throws cv::Exception naming the file for: no files; a frame of another size, CFA pattern, black or white
+ * level than the first (both named); a gain and exposure with fewer than two frames; an unreadable file. */
+DarkFrameCollection collectDarkFrames(const std::vector<String>& files, const NoiseModel& model);
 
 /** The upper chi-square quantile over its degrees of freedom, chi2_{1-p}(k) / k, to Wilson and Hilferty's
  * approximation (a relative error below 1% for k >= 3 at p >= 1e-9). */

@@ -6,7 +6,11 @@
 
 #include "../src/dark_frames.hpp"
 
+#include <map>
+
 #include <opencv2/rawgment/emva1288.hpp>
+#include <opencv2/rawgment/mosaic_files.hpp>
+#include <opencv2/rawgment/raw_io.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
 namespace cv {
@@ -211,6 +215,91 @@ TEST(DarkFrames, set001sDarkFramesHoldAFaintPatternUnderTheirFrozenNoise)
     const double halfSe = std::sqrt(2 / pixels) * (pattern + v / 25);
     EXPECT_NEAR(siteMean(a.patternVariance), siteMean(b.patternVariance), 3 * std::sqrt(2.0) * halfSe);
     EXPECT_NEAR(siteMean(a.meanVariance) - pattern, v / 25, 3 * halfSe) << "a plain mean of 25 holds v/25";
+}
+
+// Dark frames from files: mosaics with sidecars at two gains (one of them at two exposure times) and DNGs
+// whose ISO gives their gain, each group estimated as its frames in memory are; and the refusals a bank
+// needs.
+TEST(DarkFrames, filesGroupByGainAndExposureAndRefuseAnotherSensor)
+{
+    const std::string dir = test::makeTempDir("dark_frames_files");
+    const Size size(32, 24);
+    SensorParams params = test::darkComponentSensorParams(size, 0.14, 3);
+    const SensorSimulator sensor(params, size);
+    NoiseModel model = sensor.effectiveModel();
+    model.baseIso = 100;
+    std::vector<String> files;
+    std::map<std::pair<double, double>, std::vector<Mat>> frames;
+    int n = 0;
+    for (const auto& setting :
+         {std::make_pair(2.0, 0.01), std::make_pair(8.0, 0.01), std::make_pair(8.0, 0.5)})
+        for (int t = 0; t < 3; ++t) {
+            Mat raw;
+            sensor.capture(Mat::zeros(size, CV_32FC1), setting.first, 1.0, 40 + n, t, raw);
+            MosaicMetadata meta;
+            meta.format = sensor.rawFormat(setting.first);
+            meta.hasCamera = true;
+            meta.camera.exposureTime = setting.second;
+            const std::string path = dir + format("/dark_%02d.png", n++);
+            writeMosaic(path, raw, meta);
+            files.push_back(path);
+            frames[setting].push_back(raw);
+        }
+    // Camera files: ISO 400 over the model's base ISO 100 is gain 4; no exposure time stated.
+    for (int t = 0; t < 2; ++t) {
+        RawImage image;
+        sensor.capture(Mat::zeros(size, CV_32FC1), 4.0, 1.0, 77, t, image.mosaic);
+        image.format = sensor.rawFormat(1.0);
+        image.iso = 400;
+        const std::string path = dir + format("/camera_%d.dng", t);
+        writeDng(path, image);
+        files.push_back(path);
+        frames[{4.0, 0.0}].push_back(image.mosaic);
+    }
+    const detail::DarkFrameCollection c = detail::collectDarkFrames(files, model);
+    ASSERT_EQ(c.groups.size(), 4u);
+    EXPECT_EQ(c.size, size);
+    EXPECT_EQ(c.format.gain, 1);
+    for (const detail::DarkFrameGroup& g : c.groups) {
+        const std::vector<Mat>& burst = frames.at({g.gain, g.exposureTime});
+        ASSERT_EQ(g.files.size(), burst.size()) << g.gain;
+        BurstStatistics stats(sensor.rawFormat(g.gain));
+        for (const Mat& f : burst)
+            stats.add(f);
+        const DarkFrameEstimate e = estimateDarkFrames(stats);
+        EXPECT_EQ(g.estimate.frames, e.frames);
+        EXPECT_EQ(g.estimate.patternVariance, e.patternVariance) << "the files hold the frames' bits";
+        EXPECT_EQ(cv::norm(g.estimate.pattern, e.pattern, NORM_INF), 0);
+    }
+    EXPECT_EQ(c.groups[0].gain, 2);
+    EXPECT_EQ(c.groups[1].gain, 4);
+    EXPECT_EQ(c.groups[2].exposureTime, 0.01);
+    EXPECT_EQ(c.groups[3].exposureTime, 0.5);
+    // One gain is a bank; none is not.
+    EXPECT_EQ(detail::collectDarkFrames({files[0], files[1]}, model).groups.size(), 1u);
+    EXPECT_CV_ERROR_CONTAINS(detail::collectDarkFrames({}, model), "an empty bank");
+    EXPECT_CV_ERROR_CONTAINS(detail::collectDarkFrames({files[0], files[1], files[3]}, model),
+                             "gain 8, exposure 0.01 s has one frame");
+    // Another sensor: another black level, then another size.
+    const auto writeOther = [&](const std::string& name, Size otherSize, double black) {
+        SensorParams p = params;
+        p.blackLevel = Vec4d::all(black);
+        p.noise = NoiseModel(p.noise.alpha, p.noise.sigmaD2, p.noise.sigmaR2);
+        const SensorSimulator other(p, otherSize);
+        Mat raw;
+        other.capture(Mat::zeros(otherSize, CV_32FC1), 2.0, 1.0, 5, 0, raw);
+        MosaicMetadata meta;
+        meta.format = other.rawFormat(2.0);
+        writeMosaic(dir + name, raw, meta);
+        return String(dir + name);
+    };
+    EXPECT_CV_ERROR_CONTAINS(
+        detail::collectDarkFrames({files[0], files[1], writeOther("/black.png", size, 64)}, model),
+        "black 64/64/64/64");
+    EXPECT_CV_ERROR_CONTAINS(
+        detail::collectDarkFrames(
+            {files[0], files[1], writeOther("/size.png", Size(16, 24), params.blackLevel[0])}, model),
+        "16x24");
 }
 
 } // namespace
