@@ -291,7 +291,8 @@ void measureStatisticsPrecision(const TradeoffSettings& set, const Mat& timingRa
         rows.push_back({"Arithmetic (burst statistics state)", wide ? "float64 (default)" : "float32",
                         "max |variance / long-double reference - 1|, mean 60000, variance 1", worst,
                         ms / (timedFrames * megapixels(timingRaw.size())),
-                        wide ? "exact to float64 rounding" : "half the state memory; the measure's error at an extreme mean",
+                        wide ? "exact to float64 rounding"
+                             : "half the state memory; the measure's error at an extreme mean",
                         byPath});
     }
 }
