@@ -3,7 +3,6 @@
 #include "dark_frames.hpp"
 
 #include <opencv2/rawgment/files.hpp>
-
 #include <opencv2/rawgment/mosaic_files.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
 

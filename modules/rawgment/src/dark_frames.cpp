@@ -82,21 +82,23 @@ DarkFrameEstimate estimateDarkFrames(const BurstStatistics& stats, double falseA
     stats.mean(mean);
     stats.variance(variance);
     const int rows = mean.rows, cols = mean.cols;
-    DarkFrameEstimate e;
-    e.frames = M;
-    e.rowVariance.create(rows, 2, CV_64FC1);
     if (rows * cols < 16)
         CV_Error(Error::StsBadArg, format("estimateDarkFrames: %dx%d frames are too small to tell a pattern "
                                           "from noise (at least 16 pixels)",
                                           cols, rows));
-    // A row's typical variance: the median over its pixels of one column parity, over the median of chi2(k) /
-    // k.
+    DarkFrameEstimate e;
+    e.frames = M;
+    e.rowVariance.create(rows, 2, CV_64FC1);
+    // A row's typical variance at one column parity: its median over the median of chi2(k) / k, and at least
+    // 1/12 DN^2, the variance of rounding to whole DN. Below it integer frames do not resolve noise: with 0.2
+    // DN of it most pixels never change, the median is 0, and a pixel that flickers once in eight frames
+    // (variance 1/8) would be called noisy.
     const auto typicalVariance = [&](int r, int parity, int k, std::vector<double>& values) {
         const double* v = variance.ptr<double>(r);
         values.clear();
         for (int c = parity; c < cols; c += 2)
             values.push_back(v[c]);
-        return medianOf(values) / chiSquareMedianOverDof(k);
+        return std::max(medianOf(values) / chiSquareMedianOverDof(k), 1.0 / 12);
     };
     // Heavy-tailed read noise scatters the sample variances more than M - 1 degrees of freedom say (with
     // Tukey lambda -0.1 and 25 frames, the chi-square threshold flagged 0.2% of ordinary pixels as noisy).

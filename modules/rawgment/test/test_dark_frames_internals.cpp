@@ -302,6 +302,31 @@ TEST(DarkFrames, filesGroupByGainAndExposureAndRefuseAnotherSensor)
         "16x24");
 }
 
+// Coarse dark frames (0.2 DN of noise, rounded): most pixels never change, so a row's median variance is 0. A
+// threshold on 0 would call every pixel that moves noisy (171 of 199 with the row's mean standing in); the
+// rounding's 1/12 DN^2 is the least variance a row is taken to have.
+TEST(DarkFrames, coarseFramesWhoseMedianVarianceIsZeroFlagAlmostNothing)
+{
+    SensorParams p;
+    p.noise = NoiseModel(0.1, 0.0, 0.04);
+    const Size size(64, 32);
+    const SensorSimulator sensor(p, size);
+    BurstStatistics stats(sensor.rawFormat(1));
+    for (int t = 0; t < 8; ++t) {
+        Mat raw;
+        sensor.capture(Mat::zeros(size, CV_32FC1), 1.0, 1.0, 9, t, raw);
+        stats.add(raw);
+    }
+    Mat variance;
+    stats.variance(variance);
+    ASSERT_GT(countNonZero(variance), 0);
+    ASSERT_LT(countNonZero(variance), static_cast<int>(variance.total() / 2)) << "the median must be 0";
+    const DarkFrameEstimate e = estimateDarkFrames(stats);
+    std::cout << e.noisyPixels.size() << " of " << countNonZero(variance) << " moving pixels flagged\n";
+    EXPECT_LT(e.noisyPixels.size(), variance.total() / 100);
+    EXPECT_GT(e.temporalVariance[0], 0);
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv
