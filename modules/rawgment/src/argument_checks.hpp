@@ -5,6 +5,7 @@
 #define OPENCV_RAWGMENT_SRC_ARGUMENT_CHECKS_HPP
 
 #include <opencv2/core.hpp>
+#include <opencv2/rawgment/bayer.hpp>
 
 namespace cv {
 namespace rawgment {
@@ -16,9 +17,10 @@ void checkFinitePositive(double value, const char* what);
 void checkFiniteNonNegative(double value, const char* what);
 
 /** A blur kernel as float64 normalised to sum 1: the one check of motion blur and the simulator's
- * blurred captures. Throws StsBadArg naming `who` unless it is non-empty, finite, non-negative and of
- * positive sum. */
-Mat normalisedKernel(InputArray kernel, const char* who, int maxSide);
+ * blurred captures. Throws StsBadArg naming `who` unless it is non-empty, finite, non-negative, of positive
+ * sum and at most MAX_MOTION_KERNEL_SIDE on a side on the CFA planes; on a monochrome frame's pixel grid
+ * (`pattern` CFA_MONO), where a motion spans twice the pixels, 2 MAX_MOTION_KERNEL_SIDE - 1. */
+Mat normalisedKernel(InputArray kernel, const char* who, CfaPattern pattern);
 /** The Mat of an array argument, refused with StsBadArg naming `what` ("colorJitter: src") unless it has at
  * most two dimensions: an N-D array (numpy's (1, 1, H, W) through cv2) would otherwise be read as 1x1. The
  * check every entry point makes, so that every binding gets it. */

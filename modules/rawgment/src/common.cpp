@@ -67,8 +67,9 @@ Mat twoDimensional(InputArray array, const char* what)
     return m;
 }
 
-Mat normalisedKernel(InputArray _kernel, const char* who, int maxSide)
+Mat normalisedKernel(InputArray _kernel, const char* who, CfaPattern pattern)
 {
+    const int maxSide = pattern == CFA_MONO ? 2 * MAX_MOTION_KERNEL_SIDE - 1 : MAX_MOTION_KERNEL_SIDE;
     const Mat given = twoDimensional(_kernel, format("%s: kernel", who).c_str());
     if (given.rows > maxSide || given.cols > maxSide)
         CV_Error(Error::StsBadArg,

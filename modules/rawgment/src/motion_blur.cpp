@@ -261,9 +261,7 @@ void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNois
     const auto start = std::chrono::steady_clock::now();
     checkResampleInput(src, format, "motionBlur");
     const StepNoise step(model, format, noise, 1, src.size(), "motionBlur");
-    const Mat w =
-        normalisedKernel(_kernel, "motionBlur",
-                         format.isMonochrome() ? 2 * MAX_MOTION_KERNEL_SIDE - 1 : MAX_MOTION_KERNEL_SIDE);
+    const Mat w = normalisedKernel(_kernel, "motionBlur", format.pattern);
     if (w.total() == 1) {
         if (!valuesChecked)
             checkMosaicInput(src, "motionBlur");

@@ -435,18 +435,18 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
         _dst.assign(src);
         return;
     }
-    const PlaneGrid grid(format);
+    std::atomic<bool> nonFinite{false}, nonFiniteInput{false};
+    ResampleConstants k = resampleConstants(src.depth(), format, step, seed, RandomStream::SCALE_GAUSSIAN,
+                                            RandomStream::SCALE_POISSON);
+    k.nonFiniteShading = &nonFinite;
+    k.nonFiniteInput = valuesChecked ? nullptr : &nonFiniteInput;
+    const PlaneGrid& grid = k.grid;
     const Size plane = grid.plane(src.size());
     const int phases = grid.step; // the site columns (rows) of the grid: 2, or 1 for a monochrome frame
     const BilinearAxis cols[2] = {bilinearAxis(plane.width, 0, scale, grid.step),
                                   bilinearAxis(plane.width, phases - 1, scale, grid.step)};
     const BilinearAxis rows[2] = {bilinearAxis(plane.height, 0, scale, grid.step),
                                   bilinearAxis(plane.height, phases - 1, scale, grid.step)};
-    std::atomic<bool> nonFinite{false}, nonFiniteInput{false};
-    ResampleConstants k = resampleConstants(src.depth(), format, step, seed, RandomStream::SCALE_GAUSSIAN,
-                                            RandomStream::SCALE_POISSON);
-    k.nonFiniteShading = &nonFinite;
-    k.nonFiniteInput = valuesChecked ? nullptr : &nonFiniteInput;
     if (step.hasDarkComponents()) {
         // The typical weights: sum w^2 and sum w^4 of the bilinear taps averaged over the output pixels
         // (a product of the two axes' averages).

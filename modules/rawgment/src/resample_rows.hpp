@@ -48,8 +48,8 @@ struct ResampleConstants
     DarkShading inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out before the step
     uint64_t rowKey = 0, tukeyKey = 0;
     std::atomic<bool>* nonFiniteShading = nullptr; // set when a shading row held NaN or Inf
-    std::atomic<bool>* nonFiniteInput =
-        nullptr; // set when a float input row held NaN or Inf; null: unchecked
+    // Set when a float input row held NaN or Inf; null when the step's input is not to be checked.
+    std::atomic<bool>* nonFiniteInput = nullptr;
 };
 
 // The buffers of a task's rows, sized once per task for plane rows of n pixels (whole blocks where a

@@ -1,7 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Scenes (what one augmentation simulates, applied step by step) and the random scene policy.
 #include "augment_steps.hpp"
-#include "lanes.hpp"
+#include "resample_rows.hpp"
 
 #include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/seeds.hpp>
@@ -236,7 +236,7 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
             b &= Rect(0, 0, current.cols, current.rows);
         }
     // A Bayer mosaic moves by whole 2x2 blocks so that its CFA phase stays; a monochrome frame has none.
-    const int gridStep = fmt.isMonochrome() ? 1 : 2;
+    const int gridStep = detail::PlaneGrid(fmt).step;
     const Point shift = gridStep == 1
                             ? scene.shift
                             : Point(2 * cvRound(scene.shift.x / 2.0), 2 * cvRound(scene.shift.y / 2.0));
@@ -275,10 +275,12 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
     }
     // The first step that runs checks the input's values as it reads them all; its output, finite, is what
     // the later steps read, unchecked.
-    const bool shifted = shift != Point(0, 0);
+    bool valuesChecked = shift != Point(0, 0);
     if (scene.scale != 1) {
         Mat& scaled = nextBuffer();
-        detail::scaleMosaicStep(current, fmt, valid, scene.scale, scene.noise, seed, scaled, report, shifted);
+        detail::scaleMosaicStep(current, fmt, valid, scene.scale, scene.noise, seed, scaled, report,
+                                valuesChecked);
+        valuesChecked = true;
         current = scaled;
         if (boxes)
             for (Rect& b : *boxes)
@@ -288,12 +290,13 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
     Mat unchanged;
     Mat& jittered = jitters ? nextBuffer() : unchanged;
     detail::colorJitterStep(current, fmt, valid, scene.jitter, scene.noise, seed, jittered, fmt, report,
-                            noArray(), shifted || scene.scale != 1 || (!jitters && blurs));
+                            noArray(), valuesChecked || (!jitters && blurs));
+    valuesChecked = valuesChecked || jitters;
     current = jittered;
     if (blurs) {
         Mat& blurred = nextBuffer();
         detail::motionBlurStep(current, fmt, valid, scene.motionKernel, scene.noise, seed, blurred, report,
-                               shifted || scene.scale != 1 || jitters);
+                               valuesChecked);
         current = blurred;
     }
     _dst.assign(current);

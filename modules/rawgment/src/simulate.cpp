@@ -1,7 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "opencv2/rawgment/simulate.hpp"
 #include "noise_terms.hpp"
-#include "opencv2/rawgment/augment.hpp"
 #include "precomp.hpp"
 #include "random.hpp"
 
@@ -240,9 +239,7 @@ void SensorSimulator::captureBlurred(InputArray _mean, InputArray _kernel, doubl
                                      uint64 seed, int frameIndex, OutputArray raw) const
 {
     const bool mono = params_.pattern == CFA_MONO;
-    const Mat kernel =
-        detail::normalisedKernel(_kernel, "SensorSimulator::captureBlurred",
-                                 mono ? 2 * MAX_MOTION_KERNEL_SIDE - 1 : MAX_MOTION_KERNEL_SIDE);
+    const Mat kernel = detail::normalisedKernel(_kernel, "SensorSimulator::captureBlurred", params_.pattern);
     Mat blurred;
     // The kernel lies on the grid motionBlur() uses: the CFA planes, or a monochrome frame's own pixels.
     if (mono) {

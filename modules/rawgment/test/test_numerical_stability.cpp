@@ -261,7 +261,11 @@ TEST(NumericalStability, oneNonFiniteValueAnywhereIsAnErrorOfEveryStep)
                 moved.shift = Point(12, -10);
                 Scene blurred;
                 blurred.motionKernel = linearMotionKernel(9, 0, pattern);
-                for (const Scene& scene : {Scene(), moved, blurred})
+                // Each scene's first step that reads the input checks it: the jitter here, the blur after it
+                // unchecked.
+                Scene darkBlurred = blurred;
+                darkBlurred.jitter = ColorJitter::exposureChange(0.5, 2);
+                for (const Scene& scene : {Scene(), moved, blurred, darkBlurred})
                     EXPECT_CV_ERROR_CONTAINS(applyScene(src, fmt, model, scene, 1, out, f), "NaN or Inf");
                 EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy().draw(src, fmt, 1), "NaN or Inf");
             }
