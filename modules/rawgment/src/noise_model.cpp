@@ -1,16 +1,11 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 #include "opencv2/rawgment/noise_model.hpp"
 #include "dark_shading.hpp"
+#include "map_images.hpp"
 #include "noise_terms.hpp"
 #include "precomp.hpp"
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <algorithm>
-#include <cctype>
-#include <cinttypes>
-#include <filesystem>
-#include <sys/stat.h>
 
 namespace cv {
 namespace rawgment {
@@ -30,27 +25,6 @@ template <typename T> void varianceOfMeans(const Mat& mean, Mat& dst, const Nois
                 d[c] = detail::lineVariance(a, b, m[c]);
         }
     });
-}
-
-// FNV-1a over the rows of a continuous or not CV_32FC1 map: the check that a model file and its
-// dark-shading images belong together.
-std::string mapChecksum(const Mat& map)
-{
-    uint64_t h = 0xcbf29ce484222325ull;
-    for (int r = 0; r < map.rows; ++r) {
-        const uchar* p = map.ptr<uchar>(r);
-        for (size_t i = 0; i < map.cols * map.elemSize(); ++i) {
-            h ^= p[i];
-            h *= 0x100000001b3ull;
-        }
-    }
-    return format("%016" PRIx64, h);
-}
-
-String baseNameOf(const String& path)
-{
-    const size_t slash = path.find_last_of('/');
-    return slash == String::npos ? path : path.substr(slash + 1);
 }
 
 const char* const kShadingKeys[2] = {"per_gain", "offset"};
@@ -241,10 +215,10 @@ void NoiseModel::write(FileStorage& fs, const String& name, const std::vector<St
         fs << "dark_shading"
            << "{";
         fs << "width" << darkShadingPerGain.cols << "height" << darkShadingPerGain.rows;
-        for (int i = 0; i < 2; ++i)
-            fs << kShadingKeys[i] << "{"
-               << "image" << shadingImages[static_cast<size_t>(i)] << "fnv1a64" << mapChecksum(*maps[i])
-               << "}";
+        for (int i = 0; i < 2; ++i) {
+            fs << kShadingKeys[i];
+            detail::writeMapImageEntry(fs, shadingImages[static_cast<size_t>(i)], *maps[i]);
+        }
         fs << "}";
     }
     if (!failedCalibration.empty())
@@ -272,44 +246,7 @@ double readNonNegative(const FileNode& node, const char* field)
 
 Mat readShadingImage(const FileNode& entry, const char* key, const String& folder, Size size)
 {
-    const FileNode n = entry[key];
-    if (n.empty() || !n.isMap())
-        CV_Error(Error::StsParseError, format("noise model: dark_shading.%s must be a map with image and "
-                                              "fnv1a64",
-                                              key));
-    rejectUnknownKeys(n, {"image", "fnv1a64"});
-    if (!n["image"].isString() || !n["fnv1a64"].isString())
-        CV_Error(Error::StsParseError,
-                 format("noise model: dark_shading.%s.image and .fnv1a64 must be strings", key));
-    const String name = n["image"].string(), checksum = n["fnv1a64"].string();
-    // A file name in the model's folder, nothing else: a hostile model file could otherwise name a device
-    // or a pipe that blocks the reader, or a file anywhere on the machine.
-    if (name.empty() || name == "." || name == ".." || name.find('/') != String::npos)
-        CV_Error(Error::StsParseError,
-                 format("noise model: dark_shading.%s.image '%s' must be a file name in the model's folder "
-                        "(no '/')",
-                        key, name.c_str()));
-    const String path = folder + name;
-    struct stat info;
-    if (::stat(path.c_str(), &info) != 0)
-        CV_Error(Error::StsError, format("noise model: dark-shading image '%s' is missing", path.c_str()));
-    if (!S_ISREG(info.st_mode))
-        CV_Error(Error::StsParseError,
-                 format("noise model: dark-shading image '%s' is not a regular file", path.c_str()));
-    const Mat map = imread(path, IMREAD_UNCHANGED);
-    if (map.type() != CV_32FC1 || map.size() != size)
-        CV_Error(
-            Error::StsParseError,
-            format("noise model: dark-shading image '%s' must be a CV_32FC1 TIFF of %dx%d (got %s, %dx%d)",
-                   path.c_str(), size.width, size.height, typeToString(map.type()).c_str(), map.cols,
-                   map.rows));
-    if (mapChecksum(map) != checksum)
-        CV_Error(
-            Error::StsParseError,
-            format("noise model: dark-shading image '%s' does not match the model file (checksum %s, the "
-                   "file says %s): the image and the model come from different saves",
-                   path.c_str(), mapChecksum(map).c_str(), checksum.c_str()));
-    return map;
+    return detail::readMapImage(entry[key], format("noise model: dark_shading.%s", key), folder, size);
 }
 
 } // namespace
@@ -419,26 +356,10 @@ NoiseModel NoiseModel::read(const FileNode& node, const String& folder)
 
 namespace {
 
-// `<model file name>.dark_shading_<key>.<checksum>.tiff`: the model file's whole name keeps cam.yml and
-// cam.json apart, the checksum gives every new map a new name, so a save never touches the maps the
-// current model file names until that file has been switched.
-String shadingImageName(const String& modelPath, int key, const Mat& map)
+// `<model file name>.dark_shading_<key>.<checksum>.tiff` (detail::mapImageName()).
+String shadingTag(int key)
 {
-    return baseNameOf(modelPath) + ".dark_shading_" + kShadingKeys[key] + "." + mapChecksum(map) + ".tiff";
-}
-
-bool isShadingImageOf(const String& modelPath, const std::string& name)
-{
-    for (int key = 0; key < 2; ++key) {
-        const std::string prefix = baseNameOf(modelPath) + ".dark_shading_" + kShadingKeys[key] + ".";
-        if (name.size() != prefix.size() + 16 + 5 || name.compare(0, prefix.size(), prefix) != 0 ||
-            name.compare(name.size() - 5, 5, ".tiff") != 0)
-            continue;
-        if (std::all_of(name.begin() + long(prefix.size()), name.end() - 5,
-                        [](char c) { return std::isxdigit(static_cast<unsigned char>(c)) != 0; }))
-            return true;
-    }
-    return false;
+    return String("dark_shading_") + kShadingKeys[key];
 }
 
 } // namespace
@@ -449,42 +370,18 @@ void NoiseModel::save(const String& path) const
     validate();
     detail::checkDarkShadingFinite(*this);
     std::vector<String> images;
-    const Mat* maps[2] = {&darkShadingPerGain, &darkShadingOffset};
-    if (hasDarkShading())
+    std::vector<const Mat*> maps;
+    if (hasDarkShading()) {
+        maps = {&darkShadingPerGain, &darkShadingOffset};
         for (int i = 0; i < 2; ++i)
-            images.push_back(shadingImageName(path, i, *maps[i]));
+            images.push_back(detail::mapImageName(path, shadingTag(i), *maps[static_cast<size_t>(i)]));
+    }
     const std::string text =
         fileStorageText(path, [&](FileStorage& fs) { write(fs, kTopLevelName, images); });
-    const String folder = detail::folderOf(path);
-    std::vector<String> created;
-    try {
-        for (size_t i = 0; i < images.size(); ++i) {
-            const String image = folder + images[i];
-            // Same name, same checksum: a map an earlier save left is this one already (when its pixels
-            // say so; a damaged one is replaced, as nothing can load it).
-            const bool present = pathExists(image);
-            if (present && mapChecksum(imread(image, IMREAD_UNCHANGED)) == mapChecksum(*maps[i]))
-                continue;
-            std::vector<uchar> bytes;
-            if (!imencode(".tiff", *maps[i], bytes, {IMWRITE_TIFF_COMPRESSION, 1}) || bytes.empty())
-                CV_Error(Error::StsError, "NoiseModel::save: cannot encode the dark-shading image " + image);
-            writeFileAtomically(image, bytes.data(), bytes.size(), present);
-            if (!present)
-                created.push_back(image);
-        }
-        writeFileAtomically(path, text.data(), text.size(), true);
-    } catch (...) {
-        for (const String& image : created)
-            std::remove(image.c_str());
-        throw;
-    }
-    // The model file now names only the new maps: its earlier ones go.
-    std::error_code error;
-    for (const auto& entry : std::filesystem::directory_iterator(folder.empty() ? "." : folder, error)) {
-        const std::string name = entry.path().filename().string();
-        if (isShadingImageOf(path, name) && std::find(images.begin(), images.end(), name) == images.end())
-            std::filesystem::remove(entry.path(), error);
-    }
+    const std::vector<String> tags = {shadingTag(0), shadingTag(1)};
+    detail::saveWithMapImages(
+        path, text, maps, images, [&](const String& name) { return detail::isMapImageOf(path, name, tags); },
+        "NoiseModel::save");
 }
 
 double NoiseModel::readExcessKurtosis() const

@@ -501,7 +501,7 @@ TEST(NoiseModel, aSaveWithMapsIsAllOrNothingAndModelsInOneFolderKeepTheirOwnMaps
     EXPECT_NO_THROW(NoiseModel::load(dir + "/cam.json"));
     // A damaged map of the same name is written again, not taken for this save's.
     std::ofstream(dir + "/" + shadingImageOf(dir + "/cam.json", "offset"), std::ios::trunc) << "junk";
-    EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/cam.json"), "dark-shading image");
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/cam.json"), "dark_shading.offset: image");
     b.save(dir + "/cam.json");
     EXPECT_EQ(0, norm(b.darkShadingOffset, NoiseModel::load(dir + "/cam.json").darkShadingOffset, NORM_INF));
 }
@@ -532,7 +532,7 @@ TEST(NoiseModel, darkShadingImagesOfAnotherSaveOrMissingAreErrors)
         edited.replace(edited.find(from), from.size(), hostile);
         std::ofstream(dir + "/hostile.yml") << edited;
         EXPECT_CV_ERROR_CONTAINS(NoiseModel::load(dir + "/hostile.yml"),
-                                 "must be a file name in the model's folder");
+                                 "must be a file name in the same folder");
     }
     // write() without image names cannot describe the maps.
     FileStorage fs(".yml", FileStorage::WRITE | FileStorage::MEMORY);
