@@ -9,12 +9,13 @@
 
 namespace cv {
 namespace rawgment {
-namespace detail {
 
-double DarkFrameEstimate::fixedPatternRms() const
+double DarkFrameStatistics::fixedPatternRms() const
 {
     return std::sqrt((patternVariance[0] + patternVariance[1] + patternVariance[2] + patternVariance[3]) / 4);
 }
+
+namespace detail {
 
 double chiSquareUpperQuantileOverDof(int k, double p)
 {
@@ -69,7 +70,7 @@ int effectiveDegreesOfFreedom(std::vector<double>& ratios, int most)
 
 } // namespace
 
-DarkFrameEstimate estimateDarkFrames(const BurstStatistics& stats, double falseAlarm)
+DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double falseAlarm)
 {
     const int M = stats.frames();
     if (M < 2)
@@ -86,7 +87,7 @@ DarkFrameEstimate estimateDarkFrames(const BurstStatistics& stats, double falseA
         CV_Error(Error::StsBadArg, format("estimateDarkFrames: %dx%d frames are too small to tell a pattern "
                                           "from noise (at least 16 pixels)",
                                           cols, rows));
-    DarkFrameEstimate e;
+    DarkFrameStatistics e;
     e.frames = M;
     e.rowVariance.create(rows, 2, CV_64FC1);
     // A row's typical variance at one column parity: its median over the median of chi2(k) / k, and at least
@@ -178,6 +179,69 @@ DarkFrameEstimate estimateDarkFrames(const BurstStatistics& stats, double falseA
             out[c] = static_cast<float>(e.level[s] + w * (m[c] - e.level[s]));
         }
     }
+    return e;
+}
+
+DarkFrameAccumulator::DarkFrameAccumulator(const RawFormat& format) : format_(format), stats_(format) {}
+
+void DarkFrameAccumulator::add(const Mat& frame)
+{
+    stats_.add(frame);
+    const int rows = frame.rows, cols = frame.cols;
+    if (rowSum_.empty()) {
+        rowSum_.assign(2 * static_cast<size_t>(rows), 0.0);
+        rowSum2_.assign(2 * static_cast<size_t>(rows), 0.0);
+    }
+    Mat values;
+    frame.convertTo(values, CV_64F);
+    const double counts[2] = {static_cast<double>((cols + 1) / 2), static_cast<double>(cols / 2)};
+    for (int r = 0; r < rows; ++r) {
+        const double* v = values.ptr<double>(r);
+        double sums[2] = {0, 0};
+        for (int c = 0; c < cols; ++c)
+            sums[c & 1] += v[c];
+        for (int parity = 0; parity < 2; ++parity) {
+            if (counts[parity] == 0)
+                continue;
+            const double mean = sums[parity] / counts[parity];
+            rowSum_[2 * static_cast<size_t>(r) + parity] += mean;
+            rowSum2_[2 * static_cast<size_t>(r) + parity] += mean * mean;
+        }
+    }
+}
+
+/* A row's mean at one column parity over its n pixels is the row's offset plus the mean of the pixels' own
+ * noise: its variance over the M frames is s_row^2 + sum(u_c) / n^2, u_c a pixel's temporal variance less the
+ * row's (noisy pixels included, as they are in the mean). A pixel's measured variance is v_c = u_c + s_row^2,
+ * so s_row^2 = (Var(row mean) - sum(v_c) / n^2) / (1 - 1/n), averaged over the rows of the site's parity. */
+DarkFrameStatistics DarkFrameAccumulator::estimate(double falseAlarm) const
+{
+    DarkFrameStatistics e = estimateDarkFrames(stats_, falseAlarm);
+    const int M = stats_.frames();
+    Mat variance;
+    stats_.variance(variance);
+    const int rows = variance.rows, cols = variance.cols;
+    double sum[4] = {0, 0, 0, 0}, count[4] = {0, 0, 0, 0};
+    for (int r = 0; r < rows; ++r) {
+        const double* v = variance.ptr<double>(r);
+        double own[2] = {0, 0}, n[2] = {0, 0};
+        for (int c = 0; c < cols; ++c) {
+            own[c & 1] += v[c];
+            n[c & 1] += 1;
+        }
+        for (int parity = 0; parity < 2; ++parity) {
+            if (n[parity] == 0)
+                continue;
+            const size_t i = 2 * static_cast<size_t>(r) + parity;
+            const double ofMeans = (rowSum2_[i] - rowSum_[i] * rowSum_[i] / M) / (M - 1);
+            const int site = cfaSite(r, parity);
+            // Each pixel's own variance holds the row's s_row^2 too: sum(v_c) / n^2 = s_row^2 / n + the rest.
+            sum[site] += (ofMeans - own[parity] / (n[parity] * n[parity])) / (1 - 1 / n[parity]);
+            count[site] += 1;
+        }
+    }
+    for (int s = 0; s < 4; ++s)
+        e.rowNoiseVariance[s] = count[s] > 0 ? std::max(0.0, sum[s] / count[s]) : 0.0;
     return e;
 }
 

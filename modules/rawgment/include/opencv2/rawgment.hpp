@@ -7,6 +7,7 @@
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/camera_profiles.hpp>
 #include <opencv2/rawgment/cpu.hpp>
+#include <opencv2/rawgment/dark_frames.hpp>
 #include <opencv2/rawgment/emva1288.hpp>
 #include <opencv2/rawgment/files.hpp>
 #include <opencv2/rawgment/isp.hpp>
@@ -35,6 +36,7 @@ tools
 reads
     @defgroup rawgment_files Files of every topic: atomic writes, bounded reads, guarded YAML/JSON
     @defgroup rawgment_emva1288 EMVA 1288 series: the standard's descriptor, figures and calibration
+    @defgroup rawgment_dark_frames Real dark frames as the read noise: a bank per gain and exposure
     @defgroup rawgment_calibration Noise calibration from bursts: statistics, line fits, cross-gain fits
     @defgroup rawgment_cpu Instruction-set paths of the hot loops: one binary, the same bits on every CPU
     @defgroup rawgment_simulate A physical sensor simulator and a ColorChecker scene: the ground truth
