@@ -135,6 +135,49 @@ Scene seedScene()
     return scene;
 }
 
+/* A dark-frame bank of two gains, two 12x8 frames each, written in `work` with their sidecars: the seeds name
+ * these frames and their saved patterns, which lie beside the mutated input. */
+DarkFrameBank seedDarkBank(const std::string& work)
+{
+    std::vector<cv::String> files;
+    for (double gain : {1.0, 4.0})
+        for (int t = 0; t < 2; ++t) {
+            MosaicMetadata meta;
+            meta.format.blackLevel = cv::Vec4d::all(64);
+            meta.format.whiteLevel = 4095;
+            meta.format.gain = gain;
+            const std::string path = work + cv::format("/dark_g%g_%d.png", gain, t);
+            writeMosaic(
+                path, seedMosaic(cv::Size(12, 8), 80 + 10 * gain, 11 + 2 * t + static_cast<int>(gain)), meta);
+            files.push_back(path);
+        }
+    return DarkFrameBank::create(files, NoiseModel());
+}
+
+std::string checkDarkBank(const DarkFrameBank& b)
+{
+    if (b.groups.empty() || b.size.area() <= 0)
+        return "accepted an empty bank";
+    for (size_t i = 0; i < b.groups.size(); ++i) {
+        const DarkFrameGroup& g = b.groups[i];
+        const DarkFrameStatistics& s = g.statistics;
+        if (!(g.gain > 0 && std::isfinite(g.gain)) || g.files.size() < 2 || s.frames != int(g.files.size()))
+            return cv::format("accepted group %zu with gain %g and %zu frames", i, g.gain, g.files.size());
+        if (s.pattern.type() != CV_32FC1 || s.pattern.size() != b.size || !cv::checkRange(s.pattern))
+            return cv::format("accepted group %zu's pattern that is not a finite map of the frames' size", i);
+        if (s.rowVariance.rows != b.size.height || s.noisyPixels.size() != s.noisyVariance.size())
+            return cv::format("accepted group %zu's row variances or noisy pixels of another size", i);
+        for (const cv::Point& p : s.noisyPixels)
+            if (!cv::Rect(cv::Point(), b.size).contains(p))
+                return cv::format("accepted a noisy pixel (%d, %d) outside the frames", p.x, p.y);
+    }
+    // A frame the file names is read as the readers read any file: a clear error or the bank's size.
+    const cv::Mat frame = b.readFrame(0, 0);
+    if (frame.size() != b.size)
+        return "read a frame of another size than the bank's";
+    return std::string();
+}
+
 } // namespace
 
 std::vector<Target> readerTargets(const std::string& dataDir)
@@ -151,6 +194,13 @@ std::vector<Target> readerTargets(const std::string& dataDir)
                                       [](const std::string& p) { seedDarkModel().save(p); });
                  },
                  [](const std::string& in) { return checkModel(NoiseModel::load(in)); }});
+    t.push_back({"dark_bank", "input.yml", false, Errors::LIBRARY,
+                 [](const std::string& work) {
+                     const DarkFrameBank bank = seedDarkBank(work);
+                     return textSeeds(work, "dark_bank",
+                                      [&](const std::string& p) { DarkFrameBank(bank).save(p); });
+                 },
+                 [](const std::string& in) { return checkDarkBank(DarkFrameBank::load(in)); }});
     t.push_back(
         {"camera_profiles", "input.json", false, Errors::LIBRARY,
          [](const std::string&) {

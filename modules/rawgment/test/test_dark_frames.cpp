@@ -200,6 +200,97 @@ TEST(DarkFrameBank, savesBesideItsFramesAndLoadsToTheBit)
     std::filesystem::remove_all(moved);
 }
 
+std::string textOf(const std::string& path)
+{
+    std::ifstream in(path);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+/* Each edit of a saved bank's file that save() would not write is refused on load, naming what is wrong; the
+ * file as saved loads. */
+TEST(DarkFrameBank, loadRefusesWhatSaveDoesNotWrite)
+{
+    const std::string dir = test::makeTempDir("dark_bank_refusals");
+    DarkFrameBank bank = smallBank(dir);
+    bank.save(dir + "/bank.yml");
+    const std::string text = textOf(dir + "/bank.yml");
+    const struct
+    {
+        std::string from, to, error;
+    } edits[] = {
+        {"format_version: 1", "format_version: 2", "format_version 2 is not supported"},
+        {"format_version: 1", "format_version: 0", "format_version 0 is not supported"},
+        {"   width: 32", "   widht: 32", "'widht'"},
+        {"   width: 32", "   width: -32", "width and height must be > 0"},
+        {"-\n         gain: 1.", "-\n         gain: -1.", "gain must be finite and > 0"},
+        {"exposure_time: 0.", "exposure_time: .nan", "exposure time"},
+        {"         degrees_of_freedom:", "         frames_per_gain: 1\n         degrees_of_freedom:", "'frames_per_gain'"},
+        {"g1_1.png", "/dev/zero", ""},
+        {"temporal_variance: [ ", "temporal_variance: [ -", "a variance finite and >= 0"},
+        {"level: [ ", "level: [ .inf, ", "'level' must be a list of 4"},
+        {".dark_frame_pattern_0.", ".dark_frame_pattern_1.", "groups[0].pattern"},
+        {"fnv1a64: \"", "fnv1a64: \"0", "does not match the file naming it"},
+        {"row_variance: [ ", "row_variance: [ 1., ", "'row_variance' has 49 values, more than 48"},
+        {"noisy_pixels: [", "noisy_pixels: [ 40., 1., 3.,", "(40, 1) is not a pixel of the 32x24 frames"},
+        {"noisy_pixels: [", "noisy_pixels: [ 1., 1.,", "x, y and variance per pixel"},
+    };
+    for (const auto& e : edits) {
+        SCOPED_TRACE(e.from + " -> " + e.to);
+        std::string edited = text;
+        const size_t at = edited.find(e.from);
+        ASSERT_NE(at, std::string::npos) << text.substr(0, 600);
+        edited.replace(at, e.from.size(), e.to);
+        std::ofstream(dir + "/edited.yml", std::ios::trunc) << edited;
+        if (e.error.empty()) {
+            // A frame path is not read on load: where a step reads it, a device is refused by name.
+            const DarkFrameBank loaded = DarkFrameBank::load(dir + "/edited.yml");
+            EXPECT_CV_ERROR_CONTAINS(loaded.readFrame(0, 1), "/dev/zero");
+            continue;
+        }
+        EXPECT_CV_ERROR_CONTAINS(DarkFrameBank::load(dir + "/edited.yml"), e.error);
+    }
+    // A group of one frame, though its statistics are consistent otherwise.
+    DarkFrameBank one = bank;
+    one.groups[0].files.resize(1);
+    one.groups[0].fileBytes.resize(1);
+    one.groups[0].statistics.frames = 1;
+    EXPECT_CV_ERROR_CONTAINS(one.save(dir + "/one.yml"), "a group needs at least two frames");
+    EXPECT_FALSE(std::filesystem::exists(dir + "/one.yml"));
+    EXPECT_CV_ERROR_CONTAINS(DarkFrameBank().save(dir + "/empty.yml"), "an empty bank");
+    EXPECT_CV_ERROR_CONTAINS(DarkFrameBank::createFromFolder(dir + "/none", NoiseModel()), "is not a folder");
+    const std::string empty = test::makeTempDir("dark_bank_refusals_empty");
+    EXPECT_CV_ERROR_CONTAINS(DarkFrameBank::createFromFolder(empty, NoiseModel()), "holds no dark frames");
+    EXPECT_NO_THROW(DarkFrameBank::load(dir + "/bank.yml"));
+}
+
+/* The nearest group: by gain on a log scale, then by exposure; a gain beyond the bank's range is refused, one
+ * within 0.1% of its ends is its end (an ISO's rounding). */
+TEST(DarkFrameBank, theNearestGroupLiesWithinTheBanksGains)
+{
+    DarkFrameBank bank;
+    bank.size = Size(4, 4);
+    for (const auto& ge : {std::make_pair(1.0, 0.01), std::make_pair(4.0, 0.01), std::make_pair(4.0, 1.0),
+                           std::make_pair(16.0, 0.0)}) {
+        DarkFrameGroup g;
+        g.gain = ge.first;
+        g.exposureTime = ge.second;
+        bank.groups.push_back(g);
+    }
+    EXPECT_EQ(bank.nearestGroup(1.0), 0);
+    EXPECT_EQ(bank.nearestGroup(1.999), 0);
+    EXPECT_EQ(bank.nearestGroup(2.001), 1) << "log scale: 2 is as near 1 as 4";
+    EXPECT_EQ(bank.nearestGroup(4.0), 1) << "exposure 0: the shortest of the gain";
+    EXPECT_EQ(bank.nearestGroup(4.0, 0.5), 2);
+    EXPECT_EQ(bank.nearestGroup(4.0, 0.05), 1);
+    EXPECT_EQ(bank.nearestGroup(16.0 * 1.0009), 3);
+    EXPECT_CV_ERROR_CONTAINS(bank.nearestGroup(16.0 * 1.002), "outside the bank's gains [1, 16]");
+    EXPECT_CV_ERROR_CONTAINS(bank.nearestGroup(0.99), "outside the bank's gains");
+    EXPECT_CV_ERROR_CONTAINS(bank.nearestGroup(std::nan("")), "must be finite");
+    EXPECT_CV_ERROR_CONTAINS(DarkFrameBank().nearestGroup(1), "an empty bank");
+    EXPECT_CV_ERROR_CONTAINS(bank.readFrame(4, 0), "group 4 of a bank of 4");
+    EXPECT_CV_ERROR_CONTAINS(bank.readFrame(0, 0), "frame 0 of a group of 0");
+}
+
 } // namespace
 } // namespace rawgment
 } // namespace cv
