@@ -126,6 +126,8 @@ void NoiseOptions::writeFields(FileStorage& fs) const
 {
     fs << "alignment" << static_cast<int>(alignment) << "shot_sampling" << static_cast<int>(shotSampling)
        << "prior_mean" << static_cast<int>(priorMean) << "blur_noise_sum" << static_cast<int>(blurNoiseSum);
+    if (!darkBank.empty())
+        fs << "dark_bank" << darkBank << "dark_bank_tied" << static_cast<int>(darkBankTied);
 }
 
 NoiseOptions NoiseOptions::readFields(const FileNode& map)
@@ -142,6 +144,17 @@ NoiseOptions NoiseOptions::readFields(const FileNode& map)
     o.shotSampling = static_cast<ShotNoiseSampling>(field("shot_sampling", static_cast<int>(o.shotSampling)));
     o.priorMean = static_cast<PriorMeanEstimate>(field("prior_mean", static_cast<int>(o.priorMean)));
     o.blurNoiseSum = static_cast<BlurNoiseSum>(field("blur_noise_sum", static_cast<int>(o.blurNoiseSum)));
+    const FileNode bank = map["dark_bank"];
+    if (!bank.empty()) {
+        if (!bank.isString() || bank.string().empty())
+            CV_Error(Error::StsParseError,
+                     "noise options: 'dark_bank' must be the path of a dark-frame bank file");
+        o.darkBank = bank.string();
+    }
+    const int tied = field("dark_bank_tied", 0);
+    if (tied != 0 && tied != 1)
+        CV_Error(Error::StsParseError, "noise options: 'dark_bank_tied' must be 0 or 1");
+    o.darkBankTied = tied == 1;
     o.validate();
     return o;
 }

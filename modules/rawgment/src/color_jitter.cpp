@@ -2,6 +2,8 @@
 // Colour jitter: noise-accounted exposure, gain, contrast, brightness and hue (paper Eq. 11 and 13).
 #include "color_jitter_rows.hpp"
 
+#include "bank_noise.hpp"
+
 #include <opencv2/imgproc.hpp>
 
 #include <atomic>
@@ -243,12 +245,13 @@ struct JitterKeys
 template <typename T>
 void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstants& k,
                 const JitterColumnTables& tables, const JitterKeys& keys,
-                const detail::DarkShading& inputShading, const Range& rows, std::atomic<int64>& brightening,
-                std::atomic<bool>& nonFinite, std::atomic<bool>* nonFiniteInput)
+                const detail::DarkShading& inputShading, const detail::BankRead* bank, const Range& rows,
+                std::atomic<int64>& brightening, std::atomic<bool>& nonFinite,
+                std::atomic<bool>* nonFiniteInput)
 {
     const int cols = src.cols;
     const bool noise = k.alignment != NoiseAlignment::NONE;
-    const bool tails = noise && k.dark.tails, dark = noise && k.dark.any();
+    const bool tails = noise && k.dark.tails, dark = noise && (k.dark.any() || bank);
     std::vector<float> z(static_cast<size_t>(cols)), t(tails ? cols : 0), extra(dark ? cols : 0),
         blackAndShading(inputShading.empty() ? 0 : static_cast<size_t>(cols));
     const bool poisson = noise && k.sampling == ShotNoiseSampling::POISSON;
@@ -266,7 +269,9 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstant
             detail::fillTukeyUnit(keys.tukey, static_cast<uint64_t>(r), k.dark.tailTable[r & 1], t.data(),
                                   cols);
         }
-        if (dark && !detail::darkRowExtra(k.dark, keys.row, r, cols, extra.data()))
+        if (bank)
+            detail::bankRowExtra(*bank, r, cols, extra.data());
+        else if (dark && !detail::darkRowExtra(k.dark, keys.row, r, cols, extra.data()))
             nonFinite = true;
         JitterColumns col = tables.forRow(r);
         if (!inputShading.empty()) {
@@ -470,6 +475,17 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
                     ? localPriorMean(src, format, inputShading)
                     : Mat();
     k.dark = jitterDarkTerms(step, jitter);
+    // With a dark-frame bank its frames are the read part; what the input holds of it is scaled by p_c.
+    BankRead bank;
+    if (step.bank) {
+        BankPrior prior;
+        for (int m = 0; m < 4; ++m) {
+            prior.pixel[m] = prior.row[m] = jitter.contrast[m] * jitter.contrast[m];
+            prior.pattern[m] = jitter.contrast[m];
+        }
+        bank =
+            prepareBankRead(step, format, src.size(), prior, seed, RandomStream::JITTER_BANK, "colorJitter");
+    }
     Mat dst = stepOutput(src, _dst);
     std::atomic<int64> brightening{0};
     std::atomic<bool> nonFinite{false}, nonFiniteInput{false};
@@ -479,11 +495,11 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     const JitterColumnTables tables(k, src.cols);
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
-            jitterRows<ushort>(src, prior, dst, k, tables, keys, inputShading, rows, brightening, nonFinite,
-                               nullptr);
+            jitterRows<ushort>(src, prior, dst, k, tables, keys, inputShading, bank.empty() ? nullptr : &bank,
+                               rows, brightening, nonFinite, nullptr);
         else
-            jitterRows<float>(src, prior, dst, k, tables, keys, inputShading, rows, brightening, nonFinite,
-                              valuesChecked ? nullptr : &nonFiniteInput);
+            jitterRows<float>(src, prior, dst, k, tables, keys, inputShading, bank.empty() ? nullptr : &bank,
+                              rows, brightening, nonFinite, valuesChecked ? nullptr : &nonFiniteInput);
     });
     if (nonFiniteInput)
         throwNonFiniteInput("colorJitter");
@@ -495,6 +511,7 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     dstFormat.gain = newGain;
     if (report) {
         report->brighteningPixels += brightening.load();
+        report->readBrighteningPixels += bank.readBrightening;
         recordStep(report, "colorJitter", start);
     }
 }

@@ -383,6 +383,10 @@ enum class RandomStream : uint64_t
     SCALE_TUKEY = 14,
     // Which real camera's noise a sample takes (drawCameraIndex(), one draw per seed).
     CAMERA_DRAW = 15,
+    // Which dark frames of a bank a step takes (bank_noise.hpp): one stream, its first draws.
+    JITTER_BANK = 16,
+    BLUR_BANK = 17,
+    SCALE_BANK = 18,
 };
 
 /** The key of one family under a user's seed: the SplitMix64 finaliser of seed + golden * (id + 1),

@@ -240,6 +240,13 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
 ResampleConstants resampleConstants(int depth, const RawFormat& format, const StepNoise& step, uint64 seed,
                                     detail::RandomStream gaussian, detail::RandomStream poisson)
 {
+    if (step.bank)
+        CV_Error(Error::StsNotImplemented,
+                 cv::format(
+                     "%s: a dark-frame bank (NoiseOptions::darkBank '%s') drives colour jitter's read part; "
+                     "motion blur and scaling with a bank are not implemented yet",
+                     gaussian == RandomStream::BLUR_GAUSSIAN ? "motionBlur" : "scaleMosaic",
+                     step.options.darkBank.c_str()));
     ResampleConstants k;
     k.grid = PlaneGrid(format);
     for (int s = 0; s < 4; ++s)

@@ -83,7 +83,8 @@ Scene Scene::read(const FileNode& node)
             s.shift = Point(static_cast<int>(shift[0]), static_cast<int>(shift[1]));
         }
         rejectUnknownKeys(node, {"shift", "scale", "contrast", "brightness", "gain_ratio", "motion_kernel",
-                                 "alignment", "shot_sampling", "prior_mean", "blur_noise_sum"});
+                                 "alignment", "shot_sampling", "prior_mean", "blur_noise_sum", "dark_bank",
+                                 "dark_bank_tied"});
         s.scale = detail::readOptionalRealField(node, "scale", s.scale);
         const std::vector<double> contrast = detail::readRealList(node, "contrast", 4);
         for (int i = 0; i < 4; ++i)
@@ -473,10 +474,12 @@ RandomScenePolicy RandomScenePolicy::read(const FileNode& node)
         }
     };
     try {
-        rejectUnknownKeys(node, {"contrast_min", "contrast_max", "brightness_min", "brightness_max",
-                                 "hue_probability", "hue_min", "hue_max", "gain_db_min", "gain_db_max",
-                                 "blur_probability", "blur_length_max", "geometry_probability", "max_shift",
-                                 "max_scale", "alignment", "shot_sampling", "prior_mean", "blur_noise_sum"});
+        rejectUnknownKeys(node,
+                          {"contrast_min",    "contrast_max",     "brightness_min",  "brightness_max",
+                           "hue_probability", "hue_min",          "hue_max",         "gain_db_min",
+                           "gain_db_max",     "blur_probability", "blur_length_max", "geometry_probability",
+                           "max_shift",       "max_scale",        "alignment",       "shot_sampling",
+                           "prior_mean",      "blur_noise_sum",   "dark_bank",       "dark_bank_tied"});
     } catch (const Exception& e) {
         CV_Error(e.code, "random scene policy: " + e.err);
     }

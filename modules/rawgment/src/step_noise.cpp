@@ -2,6 +2,8 @@
 // A noise step's model prepared once per call (step_noise.hpp), and the dark terms' rows.
 #include "step_noise.hpp"
 
+#include "bank_noise.hpp"
+
 #include "precomp.hpp"
 
 namespace cv {
@@ -34,7 +36,36 @@ StepNoise::StepNoise(const ValidatedNoiseModel& valid, const RawFormat& format, 
     rowSigmaR2 = model.rowSigmaR2;
     tails = model.tukeyRead;
     tukeyLambda = model.tukeyLambda;
-    if (addsNoise() && model.hasDarkShading()) {
+    modelIn = in;
+    modelOut = out;
+    if (addsNoise() && !options.darkBank.empty()) {
+        bank = cachedDarkFrameBank(options.darkBank);
+        if (bank->empty())
+            CV_Error(Error::StsBadArg,
+                     cv::format("%s: the dark-frame bank '%s' is empty", who, options.darkBank.c_str()));
+        try {
+            bankGroupOut = bank->nearestGroup(gainOut);
+        } catch (const Exception& e) {
+            CV_Error(e.code, cv::format("%s: the output gain: ", who) + e.err);
+        }
+        // The input's own read noise at any gain: the nearest group's, scaled by the model's lines.
+        bankGroupIn = 0;
+        for (int i = 1; i < static_cast<int>(bank->groups.size()); ++i)
+            if (std::abs(std::log(bank->groups[size_t(i)].gain / gainIn)) <
+                std::abs(std::log(bank->groups[size_t(bankGroupIn)].gain / gainIn)) - 1e-12)
+                bankGroupIn = i;
+        const auto scaleTo = [&](const NoiseTerms<double>& at, int group) {
+            const double there = valid.termsAt(bank->groups[static_cast<size_t>(group)].gain).read();
+            return there > 0 ? std::sqrt(at.read() / there) : 1.0;
+        };
+        bankScaleIn = scaleTo(modelIn, bankGroupIn);
+        bankScaleOut = scaleTo(modelOut, bankGroupOut);
+        for (NoiseTerms<double>* t : {&in, &out})
+            t->readBeforeGain = t->readAfterGain = 0;
+        rowNoise = false;
+        tails = false;
+    }
+    if (addsNoise() && model.hasDarkShading() && !bank) {
         shading = DarkShading(model.darkShadingPerGain, model.darkShadingOffset, gainIn, format.sensorOrigin);
         shading.checkCovers(size, who);
     }

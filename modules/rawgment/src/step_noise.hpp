@@ -11,6 +11,10 @@
 #include "opencv2/rawgment/augment.hpp"
 #include "random.hpp"
 
+#include <opencv2/rawgment/dark_frames.hpp>
+
+#include <memory>
+
 namespace cv {
 namespace rawgment {
 namespace detail {
@@ -34,7 +38,16 @@ struct StepNoise
     double rowSigmaD2, rowSigmaR2;
     bool tails;          //!< NoiseModel::tukeyRead
     double tukeyLambda;  //!< the read noise's Tukey-lambda shape, when `tails`
-    DarkShading shading; //!< at gainIn; empty when the model has none or the step adds no noise
+    DarkShading shading; //!< at gainIn; empty when the model has none, the step adds no noise or uses a bank
+    /** NoiseOptions::darkBank's bank, when set and the step adds noise: it then stands in for the model's
+     * read terms, which `in` and `out` no longer hold (nor rowNoise, tails or shading); modelIn and modelOut
+     * do. */
+    std::shared_ptr<const DarkFrameBank> bank;
+    NoiseTerms<double> modelIn, modelOut; //!< the model's whole terms at gainIn and gainOut
+    int bankGroupIn = -1,
+        bankGroupOut = -1; //!< the bank's groups nearest gainIn (any) and gainOut (in range)
+    //! sqrt of the model's read variance at gainIn (gainOut) over that at its group's gain: the frames' scale
+    double bankScaleIn = 1, bankScaleOut = 1;
 
     bool addsNoise() const { return options.alignment != NoiseAlignment::NONE; }
     bool hasDarkComponents() const { return rowNoise || !shading.empty() || tails; }

@@ -4,6 +4,7 @@
 // estimate is tested against the simulator's truth in test_dark_frames_internals.cpp.
 #include "test_common.hpp"
 
+#include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/dark_frames.hpp>
 #include <opencv2/rawgment/mosaic_files.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
@@ -224,7 +225,8 @@ TEST(DarkFrameBank, loadRefusesWhatSaveDoesNotWrite)
         {"   width: 32", "   width: -32", "width and height must be > 0"},
         {"-\n         gain: 1.", "-\n         gain: -1.", "gain must be finite and > 0"},
         {"exposure_time: 0.", "exposure_time: .nan", "exposure time"},
-        {"         degrees_of_freedom:", "         frames_per_gain: 1\n         degrees_of_freedom:", "'frames_per_gain'"},
+        {"         degrees_of_freedom:", "         frames_per_gain: 1\n         degrees_of_freedom:",
+         "'frames_per_gain'"},
         {"g1_1.png", "/dev/zero", ""},
         {"temporal_variance: [ ", "temporal_variance: [ -", "a variance finite and >= 0"},
         {"level: [ ", "level: [ .inf, ", "'level' must be a list of 4"},
@@ -289,6 +291,174 @@ TEST(DarkFrameBank, theNearestGroupLiesWithinTheBanksGains)
     EXPECT_CV_ERROR_CONTAINS(DarkFrameBank().nearestGroup(1), "an empty bank");
     EXPECT_CV_ERROR_CONTAINS(bank.readFrame(4, 0), "group 4 of a bank of 4");
     EXPECT_CV_ERROR_CONTAINS(bank.readFrame(0, 0), "frame 0 of a group of 0");
+}
+
+/* A simulated sensor whose dark frames hold what the parametric components do (row noise, dark shading,
+ * Tukey tails) and what they do not (hot pixels, 1% noisy pixels), its bank of 16 frames per gain at gains 1
+ * and 4 saved in `dir`, and captures of any other frames. */
+constexpr int kBankFrames = 16;
+
+struct BankedSensor
+{
+    Size size{96, 64};
+    SensorParams params;
+    std::unique_ptr<SensorSimulator> sensor;
+    String bankPath;
+    Mat defects;
+    explicit BankedSensor(const std::string& dir)
+    {
+        params = test::darkComponentSensorParams(size, -0.1, 5);
+        params.dsnu = 0.3;
+        params.hotPixelFraction = 0.002;
+        params.noisyPixelFraction = 0.01;
+        params.noisyPixelVariance = 100;
+        sensor.reset(new SensorSimulator(params, size));
+        Mat prnu, dsnu;
+        sensor->fixedPattern(prnu, dsnu, defects);
+        std::vector<String> files;
+        for (double gain : {1.0, 4.0})
+            for (int t = 0; t < kBankFrames; ++t) {
+                MosaicMetadata meta;
+                meta.format = sensor->rawFormat(gain);
+                const std::string path = dir + format("/dark_g%g_%02d.png", gain, t);
+                writeMosaic(path, capture(0.0, gain, 1000 + t), meta);
+                files.push_back(path);
+            }
+        DarkFrameBank bank = DarkFrameBank::create(files, NoiseModel());
+        bankPath = dir + "/bank.yml";
+        bank.save(bankPath);
+    }
+    Mat capture(double meanAtUnitGain, double gain, int frame) const
+    {
+        Mat raw;
+        sensor->capture(Mat(size, CV_32FC1, Scalar(meanAtUnitGain)), gain, 1.0, 77, frame, raw);
+        return raw;
+    }
+};
+
+/* Over a stack of frames, per row: the variance of the row's mean over the pixels `keep` marks (the row part,
+ * with 1/n of the pixel part) and the mean over those pixels of their variance about the row's mean (the
+ * pixel part). One value per row for each, so that the rows' shared offsets do not pass for independent
+ * samples. */
+void rowAndPixelParts(const std::vector<Mat>& frames, const Mat& keep, std::vector<double>& rowPart,
+                      std::vector<double>& pixelPart)
+{
+    const int n = static_cast<int>(frames.size());
+    rowPart.clear();
+    pixelPart.clear();
+    for (int r = 0; r < frames[0].rows; ++r) {
+        std::vector<double> means;
+        for (const Mat& f : frames) {
+            double sum = 0, count = 0;
+            for (int c = 0; c < f.cols; ++c)
+                if (keep.at<uchar>(r, c)) {
+                    sum += f.at<ushort>(r, c);
+                    count += 1;
+                }
+            means.push_back(sum / count);
+        }
+        double s = 0, s2 = 0;
+        for (double m : means) {
+            s += m;
+            s2 += m * m;
+        }
+        rowPart.push_back((s2 - s * s / n) / (n - 1));
+        double sum = 0, count = 0;
+        for (int c = 0; c < frames[0].cols; ++c) {
+            if (!keep.at<uchar>(r, c))
+                continue;
+            double p = 0, p2 = 0;
+            for (int i = 0; i < n; ++i) {
+                const double v =
+                    frames[static_cast<size_t>(i)].at<ushort>(r, c) - means[static_cast<size_t>(i)];
+                p += v;
+                p2 += v * v;
+            }
+            sum += (p2 - p * p / n) / (n - 1);
+            count += 1;
+        }
+        pixelPart.push_back(sum / count);
+    }
+}
+
+void meanAndStandardError(const std::vector<double>& v, double& mean, double& se)
+{
+    mean = 0;
+    for (double x : v)
+        mean += x / v.size();
+    double ss = 0;
+    for (double x : v)
+        ss += (x - mean) * (x - mean);
+    se = std::sqrt(ss / (v.size() - 1) / v.size());
+}
+
+/* Darkening dark frames from gain 1 to gain 4 at contrast k = 1/2 with a bank: the input's read noise, scaled
+ * by k, is already k^2 v_s of the target's. ACCOUNT_PRIOR adds only what the target lacks, so its outputs'
+ * variance is the independent target captures'; IGNORE_PRIOR adds whole dark frames on top, k^2 v_s too much.
+ * Differences are taken per row (32 outputs each), and each claim holds within 3 standard errors of the 64
+ * rows' mean. */
+TEST(DarkFrameBank, ignoringThePriorAddsKSquaredOfTheInputsReadNoiseAndAccountingDoesNot)
+{
+    const std::string dir = test::makeTempDir("dark_bank_excess");
+    const BankedSensor s(dir);
+    // No shot noise: these dark frames hold no photons, which Eq. 13 would read into their positive values.
+    NoiseModel model = s.sensor->effectiveModel();
+    model.alpha = 0;
+    const ColorJitter jitter = ColorJitter::exposureChange(1.0 / 8, 4.0);
+    const double k = jitter.contrast[0];
+    const int n = 32;
+    std::vector<Mat> inputs, targets, account, ignore;
+    int64 readBrightening = 0;
+    for (int i = 0; i < n; ++i) {
+        inputs.push_back(s.capture(0.0, 1.0, 2000 + i));
+        targets.push_back(s.capture(0.0, 4.0, 3000 + i));
+        for (NoiseAlignment a : {NoiseAlignment::ACCOUNT_PRIOR, NoiseAlignment::IGNORE_PRIOR}) {
+            NoiseOptions options(a);
+            options.darkBank = s.bankPath;
+            options.darkBankTied = true; // the inputs are the bank's sensor's: its noisy pixels are theirs
+
+            Mat out;
+            RawFormat outFormat;
+            AugmentReport report;
+            colorJitter(inputs.back(), s.sensor->rawFormat(1.0), model, jitter, options, 500 + i, out,
+                        outFormat, report);
+            EXPECT_EQ(outFormat.gain, 4.0);
+            (a == NoiseAlignment::ACCOUNT_PRIOR ? account : ignore).push_back(out);
+            if (a == NoiseAlignment::ACCOUNT_PRIOR)
+                readBrightening += report.readBrighteningPixels;
+        }
+    }
+    // Hot pixels hold a fixed value near white: Eq. 13 reads them as bright pixels, whose shot noise is
+    // another test's.
+    const Mat keep = s.defects != 1;
+    std::vector<double> parts[4][2]; // input, target, ACCOUNT, IGNORE: row part, pixel part
+    const std::vector<Mat>* stacks[4] = {&inputs, &targets, &account, &ignore};
+    for (int i = 0; i < 4; ++i)
+        rowAndPixelParts(*stacks[i], keep, parts[i][0], parts[i][1]);
+    for (int part = 0; part < 2; ++part) {
+        const char* name = part == 0 ? "row part" : "pixel part";
+        std::vector<double> accountLess, ignoreLess, ignoreExcess;
+        for (size_t r = 0; r < parts[0][part].size(); ++r) {
+            accountLess.push_back(parts[2][part][r] - parts[1][part][r]);
+            ignoreLess.push_back(parts[3][part][r] - parts[1][part][r]);
+            ignoreExcess.push_back(parts[3][part][r] - parts[1][part][r] * (1 - 1.0 / kBankFrames) -
+                                   k * k * parts[0][part][r]);
+        }
+        double m, se;
+        meanAndStandardError(parts[1][part], m, se);
+        std::cout << name << ": target " << m << " +- " << se;
+        meanAndStandardError(parts[0][part], m, se);
+        std::cout << ", input " << m << " (k^2 of it " << k * k * m << ")\n";
+        meanAndStandardError(accountLess, m, se);
+        std::cout << "  ACCOUNT_PRIOR - target: " << m << " +- " << se << "\n";
+        EXPECT_LT(std::abs(m), 3 * se) << name;
+        meanAndStandardError(ignoreLess, m, se);
+        std::cout << "  IGNORE_PRIOR - target: " << m << " +- " << se << "\n";
+        meanAndStandardError(ignoreExcess, m, se);
+        std::cout << "  IGNORE_PRIOR - target (M - 1) / M - k^2 input: " << m << " +- " << se << "\n";
+        EXPECT_LT(std::abs(m), 3 * se) << name;
+    }
+    std::cout << "read-brightening pixels per output: " << readBrightening / n << "\n";
 }
 
 } // namespace

@@ -73,17 +73,30 @@ struct CV_EXPORTS_W_SIMPLE NoiseOptions
     CV_PROP_RW ShotNoiseSampling shotSampling; //!< shape of the added shot noise
     CV_PROP_RW PriorMeanEstimate priorMean;    //!< the estimate of mu_x
     CV_PROP_RW BlurNoiseSum blurNoiseSum;      //!< motion blur's shot-noise term
+    /** A dark-frame bank's file (DarkFrameBank::save()), or "" for none: its real dark frames then stand in
+     * for the model's read terms (read noise, row noise, dark shading, heavy tails), and the model keeps the
+     * shot noise. ACCOUNT_PRIOR adds to each pixel's row part and pixel part only what the input's own read
+     * noise, scaled by the step, lacks of the target's; IGNORE_PRIOR adds whole dark frames. Given by path so
+     * that it reaches other processes as a path: the file is read once per process while it is unchanged.
+     * docs/mathematics.md ("A bank of dark frames") gives the equations. */
+    CV_PROP_RW String darkBank;
+    /** Whether the input comes from the bank's own sensor at the same exposure and temperature, at its
+     * RawFormat::sensorOrigin: then ACCOUNT_PRIOR takes the input's fixed pattern, scaled by the step, out
+     * and puts the target's in. Otherwise (the default) the input keeps its pattern and only what the
+     * target's pattern needs in variance is added. */
+    CV_PROP_RW bool darkBankTied;
 
     //! Every field at its default, as initialised here.
     CV_WRAP NoiseOptions()
         : alignment(NoiseAlignment::ACCOUNT_PRIOR), shotSampling(ShotNoiseSampling::GAUSSIAN),
-          priorMean(PriorMeanEstimate::PIXEL_VALUE), blurNoiseSum(BlurNoiseSum::EXACT)
+          priorMean(PriorMeanEstimate::PIXEL_VALUE), blurNoiseSum(BlurNoiseSum::EXACT), darkBankTied(false)
     {
     }
     //! The given alignment with the other defaults; implicit on purpose (see above).
     CV_WRAP NoiseOptions(NoiseAlignment a) : NoiseOptions() { alignment = a; }
     CV_WRAP void validate() const; //!< throws naming an unknown enum value
-    //! Writes the options as fields of the current map (`alignment`, `shot_sampling`, ...).
+    //! Writes the options as fields of the current map (`alignment`, `shot_sampling`, ..., `dark_bank` and
+    //! `dark_bank_tied` when a bank is set).
     void writeFields(FileStorage& fs) const;
     //! Reads the fields written by writeFields(); missing ones keep their defaults.
     static NoiseOptions readFields(const FileNode& map);
@@ -93,10 +106,13 @@ struct CV_EXPORTS_W_SIMPLE NoiseOptions
 struct CV_EXPORTS_W_SIMPLE AugmentReport
 {
     //! Nothing counted, no step.
-    CV_WRAP AugmentReport() : brighteningPixels(0), saturatedPixels(0) {}
+    CV_WRAP AugmentReport() : brighteningPixels(0), saturatedPixels(0), readBrighteningPixels(0) {}
     CV_PROP int64
         brighteningPixels; //!< pixels whose noise variance to add was negative (brightening), clipped to 0
     CV_PROP int64 saturatedPixels; //!< input pixels at or above the white level (their signal is unknown)
+    /** Pixels whose read noise the input already held more of than the target has (a dark-frame bank's row or
+     * pixel part with k^2 v_s > v_t): they get none of that part, as brightening pixels get no shot noise. */
+    CV_PROP int64 readBrighteningPixels;
     CV_PROP std::vector<std::string>
         steps; //!< the steps that ran, in order; skipped identity steps are absent
     /** The wall time of each step of `steps`, in seconds (its checks, noise and output; for a profile of
