@@ -5,6 +5,7 @@
 #include "test_common.hpp"
 
 #include <opencv2/rawgment/augment.hpp>
+#include <opencv2/rawgment/cpu.hpp>
 #include <opencv2/rawgment/dark_frames.hpp>
 #include <opencv2/rawgment/mosaic_files.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
@@ -459,6 +460,78 @@ TEST(DarkFrameBank, ignoringThePriorAddsKSquaredOfTheInputsReadNoiseAndAccountin
         EXPECT_LT(std::abs(m), 3 * se) << name;
     }
     std::cout << "read-brightening pixels per output: " << readBrightening / n << "\n";
+}
+
+/* The same seed gives the same bits with a bank on every instruction-set path and thread count, for 16-bit
+ * and float inputs, tied, untied and ignoring the prior, on a crop at an odd sensor origin; another seed
+ * draws other frames. A mosaic outside the frames, or at another CFA phase, is refused. */
+TEST(DarkFrameBank, theSameSeedGivesTheSameBitsOnEveryPathAndThreadCount)
+{
+    const std::string dir = test::makeTempDir("dark_bank_bits");
+    const BankedSensor s(dir);
+    const NoiseModel model = s.sensor->effectiveModel();
+    const ColorJitter jitter = ColorJitter::exposureChange(0.3, 2.0);
+    const Rect crop(3, 2, 61, 40);
+    const RawFormat format = s.sensor->rawFormat(1.0).cropped(crop.y, crop.x);
+    const Mat whole = s.capture(400.0, 1.0, 9);
+    Mat input16 = whole(crop).clone(), input32;
+    input16.convertTo(input32, CV_32F);
+    const int threads = getNumThreads();
+    for (const Mat& input : {input16, input32})
+        for (NoiseAlignment a : {NoiseAlignment::ACCOUNT_PRIOR, NoiseAlignment::IGNORE_PRIOR})
+            for (bool tied : {false, true}) {
+                SCOPED_TRACE(cv::format("depth %d, alignment %d, tied %d", input.depth(), int(a), int(tied)));
+                NoiseOptions options(a);
+                options.darkBank = s.bankPath;
+                options.darkBankTied = tied;
+                Mat first;
+                for (CpuPath path : availableCpuPaths())
+                    for (int t : {1, 2}) {
+                        setCpuPath(path);
+                        setNumThreads(t);
+                        Mat out;
+                        RawFormat outFormat;
+                        AugmentReport report;
+                        colorJitter(input, format, model, jitter, options, 21, out, outFormat, report);
+                        if (first.empty())
+                            first = out;
+                        EXPECT_EQ(cv::norm(out, first, NORM_INF), 0)
+                            << cpuPathName(path) << ", " << t << " threads";
+                    }
+                setCpuPath(CpuPath::AUTO);
+                setNumThreads(threads);
+                Mat other;
+                RawFormat outFormat;
+                AugmentReport report;
+                colorJitter(input, format, model, jitter, options, 22, other, outFormat, report);
+                EXPECT_GT(cv::norm(other, first, NORM_INF), 0);
+            }
+    NoiseOptions options;
+    options.darkBank = s.bankPath;
+    Mat out;
+    RawFormat outFormat;
+    AugmentReport report;
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(input16, s.sensor->rawFormat(1.0).cropped(crop.y, 60), model, jitter,
+                                         options, 1, out, outFormat, report),
+                             "lies outside the dark-frame bank's 96x64 frames");
+    RawFormat shifted = format;
+    shifted.sensorOrigin.x += 1;
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(input16, shifted, model, jitter, options, 1, out, outFormat, report),
+                             "another sensor, or a crop without its offset");
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(input16, format, model, ColorJitter::exposureChange(0.3, 8.0),
+                                         options, 1, out, outFormat, report),
+                             "outside the bank's gains [1, 4]");
+    options.darkBankTied = true;
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(input16, s.sensor->rawFormat(2.0).cropped(crop.y, crop.x), model,
+                                         ColorJitter::exposureChange(0.3, 2.0), options, 1, out, outFormat,
+                                         report),
+                             "no frames at the input's gain 2");
+    options.darkBank = dir + "/missing.yml";
+    EXPECT_CV_ERROR_CONTAINS(colorJitter(input16, format, model, jitter, options, 1, out, outFormat, report),
+                             "missing.yml' is missing");
+    // NONE reads no bank, even a missing one; an identity step neither.
+    options.alignment = NoiseAlignment::NONE;
+    EXPECT_NO_THROW(colorJitter(input16, format, model, jitter, options, 1, out, outFormat, report));
 }
 
 } // namespace
