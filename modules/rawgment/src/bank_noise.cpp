@@ -79,8 +79,14 @@ Mat pixelPartVariance(const DarkFrameGroup& g, Point origin, Size size, double s
 
 } // namespace
 
-BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size size, const BankPrior& prior,
-                         uint64 seed, RandomStream stream, const char* who)
+Mat bankInputPattern(const StepNoise& step, const RawFormat& format, Size size)
+{
+    const DarkFrameGroup& in = step.bank->groups[static_cast<size_t>(step.bankGroupIn)];
+    return in.statistics.pattern(Rect(format.sensorOrigin, size)).clone();
+}
+
+BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size size,
+                         const BankPattern& pattern, uint64 seed, RandomStream stream, const char* who)
 {
     CV_Assert(step.bank);
     const DarkFrameBank& bank = *step.bank;
@@ -125,105 +131,106 @@ BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size si
 
     const DarkFrameStatistics &so = out.statistics, &si = in.statistics;
     const double at2 = step.bankScaleOut * step.bankScaleOut, as2 = step.bankScaleIn * step.bankScaleIn;
-    bool rowExceeded[4] = {false, false, false, false};
     for (int m = 0; m < 4; ++m) {
         const int S = cfaSite(m / 2 + b.origin.y, m % 2 + b.origin.x); // the sensor's site of mosaic site m
-        const double target = at2 * so.rowNoiseVariance[S],
-                     held = prior.row[m] * as2 * si.rowNoiseVariance[S];
-        rowExceeded[m] = held > target;
-        b.rowShare[m] = target > 0 ? static_cast<float>(std::sqrt(std::max(0.0, 1 - held / target))) : 0.0f;
+        b.rowTarget[m] = static_cast<float>(at2 * so.rowNoiseVariance[S]);
+        b.rowHeld[m] = static_cast<float>(as2 * si.rowNoiseVariance[S]);
     }
     // The pixel part: per row and column parity, and per noisy pixel, as the groups measured it; the input's
     // own by row and pixel only when it is the bank's sensor (tied), else pooled per site.
-    const Mat target = pixelPartVariance(out, b.origin, size, step.bankScaleOut);
-    Mat held;
+    b.pixelTarget = pixelPartVariance(out, b.origin, size, step.bankScaleOut);
     if (tied) {
-        held = pixelPartVariance(in, b.origin, size, step.bankScaleIn);
+        b.pixelHeld = pixelPartVariance(in, b.origin, size, step.bankScaleIn);
     } else {
-        held.create(size, CV_32FC1);
+        b.pixelHeld.create(size, CV_32FC1);
         for (int r = 0; r < size.height; ++r)
             for (int c = 0; c < size.width; ++c) {
                 const int S = cfaSite(r + b.origin.y, c + b.origin.x);
-                held.at<float>(r, c) =
+                b.pixelHeld.at<float>(r, c) =
                     static_cast<float>(as2 * std::max(0.0, si.temporalVariance[S] - si.rowNoiseVariance[S]));
             }
     }
-    b.pixelShare.create(size, CV_32FC1);
-    for (int r = 0; r < size.height; ++r) {
-        const float *t = target.ptr<float>(r), *h = held.ptr<float>(r);
-        float* share = b.pixelShare.ptr<float>(r);
-        for (int c = 0; c < size.width; ++c) {
-            const int m = cfaSite(r, c);
-            const double priorVariance = prior.pixel[m] * h[c];
-            share[c] =
-                t[c] > 0 ? static_cast<float>(std::sqrt(std::max(0.0, 1 - priorVariance / t[c]))) : 0.0f;
-            b.readBrightening += priorVariance > t[c] || rowExceeded[m];
-        }
-    }
-    // The pattern: tied, the input's (scaled as the step scales it) out and the target's in; untied, what the
+    // The pattern: tied, the input's (as the step leaves it) out and the target's in; untied, what the
     // target's variance lacks of the input's scaled one, as the target's own pattern.
     const Rect crop(b.origin, size);
     if (tied) {
         b.patternAdd = so.pattern(crop).clone();
-        for (int r = 0; r < size.height; ++r) {
-            float* p = b.patternAdd.ptr<float>(r);
-            const float* f = si.pattern.ptr<float>(r + b.origin.y) + b.origin.x;
-            for (int c = 0; c < size.width; ++c)
-                p[c] -= static_cast<float>(prior.pattern[cfaSite(r, c)]) * f[c];
-        }
-    } else {
-        float share[4];
-        bool any = false;
-        for (int m = 0; m < 4; ++m) {
-            const int S = cfaSite(m / 2 + b.origin.y, m % 2 + b.origin.x);
-            const double t = so.patternVariance[S],
-                         h = prior.pattern[m] * prior.pattern[m] * si.patternVariance[S];
-            share[m] = t > 0 ? static_cast<float>(std::sqrt(std::max(0.0, 1 - h / t))) : 0.0f;
-            any = any || share[m] > 0;
-        }
-        if (any) {
-            b.patternAdd.create(size, CV_32FC1);
+        if (!pattern.held.empty()) {
+            CV_Assert(pattern.held.type() == CV_32FC1 && pattern.held.size() == size);
+            b.patternAdd -= pattern.held;
+        } else {
             for (int r = 0; r < size.height; ++r) {
                 float* p = b.patternAdd.ptr<float>(r);
-                const float* f = so.pattern.ptr<float>(r + b.origin.y) + b.origin.x;
-                for (int c = 0; c < size.width; ++c) {
-                    const int m = cfaSite(r, c);
-                    p[c] = share[m] *
-                           (f[c] - static_cast<float>(so.level[cfaSite(r + b.origin.y, c + b.origin.x)]));
-                }
+                const float* f = si.pattern.ptr<float>(r + b.origin.y) + b.origin.x;
+                for (int c = 0; c < size.width; ++c)
+                    p[c] -= static_cast<float>(pattern.amplitude[cfaSite(r, c)]) * f[c];
             }
+        }
+        return b;
+    }
+    float share[4];
+    bool any = false;
+    for (int m = 0; m < 4; ++m) {
+        const int S = cfaSite(m / 2 + b.origin.y, m % 2 + b.origin.x);
+        const double a = pattern.amplitude[m], t = so.patternVariance[S], h = a * a * si.patternVariance[S];
+        share[m] = t > 0 ? static_cast<float>(std::sqrt(std::max(0.0, 1 - h / t))) : 0.0f;
+        any = any || share[m] > 0;
+    }
+    if (any) {
+        b.patternAdd.create(size, CV_32FC1);
+        for (int r = 0; r < size.height; ++r) {
+            float* p = b.patternAdd.ptr<float>(r);
+            const float* f = so.pattern.ptr<float>(r + b.origin.y) + b.origin.x;
+            for (int c = 0; c < size.width; ++c)
+                p[c] = share[cfaSite(r, c)] *
+                       (f[c] - static_cast<float>(so.level[cfaSite(r + b.origin.y, c + b.origin.x)]));
         }
     }
     return b;
 }
 
-void bankRowExtra(const BankRead& b, int r, int cols, float* extra)
+int64 bankRowExtra(const BankRead& b, int r, int first, int step, int n, const float rowFactor[2],
+                   const float* pixelFactor, float* extra)
 {
     const int R = r + b.origin.y, x0 = b.origin.x;
     const float* a = b.frameA.ptr<float>(R);
     if (b.ignore) {
-        for (int c = 0; c < cols; ++c)
-            extra[c] = b.scale * (a[c + x0] - b.black[cfaSite(R, c + x0)]);
-        return;
+        for (int j = 0; j < n; ++j) {
+            const int C = first + step * j + x0;
+            extra[j] = b.scale * (a[C] - b.black[cfaSite(R, C)]);
+        }
+        return 0;
     }
     const float* f = b.frameB.ptr<float>(R);
-    // The row part: the difference's mean over the sensor's whole row at each column parity.
+    // The row part at each sensor column parity: the difference's mean over the sensor's whole row there.
     double sum[2] = {0, 0};
     const int width = b.frameA.cols;
     for (int C = 0; C < width; ++C)
         sum[C & 1] += static_cast<double>(a[C]) - f[C];
     const float k = b.scale * static_cast<float>(1 / std::sqrt(2.0));
-    const float rho[2] = {k * static_cast<float>(sum[0] / ((width + 1) / 2)),
-                          width > 1 ? k * static_cast<float>(sum[1] / (width / 2)) : 0.0f};
-    const float* share = b.pixelShare.ptr<float>(r);
-    const float* pattern = b.patternAdd.empty() ? nullptr : b.patternAdd.ptr<float>(r);
-    const int even = 2 * (r & 1);
-    for (int c = 0; c < cols; ++c) {
-        const int C = c + x0;
-        const float row = rho[C & 1];
-        const float d = k * (a[C] - f[C]);
-        extra[c] = b.rowShare[even + (c & 1)] * row + share[c] * (d - row) + (pattern ? pattern[c] : 0.0f);
+    const float sensorRho[2] = {k * static_cast<float>(sum[0] / ((width + 1) / 2)),
+                                width > 1 ? k * static_cast<float>(sum[1] / (width / 2)) : 0.0f};
+    float rho[2], rowShare[2];
+    bool rowExceeded[2];
+    for (int p = 0; p < 2; ++p) {
+        rho[p] = sensorRho[(p + x0) & 1];
+        const int m = 2 * (r & 1) + p;
+        const float held = rowFactor[p] * b.rowHeld[m], target = b.rowTarget[m];
+        rowExceeded[p] = held > target;
+        rowShare[p] = target > 0 ? std::sqrt(std::max(0.0f, 1 - held / target)) : 0.0f;
     }
+    const float *pt = b.pixelTarget.ptr<float>(r), *ph = b.pixelHeld.ptr<float>(r);
+    const float* pattern = b.patternAdd.empty() ? nullptr : b.patternAdd.ptr<float>(r);
+    int64 exceeded = 0;
+    for (int j = 0; j < n; ++j) {
+        const int c = first + step * j, p = c & 1;
+        const float d = k * (a[c + x0] - f[c + x0]);
+        const float held = pixelFactor[j] * ph[c], target = pt[c];
+        const float share = target > 0 ? std::sqrt(std::max(0.0f, 1 - held / target)) : 0.0f;
+        exceeded += held > target || rowExceeded[p];
+        extra[j] = rowShare[p] * rho[p] + share * (d - rho[p]) + (pattern ? pattern[c] : 0.0f);
+    }
+    return exceeded;
 }
 
 } // namespace detail

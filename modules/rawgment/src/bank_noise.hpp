@@ -19,40 +19,52 @@ namespace detail {
 //! The bank saved at `path`, read once per process while the file keeps its size and modification time.
 std::shared_ptr<const DarkFrameBank> cachedDarkFrameBank(const String& path);
 
-/** What the input's values already hold of the read noise a step's output needs, per CFA site of the
- * output: the factor of the input's pixel part (a jitter's k^2, a blur's sum of w^2), of its row part (a
- * jitter's k^2; a blur's sum over kernel rows of the squared row sums) and the factor of its fixed pattern
- * (a jitter's k; none for a resampling step, which the bank does not support tied). */
-struct BankPrior
+/** How a step scales the input's fixed pattern, per CFA site of the output: `amplitude` times it (a jitter's
+ * k; a resampling step's sqrt(sum w^2), its pattern's typical spread when the pattern is not correlated), and
+ * for a tied bank the input's pattern as the step leaves it (`held`, CV_32FC1 of the mosaic's size: a
+ * resampling step's own output of bankInputPattern(); empty: amplitude times that pattern in place). */
+struct BankPattern
 {
-    Vec4d pixel = Vec4d::all(1), row = Vec4d::all(1), pattern = Vec4d::all(1);
+    Vec4d amplitude = Vec4d::all(1);
+    Mat held;
 };
 
 /** A step's read part from a bank, prepared once per call: the target group's two frames (IGNORE_PRIOR: one),
- * their scale to the output gain, and per pixel the share c of each part with k^2 v_s + c^2 v_t = v_t. */
+ * their scale to the output gain, the variances of the row part and the pixel part at the target and in the
+ * input, and the pattern to add. The rows take each part's share c from k^2 v_s + c^2 v_t = v_t with the
+ * step's factors (bankRowExtra()). */
 struct BankRead
 {
     bool ignore = false; //!< IGNORE_PRIOR: a whole dark frame
     Mat frameA, frameB;  //!< CV_32FC1 whole frames of the target group (raw DN)
     Point origin;        //!< where the mosaic lies on them
     float scale = 1;     //!< the frames' temporal noise to the output gain's (the model's read lines)
-    float black[4] = {0, 0, 0, 0};    //!< the bank's black level per sensor site
-    float rowShare[4] = {0, 0, 0, 0}; //!< c of the row part, per mosaic site
-    Mat pixelShare;                   //!< CV_32FC1, the mosaic's size: c of the pixel part
-    Mat patternAdd;                   //!< CV_32FC1, the mosaic's size, or empty: the pattern added
-    int64 readBrightening = 0;        //!< pixels whose row or pixel part the prior already exceeds
+    float black[4] = {0, 0, 0, 0};     //!< the bank's black level per sensor site
+    float rowTarget[4] = {0, 0, 0, 0}; //!< the target's row-part variance per mosaic site
+    float rowHeld[4] = {0, 0, 0, 0};   //!< the input's, before the step's factor
+    Mat pixelTarget, pixelHeld;        //!< CV_32FC1 of the mosaic's size: the pixel part's variances
+    Mat patternAdd;                    //!< CV_32FC1 of the mosaic's size, or empty: the pattern added
     bool empty() const { return frameA.empty(); }
 };
+
+/** The input's fixed pattern where the mosaic lies (the bank's group nearest the input's gain; DN above
+ * black): what a resampling step moves and mixes, for BankPattern::held. */
+Mat bankInputPattern(const StepNoise& step, const RawFormat& format, Size size);
 
 /** The read part of a step from gain step.gainIn to step.gainOut on a mosaic of `size` at
  * format.sensorOrigin, drawn with `seed` from stream family `stream`.
  * @throws cv::Exception naming `who` for a mosaic outside the bank's frames, another CFA phase, a tied bank
  * without frames at the input's gain, a target gain beyond the bank's range. */
-BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size size, const BankPrior& prior,
-                         uint64 seed, RandomStream stream, const char* who);
+BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size size,
+                         const BankPattern& pattern, uint64 seed, RandomStream stream, const char* who);
 
-//! Row r of the bank's read part into extra[0..cols) (the same bits on every path and thread count).
-void bankRowExtra(const BankRead& b, int r, int cols, float* extra);
+/** The bank's read part at columns first + step j (j < n) of mosaic row r into extra[0..n): the row part (the
+ * frames' difference averaged over the sensor's row at the column's parity) with the share left by
+ * rowFactor[p] (the input's row-part variance the step keeps, for mosaic column parity p), the pixel part
+ * with the share left by pixelFactor[j], and the pattern. The same bits on every path and thread count.
+ * Returns the pixels whose row or pixel part the input already held more of than the target has. */
+int64 bankRowExtra(const BankRead& b, int r, int first, int step, int n, const float rowFactor[2],
+                   const float* pixelFactor, float* extra);
 
 } // namespace detail
 } // namespace rawgment

@@ -238,6 +238,26 @@ struct JitterKeys
     uint64_t gaussian, poisson, row, tukey;
 };
 
+// A bank's factors of the input's read variance per mosaic row parity (p_c^2 of each column's site): what the
+// jitter keeps of the input's row part and pixel part.
+struct BankFactors
+{
+    float row[2][2];
+    std::vector<float> pixel[2];
+    BankFactors(const Vec4d& contrast, int cols)
+    {
+        for (int parity = 0; parity < 2; ++parity) {
+            pixel[parity].resize(static_cast<size_t>(cols));
+            for (int c = 0; c < cols; ++c) {
+                const double pc = contrast[2 * parity + (c & 1)];
+                pixel[parity][static_cast<size_t>(c)] = static_cast<float>(pc * pc);
+            }
+            for (int p = 0; p < 2; ++p)
+                row[parity][p] = static_cast<float>(contrast[2 * parity + p] * contrast[2 * parity + p]);
+        }
+    }
+};
+
 // inputShading (ACCOUNT_PRIOR with dark shading): the input's shading at its gain, which each row takes
 // out of its values with the black level, so that Eq. 13's prior mean is signal only (the shot noise of
 // a dark input would otherwise count its dark offset as photons); the extra terms then add the target's
@@ -245,8 +265,9 @@ struct JitterKeys
 template <typename T>
 void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstants& k,
                 const JitterColumnTables& tables, const JitterKeys& keys,
-                const detail::DarkShading& inputShading, const detail::BankRead* bank, const Range& rows,
-                std::atomic<int64>& brightening, std::atomic<bool>& nonFinite,
+                const detail::DarkShading& inputShading, const detail::BankRead* bank,
+                const BankFactors& bankFactors, const Range& rows, std::atomic<int64>& brightening,
+                std::atomic<int64>& readBrightening, std::atomic<bool>& nonFinite,
                 std::atomic<bool>* nonFiniteInput)
 {
     const int cols = src.cols;
@@ -256,7 +277,7 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstant
         blackAndShading(inputShading.empty() ? 0 : static_cast<size_t>(cols));
     const bool poisson = noise && k.sampling == ShotNoiseSampling::POISSON;
     PoissonRowBuffers poissonRows;
-    int64 localBright = 0;
+    int64 localBright = 0, localReadBright = 0;
     for (int r = rows.start; r < rows.end; ++r) {
         if (std::is_same<T, float>::value && nonFiniteInput &&
             !detail::rowIsFinite(reinterpret_cast<const float*>(src.ptr<T>(r)), cols)) {
@@ -270,7 +291,8 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstant
                                   cols);
         }
         if (bank)
-            detail::bankRowExtra(*bank, r, cols, extra.data());
+            localReadBright += detail::bankRowExtra(*bank, r, 0, 1, cols, bankFactors.row[r & 1],
+                                                    bankFactors.pixel[r & 1].data(), extra.data());
         else if (dark && !detail::darkRowExtra(k.dark, keys.row, r, cols, extra.data()))
             nonFinite = true;
         JitterColumns col = tables.forRow(r);
@@ -292,6 +314,7 @@ void jitterRows(const Mat& src, const Mat& prior, Mat& dst, const JitterConstant
         }
     }
     brightening += localBright;
+    readBrightening += localReadBright;
 }
 
 /* The dark-frame components a jitter adds (docs/mathematics.md, "Dark-frame noise"), per CFA site of
@@ -478,16 +501,14 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     // With a dark-frame bank its frames are the read part; what the input holds of it is scaled by p_c.
     BankRead bank;
     if (step.bank) {
-        BankPrior prior;
-        for (int m = 0; m < 4; ++m) {
-            prior.pixel[m] = prior.row[m] = jitter.contrast[m] * jitter.contrast[m];
-            prior.pattern[m] = jitter.contrast[m];
-        }
-        bank =
-            prepareBankRead(step, format, src.size(), prior, seed, RandomStream::JITTER_BANK, "colorJitter");
+        BankPattern pattern;
+        pattern.amplitude = jitter.contrast;
+        bank = prepareBankRead(step, format, src.size(), pattern, seed, RandomStream::JITTER_BANK,
+                               "colorJitter");
     }
+    const BankFactors bankFactors(jitter.contrast, step.bank ? src.cols : 0);
     Mat dst = stepOutput(src, _dst);
-    std::atomic<int64> brightening{0};
+    std::atomic<int64> brightening{0}, readBrightening{0};
     std::atomic<bool> nonFinite{false}, nonFiniteInput{false};
     const JitterKeys keys = {
         stepKey(seed, RandomStream::JITTER_GAUSSIAN), stepKey(seed, RandomStream::JITTER_POISSON),
@@ -496,10 +517,11 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     parallel_for_(Range(0, src.rows), [&](const Range& rows) {
         if (src.depth() == CV_16U)
             jitterRows<ushort>(src, prior, dst, k, tables, keys, inputShading, bank.empty() ? nullptr : &bank,
-                               rows, brightening, nonFinite, nullptr);
+                               bankFactors, rows, brightening, readBrightening, nonFinite, nullptr);
         else
             jitterRows<float>(src, prior, dst, k, tables, keys, inputShading, bank.empty() ? nullptr : &bank,
-                              rows, brightening, nonFinite, valuesChecked ? nullptr : &nonFiniteInput);
+                              bankFactors, rows, brightening, readBrightening, nonFinite,
+                              valuesChecked ? nullptr : &nonFiniteInput);
     });
     if (nonFiniteInput)
         throwNonFiniteInput("colorJitter");
@@ -511,7 +533,7 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     dstFormat.gain = newGain;
     if (report) {
         report->brighteningPixels += brightening.load();
-        report->readBrighteningPixels += bank.readBrightening;
+        report->readBrighteningPixels += readBrightening.load();
         recordStep(report, "colorJitter", start);
     }
 }

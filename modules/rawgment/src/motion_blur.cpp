@@ -284,7 +284,17 @@ void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNois
     const float readFactor = static_cast<float>(1 - w.dot(w));
     k.nonFiniteShading = &nonFinite;
     k.nonFiniteInput = valuesChecked ? nullptr : &nonFiniteInput;
-    if (step.hasDarkComponents()) {
+    BankRead bank;
+    std::atomic<int64> readBrightening{0};
+    if (step.bank) {
+        bank = resampleBankRead(step, format, src.size(), w.dot(w), seed, RandomStream::BLUR_BANK,
+                                "motionBlur", [&](const Mat& in, const RawFormat& f, Mat& out) {
+                                    motionBlurStep(in, f, model, w, NoiseAlignment::NONE, seed, out, nullptr,
+                                                   true);
+                                });
+        k.bank = &bank;
+        k.readBrightening = &readBrightening;
+    } else if (step.hasDarkComponents()) {
         Mat w2 = w.mul(w);
         resampleDarkTerms(k, step, sum(w2)[0], w2.dot(w2), seed, RandomStream::BLUR_ROW,
                           RandomStream::BLUR_TUKEY);
@@ -302,6 +312,8 @@ void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNois
     if (nonFinite)
         throwNonFiniteShading("motionBlur");
     _dst.assign(dst);
+    if (report)
+        report->readBrighteningPixels += readBrightening.load();
     recordStep(report, "motionBlur", start);
 }
 

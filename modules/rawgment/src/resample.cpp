@@ -223,9 +223,18 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
     const bool noise = k.alignment != NoiseAlignment::NONE;
     if (noise)
         detail::fillGaussian(k.key, stream, scratch.z.data(), n);
-    const bool dark = noise && k.dark.any(), tails = noise && k.dark.tails;
-    if (dark && !resampledDarkRow(k, site, planeRow, rowKeep, scratch.extra.data(), n))
+    const bool dark = noise && (k.dark.any() || k.bank), tails = noise && k.dark.tails;
+    if (noise && k.bank) {
+        // The input keeps sum w^2 = 1 - readFactor of its pixel part, rowKeep of its row part.
+        for (int j = 0; j < n; ++j)
+            scratch.factor[static_cast<size_t>(j)] = 1 - readFactor[j];
+        const float rowFactor[2] = {rowKeep, rowKeep};
+        *k.readBrightening +=
+            bankRowExtra(*k.bank, k.grid.mosaicRow(site, planeRow), k.grid.step == 2 ? site % 2 : 0,
+                         k.grid.step, n, rowFactor, scratch.factor.data(), scratch.extra.data());
+    } else if (dark && !resampledDarkRow(k, site, planeRow, rowKeep, scratch.extra.data(), n)) {
         *k.nonFiniteShading = true;
+    }
     if (tails)
         detail::fillTukeyUnit(k.tukeyKey, stream, k.dark.tailTable[0], scratch.t.data(), n);
     const float* extraRow = dark ? scratch.extra.data() : nullptr;
@@ -240,13 +249,6 @@ void finishPlaneRow(std::vector<float>& mean, const float* shotSum, const float*
 ResampleConstants resampleConstants(int depth, const RawFormat& format, const StepNoise& step, uint64 seed,
                                     detail::RandomStream gaussian, detail::RandomStream poisson)
 {
-    if (step.bank)
-        CV_Error(Error::StsNotImplemented,
-                 cv::format(
-                     "%s: a dark-frame bank (NoiseOptions::darkBank '%s') drives colour jitter's read part; "
-                     "motion blur and scaling with a bank are not implemented yet",
-                     gaussian == RandomStream::BLUR_GAUSSIAN ? "motionBlur" : "scaleMosaic",
-                     step.options.darkBank.c_str()));
     ResampleConstants k;
     k.grid = PlaneGrid(format);
     for (int s = 0; s < 4; ++s)
@@ -285,6 +287,28 @@ void resampleDarkTerms(ResampleConstants& k, const StepNoise& step, double sumW2
     }
     if (account)
         k.inputShading = d.shading;
+}
+
+BankRead resampleBankRead(const StepNoise& step, const RawFormat& format, Size size, double sumW2,
+                          uint64 seed, RandomStream stream, const char* who,
+                          const std::function<void(const Mat&, const RawFormat&, Mat&)>& withoutNoise)
+{
+    BankPattern pattern;
+    pattern.amplitude = Vec4d::all(std::sqrt(sumW2));
+    if (step.options.darkBankTied && step.options.alignment == NoiseAlignment::ACCOUNT_PRIOR) {
+        // The step clips its output at 0: the pattern is lifted above it by a black level, then lowered.
+        const Mat held = bankInputPattern(step, format, size);
+        double lowest = 0;
+        minMaxLoc(held, &lowest);
+        const double lift = 1024 + std::max(0.0, -lowest);
+        RawFormat lifted = format;
+        lifted.blackLevel = Vec4d::all(lift);
+        lifted.whiteLevel = 1e9;
+        Mat moved;
+        withoutNoise(Mat(held + lift), lifted, moved);
+        pattern.held = moved - lift;
+    }
+    return prepareBankRead(step, format, size, pattern, seed, stream, who);
 }
 
 } // namespace detail
@@ -454,7 +478,9 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
                                   bilinearAxis(plane.width, phases - 1, scale, grid.step)};
     const BilinearAxis rows[2] = {bilinearAxis(plane.height, 0, scale, grid.step),
                                   bilinearAxis(plane.height, phases - 1, scale, grid.step)};
-    if (step.hasDarkComponents()) {
+    BankRead bank;
+    std::atomic<int64> readBrightening{0};
+    if (step.hasDarkComponents() || step.bank) {
         // The typical weights: sum w^2 and sum w^4 of the bilinear taps averaged over the output pixels
         // (a product of the two axes' averages).
         double axis2[2] = {0, 0}, axis4[2] = {0, 0};
@@ -468,8 +494,18 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
                     axis4[a] += (std::pow(f, 4) + std::pow(1 - f, 4)) / (static_cast<double>(phases) * n);
                 }
         }
-        resampleDarkTerms(k, step, axis2[0] * axis2[1], axis4[0] * axis4[1], seed, RandomStream::SCALE_ROW,
-                          RandomStream::SCALE_TUKEY);
+        if (step.bank) {
+            bank = resampleBankRead(
+                step, format, src.size(), axis2[0] * axis2[1], seed, RandomStream::SCALE_BANK, "scaleMosaic",
+                [&](const Mat& in, const RawFormat& f, Mat& out) {
+                    scaleMosaicStep(in, f, model, scale, NoiseAlignment::NONE, seed, out, nullptr, true);
+                });
+            k.bank = &bank;
+            k.readBrightening = &readBrightening;
+        } else {
+            resampleDarkTerms(k, step, axis2[0] * axis2[1], axis4[0] * axis4[1], seed,
+                              RandomStream::SCALE_ROW, RandomStream::SCALE_TUKEY);
+        }
     }
     Mat dst = stepOutput(src, _dst);
     parallel_for_(Range(0, plane.height), [&](const Range& range) {
@@ -495,6 +531,8 @@ void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     if (nonFinite)
         throwNonFiniteShading("scaleMosaic");
     _dst.assign(dst);
+    if (report)
+        report->readBrighteningPixels += readBrightening.load();
     recordStep(report, "scale", start);
 }
 

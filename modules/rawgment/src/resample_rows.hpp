@@ -6,7 +6,10 @@
 #define OPENCV_RAWGMENT_SRC_RESAMPLE_ROWS_HPP
 
 #include "augment_steps.hpp"
+#include "bank_noise.hpp"
+
 #include "noise_terms.hpp"
+#include <functional>
 
 #include <atomic>
 
@@ -47,6 +50,10 @@ struct ResampleConstants
     double rowVariance = 0;   // the input's row variance at its gain
     DarkShading inputShading; // ACCOUNT_PRIOR: the input's dark shading, taken out before the step
     uint64_t rowKey = 0, tukeyKey = 0;
+    // A dark-frame bank's read part (resampleBankRead()), and the count of pixels whose read part the input
+    // already exceeded; null without a bank.
+    const BankRead* bank = nullptr;
+    std::atomic<int64>* readBrightening = nullptr;
     std::atomic<bool>* nonFiniteShading = nullptr; // set when a shading row held NaN or Inf
     // Set when a float input row held NaN or Inf; null when the step's input is not to be checked.
     std::atomic<bool>* nonFiniteInput = nullptr;
@@ -56,12 +63,12 @@ struct ResampleConstants
 // vector kernel reads them): a row allocates nothing.
 struct RowScratch
 {
-    std::vector<float> z, extra, t;
+    std::vector<float> z, extra, t, factor;
     std::vector<NoiseSplit> splits;
     std::vector<double> means, counts;
     explicit RowScratch(int n)
-        : z(wholeBlocks(n)), extra(wholeBlocks(n)), t(static_cast<size_t>(n)), splits(static_cast<size_t>(n)),
-          means(static_cast<size_t>(n)), counts(static_cast<size_t>(n))
+        : z(wholeBlocks(n)), extra(wholeBlocks(n)), t(static_cast<size_t>(n)), factor(static_cast<size_t>(n)),
+          splits(static_cast<size_t>(n)), means(static_cast<size_t>(n)), counts(static_cast<size_t>(n))
     {
     }
 };
@@ -129,6 +136,15 @@ ResampleConstants resampleConstants(int depth, const RawFormat& format, const St
  * on average). */
 void resampleDarkTerms(ResampleConstants& k, const StepNoise& step, double sumW2, double sumW4, uint64 seed,
                        RandomStream rowStream, RandomStream tukeyStream);
+
+/* A resampling step's read part from a dark-frame bank (bank_noise.hpp), for a step whose typical sum of w^2
+ * is sumW2: it keeps that share of the input's pixel part (each pixel's own, 1 - its read factor) and rowKeep
+ * of its row part; an untied bank's input pattern spreads as sqrt(sumW2) of its own, a tied bank's is the
+ * step's own output of it without noise (`withoutNoise`, on a float mosaic of `format` with another black
+ * level). */
+BankRead resampleBankRead(const StepNoise& step, const RawFormat& format, Size size, double sumW2,
+                          uint64 seed, RandomStream stream, const char* who,
+                          const std::function<void(const Mat&, const RawFormat&, Mat&)>& withoutNoise);
 
 } // namespace detail
 } // namespace rawgment
