@@ -56,6 +56,11 @@ def _rebuild(cls, state):
     return obj
 
 
+def _load_dark_frame_bank(path):
+    """A pickled DarkFrameBank in another process: the bank its path names (DarkFrameBank.__reduce__)."""
+    return _rawgment.DarkFrameBank.load(path)
+
+
 def _add_value_behaviour(cls):
     fields = _fields(cls)
     cls._fields = tuple(fields)
@@ -64,8 +69,10 @@ def _add_value_behaviour(cls):
     cls.__eq__ = lambda self, other: type(self) is type(other) and all(
         _same(getattr(self, f), getattr(other, f)) for f in fields)
     cls.__hash__ = None
-    # Rebuilt field by field without validation, so that any object the C++ side holds round-trips.
-    cls.__reduce__ = lambda self: (_rebuild, (type(self), {f: getattr(self, f) for f in fields}))
+    # Rebuilt field by field without validation, so that any object the C++ side holds round-trips; a class
+    # that goes to other processes otherwise (a DarkFrameBank, by its path) keeps its own.
+    if "__reduce__" not in cls.__dict__:
+        cls.__reduce__ = lambda self: (_rebuild, (type(self), {f: getattr(self, f) for f in fields}))
 
 
 for _name in __all__:

@@ -82,6 +82,8 @@ void bindNoiseOptions(py::module_& m)
         .def_readwrite("shotSampling", &NoiseOptions::shotSampling, doc("NoiseOptions::shotSampling"))
         .def_readwrite("priorMean", &NoiseOptions::priorMean, doc("NoiseOptions::priorMean"))
         .def_readwrite("blurNoiseSum", &NoiseOptions::blurNoiseSum, doc("NoiseOptions::blurNoiseSum"))
+        .def_readwrite("darkBank", &NoiseOptions::darkBank, doc("NoiseOptions::darkBank"))
+        .def_readwrite("darkBankTied", &NoiseOptions::darkBankTied, doc("NoiseOptions::darkBankTied"))
         .def("validate", &NoiseOptions::validate, doc("NoiseOptions::validate"));
     py::implicitly_convertible<NoiseAlignment, NoiseOptions>();
 
@@ -91,6 +93,8 @@ void bindNoiseOptions(py::module_& m)
                        doc("AugmentReport::brighteningPixels"))
         .def_readwrite("saturatedPixels", &AugmentReport::saturatedPixels,
                        doc("AugmentReport::saturatedPixels"))
+        .def_readwrite("readBrighteningPixels", &AugmentReport::readBrighteningPixels,
+                       doc("AugmentReport::readBrighteningPixels"))
         .def_readwrite("steps", &AugmentReport::steps, doc("AugmentReport::steps"))
         .def_readwrite("stepSeconds", &AugmentReport::stepSeconds, doc("AugmentReport::stepSeconds"));
 }

@@ -137,6 +137,7 @@ void bindCalibration(py::module_& m); // calibration, normality
 void bindAugment(py::module_& m);     // augment, raw_io, isp
 void bindBatch(py::module_& m);       // the apps' batch jobs and the benchmark hooks
 void bindEmva1288(py::module_& m);    // the EMVA 1288 descriptor and figures
+void bindDarkFrames(py::module_& m);  // the dark-frame bank
 
 } // namespace rawgment_python
 

@@ -648,6 +648,7 @@ PYBIND11_MODULE(_rawgment, m)
     bindCore(m);
     bindCalibration(m);
     bindAugment(m);
+    bindDarkFrames(m);
     bindBatch(m);
     bindEmva1288(m);
 

@@ -121,6 +121,33 @@ int main(int argc, char** argv)
         scaleMosaic(capture, format, model, 1.03, NoiseAlignment::IGNORE_PRIOR, 7, scaled);
         saveNpy("scale", scaled);
 
+        // A dark-frame bank of the same sensor: four frames at gains 2 and 4, beside its file in the folder.
+        std::vector<String> darkFiles;
+        for (double gain : {2.0, 4.0})
+            for (int t = 0; t < 4; ++t) {
+                Mat dark;
+                sim.capture(Mat::zeros(96, 128, CV_32F), gain, 1.0, 12, t, dark);
+                MosaicMetadata meta;
+                meta.format = sim.rawFormat(gain);
+                darkFiles.push_back(folder + cv::format("/dark_g%g_%d.png", gain, t));
+                writeMosaic(darkFiles.back(), dark, meta);
+            }
+        DarkFrameBank bank = DarkFrameBank::create(darkFiles, NoiseModel());
+        bank.save(folder + "/bank.yml");
+        NoiseOptions banked;
+        banked.darkBank = folder + "/bank.yml";
+        banked.darkBankTied = true;
+        Mat bankJittered, bankBlurred;
+        RawFormat bankFormat;
+        AugmentReport bankReport;
+        colorJitter(capture, format, model, ColorJitter::exposureChange(0.3, 2.0), banked, 8, bankJittered,
+                    bankFormat, &bankReport);
+        saveNpy("bank_jitter", bankJittered);
+        numbers << "bank_read_brightening " << bankReport.readBrighteningPixels << "\n";
+        banked.darkBankTied = false;
+        motionBlur(capture, format, model, linearMotionKernel(9, 30), banked, 9, bankBlurred);
+        saveNpy("bank_blur", bankBlurred);
+
         RandomScenePolicy policy;
         policy.blurProbability = 1;
         policy.geometryProbability = 1;

@@ -46,6 +46,26 @@ def test_simulator_and_noise_steps(cxx_reference, sensor, capture):
     same(cxx_reference, "scale", scaled)
 
 
+def test_dark_frame_bank(cxx_reference, sensor, capture):
+    ref = numbers(cxx_reference)
+    fmt = sensor.rawFormat(2.0)
+    model = sensor.effectiveModel()
+    path = str(cxx_reference / "bank.yml")
+    bank = rg.DarkFrameBank.load(path)
+    assert [g.gain for g in bank.groups] == [2.0, 4.0]
+    # Pickled as its path: the other process loads the same bank.
+    again = pickle.loads(pickle.dumps(bank))
+    assert again.path == path and again == bank
+    out, outFormat, report = rg.colorJitter(capture, fmt, model, rg.ColorJitter.exposureChange(0.3, 2.0),
+                                            rg.NoiseOptions(darkBank=path, darkBankTied=True), seed=8)
+    same(cxx_reference, "bank_jitter", out)
+    assert outFormat.gain == 4.0
+    assert report.readBrighteningPixels == int(ref["bank_read_brightening"][0])
+    blurred, _ = rg.motionBlur(capture, fmt, model, rg.linearMotionKernel(9, 30), rg.NoiseOptions(darkBank=path),
+                               seed=9)
+    same(cxx_reference, "bank_blur", blurred)
+
+
 def test_scene_policy_and_boxes(cxx_reference, sensor, capture):
     ref = numbers(cxx_reference)
     fmt = sensor.rawFormat(2.0)

@@ -256,6 +256,14 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
             buffers[0] = given;
     }
     const auto nextBuffer = [&]() -> Mat& { return buffers[--stepsLeft % 2]; };
+    // A tied bank takes the input's fixed pattern out where the sensor has it; a shift moves the pattern with
+    // the content, and the bank's pattern is not moved back as the dark shading is.
+    if (shift != Point(0, 0) && scene.noise.darkBankTied && !scene.noise.darkBank.empty() &&
+        scene.noise.alignment != NoiseAlignment::NONE)
+        CV_Error(Error::StsBadArg,
+                 "applyScene: a tied dark-frame bank (NoiseOptions::darkBankTied) cannot follow "
+                 "a shifted scene, which moves the input's fixed pattern; untie the bank or "
+                 "drop the shift");
     if (shift != Point(0, 0)) {
         const auto start = std::chrono::steady_clock::now();
         Mat& shifted = nextBuffer();

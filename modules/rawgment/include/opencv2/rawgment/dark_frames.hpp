@@ -64,7 +64,7 @@ struct CV_EXPORTS_W_SIMPLE DarkFrameGroup
     CV_PROP_RW std::vector<String> files; //!< the frames: read on demand, never all held
     CV_PROP_RW std::vector<double>
         fileBytes; //!< each file's size when the bank was made: a frame replaced since is refused
-    CV_PROP_RW DarkFrameStatistics statistics;
+    CV_PROP_RW DarkFrameStatistics statistics; //!< what the frames tell apart
 };
 
 /** @brief Real dark frames of one sensor as the read noise of augmentation (NoiseOptions::darkBank), grouped
