@@ -25,6 +25,12 @@ int main(int argc, char** argv)
         "fastest to train from; default: dng for RAW inputs) }"
         "{preview        | false| also write an sRGB preview PNG of each output }"
         "{accept_failed_calibration | false | also use a model whose calibration's verdict was FAIL }"
+        "{dark_bank      |      | a dark-frame bank file (rawgment_calibrate --dark_bank): its real dark "
+        "frames "
+        "are the read noise of every output, accounted for the input's own }"
+        "{dark_bank_tied | false| the inputs come from the bank's own sensor at its exposure and "
+        "temperature: "
+        "their fixed pattern is swapped for the target's }"
         "{@inputs        |      | input files (RAW files, or mosaics with a .yml sidecar) }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_augment"))
         return 2;
@@ -49,6 +55,8 @@ int main(int argc, char** argv)
     const std::string format = parser.get<std::string>("format");
     o.previews = parser.get<bool>("preview");
     o.acceptFailedCalibration = parser.get<bool>("accept_failed_calibration");
+    o.darkBank = parser.get<std::string>("dark_bank");
+    o.darkBankTied = parser.get<bool>("dark_bank_tied");
     // CommandLineParser keeps one positional value; the rest of the command line are inputs too.
     for (int i = 1; i < argc; ++i)
         if (argv[i][0] != '-')

@@ -110,11 +110,19 @@ void requireFinishedBy(const std::string& out, const std::string& input, uint64_
 Scene readSceneFile(const std::string& path)
 {
     cv::FileStorage fs = openFileStorageForReading(path, "scene");
+    Scene scene;
     try {
-        return Scene::read(fs["scene"]);
+        scene = Scene::read(fs["scene"]);
     } catch (const cv::Exception& e) {
         throw std::runtime_error("'" + path + "': " + e.err);
     }
+    // A bank named by the file lies relative to the file (RandomScenePolicy::load() does the same).
+    if (!scene.noise.darkBank.empty() && scene.noise.darkBank[0] != '/') {
+        const size_t slash = path.find_last_of('/');
+        if (slash != std::string::npos)
+            scene.noise.darkBank = path.substr(0, slash + 1) + scene.noise.darkBank;
+    }
+    return scene;
 }
 
 AugmentRecipe loadAugmentRecipe(const AugmentOptions& o)
@@ -146,6 +154,15 @@ AugmentRecipe loadAugmentRecipe(const AugmentOptions& o)
         recipe.policy = RandomScenePolicy::load(o.policy);
     else
         recipe.scene = readSceneFile(o.scene);
+    if (!o.darkBank.empty()) {
+        // Loaded once here, so that a bad bank stops the run before its first output.
+        DarkFrameBank::load(o.darkBank);
+        NoiseOptions& noise = recipe.randomScenes ? recipe.policy.noise : recipe.scene.noise;
+        noise.darkBank = o.darkBank;
+        noise.darkBankTied = o.darkBankTied;
+    } else if (o.darkBankTied) {
+        throw std::runtime_error("a tied dark-frame bank needs the bank (--dark_bank)");
+    }
     return recipe;
 }
 

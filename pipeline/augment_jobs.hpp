@@ -83,6 +83,10 @@ struct AugmentOptions
     std::string extension; //!< output container; empty: .dng for RAW inputs, else the input's
     bool previews = false;
     bool acceptFailedCalibration = false; //!< also a model whose calibration failed (NoiseModel::load())
+    /** A dark-frame bank file (DarkFrameBank::save()) as every output's read noise, instead of the scene's or
+     * policy's own (NoiseOptions::darkBank); empty: theirs. */
+    std::string darkBank;
+    bool darkBankTied = false; //!< the inputs are the bank's sensor's (NoiseOptions::darkBankTied)
 };
 
 /** One output of an augmentation run. Every front end (the app, Python, Dask workers) makes an output

@@ -28,14 +28,15 @@ RAW_EXTENSIONS = (".dng", ".nef", ".cr2", ".cr3", ".crw", ".arw", ".raf", ".rw2"
                   ".srw", ".3fr", ".iiq", ".erf", ".mef", ".mos", ".nrw", ".x3f")
 
 
-def _runJob(job, model, scene, policy, acceptFailedCalibration=False, camera=""):
+def _runJob(job, model, scene, policy, acceptFailedCalibration=False, camera="", darkBank="", darkBankTied=False):
     """One output (runs on a worker). Returns its path."""
-    _rawgment._apps.runAugmentJob(job, model, scene, policy, acceptFailedCalibration, camera)
+    _rawgment._apps.runAugmentJob(job, model, scene, policy, acceptFailedCalibration, camera, darkBank, darkBankTied)
     return job["out"]
 
 
 def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, seed=1, format=None,
-                 previews=False, client=None, progress=None, acceptFailedCalibration=False, camera=None):
+                 previews=False, client=None, progress=None, acceptFailedCalibration=False, camera=None,
+                 darkBank=None, darkBankTied=False):
     """Augments every input `variants` times, as ``rawgment_augment`` does.
 
     Args:
@@ -51,6 +52,9 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
         acceptFailedCalibration: also use a model whose calibration's verdict was FAIL (refused otherwise).
         camera: with a darktable file, a camera name, a comma-separated list of names, "good" or "usable";
             with several, each output draws one from its seed and records it in its sidecar.
+        darkBank: a dark-frame bank file (``DarkFrameBank.save``) as every output's read noise, instead of the
+            scene's or policy's own; workers read it by its path. darkBankTied: the inputs are the bank's
+            sensor's (``NoiseOptions.darkBankTied``).
 
     Returns:
         dict with ``written``, ``skipped`` (finished by an earlier run) and ``outputs`` (every output path).
@@ -71,9 +75,11 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     model = os.path.abspath(os.fspath(model))
     policy = os.path.abspath(os.fspath(policy)) if policy is not None else ""
     scene = os.path.abspath(os.fspath(scene)) if scene is not None else ""
+    darkBank = os.path.abspath(os.fspath(darkBank)) if darkBank is not None else ""
+    darkBankTied = bool(darkBankTied)
     plan = _rawgment._apps.planAugmentJobs(inputs, model, scene, policy, os.fspath(out), int(variants), int(seed),
                                            "" if format is None else "." + format, bool(previews),
-                                           bool(acceptFailedCalibration), camera)
+                                           bool(acceptFailedCalibration), camera, darkBank, darkBankTied)
     jobs = plan["jobs"]
     total = len(jobs)
     if progress is None:
@@ -83,7 +89,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     if client is None:
         for job in jobs:
             try:
-                _runJob(job, model, scene, policy, bool(acceptFailedCalibration), camera)
+                _runJob(job, model, scene, policy, bool(acceptFailedCalibration), camera, darkBank, darkBankTied)
                 written += 1
             except Exception as e:  # the others still run; the first error is raised at the end
                 errors.append("'%s' variant %d: %s" % (job["input"], job["variant"], e))
@@ -92,7 +98,8 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
         from distributed import as_completed
 
         futures = client.map(_runJob, jobs, model=model, scene=scene, policy=policy,
-                             acceptFailedCalibration=bool(acceptFailedCalibration), camera=camera, pure=False)
+                             acceptFailedCalibration=bool(acceptFailedCalibration), camera=camera,
+                             darkBank=darkBank, darkBankTied=darkBankTied, pure=False)
         where = {f.key: job for f, job in zip(futures, jobs)}
         for future in as_completed(futures):
             job = where[future.key]
@@ -153,6 +160,11 @@ def main(argv=None):
     parser.add_argument("--preview", action="store_true", help="also write an sRGB preview PNG per output")
     parser.add_argument("--accept_failed_calibration", action="store_true",
                         help="also use a model whose calibration's verdict was FAIL")
+    parser.add_argument("--dark_bank", help="a dark-frame bank file: its real dark frames are every output's read "
+                                            "noise, accounted for the input's own")
+    parser.add_argument("--dark_bank_tied", action="store_true",
+                        help="the inputs come from the bank's own sensor: their fixed pattern is swapped for the "
+                             "target's")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     where.add_argument("--workers", type=int, help="start a local Dask cluster with this many worker processes")
@@ -188,7 +200,7 @@ def main(argv=None):
         result = augmentFiles(args.inputs, args.model, args.out, policy=args.policy, scene=args.scene,
                               variants=args.variants, seed=args.seed, format=args.format, previews=args.preview,
                               client=client, acceptFailedCalibration=args.accept_failed_calibration,
-                              camera=args.camera)
+                              camera=args.camera, darkBank=args.dark_bank, darkBankTied=args.dark_bank_tied)
     except (RuntimeError, ValueError, OSError) as e:
         sys.stderr.write("rawgment.batch: %s\n" % e)
         return 1

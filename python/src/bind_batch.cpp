@@ -13,12 +13,11 @@ using namespace cv::rawgment;
 
 namespace {
 
-rawgment_pipeline::AugmentOptions optionsFrom(const std::vector<std::string>& inputs,
-                                              const std::string& model, const std::string& scene,
-                                              const std::string& policy, const std::string& outDir,
-                                              int variants, uint64 seed, const std::string& extension,
-                                              bool previews, bool acceptFailedCalibration,
-                                              const std::string& camera)
+rawgment_pipeline::AugmentOptions
+optionsFrom(const std::vector<std::string>& inputs, const std::string& model, const std::string& scene,
+            const std::string& policy, const std::string& outDir, int variants, uint64 seed,
+            const std::string& extension, bool previews, bool acceptFailedCalibration,
+            const std::string& camera, const std::string& darkBank, bool darkBankTied)
 {
     rawgment_pipeline::AugmentOptions o;
     o.inputs = inputs;
@@ -32,6 +31,8 @@ rawgment_pipeline::AugmentOptions optionsFrom(const std::vector<std::string>& in
     o.extension = extension;
     o.previews = previews;
     o.acceptFailedCalibration = acceptFailedCalibration;
+    o.darkBank = darkBank;
+    o.darkBankTied = darkBankTied;
     return o;
 }
 
@@ -69,9 +70,10 @@ void bindBatch(py::module_& m)
         [](const std::vector<std::string>& inputs, const std::string& model, const std::string& scene,
            const std::string& policy, const std::string& outDir, int variants, uint64 seed,
            const std::string& extension, bool previews, bool acceptFailedCalibration,
-           const std::string& camera) {
-            const auto options = optionsFrom(inputs, model, scene, policy, outDir, variants, seed, extension,
-                                             previews, acceptFailedCalibration, camera);
+           const std::string& camera, const std::string& darkBank, bool darkBankTied) {
+            const auto options =
+                optionsFrom(inputs, model, scene, policy, outDir, variants, seed, extension, previews,
+                            acceptFailedCalibration, camera, darkBank, darkBankTied);
             rawgment_pipeline::loadAugmentRecipe(options); // the files are checked before any job is planned
             const rawgment_pipeline::AugmentPlan plan =
                 withoutGil("planAugmentJobs", [&] { return rawgment_pipeline::planAugmentJobs(options); });
@@ -87,16 +89,18 @@ void bindBatch(py::module_& m)
         py::arg("inputs"), py::arg("model"), py::arg("scene"), py::arg("policy"), py::arg("outDir"),
         py::arg("variants"), py::arg("seed"), py::arg("extension"), py::arg("previews"),
         py::arg("acceptFailedCalibration") = false, py::arg("camera") = std::string(),
+        py::arg("darkBank") = std::string(), py::arg("darkBankTied") = false,
         "The jobs of an augmentation run, as rawgment_augment plans them: a dict with 'jobs' (each a dict: "
         "input, name, variant, seed, out, preview), 'outputs' and 'skipped' (outputs a previous run "
         "finished).");
     apps.def(
         "runAugmentJob",
         [](const py::dict& job, const std::string& model, const std::string& scene, const std::string& policy,
-           bool acceptFailedCalibration, const std::string& camera) {
+           bool acceptFailedCalibration, const std::string& camera, const std::string& darkBank,
+           bool darkBankTied) {
             const rawgment_pipeline::AugmentJob j = jobFromDict(job);
             const auto options = optionsFrom({j.input}, model, scene, policy, "", 1, 0, "", false,
-                                             acceptFailedCalibration, camera);
+                                             acceptFailedCalibration, camera, darkBank, darkBankTied);
             withoutGil("runAugmentJob", [&] {
                 const rawgment_pipeline::AugmentRecipe recipe = rawgment_pipeline::loadAugmentRecipe(options);
                 rawgment_pipeline::runAugmentJob(j, recipe);
@@ -104,6 +108,7 @@ void bindBatch(py::module_& m)
         },
         py::arg("job"), py::arg("model"), py::arg("scene"), py::arg("policy"),
         py::arg("acceptFailedCalibration") = false, py::arg("camera") = std::string(),
+        py::arg("darkBank") = std::string(), py::arg("darkBankTied") = false,
         "Makes one output of a plan, exactly as rawgment_augment does (atomic; never replaces a file).");
 
     py::module_ bench = m.def_submodule("_benchmark", "Hooks of the Python benchmark (not part of the API).");

@@ -69,6 +69,22 @@ def sensor():
 
 
 @pytest.fixture(scope="session")
+def dark_bank(tmp_path_factory, sensor):
+    """The path of a saved dark-frame bank of `sensor`: three dark frames at each of gains 1, 2 and 4."""
+    folder = tmp_path_factory.mktemp("dark_bank")
+    files = []
+    for gain in (1.0, 2.0, 4.0):
+        for t in range(3):
+            path = folder / ("dark_g%g_%d.png" % (gain, t))
+            dark = sensor.capture(np.zeros((96, 128), np.float32), gain, 1.0, seed=90, frameIndex=t)
+            rg.writeMosaic(str(path), dark, rg.MosaicMetadata(format=sensor.rawFormat(gain)))
+            files.append(str(path))
+    bank = rg.DarkFrameBank.create(files, rg.NoiseModel())
+    bank.save(str(folder / "bank.yml"))
+    return str(folder / "bank.yml")
+
+
+@pytest.fixture(scope="session")
 def capture(sensor):
     _, mean = chart_mean()
     return sensor.capture(mean, 2.0, 1.0, seed=11, frameIndex=3)

@@ -223,3 +223,46 @@ def test_a_failed_calibrations_model_is_refused_unless_accepted(job, tmp_path):
     assert run.returncode == 0, run.stderr
     import pickle
     assert pickle.loads(pickle.dumps(model)).failedCalibration == "frames per burst"
+
+
+def test_a_dark_frame_bank_reaches_the_app_and_the_workers_by_its_path(app_dir, job, dark_bank, tmp_path):
+    # A gain ratio of 2: inputs at gains 1 and 2 go to 2 and 4, within the bank.
+    policy = tmp_path / "policy.yml"
+    rg.RandomScenePolicy(blurProbability=0.5, geometryProbability=1, gainDbMin=6.0206,
+                         gainDbMax=6.0206).save(str(policy))
+    banked = dict(job, policy=str(policy))
+    app_run(app_dir, banked, tmp_path / "app", extra=["--dark_bank=" + dark_bank])
+    here = batch.augmentFiles(banked["inputs"], banked["model"], tmp_path / "here", policy=str(policy), variants=2,
+                              seed=5, darkBank=dark_bank)
+    assert here["written"] == 6
+    assert_same_files(tmp_path / "app", tmp_path / "here")
+    from distributed import Client, LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        batch.augmentFiles(banked["inputs"], banked["model"], tmp_path / "dask", policy=str(policy), variants=2,
+                           seed=5, darkBank=dark_bank, client=client)
+    assert_same_files(tmp_path / "app", tmp_path / "dask")
+    # The bank changes the noise: without it, other bytes.
+    app_run(app_dir, banked, tmp_path / "plain")
+    name = [n for n in files_of(tmp_path / "app") if n.endswith(".dng")][0]
+    assert not filecmp.cmp(tmp_path / "app" / name, tmp_path / "plain" / name, shallow=False)
+    # A policy file may name the bank itself, relative to its own folder.
+    named = tmp_path / "named.yml"
+    noise = rg.NoiseOptions(darkBank=os.path.relpath(dark_bank, tmp_path))
+    rg.RandomScenePolicy(blurProbability=0.5, geometryProbability=1, gainDbMin=6.0206, gainDbMax=6.0206,
+                         noise=noise).save(str(named))
+    assert rg.RandomScenePolicy.load(str(named)).noise.darkBank == os.path.join(str(tmp_path), noise.darkBank)
+    app_run(app_dir, dict(job, policy=str(named)), tmp_path / "named")
+    # The same images; the sidecars record the bank's path as each run named it.
+    for name in files_of(tmp_path / "app"):
+        if not name.endswith(".yml"):
+            assert filecmp.cmp(tmp_path / "app" / name, tmp_path / "named" / name, shallow=False), name
+    assert "dark_bank" in (tmp_path / "named" / "chart_v00.png.yml").read_text()
+    # A bank that cannot be read stops the run before its first output; a tied bank needs a bank.
+    with pytest.raises(RuntimeError, match="missing.yml"):
+        batch.augmentFiles(banked["inputs"], banked["model"], tmp_path / "bad", policy=str(policy),
+                           darkBank=tmp_path / "missing.yml")
+    with pytest.raises(RuntimeError, match="needs the bank"):
+        batch.augmentFiles(banked["inputs"], banked["model"], tmp_path / "bad", policy=str(policy), darkBankTied=True)
+    assert not os.path.exists(tmp_path / "bad") or not os.listdir(tmp_path / "bad")

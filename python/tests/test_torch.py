@@ -89,6 +89,18 @@ def test_dataloader_gives_the_same_samples_with_0_and_2_workers(folder, sensor):
             dataset.set_epoch(bad)
 
 
+def test_dataloader_workers_take_the_dark_frame_bank_by_its_path(folder, sensor, dark_bank):
+    # A gain ratio of 2 takes the gain-1 DNGs to gain 2, within the bank.
+    policy = rg.RandomScenePolicy(gainDbMin=6.0206, gainDbMax=6.0206, noise=rg.NoiseOptions(darkBank=dark_bank))
+    dataset = rgt.RawFolderDataset(folder, sensor.effectiveModel(), policy=policy, baseSeed=11)
+    here = batches(torch.utils.data.DataLoader(dataset, batch_size=2, num_workers=0))
+    there = batches(torch.utils.data.DataLoader(dataset, batch_size=2, num_workers=2))
+    assert all(a[0] == b[0] and torch.equal(a[1], b[1]) for a, b in zip(here, there))
+    plain = rgt.RawFolderDataset(folder, sensor.effectiveModel(), policy=rg.RandomScenePolicy(
+        gainDbMin=6.0206, gainDbMax=6.0206), baseSeed=11)
+    assert not torch.equal(plain[0]["raw"], dataset[0]["raw"])
+
+
 def test_persistent_workers_see_every_epoch(folder, sensor):
     # Persistent workers keep their copy of the dataset: set_epoch() must still reach them (they used to
     # repeat epoch 0's augmentations).

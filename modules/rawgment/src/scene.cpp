@@ -518,8 +518,12 @@ void RandomScenePolicy::save(const String& path) const
 
 RandomScenePolicy RandomScenePolicy::load(const String& path)
 {
-    return detail::loadFileStorage(path, "random_scene_policy", "random scene policy",
-                                   [](const FileNode& n) { return read(n); });
+    RandomScenePolicy p = detail::loadFileStorage(path, "random_scene_policy", "random scene policy",
+                                                  [](const FileNode& n) { return read(n); });
+    // A bank named by the file lies relative to the file, as a model's images do.
+    if (!p.noise.darkBank.empty() && p.noise.darkBank[0] != '/')
+        p.noise.darkBank = detail::folderOf(path) + p.noise.darkBank;
+    return p;
 }
 
 } // namespace rawgment
