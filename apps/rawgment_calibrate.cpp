@@ -36,6 +36,18 @@ void printCalibration(const rawgment_apps::CalibrateResult& r, const std::string
     const cv::rawgment::CalibrationReport& rep = r.report;
     printVerdict(r.verdict);
     std::printf("method %s, %d of %d samples used\n", method.c_str(), rep.samplesUsed, rep.samples);
+    if (!r.bank.empty()) {
+        std::printf("dark-frame bank %s: %zu groups in %.1f s\n", r.bank.path.c_str(), r.bank.groups.size(),
+                    r.bankSeconds);
+        for (const cv::rawgment::DarkFrameGroup& g : r.bank.groups)
+            std::printf(
+                "  gain %g%s: %zu frames, temporal variance %.4g DN^2 (row part %.4g), fixed-pattern RMS "
+                "%.4g DN, %zu noisy pixels\n",
+                g.gain, g.exposureTime > 0 ? cv::format(", exposure %g s", g.exposureTime).c_str() : "",
+                g.files.size(), cv::mean(g.statistics.temporalVariance)[0],
+                cv::mean(g.statistics.rowNoiseVariance)[0], g.statistics.fixedPatternRms(),
+                g.statistics.noisyPixels.size());
+    }
     for (const cv::rawgment::NoiseLineFit& l : rep.perGain)
         std::printf(
             "  gain %6.2f dB: variance = (%.5f +- %.2g) mean + (%.4f +- %.2g)  (R^2 %.4f, %d inliers)\n",
@@ -129,7 +141,9 @@ int main(int argc, char** argv)
         "{seed           | 0     | seed of the robust line fits (RANSAC); with --emva, of the validation }"
         "{plots          | true  | write PNG plots with gnuplot }"
         "{dark_components| false | also row noise, dark shading and the read noise's shape from the dark "
-        "bursts }";
+        "bursts }"
+        "{dark_bank      |       | also write a dark-frame bank of the dark bursts' files to this file "
+        "(bank.yml): rawgment_augment --dark_bank takes it }";
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_calibrate"))
         return 2;
     rawgment_apps::installInterruptCleanup();
@@ -208,6 +222,7 @@ int main(int argc, char** argv)
     o.plots = parser.get<bool>("plots");
     o.seed = rawgment_apps::seedOption(parser, "rawgment_calibrate");
     o.darkComponents = parser.get<bool>("dark_components");
+    o.darkBank = parser.get<std::string>("dark_bank");
     if (!parser.check() || o.manifest.empty() || o.outDir.empty() ||
         (method != "joint" && method != "two-stage") || o.shapiroPixels < 1 || o.shapiroPixels > 1000000 ||
         o.side < 2 || o.side % 2) {

@@ -23,10 +23,11 @@ TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
                                     "--out='" +
                                         dir + "/sim'");
     ASSERT_EQ(0, r.status) << r.output;
-    r = runApp("rawgment_calibrate",
-               "'" + dir + "/sim/manifest.yml' --dark_components=true --out='" + dir + "/cal'");
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --dark_components=true --dark_bank='" +
+                                         dir + "/sim/bank.yml' --out='" + dir + "/cal'");
     ASSERT_EQ(0, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("dark frames: row noise")) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("sim/bank.yml: 2 groups")) << r.output;
     for (const char* f : {"dark_calibration.yml", "dark_rows.csv", "dark_ppcc.csv", "dark_rows.png",
                           "dark_ppcc.png", "dark_shading.png", "noise_model.dark_shading_per_gain.tiff"})
         EXPECT_TRUE(exists(dir + "/cal/" + f)) << f;
@@ -47,6 +48,29 @@ TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
     // from alpha and 59% from sigma_r^2 (16 frames at 6, 12 and 24 dB).
     EXPECT_NEAR(fitted.sigmaD2, truth.sigmaD2, 0.1 * truth.sigmaD2);
     EXPECT_NEAR(fitted.alpha, truth.alpha, 0.1 * truth.alpha);
+    // The bank of the dark bursts beside them, by the gains their sidecars state; never written over; and the
+    // augmentation of a light frame from 6 to 18 dB with it, tied (the frames are its sensor's) or not.
+    const cv::rawgment::DarkFrameBank bank = cv::rawgment::DarkFrameBank::load(dir + "/sim/bank.yml");
+    ASSERT_EQ(bank.groups.size(), 2u);
+    EXPECT_NEAR(bank.groups[0].gain, std::pow(10, 6 / 20.0), 1e-9);
+    EXPECT_EQ(bank.groups[1].files.size(), 8u);
+    EXPECT_EQ(readText(dir + "/sim/bank.yml").find(dir), std::string::npos) << "frames relative to the bank";
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --dark_bank='" + dir +
+                                         "/sim/bank.yml' --plots=false --out='" + dir + "/cal_again'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("never written over")) << r.output;
+    writeExposureScene(dir + "/darker.yml", 0.125, std::pow(10, 12 / 20.0));
+    for (const char* tied : {"false", "true"}) {
+        r = runApp("rawgment_augment", "--model='" + dir +
+                                           "/cal/noise_model.yml' --accept_failed_calibration=true "
+                                           "--scene='" +
+                                           dir + "/darker.yml' --dark_bank='" + dir +
+                                           "/sim/bank.yml' --dark_bank_tied=" + tied + " --out='" + dir +
+                                           "/aug_" + tied + "' '" + dir +
+                                           "/sim/g06dB_level0.50/frame_000.png'");
+        ASSERT_EQ(0, r.status) << r.output;
+        EXPECT_TRUE(exists(dir + "/aug_" + tied + "/frame_000_v00.png")) << r.output;
+    }
     // Without dark bursts the option is an error that says what it needs.
     r = runApp("rawgment_simulate",
                "--frames=3 --levels=0.5 --format=png --validation=false --gains=6 --out='" + dir + "/plain'");

@@ -10,6 +10,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -527,6 +528,46 @@ std::vector<MeasuredNoiseLine> measuredLinesOf(const std::vector<NoiseLineFit>& 
 
 } // namespace
 
+namespace {
+
+/* --dark_bank: a bank of the dark bursts' files, each file's gain from its own ISO (through the calibrated
+ * model's base ISO) or sidecar, as augmentation reads an input's gain; a burst whose manifest gain disagrees
+ * with its files' is refused, as the bank would file its frames under another gain. */
+void writeDarkFrameBank(const CalibrateOptions& o, const std::vector<CalibrationManifest::Burst>& specs,
+                        const BurstGains& gains, CalibrateResult& result)
+{
+    if (pathExists(o.darkBank))
+        throw std::runtime_error("'" + o.darkBank + "' exists: the dark-frame bank is never written over");
+    std::vector<cv::String> files;
+    for (const CalibrationManifest::Burst& spec : specs)
+        if (spec.dark)
+            files.insert(files.end(), spec.files.begin(), spec.files.end());
+    if (files.empty())
+        throw std::runtime_error(
+            "--dark_bank needs dark bursts (dark: true in the manifest, or folders named dark*)");
+    const auto start = std::chrono::steady_clock::now();
+    result.bank = DarkFrameBank::create(files, result.report.model);
+    for (size_t i = 0; i < specs.size(); ++i) {
+        if (!specs[i].dark)
+            continue;
+        const double gain = std::pow(10.0, gains.gainsDb[i] / 20);
+        const auto holds = [&](const DarkFrameGroup& g) {
+            return std::find(g.files.begin(), g.files.end(), specs[i].files.front()) != g.files.end();
+        };
+        const auto group = std::find_if(result.bank.groups.begin(), result.bank.groups.end(), holds);
+        if (group != result.bank.groups.end() && std::abs(std::log(group->gain / gain)) > 1e-3)
+            throw std::runtime_error(cv::format("--dark_bank: '%s' is at gain %g by its own ISO or sidecar, "
+                                                "but the manifest puts its burst at %g "
+                                                "(%.2f dB): a bank files frames by the gain they state",
+                                                specs[i].files.front().c_str(), group->gain, gain,
+                                                gains.gainsDb[i]));
+    }
+    result.bank.save(o.darkBank);
+    result.bankSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+} // namespace
+
 CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
 {
     const CalibrationManifest manifest = readCalibrationManifest(o.manifest);
@@ -603,6 +644,8 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                      report.write(fs, "calibration_report");
                  }));
     writeModelAndExports(o, specs, gains, firstFormat, result);
+    if (!o.darkBank.empty())
+        writeDarkFrameBank(o, specs, gains, result);
 
     const size_t histogramGains =
         writeSampleTables(samples, report, in.shapiro, samplesCsv, linesCsv, shapiroCsv, histCsv);

@@ -64,6 +64,8 @@ struct CalibrateOptions
     uint64_t seed = 0; //!< seed of the RANSAC draws of the per-gain line fits
     //! Also the dark-frame components (row noise, dark shading, Tukey read noise) from the dark bursts.
     bool darkComponents = false;
+    //! Also a dark-frame bank of the dark bursts' files, written there (DarkFrameBank::save()); "" for none.
+    std::string darkBank;
 };
 
 struct CalibrateResult
@@ -78,7 +80,10 @@ struct CalibrateResult
     cv::rawgment::CalibrationVerdict verdict;
     //! What more data would buy: a plan's name and the standard errors it would give (projectedStdError()).
     std::vector<std::pair<std::string, cv::Vec3d>> projections;
-    bool haveDark = false;                    //!< whether the dark-frame components were calibrated
+    bool haveDark = false; //!< whether the dark-frame components were calibrated
+    //! The bank written (CalibrateOptions::darkBank), and how long making it took (s).
+    cv::rawgment::DarkFrameBank bank;
+    double bankSeconds = 0;
     cv::rawgment::DarkCalibrationReport dark; //!< their calibration (its model is report.model)
 };
 
