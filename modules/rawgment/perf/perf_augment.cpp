@@ -2,7 +2,8 @@
 // Augmentation of a 4000x3000 CV_16UC1 mosaic, and of the same mosaic as CV_32FC1 (the *F32 benchmarks), all
 // in one run:
 //   colour jitter (ACCOUNT_PRIOR; also with Tukey-lambda read noise and with Poisson shot draws), motion
-//   blur (length 13), scaling by 3%, a full random scene,
+//   blur (length 13), scaling by 3%, a full random scene, colour jitter and blur with a dark-frame bank as
+//   the read noise (NoiseOptions::darkBank: two 12 MP frames read from .npy files per step, in the time),
 //   the same colour jitter composed naively with OpenCV calls (convertTo, RNG::fill NORMAL, Mat
 //   arithmetic, sqrt), and a memcpy of the frame (the floor); and standard normals alone
 //   (fillStandardNormal); and exact Poisson draws alone, in vector lanes (detail::fillPoisson) against the
@@ -18,9 +19,13 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/cpu.hpp>
+#include <opencv2/rawgment/dark_frames.hpp>
+#include <opencv2/rawgment/mosaic_files.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
 #include <cstring>
+#include <filesystem>
+#include <unistd.h>
 
 namespace {
 
@@ -102,6 +107,59 @@ void BM_Augment_colorJitterPoissonF32(benchmark::State& state)
     timeColorJitter(state, kModel, poissonNoise(), floatFrame());
 }
 
+/* A bank of 12 MP dark frames of perfFrame()'s format, three at each of gains 2 and 4 (the jitter's input and
+ * output), saved once per run as .npy files with sidecars in a temporary folder removed at exit. */
+//! A folder removed with everything in it when the program ends.
+struct TemporaryFolder
+{
+    std::string path;
+    TemporaryFolder()
+        : path((std::filesystem::temp_directory_path() / ("rawgment_perf_bank_" + std::to_string(::getpid())))
+                   .string())
+    {
+        std::filesystem::create_directories(path);
+    }
+    ~TemporaryFolder()
+    {
+        std::error_code ignored;
+        std::filesystem::remove_all(path, ignored);
+    }
+};
+
+const String& darkBankPath()
+{
+    static const TemporaryFolder folder;
+    static const String path = [] {
+        std::vector<String> files;
+        for (double gain : {2.0, 4.0})
+            for (int t = 0; t < 3; ++t) {
+                Mat noise(frame().size(), CV_32FC1), dark;
+                RNG(100 + t + static_cast<int>(gain)).fill(noise, RNG::NORMAL, 256, gain);
+                noise.convertTo(dark, CV_16U);
+                MosaicMetadata meta;
+                meta.format = perf::perfFrameFormat(gain);
+                files.push_back(folder.path + format("/dark_g%g_%d.npy", gain, t));
+                writeMosaic(files.back(), dark, meta);
+            }
+        DarkFrameBank bank = DarkFrameBank::create(files, kModel);
+        bank.save(folder.path + "/bank.yml");
+        return String(folder.path + "/bank.yml");
+    }();
+    return path;
+}
+
+NoiseOptions bankNoise()
+{
+    NoiseOptions noise(NoiseAlignment::ACCOUNT_PRIOR);
+    noise.darkBank = darkBankPath();
+    return noise;
+}
+
+void BM_Augment_colorJitterDarkBank(benchmark::State& state)
+{
+    timeColorJitter(state, kModel, bankNoise());
+}
+
 void BM_Augment_colorJitterNaiveOpenCV(benchmark::State& state)
 {
     // Eq. 11 with whole-frame OpenCV operations and temporaries.
@@ -126,13 +184,14 @@ void BM_Augment_colorJitterNaiveOpenCV(benchmark::State& state)
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(frame().total()));
 }
 
-void timeMotionBlur13(benchmark::State& state, const Mat& input)
+void timeMotionBlur13(benchmark::State& state, const Mat& input,
+                      const NoiseOptions& noise = NoiseAlignment::ACCOUNT_PRIOR)
 {
     const Mat kernel = linearMotionKernel(13, 30);
     Mat out;
     uint64 seed = 0;
     for (auto _ : state) {
-        motionBlur(input, frameFormat(), kModel, kernel, NoiseAlignment::ACCOUNT_PRIOR, ++seed, out);
+        motionBlur(input, frameFormat(), kModel, kernel, noise, ++seed, out);
         benchmark::DoNotOptimize(out.data);
     }
     state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(input.total()));
@@ -146,6 +205,11 @@ void BM_Augment_motionBlur13(benchmark::State& state)
 void BM_Augment_motionBlur13F32(benchmark::State& state)
 {
     timeMotionBlur13(state, floatFrame());
+}
+
+void BM_Augment_motionBlur13DarkBank(benchmark::State& state)
+{
+    timeMotionBlur13(state, frame(), bankNoise());
 }
 
 void timeScale103(benchmark::State& state, const Mat& input)
@@ -345,11 +409,13 @@ int main(int argc, char** argv)
         {"BM_Augment_colorJitter", BM_Augment_colorJitter},
         {"BM_Augment_colorJitterF32", BM_Augment_colorJitterF32},
         {"BM_Augment_colorJitterTukeyRead", BM_Augment_colorJitterTukeyRead},
+        {"BM_Augment_colorJitterDarkBank", BM_Augment_colorJitterDarkBank},
         {"BM_Augment_colorJitterPoisson", BM_Augment_colorJitterPoisson},
         {"BM_Augment_colorJitterPoissonF32", BM_Augment_colorJitterPoissonF32},
         {"BM_Augment_poissonDraws", BM_Augment_poissonDraws},
         {"BM_Augment_motionBlur13", BM_Augment_motionBlur13},
         {"BM_Augment_motionBlur13F32", BM_Augment_motionBlur13F32},
+        {"BM_Augment_motionBlur13DarkBank", BM_Augment_motionBlur13DarkBank},
         {"BM_Augment_scale103", BM_Augment_scale103},
         {"BM_Augment_scale103F32", BM_Augment_scale103F32},
         {"BM_Augment_randomScene", BM_Augment_randomScene},

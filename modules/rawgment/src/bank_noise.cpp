@@ -4,6 +4,7 @@
 
 #include "precomp.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <list>
 #include <mutex>
@@ -51,30 +52,52 @@ std::shared_ptr<const DarkFrameBank> cachedDarkFrameBank(const String& path)
 
 namespace {
 
-//! The pixel part's variance of each pixel of a mosaic at `origin` in a group: its row's pooled variance less
-//! the row noise, a noisy pixel's own less the row noise; times scale^2.
-Mat pixelPartVariance(const DarkFrameGroup& g, Point origin, Size size, double scale)
+//! The pixel part's variance of a mosaic at `origin` in a group: its rows' pooled variance less the row
+//! noise, and each noisy pixel's own less the row noise; times scale^2.
+PixelPartVariance pixelPartVariance(const DarkFrameGroup& g, Point origin, Size size, double scale)
 {
     const DarkFrameStatistics& s = g.statistics;
-    Mat v(size, CV_32FC1);
+    PixelPartVariance v;
     const double s2 = scale * scale;
-    for (int r = 0; r < size.height; ++r) {
-        float* out = v.ptr<float>(r);
-        const int R = r + origin.y;
-        for (int c = 0; c < size.width; ++c) {
-            const int C = c + origin.x;
-            out[c] = static_cast<float>(
+    v.byRow.create(size.height, 2, CV_32FC1);
+    for (int r = 0; r < size.height; ++r)
+        for (int p = 0; p < 2; ++p) {
+            const int R = r + origin.y, C = p + origin.x;
+            v.byRow.at<float>(r, p) = static_cast<float>(
                 s2 * std::max(0.0, s.rowVariance.at<double>(R, C & 1) - s.rowNoiseVariance[cfaSite(R, C)]));
         }
+    std::vector<std::pair<Point, float>> inside;
+    const Rect crop(origin, size);
+    for (size_t i = 0; i < s.noisyPixels.size(); ++i)
+        if (crop.contains(s.noisyPixels[i])) {
+            const Point p = s.noisyPixels[i];
+            inside.emplace_back(
+                p - origin,
+                static_cast<float>(
+                    s2 * std::max(0.0, s.noisyVariance[i] - s.rowNoiseVariance[cfaSite(p.y, p.x)])));
+        }
+    std::sort(inside.begin(), inside.end(),
+              [](const std::pair<Point, float>& x, const std::pair<Point, float>& y) {
+                  return std::make_pair(x.first.y, x.first.x) < std::make_pair(y.first.y, y.first.x);
+              });
+    v.rowStart.assign(static_cast<size_t>(size.height) + 1, 0);
+    for (const auto& e : inside) {
+        v.column.push_back(e.first.x);
+        v.variance.push_back(e.second);
+        ++v.rowStart[static_cast<size_t>(e.first.y) + 1];
     }
-    const Rect inside(origin, size);
-    for (size_t i = 0; i < s.noisyPixels.size(); ++i) {
-        const Point p = s.noisyPixels[i];
-        if (inside.contains(p))
-            v.at<float>(p - origin) = static_cast<float>(
-                s2 * std::max(0.0, s.noisyVariance[i] - s.rowNoiseVariance[cfaSite(p.y, p.x)]));
-    }
+    for (int r = 0; r < size.height; ++r)
+        v.rowStart[static_cast<size_t>(r) + 1] += v.rowStart[static_cast<size_t>(r)];
     return v;
+}
+
+//! The variance at mosaic column c of row r: a noisy pixel's own, else the row's at the column's parity.
+float varianceAt(const PixelPartVariance& v, int r, int c)
+{
+    for (int i = v.rowStart[static_cast<size_t>(r)]; i < v.rowStart[static_cast<size_t>(r) + 1]; ++i)
+        if (v.column[static_cast<size_t>(i)] == c)
+            return v.variance[static_cast<size_t>(i)];
+    return v.byRow.at<float>(r, c & 1);
 }
 
 } // namespace
@@ -124,10 +147,12 @@ BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size si
     const int M = static_cast<int>(out.files.size());
     const int i = std::min(M - 1, static_cast<int>(rng.uniform() * M));
     const int j = (i + 1 + std::min(M - 2, static_cast<int>(rng.uniform() * (M - 1)))) % M;
-    bank.readFrame(step.bankGroupOut, i).convertTo(b.frameA, CV_32F);
+    b.frameA = bank.readFrame(step.bankGroupOut, i);
     if (b.ignore)
         return b;
-    bank.readFrame(step.bankGroupOut, j).convertTo(b.frameB, CV_32F);
+    b.frameB = bank.readFrame(step.bankGroupOut, j);
+    if (b.frameB.type() != b.frameA.type())
+        b.frameB.convertTo(b.frameB, b.frameA.type());
 
     const DarkFrameStatistics &so = out.statistics, &si = in.statistics;
     const double at2 = step.bankScaleOut * step.bankScaleOut, as2 = step.bankScaleIn * step.bankScaleIn;
@@ -142,95 +167,147 @@ BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size si
     if (tied) {
         b.pixelHeld = pixelPartVariance(in, b.origin, size, step.bankScaleIn);
     } else {
-        b.pixelHeld.create(size, CV_32FC1);
-        for (int r = 0; r < size.height; ++r)
-            for (int c = 0; c < size.width; ++c) {
-                const int S = cfaSite(r + b.origin.y, c + b.origin.x);
-                b.pixelHeld.at<float>(r, c) =
-                    static_cast<float>(as2 * std::max(0.0, si.temporalVariance[S] - si.rowNoiseVariance[S]));
-            }
+        for (int m = 0; m < 4; ++m) {
+            const int S = cfaSite(m / 2 + b.origin.y, m % 2 + b.origin.x);
+            b.pixelHeldBySite[m] =
+                static_cast<float>(as2 * std::max(0.0, si.temporalVariance[S] - si.rowNoiseVariance[S]));
+        }
     }
     // The pattern: tied, the input's (as the step leaves it) out and the target's in; untied, what the
     // target's variance lacks of the input's scaled one, as the target's own pattern.
-    const Rect crop(b.origin, size);
-    if (tied) {
-        b.patternAdd = so.pattern(crop).clone();
-        if (!pattern.held.empty()) {
-            CV_Assert(pattern.held.type() == CV_32FC1 && pattern.held.size() == size);
-            b.patternAdd -= pattern.held;
-        } else {
-            for (int r = 0; r < size.height; ++r) {
-                float* p = b.patternAdd.ptr<float>(r);
-                const float* f = si.pattern.ptr<float>(r + b.origin.y) + b.origin.x;
-                for (int c = 0; c < size.width; ++c)
-                    p[c] -= static_cast<float>(pattern.amplitude[cfaSite(r, c)]) * f[c];
-            }
-        }
-        return b;
-    }
-    float share[4];
-    bool any = false;
+    b.patternTarget = so.pattern;
     for (int m = 0; m < 4; ++m) {
         const int S = cfaSite(m / 2 + b.origin.y, m % 2 + b.origin.x);
+        b.levelTarget[m] = static_cast<float>(so.level[S]);
+        b.patternAmplitude[m] = static_cast<float>(pattern.amplitude[m]);
         const double a = pattern.amplitude[m], t = so.patternVariance[S], h = a * a * si.patternVariance[S];
-        share[m] = t > 0 ? static_cast<float>(std::sqrt(std::max(0.0, 1 - h / t))) : 0.0f;
-        any = any || share[m] > 0;
+        b.patternShare[m] = t > 0 ? static_cast<float>(std::sqrt(std::max(0.0, 1 - h / t))) : 0.0f;
     }
-    if (any) {
-        b.patternAdd.create(size, CV_32FC1);
-        for (int r = 0; r < size.height; ++r) {
-            float* p = b.patternAdd.ptr<float>(r);
-            const float* f = so.pattern.ptr<float>(r + b.origin.y) + b.origin.x;
-            for (int c = 0; c < size.width; ++c)
-                p[c] = share[cfaSite(r, c)] *
-                       (f[c] - static_cast<float>(so.level[cfaSite(r + b.origin.y, c + b.origin.x)]));
-        }
+    if (tied && !pattern.held.empty()) {
+        CV_Assert(pattern.held.type() == CV_32FC1 && pattern.held.size() == size);
+        b.pattern = BankRead::SWAP_MOVED;
+        b.movedPattern = pattern.held;
+    } else if (tied) {
+        b.pattern = BankRead::SWAP;
+        b.patternInput = si.pattern;
+    } else if (b.patternShare[0] > 0 || b.patternShare[1] > 0 || b.patternShare[2] > 0 ||
+               b.patternShare[3] > 0) {
+        b.pattern = BankRead::ADD_LACKING;
     }
     return b;
 }
 
-int64 bankRowExtra(const BankRead& b, int r, int first, int step, int n, const float rowFactor[2],
-                   const float* pixelFactor, float* extra)
+namespace {
+
+template <typename T>
+int64 bankRowExtraOf(const BankRead& b, int r, int first, int step, int n, const float rowFactor[2],
+                     const float* pixelFactor, float* extra)
 {
-    const int R = r + b.origin.y, x0 = b.origin.x;
-    const float* a = b.frameA.ptr<float>(R);
+    const int R = r + b.origin.y, x0 = b.origin.x, width = b.frameA.cols;
+    const T* a = b.frameA.ptr<T>(R);
     if (b.ignore) {
+        const float black[2] = {b.black[cfaSite(R, 0)], b.black[cfaSite(R, 1)]};
         for (int j = 0; j < n; ++j) {
             const int C = first + step * j + x0;
-            extra[j] = b.scale * (a[C] - b.black[cfaSite(R, C)]);
+            extra[j] = b.scale * (static_cast<float>(a[C]) - black[C & 1]);
         }
         return 0;
     }
-    const float* f = b.frameB.ptr<float>(R);
+    const T* f = b.frameB.ptr<T>(R);
     // The row part at each sensor column parity: the difference's mean over the sensor's whole row there.
     double sum[2] = {0, 0};
-    const int width = b.frameA.cols;
     for (int C = 0; C < width; ++C)
-        sum[C & 1] += static_cast<double>(a[C]) - f[C];
+        sum[C & 1] += static_cast<double>(a[C]) - static_cast<double>(f[C]);
     const float k = b.scale * static_cast<float>(1 / std::sqrt(2.0));
     const float sensorRho[2] = {k * static_cast<float>(sum[0] / ((width + 1) / 2)),
                                 width > 1 ? k * static_cast<float>(sum[1] / (width / 2)) : 0.0f};
-    float rho[2], rowShare[2];
+    float rho[2], rowShare[2], target[2], held[2];
     bool rowExceeded[2];
     for (int p = 0; p < 2; ++p) {
         rho[p] = sensorRho[(p + x0) & 1];
         const int m = 2 * (r & 1) + p;
-        const float held = rowFactor[p] * b.rowHeld[m], target = b.rowTarget[m];
-        rowExceeded[p] = held > target;
-        rowShare[p] = target > 0 ? std::sqrt(std::max(0.0f, 1 - held / target)) : 0.0f;
+        const float rowHeld = rowFactor[p] * b.rowHeld[m], rowTarget = b.rowTarget[m];
+        rowExceeded[p] = rowHeld > rowTarget;
+        rowShare[p] = rowTarget > 0 ? std::sqrt(std::max(0.0f, 1 - rowHeld / rowTarget)) : 0.0f;
+        target[p] = b.pixelTarget.byRow.at<float>(r, p);
+        held[p] = b.pixelHeld.empty() ? b.pixelHeldBySite[m] : b.pixelHeld.byRow.at<float>(r, p);
     }
-    const float *pt = b.pixelTarget.ptr<float>(r), *ph = b.pixelHeld.ptr<float>(r);
-    const float* pattern = b.patternAdd.empty() ? nullptr : b.patternAdd.ptr<float>(r);
-    int64 exceeded = 0;
-    for (int j = 0; j < n; ++j) {
+    const float* ft = b.pattern == BankRead::NO_PATTERN ? nullptr : b.patternTarget.ptr<float>(R) + x0;
+    const float* fs = b.pattern == BankRead::SWAP ? b.patternInput.ptr<float>(R) + x0 : nullptr;
+    const float* moved = b.pattern == BankRead::SWAP_MOVED ? b.movedPattern.ptr<float>(r) : nullptr;
+    const int even = 2 * (r & 1);
+    // One pixel with its variances: the pixel part's share c from k^2 v_s + c^2 v_t = v_t, and the pattern.
+    // The pixel part's share c from k^2 v_s + c^2 v_t = v_t, and whether the input already exceeds the
+    // target.
+    const auto shareOf = [&](int j, int p, float pixelTargetVariance, float pixelHeldVariance,
+                             bool& exceeded) {
+        const float h = pixelFactor[j] * pixelHeldVariance, t = pixelTargetVariance;
+        exceeded = h > t || rowExceeded[p];
+        return t > 0 ? std::sqrt(std::max(0.0f, 1 - h / t)) : 0.0f;
+    };
+    const auto pixel = [&](int j, float share) {
         const int c = first + step * j, p = c & 1;
-        const float d = k * (a[c + x0] - f[c + x0]);
-        const float held = pixelFactor[j] * ph[c], target = pt[c];
-        const float share = target > 0 ? std::sqrt(std::max(0.0f, 1 - held / target)) : 0.0f;
-        exceeded += held > target || rowExceeded[p];
-        extra[j] = rowShare[p] * rho[p] + share * (d - rho[p]) + (pattern ? pattern[c] : 0.0f);
+        const float d = k * (static_cast<float>(a[c + x0]) - static_cast<float>(f[c + x0]));
+        float value = rowShare[p] * rho[p] + share * (d - rho[p]);
+        switch (b.pattern) {
+        case BankRead::ADD_LACKING:
+            value += b.patternShare[even + p] * (ft[c] - b.levelTarget[even + p]);
+            break;
+        case BankRead::SWAP:
+            value += ft[c] - b.patternAmplitude[even + p] * fs[c];
+            break;
+        case BankRead::SWAP_MOVED:
+            value += ft[c] - moved[c];
+            break;
+        case BankRead::NO_PATTERN:
+            break;
+        }
+        return value;
+    };
+    int64 exceededCount = 0;
+    // A row's pixels share their parity's variances, and mostly the step's factor: its share is reused while
+    // the factor stays (the same arithmetic, so the same bits).
+    float lastFactor[2] = {-1, -1}, lastShare[2] = {0, 0};
+    bool lastExceeded[2] = {false, false};
+    for (int j = 0; j < n; ++j) {
+        const int p = (first + step * j) & 1;
+        if (pixelFactor[j] != lastFactor[p]) {
+            lastFactor[p] = pixelFactor[j];
+            lastShare[p] = shareOf(j, p, target[p], held[p], lastExceeded[p]);
+        }
+        extra[j] = pixel(j, lastShare[p]);
+        exceededCount += lastExceeded[p];
     }
-    return exceeded;
+    // Noisy pixels, of the target's group or (tied) of the input's: their own variances instead of their
+    // row's.
+    std::vector<int> noisy;
+    for (const PixelPartVariance* v : {&b.pixelTarget, &b.pixelHeld})
+        if (!v->empty())
+            noisy.insert(noisy.end(), v->column.begin() + v->rowStart[static_cast<size_t>(r)],
+                         v->column.begin() + v->rowStart[static_cast<size_t>(r) + 1]);
+    std::sort(noisy.begin(), noisy.end());
+    noisy.erase(std::unique(noisy.begin(), noisy.end()), noisy.end());
+    for (int c : noisy) {
+        if (c < first || (c - first) % step != 0 || (c - first) / step >= n)
+            continue;
+        const int j = (c - first) / step;
+        bool before, now;
+        shareOf(j, c & 1, target[c & 1], held[c & 1], before);
+        const float heldVariance = b.pixelHeld.empty() ? held[c & 1] : varianceAt(b.pixelHeld, r, c);
+        extra[j] = pixel(j, shareOf(j, c & 1, varianceAt(b.pixelTarget, r, c), heldVariance, now));
+        exceededCount += static_cast<int64>(now) - static_cast<int64>(before);
+    }
+    return exceededCount;
+}
+
+} // namespace
+
+int64 bankRowExtra(const BankRead& b, int r, int first, int step, int n, const float rowFactor[2],
+                   const float* pixelFactor, float* extra)
+{
+    return b.frameA.depth() == CV_16U
+               ? bankRowExtraOf<ushort>(b, r, first, step, n, rowFactor, pixelFactor, extra)
+               : bankRowExtraOf<float>(b, r, first, step, n, rowFactor, pixelFactor, extra);
 }
 
 } // namespace detail

@@ -29,21 +29,44 @@ struct BankPattern
     Mat held;
 };
 
-/** A step's read part from a bank, prepared once per call: the target group's two frames (IGNORE_PRIOR: one),
- * their scale to the output gain, the variances of the row part and the pixel part at the target and in the
- * input, and the pattern to add. The rows take each part's share c from k^2 v_s + c^2 v_t = v_t with the
- * step's factors (bankRowExtra()). */
+/** The pixel part's variance of a group where a mosaic lies: per mosaic row and column parity, and each noisy
+ * pixel's own, by mosaic row. */
+struct PixelPartVariance
+{
+    Mat byRow;                   //!< CV_32FC1, the mosaic's rows x 2 (column parity)
+    std::vector<int> rowStart;   //!< the noisy pixels of mosaic row r are [rowStart[r], rowStart[r + 1])
+    std::vector<int> column;     //!< each noisy pixel's mosaic column
+    std::vector<float> variance; //!< and its variance
+    bool empty() const { return byRow.empty(); }
+};
+
+/** A step's read part from a bank, prepared once per call: the target group's two frames (IGNORE_PRIOR: one)
+ * as read, their scale to the output gain, the variances of the row part and the pixel part at the target and
+ * in the input, and how the pattern is added. No map of the mosaic's size is made: the rows read the frames
+ * and the groups' statistics where the mosaic lies (bankRowExtra()). */
 struct BankRead
 {
+    enum Pattern
+    {
+        NO_PATTERN,
+        ADD_LACKING, //!< untied: patternShare (F_t - level_t)
+        SWAP,        //!< tied: F_t - patternAmplitude F_s
+        SWAP_MOVED   //!< tied, resampled: F_t - movedPattern
+    };
     bool ignore = false; //!< IGNORE_PRIOR: a whole dark frame
-    Mat frameA, frameB;  //!< CV_32FC1 whole frames of the target group (raw DN)
+    Mat frameA, frameB;  //!< whole frames of the target group as read (CV_16UC1 or CV_32FC1)
     Point origin;        //!< where the mosaic lies on them
     float scale = 1;     //!< the frames' temporal noise to the output gain's (the model's read lines)
     float black[4] = {0, 0, 0, 0};     //!< the bank's black level per sensor site
     float rowTarget[4] = {0, 0, 0, 0}; //!< the target's row-part variance per mosaic site
     float rowHeld[4] = {0, 0, 0, 0};   //!< the input's, before the step's factor
-    Mat pixelTarget, pixelHeld;        //!< CV_32FC1 of the mosaic's size: the pixel part's variances
-    Mat patternAdd;                    //!< CV_32FC1 of the mosaic's size, or empty: the pattern added
+    PixelPartVariance pixelTarget;     //!< the target's pixel part
+    PixelPartVariance pixelHeld;       //!< the input's for a tied bank; empty: pooled per site
+    float pixelHeldBySite[4] = {0, 0, 0, 0};
+    Pattern pattern = NO_PATTERN;
+    Mat patternTarget, patternInput; //!< the groups' whole patterns (shared, not copied)
+    Mat movedPattern; //!< SWAP_MOVED: the input's pattern as the step left it, the mosaic's size
+    float patternShare[4] = {0, 0, 0, 0}, patternAmplitude[4] = {0, 0, 0, 0}, levelTarget[4] = {0, 0, 0, 0};
     bool empty() const { return frameA.empty(); }
 };
 
