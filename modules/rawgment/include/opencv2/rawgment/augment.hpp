@@ -78,7 +78,7 @@ struct CV_EXPORTS_W_SIMPLE NoiseOptions
      * shot noise. ACCOUNT_PRIOR adds to each pixel's row part and pixel part only what the input's own read
      * noise, scaled by the step, lacks of the target's; IGNORE_PRIOR adds whole dark frames. Given by path so
      * that it reaches other processes as a path: the file is read once per process while it is unchanged.
-     * docs/mathematics.md ("A bank of dark frames") gives the equations. */
+     * docs/dark_frame_bank.md gives the equations and their tests. */
     CV_PROP_RW String darkBank;
     /** Whether the input comes from the bank's own sensor at the same exposure and temperature, at its
      * RawFormat::sensorOrigin: then ACCOUNT_PRIOR takes the input's fixed pattern, scaled by the step, out

@@ -26,7 +26,7 @@ namespace rawgment {
  * Var(m) - mean(v)/M (the EMVA 1288 correction), and `pattern` is the mean shrunk towards the site's level
  * by w = s_F^2 / (s_F^2 + v/M): the best linear estimate of F given m when the pattern's values scatter by
  * s_F^2 around the site's level (the level itself where the frames resolve no pattern).
- * docs/mathematics.md ("A bank of dark frames") gives the estimators and their tests.
+ * docs/dark_frame_bank.md gives the estimators and their tests.
  */
 struct CV_EXPORTS_W_SIMPLE DarkFrameStatistics
 {
