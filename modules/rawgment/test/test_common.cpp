@@ -157,6 +157,18 @@ double poissonChiSquare(const std::map<int64_t, int>& counts, double lambda, dou
     return chi2;
 }
 
+void meanAndStandardError(const std::vector<double>& values, double& mean, double& standardError)
+{
+    const double n = static_cast<double>(values.size());
+    mean = 0;
+    for (double x : values)
+        mean += x / n;
+    double ss = 0;
+    for (double x : values)
+        ss += (x - mean) * (x - mean);
+    standardError = std::sqrt(ss / (n - 1) / n);
+}
+
 } // namespace test
 } // namespace rawgment
 } // namespace cv

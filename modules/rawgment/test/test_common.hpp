@@ -74,6 +74,9 @@ SensorParams darkComponentSensorParams(Size size, double lambda, uint64 seed);
 double poissonChiSquare(const std::map<int64_t, int>& counts, double lambda, double n, int& dof,
                         double* mass = nullptr);
 
+//! The mean of independent values and its standard error, sqrt(sample variance / n); n >= 2.
+void meanAndStandardError(const std::vector<double>& values, double& mean, double& standardError);
+
 } // namespace test
 } // namespace rawgment
 } // namespace cv

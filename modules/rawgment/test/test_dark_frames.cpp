@@ -383,16 +383,7 @@ void rowAndPixelParts(const std::vector<Mat>& frames, const Mat& keep, std::vect
     }
 }
 
-void meanAndStandardError(const std::vector<double>& v, double& mean, double& se)
-{
-    mean = 0;
-    for (double x : v)
-        mean += x / v.size();
-    double ss = 0;
-    for (double x : v)
-        ss += (x - mean) * (x - mean);
-    se = std::sqrt(ss / (v.size() - 1) / v.size());
-}
+using test::meanAndStandardError;
 
 /* A noise step with a bank, as the statistics below see it: its input gain, and the share of the input's row
  * part and pixel part its output keeps (0 where the test does not know it exactly). */

@@ -167,15 +167,7 @@ TEST(DarkFrames, thePatternIsTheTruthWithoutTheTemporalNoiseItsMeanHolds)
                 plainError += std::pow(plainMean.at<double>(r, c) - e.level[s] - t, 2);
             }
     }
-    const auto meanAndSe = [](const std::vector<double>& v, double& m, double& se) {
-        m = 0;
-        for (double x : v)
-            m += x / v.size();
-        double ss = 0;
-        for (double x : v)
-            ss += (x - m) * (x - m);
-        se = std::sqrt(ss / (v.size() - 1) / v.size());
-    };
+    const auto meanAndSe = test::meanAndStandardError;
     double m, se;
     meanAndSe(patternBias, m, se);
     std::cout << "pattern variance bias " << m << " +- " << se << "\n";
