@@ -491,6 +491,8 @@ void bindSimulator(py::module_& m)
                        doc("SensorParams::noisyPixelFraction"))
         .def_readwrite("noisyPixelVariance", &SensorParams::noisyPixelVariance,
                        doc("SensorParams::noisyPixelVariance"))
+        .def_readwrite("columnNoiseVariance", &SensorParams::columnNoiseVariance,
+                       doc("SensorParams::columnNoiseVariance"))
         .def("validate", &SensorParams::validate, doc("SensorParams::validate"));
 
     py::class_<SensorSimulator>(m, "SensorSimulator", doc("SensorSimulator"))

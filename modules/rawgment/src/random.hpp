@@ -387,6 +387,9 @@ enum class RandomStream : uint64_t
     JITTER_BANK = 16,
     BLUR_BANK = 17,
     SCALE_BANK = 18,
+    // The simulator's column offsets (SensorParams::columnNoiseVariance): key stepKey(capture seed, this),
+    // stream: the frame.
+    SIMULATOR_COLUMNS = 19,
 };
 
 /** The key of one family under a user's seed: the SplitMix64 finaliser of seed + golden * (id + 1),

@@ -57,6 +57,7 @@ void SensorParams::validate() const
     checkFraction(hotPixelFraction + deadPixelFraction + noisyPixelFraction,
                   "hotPixelFraction + deadPixelFraction + noisyPixelFraction");
     detail::checkFiniteNonNegative(noisyPixelVariance, "SensorParams.noisyPixelVariance");
+    detail::checkFiniteNonNegative(columnNoiseVariance, "SensorParams.columnNoiseVariance");
 }
 
 SensorSimulator::SensorSimulator(const SensorParams& params, Size size) : params_(params), size_(size)
@@ -169,6 +170,17 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
                  format("SensorSimulator::capture: the model's dark shading is %dx%d, the sensor %dx%d",
                         shading.cols, shading.rows, size_.width, size_.height));
     const double hotLevel = std::round(0.9 * white);
+    // Column offsets of this frame, from a stream of their own beside the rows' (drawn only when asked, so
+    // frames without them keep their bits).
+    std::vector<double> columnOffset;
+    if (p.columnNoiseVariance > 0) {
+        detail::CounterRng columns(
+            detail::stepKey(seed, static_cast<uint64_t>(detail::RandomStream::SIMULATOR_COLUMNS)),
+            static_cast<uint64_t>(frameIndex));
+        const double sigma = std::sqrt(p.columnNoiseVariance);
+        for (int c = 0; c < size_.width; ++c)
+            columnOffset.push_back(sigma * columns.gaussian());
+    }
     Mat raw(size_, p.quantize ? CV_16UC1 : CV_32FC1);
     parallel_for_(Range(0, size_.height), [&](const Range& rows) {
         for (int r = rows.start; r < rows.end; ++r) {
@@ -209,6 +221,8 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
                         x += rowOffset;
                     if (shade)
                         x += shade[c];
+                    if (!columnOffset.empty())
+                        x += columnOffset[static_cast<size_t>(c)];
                     if (defect[c] == DEFECT_NOISY)
                         x += noisySigma * rng.gaussian();
                 }

@@ -307,6 +307,38 @@ TEST(Simulate, blurredCaptureBlursPhotonsNotNoise)
     EXPECT_NEAR(edgeMean, (3 * 100 + 4 * 900) / 7.0, 10);
 }
 
+/* Column banding: each column of a frame shares one offset of the stated variance. Over 64 float frames of 96
+ * rows the column means vary by the offset's variance plus the pixel noise over the rows; their average over
+ * 128 columns has a relative standard error of about sqrt(2 / 63 / 128) = 1.6%, so 5% is 3 of them. */
+TEST(Simulate, columnNoiseIsAnOffsetSharedByEachColumnOfAFrame)
+{
+    SensorParams p;
+    p.quantize = false;
+    p.columnNoiseVariance = 4;
+    const Size size(128, 96);
+    const SensorSimulator sensor(p, size);
+    const int frames = 64;
+    std::vector<double> sum(size.width, 0), sum2(size.width, 0);
+    double pixelVariance = 0;
+    for (int t = 0; t < frames; ++t) {
+        Mat raw;
+        sensor.capture(Mat::zeros(size, CV_32F), 2.0, 1.0, 3, t, raw);
+        Mat columns;
+        reduce(raw, columns, 0, REDUCE_AVG, CV_64F);
+        for (int c = 0; c < size.width; ++c) {
+            sum[c] += columns.at<double>(0, c);
+            sum2[c] += columns.at<double>(0, c) * columns.at<double>(0, c);
+        }
+    }
+    pixelVariance = sensor.effectiveModel().variance(0, 2.0);
+    double columnVariance = 0;
+    for (int c = 0; c < size.width; ++c)
+        columnVariance += (sum2[c] - sum[c] * sum[c] / frames) / (frames - 1) / size.width;
+    EXPECT_NEAR(columnVariance - pixelVariance / size.height, 4.0, 0.05 * 4.0);
+    p.columnNoiseVariance = -1;
+    EXPECT_CV_ERROR_CONTAINS(SensorSimulator(p, size), "columnNoiseVariance");
+}
+
 TEST(Simulate, rejectsBadInput)
 {
     SensorParams p = typicalParams();

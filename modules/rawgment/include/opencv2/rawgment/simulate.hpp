@@ -33,7 +33,10 @@ struct CV_RAWGMENT_EXPORTS SensorParams
     double deadPixelFraction = 0;       //!< fraction of pixels stuck at black (no signal, no variance)
     double noisyPixelFraction = 0;      //!< fraction of pixels with extra temporal noise (e.g. RTS noise)
     double noisyPixelVariance = 100;    //!< extra variance of those pixels (DN^2)
-    uint64 fixedPatternSeed = 1;        //!< seed of the sensor's fixed pattern (PRNU, DSNU, defect map)
+    /** Variance of an offset shared by each column of each frame (DN^2, at every gain): column banding, which
+     * no NoiseModel component describes (a departure for the dark-frame bank's tests); 0: none. */
+    double columnNoiseVariance = 0;
+    uint64 fixedPatternSeed = 1; //!< seed of the sensor's fixed pattern (PRNU, DSNU, defect map)
 
     //! Throws cv::Exception naming the first invalid field.
     void validate() const;
