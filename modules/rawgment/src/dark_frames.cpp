@@ -165,6 +165,35 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
         e.patternVariance[s] = std::max(0.0, e.meanVariance[s] - own[s] / n / M);
         e.temporalVariance[s] = pooledCount[s] > 0 ? pooled[s] / pooledCount[s] : own[s] / n;
     }
+    // The shrinkage is the bulk's: a site's centre and spread from the median and interquartile range of its
+    // means, which its hot pixels (a few far out, thousands of DN) leave alone. Those, beyond 6 robust standard
+    // deviations of the means, are pattern beyond doubt and kept as measured. With the plain variance 0.2% of
+    // hot pixels made every w 1 on a simulated sensor: no shrinkage at all, the mean's whole v/M kept.
+    double centre[4], robustSpread[4], outlier[4];
+    {
+        std::vector<double> site[4];
+        for (int r = 0; r < rows; ++r) {
+            const double* m = mean.ptr<double>(r);
+            for (int c = 0; c < cols; ++c)
+                site[cfaSite(r, c)].push_back(m[c]);
+        }
+        for (int s = 0; s < 4; ++s) {
+            std::vector<double>& x = site[s];
+            if (x.empty()) {
+                centre[s] = robustSpread[s] = outlier[s] = 0;
+                continue;
+            }
+            const size_t q1 = x.size() / 4, q3 = (3 * x.size()) / 4;
+            std::nth_element(x.begin(), x.begin() + long(q1), x.end());
+            const double low = x[q1];
+            std::nth_element(x.begin(), x.begin() + long(q3), x.end());
+            const double high = x[q3];
+            centre[s] = medianOf(x);
+            const double robustVariance = std::pow((high - low) / 1.349, 2);
+            robustSpread[s] = std::max(0.0, robustVariance - e.temporalVariance[s] / M);
+            outlier[s] = 6 * std::sqrt(robustVariance);
+        }
+    }
     e.pattern.create(rows, cols, CV_32FC1);
     for (int r = 0; r < rows; ++r) {
         const double* m = mean.ptr<double>(r);
@@ -173,10 +202,16 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
         float* out = e.pattern.ptr<float>(r);
         for (int c = 0; c < cols; ++c) {
             const int s = cfaSite(r, c);
+            const double departure = m[c] - centre[s];
+            if (std::abs(departure) > outlier[s] && outlier[s] > 0) {
+                out[c] = static_cast<float>(m[c]);
+                continue;
+            }
             const double frozen = (flagged[c] ? v[c] : e.rowVariance.at<double>(r, c & 1)) / M;
-            const double spread = e.patternVariance[s];
-            const double w = spread > 0 ? spread / (spread + frozen) : 0.0;
-            out[c] = static_cast<float>(e.level[s] + w * (m[c] - e.level[s]));
+            // sqrt(w), not w: the departures then scatter by s_F^2, the pattern's own variance, which is what an
+            // augmentation adds (w, the best linear estimate, scatters by w s_F^2: less pattern than the sensor).
+            const double w = robustSpread[s] > 0 ? robustSpread[s] / (robustSpread[s] + frozen) : 0.0;
+            out[c] = static_cast<float>(centre[s] + std::sqrt(w) * departure);
         }
     }
     return e;

@@ -23,9 +23,10 @@ namespace rawgment {
  * A pixel's mean m over M frames is its fixed pattern F plus temporal noise of variance v/M, frozen into
  * the mean: on EMVA 1288 set 001 (a 12-bit CCD) the spatial variance of the mean of 50 dark frames is
  * 0.214 DN^2, of which 0.190 is v/M and 0.024 the pattern. So the fixed pattern's variance per CFA site is
- * Var(m) - mean(v)/M (the EMVA 1288 correction), and `pattern` is the mean shrunk towards the site's level
- * by w = s_F^2 / (s_F^2 + v/M): the best linear estimate of F given m when the pattern's values scatter by
- * s_F^2 around the site's level (the level itself where the frames resolve no pattern).
+ * Var(m) - mean(v)/M (the EMVA 1288 correction), and `pattern` is the mean's departure from its site's level
+ * shrunk by sqrt(w), w = s_F^2 / (s_F^2 + v/M): its departures then scatter by s_F^2, the pattern's own variance
+ * and no more (a plain mean's scatter by s_F^2 + v/M; the best linear estimate of F, shrunk by w, by w s_F^2),
+ * and it is still closer to F than the plain mean (the level itself where the frames resolve no pattern).
  * docs/dark_frame_bank.md gives the estimators and their tests.
  */
 struct CV_EXPORTS_W_SIMPLE DarkFrameStatistics

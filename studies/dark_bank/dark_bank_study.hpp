@@ -1,0 +1,62 @@
+// This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
+// The dark-frame bank against independent captures on simulated sensors that depart from the parametric
+// components (hot pixels, noisy pixels, column banding), side by side with the calibrated components and the
+// plain Gaussian (docs/dark_frame_bank.md): study_dark_bank prints its table, the test holds it.
+#ifndef RAWGMENT_STUDIES_DARK_BANK_STUDY_HPP
+#define RAWGMENT_STUDIES_DARK_BANK_STUDY_HPP
+
+#include <opencv2/core.hpp>
+
+#include <string>
+#include <vector>
+
+namespace rawgment_studies {
+
+/** One study: campaigns of a sensor, each with its own fixed pattern, bank, inputs and targets. */
+struct DarkBankStudySettings
+{
+    cv::Size size{128, 96};
+    int bankFrames = 25;    //!< dark frames per gain in each campaign's bank (not the targets)
+    int outputs = 32;       //!< augmented outputs of each method, and independent target captures
+    int campaigns = 8;      //!< each with a new sensor (fixed pattern), bank, inputs and targets
+    double gainIn = 1;      //!< the inputs' gain
+    double gainOut = 8;     //!< the targets'
+    double contrast = 0.25; //!< k: the step scales the input's values (and its read noise) by it
+    int bootstrap = 100;    //!< resamplings of frames for each KS statistic's null
+    std::string workDir;    //!< where each campaign's bank is written (a folder per campaign)
+};
+
+/** A method's figures over the campaigns: each the mean of (method - target) with its standard error over
+ * campaigns, except the target's own row, which holds the target's values. */
+struct DarkBankMethod
+{
+    std::string name;
+    double rowPart = 0, rowPartSe = 0;       //!< variance of a row's mean over frames (DN^2)
+    double columnPart = 0, columnPartSe = 0; //!< variance of a column's mean over frames (DN^2)
+    double pixelPart = 0, pixelPartSe = 0;   //!< a pixel's variance about its row's mean (DN^2)
+    double fpnRms = 0, fpnRmsSe = 0; //!< fixed-pattern RMS: sqrt(Var(mean of N) - v/N), hot pixels out (DN)
+    double hotError = 0,
+           hotErrorSe = 0; //!< the hot pixels' mean level: its RMS error (the target: the level)
+    double kurtosis = 0, kurtosisSe = 0; //!< the pixel part's excess kurtosis
+    //! what the kurtosis should be for the mixture the method adds (NaN: not derived), as a difference too
+    double expectedKurtosis = 0, expectedKurtosisSe = 0;
+    double ks = 0;      //!< the mean two-sample KS statistic of the pixel parts against the target's
+    int ksRejected = 0; //!< campaigns where the bootstrap over frames rejects at 5%
+};
+
+struct DarkBankStudy
+{
+    DarkBankMethod target;
+    std::vector<DarkBankMethod> methods; //!< bank accounted, bank ignoring the prior, components, Gaussian
+    int campaigns = 0;
+};
+
+//! Runs the study (deterministic: the same settings give the same numbers).
+DarkBankStudy runDarkBankStudy(const DarkBankStudySettings& settings);
+
+//! The study as a Markdown table with its settings.
+std::string darkBankStudyMarkdown(const DarkBankStudy& study, const DarkBankStudySettings& settings);
+
+} // namespace rawgment_studies
+
+#endif // RAWGMENT_STUDIES_DARK_BANK_STUDY_HPP
