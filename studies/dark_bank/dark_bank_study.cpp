@@ -68,6 +68,7 @@ double excessKurtosis(const std::vector<double>& values)
 struct StackFigures
 {
     double rowPart = 0, columnPart = 0, pixelPart = 0, fpnVariance = 0, kurtosis = 0;
+    double ordinaryPixelPart = 0;              // the pixel part of the pixels the kurtosis pools
     std::vector<double> hotMeans;              // the hot pixels' means over the frames, in raster order
     std::vector<std::vector<float>> residuals; // per frame: the pixel part of every 7th kept pixel, for KS
 };
@@ -83,8 +84,9 @@ double varianceOf(const std::vector<double>& v)
 }
 
 /* What the study measures of N frames over the pixels `keep` marks (not hot, not dead: they have no temporal
- * noise), and the means of the `hot` ones. */
-StackFigures figuresOf(const std::vector<Mat>& frames, const Mat& keep, const Mat& hot)
+ * noise), and the means of the `hot` ones. The kurtosis is the `ordinary` pixels' (not noisy either): pooled
+ * over pixels of one variance, it is the mixture of its parts' cumulants. */
+StackFigures figuresOf(const std::vector<Mat>& frames, const Mat& keep, const Mat& hot, const Mat& ordinary)
 {
     const int n = static_cast<int>(frames.size()), rows = frames[0].rows, cols = frames[0].cols;
     std::vector<Mat> x(static_cast<size_t>(n));
@@ -115,7 +117,7 @@ StackFigures figuresOf(const std::vector<Mat>& frames, const Mat& keep, const Ma
         s.columnPart += varianceOf(m) / cols;
     s.residuals.resize(static_cast<size_t>(n));
     std::vector<double> pooled;
-    double pixelSum = 0, pixelCount = 0;
+    double pixelSum = 0, pixelCount = 0, ordinarySum = 0, ordinaryCount = 0;
     double siteSum[4] = {0, 0, 0, 0}, siteSum2[4] = {0, 0, 0, 0}, siteOwn[4] = {0, 0, 0, 0},
            siteN[4] = {0, 0, 0, 0};
     int kept = 0;
@@ -147,14 +149,20 @@ StackFigures figuresOf(const std::vector<Mat>& frames, const Mat& keep, const Ma
             for (int i = 0; i < n; ++i) {
                 const double e = y[static_cast<size_t>(i)] - yMean;
                 ss += e * e;
-                pooled.push_back(e);
+                if (ordinary.at<uchar>(r, c))
+                    pooled.push_back(e);
                 if (sampled)
                     s.residuals[static_cast<size_t>(i)].push_back(static_cast<float>(e));
             }
             pixelSum += ss / (n - 1);
             pixelCount += 1;
+            if (ordinary.at<uchar>(r, c)) {
+                ordinarySum += ss / (n - 1);
+                ordinaryCount += 1;
+            }
         }
     s.pixelPart = pixelSum / pixelCount;
+    s.ordinaryPixelPart = ordinarySum / ordinaryCount;
     s.kurtosis = excessKurtosis(pooled) / residualKurtosisFactor(n);
     for (int site = 0; site < 4; ++site) {
         const double m = siteN[site];
@@ -285,7 +293,7 @@ DarkBankStudy runDarkBankStudy(const DarkBankStudySettings& st)
         const SensorSimulator sensor(departingSensor(st.size, seed), st.size);
         Mat prnu, dsnu, defects;
         sensor.fixedPattern(prnu, dsnu, defects);
-        const Mat keep = (defects != 1) & (defects != 2), hot = defects == 1;
+        const Mat keep = (defects != 1) & (defects != 2), hot = defects == 1, ordinary = defects == 0;
         const auto capture = [&](double gain, int frame) {
             Mat raw;
             sensor.capture(Mat::zeros(st.size, CV_32F), gain, 1.0, seed, frame, raw);
@@ -340,7 +348,8 @@ DarkBankStudy runDarkBankStudy(const DarkBankStudySettings& st)
                 outputs[m].push_back(out);
             }
         }
-        const StackFigures in = figuresOf(inputs, keep, hot), t = figuresOf(targets, keep, hot);
+        const StackFigures in = figuresOf(inputs, keep, hot, ordinary),
+                           t = figuresOf(targets, keep, hot, ordinary);
         double hotLevel = 0;
         for (double h : t.hotMeans)
             hotLevel += h / t.hotMeans.size();
@@ -350,9 +359,9 @@ DarkBankStudy runDarkBankStudy(const DarkBankStudySettings& st)
         target.pixel.push_back(t.pixelPart);
         target.fpn.push_back(std::sqrt(std::max(0.0, t.fpnVariance)));
         target.kurtosis.push_back(t.kurtosis);
-        const double kappaDraws = drawKurtosis(bursts[1], keep);
+        const double kappaDraws = drawKurtosis(bursts[1], ordinary);
         for (int m = 0; m < 4; ++m) {
-            const StackFigures f = figuresOf(outputs[m], keep, hot);
+            const StackFigures f = figuresOf(outputs[m], keep, hot, ordinary);
             double hotError = 0;
             for (size_t h = 0; h < f.hotMeans.size(); ++h)
                 hotError += std::pow(f.hotMeans[h] - t.hotMeans[h], 2) / f.hotMeans.size();
@@ -368,7 +377,7 @@ DarkBankStudy runDarkBankStudy(const DarkBankStudySettings& st)
             // draws: a difference of two frames halves a frame's excess kurtosis; IGNORE's whole frames: the
             // target's), less the output's rounding (a uniform 1/12 DN^2, excess kurtosis -1.2).
             if (m < 2) {
-                const double vin = k * k * in.pixelPart, added = f.pixelPart - vin - 1.0 / 12;
+                const double vin = k * k * in.ordinaryPixelPart, added = f.ordinaryPixelPart - vin - 1.0 / 12;
                 const double kappaAdded = m == 0 ? kappaDraws : t.kurtosis;
                 const double expected = (vin * vin * in.kurtosis + added * added * kappaAdded - 1.2 / 144) /
                                         (f.pixelPart * f.pixelPart);
