@@ -30,6 +30,7 @@ void bindDarkFrames(py::module_& m)
              doc("DarkFrameStatistics::fixedPatternRms"));
     defMatProperty(stats, "pattern", &DarkFrameStatistics::pattern, doc("DarkFrameStatistics::pattern"),
                    {CV_32F});
+    defMatProperty(stats, "mean", &DarkFrameStatistics::mean, doc("DarkFrameStatistics::mean"), {CV_32F});
     defMatProperty(stats, "rowVariance", &DarkFrameStatistics::rowVariance,
                    doc("DarkFrameStatistics::rowVariance"), {CV_64F});
 

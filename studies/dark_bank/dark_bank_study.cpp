@@ -2,6 +2,7 @@
 // The dark-frame bank against independent captures (dark_bank_study.hpp).
 #include "dark_bank_study.hpp"
 
+#include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment.hpp>
 
 #include <algorithm>
@@ -225,25 +226,28 @@ std::pair<double, bool> ksAgainstTarget(const StackFigures& method, const StackF
     return {observed, (atLeast + 1.0) / (bootstrap + 1.0) < 0.05};
 }
 
-//! The bank's draws' pixel part, (f_2i - f_2i+1) / sqrt(2) less its row mean, over the kept pixels: its
-//! kurtosis.
-double drawKurtosis(const std::vector<Mat>& frames, const Mat& keep)
+//! The bank's draws' pixel part, each frame less the frames' mean (their scale does not change the shape)
+//! less its row mean, over the `ordinary` pixels: its excess kurtosis.
+double drawKurtosis(const std::vector<Mat>& frames, const Mat& ordinary)
 {
+    Mat mean = Mat::zeros(frames[0].size(), CV_64F);
+    for (const Mat& f : frames)
+        accumulate(f, mean);
+    mean /= static_cast<double>(frames.size());
     std::vector<double> values;
-    for (size_t i = 0; i + 1 < frames.size(); i += 2) {
-        Mat a, b;
-        frames[i].convertTo(a, CV_64F);
-        frames[i + 1].convertTo(b, CV_64F);
-        const Mat d = (a - b) / std::sqrt(2.0);
+    for (const Mat& f : frames) {
+        Mat d;
+        f.convertTo(d, CV_64F);
+        d -= mean;
         for (int r = 0; r < d.rows; ++r) {
             double sum = 0, count = 0;
             for (int c = 0; c < d.cols; ++c)
-                if (keep.at<uchar>(r, c)) {
+                if (ordinary.at<uchar>(r, c)) {
                     sum += d.at<double>(r, c);
                     count += 1;
                 }
             for (int c = 0; c < d.cols; ++c)
-                if (keep.at<uchar>(r, c))
+                if (ordinary.at<uchar>(r, c))
                     values.push_back(d.at<double>(r, c) - sum / count);
         }
     }
@@ -374,8 +378,8 @@ DarkBankStudy runDarkBankStudy(const DarkBankStudySettings& st)
             d.hot.push_back(std::sqrt(hotError));
             d.kurtosis.push_back(f.kurtosis - t.kurtosis);
             // The mixture's kurtosis: fourth cumulants add, k^4 of the input's, the added part's (the bank's
-            // draws: a difference of two frames halves a frame's excess kurtosis; IGNORE's whole frames: the
-            // target's), less the output's rounding (a uniform 1/12 DN^2, excess kurtosis -1.2).
+            // draws, a frame less its group's mean: measured on them; IGNORE's whole frames: the target's),
+            // less the output's rounding (a uniform 1/12 DN^2, excess kurtosis -1.2).
             if (m < 2) {
                 const double vin = k * k * in.ordinaryPixelPart, added = f.ordinaryPixelPart - vin - 1.0 / 12;
                 const double kappaAdded = m == 0 ? kappaDraws : t.kurtosis;

@@ -142,17 +142,21 @@ BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size si
     b.scale = static_cast<float>(step.bankScaleOut);
     for (int s = 0; s < 4; ++s)
         b.black[s] = static_cast<float>(bank.format.blackLevel[s]);
-    // Two different frames of the target's group, from the step's own stream.
+    // One frame of the target's group, from the step's own stream. ACCOUNT_PRIOR takes the group's mean out
+    // of it: f_i - m is the frame less the mean of the others times (M - 1) / M, so sqrt(M / (M - 1)) (f_i -
+    // m) has the frames' temporal variance, is uncorrelated with the mean (and so with the pattern estimated
+    // from it), and keeps (1 + 1/(M - 1)^3) / (1 + 1/(M - 1))^2 of a frame's excess kurtosis (0.92 at M = 25;
+    // a difference of two frames keeps half of it).
     CounterRng rng(stepKey(seed, static_cast<uint64_t>(stream)), 0);
     const int M = static_cast<int>(out.files.size());
     const int i = std::min(M - 1, static_cast<int>(rng.uniform() * M));
-    const int j = (i + 1 + std::min(M - 2, static_cast<int>(rng.uniform() * (M - 1)))) % M;
-    b.frameA = bank.readFrame(step.bankGroupOut, i);
-    if (b.ignore)
+    b.frame = bank.readFrame(step.bankGroupOut, i);
+    if (b.ignore) {
+        b.drawScale = b.scale;
         return b;
-    b.frameB = bank.readFrame(step.bankGroupOut, j);
-    if (b.frameB.type() != b.frameA.type())
-        b.frameB.convertTo(b.frameB, b.frameA.type());
+    }
+    b.groupMean = out.statistics.mean;
+    b.drawScale = b.scale * static_cast<float>(std::sqrt(M / (M - 1.0)));
 
     const DarkFrameStatistics &so = out.statistics, &si = in.statistics;
     const double at2 = step.bankScaleOut * step.bankScaleOut, as2 = step.bankScaleIn * step.bankScaleIn;
@@ -203,22 +207,24 @@ template <typename T>
 int64 bankRowExtraOf(const BankRead& b, int r, int first, int step, int n, const float rowFactor[2],
                      const float* pixelFactor, float* extra)
 {
-    const int R = r + b.origin.y, x0 = b.origin.x, width = b.frameA.cols;
-    const T* a = b.frameA.ptr<T>(R);
+    const int R = r + b.origin.y, x0 = b.origin.x, width = b.frame.cols;
+    const T* a = b.frame.ptr<T>(R);
+    // The sensor row's black level at each column parity.
+    const float black[2] = {b.black[cfaSite(R, 0)], b.black[cfaSite(R, 1)]};
     if (b.ignore) {
-        const float black[2] = {b.black[cfaSite(R, 0)], b.black[cfaSite(R, 1)]};
         for (int j = 0; j < n; ++j) {
             const int C = first + step * j + x0;
-            extra[j] = b.scale * (static_cast<float>(a[C]) - black[C & 1]);
+            extra[j] = b.drawScale * (static_cast<float>(a[C]) - black[C & 1]);
         }
         return 0;
     }
-    const T* f = b.frameB.ptr<T>(R);
-    // The row part at each sensor column parity: the difference's mean over the sensor's whole row there.
+    const float* mean = b.groupMean.ptr<float>(R);
+    // The row part at each sensor column parity: the draw's mean over the sensor's whole row there.
     double sum[2] = {0, 0};
     for (int C = 0; C < width; ++C)
-        sum[C & 1] += static_cast<double>(a[C]) - static_cast<double>(f[C]);
-    const float k = b.scale * static_cast<float>(1 / std::sqrt(2.0));
+        sum[C & 1] +=
+            static_cast<double>(a[C]) - static_cast<double>(black[C & 1]) - static_cast<double>(mean[C]);
+    const float k = b.drawScale;
     const float sensorRho[2] = {k * static_cast<float>(sum[0] / ((width + 1) / 2)),
                                 width > 1 ? k * static_cast<float>(sum[1] / (width / 2)) : 0.0f};
     float rho[2], rowShare[2], target[2], held[2];
@@ -236,7 +242,6 @@ int64 bankRowExtraOf(const BankRead& b, int r, int first, int step, int n, const
     const float* fs = b.pattern == BankRead::SWAP ? b.patternInput.ptr<float>(R) + x0 : nullptr;
     const float* moved = b.pattern == BankRead::SWAP_MOVED ? b.movedPattern.ptr<float>(r) : nullptr;
     const int even = 2 * (r & 1);
-    // One pixel with its variances: the pixel part's share c from k^2 v_s + c^2 v_t = v_t, and the pattern.
     // The pixel part's share c from k^2 v_s + c^2 v_t = v_t, and whether the input already exceeds the
     // target.
     const auto shareOf = [&](int j, int p, float pixelTargetVariance, float pixelHeldVariance,
@@ -247,7 +252,8 @@ int64 bankRowExtraOf(const BankRead& b, int r, int first, int step, int n, const
     };
     const auto pixel = [&](int j, float share) {
         const int c = first + step * j, p = c & 1;
-        const float d = k * (static_cast<float>(a[c + x0]) - static_cast<float>(f[c + x0]));
+        const int C = c + x0;
+        const float d = k * (static_cast<float>(a[C]) - black[C & 1] - mean[C]);
         float value = rowShare[p] * rho[p] + share * (d - rho[p]);
         switch (b.pattern) {
         case BankRead::ADD_LACKING:
@@ -305,7 +311,7 @@ int64 bankRowExtraOf(const BankRead& b, int r, int first, int step, int n, const
 int64 bankRowExtra(const BankRead& b, int r, int first, int step, int n, const float rowFactor[2],
                    const float* pixelFactor, float* extra)
 {
-    return b.frameA.depth() == CV_16U
+    return b.frame.depth() == CV_16U
                ? bankRowExtraOf<ushort>(b, r, first, step, n, rowFactor, pixelFactor, extra)
                : bankRowExtraOf<float>(b, r, first, step, n, rowFactor, pixelFactor, extra);
 }

@@ -54,9 +54,13 @@ struct BankRead
         SWAP_MOVED   //!< tied, resampled: F_t - movedPattern
     };
     bool ignore = false; //!< IGNORE_PRIOR: a whole dark frame
-    Mat frameA, frameB;  //!< whole frames of the target group as read (CV_16UC1 or CV_32FC1)
-    Point origin;        //!< where the mosaic lies on them
-    float scale = 1;     //!< the frames' temporal noise to the output gain's (the model's read lines)
+    Mat frame;           //!< a whole frame of the target group as read (CV_16UC1 or CV_32FC1)
+    //! ACCOUNT_PRIOR: the group's plain mean, which the draw takes out (CV_32FC1, shared, not copied)
+    Mat groupMean;
+    Point origin;    //!< where the mosaic lies on them
+    float scale = 1; //!< the frames' temporal noise to the output gain's (the model's read lines)
+    //! the draw's scale: `scale` and, for ACCOUNT_PRIOR, sqrt(M / (M - 1)) of a frame less its group's mean
+    float drawScale = 1;
     float black[4] = {0, 0, 0, 0};     //!< the bank's black level per sensor site
     float rowTarget[4] = {0, 0, 0, 0}; //!< the target's row-part variance per mosaic site
     float rowHeld[4] = {0, 0, 0, 0};   //!< the input's, before the step's factor
@@ -67,7 +71,7 @@ struct BankRead
     Mat patternTarget, patternInput; //!< the groups' whole patterns (shared, not copied)
     Mat movedPattern; //!< SWAP_MOVED: the input's pattern as the step left it, the mosaic's size
     float patternShare[4] = {0, 0, 0, 0}, patternAmplitude[4] = {0, 0, 0, 0}, levelTarget[4] = {0, 0, 0, 0};
-    bool empty() const { return frameA.empty(); }
+    bool empty() const { return frame.empty(); }
 };
 
 /** The input's fixed pattern where the mosaic lies (the bank's group nearest the input's gain; DN above

@@ -45,6 +45,7 @@ namespace {
 
 const char* const kTopLevelName = "dark_frame_bank";
 const char* const kPatternTag = "dark_frame_pattern_";
+const char* const kMeanTag = "dark_frame_mean_";
 
 String formatText(const RawFormat& f, Size size)
 {
@@ -80,19 +81,23 @@ bool allFinite(const Vec4d& v, bool nonNegative)
     return true;
 }
 
-// `<bank file name>.dark_frame_pattern_<group>.<checksum>.tiff`, a group's pattern (detail::mapImageName()).
-bool isPatternImageOf(const String& bankPath, const String& name)
+// `<bank file name>.dark_frame_<pattern or mean>_<group>.<checksum>.tiff`, a group's map
+// (detail::mapImageName()).
+bool isBankImageOf(const String& bankPath, const String& name)
 {
-    const String prefix = detail::baseNameOf(bankPath) + "." + kPatternTag;
-    if (name.compare(0, prefix.size(), prefix) != 0)
-        return false;
-    const size_t end = name.find('.', prefix.size());
-    if (end == String::npos || end == prefix.size())
-        return false;
-    const String digits = name.substr(prefix.size(), end - prefix.size());
-    if (!std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
-        return false;
-    return detail::isMapImageOf(bankPath, name, {kPatternTag + digits});
+    for (const char* tag : {kPatternTag, kMeanTag}) {
+        const String prefix = detail::baseNameOf(bankPath) + "." + tag;
+        if (name.compare(0, prefix.size(), prefix) != 0)
+            continue;
+        const size_t end = name.find('.', prefix.size());
+        if (end == String::npos || end == prefix.size())
+            continue;
+        const String digits = name.substr(prefix.size(), end - prefix.size());
+        if (std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+            detail::isMapImageOf(bankPath, name, {tag + digits}))
+            return true;
+    }
+    return false;
 }
 
 // A frame's path as the bank file names it: relative to the bank's folder when it lies inside it, so that a
@@ -135,7 +140,7 @@ DarkFrameGroup readGroup(const FileNode& n, const String& folder, Size size, int
         CV_Error(Error::StsParseError, "each entry of groups must be a map");
     rejectUnknownKeys(n, {"gain", "exposure_time", "frames", "file_bytes", "degrees_of_freedom", "level",
                           "temporal_variance", "row_noise_variance", "mean_variance", "pattern_variance",
-                          "pattern", "row_variance", "noisy_pixels"});
+                          "pattern", "mean", "row_variance", "noisy_pixels"});
     DarkFrameGroup g;
     g.gain = detail::readRealField(n, "gain");
     g.exposureTime = detail::readRealField(n, "exposure_time");
@@ -160,6 +165,7 @@ DarkFrameGroup readGroup(const FileNode& n, const String& folder, Size size, int
     s.meanVariance = readSites(n, "mean_variance");
     s.patternVariance = readSites(n, "pattern_variance");
     s.pattern = detail::readMapImage(n["pattern"], format("groups[%d].pattern", index), folder, size);
+    s.mean = detail::readMapImage(n["mean"], format("groups[%d].mean", index), folder, size);
     const std::vector<double> rows = readList(n, "row_variance", 2 * static_cast<size_t>(size.height));
     if (rows.size() != 2 * static_cast<size_t>(size.height))
         CV_Error(Error::StsParseError,
@@ -248,7 +254,8 @@ DarkFrameBank DarkFrameBank::createFromFolder(const String& folder, const NoiseM
         const String name = entry.path().filename().string();
         const String ext = detail::lowerExtensionOf(name);
         if (name.empty() || name[0] == '.' || ext == ".yml" || ext == ".yaml" || ext == ".json" ||
-            name.find(String(".") + kPatternTag) != String::npos || !isRegularFile(entry.path().string()))
+            name.find(String(".") + kPatternTag) != String::npos ||
+            name.find(String(".") + kMeanTag) != String::npos || !isRegularFile(entry.path().string()))
             continue;
         files.push_back(entry.path().string());
     }
@@ -293,10 +300,11 @@ void DarkFrameBank::validate() const
             !allFinite(s.rowNoiseVariance, true) || !allFinite(s.meanVariance, true) ||
             !allFinite(s.patternVariance, true))
             CV_Error(Error::StsBadArg, who + ": a level must be finite, a variance finite and >= 0");
-        if (s.pattern.type() != CV_32FC1 || s.pattern.size() != size || !checkRange(s.pattern))
-            CV_Error(Error::StsBadArg,
-                     who + cv::format(": the pattern must be a finite CV_32FC1 map of %dx%d", size.width,
-                                      size.height));
+        for (const Mat* map : {&s.pattern, &s.mean})
+            if (map->type() != CV_32FC1 || map->size() != size || !checkRange(*map))
+                CV_Error(Error::StsBadArg,
+                         who + cv::format(": the pattern and the mean must be finite CV_32FC1 maps of %dx%d",
+                                          size.width, size.height));
         if (s.rowVariance.type() != CV_64FC1 || s.rowVariance.rows != size.height ||
             s.rowVariance.cols != 2 || !checkRange(s.rowVariance, true, nullptr, 0, DBL_MAX))
             CV_Error(Error::StsBadArg,
@@ -323,6 +331,8 @@ void DarkFrameBank::save(const String& bankPath)
     for (size_t i = 0; i < groups.size(); ++i) {
         maps.push_back(&groups[i].statistics.pattern);
         images.push_back(detail::mapImageName(bankPath, cv::format("%s%zu", kPatternTag, i), *maps.back()));
+        maps.push_back(&groups[i].statistics.mean);
+        images.push_back(detail::mapImageName(bankPath, cv::format("%s%zu", kMeanTag, i), *maps.back()));
     }
     const std::string text = fileStorageText(bankPath, [&](FileStorage& fs) {
         fs << kTopLevelName << "{";
@@ -347,7 +357,9 @@ void DarkFrameBank::save(const String& bankPath)
                << s.rowNoiseVariance << "mean_variance" << s.meanVariance << "pattern_variance"
                << s.patternVariance;
             fs << "pattern";
-            detail::writeMapImageEntry(fs, images[i], s.pattern);
+            detail::writeMapImageEntry(fs, images[2 * i], s.pattern);
+            fs << "mean";
+            detail::writeMapImageEntry(fs, images[2 * i + 1], s.mean);
             fs << "row_variance"
                << std::vector<double>(s.rowVariance.begin<double>(), s.rowVariance.end<double>());
             std::vector<double> noisy;
@@ -361,7 +373,7 @@ void DarkFrameBank::save(const String& bankPath)
         fs << "}";
     });
     detail::saveWithMapImages(
-        bankPath, text, maps, images, [&](const String& name) { return isPatternImageOf(bankPath, name); },
+        bankPath, text, maps, images, [&](const String& name) { return isBankImageOf(bankPath, name); },
         "DarkFrameBank::save");
     path = bankPath;
 }

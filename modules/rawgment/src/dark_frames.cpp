@@ -166,9 +166,10 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
         e.temporalVariance[s] = pooledCount[s] > 0 ? pooled[s] / pooledCount[s] : own[s] / n;
     }
     // The shrinkage is the bulk's: a site's centre and spread from the median and interquartile range of its
-    // means, which its hot pixels (a few far out, thousands of DN) leave alone. Those, beyond 6 robust standard
-    // deviations of the means, are pattern beyond doubt and kept as measured. With the plain variance 0.2% of
-    // hot pixels made every w 1 on a simulated sensor: no shrinkage at all, the mean's whole v/M kept.
+    // means, which its hot pixels (a few far out, thousands of DN) leave alone. Those, beyond 6 robust
+    // standard deviations of the means, are pattern beyond doubt and kept as measured. With the plain
+    // variance 0.2% of hot pixels made every w 1 on a simulated sensor: no shrinkage at all, the mean's whole
+    // v/M kept.
     double centre[4], robustSpread[4], outlier[4];
     {
         std::vector<double> site[4];
@@ -194,6 +195,8 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
             outlier[s] = 6 * std::sqrt(robustVariance);
         }
     }
+    mean.convertTo(e.mean, CV_32F);
+    mean.convertTo(e.mean, CV_32F);
     e.pattern.create(rows, cols, CV_32FC1);
     for (int r = 0; r < rows; ++r) {
         const double* m = mean.ptr<double>(r);
@@ -208,8 +211,9 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
                 continue;
             }
             const double frozen = (flagged[c] ? v[c] : e.rowVariance.at<double>(r, c & 1)) / M;
-            // sqrt(w), not w: the departures then scatter by s_F^2, the pattern's own variance, which is what an
-            // augmentation adds (w, the best linear estimate, scatters by w s_F^2: less pattern than the sensor).
+            // sqrt(w), not w: the departures then scatter by s_F^2, the pattern's own variance, which is what
+            // an augmentation adds (w, the best linear estimate, scatters by w s_F^2: less pattern than the
+            // sensor).
             const double w = robustSpread[s] > 0 ? robustSpread[s] / (robustSpread[s] + frozen) : 0.0;
             out[c] = static_cast<float>(centre[s] + std::sqrt(w) * departure);
         }

@@ -437,11 +437,11 @@ std::vector<BankedStep> bankedSteps(const NoiseModel& model)
  * row part and pixel part are the independent target captures'; IGNORE_PRIOR adds whole dark frames on top,
  * too much by what the step kept of the input's (a jitter's k^2 v_s). A whole frame drawn from M frames
  * varies as their population, (M - 1)/M of the target's variance (1 - 1/16 here: 0.7 DN^2 of the pixel part),
- * which its expectation includes; a difference of two frames over sqrt(2) varies as their unbiased sample
- * variance. Differences are taken per row (32 outputs each, the 84 columns away from the edges, where clamped
- * taps weigh otherwise), and each claim holds within 3 standard errors of the 64 rows' mean. The output's
- * rounding adds 1/12 DN^2 to both methods' pixel part: the target's own rounding is in the frames' variance,
- * the input's in what the step kept. */
+ * which its expectation includes; a frame less their mean, times sqrt(M / (M - 1)), varies as their unbiased
+ * sample variance. Differences are taken per row (32 outputs each, the 84 columns away from the edges, where
+ * clamped taps weigh otherwise), and each claim holds within 3 standard errors of the 64 rows' mean. The
+ * output's rounding adds 1/12 DN^2 to both methods' pixel part: the target's own rounding is in the frames'
+ * variance, the input's in what the step kept. */
 TEST(DarkFrameBank, ignoringThePriorAddsWhatTheStepKeptOfTheInputsReadNoiseAndAccountingDoesNot)
 {
     const std::string dir = test::makeTempDir("dark_bank_excess");

@@ -23,11 +23,13 @@ namespace rawgment {
  * A pixel's mean m over M frames is its fixed pattern F plus temporal noise of variance v/M, frozen into
  * the mean: on EMVA 1288 set 001 (a 12-bit CCD) the spatial variance of the mean of 50 dark frames is
  * 0.214 DN^2, of which 0.190 is v/M and 0.024 the pattern. So the fixed pattern's variance per CFA site is
- * Var(m) - mean(v)/M (the EMVA 1288 correction), and `pattern` is the mean's departure from its site's level
- * shrunk by sqrt(w), w = s_F^2 / (s_F^2 + v/M): its departures then scatter by s_F^2, the pattern's own variance
- * and no more (a plain mean's scatter by s_F^2 + v/M; the best linear estimate of F, shrunk by w, by w s_F^2),
- * and it is still closer to F than the plain mean (the level itself where the frames resolve no pattern).
- * docs/dark_frame_bank.md gives the estimators and their tests.
+ * Var(m) - mean(v)/M (the EMVA 1288 correction), and `pattern` is the mean's departure from its site's median
+ * shrunk by sqrt(w), w = s_F^2 / (s_F^2 + v/M) with s_F^2 from the interquartile spread of the means: its
+ * departures then scatter by s_F^2, the pattern's own variance and no more (a plain mean's scatter by
+ * s_F^2 + v/M; the best linear estimate of F, shrunk by w, by w s_F^2), and it is still closer to F than the
+ * plain mean (the median itself where the frames resolve no pattern). Pixels beyond 6 robust standard
+ * deviations of the means (hot pixels) keep their mean: pattern beyond doubt. docs/dark_frame_bank.md gives
+ * the estimators and their tests.
  */
 struct CV_EXPORTS_W_SIMPLE DarkFrameStatistics
 {
@@ -36,6 +38,8 @@ struct CV_EXPORTS_W_SIMPLE DarkFrameStatistics
     CV_PROP_RW int frames;           //!< M
     CV_PROP_RW int degreesOfFreedom; //!< those the variances scatter with: M - 1, fewer for heavy tails
     CV_PROP_RW Mat pattern;          //!< CV_32FC1, the frames' size: the fixed pattern, shrunk for its v/M
+    //! CV_32FC1, the frames' size: their plain temporal mean (DN above black), which a step's draws take out
+    CV_PROP_RW Mat mean;
     //! CV_64FC1, rows x 2: row r's temporal variance per pixel at its columns' parities 0 and 1, pooled
     //! over the pixels that are not noisy
     CV_PROP_RW Mat rowVariance;
