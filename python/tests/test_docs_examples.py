@@ -134,6 +134,13 @@ def example_files(tmp_path, sensor, monkeypatch):
     model.baseIso = 100
     for name in ("camera.yml", "noise_model.yml"):
         model.save(str(tmp_path / name))
+    # Dark frames of that sensor at gains 2 and 8, for the dark-frame bank's example.
+    (tmp_path / "darks").mkdir()
+    for gain in (2.0, 8.0):
+        for t in range(3):
+            dark = sensor.capture(np.zeros((96, 128), np.float32), gain, 1.0, seed=6, frameIndex=t)
+            rg.writeMosaic(str(tmp_path / "darks" / ("dark_g%g_%d.png" % (gain, t))), dark,
+                           rg.MosaicMetadata(format=sensor.rawFormat(gain)))
     monkeypatch.chdir(tmp_path)
     return tmp_path
 
