@@ -196,10 +196,11 @@ TEST(DarkFrames, thePatternIsTheTruthWithoutTheTemporalNoiseItsMeanHolds)
     EXPECT_LT(shrunkError, plainError);
 }
 
-/* Hot pixels (0.2%, thousands of DN above the rest) are pattern beyond doubt: they keep their measured level, and
- * they do not stop the shrinkage of the others (with the sites' plain variance they made every w 1, so the
- * pattern kept the mean's whole v/M). Over the other pixels the shrunk pattern scatters by about v/M less than
- * the plain mean (0.61 DN^2 here); half of it is asked, far beyond one campaign's noise in that difference. */
+/* Hot pixels (0.2%, thousands of DN above the rest) are pattern beyond doubt: they keep their measured level,
+ * and they do not stop the shrinkage of the others (with the sites' plain variance they made every w 1, so
+ * the pattern kept the mean's whole v/M). Over the other pixels the shrunk pattern scatters by about v/M less
+ * than the plain mean (0.61 DN^2 here); half of it is asked, far beyond one campaign's noise in that
+ * difference. */
 TEST(DarkFrames, hotPixelsKeepTheirLevelAndLeaveTheShrinkageOfTheOthers)
 {
     DarkCampaigns setup;
@@ -215,7 +216,8 @@ TEST(DarkFrames, hotPixelsKeepTheirLevelAndLeaveTheShrinkageOfTheOthers)
                 if (cfaSite(r, c) != s)
                     continue;
                 if (defects.at<uchar>(r, c) == 1) {
-                    EXPECT_NEAR(e.pattern.at<float>(r, c), plainMean.at<double>(r, c), 1e-3) << "a hot pixel's level";
+                    EXPECT_NEAR(e.pattern.at<float>(r, c), plainMean.at<double>(r, c), 1e-3)
+                        << "a hot pixel's level";
                     continue;
                 }
                 p.push_back(plainMean.at<double>(r, c));
@@ -230,7 +232,8 @@ TEST(DarkFrames, hotPixelsKeepTheirLevelAndLeaveTheShrinkageOfTheOthers)
         shrunk += variance(q) / 4;
         frozen += e.temporalVariance[s] / e.frames / 4;
     }
-    std::cout << "spread of the means " << plain << ", of the pattern " << shrunk << ", v/M " << frozen << "\n";
+    std::cout << "spread of the means " << plain << ", of the pattern " << shrunk << ", v/M " << frozen
+              << "\n";
     EXPECT_GT(plain - shrunk, 0.5 * frozen);
 }
 
