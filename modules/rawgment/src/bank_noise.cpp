@@ -139,7 +139,6 @@ BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size si
                      "the input's gain %g (its nearest is %g)",
                      who, step.gainIn, in.gain));
     b.ignore = step.options.alignment == NoiseAlignment::IGNORE_PRIOR;
-    b.scale = static_cast<float>(step.bankScaleOut);
     for (int s = 0; s < 4; ++s)
         b.black[s] = static_cast<float>(bank.format.blackLevel[s]);
     // One frame of the target's group, from the step's own stream. ACCOUNT_PRIOR takes the group's mean out
@@ -152,11 +151,11 @@ BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size si
     const int i = std::min(M - 1, static_cast<int>(rng.uniform() * M));
     b.frame = bank.readFrame(step.bankGroupOut, i);
     if (b.ignore) {
-        b.drawScale = b.scale;
+        b.drawScale = static_cast<float>(step.bankScaleOut);
         return b;
     }
     b.groupMean = out.statistics.mean;
-    b.drawScale = b.scale * static_cast<float>(std::sqrt(M / (M - 1.0)));
+    b.drawScale = static_cast<float>(step.bankScaleOut * std::sqrt(M / (M - 1.0)));
 
     const DarkFrameStatistics &so = out.statistics, &si = in.statistics;
     const double at2 = step.bankScaleOut * step.bankScaleOut, as2 = step.bankScaleIn * step.bankScaleIn;

@@ -57,9 +57,9 @@ struct BankRead
     Mat frame;           //!< a whole frame of the target group as read (CV_16UC1 or CV_32FC1)
     //! ACCOUNT_PRIOR: the group's plain mean, which the draw takes out (CV_32FC1, shared, not copied)
     Mat groupMean;
-    Point origin;    //!< where the mosaic lies on them
-    float scale = 1; //!< the frames' temporal noise to the output gain's (the model's read lines)
-    //! the draw's scale: `scale` and, for ACCOUNT_PRIOR, sqrt(M / (M - 1)) of a frame less its group's mean
+    Point origin; //!< where the mosaic lies on them
+    /** The draw's scale: the frames' temporal noise to the output gain's (the model's read lines), and for
+     * ACCOUNT_PRIOR sqrt(M / (M - 1)) of a frame less its group's mean. */
     float drawScale = 1;
     float black[4] = {0, 0, 0, 0};     //!< the bank's black level per sensor site
     float rowTarget[4] = {0, 0, 0, 0}; //!< the target's row-part variance per mosaic site

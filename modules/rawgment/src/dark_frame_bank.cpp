@@ -23,6 +23,21 @@ namespace rawgment {
 
 namespace detail {
 
+int nearestGainGroup(const std::vector<DarkFrameGroup>& groups, double gain, double exposureTime)
+{
+    const auto logDistance = [](double a, double b) { return std::abs(std::log(std::max(a, 1e-300) / b)); };
+    int best = 0;
+    for (int i = 1; i < static_cast<int>(groups.size()); ++i) {
+        const DarkFrameGroup &g = groups[static_cast<size_t>(i)], &b = groups[static_cast<size_t>(best)];
+        const double di = logDistance(g.gain, gain), db = logDistance(b.gain, gain);
+        if (di < db - 1e-12 ||
+            (std::abs(di - db) <= 1e-12 && exposureTime > 0 &&
+             logDistance(g.exposureTime, exposureTime) < logDistance(b.exposureTime, exposureTime)))
+            best = i;
+    }
+    return best;
+}
+
 DarkFrame readDarkFrame(const String& path, const NoiseModel& model)
 {
     DarkFrame f;
@@ -441,18 +456,7 @@ int DarkFrameBank::nearestGroup(double gain, double exposureTime) const
                 "DarkFrameBank: gain %g lies outside the bank's gains [%g, %g]%s: its frames say nothing of "
                 "it; add dark frames at that gain",
                 gain, lowest, highest, path.empty() ? "" : (" ('" + path + "')").c_str()));
-    int best = 0;
-    for (int i = 1; i < static_cast<int>(groups.size()); ++i) {
-        const double di = std::abs(std::log(groups[static_cast<size_t>(i)].gain / gain)),
-                     db = std::abs(std::log(groups[static_cast<size_t>(best)].gain / gain));
-        if (di < db - 1e-12)
-            best = i;
-        else if (std::abs(di - db) <= 1e-12 && exposureTime > 0 &&
-                 std::abs(std::log(std::max(groups[size_t(i)].exposureTime, 1e-300) / exposureTime)) <
-                     std::abs(std::log(std::max(groups[size_t(best)].exposureTime, 1e-300) / exposureTime)))
-            best = i;
-    }
-    return best;
+    return detail::nearestGainGroup(groups, gain, exposureTime);
 }
 
 Mat DarkFrameBank::readFrame(int group, int index) const

@@ -159,6 +159,8 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
     }
     for (int s = 0; s < 4; ++s) {
         const double n = count[s];
+        if (n == 0) // a frame of one row or one column has two sites only
+            continue;
         e.level[s] = sum[s] / n;
         e.meanVariance[s] = n > 1 ? (sum2[s] - sum[s] * sum[s] / n) / (n - 1) : 0.0;
         // E[Var(m)] = s_F^2 + mean(v) / M, each pixel's own variance unbiased for its own noise.
@@ -190,6 +192,9 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
             std::nth_element(x.begin(), x.begin() + long(q3), x.end());
             const double high = x[q3];
             centre[s] = medianOf(x);
+            // One centre for the pattern and its users (an untied step adds F - level): the mean of a site's
+            // means moved 7 DN with 0.2% of hot pixels at 3430 DN.
+            e.level[s] = centre[s];
             const double robustVariance = std::pow((high - low) / 1.349, 2);
             robustSpread[s] = std::max(0.0, robustVariance - e.temporalVariance[s] / M);
             outlier[s] = 6 * std::sqrt(robustVariance);

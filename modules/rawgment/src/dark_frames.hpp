@@ -44,6 +44,11 @@ private:
     std::vector<double> rowSum_, rowSum2_; // per row and column parity, over frames
 };
 
+/** The group of `groups` (by increasing gain, then exposure) whose gain is nearest `gain` on a log scale,
+ * then whose exposure is nearest `exposureTime` (when > 0), at any gain: DarkFrameBank::nearestGroup() adds
+ * the bank's range to it, a step's input side (a gain the bank may not cover) takes it as it is. */
+int nearestGainGroup(const std::vector<DarkFrameGroup>& groups, double gain, double exposureTime);
+
 //! One dark frame as read: its pixels, its format at its gain, and its exposure time (0: not stated).
 struct DarkFrame
 {

@@ -3,6 +3,7 @@
 #include "step_noise.hpp"
 
 #include "bank_noise.hpp"
+#include "dark_frames.hpp"
 
 #include "precomp.hpp"
 
@@ -36,30 +37,21 @@ StepNoise::StepNoise(const ValidatedNoiseModel& valid, const RawFormat& format, 
     rowSigmaR2 = model.rowSigmaR2;
     tails = model.tukeyRead;
     tukeyLambda = model.tukeyLambda;
-    modelIn = in;
-    modelOut = out;
     if (addsNoise() && !options.darkBank.empty()) {
-        bank = cachedDarkFrameBank(options.darkBank);
-        if (bank->empty())
-            CV_Error(Error::StsBadArg,
-                     cv::format("%s: the dark-frame bank '%s' is empty", who, options.darkBank.c_str()));
+        bank = cachedDarkFrameBank(options.darkBank); // load() refuses a bank without groups
         try {
             bankGroupOut = bank->nearestGroup(gainOut);
         } catch (const Exception& e) {
             CV_Error(e.code, cv::format("%s: the output gain: ", who) + e.err);
         }
         // The input's own read noise at any gain: the nearest group's, scaled by the model's lines.
-        bankGroupIn = 0;
-        for (int i = 1; i < static_cast<int>(bank->groups.size()); ++i)
-            if (std::abs(std::log(bank->groups[size_t(i)].gain / gainIn)) <
-                std::abs(std::log(bank->groups[size_t(bankGroupIn)].gain / gainIn)) - 1e-12)
-                bankGroupIn = i;
+        bankGroupIn = nearestGainGroup(bank->groups, gainIn, 0);
         const auto scaleTo = [&](const NoiseTerms<double>& at, int group) {
             const double there = valid.termsAt(bank->groups[static_cast<size_t>(group)].gain).read();
             return there > 0 ? std::sqrt(at.read() / there) : 1.0;
         };
-        bankScaleIn = scaleTo(modelIn, bankGroupIn);
-        bankScaleOut = scaleTo(modelOut, bankGroupOut);
+        bankScaleIn = scaleTo(in, bankGroupIn);
+        bankScaleOut = scaleTo(out, bankGroupOut);
         for (NoiseTerms<double>* t : {&in, &out})
             t->readBeforeGain = t->readAfterGain = 0;
         rowNoise = false;

@@ -40,10 +40,8 @@ struct StepNoise
     double tukeyLambda;  //!< the read noise's Tukey-lambda shape, when `tails`
     DarkShading shading; //!< at gainIn; empty when the model has none, the step adds no noise or uses a bank
     /** NoiseOptions::darkBank's bank, when set and the step adds noise: it then stands in for the model's
-     * read terms, which `in` and `out` no longer hold (nor rowNoise, tails or shading); modelIn and modelOut
-     * do. */
+     * read terms, which `in` and `out` no longer hold (nor rowNoise, tails or shading). */
     std::shared_ptr<const DarkFrameBank> bank;
-    NoiseTerms<double> modelIn, modelOut; //!< the model's whole terms at gainIn and gainOut
     int bankGroupIn = -1,
         bankGroupOut = -1; //!< the bank's groups nearest gainIn (any) and gainOut (in range)
     //! sqrt of the model's read variance at gainIn (gainOut) over that at its group's gain: the frames' scale

@@ -45,7 +45,9 @@ struct CV_EXPORTS_W_SIMPLE DarkFrameStatistics
     CV_PROP_RW Mat rowVariance;
     CV_PROP_RW std::vector<Point> noisyPixels; //!< pixels whose temporal variance their row's cannot explain
     CV_PROP_RW std::vector<double> noisyVariance; //!< their own temporal variance, one per noisy pixel
-    CV_PROP_RW Vec4d level;                       //!< each CFA site's mean level
+    //! each CFA site's level: the median of its pixels' means (hot pixels do not move it), the pattern's
+    //! centre
+    CV_PROP_RW Vec4d level;
     //! each site's temporal variance per pixel, pooled over its pixels that are not noisy (row noise
     //! included)
     CV_PROP_RW Vec4d temporalVariance;
