@@ -13,6 +13,12 @@
 
 namespace rawgment_studies {
 
+double residualKurtosisFactor(int n)
+{
+    const double a = 1 - 1.0 / n;
+    return (std::pow(a, 4) + (n - 1) / std::pow(static_cast<double>(n), 4)) / (a * a);
+}
+
 namespace {
 
 using namespace cv;
@@ -42,14 +48,6 @@ SensorParams departingSensor(Size size, uint64 seed)
     p.columnNoiseVariance = 1;
     p.fixedPatternSeed = seed;
     return p;
-}
-
-// E[excess kurtosis of x - mean of N] / (excess kurtosis of x): the residuals about a pixel's own mean over N
-// frames mix in 1/N of the others, which pulls their shape towards the Gaussian.
-double residualKurtosisFactor(int n)
-{
-    const double a = 1 - 1.0 / n;
-    return (std::pow(a, 4) + (n - 1) / std::pow(static_cast<double>(n), 4)) / (a * a);
 }
 
 double excessKurtosis(const std::vector<double>& values)

@@ -57,6 +57,43 @@ DarkBankStudy runDarkBankStudy(const DarkBankStudySettings& settings);
 //! The study as a Markdown table with its settings.
 std::string darkBankStudyMarkdown(const DarkBankStudy& study, const DarkBankStudySettings& settings);
 
+/** E[excess kurtosis of x - mean of n] / (excess kurtosis of x): residuals about a pixel's own mean over n
+ * frames mix in 1/n of the others, which pulls their shape towards the Gaussian. */
+double residualKurtosisFactor(int n);
+
+/** One figure of a method on the real sensor against what the real frames show: the method's value, the real
+ * one, and the standard error of their difference. */
+struct RealComparison
+{
+    std::string part;    //!< "half against half" or the darkened step ("step 21 to 6, photon ratio 0.25")
+    std::string method;  //!< the bank (accounted, untied), the bank ignoring the prior, components, Gaussian
+    std::string measure; //!< what is compared, with its unit
+    double value = 0, real = 0, se = 0;
+    //! The difference is beyond 3 standard errors: the method is told apart from the real frames.
+    bool distinguishable() const;
+};
+
+/** The dark-frame bank on a real sensor: EMVA 1288 reference set 001 (one gain, 50 exposures; docs/
+ * dark_frame_bank.md, "A real sensor"). */
+struct Emva1288BankStudy
+{
+    std::vector<RealComparison> rows;
+    //! The first half's fixed pattern, Var(mean) - v/M per site: the bank's own figure and the study's
+    //! arithmetic
+    double bankFixedPattern = 0, studyFixedPattern = 0;
+    std::vector<std::string> notes; //!< what the reader needs to read the rows (settings, halves, exposures)
+};
+
+/** Runs the real-sensor study on an EMVA 1288 descriptor with a spatial set of dark frames: banks of the
+ * first and last halves of the spatial darks (written as PNG mosaics with sidecars under workDir), the half
+ * against half comparison of each method's read-noise figures, and bright steps darkened to darker ones with
+ * each method against the darker steps' real pairs, each augmented pair drawn `draws` times. */
+Emva1288BankStudy runEmva1288BankStudy(const std::string& descriptor, const std::string& workDir,
+                                       int draws = 8);
+
+//! The real-sensor study as a Markdown table.
+std::string emva1288BankStudyMarkdown(const Emva1288BankStudy& study);
+
 } // namespace rawgment_studies
 
 #endif // RAWGMENT_STUDIES_DARK_BANK_STUDY_HPP
