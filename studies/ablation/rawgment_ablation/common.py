@@ -6,10 +6,14 @@ import rawgment as _rg
 #: take the blind result apart (docs/ablation.md#the-control-arms). New arms go at the end: an arm's index
 #: seeds its bootstrap, so the earlier arms keep their numbers.
 ARMS = ("NONE", "IGNORE_PRIOR", "ACCOUNT_PRIOR", "ORACLE", "NOISY", "IGNORE_RESCALED", "ORACLE_PLUS_SHARE",
-        "ACCOUNT_POISSON")
+        "ACCOUNT_POISSON", "DARK_BANK", "DARK_BANK_IGNORE")
 #: The control arms: IGNORE_PRIOR's inputs with their noise scaled to the target's variance, the oracle's
 #: captures with the prior share of extra Gaussian noise, ACCOUNT_PRIOR with exact Poisson shot draws.
-CONTROL_ARMS = ARMS[5:]
+CONTROL_ARMS = ARMS[5:8]
+#: The dark-frame bank's arms (docs/dark_frame_bank.md): the read part drawn from real dark frames of the
+#: sensor (a tied bank of its dark captures), accounted (ACCOUNT_PRIOR) or as whole frames on top of the
+#: input's own (IGNORE_PRIOR: the peer's method); the shot part is the model's in both.
+BANK_ARMS = ARMS[8:]
 TRAINED_ARMS = tuple(a for a in ARMS if a != "NOISY")
 #: The arms of a run without --arms. NONE (no noise added) trails every other arm by 2 to 6 dB in every
 #: condition (docs/results.md): it is left out so that 6 replicates of both kinds of network, the fewest
@@ -20,7 +24,7 @@ DEFAULT_ARMS = ("IGNORE_PRIOR", "ACCOUNT_PRIOR", "ORACLE", "NOISY")
 DESIGNS = ("pooled", "per-condition")
 # Roles of the derived seeds (the high 32 bits of deriveSeed's index under SEED_ABLATION).
 (_ROLE_TRAIN_SCENES, _ROLE_TEST_SCENES, _ROLE_TEST_CAPTURE, _ROLE_BATCH, _ROLE_SAMPLE, _ROLE_NETWORK,
- _ROLE_BOOTSTRAP) = range(7)
+ _ROLE_BOOTSTRAP, _ROLE_BANK) = range(8)
 
 #: The blind network's default residual unit: about the noise standard deviation of the study's
 #: conditions on the network's scale (normalised planes). Unscaled, the first Adam steps moved the output

@@ -5,13 +5,18 @@ the direction expected; the report sets the Holm-corrected outcome beside it. Us
 rawgment_ablation.study."""
 import dataclasses
 
-__all__ = ["Prediction", "PREDICTIONS", "CONTROL_CONTRASTS", "predictionOutcome"]
+__all__ = ["Prediction", "PREDICTIONS", "CONTROL_CONTRASTS", "BANK_CONTRASTS", "predictionOutcome"]
 
 #: The contrasts of the control arms, each (a, b, metric): a minus b, paired by replicate. The first three
 #: isolate one change each; the last compares what the networks of the two alignments remove.
 CONTROL_CONTRASTS = (("IGNORE_PRIOR", "IGNORE_RESCALED", "psnr"), ("ORACLE_PLUS_SHARE", "ORACLE", "psnr"),
                      ("ACCOUNT_POISSON", "ACCOUNT_PRIOR", "psnr"),
                      ("IGNORE_PRIOR", "ACCOUNT_PRIOR", "removedNoiseRatio"))
+
+#: The dark-frame bank's contrasts: whether accounting matters for the read part (the bank accounted against
+#: the peer's whole frames), and the bank against the parametric components and against the oracle.
+BANK_CONTRASTS = (("DARK_BANK", "DARK_BANK_IGNORE", "psnr"), ("DARK_BANK", "ACCOUNT_PRIOR", "psnr"),
+                  ("DARK_BANK", "ORACLE", "psnr"))
 
 #: Where the prior share is large enough for IGNORE_PRIOR's excess variance to matter (x0.5 and x0.2 of the
 #: default conditions: 0.48 and 0.17), and where it is negligible (x0.05 and x0.01: 0.028 and 0.002).

@@ -11,7 +11,7 @@ import numpy as np
 
 import rawgment as _rg
 from rawgment_ablation.common import ARMS, BLIND_STEP, TRAINED_ARMS, _ROLE_BOOTSTRAP, _seed
-from rawgment_ablation.controls import CONTROL_CONTRASTS, PREDICTIONS, predictionOutcome
+from rawgment_ablation.controls import BANK_CONTRASTS, CONTROL_CONTRASTS, PREDICTIONS, predictionOutcome
 
 __all__ = ["pairedSignificance", "summarize", "writeOutputs", "writeStudiesOutputs", "writeCombinedReport", "mergeReplicates", "loadStudy",
            "studyName", "holmAdjusted", "seedsForFamily", "seedsToConfirm", "contrastRows", "correctFamily", "NETWORKS",
@@ -107,15 +107,18 @@ def contrastPairs(arms):
     where both arms ran."""
     pairs = [("ACCOUNT_PRIOR", b, "psnr") for b in ("NONE", "IGNORE_PRIOR", "ORACLE")
              if "ACCOUNT_PRIOR" in arms and b in arms]
-    return pairs + [c for c in CONTROL_CONTRASTS if c[0] in arms and c[1] in arms]
+    return pairs + [c for c in CONTROL_CONTRASTS + BANK_CONTRASTS if c[0] in arms and c[1] in arms]
 
 
 def _bootstrapItem(ci, a, b, metric):
     """The bootstrap seed's item of a contrast: ACCOUNT_PRIOR's PSNR contrasts keep the item they had before
     the control arms existed, so earlier runs' intervals are reproduced."""
-    if a == "ACCOUNT_PRIOR" and metric == "psnr":
+    if a == "ACCOUNT_PRIOR" and metric == "psnr" and ARMS.index(b) < 8:
         return (ci << 8) | ARMS.index(b)
-    return (ci << 8) | 0x80 | (0x40 if metric != "psnr" else 0) | (ARMS.index(a) << 3) | ARMS.index(b)
+    if ARMS.index(a) < 8 and ARMS.index(b) < 8:
+        return (ci << 8) | 0x80 | (0x40 if metric != "psnr" else 0) | (ARMS.index(a) << 3) | ARMS.index(b)
+    # Arms after the first eight do not fit three bits: items of their own, above every earlier one.
+    return (ci << 16) | 0x8000 | (ARMS.index(a) << 8) | (0x80 if metric != "psnr" else 0) | ARMS.index(b)
 
 
 def contrastRows(results):
@@ -304,7 +307,8 @@ def _report(results, rows, plotNote):
                    " | ".join(_fmt(byKey[(name, a)]["ssim"], byKey[(name, a)]["ssimSd"], 4) for a in arms) + " |")
     contrasts = contrastRows(results)
     if contrasts:
-        out += ["", "## ACCOUNT_PRIOR minus each arm, and the control contrasts (paired by seed)", ""]
+        out += ["", "## ACCOUNT_PRIOR minus each arm, the control and the dark-frame bank's contrasts (paired by "
+                "seed)", ""]
         out += _testsTable(contrasts)
     if any("removed" in r for r in rows):
         trained = [a for a in arms if a in TRAINED_ARMS]
@@ -604,7 +608,10 @@ def _studiesReport(byStudy, rowsOf, folders=None):
                            if a == "ACCOUNT_PRIOR" and m == "psnr"]),
                          ("The control contrasts, by study", list(dict.fromkeys(
                              (r["a"], r["b"], r["metric"]) for r in family
-                             if (r["a"], r["b"], r["metric"]) in CONTROL_CONTRASTS)))):
+                             if (r["a"], r["b"], r["metric"]) in CONTROL_CONTRASTS))),
+                         ("The dark-frame bank's contrasts, by study", list(dict.fromkeys(
+                             (r["a"], r["b"], r["metric"]) for r in family
+                             if (r["a"], r["b"], r["metric"]) in BANK_CONTRASTS)))):
         pairs = sorted(pairs, key=lambda c: ARMS.index(c[1])) if title.startswith("ACCOUNT") else pairs
         columns = [(n, c) for c in pairs for n in names
                    if any((r["a"], r["b"], r["metric"]) == c for r in contrastsOf[n])]

@@ -11,41 +11,49 @@ inputs differ):
   noise), darkened by the library (motionBlur for the blur condition, then colorJitter) with that
   NoiseAlignment;
 * ``ORACLE``: a capture simulated directly at the target exposure and gain (the upper bound);
-* ``NOISY``: no network, the test input itself (the lower bound).
+* ``NOISY``: no network, the test input itself (the lower bound);
+* ``DARK_BANK``, ``DARK_BANK_IGNORE``: as ACCOUNT_PRIOR and IGNORE_PRIOR, with the read part drawn from a tied
+  bank of the sensor's own dark captures (docs/dark_frame_bank.md), best run with ``--departing-sensor``.
 
 Test inputs are always captures simulated at the target (exact Poisson), never the augmentation.
 Every random number derives from ``--seed`` through deriveSeed(deriveSeed(seed, SEED_ABLATION, role),
 SEED_ABLATION, item), so the same seeds give the same numbers.
 """
 import argparse
-import copy
+import atexit
 import dataclasses
 import math
 import os
+import shutil
 import sys
+import tempfile
 import time
 
 import numpy as np
 import torch
 
 import rawgment as _rg
-from rawgment_ablation.common import (ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_ARMS, DESIGNS, TRAINED_ARMS,
-                                       _ROLE_BATCH, _ROLE_NETWORK, _ROLE_SAMPLE, _ROLE_TEST_CAPTURE, _ROLE_TEST_SCENES,
-                                       _ROLE_TRAIN_SCENES, _seed)
+from rawgment_ablation.common import (ARMS, BANK_ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_ARMS, DESIGNS,
+                                       TRAINED_ARMS, _ROLE_BANK, _ROLE_BATCH, _ROLE_NETWORK, _ROLE_SAMPLE,
+                                       _ROLE_TEST_CAPTURE, _ROLE_TEST_SCENES, _ROLE_TRAIN_SCENES, _seed)
 from rawgment_ablation.report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, contrastPairs, contrastRows,
                                       correctFamily, holmAdjusted, pairedSignificance, seedsForFamily, seedsToConfirm,
                                       mergeReplicates, studyName, summarize, writeCombinedReport, writeOutputs,
                                       writeStudiesOutputs)
-from rawgment_ablation.controls import CONTROL_CONTRASTS, PREDICTIONS
+from rawgment_ablation.config import (AblationConfig, Condition, defaultConditions, departingSensorParams,
+                                       quickConditions)
+from rawgment_ablation.controls import BANK_CONTRASTS, CONTROL_CONTRASTS, PREDICTIONS
 from rawgment_ablation.network import Denoiser, psnr, ssim
 from rawgment_ablation.scenes import mosaicOfScene, renderScene
 from rawgment.torch import packCfaPlanes
 
-__all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "CONTROL_ARMS", "DESIGNS",
+__all__ = ["Condition", "AblationConfig", "ARMS", "TRAINED_ARMS", "DEFAULT_ARMS", "CONTROL_ARMS", "BANK_ARMS", "DESIGNS",
            "defaultConditions", "quickConditions", "renderScene", "mosaicOfScene", "Denoiser", "psnr", "ssim",
            "runAblation", "pairedSignificance", "summarize", "writeOutputs", "NETWORKS", "BLIND_STEP", "SIGNIFICANCE",
            "writeStudiesOutputs", "writeCombinedReport", "mergeReplicates", "studyName", "seedsNeeded", "holmAdjusted", "seedsForFamily",
-           "seedsToConfirm", "contrastRows", "correctFamily", "PREDICTIONS", "CONTROL_CONTRASTS", "main"]
+           "seedsToConfirm", "contrastRows", "correctFamily", "PREDICTIONS", "CONTROL_CONTRASTS", "BANK_CONTRASTS",
+           "departingSensorParams",
+           "main"]
 
 ALIGNMENTS = {"NONE": _rg.NoiseAlignment.NONE, "IGNORE_PRIOR": _rg.NoiseAlignment.IGNORE_PRIOR,
               "ACCOUNT_PRIOR": _rg.NoiseAlignment.ACCOUNT_PRIOR}
@@ -55,135 +63,6 @@ ALIGNMENTS = {"NONE": _rg.NoiseAlignment.NONE, "IGNORE_PRIOR": _rg.NoiseAlignmen
 _FILL = 0.8
 # The reflectance at which the report states each condition's prior share (mid-grey).
 _MID_GREY = 0.18
-@dataclasses.dataclass(frozen=True)
-class Condition:
-    """One test condition: the photon ratio of the target to the bright capture, its gain ratio, and
-    an optional linear motion blur (length in CFA-plane pixels, angle in degrees; 0 = no blur)."""
-    name: str
-    photonRatio: float
-    gainRatio: float = 1.0
-    blurLength: float = 0.0
-    blurAngle: float = 0.0
-
-
-def defaultConditions():
-    """Photon ratios 0.5, 0.2, 0.05, 0.01 at the bright gain and with the gain raised to keep the
-    brightness (by 1/ratio, at most 4x = +12 dB), and a motion blur of 9 plane pixels at 30 degrees at
-    ratio 0.2."""
-    conditions = []
-    for ratio in (0.5, 0.2, 0.05, 0.01):
-        conditions.append(Condition("x%g" % ratio, ratio))
-        conditions.append(Condition("x%g +%gdB" % (ratio, round(_rg.linearGainToDb(min(4.0, 1.0 / ratio)))),
-                                    ratio, min(4.0, 1.0 / ratio)))
-    conditions.append(Condition("x0.2 blur9", 0.2, 1.0, 9.0, 30.0))
-    return conditions
-
-
-def quickConditions():
-    """The --quick run's two conditions: a moderate darkening and a very dark one with a gain change."""
-    return [Condition("x0.2", 0.2), Condition("x0.01 +12dB", 0.01, 4.0)]
-
-
-@dataclasses.dataclass
-class AblationConfig:
-    """Everything that sets the numbers of a run (all of it is written to results.json)."""
-    model: object = None            # rawgment.NoiseModel of the sensor (effective: quantisation included)
-    bitDepth: int = 12
-    blackLevel: float = 256.0
-    # Linear gain of the bright captures: +12 dB. At unit gain the default sensor's bright captures are
-    # so clean that the mildest darkening still leaves a 46 dB input, where no arm differs; at +12 dB the
-    # bright captures' own noise is a visible share of the target's, which is what the arms disagree on.
-    baseGain: float = 10.0 ** (12.0 / 20.0)
-    conditions: list = dataclasses.field(default_factory=defaultConditions)
-    arms: tuple = DEFAULT_ARMS
-    # Training replicates (network initialisation and data order); 0: the fewest whose tests can reach a
-    # verdict after Holm's correction over the study's tests (seedsNeeded()).
-    seeds: int = 0
-    # The index of the first replicate: a run with firstReplicate = n trains replicates n, n+1, ... of the
-    # same base seed (the same scenes and test captures), so that a study can be extended with more seeds
-    # and the runs merged (--combine).
-    firstReplicate: int = 0
-    seed: int = 0                   # the base seed of everything
-    iterations: int = 800
-    batch: int = 16
-    patch: int = 64                 # training crop, mosaic pixels (even)
-    trainScenes: int = 24
-    trainSceneSize: int = 192
-    testScenes: int = 8
-    testSceneSize: int = 256
-    width: int = 16                 # channels of the network's first level
-    # Whether the network is told the noise level (a noise map per plane, as the default denoiser) or is
-    # blind, seeing only the image, as the paper's detectors do (--blind).
-    noiseMaps: bool = True
-    # The training design (DESIGNS): "pooled", one network per arm on all conditions, or "per-condition",
-    # one per arm and condition (--per-condition runs both).
-    design: str = "pooled"
-    # The blind network's residual unit (Denoiser.blindScale): a design choice, so a run can vary it to
-    # see whether a verdict depends on it.
-    blindStep: float = BLIND_STEP
-    # How the augmented arms draw their added noise (NoiseOptions): the library's defaults, or the exact
-    # Poisson shape of the shot part and the local mean as the prior's level, to see what a result owes
-    # to either.
-    shotSampling: str = "GAUSSIAN"
-    priorMean: str = "PIXEL_VALUE"
-    learningRate: float = 2e-3
-    threads: int = 0                # torch threads (0: OMP_NUM_THREADS if set, else every core)
-    camera: str = ""                # the real camera of a darktable profile file the model came from
-
-    def sensorParams(self, size=None):
-        """The simulator's parameters: the model without the rounding's 1/12 DN^2, which the simulator
-        adds back by quantising (so effectiveModel() is the model given), with every dark-frame component
-        of the model (row noise, heavy-tailed read noise, dark shading). The shading maps are the sensor's:
-        a simulator of `size` (height and width, the study's square crops) takes their top-left corner,
-        where the augmentation reads them too (sensorOrigin 0); without `size`, the whole maps."""
-        if self.model is None:
-            return _rg.SensorParams(bitDepth=int(self.bitDepth), blackLevel=(float(self.blackLevel),) * 4,
-                                    quantize=True)
-        noise = copy.deepcopy(self.model)
-        noise.sigmaR2 = max(self.model.sigmaR2 - 1.0 / 12.0, 0.0)
-        if size is not None and noise.hasDarkShading():
-            rows, cols = noise.darkShadingPerGain.shape
-            if size > rows or size > cols:
-                raise ValueError("the model's dark shading is %dx%d, smaller than the study's %dx%d captures"
-                                 % (cols, rows, size, size))
-            noise.darkShadingPerGain = noise.darkShadingPerGain[:size, :size]
-            noise.darkShadingOffset = noise.darkShadingOffset[:size, :size]
-        return _rg.SensorParams(noise=noise, bitDepth=int(self.bitDepth), blackLevel=(float(self.blackLevel),) * 4,
-                                quantize=True)
-
-    def validate(self):
-        if not self.conditions:
-            raise ValueError("no condition to run")
-        for c in self.conditions:
-            if not (0.0 < c.photonRatio <= 1.0) or not (c.gainRatio >= 1.0) or c.blurLength < 0:
-                raise ValueError("condition %r: photonRatio must be in (0, 1], gainRatio >= 1, blurLength >= 0"
-                                 % (c,))
-        unknown = [a for a in self.arms if a not in ARMS]
-        if unknown or not self.arms:
-            raise ValueError("unknown arm(s) %s; the arms are %s" % (", ".join(unknown), ", ".join(ARMS)))
-        if not 0 <= int(self.firstReplicate) < 1 << 16:
-            raise ValueError("firstReplicate must be in [0, 65536), got %r" % self.firstReplicate)
-        if int(self.seeds) < 0:
-            raise ValueError("seeds must be >= 1 (or 0: as many as the study's tests need), got %r" % self.seeds)
-        for name in ("iterations", "batch", "trainScenes", "testScenes", "width"):
-            if int(getattr(self, name)) < 1:
-                raise ValueError("%s must be >= 1, got %r" % (name, getattr(self, name)))
-        for name in ("patch", "trainSceneSize", "testSceneSize"):
-            value = int(getattr(self, name))
-            # Even for the CFA, and a multiple of 4 so the network's half-resolution level fits.
-            if value < 16 or value % 4:
-                raise ValueError("%s must be a multiple of 4 and >= 16, got %r" % (name, value))
-        if self.patch > self.trainSceneSize:
-            raise ValueError("patch (%d) is larger than trainSceneSize (%d)" % (self.patch, self.trainSceneSize))
-        if self.baseGain <= 0 or not (self.learningRate > 0) or not (0 < self.blindStep <= 1):
-            raise ValueError("baseGain and learningRate must be > 0, blindStep in (0, 1]")
-        if self.design not in DESIGNS:
-            raise ValueError("design must be one of %s, got %r" % (", ".join(DESIGNS), self.design))
-        if self.shotSampling not in ("GAUSSIAN", "POISSON") or self.priorMean not in ("PIXEL_VALUE", "LOCAL_MEAN"):
-            raise ValueError("shotSampling must be GAUSSIAN or POISSON and priorMean PIXEL_VALUE or LOCAL_MEAN, "
-                             "got %r and %r" % (self.shotSampling, self.priorMean))
-        for size in (16, self.patch, self.trainSceneSize, self.testSceneSize):
-            self.sensorParams(int(size)).validate()
 
 
 class _Study:
@@ -206,6 +85,7 @@ class _Study:
         self.level = _FILL * self.range / config.baseGain
         self.simulators = {}
         self.kernels = {}
+        self.bank = None
 
     def simulator(self, size):
         if size not in self.simulators:
@@ -250,12 +130,38 @@ class _Study:
         """The bright capture of a training crop (its own noise): the input of every augmented arm."""
         return self.simulator(mean.shape[0]).capture(mean, self.config.baseGain, 1.0, seed)
 
-    def augmented(self, bright, condition, alignment, seed, shotSampling=None):
+    def bankPath(self):
+        """The bank arms' dark-frame bank, made on first use: config.bankFrames dark captures of the training
+        crops' sensor (the simulator of the crop size, whose fixed pattern the crops share) at every gain of
+        the run, tied to the crops. Written to a temporary folder removed when the process ends."""
+        if self.bank is None:
+            folder = tempfile.mkdtemp(prefix="rawgment_ablation_bank_")
+            atexit.register(shutil.rmtree, folder, True)
+            size = int(self.config.patch)
+            sim = self.simulator(size)
+            gains = sorted({self.config.baseGain} | {self.config.baseGain * c.gainRatio for c in self.config.conditions})
+            files = []
+            for gi, gain in enumerate(gains):
+                for t in range(int(self.config.bankFrames)):
+                    dark = sim.capture(np.zeros((size, size), np.float32), gain, 1.0,
+                                       _seed(self.config.seed, _ROLE_BANK, gi), frameIndex=t)
+                    files.append(os.path.join(folder, "dark_%d_%03d.png" % (gi, t)))
+                    _rg.writeMosaic(files[-1], dark, _rg.MosaicMetadata(format=sim.rawFormat(gain)))
+            bank = _rg.DarkFrameBank.create(files, _rg.NoiseModel())
+            self.bank = os.path.join(folder, "bank.yml")
+            bank.save(self.bank)
+        return self.bank
+
+    def augmented(self, bright, condition, alignment, seed, shotSampling=None, bank=False):
         """The bright capture darkened (and blurred) by the library with an alignment (a name of
-        ALIGNMENTS); the shot part drawn as the run's --shot-sampling, or as `shotSampling` if given."""
+        ALIGNMENTS); the shot part drawn as the run's --shot-sampling, or as `shotSampling` if given; with
+        `bank`, the read part from the tied bank (bankPath())."""
         options = _rg.NoiseOptions(ALIGNMENTS[alignment])
         options.shotSampling = getattr(_rg.ShotNoiseSampling, shotSampling or self.config.shotSampling)
         options.priorMean = getattr(_rg.PriorMeanEstimate, self.config.priorMean)
+        if bank:
+            options.darkBank = self.bankPath()
+            options.darkBankTied = True
         stepSeeds = [_rg.deriveSeed(seed, _rg.SEED_ABLATION, step) for step in (1, 2)]
         if condition.blurLength > 0:
             bright, _ = _rg.motionBlur(bright, self.format, self.model, self.kernel(condition), options,
@@ -338,9 +244,10 @@ class _Study:
                 else:
                     if "bright" not in raws:
                         raws["bright"] = self.brightCapture(mean, seed)
-                    alignment = "ACCOUNT_PRIOR" if arm == "ACCOUNT_POISSON" else arm
+                    alignment = {"ACCOUNT_POISSON": "ACCOUNT_PRIOR", "DARK_BANK": "ACCOUNT_PRIOR",
+                                 "DARK_BANK_IGNORE": "IGNORE_PRIOR"}.get(arm, arm)
                     raws[arm] = self.augmented(raws["bright"], condition, alignment, seed,
-                                               "POISSON" if arm == "ACCOUNT_POISSON" else None)
+                                               "POISSON" if arm == "ACCOUNT_POISSON" else None, arm in BANK_ARMS)
             return raws[arm]
 
         return {arm: self.inputPlanes(raw(arm), condition) for arm in arms}
@@ -573,6 +480,10 @@ def _parser():
     parser.add_argument("--prior-mean", default="PIXEL_VALUE", type=str.upper,
                         help="the augmented arms' estimate of the prior's level: PIXEL_VALUE (the paper's, "
                              "default) or LOCAL_MEAN")
+    parser.add_argument("--departing-sensor", action="store_true",
+                        help="simulate a sensor that departs from the model's components (hot, noisy pixels, "
+                             "column banding, DSNU; row noise and heavy tails where the model has none): what the "
+                             "arms DARK_BANK and DARK_BANK_IGNORE are about")
     parser.add_argument("--blind-step", type=float, default=BLIND_STEP,
                         help="the blind network's residual unit, a fraction of white - black (default 0.02)")
     return parser
@@ -687,6 +598,7 @@ def main(argv=None):
               % args.designs, file=sys.stderr)
         return 2
     config.blindStep = args.blind_step
+    config.departingSensor = args.departing_sensor
     config.shotSampling, config.priorMean = args.shot_sampling, args.prior_mean
     if args.seeds is not None:
         config.seeds = args.seeds

@@ -281,7 +281,9 @@ def test_the_arms_are_fed_the_noise_they_claim():
     share = study.priorShare(condition)
     expected = {"ORACLE": target, "ACCOUNT_PRIOR": target, "IGNORE_PRIOR": (1 + share) * target,
                 "NONE": share * target, "IGNORE_RESCALED": target, "ORACLE_PLUS_SHARE": (1 + share) * target,
-                "ACCOUNT_POISSON": target}
+                "ACCOUNT_POISSON": target, "DARK_BANK": target,
+                # Whole frames drawn from 25 lack 1/25 of the read part, under 0.4% of the target here.
+                "DARK_BANK_IGNORE": (1 + share) * target}
     assert set(expected) == set(ab.TRAINED_ARMS)
     # 2 x 128 x 128 green samples: a sample variance's relative standard deviation is sqrt(2 / n) = 0.55%;
     # 4% is above 7 of them, and far below the 49% that separates ACCOUNT_PRIOR from IGNORE_PRIOR here.
@@ -312,6 +314,52 @@ def test_the_arms_are_fed_the_noise_they_claim():
     # Independent: over 2 x 128 x 128 samples a correlation's standard error is 1 / sqrt(32768) = 0.0055.
     pair = torch.stack([extra.flatten(), inputs["ORACLE"][1:3].flatten().double()])
     assert abs(float(torch.corrcoef(pair)[0, 1])) < 0.02
+
+
+def test_the_bank_arms_carry_what_the_departing_sensor_has_and_the_components_lack(tmp_path):
+    """On a black scene at x0.5 (k = 0.5) of the departing sensor (hot pixels left out), the training inputs'
+    pixel variance and column-mean variance (DN^2; the departures: column banding 2, DSNU 2 DN, 1% of pixels
+    with 100 more): DARK_BANK carries the oracle's; ACCOUNT_PRIOR, whose components have none of them, keeps only
+    k^2 of the input's (its pixel variance 16% low, its columns 0.5 + v/256 against 2 + v/256); the peer's
+    whole frames add k^2 of the input's whole read variance on top (25%)."""
+    config = ab.AblationConfig(conditions=[ab.Condition("x0.5", 0.5)], patch=256, departingSensor=True)
+    study = ab._Study(config)
+    condition = config.conditions[0]
+    mean = np.zeros((256, 256), np.float32)
+    arms = ("ORACLE", "ACCOUNT_PRIOR", "DARK_BANK", "DARK_BANK_IGNORE")
+    inputs = study.trainingInputs(mean, condition, arms, seed=5)
+    scale = float(study.range * condition.photonRatio * condition.gainRatio)
+    figures = {}
+    for arm in arms:
+        planes = inputs[arm][:4].double() * scale  # DN at the target
+        ordinary = planes < 0.5 * scale  # hot pixels sit near white
+        values = planes[ordinary]
+        pixel = float(values.var())
+        # Mosaic columns: each plane's columns are means over its 128 rows (hot pixels out).
+        counts = ordinary.sum(dim=1).double()
+        columnMeans = (planes * ordinary).sum(dim=1) / counts
+        figures[arm] = (pixel, float(columnMeans.var()))
+    oracle = figures["ORACLE"]
+    # 4 x 128 x 128 pixels: a variance's relative error is about 1% (heavy tails and noisy pixels included);
+    # 512 column means: sqrt(2 / 511) = 6%.
+    assert figures["DARK_BANK"][0] == pytest.approx(oracle[0], rel=0.05)
+    assert figures["DARK_BANK"][1] == pytest.approx(oracle[1], rel=0.25)
+    assert figures["ACCOUNT_PRIOR"][0] < 0.9 * oracle[0]
+    assert figures["ACCOUNT_PRIOR"][1] < 0.6 * oracle[1]
+    assert figures["DARK_BANK_IGNORE"][0] > 1.15 * oracle[0]
+
+
+def test_the_bank_arms_run_and_their_contrasts_reach_the_report(tmp_path):
+    out = tmp_path / "bank"
+    assert ab.main(["--quick", "--networks", "told", "--departing-sensor", "--arms",
+                    "ACCOUNT_PRIOR,ORACLE,DARK_BANK,DARK_BANK_IGNORE", "--seeds", "2", "--iterations", "2",
+                    "--out", str(out)]) == 0
+    results = json.loads((out / "results.json").read_text())
+    assert results["config"]["departingSensor"] is True and results["config"]["bankFrames"] == 25
+    assert set(results["conditions"][0]["arms"]) == {"ACCOUNT_PRIOR", "ORACLE", "DARK_BANK", "DARK_BANK_IGNORE"}
+    report = (out / "report.md").read_text()
+    for a, b, _ in ab.BANK_CONTRASTS:
+        assert "| %s minus %s | PSNR dB |" % (a, b) in report, (a, b)
 
 
 def test_ssim_and_psnr_on_known_cases():
