@@ -58,7 +58,7 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
          {"Shot-noise sampling", "Prior mean", "Motion-blur noise sum", "Arithmetic",
           "Calibration burst length", "Calibration patch size", "Calibration RANSAC iterations",
           "Shapiro-Wilk", "Row noise (dark-frame component)", "Dark shading (dark-frame component)",
-          "Read-noise tails (dark-frame component)"})
+          "Read-noise tails (dark-frame component)", "Dark-frame bank frames per gain"})
         EXPECT_NE(std::string::npos, md.find(knob)) << knob;
     // What more data buys: a row per burst length, per square side, for two gains and for dark frames,
     // each with the stated and the made error of every parameter.
@@ -70,6 +70,8 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
     const size_t perCalibration = md.find("## A calibration: the frames to shoot, its time, its error");
     ASSERT_NE(std::string::npos, perCalibration);
     EXPECT_NE(std::string::npos, md.find("| Calibration burst length | 16 frames | 96 |", perCalibration));
+    EXPECT_NE(std::string::npos,
+              md.find("| Dark-frame bank frames per gain | 8 frames | 8 |", perCalibration));
     expectPngDecodes(dir + "/t/tradeoffs.png");
     // The figure: one view of every knob relative to its reference setting, then a panel per knob whose
     // y axis names the knob's own measure (the axes once said only "error").
@@ -105,18 +107,19 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
         const double e = std::stod(cells[3]), t = std::stod(cells[7]);
         EXPECT_TRUE(std::isfinite(e) && e >= 0) << line;
         EXPECT_TRUE(std::isfinite(t) && t > 0) << line;
-        const bool calibration = cells[0].rfind("Calibration", 0) == 0;
-        if (calibration) {
+        const bool calibration = cells[0].rfind("Calibration", 0) == 0,
+                   bank = cells[0] == "Dark-frame bank frames per gain";
+        if (calibration || bank) {
             // --quick runs two campaigns: each error has a standard error, each calibration its frames (6
-            // bursts) and time.
+            // bursts; a bank's group its frames per gain) and time.
             EXPECT_GT(std::stod(cells[4]), 0) << line;
-            EXPECT_EQ(0, std::stoi(cells[5]) % 6) << line;
+            EXPECT_EQ(0, std::stoi(cells[5]) % (bank ? 4 : 6)) << line;
             EXPECT_GT(std::stod(cells[6]), 0) << line;
         } else {
             EXPECT_TRUE(cells[4].empty() && cells[5].empty() && cells[6].empty()) << line;
         }
         // The augmentation and burst-statistics knobs run dispatched loops: timed on every path.
-        const bool dispatched = !calibration && cells[0] != "Shapiro-Wilk";
+        const bool dispatched = !calibration && !bank && cells[0] != "Shapiro-Wilk";
         for (size_t k = fixed; k < cells.size(); ++k)
             if (dispatched)
                 EXPECT_GT(std::stod(cells[k]), 0) << line;
@@ -126,9 +129,9 @@ TEST(Apps, tradeoffReportMeasuresEveryKnob)
         errorOfKnob[cells[0] + " | " + cells[1]] = e;
         ++rows;
     }
-    // 2 settings of 2 knobs, 4 blur rows, 2 burst lengths (--quick), 3 + 3, 2, and 2 for each of the
-    // 3 dark-frame components.
-    EXPECT_EQ(rows, 26);
+    // 2 settings of 2 knobs, 4 blur rows, 2 burst lengths (--quick), 3 + 3, 2, 2 for each of the 3 dark-frame
+    // components, and 2 bank sizes (--quick).
+    EXPECT_EQ(rows, 28);
     for (const char* component : {"Row noise", "Dark shading", "Read-noise tails"}) {
         const std::string knob = std::string(component) + " (dark-frame component) | ";
         EXPECT_LT(errorOfKnob[knob + "in the model"], errorOfKnob[knob + "absent from the model"] / 1.5)

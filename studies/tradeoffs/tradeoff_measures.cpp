@@ -482,6 +482,8 @@ void measureTradeoffs(const TradeoffSettings& set, ProgressBar& progress, std::v
     progress.advance();
     measureDarkComponents(set, timingRaw, timingFmt, timingModel, rows);
     progress.advance();
+    tradeoff_study::measureDarkBankFrames(set, rows);
+    progress.advance();
 }
 
 } // namespace rawgment_apps

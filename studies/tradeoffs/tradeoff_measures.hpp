@@ -25,6 +25,7 @@ struct TradeoffSettings
     int seeds = 32;
     std::vector<int> burstLengths{8, 16, 32, 100};
     std::vector<int> ransacIterations{20, 100, 2000}; // the RANSAC knob's settings (500 is the library's)
+    std::vector<int> bankFrames{4, 8, 16, 25, 50};    // dark frames per gain in a dark-frame bank
     // Also the stated against the made errors (PrecisionRow), each fit with its bootstrap, and dark bursts.
     bool precision = true;
     int shapiroSeries = 100000; // series of 64 values in the Shapiro-Wilk timing
@@ -76,7 +77,7 @@ struct PrecisionRow
 
 /** Measures every knob in one run (colour jitter, blur, burst statistics, calibration, Shapiro-Wilk)
  * and appends one row per setting, and the calibration's precision per set-up; `progress` advances by
- * 6 + 9 * settings.seeds. */
+ * 7 + 9 * settings.seeds. */
 void measureTradeoffs(const TradeoffSettings& settings, ProgressBar& progress, std::vector<TradeoffRow>& rows,
                       std::vector<PrecisionRow>& precision);
 

@@ -34,7 +34,8 @@ enum StudyDraw : uint64_t
     DRAW_CAMPAIGN_BURST,
     DRAW_DARK_INPUT,
     DRAW_DARK_TARGET,
-    DRAW_DARK_STEP
+    DRAW_DARK_STEP,
+    DRAW_BANK_CAMPAIGN
 };
 
 //! The seed of one draw of the study.
@@ -52,6 +53,9 @@ double megapixels(cv::Size s);
  * errors (tradeoff_calibration.cpp). */
 void measureCalibrationKnobs(const TradeoffSettings& set, std::vector<TradeoffRow>& rows,
                              std::vector<PrecisionRow>& precision, ProgressBar& progress);
+/** The dark-frame bank's frames per gain (settings.bankFrames) against the RMS error of its fixed pattern
+ * over simulated campaigns, and the time to make one gain's group (tradeoff_dark_bank.cpp). */
+void measureDarkBankFrames(const TradeoffSettings& set, std::vector<TradeoffRow>& rows);
 
 } // namespace tradeoff_study
 } // namespace rawgment_apps
