@@ -149,6 +149,27 @@ double siteAverage(const Vec4d& perSite)
     return (perSite[0] + perSite[1] + perSite[2] + perSite[3]) / 4;
 }
 
+//! The variance of `map` over each site of the row and column parities, averaged over the four (the sites'
+//! levels differ, which a bank keeps as each site's level and a pattern does not add).
+double siteSpatialVariance(const Mat& map)
+{
+    Mat m;
+    map.convertTo(m, CV_64F);
+    double total = 0;
+    for (int site = 0; site < 4; ++site) {
+        double s = 0, s2 = 0, n = 0;
+        for (int y = site / 2; y < m.rows; y += 2)
+            for (int x = site % 2; x < m.cols; x += 2) {
+                const double v = m.at<double>(y, x);
+                s += v;
+                s2 += v * v;
+                n += 1;
+            }
+        total += (s2 - s * s / n) / (n - 1) / 4;
+    }
+    return total;
+}
+
 double spatialVariance(const Mat& map)
 {
     Scalar m, sd;
@@ -322,7 +343,7 @@ Emva1288BankStudy runEmva1288BankStudy(const std::string& descriptor, const std:
     const char* kurtosis = "excess kurtosis of a frame";
     add(halves, bankName, temporal, siteAverage(bs.temporalVariance), b.first.temporal,
         std::hypot(a.second.temporal, b.second.temporal));
-    add(halves, bankName, pattern, spatialVariance(bs.pattern), b.first.fixedPattern,
+    add(halves, bankName, pattern, siteSpatialVariance(bs.pattern), b.first.fixedPattern,
         std::hypot(a.second.fixedPattern, b.second.fixedPattern));
     add(halves, bankName, rows, siteAverage(bs.rowNoiseVariance), b.first.rowNoise,
         std::hypot(a.second.rowNoise, b.second.rowNoise));
@@ -332,7 +353,7 @@ Emva1288BankStudy runEmva1288BankStudy(const std::string& descriptor, const std:
     const char* componentsName = "calibrated components";
     add(halves, componentsName, temporal, ds.pixelVariance + ds.rowVariance, b.first.temporal,
         std::hypot(a.second.temporal, b.second.temporal));
-    add(halves, componentsName, pattern, spatialVariance(offset), b.first.fixedPattern,
+    add(halves, componentsName, pattern, siteSpatialVariance(offset), b.first.fixedPattern,
         std::hypot(a.second.meanVariance, b.second.fixedPattern));
     add(halves, componentsName, rows, ds.rowVariance, b.first.rowNoise,
         std::hypot(a.second.rowNoise, b.second.rowNoise));
