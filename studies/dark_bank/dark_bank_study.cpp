@@ -19,6 +19,23 @@ double residualKurtosisFactor(int n)
     return (std::pow(a, 4) + (n - 1) / std::pow(static_cast<double>(n), 4)) / (a * a);
 }
 
+double ksStatistic(std::vector<float> a, std::vector<float> b)
+{
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    size_t i = 0, j = 0;
+    double d = 0;
+    while (i < a.size() && j < b.size()) {
+        const float t = std::min(a[i], b[j]);
+        while (i < a.size() && a[i] == t)
+            ++i;
+        while (j < b.size() && b[j] == t)
+            ++j;
+        d = std::max(d, std::abs(static_cast<double>(i) / a.size() - static_cast<double>(j) / b.size()));
+    }
+    return d;
+}
+
 namespace {
 
 using namespace cv;
@@ -169,23 +186,6 @@ StackFigures figuresOf(const std::vector<Mat>& frames, const Mat& keep, const Ma
             ((siteSum2[site] - siteSum[site] * siteSum[site] / m) / (m - 1) - siteOwn[site] / m / n) / 4;
     }
     return s;
-}
-
-double ksStatistic(std::vector<float> a, std::vector<float> b)
-{
-    std::sort(a.begin(), a.end());
-    std::sort(b.begin(), b.end());
-    size_t i = 0, j = 0;
-    double d = 0;
-    while (i < a.size() && j < b.size()) {
-        const float t = std::min(a[i], b[j]);
-        while (i < a.size() && a[i] == t)
-            ++i;
-        while (j < b.size() && b[j] == t)
-            ++j;
-        d = std::max(d, std::abs(static_cast<double>(i) / a.size() - static_cast<double>(j) / b.size()));
-    }
-    return d;
 }
 
 std::vector<float> concatenated(const std::vector<const std::vector<float>*>& frames)

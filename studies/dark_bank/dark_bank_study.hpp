@@ -61,6 +61,9 @@ std::string darkBankStudyMarkdown(const DarkBankStudy& study, const DarkBankStud
  * frames mix in 1/n of the others, which pulls their shape towards the Gaussian. */
 double residualKurtosisFactor(int n);
 
+//! The two-sample Kolmogorov-Smirnov statistic of a and b (ties handled as one step).
+double ksStatistic(std::vector<float> a, std::vector<float> b);
+
 /** One figure of a method on the real sensor against what the real frames show: the method's value, the real
  * one, and the standard error of their difference. */
 struct RealComparison

@@ -223,23 +223,6 @@ PairFigures figuresOfPair(const Mat& a, const Mat& b, uint64 ditherSeed)
     return p;
 }
 
-double ksStatistic(std::vector<float> a, std::vector<float> b)
-{
-    std::sort(a.begin(), a.end());
-    std::sort(b.begin(), b.end());
-    size_t i = 0, j = 0;
-    double d = 0;
-    while (i < a.size() && j < b.size()) {
-        const float t = std::min(a[i], b[j]);
-        while (i < a.size() && a[i] == t)
-            ++i;
-        while (j < b.size() && b[j] == t)
-            ++j;
-        d = std::max(d, std::abs(static_cast<double>(i) / a.size() - static_cast<double>(j) / b.size()));
-    }
-    return d;
-}
-
 // The spatial set's dark stack, each frame as read (CV_16UC1) and as doubles.
 struct DarkStack
 {
