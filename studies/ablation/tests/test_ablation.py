@@ -358,6 +358,7 @@ def test_the_bank_arms_run_and_their_contrasts_reach_the_report(tmp_path):
     assert results["config"]["departingSensor"] is True and results["config"]["bankFrames"] == 25
     assert set(results["conditions"][0]["arms"]) == {"ACCOUNT_PRIOR", "ORACLE", "DARK_BANK", "DARK_BANK_IGNORE"}
     report = (out / "report.md").read_text()
+    assert "The simulated sensor departs from the model (--departing-sensor)" in report
     for a, b, _ in ab.BANK_CONTRASTS:
         assert "| %s minus %s | PSNR dB |" % (a, b) in report, (a, b)
 
