@@ -293,7 +293,7 @@ def _report(results, rows, plotNote):
                    ("Dark-frame components in every capture and augmentation: %s." % ", ".join(extras)
                     if extras else ""))
     if config.get("departingSensor"):
-        out += ["", "The simulated sensor departs from the model (--departing-sensor): 0.2% hot and 1% noisy pixels "
+        out += ["", "The simulated sensor departs from the model (--departing-sensor): 0.2%% hot and 1%% noisy pixels "
                 "(100 DN^2 more), column banding of 2 DN^2 and a DSNU of 2 DN, which no model component describes; "
                 "the bank arms draw their read part from %d dark captures per gain." % int(config.get("bankFrames", 25))]
     out += ["", "![PSNR against darkening](psnr.png)" if plotNote is None else "Plot: " + plotNote, ""]
