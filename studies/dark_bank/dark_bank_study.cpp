@@ -133,7 +133,7 @@ StackFigures figuresOf(const std::vector<Mat>& frames, const Mat& keep, const Ma
         s.columnPart += varianceOf(m) / cols;
     s.residuals.resize(static_cast<size_t>(n));
     std::vector<double> pooled;
-    double pixelSum = 0, pixelCount = 0, ordinarySum = 0, ordinaryCount = 0;
+    double pixelSum = 0, pixelCount = 0, ordinarySum = 0, ordinaryCount = 0, ordinarySquares = 0;
     double siteSum[4] = {0, 0, 0, 0}, siteSum2[4] = {0, 0, 0, 0}, siteOwn[4] = {0, 0, 0, 0},
            siteN[4] = {0, 0, 0, 0};
     int kept = 0;
@@ -174,12 +174,23 @@ StackFigures figuresOf(const std::vector<Mat>& frames, const Mat& keep, const Ma
             pixelCount += 1;
             if (ordinary.at<uchar>(r, c)) {
                 ordinarySum += ss / (n - 1);
+                ordinarySquares += (ss / (n - 1)) * (ss / (n - 1));
                 ordinaryCount += 1;
             }
         }
     s.pixelPart = pixelSum / pixelCount;
     s.ordinaryPixelPart = ordinarySum / ordinaryCount;
-    s.kurtosis = excessKurtosis(pooled) / residualKurtosisFactor(n);
+    /* Residuals about each pixel's own mean of n frames mix in 1/n of the others, which scales the fourth
+     * cumulants by residualKurtosisFactor(n), but not the part of a pooled kurtosis that comes from pixels of
+     * different variances, 3 (E[sigma^4] / E[sigma^2]^2 - 1): a bank's draws carry it (each pixel's M frames
+     * have their own spread). Dividing it by the factor too put the bank's kurtosis 0.04 high. Each pixel's
+     * sample variance over n frames scatters by kappa / n + 2 / (n - 1) of its square, which comes out of
+     * E[sigma^4]. */
+    const double factor = residualKurtosisFactor(n), raw = excessKurtosis(pooled);
+    const double meanVariance = ordinarySum / ordinaryCount,
+                 meanSquare = ordinarySquares / ordinaryCount / (1 + raw / factor / n + 2.0 / (n - 1));
+    const double spread = std::max(0.0, 3 * (meanSquare / (meanVariance * meanVariance) - 1));
+    s.kurtosis = raw / factor - spread * (1 / factor - 1);
     for (int site = 0; site < 4; ++site) {
         const double m = siteN[site];
         s.fpnVariance +=
@@ -375,14 +386,15 @@ DarkBankStudy runDarkBankStudy(const DarkBankStudySettings& st)
                             std::sqrt(std::max(0.0, t.fpnVariance)));
             d.hot.push_back(std::sqrt(hotError));
             d.kurtosis.push_back(f.kurtosis - t.kurtosis);
-            // The mixture's kurtosis: fourth cumulants add, k^4 of the input's, the added part's (the bank's
-            // draws, a frame less its group's mean: measured on them; IGNORE's whole frames: the target's),
-            // less the output's rounding (a uniform 1/12 DN^2, excess kurtosis -1.2).
+            // The mixture's kurtosis over the pixels it pools: fourth cumulants add, k^4 of the input's, the
+            // added part's, less the output's rounding (a uniform 1/12 DN^2, excess kurtosis -1.2). The added
+            // part of a pixel, accounted or whole frames, is drawn with replacement from its M frames (less
+            // their mean, which a pixel's own mean over the outputs takes out): its shape is that finite
+            // population's, measured on the frames themselves, not the sensor's.
             if (m < 2) {
                 const double vin = k * k * in.ordinaryPixelPart, added = f.ordinaryPixelPart - vin - 1.0 / 12;
-                const double kappaAdded = m == 0 ? kappaDraws : t.kurtosis;
-                const double expected = (vin * vin * in.kurtosis + added * added * kappaAdded - 1.2 / 144) /
-                                        (f.pixelPart * f.pixelPart);
+                const double expected = (vin * vin * in.kurtosis + added * added * kappaDraws - 1.2 / 144) /
+                                        (f.ordinaryPixelPart * f.ordinaryPixelPart);
                 d.expected.push_back(f.kurtosis - expected);
             }
             const auto ks = ksAgainstTarget(f, t, st.bootstrap, seed * 10 + static_cast<uint64>(m));

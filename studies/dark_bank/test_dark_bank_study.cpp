@@ -26,10 +26,12 @@ double combined(double a, double b)
  *   simulated 1 DN^2: the bank's parts are rows and pixels, so the columns the input holds are not taken out;
  * - it is at least as close as the calibrated components on the row and pixel parts, and closer where the
  *   sensor departs from them: the column part (the components have no columns), the hot pixels (a shading
- * line per pixel) and the fixed pattern (the components' maps hold their frames' v/M). The kurtosis and the
- * KS test are reported, not held (docs/dark_frame_bank.md: the draws' differences halve a frame's excess
- * kurtosis). 28 s on host H3; the library code it runs is under the sanitizers in test_dark_frames.cpp, so
- * this runs in the Release build only. */
+ * line per pixel) and the fixed pattern (the components' maps hold their frames' v/M);
+ * - its kurtosis is its mixture's (the input's k^4 share and the frames' own population, drawn with
+ *   replacement, with the output's rounding): +0.039 +- 0.031 measured. Against the targets it is 0.92 of a
+ *   frame's by design (a frame less its group's mean), which docs/dark_frame_bank.md reports; the KS test is
+ *   reported too, not held (its bootstrap is off here). 16 s on host H3; the library code it runs is under
+ *   the sanitizers in test_dark_frames.cpp, so this runs in the Release build only. */
 TEST(DarkBankStudy, theAccountedBankMatchesIndependentCapturesAndBeatsTheComponentsWhereTheSensorDeparts)
 {
     rawgment_studies::DarkBankStudySettings settings;
@@ -45,6 +47,7 @@ TEST(DarkBankStudy, theAccountedBankMatchesIndependentCapturesAndBeatsTheCompone
     EXPECT_LT(std::abs(bank.pixelPart - 1.0 / 12), 3 * bank.pixelPartSe);
     EXPECT_LT(std::abs(bank.fpnRms), 3 * bank.fpnRmsSe);
     EXPECT_LT(bank.hotError, 0.01);
+    EXPECT_LT(std::abs(bank.expectedKurtosis), 3 * bank.expectedKurtosisSe);
     const double inputColumns = settings.contrast * settings.contrast * 1.0;
     EXPECT_LT(std::abs(bank.columnPart - inputColumns), 3 * bank.columnPartSe);
     EXPECT_LE(std::abs(bank.rowPart),
