@@ -533,8 +533,8 @@ namespace {
 /* --dark_bank: a bank of the dark bursts' files, each file's gain from its own ISO (through the calibrated
  * model's base ISO) or sidecar, as augmentation reads an input's gain; a burst whose manifest gain disagrees
  * with its files' is refused, as the bank would file its frames under another gain. */
-void writeDarkFrameBank(const CalibrateOptions& o, const std::vector<CalibrationManifest::Burst>& specs,
-                        const BurstGains& gains, CalibrateResult& result)
+std::vector<cv::String> darkBankFiles(const CalibrateOptions& o,
+                                      const std::vector<CalibrationManifest::Burst>& specs)
 {
     if (pathExists(o.darkBank))
         throw std::runtime_error("'" + o.darkBank + "' exists: the dark-frame bank is never written over");
@@ -545,6 +545,13 @@ void writeDarkFrameBank(const CalibrateOptions& o, const std::vector<Calibration
     if (files.empty())
         throw std::runtime_error(
             "--dark_bank needs dark bursts (dark: true in the manifest, or folders named dark*)");
+    return files;
+}
+
+void writeDarkFrameBank(const CalibrateOptions& o, const std::vector<CalibrationManifest::Burst>& specs,
+                        const BurstGains& gains, CalibrateResult& result)
+{
+    const std::vector<cv::String> files = darkBankFiles(o, specs);
     const auto start = std::chrono::steady_clock::now();
     result.bank = DarkFrameBank::create(files, result.report.model);
     for (size_t i = 0; i < specs.size(); ++i) {
@@ -571,6 +578,9 @@ void writeDarkFrameBank(const CalibrateOptions& o, const std::vector<Calibration
 CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
 {
     const CalibrationManifest manifest = readCalibrationManifest(o.manifest);
+    // A bank that cannot be written is refused before the calibration, not after it.
+    if (!o.darkBank.empty())
+        darkBankFiles(o, manifest.bursts);
     prepareOutputDirectory(o.outDir);
     const std::string reportPath = o.outDir + "/calibration_report.yml",
                       samplesCsv = o.outDir + "/samples.csv", linesCsv = o.outDir + "/lines.csv",
