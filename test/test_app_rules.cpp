@@ -154,6 +154,43 @@ TEST(Apps, unusableValuesAreRefusedAndFailedRunsLeaveNoEmptyFolder)
     EXPECT_NE(std::string::npos, r.output.find("is not a file")) << r.output;
 }
 
+std::string shellQuoted(const std::string& text)
+{
+    std::string quoted = "'";
+    for (const char c : text)
+        quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return quoted + "'";
+}
+
+TEST(Apps, aPlotsPathIsDataToGnuplotNeverAProgram)
+{
+    // An --out folder named to end gnuplot's quoted string and call system() ran the command: each
+    // plot's data path went between single quotes unescaped. Every character gnuplot could act on is
+    // in this one name: both quotes, backquotes, $(), a backslash, '@' (a macro), a newline and UTF-8.
+    const std::string dir = freshDir("hostile_plot_paths");
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir +
+                                               "/sim' --frames=4 --gains=6,18 --levels=0.5 "
+                                               "--format=png --validation=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string hostile = "x'.system('touch PWNED1').'\" `touch PWNED2` $(touch PWNED3) \\ @x "
+                                "\xc3\xa9\nline";
+    const std::string out = dir + "/" + hostile;
+    for (const char* name : {"PWNED1", "PWNED2", "PWNED3"})
+        std::remove(name);
+    r = runApp("rawgment_calibrate", shellQuoted(dir + "/sim/manifest.yml") + " --out=" + shellQuoted(out));
+    ASSERT_EQ(0, r.status) << r.output;
+    for (const char* name : {"PWNED1", "PWNED2", "PWNED3"}) {
+        EXPECT_FALSE(exists(name)) << name;
+        EXPECT_FALSE(exists(dir + "/" + name)) << name;
+    }
+    for (const char* png : {"calib_mean_variance.png", "calib_histograms.png", "calib_cross_gain.png"})
+        expectPngDecodes(out + "/" + png);
+    // The saved script names its files by the same escapes, so that a user can run it as it is.
+    const std::string script = readText(out + "/calib_mean_variance.png.gp");
+    EXPECT_EQ(std::string::npos, script.find("PWNED1')")) << script;
+    EXPECT_NE(std::string::npos, script.find("\\047")) << script;
+}
+
 TEST(Apps, aRunRemovesTheTemporariesThatKilledRunsLeft)
 {
     const std::string dir = freshDir("interrupts");

@@ -5,15 +5,18 @@
 #include <opencv2/rawgment/raw_io.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <spawn.h>
 #include <sstream>
 #include <stdexcept>
 #include <sys/stat.h>
@@ -44,6 +47,10 @@ void installInterruptCleanup()
     for (int signal : {SIGINT, SIGTERM, SIGHUP})
         if (::sigaction(signal, &action, nullptr) != 0)
             std::cerr << "warning: cannot install the cleanup on signal " << signal << "\n";
+    // A file-size limit (ulimit -f) killed the run with SIGXFSZ, no message and a temporary left; ignored,
+    // write() fails with EFBIG instead, which the atomic writer reports naming the file, as a full disk.
+    if (::signal(SIGXFSZ, SIG_IGN) == SIG_ERR)
+        std::cerr << "warning: cannot ignore SIGXFSZ\n";
 }
 
 uint64_t parseSeed(const std::string& text)
@@ -245,6 +252,59 @@ bool gnuplotAvailable()
     return std::system("gnuplot --version > /dev/null 2>&1") == 0;
 }
 
+namespace {
+
+/** gnuplot on one script, its standard output collected: started without a shell (posix_spawnp with
+ * the script as its one argument), so no byte of a path is ever read as a command. Returns gnuplot's
+ * exit status, or -1 when it could not be started. */
+int runGnuplot(const std::string& script, std::vector<char>& out)
+{
+    int fds[2];
+    if (::pipe2(fds, O_CLOEXEC) != 0)
+        return -1;
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, fds[1], STDOUT_FILENO);
+    std::string program = "gnuplot", argument = script;
+    char* argv[] = {program.data(), argument.data(), nullptr};
+    pid_t pid = -1;
+    const int spawned = ::posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(fds[1]);
+    if (spawned != 0) {
+        ::close(fds[0]);
+        return -1;
+    }
+    char buf[65536];
+    for (;;) {
+        const ssize_t n = ::read(fds[0], buf, sizeof buf);
+        if (n > 0)
+            out.insert(out.end(), buf, buf + n);
+        else if (n == 0 || errno != EINTR)
+            break;
+    }
+    ::close(fds[0]);
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR)
+            return -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+} // namespace
+
+std::string gnuplotString(const std::string& text)
+{
+    std::string literal = "\"";
+    for (const unsigned char c : text) {
+        if (std::isalnum(c) || c == '.' || c == '_' || c == '/' || c == '-')
+            literal += static_cast<char>(c);
+        else
+            literal += cv::format("\\%03o", c);
+    }
+    return literal + "\"";
+}
+
 bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, std::string& message,
                      int width, int height)
 {
@@ -255,8 +315,8 @@ bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, 
                                  "set datafile separator ','\n";
     // The saved script writes the PNG itself, so that a user can re-run it as it is; the run writes
     // to standard output, and the PNG reaches its name through the one atomic writer.
-    writeTextAtomically(scriptPath,
-                        preamble + "set output '" + pngPath + "'\n" + scriptBody + "\nunset output\n");
+    writeTextAtomically(scriptPath, preamble + "set output " + gnuplotString(pngPath) + "\n" + scriptBody +
+                                        "\nunset output\n");
     if (!gnuplotAvailable()) {
         message =
             "gnuplot is not installed (apt-get install gnuplot-nox); plot with: gnuplot '" + scriptPath + "'";
@@ -275,16 +335,8 @@ bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, 
         runScript = scriptPath + "." + std::to_string(::getpid()) + ".run";
         writeTextAtomically(runScript, runBody);
     }
-    const std::string command = "gnuplot '" + runScript + "'";
-    FILE* pipe = ::popen(command.c_str(), "r");
     std::vector<char> png;
-    if (pipe) {
-        char buf[65536];
-        size_t n;
-        while ((n = std::fread(buf, 1, sizeof buf, pipe)) > 0)
-            png.insert(png.end(), buf, buf + n);
-    }
-    const int status = pipe ? ::pclose(pipe) : -1;
+    const int status = runGnuplot(runScript, png);
     if (memfd >= 0)
         ::close(memfd);
     if (runScript.compare(0, 8, "/dev/fd/") != 0)

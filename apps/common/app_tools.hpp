@@ -103,6 +103,12 @@ bool plotWithGnuplot(const std::string& pngPath, const std::string& scriptBody, 
 //! Whether gnuplot can be run.
 bool gnuplotAvailable();
 
+/** A gnuplot string literal holding `text` exactly, for every path or name a script mentions. Scripts
+ * never splice a user's string between quotes: gnuplot runs backquoted commands inside double quotes and
+ * a quote in a path would end a single-quoted string, so every byte but letters, digits and `._/-` is
+ * written as an octal escape, and the literal holds no character gnuplot could act on. */
+std::string gnuplotString(const std::string& text);
+
 } // namespace rawgment_apps
 
 #endif // RAWGMENT_APPS_APP_TOOLS_HPP

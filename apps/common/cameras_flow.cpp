@@ -326,16 +326,15 @@ PlotsWritten plotReport(const std::string& dir)
     PlotsWritten out;
     std::string message;
     const std::string slope = dir + "/real_cameras_slope.png";
-    if (plotWithGnuplot(
-            slope,
-            "set logscale x\nset key off\n"
-            "set title 'Measured shot slope over the fitted g alpha, every ISO of every imported "
-            "camera'\nset xlabel 'ISO'\nset ylabel 'slope / (g alpha)'\nset yrange [0:2.5]\n"
-            "set grid\nplot '" +
-                dir +
-                "/iso_points.csv' every ::1 using 1:2 with points pt 7 ps 0.4 lc rgb '#3060a0', 1 "
-                "with lines lw 2 lc rgb 'black'\n",
-            message))
+    if (plotWithGnuplot(slope,
+                        "set logscale x\nset key off\n"
+                        "set title 'Measured shot slope over the fitted g alpha, every ISO of every imported "
+                        "camera'\nset xlabel 'ISO'\nset ylabel 'slope / (g alpha)'\nset yrange [0:2.5]\n"
+                        "set grid\nplot " +
+                            gnuplotString(dir + "/iso_points.csv") +
+                            " every ::1 using 1:2 with points pt 7 ps 0.4 lc rgb '#3060a0', 1 "
+                            "with lines lw 2 lc rgb 'black'\n",
+                        message))
         out.pngs.push_back(slope);
     else
         out.notes.push_back(message);
@@ -345,14 +344,14 @@ PlotsWritten plotReport(const std::string& dir)
             "set multiplot layout 1,2\nset key off\nset grid\n"
             "set logscale x\nset title 'Full well and read noise at base ISO (imported cameras)'\n"
             "set xlabel 'full well 1/alpha (e-)'\nset ylabel 'read noise (e-)'\nset logscale y\n"
-            "plot '" +
-                dir +
-                "/cameras.csv' every ::1 using 8:9 with points pt 7 ps 0.6 lc rgb '#a03030'\n"
+            "plot " +
+                gnuplotString(dir + "/cameras.csv") +
+                " every ::1 using 8:9 with points pt 7 ps 0.6 lc rgb '#a03030'\n"
                 "unset logscale\nset title 'Share of read variance before the gain, base ISO'\n"
                 "set xlabel 'share'\nset ylabel 'cameras'\nset xrange [0:1]\nset boxwidth 0.05\n"
-                "set style fill solid 0.6\nbin(x) = 0.05 * floor(x / 0.05) + 0.025\nplot '" +
-                dir +
-                "/cameras.csv' every ::1 using (bin($11)):(1) smooth frequency with boxes lc rgb "
+                "set style fill solid 0.6\nbin(x) = 0.05 * floor(x / 0.05) + 0.025\nplot " +
+                gnuplotString(dir + "/cameras.csv") +
+                " every ::1 using (bin($11)):(1) smooth frequency with boxes lc rgb "
                 "'#30a060'\nunset multiplot\n",
             message, 1400, 600))
         out.pngs.push_back(params);

@@ -47,9 +47,9 @@ PlotsWritten plotCalibration(const std::string& outDir, const CalibrationReport&
         const NoiseLineFit& l = report.perGain[i];
         const double gDb = linearGainToDb(l.gain);
         const std::string colour = kSeriesColours[i % 7];
-        s += cv::format("'%s' every ::1 using ($3 > %.6f && $3 < %.6f ? $1 : 1/0):2 with points pt 7 ps 0.25 "
+        s += cv::format("%s every ::1 using ($3 > %.6f && $3 < %.6f ? $1 : 1/0):2 with points pt 7 ps 0.25 "
                         "lc rgb '%s' title '%.1f dB samples', ",
-                        files.samplesCsv.c_str(), gDb - 0.01, gDb + 0.01, colour.c_str(), gDb);
+                        gnuplotString(files.samplesCsv).c_str(), gDb - 0.01, gDb + 0.01, colour.c_str(), gDb);
         s += cv::format(
             "%.10g*x + %.10g with lines lw 2 lc rgb '%s' dt 2 title 'line fit: %.4f {/Symbol m} + %.3f "
             "(R^2 %.4f)', ",
@@ -66,8 +66,9 @@ PlotsWritten plotCalibration(const std::string& outDir, const CalibrationReport&
     s = "set title 'Sample variance over fitted variance, per gain (ideal: centred on 1)'\n";
     s += "set xlabel 'variance / fitted variance'\nset ylabel 'samples'\nset key right top\nset grid\nplot ";
     for (size_t i = 0; i < histogramSeries; ++i)
-        s += cv::format("%s'%s' every ::1 using 1:%zu with steps lw 2 lc rgb '%s' title columnhead(%zu)",
-                        i ? ", " : "", files.histogramCsv.c_str(), i + 2, kSeriesColours[i % 7], i + 2);
+        s += cv::format("%s%s every ::1 using 1:%zu with steps lw 2 lc rgb '%s' title columnhead(%zu)",
+                        i ? ", " : "", gnuplotString(files.histogramCsv).c_str(), i + 2,
+                        kSeriesColours[i % 7], i + 2);
     plotOrNote(outDir + "/calib_histograms.png", s, out);
 
     // A cross-gain fit needs two gains, a Shapiro-Wilk plot tested pixels (bursts of >= 3 frames).
@@ -82,16 +83,16 @@ PlotsWritten plotCalibration(const std::string& outDir, const CalibrationReport&
                         "set ylabel 'a_g (DN per DN)'\n",
                         report.rSquaredSlope);
         s += cv::format(
-            "plot '%s' every ::1 using 2:3 with points pt 7 ps 1.5 title 'per-gain fits', %.10g*x with lines "
+            "plot %s every ::1 using 2:3 with points pt 7 ps 1.5 title 'per-gain fits', %.10g*x with lines "
             "lw 2 title 'g {/Symbol a}'\n",
-            files.linesCsv.c_str(), model.alpha);
+            gnuplotString(files.linesCsv).c_str(), model.alpha);
         s += cv::format("set title 'offset b_g = g^2 {/Symbol s}_d^2 + {/Symbol s}_r^2   (R^2 %.4f)'\n"
                         "set xlabel 'g^2'\nset ylabel 'b_g (DN^2)'\n",
                         report.rSquaredOffset);
-        s += cv::format("plot '%s' every ::1 using ($2*$2):4 with points pt 7 ps 1.5 title 'per-gain fits', "
+        s += cv::format("plot %s every ::1 using ($2*$2):4 with points pt 7 ps 1.5 title 'per-gain fits', "
                         "%.10g*x + %.10g with lines lw 2 title 'g^2 {/Symbol s}_d^2 + {/Symbol "
                         "s}_r^2'\nunset multiplot\n",
-                        files.linesCsv.c_str(), model.sigmaD2, model.sigmaR2);
+                        gnuplotString(files.linesCsv).c_str(), model.sigmaD2, model.sigmaR2);
         plotOrNote(outDir + "/calib_cross_gain.png", s, out);
     }
     if (!haveShapiro)
@@ -104,10 +105,10 @@ PlotsWritten plotCalibration(const std::string& outDir, const CalibrationReport&
     s += "set key right bottom box opaque\nset grid\nplot ";
     for (size_t i = 0; i < gainsDb.size(); ++i)
         s += cv::format(
-            "'%s' every ::1 using ($1 > %.6f && $1 < %.6f ? $2 : 1/0):($3 < 1e-6 ? 1e-6 : $3) with points "
+            "%s every ::1 using ($1 > %.6f && $1 < %.6f ? $2 : 1/0):($3 < 1e-6 ? 1e-6 : $3) with points "
             "pt 7 ps 0.3 lc rgb '%s' title '%.1f dB', ",
-            files.shapiroCsv.c_str(), gainsDb[i] - 0.01, gainsDb[i] + 0.01, kSeriesColours[i % 7],
-            gainsDb[i]);
+            gnuplotString(files.shapiroCsv).c_str(), gainsDb[i] - 0.01, gainsDb[i] + 0.01,
+            kSeriesColours[i % 7], gainsDb[i]);
     s += "0.05 with lines lw 2 lc rgb 'black' dt 2 title 'p = 0.05'\n";
     plotOrNote(outDir + "/shapiro_pvalue.png", s, out);
     return out;
@@ -122,20 +123,21 @@ PlotsWritten plotDarkComponents(const std::string& outDir, const DarkCalibration
     rows += "set xlabel 'linear gain'\nset ylabel 'row variance (DN^2)'\nset logscale xy\nset grid\n";
     rows += "set key left top box opaque\nset datafile separator ','\n";
     rows += cv::format(
-        "plot '%s' every ::1 using 2:3:4 with yerrorbars pt 7 lc rgb '%s' title 'measured (+- 1 "
+        "plot %s every ::1 using 2:3:4 with yerrorbars pt 7 lc rgb '%s' title 'measured (+- 1 "
         "standard error)', x*x*%.10g + %.10g with lines lw 2 lc rgb '%s' title 'fit: g^2 %.4g + %.4g'\n",
-        rowsCsv.c_str(), kSeriesColours[0], m.rowSigmaD2, m.rowSigmaR2, kSeriesColours[1], m.rowSigmaD2,
-        m.rowSigmaR2);
+        gnuplotString(rowsCsv).c_str(), kSeriesColours[0], m.rowSigmaD2, m.rowSigmaR2, kSeriesColours[1],
+        m.rowSigmaD2, m.rowSigmaR2);
     plotOrNote(outDir + "/dark_rows.png", rows, out);
     std::string ppcc = "set title 'Read-noise shape: probability-plot correlation against Tukey lambda'\n";
     ppcc += "set xlabel 'lambda (0.14: Gaussian, smaller: heavier tails)'\nset ylabel 'PPCC'\nset grid\n";
     ppcc += "set datafile separator ','\nset key left bottom box opaque\n";
     ppcc += cv::format("set arrow from %.6g, graph 0 to %.6g, graph 1 nohead dt 2 lc rgb '%s'\n",
                        dark.lambdaOfResiduals, dark.lambdaOfResiduals, kSeriesColours[1]);
-    ppcc += cv::format(
-        "plot '%s' every ::1 using 1:2 with linespoints pt 7 ps 0.5 lc rgb '%s' title "
-        "'residuals (best %.3f; Gaussian plot %.5f); model lambda %.3f after the correction'\n",
-        ppccCsv.c_str(), kSeriesColours[0], dark.lambdaOfResiduals, dark.ppccGaussian, m.tukeyLambda);
+    ppcc +=
+        cv::format("plot %s every ::1 using 1:2 with linespoints pt 7 ps 0.5 lc rgb '%s' title "
+                   "'residuals (best %.3f; Gaussian plot %.5f); model lambda %.3f after the correction'\n",
+                   gnuplotString(ppccCsv).c_str(), kSeriesColours[0], dark.lambdaOfResiduals,
+                   dark.ppccGaussian, m.tukeyLambda);
     plotOrNote(outDir + "/dark_ppcc.png", ppcc, out);
     if (!m.hasDarkShading())
         return out;
@@ -188,9 +190,9 @@ PlotsWritten plotValidation(const std::string& outDir, const std::string& csvPat
         s += cv::format("set title 'x%.2f exposure'\nset xrange [0:%.6g]\nset yrange [0:*]\n", f,
                         panels[i].largestMean * 1.05);
         s += cv::format(
-            "plot '%s' every ::1 using %s:6 with points pt 7 ps 1.6 lc rgb 'black' title 'real darker "
+            "plot %s every ::1 using %s:6 with points pt 7 ps 1.6 lc rgb 'black' title 'real darker "
             "burst', ",
-            csvPath.c_str(), sel.c_str());
+            gnuplotString(csvPath).c_str(), sel.c_str());
         s += cv::format(
             "'' every ::1 using %s:9 with linespoints lw 2 pt 5 lc rgb '#2ca02c' title 'ACCOUNT\\_PRIOR "
             "(ours)', ",
