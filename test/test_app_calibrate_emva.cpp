@@ -113,6 +113,27 @@ TEST(Apps, calibrateEmvaSeparatesTheReadNoiseOfAManifestOfGainsAndRefusesBadInpu
     bad = runApp("rawgment_calibrate", "--emva='" + dir + "/typo.yml' --out='" + dir + "/bad3'");
     EXPECT_EQ(2, bad.status) << bad.output;
     EXPECT_NE(bad.output.find("gain_bd"), std::string::npos) << bad.output;
+    // A boolean is not a number (gain_db: true calibrated at 1 dB), in YAML or JSON.
+    std::ofstream(dir + "/boolean.json") << "{\"emva1288_manifest\": {\"series\": [{\"descriptor\": "
+                                            "\"g0/EMVA1288_Data.txt\", \"gain_db\": true}]}}";
+    bad = runApp("rawgment_calibrate", "--emva='" + dir + "/boolean.json' --out='" + dir + "/bad4'");
+    EXPECT_EQ(2, bad.status) << bad.output;
+    EXPECT_NE(bad.output.find("'gain_db' is not a finite number"), std::string::npos) << bad.output;
+    std::ofstream(dir + "/boolean_iso.yml") << "emva1288_manifest:\n  base_iso: true\n  series:\n    - { "
+                                               "descriptor: g0/EMVA1288_Data.txt, iso: 100 }\n";
+    bad = runApp("rawgment_calibrate", "--emva='" + dir + "/boolean_iso.yml' --out='" + dir + "/bad5'");
+    EXPECT_EQ(2, bad.status) << bad.output;
+    EXPECT_NE(bad.output.find("'base_iso' is not a finite number"), std::string::npos) << bad.output;
+    // One descriptor twice under two spellings shrank alpha's stated error (0.0011 to 0.0008).
+    std::ofstream(dir + "/twice.yml") << "emva1288_manifest:\n  series:\n"
+                                         "    - { descriptor: g0/EMVA1288_Data.txt, gain_db: 0 }\n"
+                                         "    - { descriptor: g0/./EMVA1288_Data.txt, gain_db: 6 }\n";
+    bad = runApp("rawgment_calibrate", "--emva='" + dir + "/twice.yml' --out='" + dir + "/bad6'");
+    EXPECT_EQ(2, bad.status) << bad.output;
+    EXPECT_NE(bad.output.find("series: entries 1 ('" + dir + "/g0/EMVA1288_Data.txt') and 2"),
+              std::string::npos)
+        << bad.output;
+    EXPECT_NE(bad.output.find("are one file"), std::string::npos) << bad.output;
     EXPECT_FALSE(exists(dir + "/bad1")) << "a failed run leaves no empty folder";
 }
 

@@ -97,9 +97,12 @@ CalibrationManifest readCalibrationManifest(const std::string& path)
                 throw std::runtime_error(where + ": 'gain_db' is not finite");
         }
         if (!b["dark"].empty()) {
-            // The module's reader reads YAML's and JSON's true and false as 1 and 0, as OpenCV writes them.
+            // The module's reader hands YAML's and JSON's booleans over as "true" and "false", which no
+            // number reader takes; 1 and 0 are how OpenCV writes a bool.
             const cv::FileNode dark = b["dark"];
-            if (dark.isInt() && (int(dark) == 0 || int(dark) == 1))
+            if (dark.isString() && (dark.string() == "true" || dark.string() == "false"))
+                burst.dark = dark.string() == "true";
+            else if (dark.isInt() && (int(dark) == 0 || int(dark) == 1))
                 burst.dark = int(dark) == 1;
             else
                 throw std::runtime_error(where + ": 'dark' must be true or false");

@@ -75,6 +75,14 @@ std::vector<Emva1288Input> readManifest(const std::string& path)
         }
         inputs.push_back(in);
     }
+    std::vector<cv::String> descriptors;
+    for (const Emva1288Input& in : inputs)
+        descriptors.push_back(in.descriptor);
+    try {
+        refuseRepeatedFiles(descriptors, "'" + path + "' series");
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error(e.err);
+    }
     return inputs;
 }
 
@@ -117,13 +125,13 @@ PlotsWritten plotSeries(const std::string& outDir, const std::string& pointsCsv,
     s += "set xlabel 'mean signal above dark (DN)'\nset ylabel 'variance above dark (DN^2)'\nset grid\n";
     s += "set key left top box opaque\n";
     s += cv::format(
-        "plot '%s' every ::1 using ($1 == 0 ? $3-$6 : 1/0):($4-$7) with points pt 7 ps 0.8 lc rgb '#1f77b4' "
+        "plot %s every ::1 using ($1 == 0 ? $3-$6 : 1/0):($4-$7) with points pt 7 ps 0.8 lc rgb '#1f77b4' "
         "title "
         "'steps', (x <= %.6g ? %.10g*x : 1/0) with lines lw 2 lc rgb '#d62728' title 'standard: K %.5f "
         "(fitted to 70%% of saturation)', (x <= %.6g ? %.10g*x : 1/0) with lines lw 2 dt 2 lc rgb "
         "'#2ca02c' title 'model: %.5f (fitted to %.0f%%)'\n",
-        pointsCsv.c_str(), fitEnd, r.K, r.K, params.maxSignalFraction * saturated, line.line.a, line.line.a,
-        100 * params.maxSignalFraction);
+        gnuplotString(pointsCsv).c_str(), fitEnd, r.K, r.K, params.maxSignalFraction * saturated, line.line.a,
+        line.line.a, 100 * params.maxSignalFraction);
     std::string message;
     const auto plot = [&](const std::string& png, const std::string& script) {
         // A plot an interrupted run of the same job already made is kept, never drawn over.
@@ -137,19 +145,20 @@ PlotsWritten plotSeries(const std::string& outDir, const std::string& pointsCsv,
         s = "set title 'SNR against photons per pixel (first series)'\nset logscale xy\nset grid\n";
         s += "set xlabel 'photons per pixel'\nset ylabel 'SNR'\nset key left top box opaque\n";
         s += cv::format(
-            "plot '%s' every ::1 using ($1 == 0 ? $2 : 1/0):(($3-$6)/sqrt($4)) with points pt 7 ps 0.8 lc "
+            "plot %s every ::1 using ($1 == 0 ? $2 : 1/0):(($3-$6)/sqrt($4)) with points pt 7 ps 0.8 lc "
             "rgb '#1f77b4' "
             "title 'measured', sqrt(%.10g*x) with lines lw 2 lc rgb '#2ca02c' title 'ideal sensor (eta "
             "%.1f%%)', %.10g*x/sqrt(%.10g*x + %.10g) with lines lw 2 dt 2 lc rgb '#d62728' title "
             "'model'\n",
-            pointsCsv.c_str(), r.eta / 100, r.eta, r.responsivity, line.line.a * r.responsivity, line.line.b);
+            gnuplotString(pointsCsv).c_str(), r.eta / 100, r.eta, r.responsivity,
+            line.line.a * r.responsivity, line.line.b);
         plot(outDir + "/emva_snr.png", s);
         s = "set title 'Linearity: deviation from the standard''s fit (first series)'\nset grid\n";
         s += "set xlabel 'photons per pixel'\nset ylabel 'deviation (%)'\nset key left top box opaque\n";
-        s += cv::format("plot '%s' every ::1 using ($1 == 0 ? $2 : 1/0):9 with linespoints pt 7 lc rgb "
+        s += cv::format("plot %s every ::1 using ($1 == 0 ? $2 : 1/0):9 with linespoints pt 7 lc rgb "
                         "'#1f77b4' title 'deviation "
                         "(fit range %.0f%% to %.0f%% of saturation: 5%% to 95%%)'\n",
-                        pointsCsv.c_str(), 5.0, 95.0);
+                        gnuplotString(pointsCsv).c_str(), 5.0, 95.0);
         plot(outDir + "/emva_linearity.png", s);
     }
     if (!validationCsv.empty()) {
@@ -161,19 +170,19 @@ PlotsWritten plotSeries(const std::string& outDir, const std::string& pointsCsv,
         s += "plot ";
         for (int a = 0; a < 3; ++a)
             s += cv::format(
-                "'%s' every ::1 using ($3 == %d ? $1 + %.2f : 1/0):6:7 with yerrorbars pt 7 lc rgb '%s' "
+                "%s every ::1 using ($3 == %d ? $1 + %.2f : 1/0):6:7 with yerrorbars pt 7 lc rgb '%s' "
                 "title '%s', ",
-                validationCsv.c_str(), a + 1, 0.12 * (a - 1), kColours[a], names[a]);
+                gnuplotString(validationCsv).c_str(), a + 1, 0.12 * (a - 1), kColours[a], names[a]);
         s += "1 with lines lc rgb 'black' title 'the real darker pair'\n";
         plot(outDir + "/emva_validation.png", s);
         s = "set title 'Pixel differences (A - B) / sqrt 2 of the darker pair: real and augmented'\nset "
             "grid\n";
         s += "set xlabel 'DN'\nset ylabel 'fraction of pixels'\nset key left top box opaque\nplot ";
-        s += cv::format("'%s' every ::1 using 1:2 with steps lw 3 lc rgb 'black' title 'real darker pair', ",
-                        histogramCsv.c_str());
+        s += cv::format("%s every ::1 using 1:2 with steps lw 3 lc rgb 'black' title 'real darker pair', ",
+                        gnuplotString(histogramCsv).c_str());
         for (int a = 0; a < 3; ++a)
-            s += cv::format("%s'%s' every ::1 using 1:%d with steps lw 2 lc rgb '%s' title '%s'",
-                            a ? ", " : "", histogramCsv.c_str(), a + 3, kColours[a], names[a]);
+            s += cv::format("%s%s every ::1 using 1:%d with steps lw 2 lc rgb '%s' title '%s'", a ? ", " : "",
+                            gnuplotString(histogramCsv).c_str(), a + 3, kColours[a], names[a]);
         plot(outDir + "/emva_validation_histograms.png", s + "\n");
     }
     return out;

@@ -151,10 +151,11 @@ NoiseOptions NoiseOptions::readFields(const FileNode& map)
                      "noise options: 'dark_bank' must be the path of a dark-frame bank file");
         o.darkBank = bank.string();
     }
-    const int tied = field("dark_bank_tied", 0);
-    if (tied != 0 && tied != 1)
-        CV_Error(Error::StsParseError, "noise options: 'dark_bank_tied' must be 0 or 1");
-    o.darkBankTied = tied == 1;
+    try {
+        o.darkBankTied = detail::readOptionalFlagField(map, "dark_bank_tied", false);
+    } catch (const Exception& e) {
+        CV_Error(e.code, "noise options: " + e.err);
+    }
     o.validate();
     return o;
 }

@@ -167,7 +167,9 @@ CalibrationReport CalibrationReport::read(const FileNode& node)
     if (!method.isString() || (method.string() != "joint" && method.string() != "two_stage"))
         CV_Error(Error::StsParseError, "calibration report: field 'method' must be 'joint' or 'two_stage'");
     r.method = method.string() == "joint" ? NOISE_FIT_JOINT : NOISE_FIT_TWO_STAGE;
-    r.separable = detail::readRealField(node, "separable") != 0;
+    if (node["separable"].empty())
+        CV_Error(Error::StsParseError, "field 'separable' is missing");
+    r.separable = detail::readOptionalFlagField(node, "separable", false);
     r.model = NoiseModel::read(node["noise_model"]);
     r.rSquaredSlope = detail::readRealField(node, "r_squared_slope");
     r.rSquaredOffset = detail::readRealField(node, "r_squared_offset");

@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // The verdict of a calibration (judgeCalibration()): each check a measured figure against a stated
 // threshold. Where each threshold comes from is in docs/calibrate_your_camera.md.
+#include "calibration_lines.hpp"
 #include "opencv2/rawgment/calibration.hpp"
 #include "precomp.hpp"
 
@@ -44,56 +45,19 @@ VerdictCheck check(const std::string& name, bool pass, const std::string& figure
     return {name, pass, figure};
 }
 
-/* Whether each gain's fitted slope a_g = g alpha agrees with the gain its files' ISO (or the manifest's
- * gain_db) gives: a burst shot at another gain than its tag says (a camera that switches its analog gain at
- * other ISOs than it reports) moves its whole line, and the residual check then blames whichever bin of
- * whichever gain deviates most. alpha is taken as the median of a_g / g over the gains, so that one wrong
- * gain of three or more does not move it; a gain disagrees when a_g / (g alpha) is off by more than 5%
- * beyond 4 of its standard errors. With two gains the two can only disagree with each other. */
 VerdictCheck gainsAgreeWithSlopes(const CalibrationReport& report,
                                   const std::vector<CalibrationBurstFacts>& bursts)
 {
-    const char* name = "gain of each burst against its slope";
-    std::vector<double> perGainAlpha;
-    for (const NoiseLineFit& f : report.perGain)
-        if (f.line.a > 0)
-            perGainAlpha.push_back(f.line.a / f.gain);
-    if (perGainAlpha.size() < 2)
-        return check(name, true, "one gain with a positive slope: nothing to compare");
-    const double alpha = median(perGainAlpha);
-    const auto burstsAt = [&](double gain) {
-        std::string names;
-        for (const CalibrationBurstFacts& b : bursts)
-            if (!b.dark && std::abs(b.gainDb - linearGainToDb(gain)) < 0.01)
-                names += (names.empty() ? "" : ", ") + b.name;
-        return names.empty() ? std::string("no burst") : names;
-    };
-    std::string wrong;
-    double worst = 1; // the ratio furthest from 1 so far
-    for (const NoiseLineFit& f : report.perGain) {
-        if (!(f.line.a > 0))
-            continue;
-        const double ratio = f.line.a / (f.gain * alpha), se = f.slopeStdError / (f.gain * alpha);
-        if (std::abs(ratio - 1) - 4 * se > kMaxGainDeviation && std::abs(ratio - 1) > std::abs(worst - 1)) {
-            worst = ratio;
-            wrong = format("%.2f dB (%s): its slope says gain %.3g (%.2f dB), %.3f times the gain its ISO "
-                           "or gain_db gives",
-                           linearGainToDb(f.gain), burstsAt(f.gain).c_str(), f.gain * ratio,
-                           linearGainToDb(f.gain * ratio), ratio);
-        }
-    }
-    if (wrong.empty())
-        return check(name, true,
-                     format("every gain's slope within %.0f%% (+4 standard errors) of g alpha, alpha the "
-                            "median over %zu gains",
-                            100 * kMaxGainDeviation, perGainAlpha.size()));
-    return check(name, false,
-                 wrong + format("; threshold %.0f%% beyond 4 standard errors%s", 100 * kMaxGainDeviation,
-                                perGainAlpha.size() == 2
-                                    ? ": with two gains either may be the wrong one; check both ISOs, or "
-                                      "add a third gain"
-                                    : ": that burst was not shot at the gain its ISO says; give it a gain_db "
-                                      "or leave it out"));
+    return detail::slopesAgreeWithGains(
+        report,
+        [&](double gain) {
+            std::string names;
+            for (const CalibrationBurstFacts& b : bursts)
+                if (!b.dark && std::abs(b.gainDb - linearGainToDb(gain)) < 0.01)
+                    names += (names.empty() ? "" : ", ") + b.name;
+            return names.empty() ? std::string("no burst") : names;
+        },
+        "burst");
 }
 
 } // namespace
@@ -309,6 +273,59 @@ std::vector<VerdictCheck> perGainChecks(const std::vector<NoiseSample>& samples,
 }
 
 } // namespace
+
+namespace detail {
+
+/* Whether each gain's fitted slope a_g = g alpha agrees with the gain its files' ISO (or the manifest's
+ * gain_db) gives: a burst shot at another gain than its tag says (a camera that switches its analog gain at
+ * other ISOs than it reports) moves its whole line, and the residual check then blames whichever bin of
+ * whichever gain deviates most. alpha is taken as the median of a_g / g over the gains, so that one wrong
+ * gain of three or more does not move it; a gain disagrees when a_g / (g alpha) is off by more than 5%
+ * beyond 4 of its standard errors. With two gains the two can only disagree with each other. */
+VerdictCheck slopesAgreeWithGains(const CalibrationReport& report,
+                                  const std::function<std::string(double gain)>& namesAt, const char* unit)
+{
+    const std::string name = format("gain of each %s against its slope", unit);
+    std::vector<double> perGainAlpha;
+    for (const NoiseLineFit& f : report.perGain)
+        if (f.line.a > 0)
+            perGainAlpha.push_back(f.line.a / f.gain);
+    if (perGainAlpha.size() < 2)
+        return VerdictCheck{name, true, "one gain with a positive slope: nothing to compare"};
+    const double alpha = median(perGainAlpha);
+    std::string wrong;
+    double worst = 1; // the ratio furthest from 1 so far
+    for (const NoiseLineFit& f : report.perGain) {
+        if (!(f.line.a > 0))
+            continue;
+        const double ratio = f.line.a / (f.gain * alpha), se = f.slopeStdError / (f.gain * alpha);
+        if (std::abs(ratio - 1) - 4 * se > kMaxGainDeviation && std::abs(ratio - 1) > std::abs(worst - 1)) {
+            worst = ratio;
+            wrong = format("%.2f dB (%s): its slope says gain %.3g (%.2f dB), %.3f times the gain its ISO "
+                           "or gain_db gives",
+                           linearGainToDb(f.gain), namesAt(f.gain).c_str(), f.gain * ratio,
+                           linearGainToDb(f.gain * ratio), ratio);
+        }
+    }
+    if (wrong.empty())
+        return VerdictCheck{
+            name, true,
+            format("every gain's slope within %.0f%% (+4 standard errors) of g alpha, alpha the "
+                   "median over %zu gains",
+                   100 * kMaxGainDeviation, perGainAlpha.size())};
+    return VerdictCheck{name, false,
+                        wrong +
+                            format("; threshold %.0f%% beyond 4 standard errors%s", 100 * kMaxGainDeviation,
+                                   perGainAlpha.size() == 2
+                                       ? ": with two gains either may be the wrong one; check both ISOs, or "
+                                         "add a third gain"
+                                       : format(": that %s was not shot at the gain its ISO says; give it "
+                                                "a gain_db or leave it out",
+                                                unit)
+                                             .c_str())};
+}
+
+} // namespace detail
 
 CalibrationVerdict judgeCalibration(const std::vector<NoiseSample>& samples, const CalibrationReport& report,
                                     const std::vector<CalibrationBurstFacts>& bursts, double signalRange)

@@ -119,10 +119,7 @@ std::vector<MeasuredProfile> readProfiles(const FileNode& modelNode, const Strin
             if (!p.isMap())
                 CV_Error(Error::StsParseError, "expected a map");
             rejectUnknownKeys(p, {"name", "iso", "a", "b", "skip", "comment"});
-            const FileNode skip = p["skip"];
-            if (!skip.empty() && !skip.isInt())
-                CV_Error(Error::StsParseError, "field 'skip' must be true or false");
-            if (!skip.empty() && int(skip) != 0) {
+            if (detail::readOptionalFlagField(p, "skip", false)) {
                 ++skipped;
                 continue;
             }

@@ -122,6 +122,18 @@ double readOptionalRealField(const FileNode& node, const char* field, double fal
     return isAbsent(f) ? fallback : numberOf(f, field);
 }
 
+bool readOptionalFlagField(const FileNode& node, const char* field, bool fallback)
+{
+    const FileNode f = node[field];
+    if (isAbsent(f))
+        return fallback;
+    if (f.isString() && (f.string() == "true" || f.string() == "false"))
+        return f.string() == "true";
+    if (f.isInt() && (int(f) == 0 || int(f) == 1))
+        return int(f) == 1;
+    CV_Error(Error::StsParseError, format("field '%s' must be true or false (or 1 or 0)", field));
+}
+
 int readOptionalIntField(const FileNode& node, const char* field, int fallback)
 {
     const FileNode f = node[field];

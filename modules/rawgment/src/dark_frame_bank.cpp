@@ -211,6 +211,7 @@ DarkFrameBank DarkFrameBank::create(const std::vector<String>& files, const Nois
     if (!(falseAlarm > 0 && falseAlarm < 0.5))
         CV_Error(Error::StsOutOfRange,
                  cv::format("DarkFrameBank::create: falseAlarm %g must lie in (0, 0.5)", falseAlarm));
+    refuseRepeatedFiles(files, "DarkFrameBank::create");
     DarkFrameBank bank;
     // The statistics per (gain, exposure time), fed one frame at a time.
     std::map<std::pair<double, double>,
@@ -238,7 +239,11 @@ DarkFrameBank DarkFrameBank::create(const std::vector<String>& files, const Nois
             g.second.gain = f.format.gain;
             g.second.exposureTime = f.exposureTime;
         }
-        g.first->add(f.mosaic);
+        try {
+            g.first->add(f.mosaic);
+        } catch (const Exception& e) {
+            CV_Error(e.code, "DarkFrameBank::create: '" + path + "': " + e.err);
+        }
         g.second.files.push_back(path);
         g.second.fileBytes.push_back(fileBytesOf(path));
     }

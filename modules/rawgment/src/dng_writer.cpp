@@ -233,6 +233,11 @@ std::vector<uint32_t> checkDngImage(const String& path, const RawImage& image)
         CV_Error(Error::StsBadArg,
                  format("writeDng: '%s': white level %g does not fit 16-bit data (<= 65535)", path.c_str(),
                         image.format.whiteLevel));
+    // WhiteLevel is an integer tag: 4095.5 was written as 4096 and read back so, another sensor.
+    if (image.format.whiteLevel != std::round(image.format.whiteLevel))
+        CV_Error(Error::StsBadArg, format("writeDng: '%s': white level %.17g is not an integer; DNG stores "
+                                          "integer levels for 16-bit data",
+                                          path.c_str(), image.format.whiteLevel));
     if (!(image.exposureTime >= 0 && image.exposureTime <= 4294967295.0))
         CV_Error(Error::StsBadArg, format("writeDng: '%s': exposure time %g s does not fit its DNG tag "
                                           "(a rational of at most 4294967295 s)",

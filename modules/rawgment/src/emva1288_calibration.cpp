@@ -4,6 +4,7 @@
 // degree of freedom and is 0 whenever the two integer readings tie; fitNoiseLine()'s inlier band dropped
 // every tie until its lower edge took a continuity correction (docs/emva1288.md). The pooled pair statistic
 // selects nothing, and its standard error is measured from the pixels' own fourth moment (or the rows).
+#include "calibration_lines.hpp"
 #include "noise_terms.hpp"
 #include "precomp.hpp"
 
@@ -341,6 +342,21 @@ CalibrationVerdict judgeEmva1288(const std::vector<Emva1288Results>& results,
             cv::format("the standard's linearity error %.3f%% to %.3f%% (threshold: +-3%%)",
                        r.linearityErrorMin, r.linearityErrorMax));
     }
+    // Two series labelled with other gains than their slopes show (both K 0.30, one said to be 12 dB)
+    // passed with an alpha of 0.089 +- 0.054: the cross-gain fit had nothing to contradict it.
+    if (gains.size() < 2)
+        return v;
+    const VerdictCheck slopes = detail::slopesAgreeWithGains(
+        report,
+        [&](double gain) {
+            std::string names;
+            for (size_t k = 0; k < gains.size(); ++k)
+                if (std::abs(linearGainToDb(gains[k]) - linearGainToDb(gain)) < 0.01)
+                    names += (names.empty() ? "series " : ", ") + std::to_string(k + 1);
+            return names.empty() ? std::string("no series") : names;
+        },
+        "series");
+    add(slopes.name, slopes.pass, slopes.figure);
     return v;
 }
 

@@ -166,6 +166,9 @@ Emva1288Series readEmva1288(const String& path)
     Emva1288Images* open = nullptr;
     bool sawFormat = false;
     long long imageCount = 0;
+    // Each image by its file's identity: one image listed twice (in a pair, a stack or two steps) made a
+    // temporal variance of 0 between them, and every figure carried it.
+    std::map<detail::FileIdentity, std::pair<int, String>> imageLines;
     std::istringstream lines(text);
     int lineNumber = 0;
     for (std::string raw; std::getline(lines, raw);) {
@@ -194,6 +197,16 @@ Emva1288Series readEmva1288(const String& path)
                 badLine(path, lineNumber, "image '" + image + "' does not exist");
             detail::checkRegularFile(image, "EMVA 1288 image (descriptor '" + path +
                                                 cv::format("', line %d)", lineNumber));
+            detail::FileIdentity id;
+            if (detail::fileIdentityOf(image, id)) {
+                const auto first = imageLines.emplace(id, std::make_pair(lineNumber, image));
+                if (!first.second)
+                    badLine(path, lineNumber,
+                            cv::format("image '%s' is the file of line %d ('%s'); every image of a series is "
+                                       "a capture of its own",
+                                       image.c_str(), first.first->second.first,
+                                       first.first->second.second.c_str()));
+            }
             open->images.push_back(image);
             continue;
         }

@@ -130,6 +130,14 @@ int saturationIndexOf(const std::vector<double>& variance)
     return maxIndex;
 }
 
+//! Whether at least half of a frame's pixels hold its largest value: a step clipped but for a few pixels.
+bool mostlyClipped(const Mat& frame)
+{
+    double lo, hi;
+    minMaxLoc(frame.reshape(1, 1), &lo, &hi);
+    return 2 * countNonZero(frame == hi) >= int(frame.total());
+}
+
 } // namespace
 
 Emva1288Pair measureEmva1288Pair(InputArray _a, InputArray _b, double exposureNs, double photons, bool dark)
@@ -181,6 +189,13 @@ Emva1288Pair measureEmva1288Pair(InputArray _a, InputArray _b, double exposureNs
             spread += (r / a.cols - mean) * (r / a.cols - mean);
         rowError = 0.5 * std::sqrt(spread / (a.rows - 1) / a.rows);
     }
+    // Two captures never differ by a constant where they are not clipped: such a pair is one capture twice
+    // (copied or listed again), whose variance of 0 every figure would carry. A step clipped in most
+    // pixels (its defective pixels aside) may well be the same twice.
+    if (m2 == 0 && !mostlyClipped(a))
+        CV_Error(Error::StsBadArg,
+                 "measureEmva1288Pair: the two frames differ by a constant, so they are one "
+                 "capture twice; a pair is two captures of its own");
     Emva1288Pair p;
     p.exposureNs = exposureNs;
     p.photons = photons;
@@ -202,10 +217,26 @@ Emva1288Stack measureEmva1288Stack(InputArrayOfArrays _frames, double exposureNs
     detail::checkFiniteNonNegative(exposureNs, "measureEmva1288Stack: exposureNs");
     detail::checkFiniteNonNegative(photons, "measureEmva1288Stack: photons");
     StackAccumulator acc;
-    for (const Mat& f : frames) {
+    std::vector<Vec2d> sums; // each frame's sum and sum of squares: frames compared only where these agree
+    for (size_t k = 0; k < frames.size(); ++k) {
+        const Mat& f = frames[k];
         checkFrame(f, "measureEmva1288Stack", "every frame");
-        if (f.size() != frames[0].size() || f.type() != frames[0].type())
-            CV_Error(Error::StsBadArg, "measureEmva1288Stack: the frames must share one size and type");
+        if (f.size() != frames[0].size() || f.type() != frames[0].type() || f.total() < 2)
+            CV_Error(Error::StsBadArg,
+                     cv::format("measureEmva1288Stack: the frames must share one size and type and hold at "
+                                "least 2 pixels (frame 0 is %dx%d %s, this one %dx%d %s)",
+                                frames[0].cols, frames[0].rows, typeToString(frames[0].type()).c_str(),
+                                f.cols, f.rows, typeToString(f.type()).c_str()));
+        // As for a pair: a frame not clipped that equals another is one capture listed twice.
+        Mat f64;
+        f.convertTo(f64, CV_64F);
+        sums.push_back(Vec2d(sum(f64)[0], f64.dot(f64)));
+        for (size_t j = 0; j < k; ++j)
+            if (sums[j] == sums[k] && norm(f, frames[j], NORM_INF) == 0 && !mostlyClipped(f))
+                CV_Error(Error::StsBadArg,
+                         cv::format("measureEmva1288Stack: frames %zu and %zu are equal, so they are one "
+                                    "capture twice; a stack is captures of their own",
+                                    j, k));
         acc.add(f);
     }
     return acc.stack(exposureNs, photons, dark);

@@ -24,6 +24,10 @@ double readOptionalRealField(const FileNode& node, const char* field, double fal
 //! An optional integer field: as readOptionalRealField(), and an error when it has a fraction or does
 //! not fit an int.
 int readOptionalIntField(const FileNode& node, const char* field, int fallback);
+/** An optional flag: true or false (YAML's and JSON's booleans) or 1 or 0 (how this module's writers
+ * write a bool); `fallback` when absent, an error naming it otherwise. The text checks hand OpenCV a
+ * boolean as the string "true" or "false", so that no number reader takes it for 1 or 0. */
+bool readOptionalFlagField(const FileNode& node, const char* field, bool fallback);
 //! A required list of exactly `n` numbers, named (and the element) in the error.
 std::vector<double> readRealList(const FileNode& node, const char* field, int n);
 
@@ -62,6 +66,17 @@ private:
     int fd_;
     long long size_ = 0;
 };
+//! A file's device and inode: what two spellings of one path, or two hard links, share.
+struct FileIdentity
+{
+    unsigned long long device = 0, inode = 0;
+    bool operator<(const FileIdentity& o) const
+    {
+        return device != o.device ? device < o.device : inode < o.inode;
+    }
+};
+//! The identity of the file at `path` (links followed); false when it cannot be stat'ed.
+bool fileIdentityOf(const String& path, FileIdentity& id);
 //! The deepest nesting of maps and lists openFileStorageForReading() accepts; this module's files nest
 //! at most five levels, and OpenCV's readers recurse once per level.
 constexpr int MAX_NESTING_DEPTH = 64;

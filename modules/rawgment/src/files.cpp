@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
+#include <map>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -93,6 +94,37 @@ const char* notRegularReason(unsigned mode)
 bool pathExists(const String& path)
 {
     return ::access(path.c_str(), F_OK) == 0;
+}
+
+namespace detail {
+
+bool fileIdentityOf(const String& path, FileIdentity& id)
+{
+    struct stat status;
+    if (::stat(path.c_str(), &status) != 0)
+        return false;
+    id = FileIdentity{static_cast<unsigned long long>(status.st_dev),
+                      static_cast<unsigned long long>(status.st_ino)};
+    return true;
+}
+
+} // namespace detail
+
+void refuseRepeatedFiles(const std::vector<String>& paths, const String& what)
+{
+    std::map<detail::FileIdentity, size_t> seen;
+    for (size_t k = 0; k < paths.size(); ++k) {
+        detail::FileIdentity id;
+        if (!detail::fileIdentityOf(paths[k], id))
+            continue;
+        const auto first = seen.emplace(id, k);
+        if (!first.second)
+            CV_Error(Error::StsBadArg,
+                     format("%s: entries %zu ('%s') and %zu ('%s') are one file; every entry must be a "
+                            "capture of its own",
+                            what.c_str(), first.first->second + 1, paths[first.first->second].c_str(), k + 1,
+                            paths[k].c_str()));
+    }
 }
 
 bool isRegularFile(const String& path)

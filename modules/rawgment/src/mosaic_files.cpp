@@ -96,9 +96,11 @@ MosaicMetadata MosaicMetadata::read(const FileNode& node)
         m.camera = CameraTags::read(node["camera"]);
     const FileNode gainFromIso = node["gain_from_iso"];
     if (!gainFromIso.empty()) {
-        if (!gainFromIso.isInt() || (int(gainFromIso) != 0 && int(gainFromIso) != 1))
-            CV_Error(Error::StsParseError, "mosaic metadata: field 'gain_from_iso' must be 0 or 1");
-        m.gainFromIso = int(gainFromIso) == 1;
+        try {
+            m.gainFromIso = detail::readOptionalFlagField(node, "gain_from_iso", false);
+        } catch (const Exception& e) {
+            CV_Error(e.code, "mosaic metadata: " + e.err);
+        }
         if (m.gainFromIso && !(m.hasCamera && m.camera.iso > 0 && m.format.gain == 1))
             CV_Error(
                 Error::StsParseError,

@@ -552,7 +552,7 @@ std::vector<ExportedProfile> readExportedProfiles(const String& path, const Stri
                     continue;
                 for (const FileNode& p : modelNode["profiles"]) {
                     rejectUnknownKeys(p, {"name", "iso", "a", "b", "skip", "comment"});
-                    if (!p["skip"].empty() && p["skip"].isInt() && int(p["skip"]) != 0)
+                    if (detail::readOptionalFlagField(p, "skip", false))
                         continue;
                     ExportedProfile profile{detail::readRealField(p, "iso"), detail::readRealList(p, "a", 3),
                                             detail::readRealList(p, "b", 3)};

@@ -152,6 +152,13 @@ public:
         write(line, [&] { out_.write(key, static_cast<int>(value)); });
     }
 
+    //! A boolean as "true"/"false", for the flag reader only: as 1 or 0, `gain_db: true` was 1 dB.
+    void boolean(bool value, int line)
+    {
+        const std::string key = takeKey();
+        write(line, [&] { out_.write(key, std::string(value ? "true" : "false")); });
+    }
+
     void real(double value, int line)
     {
         const std::string key = takeKey();
@@ -306,9 +313,8 @@ public:
             refuse(line,
                    "an empty or null value; OpenCV's files have no null: write a value, or leave the key "
                    "out");
-        // A boolean is 1 or 0, as OpenCV's JSON reader reads JSON's and as its writer writes a bool.
         if (v == "true" || v == "True" || v == "TRUE" || v == "false" || v == "False" || v == "FALSE") {
-            out_.integer(v[0] == 't' || v[0] == 'T' ? 1 : 0, line, v);
+            out_.boolean(v[0] == 't' || v[0] == 'T', line);
             return;
         }
         if (integer(v, line))
@@ -595,8 +601,7 @@ public:
     }
     bool boolean(bool value) override
     {
-        // As OpenCV's own JSON reader takes them.
-        out_.integer(value ? 1 : 0, 0, value ? "true" : "false");
+        out_.boolean(value, 0);
         return true;
     }
     bool number_integer(number_integer_t value) override { return integer(value); }

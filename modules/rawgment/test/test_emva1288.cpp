@@ -9,6 +9,7 @@
 
 #include <fstream>
 #include <numeric>
+#include <unistd.h>
 
 namespace cv {
 namespace rawgment {
@@ -159,6 +160,9 @@ struct SmallSeries
             steps += cv::format("b %d %d\r\ni b%d_1.png\r\ni b%d_2.png\r\n", 1000 * (s + 1), 50 * s, s, s);
             steps += cv::format("d %d\r\ni d%d_1.png\r\ni d%d_2.png\r\n", 1000 * (s + 1), s, s);
         }
+        // Captures of their own for the cases that need more steps: a descriptor lists a file once.
+        for (int k = 0; k < 12; ++k)
+            writeFlat(dir, cv::format("x%d.png", k), size, 100);
     }
     std::string write(const std::string& text) const { return writeDescriptor(dir, text); }
 };
@@ -211,11 +215,16 @@ TEST(Emva1288, everyBadDescriptorIsAnErrorNamingTheFileAndLine)
         {h + "i b0_1.png\n", "an image ('i') before any 'b' or 'd' line"},
         {h + "b 5 10\ni missing.png\ni b0_2.png\n", "image '" + s.dir + "/missing.png' does not exist"},
         {h + "b 5 10\ni\n", "expected 'i <image path>'"},
-        {h + s.steps + "b 1000 0\ni b0_1.png\ni b0_2.png\n",
+        {h + s.steps + "b 1000 0\ni x0.png\ni x1.png\n",
          "exposure 1000 with 0 photons is listed again (first on line 4)"},
+        // One image twice, in one pair, as another spelling, or in two steps (sigma_y.dark 2.095 DN, not
+        // 2.974, from a dark pair of one image).
+        {h + "b 5 10\ni b0_1.png\ni b0_1.png\n",
+         "line 6: image '" + s.dir + "/b0_1.png' is the file of line 5"},
+        {h + "b 5 10\ni b0_1.png\ni ./b0_1.png\n", "is the file of line 5 ('" + s.dir + "/b0_1.png')"},
+        {h + s.steps + "b 9 10\ni x0.png\ni b2_2.png\n", "is the file of line"},
         {h + "b 5 10\ni b0_1.png\ni b0_2.png\n", "exposure 5 has no dark pair"},
-        {h + s.steps + "b 9 10\ni b0_1.png\ni b0_2.png\ni b1_1.png\n",
-         "must be one bright and one dark stack"},
+        {h + s.steps + "b 9 10\ni x0.png\ni x1.png\ni x2.png\n", "must be one bright and one dark stack"},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.text.substr(0, 80));
@@ -223,6 +232,10 @@ TEST(Emva1288, everyBadDescriptorIsAnErrorNamingTheFileAndLine)
         EXPECT_CV_ERROR_CONTAINS(readEmva1288(path), c.fragment);
         EXPECT_CV_ERROR_CONTAINS(readEmva1288(path), path);
     }
+    // A hard link is the same file under another name.
+    ASSERT_EQ(0, ::link((s.dir + "/b0_2.png").c_str(), (s.dir + "/linked.png").c_str()));
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288(s.write(h + "b 5 10\ni b0_2.png\ni linked.png\n")),
+                             "line 6: image '" + s.dir + "/linked.png' is the file of line 5");
     EXPECT_CV_ERROR_CONTAINS(readEmva1288(s.dir + "/none.txt"), "none.txt");
     EXPECT_CV_ERROR_CONTAINS(readEmva1288(s.dir), "it is a directory");
 }
@@ -259,7 +272,8 @@ TEST(Emva1288, aSeriesWithoutSignalIsAClearError)
     // Every step at the dark level: there is no K to fit.
     std::string flat = s.header;
     for (int i = 0; i < 3; ++i)
-        flat += cv::format("b %d 10\ni d0_1.png\ni d0_2.png\nd %d\ni d0_1.png\ni d0_2.png\n", i + 1, i + 1);
+        flat += cv::format("b %d 10\ni x%d.png\ni x%d.png\nd %d\ni x%d.png\ni x%d.png\n", i + 1, 4 * i,
+                           4 * i + 1, i + 1, 4 * i + 2, 4 * i + 3);
     EXPECT_CV_ERROR_CONTAINS(emva1288Results(readEmva1288(s.write(flat))), "K needs a signal that rises");
     std::string two = s.header + "b 1 10\ni b1_1.png\ni b1_2.png\nd 1\ni d0_1.png\ni d0_2.png\n";
     EXPECT_CV_ERROR_CONTAINS(emva1288Results(readEmva1288(s.write(two))), "1 bright temporal step(s)");
@@ -437,6 +451,25 @@ TEST(Emva1288, seriesAtThreeGainsSeparateReadNoiseBeforeAndAfterTheGain)
     EXPECT_LT(se[NOISE_PARAM_SIGMA_D2], 0.1);
     EXPECT_LT(se[NOISE_PARAM_SIGMA_R2], 0.2);
     EXPECT_LT(rep.uncertainty.correlation(NOISE_PARAM_SIGMA_D2, NOISE_PARAM_SIGMA_R2), 0);
+    const auto slopeCheck = [](const CalibrationVerdict& v) {
+        for (const VerdictCheck& c : v.checks)
+            if (c.name == "gain of each series against its slope")
+                return c;
+        return VerdictCheck{"missing", false, "no slope check"};
+    };
+    const VerdictCheck agree = slopeCheck(judgeEmva1288(measured, gains, rep));
+    EXPECT_TRUE(agree.pass) << agree.figure;
+    // The same sensor at gain 1 twice, the second series labelled 12 dB: each slope says the gains are
+    // equal (it passed with alpha 0.089 +- 0.054). The series whose slope disagrees is named.
+    const std::vector<Emva1288Results> same{emva1288Results(simulatePairs(s, 1, 50)),
+                                            emva1288Results(simulatePairs(s, 1, 51)),
+                                            emva1288Results(simulatePairs(s, 1, 52))};
+    const std::vector<double> labelled{1, 1, dbToLinearGain(12)};
+    const CalibrationVerdict wrong = judgeEmva1288(same, labelled, calibrateEmva1288(same, labelled));
+    EXPECT_FALSE(wrong.pass);
+    const VerdictCheck disagree = slopeCheck(wrong);
+    EXPECT_FALSE(disagree.pass);
+    EXPECT_NE(std::string::npos, disagree.figure.find("12.00 dB (series 3)")) << disagree.figure;
 }
 
 TEST(Emva1288, calibrationRefusesWhatItCannotFit)
@@ -462,6 +495,20 @@ TEST(Emva1288, calibrationRefusesWhatItCannotFit)
                              "share one size and type");
     EXPECT_CV_ERROR_CONTAINS(measureEmva1288Stack(std::vector<Mat>{Mat(4, 4, CV_16U)}, 1, 1, false),
                              "at least 2 frames");
+    // Three 1x1 frames gave a NaN spatial variance (n - 1 = 0), where a pair of them is refused.
+    const std::vector<Mat> dots(3, Mat(1, 1, CV_16U, Scalar(7)));
+    EXPECT_CV_ERROR_CONTAINS(measureEmva1288Stack(dots, 1, 1, false), "hold at least 2 pixels");
+    // One capture twice (a copied file) is refused by content; a step clipped in most pixels is not.
+    Mat frame(16, 16, CV_16U), other(16, 16, CV_16U);
+    randu(frame, 0, 4096);
+    randu(other, 0, 4096);
+    EXPECT_CV_ERROR_CONTAINS(measureEmva1288Pair(frame, frame.clone(), 1, 1, false), "one capture twice");
+    EXPECT_CV_ERROR_CONTAINS(measureEmva1288Pair(frame, frame + 3, 1, 1, false), "one capture twice");
+    EXPECT_CV_ERROR_CONTAINS(measureEmva1288Stack(std::vector<Mat>{frame, other, frame.clone()}, 1, 1, false),
+                             "frames 0 and 2 are equal");
+    Mat clipped(16, 16, CV_16U, Scalar(4095));
+    clipped(Rect(0, 0, 3, 1)).setTo(4000); // a few defective pixels below the clipping
+    EXPECT_EQ(0, measureEmva1288Pair(clipped, clipped.clone(), 1, 1, false).variance);
 }
 
 } // namespace

@@ -3,6 +3,8 @@
 // and the guarded YAML/JSON reader.
 #include "test_common.hpp"
 
+#include "../src/file_access.hpp"
+
 #include <opencv2/rawgment/augment.hpp>
 #include <opencv2/rawgment/calibration.hpp>
 #include <opencv2/rawgment/camera_profiles.hpp>
@@ -328,8 +330,10 @@ TEST(Files, scalarsAreTypedByYamlsCoreSchemaAndWhatOpenCvReadsOtherwiseIsRefused
     // What both read alike, and what YAML reads unambiguously, is read as the value written.
     EXPECT_EQ(16, int(readOneValue(fs, "0x10")));
     EXPECT_EQ(1, int(readOneValue(fs, "+1")));
-    EXPECT_EQ(1, int(readOneValue(fs, "true"))); // as OpenCV's JSON reader reads JSON's booleans
-    EXPECT_EQ(0, int(readOneValue(fs, "False")));
+    // A boolean is handed over as the string "true" or "false": as OpenCV's 1 or 0 every number reader
+    // took it (`gain_db: true` calibrated at 1 dB). Only the flag reader takes it.
+    EXPECT_EQ("true", std::string(readOneValue(fs, "true")));
+    EXPECT_EQ("false", std::string(readOneValue(fs, "False")));
     EXPECT_EQ("yes", std::string(readOneValue(fs, "yes"))); // YAML 1.1's boolean, a string to YAML 1.2
     EXPECT_EQ(0.5, double(readOneValue(fs, ".5")));
     EXPECT_EQ(-0.5, double(readOneValue(fs, "-.5")));
@@ -392,11 +396,18 @@ TEST(Files, everyTextOpenCvsParserCouldNotTakeIsReadOrNamed)
                              "UTF-16 or UTF-32 text? This module reads UTF-8");
     EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(textFile(dir, "u2.yml", utf16.substr(2)), "x"),
                              "UTF-16 or UTF-32 text?");
-    // JSON's booleans read as OpenCV's JSON reader reads them, a null as a key left out.
+    // JSON's booleans are flags, never numbers; a null is a key left out.
     const FileStorage b = openFileStorageForReading(
-        textFile(dir, "b.json", "{ \"t\": true, \"f\": false, \"n\": null, \"k\": 2 }"), "x");
-    EXPECT_EQ(1, int(b["t"]));
-    EXPECT_EQ(0, int(b["f"]));
+        textFile(dir, "b.json", "{ \"t\": true, \"f\": false, \"n\": null, \"k\": 2, \"o\": 1 }"), "x");
+    EXPECT_FALSE(b["t"].isInt() || b["t"].isReal());
+    EXPECT_TRUE(detail::readOptionalFlagField(b.root(), "t", false));
+    EXPECT_FALSE(detail::readOptionalFlagField(b.root(), "f", true));
+    EXPECT_TRUE(detail::readOptionalFlagField(b.root(), "o", false)); // a bool as OpenCV writes one
+    EXPECT_TRUE(detail::readOptionalFlagField(b.root(), "n", true));
+    EXPECT_CV_ERROR_CONTAINS(detail::readOptionalFlagField(b.root(), "k", false),
+                             "field 'k' must be true or false");
+    EXPECT_CV_ERROR_CONTAINS(detail::readRealField(b.root(), "t"), "field 't' is not a number");
+    EXPECT_CV_ERROR_CONTAINS(detail::readOptionalIntField(b.root(), "f", 0), "field 'f' must be an integer");
     EXPECT_TRUE(b["n"].empty());
     EXPECT_CV_ERROR_CONTAINS(
         openFileStorageForReading(textFile(dir, "n.json", "{ \"a\": [ 1, null ] }"), "x"),

@@ -147,6 +147,10 @@ TEST(RawIo, writeDngRejectsWhatDngCannotHold)
     img.format.blackLevel = Vec4d(10.5, 10, 10, 10);
     EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "not an integer");
     img.format.blackLevel = Vec4d::all(10);
+    // A white level of 4095.5 was written and read back as 4096: another sensor's clipping.
+    img.format.whiteLevel = 4095.5;
+    EXPECT_CV_ERROR_CONTAINS(writeDng(dir + "/a.dng", img), "white level 4095.5 is not an integer");
+    img.format.whiteLevel = 4095;
     // LibRaw reads no RAW file under 22 pixels on a side: such a DNG would be written, then refused by
     // readRaw as "not RAW file".
     for (const Size size : {Size(2, 2), Size(16, 16), Size(20, 64), Size(64, 20)}) {

@@ -46,6 +46,18 @@ CV_RAWGMENT_EXPORTS void removeTemporaryFilesInProgress();
  * the library, its pipeline and its apps. */
 CV_RAWGMENT_EXPORTS bool pathExists(const String& path);
 
+/** @brief Refuses a list of input files in which two entries are one file.
+ *
+ * Two entries are one file when they share a device and an inode: the same path spelt otherwise
+ * (`d/f`, `d/./f`, a link to it) or a hard link. A series, a burst or a bank that holds one capture twice
+ * has a temporal variance of 0 between those entries, which every figure drawn from it would carry
+ * silently. Entries that do not exist are left to the reader that opens them.
+ * @param paths the entries, in the order they were given
+ * @param what what the list is, for the message ("EMVA 1288 manifest 'm.yml'")
+ * @throws cv::Exception StsBadArg naming both entries and their places (1-based) in the list.
+ */
+CV_RAWGMENT_EXPORTS void refuseRepeatedFiles(const std::vector<String>& paths, const String& what);
+
 /** @brief Whether `path` is a regular file, or a link to one: what every reader of this module opens (a FIFO,
  * a device or a folder never is). */
 CV_RAWGMENT_EXPORTS bool isRegularFile(const String& path);
