@@ -191,6 +191,30 @@ TEST(Apps, aPlotsPathIsDataToGnuplotNeverAProgram)
     EXPECT_NE(std::string::npos, script.find("\\047")) << script;
 }
 
+TEST(Apps, aFileSizeLimitIsAnErrorNamingTheFileAsAFullDiskIs)
+{
+    // Under `ulimit -f 16` rawgment_calibrate was killed by SIGXFSZ (exit 153), without a word, and left
+    // samples.csv.tmp-*.
+    const std::string dir = freshDir("file_size_limit");
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir +
+                                               "/sim' --frames=4 --gains=6,18 --levels=0.5 "
+                                               "--format=png --validation=false");
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string log = dir + "/limited.log", out = dir + "/cal";
+    const std::string command = "(ulimit -f 16; exec '" + std::string(RAWGMENT_APP_DIR) +
+                                "/rawgment_calibrate' '" + dir + "/sim/manifest.yml' --out='" + out +
+                                "') > '" + log + "' 2>&1";
+    const int raw = std::system(command.c_str());
+    ASSERT_TRUE(WIFEXITED(raw)) << "killed by a signal: " << (WIFSIGNALED(raw) ? WTERMSIG(raw) : 0);
+    EXPECT_EQ(1, WEXITSTATUS(raw));
+    const std::string output = readText(log);
+    EXPECT_NE(std::string::npos, output.find(std::strerror(EFBIG))) << output;
+    EXPECT_NE(std::string::npos, output.find(out + "/")) << output;
+    if (exists(out))
+        for (const auto& entry : std::filesystem::recursive_directory_iterator(out))
+            EXPECT_EQ(std::string::npos, entry.path().string().find(".tmp-")) << entry.path();
+}
+
 TEST(Apps, aRunRemovesTheTemporariesThatKilledRunsLeft)
 {
     const std::string dir = freshDir("interrupts");

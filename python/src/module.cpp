@@ -638,6 +638,11 @@ PYBIND11_MODULE(_rawgment, m)
             if (p)
                 std::rethrow_exception(p);
         } catch (const cv::Exception& e) {
+            // As Python's own open() does for a path it cannot pass to the system.
+            if (e.code == cv::Error::StsBadArg && e.err.rfind("a path holds a NUL character", 0) == 0) {
+                PyErr_SetString(PyExc_ValueError, e.err.c_str());
+                return;
+            }
             py::object type = error;
             py::object instance = type(e.err);
             instance.attr("err") = e.err;

@@ -162,6 +162,23 @@ def test_devices_and_fifos_are_refused_not_read(tmp_path):
         rg.NoiseModel.load(fifo)
 
 
+def test_a_nul_in_a_path_is_a_value_error_and_writes_nothing(tmp_path, dark_bank):
+    # bank.save("other.yml\0.json") wrote the maps and the bank over each other into other.yml.
+    import os
+
+    bank = rg.DarkFrameBank.load(dark_bank)
+    target = str(tmp_path / "other.yml")
+    with pytest.raises(ValueError, match="a path holds a NUL character"):
+        bank.save(target + "\0.json")
+    with pytest.raises(ValueError, match="a path holds a NUL character"):
+        rg.NoiseModel().save(target + "\0.json")
+    with pytest.raises(ValueError, match="a path holds a NUL character"):
+        rg.NoiseModel.load(dark_bank + "\0.yml")
+    with pytest.raises(ValueError, match="a path holds a NUL character"):
+        rg.readRaw(target + "\0.dng")
+    assert os.listdir(str(tmp_path)) == []
+
+
 def test_cxx_errors_are_rawgment_error_with_the_cxx_message(sensor, tmp_path):
     with pytest.raises(rg.error) as info:
         rg.NoiseModel(-1, 0, 0)

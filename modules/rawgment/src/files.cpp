@@ -43,6 +43,7 @@ String folderOf(const String& path)
 
 void checkRegularFile(const String& path, const String& what)
 {
+    checkPathHasNoNul(path);
     struct stat status;
     if (::stat(path.c_str(), &status) != 0)
         CV_Error(Error::StsError, "cannot open " + what + " '" + path +
@@ -54,6 +55,7 @@ void checkRegularFile(const String& path, const String& what)
 
 RegularFileForReading::RegularFileForReading(const String& path, const String& what)
 {
+    checkPathHasNoNul(path);
     // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer that may never come.
     fd_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
     if (fd_ < 0)
@@ -91,8 +93,17 @@ const char* notRegularReason(unsigned mode)
 
 } // namespace detail
 
+void checkPathHasNoNul(const String& path)
+{
+    const size_t nul = path.find('\0');
+    if (nul != String::npos)
+        CV_Error(Error::StsBadArg,
+                 format("a path holds a NUL character (after '%s'); no file can be named so", path.c_str()));
+}
+
 bool pathExists(const String& path)
 {
+    checkPathHasNoNul(path);
     return ::access(path.c_str(), F_OK) == 0;
 }
 
@@ -100,6 +111,7 @@ namespace detail {
 
 bool fileIdentityOf(const String& path, FileIdentity& id)
 {
+    checkPathHasNoNul(path);
     struct stat status;
     if (::stat(path.c_str(), &status) != 0)
         return false;
@@ -129,6 +141,7 @@ void refuseRepeatedFiles(const std::vector<String>& paths, const String& what)
 
 bool isRegularFile(const String& path)
 {
+    checkPathHasNoNul(path);
     struct stat status;
     return ::stat(path.c_str(), &status) == 0 && S_ISREG(status.st_mode);
 }
@@ -338,6 +351,7 @@ void writeFileAtomically(const String& path, const void* data, size_t size, bool
 {
     if (path.empty())
         CV_Error(Error::StsBadArg, "writeFileAtomically: the path is empty");
+    checkPathHasNoNul(path);
     if (!data && size > 0)
         CV_Error(Error::StsBadArg, "writeFileAtomically: no data for " + std::to_string(size) + " bytes");
     const String tmp = temporaryPathFor(path);

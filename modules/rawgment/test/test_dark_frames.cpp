@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -80,6 +81,20 @@ TEST(DarkFrameBank, filesGroupByGainAndExposureAndRefuseAnotherSensor)
     // One gain is a bank; none is not.
     EXPECT_EQ(DarkFrameBank::create({files[0], files[1]}, model).groups.size(), 1u);
     EXPECT_CV_ERROR_CONTAINS(DarkFrameBank::create({}, model), "an empty bank");
+    // One frame twice (another spelling of its path) made a group of temporal variance 0.
+    const String respelt = dir + "/./dark_00.png";
+    EXPECT_CV_ERROR_CONTAINS(DarkFrameBank::create({files[0], files[1], respelt}, model),
+                             "entries 1 ('" + files[0] + "') and 3 ('" + respelt + "') are one file");
+    // A frame the statistics refuse (a float frame among integer ones) is named by its file.
+    Mat floats;
+    sensor.capture(Mat::zeros(size, CV_32FC1), 2.0, 1.0, 99, 0, floats);
+    floats.convertTo(floats, CV_32F);
+    floats.at<float>(3, 3) = std::numeric_limits<float>::quiet_NaN();
+    MosaicMetadata floatMeta;
+    floatMeta.format = sensor.rawFormat(2.0);
+    writeMosaic(dir + "/nan.npy", floats, floatMeta);
+    EXPECT_CV_ERROR_CONTAINS(DarkFrameBank::create({files[0], files[1], dir + "/nan.npy"}, model),
+                             "'" + dir + "/nan.npy'");
     EXPECT_CV_ERROR_CONTAINS(DarkFrameBank::create({files[0], files[1], files[3]}, model),
                              "gain 8, exposure 0.01 s has one frame");
     // Another sensor: another black level, then another size.

@@ -262,6 +262,19 @@ TEST(Files, aYamlTextOnWhichOpenCvNeverFinishesIsAnErrorNotAHang)
     EXPECT_NO_THROW(readText("ok.yml", "%YAML:1.0\n---\nm:\n   a: 1\n"));
 }
 
+TEST(Files, aPathWithANulIsRefusedByEveryReaderAndWriter)
+{
+    // The system reads a path up to its NUL: "other.yml\0.json" was written as other.yml.
+    const std::string dir = makeTempDir("files_nul");
+    const std::string nul = dir + "/other.yml" + std::string(1, '\0') + ".json";
+    EXPECT_CV_ERROR_CONTAINS(writeFileAtomically(nul, "x", 1), "a path holds a NUL character");
+    EXPECT_CV_ERROR_CONTAINS(NoiseModel().save(nul), "a path holds a NUL character");
+    EXPECT_CV_ERROR_CONTAINS(pathExists(nul), "a path holds a NUL character");
+    EXPECT_CV_ERROR_CONTAINS(openFileStorageForReading(nul, "x"), "a path holds a NUL character");
+    EXPECT_CV_ERROR_CONTAINS(readRaw(nul), "a path holds a NUL character");
+    EXPECT_TRUE(filesIn(dir).empty());
+}
+
 TEST(Files, theYamlReaderNamesTheLineAndWhatIsWrong)
 {
     const auto read = [](const std::string& text) { return readText("a.yml", text); };

@@ -42,6 +42,13 @@ CV_RAWGMENT_EXPORTS void writeFileAtomically(const String& path, const void* dat
  */
 CV_RAWGMENT_EXPORTS void removeTemporaryFilesInProgress();
 
+/** @brief Refuses a path that holds a NUL character, as Python's open() does: the operating system reads
+ * such a path only up to the NUL, so `bank.save("other.yml\0.json")` wrote its maps and its bank over one
+ * another into `other.yml`. Every reader and writer of the module checks its paths with this.
+ * @throws cv::Exception StsBadArg whose message starts with "a path holds a NUL character" (the Python
+ * module raises ValueError for it). */
+CV_RAWGMENT_EXPORTS void checkPathHasNoNul(const String& path);
+
 /** @brief Whether anything (a file, a folder, or a link to one) exists at `path`: the one existence check of
  * the library, its pipeline and its apps. */
 CV_RAWGMENT_EXPORTS bool pathExists(const String& path);
