@@ -61,7 +61,7 @@ bool sameReal(double a, double b)
 constexpr int kUntyped = -1;
 
 //! The value YAML 1.2's core schema gives a plain scalar, as the FileNode type it must be read as.
-int coreSchemaType(const std::string& v, double& number)
+int coreSchemaType(std::string& v, double& number)
 {
     static const std::regex decimal("[-+]?[0-9]+"), hex("0x[0-9a-fA-F]+"),
         real("[-+]?(\\.[0-9]+|[0-9]+(\\.[0-9]*)?)([eE][-+]?[0-9]+)?"), inf("[-+]?\\.(inf|Inf|INF)"),
@@ -70,9 +70,10 @@ int coreSchemaType(const std::string& v, double& number)
     if (v.size() > 200)
         return kUntyped;
     static const std::regex boolean("true|True|TRUE|false|False|FALSE");
+    // A boolean reaches OpenCV as the string "true" or "false", which only the flag reader takes.
     if (std::regex_match(v, boolean)) {
-        number = v[0] == 't' || v[0] == 'T' ? 1 : 0;
-        return cv::FileNode::INT;
+        v = v[0] == 't' || v[0] == 'T' ? "true" : "false";
+        return cv::FileNode::STRING;
     }
     if (std::regex_match(v, decimal) || std::regex_match(v, hex)) {
         number = double(std::strtoll(v.c_str(), nullptr, v.size() > 1 && v[1] == 'x' ? 16 : 10));
@@ -129,7 +130,7 @@ std::string compareYaml(yaml_document_t& doc, const yaml_node_t* node, const cv:
         }
         return std::string();
     }
-    const std::string value(reinterpret_cast<const char*>(node->data.scalar.value), node->data.scalar.length);
+    std::string value(reinterpret_cast<const char*>(node->data.scalar.value), node->data.scalar.length);
     const std::string tag = node->tag ? reinterpret_cast<const char*>(node->tag) : "";
     double number = 0;
     int type = cv::FileNode::STRING;
@@ -186,7 +187,8 @@ std::string compareJson(const nlohmann::json& j, const cv::FileNode& fn, const s
     if (j.is_string())
         return fn.isString() && fn.string() == j.get<std::string>() ? std::string() : at + ": another string";
     if (j.is_boolean())
-        return fn.isInt() && int(fn) == (j.get<bool>() ? 1 : 0) ? std::string() : at + ": another boolean";
+        return fn.isString() && fn.string() == (j.get<bool>() ? "true" : "false") ? std::string()
+                                                                                  : at + ": another boolean";
     if (j.is_number_float())
         return fn.isReal() && sameReal(fn.real(), j.get<double>()) ? std::string() : at + ": another real";
     if (j.is_number())

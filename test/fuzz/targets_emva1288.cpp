@@ -21,9 +21,10 @@ std::vector<Target> emva1288Targets()
     // reduced to the standard's figures; and one image of such a series, mutated.
     const auto emvaImages = [](const std::string& work) {
         cv::RNG rng(1288);
-        for (int s = 0; s < 4; ++s)
+        // Steps 0-3 are the temporal pairs, step 4 the spatial stacks' frames: a series lists a file once.
+        for (int s = 0; s < 5; ++s)
             for (const char* kind : {"b", "d"})
-                for (int f = 0; f < 2; ++f) {
+                for (int f = 0; f < (s < 4 ? 2 : 3); ++f) {
                     cv::Mat image(12, 16, CV_16UC1);
                     const double level = 100 + (*kind == 'b' ? 600.0 * (s + 1) : 0.0);
                     rng.fill(image, cv::RNG::NORMAL, level, std::sqrt(9 + (level - 100) * 0.3));
@@ -46,8 +47,8 @@ std::vector<Target> emva1288Targets()
                  spatial += cv::format("b %d,5 %d\ni images\\..\\b%d_0.png\ni b%d_1.png\nd %d,5\ni "
                                        "d%d_0.png\ni d%d_1.png\n",
                                        s + 1, 2000 * (s + 1), s, s, s + 1, s, s);
-             spatial += "b 9 500\ni b0_0.png\ni b0_1.png\ni b1_0.png\nd 9\ni d0_0.png\ni d0_1.png\ni "
-                        "d1_0.png\n";
+             spatial += "b 9 500\ni b4_0.png\ni b4_1.png\ni b4_2.png\nd 9\ni d4_0.png\ni d4_1.png\ni "
+                        "d4_2.png\n";
              fs::create_directories(work + "/images");
              return std::vector<std::string>{text, spatial};
          },
