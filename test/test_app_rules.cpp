@@ -154,6 +154,14 @@ TEST(Apps, unusableValuesAreRefusedAndFailedRunsLeaveNoEmptyFolder)
     EXPECT_NE(std::string::npos, r.output.find("is not a file")) << r.output;
 }
 
+//! Small bursts at 6 and 18 dB in `dir`/sim, for the tests that need a calibration with plots.
+AppRun simulateTwoGains(const std::string& dir)
+{
+    return runApp("rawgment_simulate",
+                  "--out='" + dir +
+                      "/sim' --frames=4 --gains=6,18 --levels=0.5 --format=png --validation=false");
+}
+
 std::string shellQuoted(const std::string& text)
 {
     std::string quoted = "'";
@@ -168,9 +176,7 @@ TEST(Apps, aPlotsPathIsDataToGnuplotNeverAProgram)
     // plot's data path went between single quotes unescaped. Every character gnuplot could act on is
     // in this one name: both quotes, backquotes, $(), a backslash, '@' (a macro), a newline and UTF-8.
     const std::string dir = freshDir("hostile_plot_paths");
-    AppRun r = runApp("rawgment_simulate", "--out='" + dir +
-                                               "/sim' --frames=4 --gains=6,18 --levels=0.5 "
-                                               "--format=png --validation=false");
+    AppRun r = simulateTwoGains(dir);
     ASSERT_EQ(0, r.status) << r.output;
     const std::string hostile = "x'.system('touch PWNED1').'\" `touch PWNED2` $(touch PWNED3) \\ @x "
                                 "\xc3\xa9\nline";
@@ -196,9 +202,7 @@ TEST(Apps, aFileSizeLimitIsAnErrorNamingTheFileAsAFullDiskIs)
     // Under `ulimit -f 16` rawgment_calibrate was killed by SIGXFSZ (exit 153), without a word, and left
     // samples.csv.tmp-*.
     const std::string dir = freshDir("file_size_limit");
-    AppRun r = runApp("rawgment_simulate", "--out='" + dir +
-                                               "/sim' --frames=4 --gains=6,18 --levels=0.5 "
-                                               "--format=png --validation=false");
+    AppRun r = simulateTwoGains(dir);
     ASSERT_EQ(0, r.status) << r.output;
     const std::string log = dir + "/limited.log", out = dir + "/cal";
     const std::string command = "(ulimit -f 16; exec '" + std::string(RAWGMENT_APP_DIR) +
@@ -236,9 +240,7 @@ TEST(Apps, aRunStoppedWhileAPlotIsDrawnLeavesNoScriptBehind)
     // moment it has a gnuplot running on a plot script (a child process whose command line names one),
     // and nothing but finished files may stay.
     const std::string dir = freshDir("interrupted_plot");
-    AppRun r = runApp("rawgment_simulate", "--out='" + dir +
-                                               "/sim' --frames=4 --gains=6,18 --levels=0.5 "
-                                               "--format=png --validation=false");
+    AppRun r = simulateTwoGains(dir);
     ASSERT_EQ(0, r.status) << r.output;
     const std::string out = dir + "/cal", manifest = dir + "/sim/manifest.yml";
     const std::string app = std::string(RAWGMENT_APP_DIR) + "/rawgment_calibrate";
