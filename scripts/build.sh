@@ -26,7 +26,9 @@ case "$flavour" in
 esac
 
 build="$root/build/$flavour"
-if [ ! -f "$build/CMakeCache.txt" ]; then
+# A configure that failed (a package missing) leaves a cache but no build files: configure again then.
+if [ ! -f "$build/CMakeCache.txt" ] || { [ ! -f "$build/build.ninja" ] && [ ! -f "$build/Makefile" ]; }; then
+  rm -rf "$build"
   cmake -S "$root" -B "$build" "${generator[@]}" "${args[@]}"
 fi
 cmake --build "$build" --parallel "$jobs" "${targets[@]}"

@@ -59,6 +59,15 @@ TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
                                          "/sim/bank.yml' --plots=false --out='" + dir + "/cal_again'");
     EXPECT_EQ(1, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("never written over")) << r.output;
+    // A bank no reader takes, or in a folder that does not exist, is refused before the calibration runs
+    // (#79 item 23): the run writes nothing, not its whole calibration and then an error.
+    for (const std::string& bad : {dir + "/sim/bank.txt", dir + "/no_such_folder/bank.yml"}) {
+        r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --dark_bank='" + bad +
+                                             "' --plots=false --out='" + dir + "/cal_refused'");
+        EXPECT_EQ(1, r.status) << r.output;
+        EXPECT_NE(std::string::npos, r.output.find(bad)) << r.output;
+        EXPECT_FALSE(exists(dir + "/cal_refused")) << bad;
+    }
     writeExposureScene(dir + "/darker.yml", 0.125, std::pow(10, 12 / 20.0));
     for (const char* tied : {"false", "true"}) {
         r = runApp("rawgment_augment", "--model='" + dir +

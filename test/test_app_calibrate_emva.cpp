@@ -5,8 +5,12 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/rawgment.hpp>
 
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
 #include <vector>
 
 namespace {
@@ -69,12 +73,16 @@ TEST(Apps, calibrateEmvaSeparatesTheReadNoiseOfAManifestOfGainsAndRefusesBadInpu
         std::ofstream d(series + "/EMVA1288_Data.txt");
         d << "v 4.0\nn 12 128 96\n";
         std::vector<cv::Mat> frames;
-        for (int k = 0; k < 12; ++k) {
+        // Exposures 1 to 12, and 0.4: a step at most a quarter as bright as one between 10% and 30% of
+        // saturation, which the real-frame validation needs.
+        for (int k = 0; k < 13; ++k) {
+            const double exposure = k < 12 ? k + 1 : 0.4;
             const cv::Mat light(96, 128, CV_32FC1, cv::Scalar(1.15 * 4031 / gain / 12));
             for (int dark = 0; dark < 2; ++dark) {
-                sim.captureBurst(dark ? cv::Mat::zeros(96, 128, CV_32FC1) : light, gain, k + 1, 2,
+                sim.captureBurst(dark ? cv::Mat::zeros(96, 128, CV_32FC1) : light, gain, exposure, 2,
                                  uint64_t(100 * g + 2 * k + dark), frames);
-                d << (dark ? cv::format("d %d\n", k + 1) : cv::format("b %d %d\n", k + 1, 1000 * (k + 1)));
+                d << (dark ? cv::format("d %g\n", exposure)
+                           : cv::format("b %g %g\n", exposure, 1000 * exposure));
                 for (int f = 0; f < 2; ++f) {
                     const std::string name = cv::format("%s%d_%d.png", dark ? "d" : "b", k, f);
                     ASSERT_TRUE(cv::imwrite(series + "/" + name, frames[f]));
@@ -96,6 +104,22 @@ TEST(Apps, calibrateEmvaSeparatesTheReadNoiseOfAManifestOfGainsAndRefusesBadInpu
     // 128x96 series: both read variances to within 5 of their stated standard errors of the truth.
     EXPECT_NEAR(rep.model.sigmaD2, 2.0, 5 * rep.uncertainty.stdError[1]);
     EXPECT_NEAR(rep.model.sigmaR2, 4.0 + 1.0 / 12, 5 * rep.uncertainty.stdError[2]);
+    // The validation of both series in one file: each row names its series, and no pair number is given
+    // twice (the second series' restarted at 1, #79 item 26).
+    std::istringstream csv(readText(dir + "/cal/emva1288_validation.csv"));
+    std::string row;
+    ASSERT_TRUE(std::getline(csv, row));
+    EXPECT_EQ(0u, row.find("series,pair,bright_point,")) << row;
+    std::map<int, std::set<int>> pairsOfSeries;
+    while (std::getline(csv, row)) {
+        int seriesNumber = 0, pair = 0;
+        ASSERT_EQ(2, std::sscanf(row.c_str(), "%d,%d,", &seriesNumber, &pair)) << row;
+        pairsOfSeries[seriesNumber].insert(pair);
+    }
+    ASSERT_EQ(2u, pairsOfSeries.size());
+    ASSERT_FALSE(pairsOfSeries[0].empty());
+    ASSERT_FALSE(pairsOfSeries[1].empty());
+    EXPECT_LT(*pairsOfSeries[0].rbegin(), *pairsOfSeries[1].begin());
 
     // Bad input is a usage error (status 2) naming what is wrong and where.
     std::ofstream(dir + "/huge.txt") << "v 4.0\nn 16 100000 100000\n";

@@ -541,6 +541,16 @@ std::vector<cv::String> darkBankFiles(const CalibrateOptions& o,
 {
     if (pathExists(o.darkBank))
         throw std::runtime_error("'" + o.darkBank + "' exists: the dark-frame bank is never written over");
+    // What save() would refuse at the end is refused here, before the calibration's work (#79 item 23).
+    const std::string ext = std::filesystem::path(o.darkBank).extension().string();
+    if (ext != ".yml" && ext != ".yaml" && ext != ".json")
+        throw std::runtime_error("--dark_bank '" + o.darkBank +
+                                 "': a bank file is .yml, .yaml or .json (the extension picks the format)");
+    const std::filesystem::path folder = std::filesystem::path(o.darkBank).parent_path();
+    std::error_code error;
+    if (!folder.empty() && !std::filesystem::is_directory(folder, error))
+        throw std::runtime_error("--dark_bank '" + o.darkBank + "': its folder '" + folder.string() +
+                                 "' does not exist (or is not a folder)");
     std::vector<cv::String> files;
     for (const CalibrationManifest::Burst& spec : specs)
         if (spec.dark)

@@ -170,7 +170,7 @@ PlotsWritten plotSeries(const std::string& outDir, const std::string& pointsCsv,
         s += "plot ";
         for (int a = 0; a < 3; ++a)
             s += cv::format(
-                "%s every ::1 using ($3 == %d ? $1 + %.2f : 1/0):6:7 with yerrorbars pt 7 lc rgb '%s' "
+                "%s every ::1 using ($4 == %d ? $2 + %.2f : 1/0):7:8 with yerrorbars pt 7 lc rgb '%s' "
                 "title '%s', ",
                 gnuplotString(validationCsv).c_str(), a + 1, 0.12 * (a - 1), kColours[a], names[a]);
         s += "1 with lines lc rgb 'black' title 'the real darker pair'\n";
@@ -269,8 +269,12 @@ Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
     out.inputs = inputs;
 
     // The paper's validation on each series' own darker steps, with the model's line at its gain.
-    CsvTable validation({"pair", "bright_point", "alignment", "dark_point", "photon_ratio", "ratio",
+    // Pairs are numbered through the whole file, each row naming its series (0 for the manifest's first, as
+    // in emva1288_points.csv), so that a manifest of several series has no two rows of one number (#79 item
+    // 26).
+    CsvTable validation({"series", "pair", "bright_point", "alignment", "dark_point", "photon_ratio", "ratio",
                          "ratio_std_error", "augmented_variance", "real_variance"});
+    size_t pairsBefore = 0;
     for (size_t k = 0; k < series.size(); ++k) {
         const NoiseLineFit& line = emva1288LineAtGain(out.report, gains[k]);
         const NoiseModel atGain(line.line.a, 0.0, std::max(line.line.b, 0.0));
@@ -317,11 +321,12 @@ Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
         for (size_t i = 0; i < d.size(); ++i) {
             out.darkening.push_back(d[i]);
             out.darkeningSeries.push_back(int(k));
-            validation.addRow(std::vector<double>{double(i / 3 + 1), double(d[i].brightPoint),
-                                                  double(int(d[i].alignment) + 1), double(d[i].darkPoint),
-                                                  d[i].photonRatio, d[i].ratio, d[i].ratioStdError,
-                                                  d[i].augmentedVariance, d[i].realVariance});
+            validation.addRow(std::vector<double>{
+                double(k), double(pairsBefore + i / 3 + 1), double(d[i].brightPoint),
+                double(int(d[i].alignment) + 1), double(d[i].darkPoint), d[i].photonRatio, d[i].ratio,
+                d[i].ratioStdError, d[i].augmentedVariance, d[i].realVariance});
         }
+        pairsBefore += d.size() / 3;
     }
 
     // Files: never over an existing one (writeNewText), each atomically.

@@ -346,6 +346,11 @@ class RawFolderDataset(torch.utils.data.Dataset):
             mosaic, fmt, camera = result.raw, result.format, result.camera or ""
             for name, seconds in zip(result.report.steps, result.report.stepSeconds):
                 steps[name] = steps.get(name, 0.0) + seconds
+        elif iso:
+            # The item's gain is the file's whatever the augmentation (#79 item 29): an ISO-1600 capture is
+            # at gain 16 of a base-ISO-100 model whether or not noise was added.
+            model, _ = self.transform._models.at(fmt, sampleSeed(self.transform.baseSeed, self.epoch, index))
+            fmt = _rg.formatAtIso(fmt, iso, model)
         beforeTensor = time.perf_counter()
         raw = _tensorOf(mosaic, fmt, self.pack, self.normalize)
         if self.timings is not None:

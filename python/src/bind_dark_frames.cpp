@@ -6,6 +6,21 @@ namespace rawgment_python {
 
 using namespace cv::rawgment;
 
+namespace {
+
+DarkFrameBank deepCopyOf(const DarkFrameBank& bank)
+{
+    DarkFrameBank copy = bank;
+    for (DarkFrameGroup& g : copy.groups) {
+        g.statistics.pattern = g.statistics.pattern.clone();
+        g.statistics.mean = g.statistics.mean.clone();
+        g.statistics.rowVariance = g.statistics.rowVariance.clone();
+    }
+    return copy;
+}
+
+} // namespace
+
 void bindDarkFrames(py::module_& m)
 {
     py::class_<DarkFrameStatistics> stats(m, "DarkFrameStatistics", doc("DarkFrameStatistics"));
@@ -95,9 +110,22 @@ void bindDarkFrames(py::module_& m)
             },
             py::arg("group"), py::arg("index"),
             doc("DarkFrameBank::readFrame", "Python: the uint16 or float32 array."))
+        // Copies are made in memory, maps and all: a copy through __reduce__ reloaded the file, which undid
+        // every edit since loading and refused a bank not saved (#79 item 11).
+        .def("__copy__", [](const DarkFrameBank& self) { return deepCopyOf(self); })
+        .def("__deepcopy__", [](const DarkFrameBank& self, py::object) { return deepCopyOf(self); })
         .def("__reduce__", [](const DarkFrameBank& self) {
             if (self.path.empty())
                 throw py::type_error("a DarkFrameBank goes to other processes by its path: save() it first");
+            // By an absolute path (load and save make it so), and only as the file holds it: an edited bank,
+            // or one whose file was replaced, would arrive in the other process as another bank (item 9).
+            bool matches = false;
+            withoutGil("DarkFrameBank pickling", [&] { matches = self.matchesItsFile(); });
+            if (!matches)
+                throw py::type_error(
+                    "this DarkFrameBank is not its file '" + self.path +
+                    "' (edited since it was loaded or saved, or the file replaced): save() it "
+                    "to pass it to other processes");
             return py::make_tuple(py::module_::import("rawgment").attr("_load_dark_frame_bank"),
                                   py::make_tuple(self.path));
         });

@@ -158,6 +158,9 @@ def test_an_iso_1600_file_is_at_gain_16_through_the_app_the_library_and_the_data
     for source in (folder, converted):
         data = rgt.RawFolderDataset(source, model, policy=policy)
         assert data[0]["gain"] == pytest.approx(16, rel=1e-12), source
+        # #79 item 29: without augmentation the item's gain is still the file's, never the format's 1.
+        plain = rgt.RawFolderDataset(source, model, augment=False)
+        assert plain[0]["gain"] == pytest.approx(16, rel=1e-12), source
         assert rgt.loadMosaic(data.files[0])[2] == 1600
 
     # A model without a base ISO cannot say which gain ISO 1600 is: refused everywhere, never gain 1.

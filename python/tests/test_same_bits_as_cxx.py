@@ -3,6 +3,7 @@ module with the same parameters and seeds, is identical (arrays bit for bit, num
 import pickle
 
 import numpy as np
+import pytest
 
 import rawgment as rg
 from conftest import chart_mean
@@ -64,6 +65,44 @@ def test_dark_frame_bank(cxx_reference, sensor, capture):
     blurred, _ = rg.motionBlur(capture, fmt, model, rg.linearMotionKernel(9, 30), rg.NoiseOptions(darkBank=path),
                                seed=9)
     same(cxx_reference, "bank_blur", blurred)
+
+
+def test_a_bank_is_copied_in_memory_and_pickled_only_as_its_own_file(cxx_reference, tmp_path, monkeypatch):
+    """#79 items 9 and 11: a bank loaded by a relative path loaded another bank in a worker with another
+    working folder; copy.deepcopy of an edited bank reverted to the file (gain 1.5 back to 1), and of an
+    unsaved bank raised TypeError."""
+    import copy
+    monkeypatch.chdir(cxx_reference)
+    bank = rg.DarkFrameBank.load("bank.yml")
+    assert bank.path == str(cxx_reference / "bank.yml")
+    monkeypatch.chdir(tmp_path)
+    assert pickle.loads(pickle.dumps(bank)) == bank
+    assert bank.readFrame(0, 0).size > 0  # its frames were resolved against the absolute folder too
+    edited = copy.deepcopy(bank)
+    groups = edited.groups
+    groups[0].gain = 1.5
+    edited.groups = groups
+    assert copy.deepcopy(edited).groups[0].gain == 1.5 and copy.copy(edited).groups[0].gain == 1.5
+    with pytest.raises(TypeError, match="is not its file"):
+        pickle.dumps(edited)
+    # A deep copy owns its maps: writing into the copy's pattern leaves the original's as it was.
+    twin = copy.deepcopy(bank)
+    statistics = twin.groups[0].statistics
+    pattern = statistics.pattern
+    pattern[0, 0] += 1000
+    statistics.pattern = pattern
+    groups = twin.groups
+    groups[0].statistics = statistics
+    twin.groups = groups
+    assert twin.groups[0].statistics.pattern[0, 0] != bank.groups[0].statistics.pattern[0, 0]
+    with pytest.raises(TypeError, match="is not its file"):
+        pickle.dumps(twin)
+    unsaved = rg.DarkFrameBank()
+    unsaved.groups = bank.groups
+    unsaved.format, unsaved.size = bank.format, bank.size
+    assert copy.deepcopy(unsaved) == unsaved
+    with pytest.raises(TypeError, match="save"):
+        pickle.dumps(unsaved)
 
 
 def test_scene_policy_and_boxes(cxx_reference, sensor, capture):

@@ -9,6 +9,7 @@ would let one library's symbols stand in for the other's, and the comparison wou
 import os
 import pathlib
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -292,3 +293,47 @@ def test_emva1288_series_figures_and_calibration(tmp_path):
         assert abs(figures.K / 0.28006 - 1) < 0.005
         assert abs(figures.sigmaYDark / 3.0731 - 1) < 0.005
         assert abs(figures.dynamicRangeDb - 61.73) < 0.04
+
+
+CONSTRUCT_AND_CALL_EACH = r"""
+import sys
+import cv2
+cls = getattr(cv2.rawgment, sys.argv[1])
+obj = cls()
+for name in sorted(n for n in dir(obj) if not n.startswith("__")):
+    try:
+        member = getattr(obj, name)
+        if callable(member):
+            member()
+    except (cv2.error, TypeError, ValueError):
+        pass
+"""
+
+
+def test_every_class_constructs_a_valid_object_and_no_method_crashes():
+    """#79 item 30: cv2.rawgment.BurstStatistics() made an object holding no C++ object, and add() on it
+    died with SIGSEGV. Each class is constructed and each method called once, with no arguments, in a
+    process of its own so that a crash is a failure naming the class, not the end of the run."""
+    classes = sorted(n for n in dir(rg) if isinstance(getattr(rg, n), type))
+    assert "BurstStatistics" in classes and "DarkFrameBank" in classes
+    crashed = {}
+    for name in classes:
+        run = subprocess.run([sys.executable, "-c", CONSTRUCT_AND_CALL_EACH, name], capture_output=True, text=True,
+                             env=dict(os.environ), timeout=120)
+        if run.returncode != 0:
+            crashed[name] = (run.returncode, run.stderr[-400:])
+    assert not crashed, crashed
+
+
+def test_a_burst_made_without_a_format_is_refused_naming_the_factory():
+    stats = rg.BurstStatistics()
+    with pytest.raises(cv2.error, match="BurstStatistics_create"):
+        stats.add(np.zeros((4, 4), np.uint16))
+    with pytest.raises(TypeError):
+        rg.BurstStatistics(rg.RawFormat())  # arguments are refused, never ignored
+    fmt = rg.RawFormat()
+    fmt.whiteLevel = 4095
+    stats.reset(fmt)
+    stats.add(np.full((4, 4), 700, np.uint16))
+    stats.add(np.full((4, 4), 702, np.uint16))
+    assert stats.frames() == 2 and np.all(stats.variance() == 2.0)

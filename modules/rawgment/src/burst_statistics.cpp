@@ -305,6 +305,7 @@ struct BurstStatistics::Impl
     int groupFrames = 8;
     int stateDepth = CV_64F;
     RawFormat format;
+    bool formatted = false; // false only after the default constructor, until reset()
     int type = -1;
     int merged = 0; // frames folded into mean/m2
     Mat mean, m2, clipped;
@@ -350,7 +351,13 @@ BurstStatistics::BurstStatistics(const RawFormat& format, int groupFrames, int s
     impl_->stateDepth = stateDepth;
     impl_->format = format;
     impl_->groupFrames = groupFrames;
+    impl_->formatted = true;
     impl_->buffers.resize(static_cast<size_t>(groupFrames));
+}
+
+BurstStatistics::BurstStatistics() : impl_(std::make_unique<Impl>())
+{
+    impl_->buffers.resize(static_cast<size_t>(impl_->groupFrames));
 }
 
 // Defined here, where Impl is complete, for the unique_ptr.
@@ -367,6 +374,10 @@ void BurstStatistics::add(InputArray _frame)
                             "or CV_32FC1",
                             typeToString(frame.type()).c_str()));
     Impl& d = *impl_;
+    if (!d.formatted)
+        CV_Error(Error::StsBadArg, "BurstStatistics::add: this object has no format: make it with "
+                                   "BurstStatistics::create(format) (cv2: BurstStatistics_create), or call "
+                                   "reset(format) first");
     if (d.type < 0 || (frames() == 0 && (frame.type() != d.type || frame.size() != d.mean.size()))) {
         // The first frame of the first burst, or of a burst after reset() of another size or type. The
         // state is written, not accumulated, by the first merge (mergeGroupRows()), so a reused state
@@ -408,6 +419,7 @@ void BurstStatistics::reset(const RawFormat& format)
     format.validate();
     Impl& d = *impl_;
     d.format = format;
+    d.formatted = true;
     d.merged = 0;
     d.pending = 0;
 }

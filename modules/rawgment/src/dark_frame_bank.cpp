@@ -341,28 +341,28 @@ void DarkFrameBank::validate() const
     }
 }
 
-void DarkFrameBank::save(const String& bankPath)
+namespace {
+
+//! The text save() writes for `bank` at `bankPath`, and its maps with the names the text gives them: the
+//! names hold each map's checksum, so two banks of one text are one bank, maps included.
+std::string bankFileText(const DarkFrameBank& bank, const String& bankPath, std::vector<String>& images,
+                         std::vector<const Mat*>& maps)
 {
-    if (empty())
-        CV_Error(Error::StsBadArg, "DarkFrameBank::save: an empty bank");
-    validate();
-    std::vector<String> images;
-    std::vector<const Mat*> maps;
-    for (size_t i = 0; i < groups.size(); ++i) {
-        maps.push_back(&groups[i].statistics.pattern);
+    for (size_t i = 0; i < bank.groups.size(); ++i) {
+        maps.push_back(&bank.groups[i].statistics.pattern);
         images.push_back(detail::mapImageName(bankPath, cv::format("%s%zu", kPatternTag, i), *maps.back()));
-        maps.push_back(&groups[i].statistics.mean);
+        maps.push_back(&bank.groups[i].statistics.mean);
         images.push_back(detail::mapImageName(bankPath, cv::format("%s%zu", kMeanTag, i), *maps.back()));
     }
-    const std::string text = fileStorageText(bankPath, [&](FileStorage& fs) {
+    return fileStorageText(bankPath, [&](FileStorage& fs) {
         fs << kTopLevelName << "{";
-        fs << "format_version" << FORMAT_VERSION;
-        format.write(fs, "format");
-        fs << "width" << size.width << "height" << size.height;
+        fs << "format_version" << DarkFrameBank::FORMAT_VERSION;
+        bank.format.write(fs, "format");
+        fs << "width" << bank.size.width << "height" << bank.size.height;
         fs << "groups"
            << "[";
-        for (size_t i = 0; i < groups.size(); ++i) {
-            const DarkFrameGroup& g = groups[i];
+        for (size_t i = 0; i < bank.groups.size(); ++i) {
+            const DarkFrameGroup& g = bank.groups[i];
             const DarkFrameStatistics& s = g.statistics;
             fs << "{";
             fs << "gain" << g.gain << "exposure_time" << g.exposureTime;
@@ -392,10 +392,45 @@ void DarkFrameBank::save(const String& bankPath)
         fs << "]";
         fs << "}";
     });
+}
+
+//! A bank's path made absolute: it is how the bank reaches other processes, whose working folder differs.
+String absoluteBankPath(const String& bankPath)
+{
+    std::error_code error;
+    const std::filesystem::path absolute = std::filesystem::absolute(bankPath, error);
+    return error ? bankPath : absolute.string();
+}
+
+} // namespace
+
+bool DarkFrameBank::matchesItsFile() const
+{
+    if (path.empty())
+        return false;
+    std::string onDisk;
+    try {
+        onDisk = detail::readTextFile(path);
+    } catch (const Exception&) {
+        return false;
+    }
+    std::vector<String> images;
+    std::vector<const Mat*> maps;
+    return bankFileText(*this, path, images, maps) == onDisk;
+}
+
+void DarkFrameBank::save(const String& bankPath)
+{
+    if (empty())
+        CV_Error(Error::StsBadArg, "DarkFrameBank::save: an empty bank");
+    validate();
+    std::vector<String> images;
+    std::vector<const Mat*> maps;
+    const std::string text = bankFileText(*this, bankPath, images, maps);
     detail::saveWithMapImages(
         bankPath, text, maps, images, [&](const String& name) { return isBankImageOf(bankPath, name); },
         "DarkFrameBank::save");
-    path = bankPath;
+    path = absoluteBankPath(bankPath);
 }
 
 DarkFrameBank DarkFrameBank::load(const String& bankPath)
@@ -426,7 +461,8 @@ DarkFrameBank DarkFrameBank::load(const String& bankPath)
             const FileNode list = n["groups"];
             if (!list.isSeq() || list.size() == 0)
                 CV_Error(Error::StsParseError, "dark-frame bank: field 'groups' must be a non-empty list");
-            const String folder = detail::folderOf(bankPath);
+            // Frames resolved against the absolute folder: a later change of working folder moves nothing.
+            const String folder = detail::folderOf(absoluteBankPath(bankPath));
             int index = 0;
             for (const FileNode& g : list) {
                 try {
@@ -439,7 +475,7 @@ DarkFrameBank DarkFrameBank::load(const String& bankPath)
             b.validate();
             return b;
         });
-    bank.path = bankPath;
+    bank.path = absoluteBankPath(bankPath);
     return bank;
 }
 

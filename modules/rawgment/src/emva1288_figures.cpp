@@ -420,15 +420,35 @@ Emva1288Results emva1288Results(const Emva1288Series& series, const std::functio
                                 series.path.c_str(), g.line, int(g.images.size())));
         const Mat a = readEmva1288Image(series, g.images[0], g.line);
         const Mat b = readEmva1288Image(series, g.images[1], g.line);
-        pairs.push_back(measureEmva1288Pair(a, b, g.exposureNs, g.photons, g.dark));
+        // A refused pair names its descriptor, line and images: the frames alone say nothing of where
+        // they came from (#79 item 24).
+        try {
+            pairs.push_back(measureEmva1288Pair(a, b, g.exposureNs, g.photons, g.dark));
+        } catch (const Exception& e) {
+            CV_Error(e.code, cv::format("emva1288Results: '%s', line %d, images '%s' and '%s': %s",
+                                        series.path.c_str(), g.line, g.images[0].c_str(), g.images[1].c_str(),
+                                        e.err.c_str()));
+        }
         stepDone();
     }
     std::vector<Emva1288Stack> stacks;
     for (const Emva1288Images& g : series.spatial) {
         StackAccumulator acc;
-        for (const String& image : g.images)
-            acc.add(readEmva1288Image(series, image, g.line));
-        stacks.push_back(acc.stack(g.exposureNs, g.photons, g.dark));
+        for (const String& image : g.images) {
+            const Mat frame = readEmva1288Image(series, image, g.line);
+            try {
+                acc.add(frame);
+            } catch (const Exception& e) {
+                CV_Error(e.code, cv::format("emva1288Results: '%s', line %d, image '%s': %s",
+                                            series.path.c_str(), g.line, image.c_str(), e.err.c_str()));
+            }
+        }
+        try {
+            stacks.push_back(acc.stack(g.exposureNs, g.photons, g.dark));
+        } catch (const Exception& e) {
+            CV_Error(e.code, cv::format("emva1288Results: '%s', line %d: %s", series.path.c_str(), g.line,
+                                        e.err.c_str()));
+        }
         stepDone();
     }
     try {

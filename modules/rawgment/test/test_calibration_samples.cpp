@@ -142,6 +142,38 @@ TEST(Calibration, burstStatisticsResetGivesTheBitsOfANewObject)
     EXPECT_CV_ERROR_CONTAINS(reused.reset(bad), "whiteLevel");
 }
 
+// The default constructor is the one cv2 wraps (#79 item 30): an object with no format refuses frames,
+// naming the factory, and once reset() gives it a format it is the constructed object, bit for bit.
+TEST(Calibration, aBurstMadeWithoutAFormatRefusesFramesUntilResetThenMatchesAConstructedOne)
+{
+    BurstStatistics unformatted;
+    const Mat frame(8, 6, CV_16UC1, Scalar(700));
+    EXPECT_CV_ERROR_CONTAINS(unformatted.add(frame), "no format: make it with BurstStatistics::create");
+    EXPECT_EQ(0, unformatted.frames());
+    EXPECT_CV_ERROR_CONTAINS(
+        {
+            Mat m;
+            unformatted.mean(m);
+        },
+        "no frame was added");
+    RawFormat fmt;
+    fmt.blackLevel = Vec4d(60, 61, 62, 63);
+    fmt.whiteLevel = 4095;
+    unformatted.reset(fmt);
+    BurstStatistics constructed(fmt);
+    RNG rng(7);
+    for (int t = 0; t < 11; ++t) {
+        Mat f(8, 6, CV_16UC1);
+        rng.fill(f, RNG::UNIFORM, 0, 4096);
+        unformatted.add(f);
+        constructed.add(f);
+    }
+    Mat v1, v2;
+    unformatted.variance(v1);
+    constructed.variance(v2);
+    EXPECT_EQ(0, cv::norm(v1, v2, NORM_INF));
+}
+
 TEST(Calibration, burstStatisticsMarkClippedPixelsAndCheckFrames)
 {
     RawFormat fmt;

@@ -264,6 +264,13 @@ TEST(Emva1288, anImageThatDoesNotMatchItsDescriptorIsAnErrorNamingItAndTheLine)
     const Mat tiff = readEmva1288Image(series, s.dir + "/ok.tif", 7);
     EXPECT_EQ(tiff.type(), CV_16UC1);
     EXPECT_EQ(tiff.at<ushort>(5, 7), 100);
+    // Each image fits the descriptor, but the pair is one 8-bit and one 16-bit PNG: the error names the
+    // descriptor, the line and both images, not only "the frames must share one size and type" (#79 item 24).
+    writeFlat(s.dir, "eight.png", Size(8, 6), 100, CV_8U);
+    const std::string mixed = s.write(s.header + "b 1000 10\ni x0.png\ni eight.png\n" + s.steps);
+    for (const std::string& fragment : {mixed + "', line 4, images '", "x0.png' and '" + s.dir + "/eight.png",
+                                        std::string("share one size and type")})
+        EXPECT_CV_ERROR_CONTAINS(emva1288Results(readEmva1288(mixed)), fragment);
 }
 
 TEST(Emva1288, aSeriesWithoutSignalIsAClearError)

@@ -413,14 +413,7 @@ TEST(Files, everyTextOpenCvsParserCouldNotTakeIsReadOrNamed)
     const FileStorage b = openFileStorageForReading(
         textFile(dir, "b.json", "{ \"t\": true, \"f\": false, \"n\": null, \"k\": 2, \"o\": 1 }"), "x");
     EXPECT_FALSE(b["t"].isInt() || b["t"].isReal());
-    EXPECT_TRUE(detail::readOptionalFlagField(b.root(), "t", false));
-    EXPECT_FALSE(detail::readOptionalFlagField(b.root(), "f", true));
-    EXPECT_TRUE(detail::readOptionalFlagField(b.root(), "o", false)); // a bool as OpenCV writes one
-    EXPECT_TRUE(detail::readOptionalFlagField(b.root(), "n", true));
-    EXPECT_CV_ERROR_CONTAINS(detail::readOptionalFlagField(b.root(), "k", false),
-                             "field 'k' must be true or false");
-    EXPECT_CV_ERROR_CONTAINS(detail::readRealField(b.root(), "t"), "field 't' is not a number");
-    EXPECT_CV_ERROR_CONTAINS(detail::readOptionalIntField(b.root(), "f", 0), "field 'f' must be an integer");
+    // The field readers' part is in test_files_internals.cpp (private functions).
     EXPECT_TRUE(b["n"].empty());
     EXPECT_CV_ERROR_CONTAINS(
         openFileStorageForReading(textFile(dir, "n.json", "{ \"a\": [ 1, null ] }"), "x"),

@@ -45,6 +45,12 @@ public:
      *         merge's delta: at mean 60000 and variance 1 the variance errs by 0.00247 relative
      *         (rawgment_tradeoffs measures it, docs/performance.md), at ordinary means far less. */
     explicit BurstStatistics(const RawFormat& format, int groupFrames = 8, int stateDepth = CV_64F);
+    /** @brief A burst with no format yet (8 frames per group, float64 state): reset(format) gives it one,
+     * and add() before that is refused, naming create(). It never throws, so it is the constructor cv2
+     * wraps: OpenCV 4.6's generated type of a class with no wrapped constructor makes an object holding
+     * no C++ object, whose first method call crashed the interpreter. format() is a default RawFormat
+     * until reset(). */
+    CV_WRAP BurstStatistics();
     /** @brief The constructor's object, held by a Ptr: the way bindings make one. OpenCV 4.6's generated
      * cv2 constructor cannot raise cv2.error (a refused argument came out as SystemError), a function can.
      * @throws cv::Exception as the constructor does. */

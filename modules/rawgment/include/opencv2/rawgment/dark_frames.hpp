@@ -90,7 +90,7 @@ struct CV_EXPORTS_W_SIMPLE DarkFrameBank
 
     //! An empty bank: no noise step uses it.
     CV_WRAP DarkFrameBank() {}
-    CV_PROP_RW String path;      //!< the file it was loaded from or saved to ("" before either)
+    CV_PROP_RW String path;      //!< the file it was loaded from or saved to, absolute ("" before either)
     CV_PROP_RW RawFormat format; //!< the frames' format, at gain 1
     CV_PROP_RW Size size;        //!< the frames' size
     CV_PROP_RW std::vector<DarkFrameGroup> groups; //!< by gain, then exposure time
@@ -123,6 +123,12 @@ struct CV_EXPORTS_W_SIMPLE DarkFrameBank
     /** @brief Writes the bank to `path` (.yml, .yaml or .json) and its patterns beside it, atomically, and
      * sets `path`. The earlier patterns of that file are removed once it names the new ones. */
     CV_WRAP void save(const String& path);
+    /** @brief True when the bank is its file's, as load() or save() left it: the text save() would write at
+     * `path` is the file's, and the maps' checksums in that text are the maps'. A bank goes to other
+     * processes by its path, so one edited in memory, or whose file was replaced, would arrive there as
+     * another bank: the Python binding refuses to pickle it. Costs a read of the file and a checksum of each
+     * map. */
+    bool matchesItsFile() const;
     /** @brief Throws cv::Exception naming the group and field when the bank is not one create() or load()
      * could make: groups not by increasing gain, fewer than two frames, maps of another size or type,
      * statistics that are negative or not finite. */
