@@ -138,6 +138,24 @@ BankRead prepareBankRead(const StepNoise& step, const RawFormat& format, Size si
                      "%s: a tied dark-frame bank takes the input's own pattern out, but it has no frames at "
                      "the input's gain %g (its nearest is %g)",
                      who, step.gainIn, in.gain));
+    if (tied) {
+        // Tied means the input was taken by the bank's own sensor: its black and white levels are the
+        // frames' (#79 item 8). An input at black 512 and white 16383 against frames at 64 and 4095 is not.
+        const RawFormat frames = bank.format.cropped(b.origin.y, b.origin.x);
+        bool same = std::abs(frames.whiteLevel - format.whiteLevel) <= 1e-9 * frames.whiteLevel;
+        for (int s = 0; s < 4; ++s)
+            same = same && std::abs(frames.blackLevel[s] - format.blackLevel[s]) <= 1e-9 * frames.whiteLevel;
+        if (!same)
+            CV_Error(
+                Error::StsBadArg,
+                cv::format("%s: a tied dark-frame bank ('%s') holds its own sensor's frames, black (%g, %g, "
+                           "%g, %g) and white %g at this crop, but the input is at black (%g, %g, %g, %g) "
+                           "and white %g: another sensor (a bank of other sensors' frames is untied)",
+                           who, step.options.darkBank.c_str(), frames.blackLevel[0], frames.blackLevel[1],
+                           frames.blackLevel[2], frames.blackLevel[3], frames.whiteLevel,
+                           format.blackLevel[0], format.blackLevel[1], format.blackLevel[2],
+                           format.blackLevel[3], format.whiteLevel));
+    }
     b.ignore = step.options.alignment == NoiseAlignment::IGNORE_PRIOR;
     for (int s = 0; s < 4; ++s)
         b.black[s] = static_cast<float>(bank.format.blackLevel[s]);

@@ -593,6 +593,16 @@ TEST(DarkFrameBank, theSameSeedGivesTheSameBitsOnEveryPathAndThreadCount)
                                          ColorJitter::exposureChange(0.3, 2.0), options, 1, out, outFormat,
                                          report),
                              "no frames at the input's gain 2");
+    // Tied to another sensor's levels: black 512 and white 16383 against the frames' own (#79 item 8).
+    RawFormat otherSensor = format;
+    otherSensor.blackLevel = Vec4d::all(512);
+    otherSensor.whiteLevel = 16383;
+    EXPECT_CV_ERROR_CONTAINS(
+        colorJitter(input16, otherSensor, model, jitter, options, 1, out, outFormat, report),
+        "holds its own sensor's frames");
+    options.darkBankTied = false;
+    EXPECT_NO_THROW(colorJitter(input16, otherSensor, model, jitter, options, 1, out, outFormat, report));
+    options.darkBankTied = true;
     options.darkBank = dir + "/missing.yml";
     EXPECT_CV_ERROR_CONTAINS(colorJitter(input16, format, model, jitter, options, 1, out, outFormat, report),
                              "missing.yml' is missing");
