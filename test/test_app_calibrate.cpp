@@ -384,7 +384,7 @@ TEST(Apps, aFailedCalibrationLeavesNoFileThatSilentlyWorks)
     EXPECT_FALSE(exists(dir + "/cal/darktable_noiseprofiles.json"));
     EXPECT_FALSE(exists(dir + "/cal/android_noise_profile.yml"));
     EXPECT_NE(std::string::npos,
-              readText(dir + "/cal/noise_model.yml").find("failed_calibration: frames per burst"));
+              readText(dir + "/cal/noise_model.yml").find("failed_calibration: \"frames per burst"));
     writeExposureScene(dir + "/scene.yml", 0.5, 1.0);
     const std::string frame = "'" + dir + "/sim/g06dB_level0.90/frame_000.png'";
     r = runApp("rawgment_augment", "--model='" + dir + "/cal/noise_model.yml' --scene='" + dir +

@@ -197,6 +197,28 @@ TEST(Apps, aPlotsPathIsDataToGnuplotNeverAProgram)
     EXPECT_NE(std::string::npos, script.find("\\047")) << script;
 }
 
+TEST(Apps, aPathWithBracketsOrBracesIsTextInEveryFileAnAppWrites)
+{
+    // An input "[in].png" broke the sidecar's YAML ("The closing '}' does not match the opening ']'"):
+    // OpenCV's `fs << path` opened a list for it (#79 item 18). Every writer now writes paths as strings.
+    const std::string dir = freshDir("brackets");
+    AppRun r = simulateTwoGains(dir);
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string input = dir + "/[in] {x}.png";
+    ASSERT_EQ(0, std::system(("cp '" + dir + "/sim/g06dB_level0.50/frame_000.png' '" + input + "' && cp '" +
+                              dir + "/sim/g06dB_level0.50/frame_000.png.yml' '" + input + ".yml'")
+                                 .c_str()));
+    writeExposureScene(dir + "/[scene].yml", 0.25, 2.0);
+    r = runApp("rawgment_augment", "--model='" + dir + "/sim/truth_noise_model.yml' --scene='" + dir +
+                                       "/[scene].yml' --out='" + dir + "/{out}' '" + input + "'");
+    ASSERT_EQ(0, r.status) << r.output;
+    cv::Mat mosaic;
+    const cv::rawgment::MosaicMetadata meta =
+        cv::rawgment::readMosaic(dir + "/{out}/[in] {x}_v00.png", mosaic);
+    EXPECT_EQ(input, meta.source);
+    EXPECT_FALSE(mosaic.empty());
+}
+
 TEST(Apps, aFileSizeLimitIsAnErrorNamingTheFileAsAFullDiskIs)
 {
     // Under `ulimit -f 16` rawgment_calibrate was killed by SIGXFSZ (exit 153), without a word, and left

@@ -95,7 +95,8 @@ std::string emvaFiguresYaml(const std::vector<Emva1288Input>& inputs,
         for (size_t k = 0; k < results.size(); ++k) {
             const Emva1288Results& r = results[k];
             fs << "{";
-            fs << "descriptor" << inputs[k].descriptor << "gain_db" << inputs[k].gainDb;
+            cv::rawgment::writeString(fs, "descriptor", inputs[k].descriptor);
+            fs << "gain_db" << inputs[k].gainDb;
             // The reference implementation's names (EMVA1288/emva1288, Results1288), in its units.
             fs << "K" << r.K << "inverse_K" << 1 / r.K << "QE" << r.eta << "sigma_y_dark" << r.sigmaYDark
                << "sigma_d" << r.sigmaD << "u_p_min" << r.muPMin << "u_e_min" << r.eta * r.muPMin / 100

@@ -213,13 +213,14 @@ std::string validationManifestText(const SimulateOptions& o,
         fs << "patches"
            << "patches.yml";
         fs << "gain_db" << o.validationGainDb;
-        fs << "bright" << files[calibrationBursts];
+        writeStringList(fs, "bright", files[calibrationBursts]);
         fs << "targets"
            << "[";
         for (size_t k = 1; k <= 2; ++k) {
             fs << "{"
                << "factor" << (k == 1 ? 0.5 : 0.1);
-            fs << "files" << files[calibrationBursts + k] << "}";
+            writeStringList(fs, "files", files[calibrationBursts + k]);
+            fs << "}";
         }
         fs << "]"
            << "}";
@@ -242,7 +243,8 @@ std::string calibrationManifestText(const std::vector<PlannedBurst>& bursts,
                << "gain_db" << bursts[i].gainDb << "level" << bursts[i].level;
             if (bursts[i].dark)
                 fs << "dark" << 1;
-            fs << "files" << files[i] << "}";
+            writeStringList(fs, "files", files[i]);
+            fs << "}";
         }
         fs << "]"
            << "}";

@@ -126,8 +126,10 @@ void NoiseOptions::writeFields(FileStorage& fs) const
 {
     fs << "alignment" << static_cast<int>(alignment) << "shot_sampling" << static_cast<int>(shotSampling)
        << "prior_mean" << static_cast<int>(priorMean) << "blur_noise_sum" << static_cast<int>(blurNoiseSum);
-    if (!darkBank.empty())
-        fs << "dark_bank" << darkBank << "dark_bank_tied" << static_cast<int>(darkBankTied);
+    if (!darkBank.empty()) {
+        writeString(fs, "dark_bank", darkBank);
+        fs << "dark_bank_tied" << static_cast<int>(darkBankTied);
+    }
 }
 
 NoiseOptions NoiseOptions::readFields(const FileNode& map)

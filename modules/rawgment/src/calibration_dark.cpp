@@ -429,11 +429,7 @@ void DarkCalibrationReport::write(FileStorage& fs, const String& name) const
     for (const Vec2d& p : ppcc)
         fs << "[:" << p[0] << p[1] << "]";
     fs << "]";
-    fs << "notes"
-       << "[";
-    for (const std::string& note : notes)
-        fs << note;
-    fs << "]";
+    writeStringList(fs, "notes", std::vector<String>(notes.begin(), notes.end()));
     fs << "}";
 }
 

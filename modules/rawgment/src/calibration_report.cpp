@@ -120,11 +120,7 @@ void CalibrationReport::write(FileStorage& fs, const String& name) const
         fs << "}";
     }
     fs << "]";
-    fs << "notes"
-       << "[";
-    for (const std::string& n : notes)
-        fs << n;
-    fs << "]";
+    writeStringList(fs, "notes", std::vector<String>(notes.begin(), notes.end()));
     fs << "}";
 }
 

@@ -366,11 +366,10 @@ std::string bankFileText(const DarkFrameBank& bank, const String& bankPath, std:
             const DarkFrameStatistics& s = g.statistics;
             fs << "{";
             fs << "gain" << g.gain << "exposure_time" << g.exposureTime;
-            fs << "frames"
-               << "[";
+            std::vector<String> frames;
             for (const String& f : g.files)
-                fs << pathInBankFile(f, bankPath);
-            fs << "]";
+                frames.push_back(pathInBankFile(f, bankPath));
+            writeStringList(fs, "frames", frames);
             fs << "file_bytes" << g.fileBytes;
             fs << "degrees_of_freedom" << s.degreesOfFreedom;
             fs << "level" << s.level << "temporal_variance" << s.temporalVariance << "row_noise_variance"
@@ -421,6 +420,7 @@ bool DarkFrameBank::matchesItsFile() const
 
 void DarkFrameBank::save(const String& bankPath)
 {
+    checkPathHasNoNul(bankPath); // before the text, which names the maps after the path
     if (empty())
         CV_Error(Error::StsBadArg, "DarkFrameBank::save: an empty bank");
     validate();

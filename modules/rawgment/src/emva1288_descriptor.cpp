@@ -42,6 +42,10 @@ double realOf(const String& path, int line, std::string word, const char* what)
     for (char& c : word)
         if (c == ',')
             c = '.';
+    // Decimal only: strtod also takes hex (0x3e8) and "inf", which the reference's float() reads otherwise
+    // or not at all (decided for #79's minor items).
+    if (word.find_first_not_of("0123456789+-.eE") != std::string::npos)
+        badLine(path, line, cv::format("%s '%s' is not a decimal number", what, word.c_str()));
     const char* begin = word.c_str();
     char* end = nullptr;
     errno = 0;
@@ -169,8 +173,17 @@ Emva1288Series readEmva1288(const String& path)
     // Each image by its file's identity: one image listed twice (in a pair, a stack or two steps) made a
     // temporal variance of 0 between them, and every figure carried it.
     std::map<detail::FileIdentity, std::pair<int, String>> imageLines;
-    std::istringstream lines(text);
+    // Line ends CRLF, LF or a lone CR (classic Mac OS): with CR alone, every line was "line 1".
+    std::string unified;
+    unified.reserve(text.size());
+    for (size_t k = 0; k < text.size(); ++k)
+        if (text[k] != '\r')
+            unified += text[k];
+        else if (k + 1 == text.size() || text[k + 1] != '\n')
+            unified += '\n';
+    std::istringstream lines(unified);
     int lineNumber = 0;
+    int versionLine = 0;
     for (std::string raw; std::getline(lines, raw);) {
         ++lineNumber;
         if (!raw.empty() && raw.back() == '\r')
@@ -218,6 +231,11 @@ Emva1288Series readEmva1288(const String& path)
         if (command == "v") {
             if (words.size() != 2)
                 badLine(path, lineNumber, "expected 'v <release>'");
+            if (versionLine > 0)
+                badLine(path, lineNumber,
+                        cv::format("a second 'v' line (the first is line %d): which release holds is a guess",
+                                   versionLine));
+            versionLine = lineNumber;
             series.version = words[1];
         } else if (command == "n") {
             if (words.size() != 4)

@@ -101,6 +101,80 @@ void checkPathHasNoNul(const String& path)
                  format("a path holds a NUL character (after '%s'); no file can be named so", path.c_str()));
 }
 
+namespace {
+
+/* The code point of the UTF-8 sequence at value[i] (advancing i), or -1 when it is not one: a byte that no
+ * sequence starts with, a sequence cut short, an overlong form, a surrogate or a value beyond U+10FFFF. */
+long decodeUtf8(const String& value, size_t& i)
+{
+    const auto byte = [&](size_t k) { return static_cast<unsigned char>(value[k]); };
+    const unsigned char lead = byte(i);
+    const int length = lead < 0x80                   ? 1
+                       : lead >= 0xc2 && lead < 0xe0 ? 2
+                       : lead >= 0xe0 && lead < 0xf0 ? 3
+                       : lead >= 0xf0 && lead < 0xf5 ? 4
+                                                     : 0;
+    if (length == 0 || i + length > value.size())
+        return -1;
+    long code = length == 1 ? lead : lead & (0x7f >> length);
+    for (int k = 1; k < length; ++k) {
+        if ((byte(i + k) & 0xc0) != 0x80)
+            return -1;
+        code = (code << 6) | (byte(i + k) & 0x3f);
+    }
+    static const long smallest[] = {0, 0, 0x80, 0x800, 0x10000};
+    if (code < smallest[length] || (code >= 0xd800 && code < 0xe000) || code > 0x10ffff)
+        return -1;
+    i += static_cast<size_t>(length);
+    return code;
+}
+
+//! YAML's printable characters (YAML 1.1, 5.1), which libyaml, the check of every file read, demands;
+//! but U+0085, a line break to libyaml, which a quoted string gives back as a space.
+bool yamlPrintable(long c)
+{
+    return c == 0x9 || c == 0xa || c == 0xd || (c >= 0x20 && c <= 0x7e) || (c >= 0xa0 && c <= 0xd7ff) ||
+           (c >= 0xe000 && c <= 0xfffd) || (c >= 0x10000 && c <= 0x10ffff);
+}
+
+} // namespace
+
+void writeString(FileStorage& fs, const String& key, const String& value)
+{
+    // OpenCV's emitter writes a string that starts and ends with '"' as it is: the escaped form given here
+    // is that, and its readers undo exactly these escapes.
+    std::string quoted = "\"";
+    for (size_t i = 0; i < value.size();) {
+        const size_t at = i;
+        const long code = decodeUtf8(value, i);
+        if (code < 0 || !yamlPrintable(code))
+            CV_Error(Error::StsBadArg,
+                     format("'%s': the text holds %s at byte %zu, which the module's readers refuse (text is "
+                            "UTF-8 without control characters but tab, line feed and carriage return)",
+                            key.c_str(), code < 0 ? "a byte that is not UTF-8" : "a control character", at));
+        const char c = value[at];
+        if (c == '\\' || c == '"')
+            quoted += {'\\', c};
+        else if (c == '\n')
+            quoted += "\\n";
+        else if (c == '\t')
+            quoted += "\\t";
+        else if (c == '\r')
+            quoted += "\\r";
+        else
+            quoted.append(value, at, i - at);
+    }
+    fs.write(key, quoted + "\"");
+}
+
+void writeStringList(FileStorage& fs, const String& key, const std::vector<String>& values)
+{
+    fs << key << "[";
+    for (const String& v : values)
+        writeString(fs, String(), v);
+    fs << "]";
+}
+
 bool pathExists(const String& path)
 {
     checkPathHasNoNul(path);

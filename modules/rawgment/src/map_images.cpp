@@ -131,8 +131,9 @@ Mat readMapImage(const FileNode& entry, const String& what, const String& folder
 
 void writeMapImageEntry(FileStorage& fs, const String& name, const Mat& map)
 {
-    fs << "{"
-       << "image" << name << "fnv1a64" << mapChecksum(map) << "}";
+    fs << "{";
+    writeString(fs, "image", name);
+    fs << "fnv1a64" << mapChecksum(map) << "}";
 }
 
 } // namespace detail

@@ -30,7 +30,7 @@ void MosaicMetadata::write(FileStorage& fs, const String& name) const
     format.write(fs, "raw_format");
     fs << "size" << size;
     fs << "type" << typeToString(type);
-    fs << "source" << source;
+    writeString(fs, "source", source);
     fs << "has_scene" << int(hasScene);
     if (hasScene) {
         scene.write(fs, "scene");
@@ -40,7 +40,7 @@ void MosaicMetadata::write(FileStorage& fs, const String& name) const
     if (hasCamera)
         camera.write(fs, "camera");
     if (!noiseCamera.empty())
-        fs << "noise_camera" << noiseCamera;
+        writeString(fs, "noise_camera", noiseCamera);
     if (gainFromIso)
         fs << "gain_from_iso" << 1;
     fs << "}";

@@ -222,7 +222,7 @@ void NoiseModel::write(FileStorage& fs, const String& name, const std::vector<St
         fs << "}";
     }
     if (!failedCalibration.empty())
-        fs << "failed_calibration" << failedCalibration;
+        writeString(fs, "failed_calibration", failedCalibration);
     if (hasMeasuredLines())
         detail::writeMeasuredLines(fs, measuredLines);
     fs << "}";
@@ -366,7 +366,9 @@ String shadingTag(int key)
 
 void NoiseModel::save(const String& path) const
 {
-    // Everything that can refuse the model runs before the first byte is written.
+    // Everything that can refuse the model runs before the first byte is written; the path first, as the
+    // maps' names in the text are made of it.
+    checkPathHasNoNul(path);
     validate();
     detail::checkDarkShadingFinite(*this);
     std::vector<String> images;

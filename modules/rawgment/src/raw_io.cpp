@@ -268,7 +268,9 @@ void CameraTags::applyTo(RawImage& image) const
 void CameraTags::write(FileStorage& fs, const String& name) const
 {
     fs << name << "{";
-    fs << "make" << make << "model" << model << "iso" << iso << "exposure_time" << exposureTime;
+    writeString(fs, "make", make);
+    writeString(fs, "model", model);
+    fs << "iso" << iso << "exposure_time" << exposureTime;
     fs << "white_balance" << std::vector<double>(whiteBalance.val, whiteBalance.val + 3);
     fs << "camera_to_srgb" << std::vector<double>(cameraToSrgb.val, cameraToSrgb.val + 9);
     std::vector<double> pairs;

@@ -80,7 +80,7 @@ size_t digitsFrom(const std::string& s, size_t at)
 
 /** Writes the values of a parsed text with OpenCV's own JSON writer: the text OpenCV's reader is given.
  * It refuses what that writer cannot write so that its reader reads it back the same (keys outside
- * OpenCV's alphabet, strings it would misquote or truncate), repeated keys, nesting beyond
+ * OpenCV's alphabet, strings it would truncate), repeated keys, nesting beyond
  * MAX_NESTING_DEPTH and integers beyond 32 bits. The root must be a map: it is the storage's own. */
 class OpenCvTextWriter
 {
@@ -173,18 +173,18 @@ public:
             refuseAt(path_, line,
                      format("a string of %zu bytes; OpenCV's files hold at most %zu", value.size(),
                             kMaxStringBytes));
-        // OpenCV's JSON writer writes a string that starts and ends with one quote character as it is,
-        // taking those for its own quotes, and its reader takes "$base64$..." for binary data.
-        if (!value.empty() && (value[0] == '"' || value[0] == '\'') && value.back() == value[0])
-            refuseAt(path_, line,
-                     format("a string that starts and ends with the quote character %c, which OpenCV's "
-                            "writer would take for its own quotes",
-                            value[0]));
+        // Strings go through writeString() (below); OpenCV's reader takes "$base64$..." for binary data.
         if (value.compare(0, 8, "$base64$") == 0)
             refuseAt(path_, line,
                      "a string that starts with $base64$, which OpenCV's reader takes for binary data");
         const std::string key = takeKey();
-        write(line, [&] { out_.write(key, value); });
+        write(line, [&] {
+            try {
+                writeString(out_, key, value);
+            } catch (const Exception&) { // a control character: as OpenCV writes it, for readers that show it
+                out_.write(key, value);
+            }
+        });
     }
 
     //! A JSON null: a key without a value is left out (a lookup finds nothing, as for a null).

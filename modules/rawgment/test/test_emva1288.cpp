@@ -7,6 +7,7 @@
 #include <opencv2/rawgment/emva1288.hpp>
 #include <opencv2/rawgment/simulate.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <numeric>
 #include <unistd.h>
@@ -185,6 +186,17 @@ TEST(Emva1288, aDescriptorIsReadAsTheReferenceReadsIt)
     EXPECT_EQ(series.temporal[0].images[0], s.dir + "/images/b0_1.png");
     EXPECT_EQ(series.temporal[0].line, 4);
     EXPECT_TRUE(series.spatial.empty());
+    // Lone CRs (classic Mac OS) end lines too: every line was "line 1" before.
+    std::string crOnly = s.header + s.steps;
+    for (char& c : crOnly)
+        if (c == '\n')
+            c = '\r';
+    crOnly.erase(
+        std::unique(crOnly.begin(), crOnly.end(), [](char a, char b) { return a == '\r' && b == '\r'; }),
+        crOnly.end());
+    const Emva1288Series mac = readEmva1288(s.write(crOnly));
+    EXPECT_EQ(mac.temporal.size(), 6u);
+    EXPECT_EQ(mac.temporal[1].line, 7);
 }
 
 TEST(Emva1288, everyBadDescriptorIsAnErrorNamingTheFileAndLine)
@@ -207,7 +219,10 @@ TEST(Emva1288, everyBadDescriptorIsAnErrorNamingTheFileAndLine)
         {"n twelve 8 6\n", "bits 'twelve' is not an integer"},
         {h + "b -5 10\ni b0_1.png\ni b0_2.png\n" + s.steps, "line 4: exposure -5 is negative"},
         {h + "b 5 -10\ni b0_1.png\ni b0_2.png\n" + s.steps, "line 4: photons -10 is negative"},
-        {h + "b 5 nan\ni b0_1.png\ni b0_2.png\n" + s.steps, "photons 'nan' is not a finite number"},
+        {h + "b 5 nan\ni b0_1.png\ni b0_2.png\n" + s.steps, "photons 'nan' is not a decimal number"},
+        // Decided (#79, minor): numbers are decimal (strtod took 0x3e8 for 1000), and one 'v' line holds.
+        {h + "b 0x3e8 10\ni b0_1.png\ni b0_2.png\n" + s.steps, "line 4: exposure '0x3e8' is not a decimal"},
+        {h + "v 3.0\n" + s.steps, "line 4: a second 'v' line (the first is line 2)"},
         {h + "b 5 1e308\ni b0_1.png\ni b0_2.png\n" + s.steps, "photons 1e+308 is beyond the 1e+12"},
         {h + "d 1e16\ni b0_1.png\ni b0_2.png\n" + s.steps, "exposure 1e+16 is beyond the 1e+15"},
         {h + "b 5 10\ni b0_1.png\n" + s.steps, "line 4: the exposure has 1 image(s)"},

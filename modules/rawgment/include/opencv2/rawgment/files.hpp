@@ -49,6 +49,22 @@ CV_RAWGMENT_EXPORTS void removeTemporaryFilesInProgress();
  * module raises ValueError for it). */
 CV_RAWGMENT_EXPORTS void checkPathHasNoNul(const String& path);
 
+/** @brief Writes `value` into `fs` as a string, whatever it holds: the one way every writer of the module
+ * and its apps puts a path, a name or a note into a YAML or JSON file. OpenCV's `fs << value` opens a list
+ * or a map when the string starts with '[' or '{' (a path `[0] dark.png` broke the file), and its writer
+ * drops the quotes of `"q"` and the spaces that end `a `; here the value is quoted and escaped, so that
+ * OpenCV's reader gives back exactly `value`.
+ * @param fs an open FileStorage for writing, where a value is expected
+ * @param key the entry's name, or "" for an element of the list being written
+ * @param value UTF-8 text without a control character other than tab, line feed and carriage return
+ * @throws cv::Exception naming the key and the byte for a NUL, another control character or bytes that are
+ * not UTF-8: the module's readers (libyaml's check, then OpenCV's parser) refuse or cannot give back those,
+ * so a file holding them is never written. */
+CV_RAWGMENT_EXPORTS void writeString(FileStorage& fs, const String& key, const String& value);
+//! @brief writeString() of a list: `key: [values...]`, each element a string.
+CV_RAWGMENT_EXPORTS void writeStringList(FileStorage& fs, const String& key,
+                                         const std::vector<String>& values);
+
 /** @brief Whether anything (a file, a folder, or a link to one) exists at `path`: the one existence check of
  * the library, its pipeline and its apps. */
 CV_RAWGMENT_EXPORTS bool pathExists(const String& path);
