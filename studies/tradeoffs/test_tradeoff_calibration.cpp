@@ -146,8 +146,10 @@ TEST(Tradeoffs, theBanksPatternComesCloserToTheSensorsWithEveryFramePerGain)
     const std::map<std::string, const TradeoffRow*> row = bySetting(rows, "Dark-frame bank frames per gain");
     // The sensor's temporal variance at gain 4 (tradeoff_dark_bank.cpp): read noise, row noise 0.3 g^2 + 0.5,
     // rounding; its pattern's variance s_F^2 = 1 DN^2 (DSNU 1 DN).
-    const cv::rawgment::NoiseModel m = cv::rawgment::SensorParams().noise;
-    const double gain = 4, v = gain * gain * (m.sigmaD2 + 0.3) + m.sigmaR2 + 0.5 + 1.0 / 12;
+    cv::rawgment::NoiseModel m = cv::rawgment::SensorParams().noise;
+    m.rowSigmaD2 = 0.3;
+    m.rowSigmaR2 = 0.5;
+    const double gain = 4, v = m.variance(0, gain) + m.rowVariance(gain) + 1.0 / 12;
     ASSERT_EQ(row.size(), set.bankFrames.size());
     for (size_t k = 0; k < set.bankFrames.size(); ++k) {
         const TradeoffRow& r = *row.at(cv::format("%d frames", set.bankFrames[k]));
