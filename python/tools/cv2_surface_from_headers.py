@@ -144,7 +144,6 @@ def read_header(path, surface):
 
     def enum(head, body):
         scoped = re.match(r"\s*enum\s+(class|struct)\s+(\w+)", head)
-        named = re.match(r"\s*enum\s+(\w+)", head)
         values = [re.split(r"=", v)[0].strip() for v in body.split(",")]
         values = [v for v in values if v]
         if not in_module():
@@ -160,7 +159,6 @@ def read_header(path, surface):
                 surface.add("%s_%s" % (cls[1], value), "int", where)
             else:
                 surface.add(value, "int", where)
-        del named
 
     pos = 0
     head_start = 0
