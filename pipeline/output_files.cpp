@@ -7,7 +7,6 @@
 #include <opencv2/rawgment/files.hpp>
 
 #include <cerrno>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -18,6 +17,17 @@
 #include <unistd.h>
 
 namespace rawgment_pipeline {
+
+void reportRemovedTemporaries()
+{
+    const std::vector<std::string> removed = cv::rawgment::takeRemovedStaleTemporaries();
+    if (removed.empty())
+        return;
+    std::cerr << "removed " << removed.size() << " temporary file(s) that interrupted runs left:";
+    for (const std::string& path : removed)
+        std::cerr << " '" << path << "'";
+    std::cerr << "\n";
+}
 
 void writeBytesAtomically(const std::string& path, const void* data, size_t size)
 {
@@ -68,51 +78,11 @@ void writeNewBytes(const std::string& path, const std::vector<uchar>& bytes)
     }
 }
 
-/* The process that wrote a temporary file: "<file>.tmp-<pid>-<n>" (writeFileAtomically) or
- * "<plot>.gp.<pid>.run" (a gnuplot script); 0 for any other name. */
-pid_t temporaryOwner(const std::string& name)
-{
-    // Digits only, at most 9 of them (pids are far below), so that the number always fits.
-    const auto number = [&](size_t from, size_t to) -> long {
-        if (to <= from || to - from > 9)
-            return 0;
-        for (size_t i = from; i < to; ++i)
-            if (name[i] < '0' || name[i] > '9')
-                return 0;
-        return std::stol(name.substr(from, to - from));
-    };
-    const size_t tmp = name.rfind(".tmp-");
-    if (tmp != std::string::npos) {
-        const size_t dash = name.find('-', tmp + 5);
-        if (dash != std::string::npos && dash + 1 < name.size() &&
-            name.find_first_not_of("0123456789", dash + 1) == std::string::npos)
-            return static_cast<pid_t>(number(tmp + 5, dash));
-    }
-    const size_t gp = name.rfind(".gp.");
-    if (gp != std::string::npos && name.size() >= gp + 8 && name.compare(name.size() - 4, 4, ".run") == 0)
-        return static_cast<pid_t>(number(gp + 4, name.size() - 4));
-    return 0;
-}
-
 } // namespace
 
 void prepareOutputDirectory(const std::string& dir)
 {
     makeDirectories(dir);
-    int removed = 0;
-    std::error_code error;
-    for (auto it = std::filesystem::recursive_directory_iterator(dir, error);
-         !error && it != std::filesystem::recursive_directory_iterator(); it.increment(error)) {
-        const pid_t pid = temporaryOwner(it->path().filename().string());
-        if (pid <= 0 || !it->is_regular_file(error))
-            continue;
-        if (pid != ::getpid() && ::kill(pid, 0) != 0 && errno == ESRCH &&
-            std::remove(it->path().c_str()) == 0)
-            ++removed;
-    }
-    if (removed > 0)
-        std::cerr << "removed " << removed << " temporary file(s) that interrupted runs left in " << dir
-                  << "\n";
     const std::string probe = dir + "/.rawgment-write-test-" + std::to_string(::getpid());
     try {
         cv::rawgment::writeFileAtomically(probe, "ok", 2, true);

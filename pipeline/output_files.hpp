@@ -18,10 +18,12 @@ using cv::rawgment::isRegularFile;
 using cv::rawgment::pathExists;
 //! `path` with '.', '..' and links resolved (as far as it exists): two names of one file compare equal.
 std::string canonicalPath(const std::string& path);
-/** Makes `dir` (and its parents), removes the temporaries that interrupted runs left in it (files
- * `*.tmp-<pid>-<n>` and `*.gp.<pid>.run` of processes that are gone, saying how many), and checks that a
- * file can be written there: before any computation, not after it. Throws std::runtime_error. */
+/** Makes `dir` (and its parents) and checks that a file can be written there: before any computation,
+ * not after it. The temporaries that killed runs left are removed by the writer, one output at a time
+ * (cv::rawgment::takeRemovedStaleTemporaries()), never by walking the folder. Throws std::runtime_error. */
 void prepareOutputDirectory(const std::string& dir);
+//! Says on stderr which temporaries of killed runs the writes of this process removed (the apps, at exit).
+void reportRemovedTemporaries();
 
 //! Creates a directory and its parents (like mkdir -p); throws std::runtime_error naming the path.
 void makeDirectories(const std::string& path);

@@ -249,11 +249,21 @@ TEST(Apps, aRunRemovesTheTemporariesThatKilledRunsLeft)
     while (::kill(gone, 0) == 0 || errno != ESRCH)
         --gone;
     std::ofstream(dir + "/manifest.yml.tmp-" + std::to_string(gone) + "-0") << "half a file";
+    // Round 5 item 16: a user's files whose names look like temporaries, but not of this job's outputs,
+    // stay; the cleanup used to walk the tree and remove "sub/thesis.tmp-20240101-1".
+    ::mkdir((dir + "/sub").c_str(), 0755);
+    const std::vector<std::string> users = {"sub/thesis.tmp-20240101-1",
+                                            "notes.txt.tmp-" + std::to_string(gone) + "-0",
+                                            "sub/manifest.yml.tmp-" + std::to_string(gone) + "-0"};
+    for (const std::string& name : users)
+        std::ofstream(dir + "/" + name) << "the user's";
     AppRun r =
         runApp("rawgment_simulate", "--out='" + dir + "' --frames=3 --gains=6 --levels=0.5 --format=png");
     ASSERT_EQ(0, r.status) << r.output;
     EXPECT_NE(std::string::npos, r.output.find("removed 1 temporary file(s)")) << r.output;
     EXPECT_FALSE(exists(dir + "/manifest.yml.tmp-" + std::to_string(gone) + "-0"));
+    for (const std::string& name : users)
+        EXPECT_TRUE(exists(dir + "/" + name)) << name;
 }
 
 TEST(Apps, aRunStoppedWhileAPlotIsDrawnLeavesNoScriptBehind)

@@ -98,7 +98,7 @@ TEST(Pipeline, aNewFileNeverReplacesAnotherButKeepsItsOwnBytes)
     EXPECT_FALSE(pathExists(dir + "/missing"));
 }
 
-TEST(Pipeline, anOutputFolderLosesOnlyTheTemporariesOfRunsThatAreGone)
+TEST(Pipeline, anOutputFolderLosesOnlyTheTemporariesOfItsOutputsWhoseRunsAreGone)
 {
     const std::string dir = freshFolder("temporaries");
     // A process id that is not running: fork a child that exits at once, and wait for it.
@@ -109,12 +109,19 @@ TEST(Pipeline, anOutputFolderLosesOnlyTheTemporariesOfRunsThatAreGone)
     int status = 0;
     ASSERT_EQ(waitpid(gone, &status, 0), gone);
     const std::string stale = dir + "/out.npy.tmp-" + std::to_string(gone) + "-1";
-    const std::string live = dir + "/out.npy.tmp-" + std::to_string(getpid()) + "-1";
+    // The parent (ctest or a shell) is alive; this process's own pid would collide with its own writer's
+    // names.
+    const std::string live = dir + "/out.npy.tmp-" + std::to_string(getppid()) + "-1";
     for (const std::string& p : {stale, live, dir + "/keep.npy"})
         std::ofstream(p) << "x";
+    const std::string other = dir + "/other.npy.tmp-" + std::to_string(gone) + "-1";
+    std::ofstream(other) << "x";
     prepareOutputDirectory(dir);
-    EXPECT_FALSE(pathExists(stale)) << "a killed run's temporary stays";
+    EXPECT_TRUE(pathExists(stale)) << "preparing a folder removes nothing (round 5 item 16)";
+    writeNewText(dir + "/out.npy", "new");
+    EXPECT_FALSE(pathExists(stale)) << "a killed run's temporary of this output stays";
     EXPECT_TRUE(pathExists(live)) << "a running process's temporary was removed";
+    EXPECT_TRUE(pathExists(other)) << "a temporary of a file this run did not write was removed";
     EXPECT_TRUE(pathExists(dir + "/keep.npy"));
     prepareOutputDirectory(dir + "/new/nested");
     EXPECT_TRUE(fs::is_directory(dir + "/new/nested"));

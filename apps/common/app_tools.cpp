@@ -51,6 +51,7 @@ void installInterruptCleanup()
     // write() fails with EFBIG instead, which the atomic writer reports naming the file, as a full disk.
     if (::signal(SIGXFSZ, SIG_IGN) == SIG_ERR)
         std::cerr << "warning: cannot ignore SIGXFSZ\n";
+    std::atexit(reportRemovedTemporaries);
 }
 
 uint64_t parseSeed(const std::string& text)

@@ -8,8 +8,11 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <dirent.h>
 #include <fcntl.h>
 #include <map>
+#include <mutex>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -412,7 +415,133 @@ void commitTemporaryFileNoReplace(const String& tmpPath, const String& path)
     CV_Error(Error::StsError, "cannot create '" + path + "': " + std::strerror(err));
 }
 
+/* The process that left `entry` as a temporary of a file named `target` in the same folder: the pid of
+ * "<target>.tmp-<pid>-<n>" (this writer's) or "<target>.<pid>.run" with a target "<plot>.gp" (a plot's
+ * script when the kernel has no memfd); 0 for any other name. */
+long temporaryOwnerOf(const String& entry, String& target)
+{
+    const auto digitsBetween = [&](size_t from, size_t to) {
+        return to > from && to - from <= 9 &&
+               std::all_of(entry.begin() + from, entry.begin() + to,
+                           [](char c) { return c >= '0' && c <= '9'; });
+    };
+    const size_t tmp = entry.rfind(".tmp-");
+    if (tmp != String::npos && tmp > 0) {
+        const size_t dash = entry.find('-', tmp + 5);
+        if (dash != String::npos && digitsBetween(tmp + 5, dash) && digitsBetween(dash + 1, entry.size())) {
+            target = entry.substr(0, tmp);
+            return std::stol(entry.substr(tmp + 5, dash - tmp - 5));
+        }
+    }
+    if (entry.size() > 4 && entry.compare(entry.size() - 4, 4, ".run") == 0) {
+        const size_t dot = entry.rfind('.', entry.size() - 5);
+        if (dot != String::npos && dot >= 3 && entry.compare(dot - 3, 3, ".gp") == 0 &&
+            digitsBetween(dot + 1, entry.size() - 4)) {
+            target = entry.substr(0, dot);
+            return std::stol(entry.substr(dot + 1, entry.size() - 5 - dot));
+        }
+    }
+    return 0;
+}
+
+/* The temporaries that killed writers left, by folder. A folder is listed again only when its mtime is not
+ * the one this process's own last write left: a folder of 100 000 outputs costs one listing, not one per
+ * output, and a temporary another process leaves later (a killed run beside a long-lived Python process)
+ * is still seen. */
+struct FolderListing
+{
+    timespec mtime{};
+    std::multimap<String, std::pair<String, long>> temporaries; // target -> (entry, pid)
+};
+struct StaleTemporaries
+{
+    std::mutex mutex;
+    std::map<String, FolderListing> byFolder;
+    std::vector<String> removed;
+};
+StaleTemporaries& staleTemporaries()
+{
+    static StaleTemporaries* stale = new StaleTemporaries; // never destroyed: writes may run at exit
+    return *stale;
+}
+
+String folderOf(const String& path)
+{
+    const size_t slash = path.find_last_of('/');
+    return slash == String::npos ? String(".") : slash == 0 ? String("/") : path.substr(0, slash);
+}
+
+bool sameTime(const timespec& a, const timespec& b)
+{
+    return a.tv_sec == b.tv_sec && a.tv_nsec == b.tv_nsec;
+}
+
+/* Removes "<path>.tmp-<pid>-<n>" (and a plot script's "<path>.<pid>.run") whose process is gone: what a
+ * SIGKILL left of an earlier write of this very file. Temporaries of other names are never touched, nor
+ * those of a live process, nor anything that is not a regular file. */
+void removeStaleTemporariesOf(const String& path)
+{
+    const String folder = folderOf(path);
+    const size_t slash = path.find_last_of('/');
+    const String name = slash == String::npos ? path : path.substr(slash + 1);
+    struct stat folderStat;
+    if (::stat(folder.c_str(), &folderStat) != 0)
+        return; // the write itself reports a missing folder
+    StaleTemporaries& stale = staleTemporaries();
+    const std::lock_guard<std::mutex> lock(stale.mutex);
+    FolderListing& listing = stale.byFolder[folder];
+    if (!sameTime(listing.mtime, folderStat.st_mtim)) {
+        listing.mtime = folderStat.st_mtim;
+        listing.temporaries.clear();
+        if (DIR* dir = ::opendir(folder.c_str())) {
+            while (const dirent* entry = ::readdir(dir)) {
+                String target;
+                const long pid = temporaryOwnerOf(entry->d_name, target);
+                if (pid > 0)
+                    listing.temporaries.emplace(target, std::make_pair(String(entry->d_name), pid));
+            }
+            ::closedir(dir);
+        }
+    }
+    const auto range = listing.temporaries.equal_range(name);
+    for (auto it = range.first; it != range.second; ++it) {
+        const long pid = it->second.second;
+        const String entryPath =
+            (slash == String::npos ? String() : path.substr(0, slash + 1)) + it->second.first;
+        struct stat st;
+        if (pid == static_cast<long>(::getpid()) || ::kill(static_cast<pid_t>(pid), 0) == 0 ||
+            errno != ESRCH || ::lstat(entryPath.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
+            continue;
+        if (::unlink(entryPath.c_str()) == 0)
+            stale.removed.push_back(entryPath);
+    }
+    listing.temporaries.erase(range.first, range.second);
+}
+
+// After this process wrote into the folder of `path`: its own change needs no new listing.
+void noteOwnWriteInFolderOf(const String& path)
+{
+    const String folder = folderOf(path);
+    struct stat folderStat;
+    if (::stat(folder.c_str(), &folderStat) != 0)
+        return;
+    StaleTemporaries& stale = staleTemporaries();
+    const std::lock_guard<std::mutex> lock(stale.mutex);
+    const auto listing = stale.byFolder.find(folder);
+    if (listing != stale.byFolder.end())
+        listing->second.mtime = folderStat.st_mtim;
+}
+
 } // namespace
+
+std::vector<String> takeRemovedStaleTemporaries()
+{
+    StaleTemporaries& stale = staleTemporaries();
+    const std::lock_guard<std::mutex> lock(stale.mutex);
+    std::vector<String> removed;
+    removed.swap(stale.removed);
+    return removed;
+}
 
 void removeTemporaryFilesInProgress()
 {
@@ -428,6 +557,7 @@ void writeFileAtomically(const String& path, const void* data, size_t size, bool
     checkPathHasNoNul(path);
     if (!data && size > 0)
         CV_Error(Error::StsBadArg, "writeFileAtomically: no data for " + std::to_string(size) + " bytes");
+    removeStaleTemporariesOf(path);
     const String tmp = temporaryPathFor(path);
     const TemporaryRegistration registration(tmp);
     FILE* f = std::fopen(tmp.c_str(), "wb");
@@ -447,6 +577,7 @@ void writeFileAtomically(const String& path, const void* data, size_t size, bool
     else
         commitTemporaryFileNoReplace(tmp, path);
     syncDirectoryOf(path);
+    noteOwnWriteInFolderOf(path);
 }
 
 } // namespace rawgment

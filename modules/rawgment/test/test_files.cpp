@@ -190,6 +190,46 @@ TEST(Files, removeTemporaryFilesInProgressRemovesAWriteInFlight)
     EXPECT_TRUE(filesIn(dir).empty()) << "neither the temporary nor the target may remain";
 }
 
+TEST(Files, aWriteRemovesOnlyItsOwnTargetsTemporariesThatAGoneProcessLeft)
+{
+    const auto fileExists = [](const std::string& path) {
+        struct stat st;
+        return ::lstat(path.c_str(), &st) == 0;
+    };
+    // Round 5 item 16: the cleanup walked the whole output tree and matched a name pattern, so a user's
+    // "sub/thesis.tmp-20240101-1" was deleted. Now only "<target>.tmp-<pid>-<n>" of the file being
+    // written goes, and only when no process <pid> is alive.
+    const std::string dir = makeTempDir("stale_temporaries");
+    ASSERT_EQ(0, ::mkdir((dir + "/sub").c_str(), 0755));
+    pid_t gone = 4194000;
+    while (::kill(gone, 0) == 0 || errno != ESRCH)
+        --gone;
+    const std::string g = std::to_string(gone), alive = std::to_string(::getppid());
+    const std::vector<std::string> kept = {"sub/thesis.tmp-20240101-1", "sub/out.yml.tmp-" + g + "-0",
+                                           "other.yml.tmp-" + g + "-0", "out.yml.tmp-" + alive + "-0",
+                                           "out.yml.tmp-" + g + "-x",   "out.yml.gp.tmp-" + g,
+                                           "out.yml." + g + ".run"};
+    const std::vector<std::string> removed = {"out.yml.tmp-" + g + "-0", "out.yml.tmp-" + g + "-17",
+                                              "plot.png.gp." + g + ".run"};
+    for (const std::string& name : kept)
+        std::ofstream(dir + "/" + name) << "the user's";
+    for (const std::string& name : removed)
+        std::ofstream(dir + "/" + name) << "half a file";
+    ASSERT_EQ(0, ::symlink("/nonexistent", (dir + "/plot.png.gp.tmp-" + g + "-1").c_str()));
+    takeRemovedStaleTemporaries();
+    writeFileAtomically(dir + "/out.yml", "a: 1\n", 5, true);
+    writeFileAtomically(dir + "/plot.png.gp", "plot x\n", 7, true);
+    for (const std::string& name : kept)
+        EXPECT_TRUE(fileExists(dir + "/" + name)) << name << " is not a temporary of a file written here";
+    for (const std::string& name : removed)
+        EXPECT_FALSE(fileExists(dir + "/" + name)) << name;
+    struct stat st;
+    EXPECT_EQ(0, ::lstat((dir + "/plot.png.gp.tmp-" + g + "-1").c_str(), &st)) << "a link is never removed";
+    const std::vector<std::string> reported = takeRemovedStaleTemporaries();
+    EXPECT_EQ(removed.size(), reported.size());
+    EXPECT_TRUE(takeRemovedStaleTemporaries().empty()) << "a report is given once";
+}
+
 TEST(Files, openFileStorageForReadingRefusesStreamsOpenCvNeverFinishes)
 {
     // Found by test/fuzz (minimised): OpenCV 4.6's YAML parser loops forever on each of these. libyaml

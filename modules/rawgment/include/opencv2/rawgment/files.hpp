@@ -38,9 +38,21 @@ CV_RAWGMENT_EXPORTS void writeFileAtomically(const String& path, const void* dat
  * Async-signal-safe: meant for a SIGINT or SIGTERM handler of a program that must leave no partial
  * file behind when it is stopped (the apps install one). The target files are untouched: a write in
  * progress simply never happened. Temporaries are named `<target>.tmp-<pid>-<n>`; a process killed
- * with SIGKILL leaves its own, which a later run may remove once that pid is gone.
+ * with SIGKILL leaves its own, which the next writeFileAtomically() of that same target removes once
+ * that pid is gone (see takeRemovedStaleTemporaries()).
  */
 CV_RAWGMENT_EXPORTS void removeTemporaryFilesInProgress();
+
+/** @brief The temporaries of killed writers that writeFileAtomically() removed in this process since the
+ * last call, and forgets them: what an app reports when it ends.
+ *
+ * Before it writes `path`, writeFileAtomically() removes `<path>.tmp-<pid>-<n>` (and `<path>.<pid>.run`,
+ * a plot script's, for a `path` ending in `.gp`) when no process `<pid>` is alive: only the leftovers of
+ * an earlier write of that same file. A file of any other name, one whose writer still runs, and anything
+ * that is not a regular file are never removed, and folders are never walked. Each folder is listed once
+ * per process, at the first write into it.
+ */
+CV_RAWGMENT_EXPORTS std::vector<String> takeRemovedStaleTemporaries();
 
 /** @brief Refuses a path that holds a NUL character, as Python's open() does: the operating system reads
  * such a path only up to the NUL, so `bank.save("other.yml\0.json")` wrote its maps and its bank over one
