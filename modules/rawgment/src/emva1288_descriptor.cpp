@@ -3,6 +3,7 @@
 // reference implementation reads it (commands v, n, b, d, i; '#' comments; CRLF; Windows separators; a
 // decimal comma), but strictly: what it would warn about and skip is an error naming the line here. An
 // image's header is read before the image is decoded, so a file that claims a huge image allocates nothing.
+#include "image_headers.hpp"
 #include "precomp.hpp"
 
 #include <opencv2/imgcodecs.hpp>
@@ -73,86 +74,6 @@ String resolvedImagePath(const String& folder, std::string name)
         if (c == '\\')
             c = '/';
     return (!name.empty() && name[0] == '/') ? String(name) : folder + name;
-}
-
-uint32_t bigEndian32(const uchar* p)
-{
-    return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | uint32_t(p[3]);
-}
-
-//! What an image file's header states, read before it is decoded.
-struct ImageHeader
-{
-    long long width = 0, height = 0;
-    int bitDepth = 0, channels = 0;
-};
-
-bool pngHeader(const std::string& bytes, ImageHeader& h)
-{
-    static const char kSignature[] = "\x89PNG\r\n\x1a\n";
-    if (bytes.size() < 33 || bytes.compare(0, 8, kSignature, 8) != 0)
-        return false;
-    const uchar* p = reinterpret_cast<const uchar*>(bytes.data());
-    if (std::memcmp(p + 12, "IHDR", 4) != 0)
-        return false;
-    h.width = bigEndian32(p + 16);
-    h.height = bigEndian32(p + 20);
-    h.bitDepth = p[24];
-    const int colourType = p[25];
-    h.channels = colourType == 0 ? 1 : colourType == 4 ? 2 : colourType == 2 ? 3 : colourType == 6 ? 4 : 0;
-    return true;
-}
-
-/** A classic TIFF's first directory: ImageWidth (256), ImageLength (257), BitsPerSample (258),
- * SamplesPerPixel (277). Every offset is checked against the file's size. */
-bool tiffHeader(const std::string& bytes, ImageHeader& h, std::string& why)
-{
-    if (bytes.size() < 8)
-        return false;
-    const bool little = bytes.compare(0, 4, "II*\0", 4) == 0;
-    const bool big = bytes.compare(0, 4, "MM\0*", 4) == 0;
-    if (!little && !big) {
-        if (bytes.compare(0, 4, "II+\0", 4) == 0 || bytes.compare(0, 4, "MM\0+", 4) == 0)
-            why = "it is a BigTIFF; only classic TIFF and PNG images are read";
-        return false;
-    }
-    const uchar* p = reinterpret_cast<const uchar*>(bytes.data());
-    const auto u16 = [&](size_t at) {
-        return little ? uint32_t(p[at] | (p[at + 1] << 8)) : uint32_t((p[at] << 8) | p[at + 1]);
-    };
-    const auto u32 = [&](size_t at) {
-        return little ? (uint32_t(p[at]) | (uint32_t(p[at + 1]) << 8) | (uint32_t(p[at + 2]) << 16) |
-                         (uint32_t(p[at + 3]) << 24))
-                      : bigEndian32(p + at);
-    };
-    const size_t ifd = u32(4);
-    if (ifd + 2 > bytes.size()) {
-        why = "its TIFF directory lies beyond the end of the file";
-        return false;
-    }
-    const size_t entries = u16(ifd);
-    if (ifd + 2 + 12 * entries > bytes.size()) {
-        why = "its TIFF directory runs beyond the end of the file";
-        return false;
-    }
-    h.channels = 1;
-    for (size_t e = 0; e < entries; ++e) {
-        const size_t at = ifd + 2 + 12 * e;
-        const uint32_t tag = u16(at), type = u16(at + 2), count = u32(at + 4);
-        // SHORT values sit in the first two bytes of the value field, LONG in all four.
-        const uint32_t value = type == 3 ? u16(at + 8) : u32(at + 8);
-        if (tag == 256)
-            h.width = value;
-        else if (tag == 257)
-            h.height = value;
-        else if (tag == 258)
-            h.bitDepth = count == 1 ? int(value) : -1;
-        else if (tag == 277)
-            h.channels = int(value);
-    }
-    if (h.bitDepth == 0)
-        h.bitDepth = 1; // TIFF's default BitsPerSample
-    return true;
 }
 
 } // namespace
@@ -347,9 +268,9 @@ Mat readEmva1288Image(const Emva1288Series& series, const String& imagePath, int
     // A PNG may be a little larger than its pixels (incompressible noise); 16 bits each, twice, bounds both.
     const long long maxBytes = 4LL * series.width * series.height + (1LL << 20);
     const std::string bytes = readFileBounded(imagePath, maxBytes, where);
-    ImageHeader h;
+    detail::ImageHeader h;
     std::string why;
-    if (!pngHeader(bytes, h) && !tiffHeader(bytes, h, why))
+    if (!detail::readImageHeader(bytes, h, why))
         fail(why.empty() ? "it is neither a PNG nor a TIFF image" : why);
     if (h.width != series.width || h.height != series.height)
         fail(cv::format("it is %lld x %lld, but the descriptor's 'n' line says %d x %d", h.width, h.height,

@@ -3,6 +3,7 @@
 #include "map_images.hpp"
 
 #include "file_access.hpp"
+#include "image_headers.hpp"
 #include "precomp.hpp"
 
 #include <opencv2/imgcodecs.hpp>
@@ -17,6 +18,22 @@
 namespace cv {
 namespace rawgment {
 namespace detail {
+
+namespace {
+
+// Whether the file at `image` holds exactly `map`: read with the bound and header check of any map image,
+// so a damaged or hostile file there is simply not this map.
+bool isOwnMapImage(const String& image, const Mat& map)
+{
+    try {
+        return mapChecksum(readImageFileOfSize(image, map.size(), map.type(), "map image")) ==
+               mapChecksum(map);
+    } catch (const Exception&) {
+        return false;
+    }
+}
+
+} // namespace
 
 std::string mapChecksum(const Mat& map)
 {
@@ -69,7 +86,7 @@ void saveWithMapImages(const String& ownerPath, const std::string& text, const s
             // Same name, same checksum: a map an earlier save left is this one already (when its pixels
             // say so; a damaged one is replaced, as nothing can load it).
             const bool present = pathExists(image);
-            if (present && mapChecksum(imread(image, IMREAD_UNCHANGED)) == mapChecksum(*maps[i]))
+            if (present && isOwnMapImage(image, *maps[i]))
                 continue;
             std::vector<uchar> bytes;
             if (!imencode(".tiff", *maps[i], bytes, {IMWRITE_TIFF_COMPRESSION, 1}) || bytes.empty())
@@ -114,12 +131,9 @@ Mat readMapImage(const FileNode& entry, const String& what, const String& folder
     if (!S_ISREG(info.st_mode))
         CV_Error(Error::StsParseError,
                  format("%s: image '%s' is not a regular file", what.c_str(), path.c_str()));
-    const Mat map = imread(path, IMREAD_UNCHANGED);
-    if (map.type() != CV_32FC1 || map.size() != size)
-        CV_Error(Error::StsParseError,
-                 format("%s: image '%s' must be a CV_32FC1 TIFF of %dx%d (got %s, %dx%d)", what.c_str(),
-                        path.c_str(), size.width, size.height, typeToString(map.type()).c_str(), map.cols,
-                        map.rows));
+    // Its header is checked against the size before anything is decoded: a header claiming 30000x30000
+    // floats was decoded (3.6 GB) before the size was compared (round 5 item 20).
+    const Mat map = readImageFileOfSize(path, size, CV_32FC1, what + ": image");
     if (mapChecksum(map) != checksum)
         CV_Error(
             Error::StsParseError,

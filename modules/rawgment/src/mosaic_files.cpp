@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // The mosaic_files topic (mosaic_files.hpp): mosaics written with a YAML sidecar of their format, scene,
 // seed and camera tags, and read back with every field checked against the image.
+#include "image_headers.hpp"
 #include "raw_io_detail.hpp"
 
 #include <opencv2/imgcodecs.hpp>
@@ -246,7 +247,15 @@ MosaicMetadata readMosaic(const String& path, OutputArray _mosaic)
     } else if (lowerExtensionOf(path) == ".npy") {
         mosaic = detail::readNpyMosaic(path);
     } else {
-        mosaic = imread(path, IMREAD_UNCHANGED);
+        // The header is held to the sidecar before any decode (round 5 item 20: a PNG claiming another
+        // size was decoded first).
+        try {
+            mosaic = detail::readImageFileOfSize(path, meta.size, meta.type, "readMosaic: mosaic");
+        } catch (const Exception& e) {
+            CV_Error(Error::StsError, e.err + " (its sidecar says " +
+                                          cv::format("%dx%d %s)", meta.size.width, meta.size.height,
+                                                     typeToString(meta.type).c_str()));
+        }
     }
     if (mosaic.empty())
         CV_Error(Error::StsError, "readMosaic: '" + path + "': OpenCV cannot decode it");

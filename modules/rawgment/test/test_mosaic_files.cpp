@@ -6,10 +6,12 @@
 #include "../src/precomp.hpp"
 
 #include <opencv2/rawgment/augment.hpp>
+#include <opencv2/rawgment/emva1288.hpp>
 #include <opencv2/rawgment/mosaic_files.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -332,7 +334,85 @@ TEST(MosaicFiles, readMosaicChecksTheSidecar)
     Mat other(4, 4, CV_16UC1, Scalar(1));
     writeMosaic(dir + "/c.png", other, meta);
     ASSERT_EQ(0, std::rename((dir + "/c.png.yml").c_str(), (dir + "/a.png.yml").c_str()));
-    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/a.png", back), "but its sidecar says 4x4");
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/a.png", back), "its sidecar says 4x4");
+}
+
+// A little-endian classic TIFF of 8x8 uint16 zeros whose directory holds `entries` (tag, type, value) as
+// given, in that order: hostile headers are written exactly as the test says.
+std::vector<char> tiffWithDirectory(const std::vector<std::array<uint32_t, 3>>& entries)
+{
+    std::vector<char> b = {'I', 'I', 42, 0, 0, 0, 0, 0};
+    b.resize(8 + 128, 0); // the pixels
+    const auto put16 = [&](uint32_t v) {
+        b.push_back(char(v & 0xff));
+        b.push_back(char(v >> 8));
+    };
+    const auto put32 = [&](uint32_t v) {
+        put16(v & 0xffff);
+        put16(v >> 16);
+    };
+    const uint32_t ifd = uint32_t(b.size());
+    std::memcpy(&b[4], &ifd, 4);
+    put16(uint32_t(entries.size()));
+    for (const auto& e : entries) {
+        put16(e[0]);
+        put16(e[1]);
+        put32(1);
+        if (e[1] == 3) {
+            put16(e[2]);
+            put16(0);
+        } else {
+            put32(e[2]);
+        }
+    }
+    put32(0);
+    return b;
+}
+
+TEST(MosaicFiles, imageHeadersAreReadAsTheDecoderReadsThemAndCheckedBeforeAnyDecode)
+{
+    // Round 5 item 20: a TIFF whose first width/height tags said 30000x30000 and whose last said 8x8 passed
+    // a check that read the last tags, and libtiff, which reads the first, allocated 1.8 GB; readMosaic
+    // decoded a PNG before holding its header to the sidecar.
+    const std::string dir = makeTempDir("image_headers");
+    const std::vector<std::array<uint32_t, 3>> duplicated = {
+        {256, 4, 30000}, {257, 4, 30000}, {256, 3, 8}, {257, 3, 8}, {258, 3, 16}, {259, 3, 1},
+        {262, 3, 1},     {273, 4, 8},     {277, 3, 1}, {278, 3, 8}, {279, 4, 128}};
+    const std::vector<std::array<uint32_t, 3>> huge = {{256, 4, 30000}, {257, 4, 30000}, {258, 3, 16},
+                                                       {259, 3, 1},     {262, 3, 1},     {273, 4, 8},
+                                                       {277, 3, 1},     {278, 3, 8},     {279, 4, 128}};
+    const Mat m(8, 8, CV_16UC1, Scalar(0));
+    MosaicMetadata meta;
+    writeMosaic(dir + "/a.tif", m, meta);
+    Mat back;
+    ASSERT_NO_THROW(readMosaic(dir + "/a.tif", back));
+    writeBytes(dir + "/a.tif", tiffWithDirectory(duplicated));
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/a.tif", back), "names tag 256 twice");
+    writeBytes(dir + "/a.tif", tiffWithDirectory(huge));
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/a.tif", back), "header says 30000 x 30000");
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/a.tif", back), "nothing was decoded");
+
+    // A PNG whose IHDR claims 30000x30000 beside a sidecar of 8x8: refused before libpng is asked.
+    writeMosaic(dir + "/b.png", m, meta);
+    std::vector<char> png = readBytes(dir + "/b.png");
+    ASSERT_GE(png.size(), size_t(24));
+    const char side[4] = {0, 0, 0x75, 0x30}; // 30000, big-endian
+    std::memcpy(&png[16], side, 4);
+    std::memcpy(&png[20], side, 4);
+    writeBytes(dir + "/b.png", png);
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/b.png", back), "PNG header says 30000 x 30000");
+    EXPECT_CV_ERROR_CONTAINS(readMosaic(dir + "/b.png", back), "its sidecar says 8x8");
+
+    // The EMVA 1288 reader reads its images' headers with the same reader.
+    Emva1288Series series;
+    series.path = dir + "/set.txt";
+    series.width = 8;
+    series.height = 8;
+    series.bits = 12;
+    writeBytes(dir + "/e.tif", tiffWithDirectory(duplicated));
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288Image(series, dir + "/e.tif", 3), "names tag 256 twice");
+    writeBytes(dir + "/e.tif", tiffWithDirectory(huge));
+    EXPECT_CV_ERROR_CONTAINS(readEmva1288Image(series, dir + "/e.tif", 3), "it is 30000 x 30000");
 }
 
 TEST(MosaicFiles, readMosaicRefusesASidecarThatContradictsItsDng)
