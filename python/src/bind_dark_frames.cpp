@@ -55,6 +55,7 @@ void bindDarkFrames(py::module_& m)
         .def_readwrite("exposureTime", &DarkFrameGroup::exposureTime, doc("DarkFrameGroup::exposureTime"))
         .def_readwrite("files", &DarkFrameGroup::files, doc("DarkFrameGroup::files"))
         .def_readwrite("fileBytes", &DarkFrameGroup::fileBytes, doc("DarkFrameGroup::fileBytes"))
+        .def_readwrite("fingerprints", &DarkFrameGroup::fingerprints, doc("DarkFrameGroup::fingerprints"))
         .def_readwrite("statistics", &DarkFrameGroup::statistics, doc("DarkFrameGroup::statistics"));
 
     py::class_<DarkFrameBank>(m, "DarkFrameBank",

@@ -149,13 +149,35 @@ Vec4d readSites(const FileNode& node, const char* field)
     return Vec4d(v[0], v[1], v[2], v[3]);
 }
 
-DarkFrameGroup readGroup(const FileNode& n, const String& folder, Size size, int index)
+bool isFingerprint(const String& text)
+{
+    return text.size() == 16 && std::all_of(text.begin(), text.end(), [](char c) {
+               return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+           });
+}
+
+DarkFrameGroup readGroup(const FileNode& n, const String& folder, Size size, int index, int version)
 {
     if (!n.isMap())
         CV_Error(Error::StsParseError, "each entry of groups must be a map");
-    rejectUnknownKeys(n, {"gain", "exposure_time", "frames", "file_bytes", "degrees_of_freedom", "level",
-                          "temporal_variance", "row_noise_variance", "mean_variance", "pattern_variance",
-                          "pattern", "mean", "row_variance", "noisy_pixels"});
+    std::vector<String> keys = {"gain",
+                                "exposure_time",
+                                "frames",
+                                "file_bytes",
+                                "degrees_of_freedom",
+                                "level",
+                                "temporal_variance",
+                                "row_noise_variance",
+                                "mean_variance",
+                                "pattern_variance",
+                                "pattern",
+                                "mean",
+                                "row_variance",
+                                "noisy_pixels"};
+    // Version 1 recorded no fingerprints: its frames are held to their sizes, as it stated.
+    if (version >= 2)
+        keys.push_back("fingerprints");
+    rejectUnknownKeys(n, keys);
     DarkFrameGroup g;
     g.gain = detail::readRealField(n, "gain");
     g.exposureTime = detail::readRealField(n, "exposure_time");
@@ -171,6 +193,18 @@ DarkFrameGroup readGroup(const FileNode& n, const String& folder, Size size, int
     g.fileBytes = readList(n, "file_bytes", g.files.size());
     if (g.fileBytes.size() != g.files.size())
         CV_Error(Error::StsParseError, "field 'file_bytes' must have one size per frame");
+    if (version >= 2) {
+        const FileNode prints = n["fingerprints"];
+        if (!prints.isSeq() || prints.size() != g.files.size())
+            CV_Error(Error::StsParseError,
+                     "field 'fingerprints' must be a list of one fingerprint per frame");
+        for (const FileNode& f : prints) {
+            if (!f.isString() || !isFingerprint(f.string()))
+                CV_Error(Error::StsParseError,
+                         "field 'fingerprints' must hold 16 lower-case hex digits (FNV-1a 64) per frame");
+            g.fingerprints.push_back(f.string());
+        }
+    }
     DarkFrameStatistics& s = g.statistics;
     s.frames = static_cast<int>(g.files.size());
     s.degreesOfFreedom = detail::readOptionalIntField(n, "degrees_of_freedom", 0);
@@ -246,6 +280,7 @@ DarkFrameBank DarkFrameBank::create(const std::vector<String>& files, const Nois
         }
         g.second.files.push_back(path);
         g.second.fileBytes.push_back(fileBytesOf(path));
+        g.second.fingerprints.push_back(detail::contentFingerprintOf(path, "dark frame"));
     }
     for (auto& entry : groups) {
         DarkFrameGroup& g = entry.second.second;
@@ -313,6 +348,14 @@ void DarkFrameBank::validate() const
                 who + cv::format(": %zu frames, %zu file sizes and statistics of %d frames: a group needs at "
                                  "least two frames, and one size each",
                                  g.files.size(), g.fileBytes.size(), s.frames));
+        if (!g.fingerprints.empty() &&
+            (g.fingerprints.size() != g.files.size() ||
+             !std::all_of(g.fingerprints.begin(), g.fingerprints.end(), isFingerprint)))
+            CV_Error(Error::StsBadArg,
+                     who + ": fingerprints must be empty (a bank of format_version 1) or 16 lower-case hex "
+                           "digits (FNV-1a 64) per frame");
+        if ((g.fingerprints.empty()) != (groups[0].fingerprints.empty()))
+            CV_Error(Error::StsBadArg, who + ": every group or none has its frames' fingerprints");
         if (s.degreesOfFreedom < 1 || s.degreesOfFreedom > s.frames - 1)
             CV_Error(Error::StsBadArg, who + cv::format(": degrees of freedom %d must lie in [1, %d]",
                                                         s.degreesOfFreedom, s.frames - 1));
@@ -356,7 +399,9 @@ std::string bankFileText(const DarkFrameBank& bank, const String& bankPath, std:
     }
     return fileStorageText(bankPath, [&](FileStorage& fs) {
         fs << kTopLevelName << "{";
-        fs << "format_version" << DarkFrameBank::FORMAT_VERSION;
+        // A bank loaded from version 1 has no fingerprints to write: it stays what it was.
+        const bool fingerprinted = !bank.groups.empty() && !bank.groups[0].fingerprints.empty();
+        fs << "format_version" << (fingerprinted ? DarkFrameBank::FORMAT_VERSION : 1);
         bank.format.write(fs, "format");
         fs << "width" << bank.size.width << "height" << bank.size.height;
         fs << "groups"
@@ -371,6 +416,8 @@ std::string bankFileText(const DarkFrameBank& bank, const String& bankPath, std:
                 frames.push_back(pathInBankFile(f, bankPath));
             writeStringList(fs, "frames", frames);
             fs << "file_bytes" << g.fileBytes;
+            if (fingerprinted)
+                writeStringList(fs, "fingerprints", g.fingerprints);
             fs << "degrees_of_freedom" << s.degreesOfFreedom;
             fs << "level" << s.level << "temporal_variance" << s.temporalVariance << "row_noise_variance"
                << s.rowNoiseVariance << "mean_variance" << s.meanVariance << "pattern_variance"
@@ -466,7 +513,7 @@ DarkFrameBank DarkFrameBank::load(const String& bankPath)
             int index = 0;
             for (const FileNode& g : list) {
                 try {
-                    b.groups.push_back(readGroup(g, folder, b.size, index));
+                    b.groups.push_back(readGroup(g, folder, b.size, index, int(version)));
                 } catch (const Exception& e) {
                     CV_Error(e.code, cv::format("dark-frame bank: groups[%d]: ", index) + e.err);
                 }
@@ -518,6 +565,15 @@ Mat DarkFrameBank::readFrame(int group, int index) const
                 "DarkFrameBank: dark frame '%s' is %.0f bytes, but %.0f when the bank was made: the file "
                 "was replaced; make the bank again",
                 file.c_str(), bytes, g.fileBytes[static_cast<size_t>(index)]));
+    if (index < static_cast<int>(g.fingerprints.size())) {
+        const std::string now = detail::contentFingerprintOf(file, "dark frame");
+        if (now != g.fingerprints[static_cast<size_t>(index)])
+            CV_Error(
+                Error::StsError,
+                cv::format("DarkFrameBank: dark frame '%s' holds other bytes than when the bank was made "
+                           "(FNV-1a 64 %s, the bank's %s): the file was replaced; make the bank again",
+                           file.c_str(), now.c_str(), g.fingerprints[static_cast<size_t>(index)].c_str()));
+    }
     Mat mosaic;
     if (pathExists(sidecarPathOf(file)))
         readMosaic(file, mosaic);

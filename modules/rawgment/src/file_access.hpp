@@ -77,6 +77,12 @@ struct FileIdentity
 };
 //! The identity of the file at `path` (links followed); false when it cannot be stat'ed.
 bool fileIdentityOf(const String& path, FileIdentity& id);
+/** The FNV-1a 64 of a regular file's bytes, as 16 lower-case hex digits: what a dark-frame bank records of
+ * each frame, so that a frame replaced by another of the same size is seen. Hashed once per process per
+ * (device, inode, size, modification time in ns), since a 24 MB frame costs about 30 ms, more than a step's
+ * draw: a frame rewritten in place within one process with all four kept is not hashed again. Throws
+ * StsError naming `what` and `path` for a file that cannot be read or changed while it was hashed. */
+std::string contentFingerprintOf(const String& path, const String& what);
 //! The deepest nesting of maps and lists openFileStorageForReading() accepts; this module's files nest
 //! at most five levels, and OpenCV's readers recurse once per level.
 constexpr int MAX_NESTING_DEPTH = 64;

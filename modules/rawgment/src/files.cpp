@@ -14,6 +14,8 @@
 #include <mutex>
 #include <signal.h>
 #include <sys/stat.h>
+#include <sys/types.h>
+#include <tuple>
 #include <unistd.h>
 
 namespace cv {
@@ -195,6 +197,69 @@ bool fileIdentityOf(const String& path, FileIdentity& id)
     id = FileIdentity{static_cast<unsigned long long>(status.st_dev),
                       static_cast<unsigned long long>(status.st_ino)};
     return true;
+}
+
+namespace {
+
+struct FingerprintKey
+{
+    unsigned long long device, inode;
+    long long size, mtimeNs;
+    bool operator<(const FingerprintKey& o) const
+    {
+        return std::tie(device, inode, size, mtimeNs) < std::tie(o.device, o.inode, o.size, o.mtimeNs);
+    }
+};
+
+FingerprintKey fingerprintKeyOf(const struct stat& s)
+{
+    return FingerprintKey{static_cast<unsigned long long>(s.st_dev),
+                          static_cast<unsigned long long>(s.st_ino), static_cast<long long>(s.st_size),
+                          static_cast<long long>(s.st_mtim.tv_sec) * 1000000000LL + s.st_mtim.tv_nsec};
+}
+
+} // namespace
+
+std::string contentFingerprintOf(const String& path, const String& what)
+{
+    static std::mutex mutex;
+    static std::map<FingerprintKey, std::string> known;
+    RegularFileForReading file(path, what);
+    struct stat before;
+    if (::fstat(file.fd(), &before) != 0)
+        CV_Error(Error::StsError, "cannot read " + what + " '" + path + "': " + std::strerror(errno));
+    const FingerprintKey key = fingerprintKeyOf(before);
+    {
+        std::lock_guard<std::mutex> lock(mutex);
+        const auto hit = known.find(key);
+        if (hit != known.end())
+            return hit->second;
+    }
+    uint64_t h = 0xcbf29ce484222325ull;
+    std::vector<unsigned char> chunk(1 << 20);
+    long long offset = 0;
+    for (;;) {
+        const ssize_t got = ::pread(file.fd(), chunk.data(), chunk.size(), static_cast<off_t>(offset));
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got < 0)
+            CV_Error(Error::StsError, "cannot read " + what + " '" + path + "': " + std::strerror(errno));
+        if (got == 0)
+            break;
+        for (ssize_t i = 0; i < got; ++i) {
+            h ^= chunk[static_cast<size_t>(i)];
+            h *= 0x100000001b3ull;
+        }
+        offset += got;
+    }
+    struct stat after;
+    if (::fstat(file.fd(), &after) != 0 || offset != key.size ||
+        fingerprintKeyOf(after).mtimeNs != key.mtimeNs)
+        CV_Error(Error::StsError, "cannot read " + what + " '" + path + "': it changed while it was read");
+    const std::string hex = format("%016llx", static_cast<unsigned long long>(h));
+    std::lock_guard<std::mutex> lock(mutex);
+    known.emplace(key, hex);
+    return hex;
 }
 
 } // namespace detail

@@ -120,7 +120,8 @@ TEST(DarkFrameBank, filesGroupByGainAndExposureAndRefuseAnotherSensor)
 }
 
 //! A small bank in `dir`: two gains of three mosaic files each, with sidecars.
-DarkFrameBank smallBank(const std::string& dir, std::vector<String>* files = nullptr)
+DarkFrameBank smallBank(const std::string& dir, std::vector<String>* files = nullptr,
+                        const char* extension = "png")
 {
     const Size size(32, 24);
     const SensorSimulator sensor(test::darkComponentSensorParams(size, 0.14, 3), size);
@@ -131,7 +132,7 @@ DarkFrameBank smallBank(const std::string& dir, std::vector<String>* files = nul
             sensor.capture(Mat::zeros(size, CV_32FC1), gain, 1.0, 7, t + 10 * static_cast<int>(gain), raw);
             MosaicMetadata meta;
             meta.format = sensor.rawFormat(gain);
-            const std::string path = dir + format("/g%g_%d.png", gain, t);
+            const std::string path = dir + format("/g%g_%d.%s", gain, t, extension);
             writeMosaic(path, raw, meta);
             written.push_back(path);
         }
@@ -153,6 +154,7 @@ void expectSameBank(const DarkFrameBank& a, const DarkFrameBank& b)
         for (size_t f = 0; f < x.files.size(); ++f)
             EXPECT_TRUE(std::filesystem::equivalent(std::string(x.files[f]), std::string(y.files[f])));
         EXPECT_EQ(x.fileBytes, y.fileBytes);
+        EXPECT_EQ(x.fingerprints, y.fingerprints);
         const DarkFrameStatistics &s = x.statistics, &t = y.statistics;
         EXPECT_EQ(s.frames, t.frames);
         EXPECT_EQ(s.degreesOfFreedom, t.degreesOfFreedom);
@@ -224,6 +226,70 @@ std::string textOf(const std::string& path)
     return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
+//! FNV-1a 64 as its definition gives it, byte by byte (http://www.isthe.com/chongo/tech/comp/fnv/).
+std::string fnv1a64Of(const std::string& bytes)
+{
+    uint64_t h = 14695981039346656037ull;
+    for (unsigned char c : bytes)
+        h = (h ^ c) * 1099511628211ull;
+    return format("%016llx", static_cast<unsigned long long>(h));
+}
+
+/* Each frame's content is recorded: a frame replaced after saving by a flat frame of the same size (an .npy,
+ * whose size follows from its shape alone) is refused where a step would draw it, naming the file; a bank of
+ * format_version 1, which recorded sizes alone, loads and holds its frames to their sizes, as it stated. */
+TEST(DarkFrameBank, aFrameReplacedByAnotherOfItsSizeIsRefusedWhereItIsRead)
+{
+    const std::string dir = test::makeTempDir("dark_bank_fingerprints");
+    std::vector<String> files;
+    DarkFrameBank bank = smallBank(dir, &files, "npy");
+    ASSERT_EQ(bank.groups.size(), 2u);
+    for (const DarkFrameGroup& g : bank.groups) {
+        ASSERT_EQ(g.fingerprints.size(), g.files.size());
+        for (size_t f = 0; f < g.files.size(); ++f)
+            EXPECT_EQ(g.fingerprints[f], fnv1a64Of(textOf(g.files[f]))) << g.files[f];
+    }
+    bank.save(dir + "/bank.yml");
+    EXPECT_NE(textOf(dir + "/bank.yml").find("format_version: 2"), std::string::npos);
+    const DarkFrameBank loaded = DarkFrameBank::load(dir + "/bank.yml");
+    expectSameBank(bank, loaded);
+
+    DarkFrameBank version1 = bank;
+    for (DarkFrameGroup& g : version1.groups)
+        g.fingerprints.clear();
+    version1.save(dir + "/bank_v1.yml");
+    const std::string v1Text = textOf(dir + "/bank_v1.yml");
+    EXPECT_NE(v1Text.find("format_version: 1"), std::string::npos);
+    EXPECT_EQ(v1Text.find("fingerprints"), std::string::npos);
+    const DarkFrameBank oldBank = DarkFrameBank::load(dir + "/bank_v1.yml");
+    EXPECT_TRUE(oldBank.groups[1].fingerprints.empty());
+
+    // The case: flat 4000 DN frames of the same size, written over a saved bank's frames.
+    const String replaced = bank.groups[1].files[1];
+    MosaicMetadata meta;
+    Mat original;
+    meta = readMosaic(replaced, original);
+    const double bytes = bank.groups[1].fileBytes[1];
+    std::filesystem::remove(std::string(replaced));
+    writeMosaic(replaced, Mat(original.size(), CV_16UC1, Scalar(4000)), meta);
+    ASSERT_EQ(double(std::filesystem::file_size(std::string(replaced))), bytes) << "the test's premise";
+    EXPECT_CV_ERROR_CONTAINS(loaded.readFrame(1, 1), "holds other bytes than when the bank was made");
+    EXPECT_CV_ERROR_CONTAINS(DarkFrameBank::load(dir + "/bank.yml").readFrame(1, 1), replaced);
+    EXPECT_EQ(cv::norm(loaded.readFrame(1, 0), Mat(original.size(), CV_16UC1, Scalar(4000)), NORM_INF) > 0,
+              true)
+        << "the frames not replaced are still drawn";
+    EXPECT_EQ(cv::mean(oldBank.readFrame(1, 1))[0], 4000) << "version 1 holds a frame to its size alone";
+
+    // Every group or none has fingerprints: a bank half of version 1 is not one any file could hold.
+    DarkFrameBank mixed = bank;
+    mixed.groups[0].fingerprints.clear();
+    EXPECT_CV_ERROR_CONTAINS(mixed.validate(), "every group or none");
+    DarkFrameBank bad = bank;
+    bad.groups[0].fingerprints[0] = "not hex";
+    EXPECT_CV_ERROR_CONTAINS(bad.validate(), "16 lower-case hex digits");
+    std::filesystem::remove_all(dir);
+}
+
 /* Each edit of a saved bank's file that save() would not write is refused on load, naming what is wrong; the
  * file as saved loads. */
 TEST(DarkFrameBank, loadRefusesWhatSaveDoesNotWrite)
@@ -236,8 +302,10 @@ TEST(DarkFrameBank, loadRefusesWhatSaveDoesNotWrite)
     {
         std::string from, to, error;
     } edits[] = {
-        {"format_version: 1", "format_version: 2", "format_version 2 is not supported"},
-        {"format_version: 1", "format_version: 0", "format_version 0 is not supported"},
+        {"format_version: 2", "format_version: 3", "format_version 3 is not supported"},
+        {"format_version: 2", "format_version: 0", "format_version 0 is not supported"},
+        {"format_version: 2", "format_version: 1", "'fingerprints'"},
+        {"fingerprints:\n            - \"", "fingerprints:\n            - \"0", "16 lower-case hex digits"},
         {"   width: 32", "   widht: 32", "'widht'"},
         {"   width: 32", "   width: -32", "width and height must be > 0"},
         {"-\n         gain: 1.", "-\n         gain: -1.", "gain must be finite and > 0"},
@@ -272,6 +340,7 @@ TEST(DarkFrameBank, loadRefusesWhatSaveDoesNotWrite)
     DarkFrameBank one = bank;
     one.groups[0].files.resize(1);
     one.groups[0].fileBytes.resize(1);
+    one.groups[0].fingerprints.resize(1);
     one.groups[0].statistics.frames = 1;
     EXPECT_CV_ERROR_CONTAINS(one.save(dir + "/one.yml"), "a group needs at least two frames");
     EXPECT_FALSE(std::filesystem::exists(dir + "/one.yml"));

@@ -69,8 +69,13 @@ struct CV_EXPORTS_W_SIMPLE DarkFrameGroup
     CV_PROP_RW double gain;               //!< the linear gain the frames were taken at
     CV_PROP_RW double exposureTime;       //!< seconds; 0 when the frames do not state it
     CV_PROP_RW std::vector<String> files; //!< the frames: read on demand, never all held
-    CV_PROP_RW std::vector<double>
-        fileBytes; //!< each file's size when the bank was made: a frame replaced since is refused
+    //! each file's size when the bank was made: a frame whose size changed since is refused
+    CV_PROP_RW std::vector<double> fileBytes;
+    //! each file's content when the bank was made, its bytes' FNV-1a 64 as 16 hex digits: a frame replaced
+    //! since, whatever its size, is refused where it is read (checked once per process per file identity,
+    //! size and modification time). Empty in a bank of format_version 1, which recorded none: its frames
+    //! are held to their sizes alone.
+    CV_PROP_RW std::vector<String> fingerprints;
     CV_PROP_RW DarkFrameStatistics statistics; //!< what the frames tell apart
 };
 
@@ -85,8 +90,9 @@ struct CV_EXPORTS_W_SIMPLE DarkFrameGroup
  */
 struct CV_EXPORTS_W_SIMPLE DarkFrameBank
 {
-    //! The version of the bank's file that save() writes; load() reads versions up to it.
-    static constexpr int FORMAT_VERSION = 1;
+    //! The version of the bank's file that save() writes (2: with each frame's fingerprint; a bank loaded
+    //! from version 1, which has none, is saved as version 1); load() reads versions up to it.
+    static constexpr int FORMAT_VERSION = 2;
 
     //! An empty bank: no noise step uses it.
     CV_WRAP DarkFrameBank() {}
@@ -140,7 +146,8 @@ struct CV_EXPORTS_W_SIMPLE DarkFrameBank
     CV_WRAP int nearestGroup(double gain, double exposureTime = 0) const;
     /** @brief Reads frame `index` of group `group` again (raw DN, black level included).
      * @throws cv::Exception for an index out of range, a file that is missing, unreadable, of another size or
-     * format, or of another byte size than when the bank was made. */
+     * format, or of another byte size or content (DarkFrameGroup::fingerprints) than when the bank was
+     * made. */
     CV_WRAP Mat readFrame(int group, int index) const;
 };
 
