@@ -166,6 +166,123 @@ AugmentRecipe loadAugmentRecipe(const AugmentOptions& o)
     return recipe;
 }
 
+namespace {
+
+//! One field of a job record: `identity` fields decide whether two runs are one job, the others (file
+//! names) are there for a reader: a model moved with its content kept is the same model.
+struct JobField
+{
+    std::string key, value;
+    bool identity;
+};
+
+/* What decides an output's bytes besides its input: the version, the content of the model, the scene or
+ * policy and the bank (the options' or the one the scene or policy names; its file holds its frames'
+ * fingerprints and its maps' checksums), and the options. Previews are outputs of their own, not a
+ * recipe. */
+std::vector<JobField> recipeFields(const AugmentOptions& o)
+{
+    const bool random = o.scene.empty();
+    const std::string recipeFile = random ? o.policy : o.scene;
+    std::string bank = o.darkBank;
+    if (bank.empty())
+        bank = random ? std::string(RandomScenePolicy::load(o.policy).noise.darkBank)
+                      : std::string(readSceneFile(o.scene).noise.darkBank);
+    return {{"version", RAWGMENT_PROJECT_VERSION, true},
+            {"model", o.model, false},
+            {"model_fnv1a64", fileFingerprint(o.model), true},
+            {"camera", o.camera, true},
+            {"recipe_kind", random ? "policy" : "scene", true},
+            {"recipe", recipeFile, false},
+            {"recipe_fnv1a64", fileFingerprint(recipeFile), true},
+            {"dark_bank", bank, false},
+            {"dark_bank_fnv1a64", bank.empty() ? std::string() : fileFingerprint(bank), true},
+            {"dark_bank_tied", o.darkBankTied ? "true" : "false", true},
+            {"seed", cv::format("%llu", static_cast<unsigned long long>(o.seed)), true},
+            {"extension", o.extension, true}};
+}
+
+/* The job record of an output folder (`augment_job.yml`): a rerun into the folder resumes only the same job
+ * (the same recipe; each input it shares with the record of the same content), and adds its new inputs.
+ * Under a lock of the folder, so that runs at the same time take turns; identical runs agree. */
+void claimAugmentJob(const AugmentOptions& o)
+{
+    const std::vector<JobField> recipe = recipeFields(o);
+    std::vector<std::pair<std::string, std::string>> inputs; // canonical path, fingerprint
+    for (const std::string& in : o.inputs)
+        inputs.emplace_back(canonicalPath(in), fileFingerprint(in));
+    const std::string path = o.outDir + "/augment_job.yml";
+    const FolderLock lock(o.outDir);
+    std::vector<std::pair<std::string, std::string>> recorded;
+    if (pathExists(path)) {
+        cv::FileStorage fs = openFileStorageForReading(path, "augment job record");
+        const cv::FileNode job = fs["augment_job"];
+        try {
+            std::vector<cv::String> keys = {"inputs"};
+            for (const JobField& f : recipe)
+                keys.push_back(f.key);
+            if (!job.isMap())
+                throw std::runtime_error("no map 'augment_job'");
+            rejectUnknownKeys(job, keys);
+            for (const JobField& f : recipe) {
+                const cv::FileNode n = job[f.key];
+                // OpenCV reads an empty string back as no value: an option not given.
+                if (!n.isString() && !n.isNone())
+                    throw std::runtime_error("field '" + f.key + "' is not a string");
+                const std::string value = n.isString() ? n.string() : std::string();
+                if (f.identity && value != f.value)
+                    throw std::runtime_error(
+                        "it records another augmentation job: its " + f.key + " is '" + value +
+                        "', this run's '" + f.value +
+                        "' (other model, scene or policy, bank, seed, options or version); its outputs are "
+                        "not this job's");
+            }
+            for (const cv::FileNode& n : job["inputs"]) {
+                if (!n.isMap() || !n["path"].isString() || !n["fnv1a64"].isString())
+                    throw std::runtime_error("each of 'inputs' must be a map of path and fnv1a64");
+                recorded.emplace_back(n["path"].string(), n["fnv1a64"].string());
+            }
+        } catch (const std::runtime_error& e) {
+            throw std::runtime_error("'" + path + "': " + e.what() + "; choose another --out");
+        } catch (const cv::Exception& e) {
+            throw std::runtime_error("'" + path + "': " + e.err + "; choose another --out");
+        }
+    }
+    bool changed = !pathExists(path);
+    for (size_t i = 0; i < inputs.size(); ++i) {
+        const auto known = std::find_if(recorded.begin(), recorded.end(),
+                                        [&](const auto& r) { return r.first == inputs[i].first; });
+        if (known == recorded.end()) {
+            recorded.push_back(inputs[i]);
+            changed = true;
+        } else if (known->second != inputs[i].second) {
+            throw std::runtime_error("input '" + o.inputs[i] + "' is not the file it was when '" + path +
+                                     "' recorded it (its content changed): its outputs there are of the "
+                                     "old file; choose another --out");
+        }
+    }
+    if (!changed)
+        return;
+    writeTextAtomically(path, fileStorageText(path, [&](cv::FileStorage& fs) {
+                            fs << "augment_job"
+                               << "{";
+                            for (const JobField& f : recipe)
+                                writeString(fs, f.key, f.value);
+                            fs << "inputs"
+                               << "[";
+                            for (const auto& in : recorded) {
+                                fs << "{";
+                                writeString(fs, "path", in.first);
+                                writeString(fs, "fnv1a64", in.second);
+                                fs << "}";
+                            }
+                            fs << "]"
+                               << "}";
+                        }));
+}
+
+} // namespace
+
 //! The most variants of one input, and outputs of one run (each job is a few hundred bytes in the plan).
 const int kMaxVariants = 100000;
 const size_t kMaxJobs = 1000000;
@@ -191,6 +308,7 @@ AugmentPlan planAugmentJobs(const AugmentOptions& o)
     }
     refuseOutputsAmongInputs(o.outDir, o.inputs);
     prepareOutputDirectory(o.outDir);
+    claimAugmentJob(o);
 
     AugmentPlan plan;
     std::vector<std::string> extensions;

@@ -9,10 +9,12 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <fcntl.h>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -27,6 +29,27 @@ void reportRemovedTemporaries()
     for (const std::string& path : removed)
         std::cerr << " '" << path << "'";
     std::cerr << "\n";
+}
+
+FolderLock::FolderLock(const std::string& folder)
+{
+    cv::rawgment::checkPathHasNoNul(folder);
+    fd_ = ::open(folder.empty() ? "." : folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd_ < 0)
+        throw std::runtime_error("cannot open the folder '" + folder +
+                                 "' to lock it: " + std::strerror(errno));
+    while (::flock(fd_, LOCK_EX) != 0) {
+        if (errno == EINTR)
+            continue;
+        const int err = errno;
+        ::close(fd_);
+        throw std::runtime_error("cannot lock the folder '" + folder + "': " + std::strerror(err));
+    }
+}
+
+FolderLock::~FolderLock()
+{
+    ::close(fd_); // releases the lock
 }
 
 void writeBytesAtomically(const std::string& path, const void* data, size_t size)

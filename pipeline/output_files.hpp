@@ -25,6 +25,22 @@ void prepareOutputDirectory(const std::string& dir);
 //! Says on stderr which temporaries of killed runs the writes of this process removed (the apps, at exit).
 void reportRemovedTemporaries();
 
+/** An exclusive lock on a folder (flock() of the folder itself, so no file is left in it), held while the
+ * object lives: two runs that decide, each, whether a shared file (a job record, a bank) is theirs to write,
+ * and then write it, take turns. Blocks until the lock is free; the lock goes with the process, even when
+ * it is killed. Throws std::runtime_error naming the folder when it cannot be opened or locked. */
+class FolderLock
+{
+public:
+    explicit FolderLock(const std::string& folder);
+    ~FolderLock();
+    FolderLock(const FolderLock&) = delete;
+    FolderLock& operator=(const FolderLock&) = delete;
+
+private:
+    int fd_;
+};
+
 //! Creates a directory and its parents (like mkdir -p); throws std::runtime_error naming the path.
 void makeDirectories(const std::string& path);
 //! The directory part of a path ("." when there is none).

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <tuple>
 #include <unistd.h>
 
 namespace {
@@ -91,6 +92,62 @@ TEST(Apps, augmentKeepsInputsWithOneStemApartAndNeverTakesAnotherInputsOutput)
     EXPECT_EQ("not a preview", readText(dir + "/single/frame_000_v01_preview.png"));
 }
 
+/* Round 5 item 12: a rerun into the same --out with another scene, another seed or a bank said "wrote 0,
+ * skipped 2" and exited 0 with the first job's outputs. The folder records its job (augment_job.yml: the
+ * version, the content of the model, scene or policy and bank, the options, each input's content); a rerun
+ * resumes only that job and adds inputs to it. */
+TEST(Apps, aRerunResumesOnlyTheSameJob)
+{
+    const std::string dir = freshDir("augment_job_identity");
+    AppRun r = runApp("rawgment_simulate", "--out='" + dir +
+                                               "/sim' --frames=3 --gains=6 --levels=0.5 --validation=false "
+                                               "--dark=true --format=png");
+    ASSERT_EQ(0, r.status) << r.output;
+    writeExposureScene(dir + "/scene.yml", 0.5, 1.0);
+    writeExposureScene(dir + "/other.yml", 0.25, 1.0);
+    std::vector<cv::String> darkFiles;
+    for (int f = 0; f < 3; ++f)
+        darkFiles.push_back(dir + cv::format("/sim/dark_g06dB/frame_%03d.png", f));
+    cv::rawgment::DarkFrameBank::create(darkFiles, cv::rawgment::NoiseModel()).save(dir + "/bank.yml");
+    const std::string a = dir + "/sim/g06dB_level0.50/frame_000.png",
+                      b = dir + "/sim/g06dB_level0.50/frame_001.png";
+    const auto augment = [&](const std::string& scene, const std::string& extra, const std::string& inputs) {
+        return runApp("rawgment_augment", "--model='" + dir + "/sim/truth_noise_model.yml' --scene='" + dir +
+                                              "/" + scene + "' --out='" + dir + "/out' " + extra + " " +
+                                              inputs);
+    };
+    r = augment("scene.yml", "", "'" + a + "'");
+    ASSERT_EQ(0, r.status) << r.output;
+    const std::string record = readText(dir + "/out/augment_job.yml");
+    EXPECT_NE(std::string::npos, record.find("recipe_fnv1a64")) << record;
+    const std::string first = readText(dir + "/out/frame_000_v00.png");
+    using Rerun = std::tuple<std::string, std::string, std::string>;
+    for (const auto& [scene, extra, field] :
+         {Rerun("other.yml", "", "recipe_fnv1a64"), Rerun("scene.yml", "--seed=2", "seed"),
+          Rerun("scene.yml", "--dark_bank='" + dir + "/bank.yml'", "dark_bank_fnv1a64")}) {
+        r = augment(scene, extra, "'" + a + "'");
+        EXPECT_EQ(1, r.status) << extra << r.output;
+        EXPECT_NE(
+            std::string::npos,
+            r.output.find("augment_job.yml': it records another augmentation job: its " + std::string(field)))
+            << r.output;
+    }
+    EXPECT_EQ(first, readText(dir + "/out/frame_000_v00.png"));
+    EXPECT_EQ(record, readText(dir + "/out/augment_job.yml")) << "a refused run leaves the record as it was";
+    // The same job resumes, and takes a new input; a moved scene file of the same content is the same job.
+    ASSERT_EQ(0, std::system(("cp '" + dir + "/scene.yml' '" + dir + "/moved.yml'").c_str()));
+    r = augment("moved.yml", "", "'" + a + "' '" + b + "'");
+    EXPECT_EQ(0, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("skipped 1")) << r.output;
+    // An input whose content changed since its outputs were made is not their input.
+    cv::Mat changed = cv::imread(b, cv::IMREAD_UNCHANGED);
+    changed.at<uint16_t>(0, 0) += 1;
+    ASSERT_TRUE(cv::imwrite(b, changed));
+    r = augment("scene.yml", "", "'" + b + "'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("is not the file it was when")) << r.output;
+}
+
 TEST(Apps, twoIdenticalRunsIntoOneFolderBothFinishWithCompletePairs)
 {
     // Both runs exited 1 in 13 of 15 tries and left an image without its sidecar: the process whose image
@@ -109,25 +166,30 @@ TEST(Apps, twoIdenticalRunsIntoOneFolderBothFinishWithCompletePairs)
         const std::string out = dir + "/out" + std::to_string(attempt);
         const std::string run = std::string(RAWGMENT_APP_DIR) + "/rawgment_augment --model='" + dir +
                                 "/sim/truth_noise_model.yml' --scene='" + dir +
-                                "/scene.yml' --variants=4 --out='" + out + "'" + inputs;
+                                "/scene.yml' --variants=4 --preview=true --out='" + out + "'" + inputs;
         const std::string both = "(" + run + " > '" + dir + "/log1' 2>&1; echo $? > '" + dir +
                                  "/status1') & (" + run + " > '" + dir + "/log2' 2>&1; echo $? > '" + dir +
                                  "/status2') & wait";
         ASSERT_EQ(0, std::system(both.c_str()));
         EXPECT_EQ("0\n", readText(dir + "/status1")) << readText(dir + "/log1");
         EXPECT_EQ("0\n", readText(dir + "/status2")) << readText(dir + "/log2");
-        int images = 0;
+        int images = 0, previews = 0;
         for (const auto& entry : std::filesystem::directory_iterator(out)) {
             const std::string path = entry.path().string();
             const bool sidecar = path.size() > 4 && path.compare(path.size() - 4, 4, ".yml") == 0;
+            if (entry.path().filename() == "augment_job.yml")
+                continue; // the run's record, not an output
+            const bool preview = path.find("_preview.png") != std::string::npos;
+            previews += preview;
             if (sidecar)
                 EXPECT_TRUE(exists(path.substr(0, path.size() - 4))) << path << " has no image";
-            else if (path.find(".tmp-") == std::string::npos) {
+            else if (!preview && path.find(".tmp-") == std::string::npos) {
                 EXPECT_TRUE(exists(path + ".yml")) << path << " has no sidecar";
                 ++images;
             }
         }
         EXPECT_EQ(12, images) << out;
+        EXPECT_EQ(12, previews) << out << ": two identical runs with previews both finish (round 5, item 21)";
     }
 }
 

@@ -3,8 +3,10 @@
 #include "app_runs.hpp"
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/rawgment.hpp>
 
+#include <cstdlib>
 #include <cstring>
 #include <fcntl.h>
 #include <fstream>
@@ -55,10 +57,20 @@ TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
     EXPECT_NEAR(bank.groups[0].gain, std::pow(10, 6 / 20.0), 1e-9);
     EXPECT_EQ(bank.groups[1].files.size(), 8u);
     EXPECT_EQ(readText(dir + "/sim/bank.yml").find(dir), std::string::npos) << "frames relative to the bank";
-    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --dark_bank='" + dir +
-                                         "/sim/bank.yml' --plots=false --out='" + dir + "/cal_again'");
-    EXPECT_EQ(1, r.status) << r.output;
-    EXPECT_NE(std::string::npos, r.output.find("never written over")) << r.output;
+    // An identical rerun into another folder finds the bank it makes (the same frames, fingerprints and
+    // statistics) and accepts it (round 5, item 22); two identical runs at once, writing one bank and one
+    // folder, both finish (item 21), taking turns at the bank (item 15).
+    const std::string bankText = readText(dir + "/sim/bank.yml");
+    const std::string again = std::string(RAWGMENT_APP_DIR) + "/rawgment_calibrate '" + dir +
+                              "/sim/manifest.yml' --dark_bank='" + dir + "/sim/bank.yml' --out='" + dir +
+                              "/cal_again'";
+    const std::string both = "(" + again + " > '" + dir + "/log1' 2>&1; echo $? > '" + dir +
+                             "/status1') & (" + again + " > '" + dir + "/log2' 2>&1; echo $? > '" + dir +
+                             "/status2') & wait";
+    ASSERT_EQ(0, std::system(both.c_str()));
+    EXPECT_EQ("0\n", readText(dir + "/status1")) << readText(dir + "/log1");
+    EXPECT_EQ("0\n", readText(dir + "/status2")) << readText(dir + "/log2");
+    EXPECT_EQ(bankText, readText(dir + "/sim/bank.yml"));
     // A bank no reader takes, or in a folder that does not exist, is refused before the calibration runs
     // (#79 item 23): the run writes nothing, not its whole calibration and then an error.
     for (const std::string& bad : {dir + "/sim/bank.txt", dir + "/no_such_folder/bank.yml"}) {
@@ -80,6 +92,17 @@ TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
         ASSERT_EQ(0, r.status) << r.output;
         EXPECT_TRUE(exists(dir + "/aug_" + tied + "/frame_000_v00.png")) << r.output;
     }
+    // A bank of these frames whose content changed since is another bank: never written over, named.
+    const std::string darkFrame = bank.groups[0].files[0];
+    cv::Mat changed = cv::imread(darkFrame, cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(changed.empty()) << darkFrame;
+    changed.at<uint16_t>(0, 0) += 1;
+    ASSERT_TRUE(cv::imwrite(darkFrame, changed));
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --dark_bank='" + dir +
+                                         "/sim/bank.yml' --plots=false --out='" + dir + "/cal_changed'");
+    EXPECT_EQ(1, r.status) << r.output;
+    EXPECT_NE(std::string::npos, r.output.find("is another bank than this run's")) << r.output;
+    EXPECT_EQ(bankText, readText(dir + "/sim/bank.yml"));
     // Without dark bursts the option is an error that says what it needs.
     r = runApp("rawgment_simulate",
                "--frames=3 --levels=0.5 --format=png --validation=false --gains=6 --out='" + dir + "/plain'");

@@ -51,10 +51,16 @@ TEST(Apps, calibrateEmvaOnSet001WritesTheStandardsFiguresTheModelPlotsAndTheVali
     // Which slope is right on a curve that bends: the sensor's own darker steps decide (docs/emva1288.md).
     EXPECT_NE(report.find("the model's line predicts this sensor's darker steps better"), std::string::npos)
         << report;
-    // A finished run is not redone over its outputs.
+    // An identical rerun finds its own outputs, byte for byte, and succeeds (round 5, item 21); an output
+    // changed since is never written over, and the run names it.
     const AppRun again = runApp("rawgment_calibrate", args);
-    EXPECT_NE(0, again.status);
-    EXPECT_NE(again.output.find("exists"), std::string::npos) << again.output;
+    EXPECT_EQ(0, again.status) << again.output;
+    EXPECT_EQ(report, readText(dir + "/cal/report.md"));
+    std::ofstream(dir + "/cal/report.md", std::ios::app) << "the user's note\n";
+    const AppRun edited = runApp("rawgment_calibrate", args);
+    EXPECT_NE(0, edited.status);
+    EXPECT_NE(edited.output.find("report.md' already exists"), std::string::npos) << edited.output;
+    EXPECT_EQ(report + "the user's note\n", readText(dir + "/cal/report.md"));
 }
 
 TEST(Apps, calibrateEmvaSeparatesTheReadNoiseOfAManifestOfGainsAndRefusesBadInputWithStatus2)

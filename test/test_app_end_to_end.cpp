@@ -89,10 +89,18 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
          {"calib_mean_variance.png", "calib_histograms.png", "calib_cross_gain.png", "shapiro_pvalue.png"})
         expectPngDecodes(dir + "/cal/" + png);
     const std::string modelBefore = readText(dir + "/cal/noise_model.yml");
+    // An identical rerun finds its own outputs and succeeds; an output changed since is never overwritten.
+    r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + dir + "/cal'");
+    EXPECT_EQ(0, r.status) << r.output;
+    EXPECT_EQ(modelBefore, readText(dir + "/cal/noise_model.yml"));
+    const std::string linesBefore = readText(dir + "/cal/lines.csv");
+    std::ofstream(dir + "/cal/lines.csv", std::ios::app) << "edited\n";
     r = runApp("rawgment_calibrate", "'" + dir + "/sim/manifest.yml' --out='" + dir + "/cal'");
     EXPECT_EQ(1, r.status);
-    EXPECT_EQ(modelBefore, readText(dir + "/cal/noise_model.yml"))
+    EXPECT_NE(r.output.find("lines.csv' already exists"), std::string::npos) << r.output;
+    EXPECT_EQ(linesBefore + "edited\n", readText(dir + "/cal/lines.csv"))
         << "an existing output is never overwritten";
+    std::ofstream(dir + "/cal/lines.csv", std::ios::trunc) << linesBefore;
     // A run that died before its plots and its last table is completed by the same command.
     std::remove((dir + "/cal/shapiro_pvalue.png").c_str());
     std::remove((dir + "/cal/variance_ratio_histogram.csv").c_str());

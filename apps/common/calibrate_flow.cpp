@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <set>
 #include <stdexcept>
 
 namespace rawgment_apps {
@@ -539,8 +540,6 @@ namespace {
 std::vector<cv::String> darkBankFiles(const CalibrateOptions& o,
                                       const std::vector<CalibrationManifest::Burst>& specs)
 {
-    if (pathExists(o.darkBank))
-        throw std::runtime_error("'" + o.darkBank + "' exists: the dark-frame bank is never written over");
     // What save() would refuse at the end is refused here, before the calibration's work (#79 item 23).
     const std::string ext = std::filesystem::path(o.darkBank).extension().string();
     if (ext != ".yml" && ext != ".yaml" && ext != ".json")
@@ -558,7 +557,50 @@ std::vector<cv::String> darkBankFiles(const CalibrateOptions& o,
     if (files.empty())
         throw std::runtime_error(
             "--dark_bank needs dark bursts (dark: true in the manifest, or folders named dark*)");
+    // An existing bank is refused before the work unless it is one this run may have made: a bank of these
+    // very files (a rerun, or an identical run at the same time). Its content is compared at the end.
+    if (pathExists(o.darkBank)) {
+        std::set<std::string> ours, its;
+        for (const cv::String& f : files)
+            ours.insert(canonicalPath(f));
+        try {
+            for (const DarkFrameGroup& g : DarkFrameBank::load(o.darkBank).groups)
+                for (const cv::String& f : g.files)
+                    its.insert(canonicalPath(f));
+        } catch (const cv::Exception& e) {
+            throw std::runtime_error("'" + o.darkBank + "' exists and is not a bank this run makes (" +
+                                     e.err + "); the dark-frame bank is never written over");
+        }
+        if (ours != its)
+            throw std::runtime_error("'" + o.darkBank +
+                                     "' exists and holds other dark frames than this run's; the dark-frame "
+                                     "bank is never written over");
+    }
     return files;
+}
+
+/* Saves `bank` at `path` unless a bank is there, under a lock of its folder so that two runs take turns. An
+ * existing bank is this run's output when it loads (maps checked) and is, text for text, the bank this run
+ * made: the same frames with the same fingerprints, the same statistics and maps. Any other is refused. */
+void saveNewDarkFrameBank(DarkFrameBank& bank, const std::string& path)
+{
+    const FolderLock lock(directoryOf(path));
+    if (!pathExists(path)) {
+        bank.save(path);
+        return;
+    }
+    DarkFrameBank existing;
+    try {
+        existing = DarkFrameBank::load(path);
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error("'" + path + "' exists and is not a bank (" + e.err +
+                                 "); the dark-frame bank is never written over");
+    }
+    bank.path = existing.path;
+    if (!bank.matchesItsFile())
+        throw std::runtime_error("'" + path +
+                                 "' exists and is another bank than this run's (other frames, frame content "
+                                 "or statistics); the dark-frame bank is never written over");
 }
 
 void writeDarkFrameBank(const CalibrateOptions& o, const std::vector<CalibrationManifest::Burst>& specs,
@@ -582,7 +624,7 @@ void writeDarkFrameBank(const CalibrateOptions& o, const std::vector<Calibration
                                                 specs[i].files.front().c_str(), group->gain, gain,
                                                 gains.gainsDb[i]));
     }
-    result.bank.save(o.darkBank);
+    saveNewDarkFrameBank(result.bank, o.darkBank);
     result.bankSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -599,17 +641,9 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
                       samplesCsv = o.outDir + "/samples.csv", linesCsv = o.outDir + "/lines.csv",
                       shapiroCsv = o.outDir + "/shapiro.csv",
                       histCsv = o.outDir + "/variance_ratio_histogram.csv";
-    // A finished calibration is never redone into its folder. A run that died before its end is
-    // completed: the calibration is deterministic, outputs already there must be what this run writes
-    // (writeNewText refuses anything else) and the missing ones are added.
-    std::vector<std::string> finished = {reportPath, samplesCsv, linesCsv,
-                                         shapiroCsv, histCsv,    o.outDir + "/report.md"};
-    if (o.plots)
-        for (const char* png : {"calib_mean_variance.png", "calib_histograms.png", "calib_cross_gain.png",
-                                "shapiro_pvalue.png"})
-            finished.push_back(o.outDir + "/" + png);
-    if (std::all_of(finished.begin(), finished.end(), [](const std::string& p) { return pathExists(p); }))
-        refuseExisting(finished);
+    // The calibration is deterministic, so every output already there must be what this run writes
+    // (writeNewText refuses anything else, naming it): a run that died before its end is completed, and a
+    // rerun of a finished one, or an identical run at the same time, finds its own outputs and succeeds.
 
     CalibrateResult result;
     const std::vector<CalibrationManifest::Burst>& specs = manifest.bursts;

@@ -246,14 +246,8 @@ Emva1288FlowResult calibrateFromEmva1288(const Emva1288Options& o)
         total += series.back().temporal.size() + series.back().spatial.size();
     }
     prepareOutputDirectory(o.outDir);
-    // A finished run is never redone into its folder; one that died before its end is completed (the run is
-    // deterministic: outputs already there must be what this run writes, which writeNewText checks).
-    std::vector<std::string> finished;
-    for (const char* name :
-         {"noise_model.yml", "calibration_report.yml", "emva1288.yml", "emva1288_points.csv", "report.md"})
-        finished.push_back(o.outDir + "/" + name);
-    if (std::all_of(finished.begin(), finished.end(), [](const std::string& p) { return pathExists(p); }))
-        refuseExisting(finished);
+    // The run is deterministic: outputs already there must be what this run writes (writeNewText checks,
+    // naming any other), so a run that died before its end is completed and an identical rerun succeeds.
     ProgressBar bar("EMVA 1288 steps", total);
     std::vector<Emva1288Results> results;
     std::vector<double> gains;

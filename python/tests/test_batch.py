@@ -63,7 +63,7 @@ def test_one_process_dask_and_the_app_make_the_same_bytes(app_dir, job):
         on_dask = batch.augmentFiles(job["inputs"], job["model"], root / "dask", policy=job["policy"], variants=2,
                                      seed=5, client=client)
     assert on_dask["written"] == 6
-    assert len(files_of(root / "app")) == 12  # 6 mosaics, each with its sidecar
+    assert len(files_of(root / "app")) == 13  # 6 mosaics, each with its sidecar, and the job record
     assert_same_files(root / "app", root / "here")
     assert_same_files(root / "app", root / "dask")
 
@@ -87,7 +87,7 @@ def test_a_rerun_resumes_and_replaces_nothing(app_dir, job):
     app_run(app_dir, job, root / "app_for_resume")
     assert_same_files(root / "app_for_resume", out)
     # Another seed into the same folder is refused: its outputs would be different files of one name.
-    with pytest.raises(RuntimeError, match="was made from"):
+    with pytest.raises(RuntimeError, match="records another augmentation job: its seed"):
         batch.augmentFiles(job["inputs"], job["model"], out, policy=job["policy"], variants=2, seed=6)
 
 

@@ -30,7 +30,7 @@ def test_augment_folder(source_dir, tmp_path, sensor, capture):
     out = run_sample(source_dir, "augment_folder.py", "--model", str(tmp_path / "m.yml"), "--variants", "2",
                      str(tmp_path / "raws"), str(tmp_path / "out"))
     assert "wrote 2" in out
-    assert sorted(os.listdir(tmp_path / "out")) == ["policy.yml", "x_v00.dng", "x_v00.dng.yml", "x_v01.dng",
+    assert sorted(os.listdir(tmp_path / "out")) == ["augment_job.yml", "policy.yml", "x_v00.dng", "x_v00.dng.yml", "x_v01.dng",
                                                     "x_v01.dng.yml"]
 
 

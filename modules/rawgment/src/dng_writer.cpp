@@ -400,8 +400,7 @@ std::vector<uint8_t> dngFileBytes(const String& path, const RawImage& image)
 void writeDng(const String& path, const RawImage& image)
 {
     const std::vector<uint8_t> bytes = detail::dngFileBytes(path, image);
-    if (pathExists(path))
-        CV_Error(Error::StsError, "writeDng: '" + path + "' already exists; it is never overwritten");
+    // Never replaces: an existing file of these very bytes is this call's output, any other an error.
     writeFileAtomically(path, bytes.data(), bytes.size(), false);
 }
 

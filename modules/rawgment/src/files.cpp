@@ -264,6 +264,11 @@ std::string contentFingerprintOf(const String& path, const String& what)
 
 } // namespace detail
 
+std::string fileFingerprint(const String& path)
+{
+    return detail::contentFingerprintOf(path, "file");
+}
+
 void refuseRepeatedFiles(const std::vector<String>& paths, const String& what)
 {
     std::map<detail::FileIdentity, size_t> seen;
@@ -454,25 +459,39 @@ void commitTemporaryFile(const String& tmpPath, const String& path)
     }
 }
 
-// Like commitTemporaryFile(), but fails (removing the temporary) when `path` already exists.
-void commitTemporaryFileNoReplace(const String& tmpPath, const String& path)
+// Whether the regular file `path` holds exactly `size` bytes equal to `data`; false when it cannot be read.
+bool fileHoldsExactly(const String& path, const void* data, size_t size)
 {
+    try {
+        const std::string existing = readFileBounded(path, static_cast<long long>(size), "file");
+        return existing.size() == size && (size == 0 || std::memcmp(existing.data(), data, size) == 0);
+    } catch (const Exception&) {
+        return false; // larger, unreadable, not a regular file: not these bytes
+    }
+}
+
+/* Like commitTemporaryFile(), but never replaces `path`: an existing file with the temporary's bytes
+ * (`data`, `size`) is kept as this write's output, any other fails the call (removing the temporary). */
+void commitTemporaryFileNoReplace(const String& tmpPath, const String& path, const void* data, size_t size)
+{
+    const auto refuse = [&] {
+        std::remove(tmpPath.c_str());
+        if (fileHoldsExactly(path, data, size))
+            return;
+        CV_Error(Error::StsError, "'" + path + "' already exists; it is never overwritten");
+    };
     // link() fails with EEXIST instead of replacing, which makes "never overwrite" atomic too.
     if (::link(tmpPath.c_str(), path.c_str()) == 0) {
         std::remove(tmpPath.c_str());
         return;
     }
     const int err = errno;
-    if (err == EEXIST) {
-        std::remove(tmpPath.c_str());
-        CV_Error(Error::StsError, "'" + path + "' already exists; it is never overwritten");
-    }
+    if (err == EEXIST)
+        return refuse();
     // Some file systems (FAT, some network mounts) have no hard links: fall back to check-then-rename.
     if (err == EPERM || err == ENOTSUP || err == EXDEV || err == ENOSYS) {
-        if (::access(path.c_str(), F_OK) == 0) {
-            std::remove(tmpPath.c_str());
-            CV_Error(Error::StsError, "'" + path + "' already exists; it is never overwritten");
-        }
+        if (::access(path.c_str(), F_OK) == 0)
+            return refuse();
         commitTemporaryFile(tmpPath, path);
         return;
     }
@@ -640,7 +659,7 @@ void writeFileAtomically(const String& path, const void* data, size_t size, bool
     if (replace)
         commitTemporaryFile(tmp, path);
     else
-        commitTemporaryFileNoReplace(tmp, path);
+        commitTemporaryFileNoReplace(tmp, path, data, size);
     syncDirectoryOf(path);
     noteOwnWriteInFolderOf(path);
 }

@@ -230,6 +230,42 @@ TEST(Files, aWriteRemovesOnlyItsOwnTargetsTemporariesThatAGoneProcessLeft)
     EXPECT_TRUE(takeRemovedStaleTemporaries().empty()) << "a report is given once";
 }
 
+/* Round 5 items 15, 21, 22: an output that exists with exactly the bytes a write makes is that write's
+ * output (a rerun of the job, or an identical run that got there first); any other file there is never
+ * overwritten. Eight threads racing to create one file with the same bytes all succeed, and none leaves a
+ * temporary: before, every one but the first failed with "already exists". */
+TEST(Files, aNewFileThatExistsWithTheSameBytesIsThisWritesOutputAndAnyOtherIsKept)
+{
+    const std::string dir = makeTempDir("no_replace_same_bytes");
+    const std::string path = dir + "/out.bin";
+    writeFileAtomically(path, "abc", 3);
+    EXPECT_NO_THROW(writeFileAtomically(path, "abc", 3));
+    for (const std::string other : {"abd", "ab", "abcd", ""}) {
+        SCOPED_TRACE(other);
+        EXPECT_CV_ERROR_CONTAINS(writeFileAtomically(path, other.data(), other.size()),
+                                 "already exists; it is never overwritten");
+        EXPECT_EQ(readFileBounded(path, 100, "file"), "abc");
+    }
+    const std::vector<char> bytes(1 << 20, 'x');
+    for (int round = 0; round < 10; ++round) {
+        const std::string target = dir + cv::format("/race_%d.bin", round);
+        std::atomic<int> failures(0);
+        std::vector<std::thread> writers;
+        for (int t = 0; t < 8; ++t)
+            writers.emplace_back([&] {
+                try {
+                    writeFileAtomically(target, bytes.data(), bytes.size());
+                } catch (const cv::Exception&) {
+                    ++failures;
+                }
+            });
+        for (std::thread& w : writers)
+            w.join();
+        EXPECT_EQ(failures.load(), 0) << target;
+    }
+    EXPECT_EQ(filesIn(dir).size(), 11u) << "no temporary is left";
+}
+
 TEST(Files, openFileStorageForReadingRefusesStreamsOpenCvNeverFinishes)
 {
     // Found by test/fuzz (minimised): OpenCV 4.6's YAML parser loops forever on each of these. libyaml

@@ -22,7 +22,9 @@ namespace rawgment {
  * the flush and an fsync are checked (a full disk is an error, not a short file); then the temporary
  * is moved into place and the directory is synced, so the new name survives a power cut. With
  * `replace` false the move fails when `path` exists, atomically too (a hard link), so an existing file
- * is never overwritten; with `replace` true it replaces `path`. On any error the temporary is removed
+ * is never overwritten, unless it holds exactly these bytes: then it is this write's output (a rerun of
+ * the same job, or an identical run at the same time that got there first) and the call succeeds
+ * leaving it as it is. With `replace` true it replaces `path`. On any error the temporary is removed
  * and `path` is left as it was.
  * @param path destination file
  * @param data the bytes (may be null when size is 0)
@@ -149,6 +151,13 @@ CV_RAWGMENT_EXPORTS std::string readFileBounded(const String& path, long long ma
  * refusals above, each with the line where it is known.
  */
 CV_RAWGMENT_EXPORTS FileStorage openFileStorageForReading(const String& path, const String& what);
+
+/** @brief The FNV-1a 64 of a regular file's bytes, as 16 lower-case hex digits: what a dark-frame bank
+ * records of each frame and an augmentation run of its recipe files and inputs. Hashed once per process per
+ * (device, inode, size, modification time in ns): about 30 ms for 24 MB, paid once.
+ * @throws cv::Exception naming the file when it is not a regular file, cannot be read, or changed while it
+ * was read. */
+CV_RAWGMENT_EXPORTS std::string fileFingerprint(const String& path);
 
 /** @brief Refuses a map with a key outside `valid` or a key that appears twice: a misspelled key
  * (`contrst_min`) must not fall back to a default, and of a repeated key OpenCV keeps both entries and a

@@ -241,13 +241,15 @@ CV_EXPORTS_W RawImage readRaw(const String& path);
  * make and model, ISO, exposure time, the as-shot neutral from the white balance and, when
  * RawImage::noiseProfile is not empty, the NoiseProfile tag (51041). The ISO is rounded to an integer (the
  * EXIF tags hold integers); from 65535 on it goes to EXIF 2.3's 32-bit ISOSpeed, which readRaw() reads back.
- * It is written atomically (a temporary file, then a hard link that fails if `path` exists).
- * @param path destination, which must not exist
+ * It is written atomically (a temporary file, then a hard link that fails if `path` exists): an existing
+ * file of exactly these bytes is this call's output (an identical run that got there first), any other is
+ * never overwritten.
+ * @param path destination, which must not exist or hold exactly the bytes this call writes
  * @param image `mosaic` must be CV_16UC1 with even sides of at least 22 pixels (LibRaw, and so readRaw(),
  *        reads no smaller RAW file); `iso` 0 (unknown) up to 4294967295; the other fields are written as
  *        they are (`format.gain` is not a DNG field; writeMosaic() keeps it in the sidecar)
- * @throws cv::Exception when `path` exists, the mosaic is unsupported, the noise profile is invalid
- *         (see noiseLineFromDngProfile()), or any write fails.
+ * @throws cv::Exception when `path` exists with other bytes, the mosaic is unsupported, the noise profile
+ *         is invalid (see noiseLineFromDngProfile()), or any write fails.
  */
 CV_EXPORTS_W void writeDng(const String& path, const RawImage& image);
 
