@@ -249,13 +249,13 @@ void claimAugmentJob(const AugmentOptions& o)
         }
     }
     bool changed = !pathExists(path);
+    std::map<std::string, std::string> known(recorded.begin(), recorded.end()); // a run may have 10^6 inputs
     for (size_t i = 0; i < inputs.size(); ++i) {
-        const auto known = std::find_if(recorded.begin(), recorded.end(),
-                                        [&](const auto& r) { return r.first == inputs[i].first; });
-        if (known == recorded.end()) {
+        const auto entry = known.emplace(inputs[i]);
+        if (entry.second) {
             recorded.push_back(inputs[i]);
             changed = true;
-        } else if (known->second != inputs[i].second) {
+        } else if (entry.first->second != inputs[i].second) {
             throw std::runtime_error("input '" + o.inputs[i] + "' is not the file it was when '" + path +
                                      "' recorded it (its content changed): its outputs there are of the "
                                      "old file; choose another --out");
