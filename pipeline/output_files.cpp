@@ -75,25 +75,10 @@ std::vector<uchar> encodeByExtension(const std::string& path, const cv::Mat& ima
     return bytes;
 }
 
-// Never replaces: an existing file with exactly these bytes (an interrupted run of the same job) is
-// kept, any other is an error.
+// Never replaces: an existing file with exactly these bytes (an interrupted or identical run of the same
+// job) is kept, any other is an error; the library's writer decides both, atomically.
 void writeNewBytes(const std::string& path, const std::vector<uchar>& bytes)
 {
-    if (pathExists(path)) {
-        // Read no more than the new bytes: a larger file, a FIFO or a device differs anyway.
-        bool same = false;
-        try {
-            const std::string existing =
-                cv::rawgment::readFileBounded(path, static_cast<long long>(bytes.size()), "existing output");
-            same =
-                existing.size() == bytes.size() && std::equal(bytes.begin(), bytes.end(), existing.begin(),
-                                                              [](uchar a, char b) { return a == uchar(b); });
-        } catch (const cv::Exception&) {
-        }
-        if (same)
-            return;
-        throw std::runtime_error("'" + path + "' already exists; it is never overwritten");
-    }
     try {
         cv::rawgment::writeFileAtomically(path, bytes.data(), bytes.size(), false);
     } catch (const cv::Exception& e) {

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
 
 namespace rawgment_app_tests {
 
@@ -38,6 +39,9 @@ enum class AllocationStacks
 AppRun runApp(const std::string& app, const std::string& args,
               AllocationStacks stacks = AllocationStacks::FAST);
 
+/** Runs a shell command (an app of this build with its arguments, shell-quoted by the caller) twice at the
+ * same time, each with its own log in `dir`: two identical runs racing for one folder. */
+std::pair<AppRun, AppRun> runTwiceAtOnce(const std::string& command, const std::string& dir);
 //! A fresh, empty folder for one test, removed at the end when every test passed.
 std::string freshDir(const std::string& name);
 

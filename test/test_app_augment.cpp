@@ -167,12 +167,9 @@ TEST(Apps, twoIdenticalRunsIntoOneFolderBothFinishWithCompletePairs)
         const std::string run = std::string(RAWGMENT_APP_DIR) + "/rawgment_augment --model='" + dir +
                                 "/sim/truth_noise_model.yml' --scene='" + dir +
                                 "/scene.yml' --variants=4 --preview=true --out='" + out + "'" + inputs;
-        const std::string both = "(" + run + " > '" + dir + "/log1' 2>&1; echo $? > '" + dir +
-                                 "/status1') & (" + run + " > '" + dir + "/log2' 2>&1; echo $? > '" + dir +
-                                 "/status2') & wait";
-        ASSERT_EQ(0, std::system(both.c_str()));
-        EXPECT_EQ("0\n", readText(dir + "/status1")) << readText(dir + "/log1");
-        EXPECT_EQ("0\n", readText(dir + "/status2")) << readText(dir + "/log2");
+        const auto [first, second] = runTwiceAtOnce(run, dir);
+        EXPECT_EQ(0, first.status) << first.output;
+        EXPECT_EQ(0, second.status) << second.output;
         int images = 0, previews = 0;
         for (const auto& entry : std::filesystem::directory_iterator(out)) {
             const std::string path = entry.path().string();

@@ -64,12 +64,9 @@ TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
     const std::string again = std::string(RAWGMENT_APP_DIR) + "/rawgment_calibrate '" + dir +
                               "/sim/manifest.yml' --dark_bank='" + dir + "/sim/bank.yml' --out='" + dir +
                               "/cal_again'";
-    const std::string both = "(" + again + " > '" + dir + "/log1' 2>&1; echo $? > '" + dir +
-                             "/status1') & (" + again + " > '" + dir + "/log2' 2>&1; echo $? > '" + dir +
-                             "/status2') & wait";
-    ASSERT_EQ(0, std::system(both.c_str()));
-    EXPECT_EQ("0\n", readText(dir + "/status1")) << readText(dir + "/log1");
-    EXPECT_EQ("0\n", readText(dir + "/status2")) << readText(dir + "/log2");
+    const auto [first, second] = runTwiceAtOnce(again, dir);
+    EXPECT_EQ(0, first.status) << first.output;
+    EXPECT_EQ(0, second.status) << second.output;
     EXPECT_EQ(bankText, readText(dir + "/sim/bank.yml"));
     // A bank no reader takes, or in a folder that does not exist, is refused before the calibration runs
     // (#79 item 23): the run writes nothing, not its whole calibration and then an error.

@@ -557,8 +557,14 @@ std::vector<cv::String> darkBankFiles(const CalibrateOptions& o,
     if (files.empty())
         throw std::runtime_error(
             "--dark_bank needs dark bursts (dark: true in the manifest, or folders named dark*)");
-    // An existing bank is refused before the work unless it is one this run may have made: a bank of these
-    // very files (a rerun, or an identical run at the same time). Its content is compared at the end.
+    return files;
+}
+
+/* An existing bank is refused before the work unless it is one this run may have made: a bank of these very
+ * files (a rerun, or an identical run at the same time). Its content is compared when the bank is saved
+ * (saveNewDarkFrameBank). */
+void refuseAnotherExistingBank(const CalibrateOptions& o, const std::vector<cv::String>& files)
+{
     if (pathExists(o.darkBank)) {
         std::set<std::string> ours, its;
         for (const cv::String& f : files)
@@ -576,7 +582,6 @@ std::vector<cv::String> darkBankFiles(const CalibrateOptions& o,
                                      "' exists and holds other dark frames than this run's; the dark-frame "
                                      "bank is never written over");
     }
-    return files;
 }
 
 /* Saves `bank` at `path` unless a bank is there, under a lock of its folder so that two runs take turns. An
@@ -635,7 +640,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     const CalibrationManifest manifest = readCalibrationManifest(o.manifest);
     // A bank that cannot be written is refused before the calibration, not after it.
     if (!o.darkBank.empty())
-        darkBankFiles(o, manifest.bursts);
+        refuseAnotherExistingBank(o, darkBankFiles(o, manifest.bursts));
     prepareOutputDirectory(o.outDir);
     const std::string reportPath = o.outDir + "/calibration_report.yml",
                       samplesCsv = o.outDir + "/samples.csv", linesCsv = o.outDir + "/lines.csv",
