@@ -388,14 +388,15 @@ void runAugmentJob(const AugmentJob& job, const AugmentRecipe& recipe)
     meta.source = job.input;
     meta.noiseCamera = cameraName;
     // The output is the camera's capture of the darker or brighter scene: the input's camera tags, with
-    // the ISO scaled by the gain ratio, the exposure time by the photon ratio (of green, which hue leaves
-    // alone) and the noise profile of the model at the output's gain.
+    // the ISO scaled by the gain ratio, the target's exposure time (the scene's, by default the input's:
+    // the darkening is the light's, and a bank's dark frames were drawn at that exposure) and the noise
+    // profile of the model at the output's gain.
     const double signalRatio =
         scene.jitter.contrast[m.format.isMonochrome() ? 0 : cfaSiteOfChannel(m.format.pattern, CFA_G1)];
     meta.hasCamera = true;
     meta.camera = m.camera;
     meta.camera.iso = m.camera.iso * outFormat.gain / m.format.gain;
-    meta.camera.exposureTime = m.camera.exposureTime * signalRatio / scene.jitter.gainRatio;
+    meta.camera.exposureTime = outFormat.exposureTime;
     meta.camera.noiseProfile = model.alpha > 0 ? dngNoiseProfile(model, outFormat) : std::vector<cv::Vec2d>();
     // A preview brightened back to the input's level shows the noise the scene added, not a dark frame.
     if (!job.preview.empty())

@@ -107,6 +107,7 @@ void bindNoiseSteps(py::module_& m)
         .def_readwrite("contrast", &ColorJitter::contrast, doc("ColorJitter::contrast"))
         .def_readwrite("brightness", &ColorJitter::brightness, doc("ColorJitter::brightness"))
         .def_readwrite("gainRatio", &ColorJitter::gainRatio, doc("ColorJitter::gainRatio"))
+        .def_readwrite("exposureTime", &ColorJitter::exposureTime, doc("ColorJitter::exposureTime"))
         .def_static("exposureChange", &ColorJitter::exposureChange, py::arg("photonRatio"),
                     py::arg("gainRatio"), doc("ColorJitter::exposureChange"))
         .def("isIdentity", &ColorJitter::isIdentity, doc("ColorJitter::isIdentity"));

@@ -280,6 +280,7 @@ void bindBayer(py::module_& m)
         .def_readwrite("gain", &RawFormat::gain, doc("RawFormat::gain"))
         .def_readwrite("sensorOrigin", &RawFormat::sensorOrigin,
                        doc("RawFormat::sensorOrigin", "Python: a tuple (x, y)."))
+        .def_readwrite("exposureTime", &RawFormat::exposureTime, doc("RawFormat::exposureTime"))
         .def("validate", &RawFormat::validate, doc("RawFormat::validate"))
         .def("blackAt", &RawFormat::blackAt, py::arg("row"), py::arg("col"), doc("RawFormat::blackAt"))
         .def("isMonochrome", &RawFormat::isMonochrome, doc("RawFormat::isMonochrome"))

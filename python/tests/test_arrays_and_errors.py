@@ -329,3 +329,35 @@ def test_calibration_errors_intervals_and_projections(sensor, tmp_path):
         report.interval(rg.NOISE_PARAM_ALPHA, 1.5)
     with pytest.raises(rg.error, match="frameFactor"):
         rg.projectedStdError(samples, report, rg.CalibrationPlan(frameFactor=-1))
+
+
+def test_an_exposure_time_travels_through_files_and_chooses_the_banks_group(tmp_path):
+    # #79 item 10: the format states the exposure; a bank's group is the input's exposure's, the target's the
+    # jitter's when it states one, and an exposure the bank has no frames of is refused naming those it has.
+    fmt = rg.RawFormat(blackLevel=(64, 64, 64, 64), whiteLevel=4095, exposureTime=1.0)
+    assert pickle.loads(pickle.dumps(fmt)).exposureTime == 1.0
+    rng = np.random.default_rng(5)
+    files = []
+    for exposure, sigma in ((0.001, 2.0), (1.0, 6.0)):
+        for i in range(4):
+            frame = np.round(64 + sigma * rng.standard_normal((48, 64))).astype(np.uint16)
+            path = str(tmp_path / ("dark_%g_%d.npy" % (exposure, i)))
+            rg.writeMosaic(path, frame, rg.MosaicMetadata(format=rg.RawFormat(
+                blackLevel=(64, 64, 64, 64), whiteLevel=4095, exposureTime=exposure)))
+            files.append(path)
+    _, meta = rg.readMosaic(files[-1])
+    assert meta.format.exposureTime == 1.0
+    bank = rg.DarkFrameBank.create(files, rg.NoiseModel())
+    assert [g.exposureTime for g in bank.groups] == [0.001, 1.0]
+    assert bank.nearestGroup(1.0, 1.1) == 1
+    bank.save(str(tmp_path / "bank.yml"))
+    options = rg.NoiseOptions(alignment=rg.NoiseAlignment.IGNORE_PRIOR, darkBank=str(tmp_path / "bank.yml"))
+    flat = np.full((48, 64), 64, np.uint16)
+    out, out_format, _ = rg.colorJitter(flat, fmt, rg.NoiseModel(0, 0, 1), rg.ColorJitter(contrast=(0.5,) * 4),
+                                        options, seed=1)
+    assert out_format.exposureTime == 1.0
+    assert 0.75 * 36 < np.var(out.astype(np.float64)) < 1.35 * 36, "the 1 s frames vary as 36 DN^2, 1 ms as 4"
+    with pytest.raises(rg.error, match=r"no frames within a third of a stop of exposure 0.1 s at gain 1; "
+                                       r"it has 0.001 s, 1 s there"):
+        rg.colorJitter(flat, fmt, rg.NoiseModel(0, 0, 1), rg.ColorJitter(contrast=(0.5,) * 4, exposureTime=0.1),
+                       options, seed=1)

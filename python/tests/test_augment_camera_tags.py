@@ -66,8 +66,10 @@ def test_augmented_dng_keeps_the_camera_and_states_the_simulated_capture(tmp_pat
     before, after = rg.readRaw(source), rg.readRaw(out)
     assert (after.make, after.model) == (before.make, before.model)
     assert after.iso == pytest.approx(before.iso * GAIN_RATIO)
-    # The DNG stores the exposure time as a rational: exact to a part in 1e6 at these values.
-    assert after.exposureTime == pytest.approx(before.exposureTime * PHOTON_RATIO, rel=1e-6)
+    # The darkening is the scene's light, so the exposure stays the input's (a scene states another as
+    # exposure_time); the DNG stores it as a rational: exact to a part in 1e6 at these values.
+    assert after.exposureTime == pytest.approx(before.exposureTime, rel=1e-6)
+    assert after.format.exposureTime == after.exposureTime
     # White balance and colour matrix go through DNG rationals and LibRaw's own normalisation.
     assert after.whiteBalance == pytest.approx(before.whiteBalance, rel=1e-5)
     for row_after, row_before in zip(after.cameraToSrgb, before.cameraToSrgb):

@@ -175,6 +175,9 @@ void RawFormat::validate() const
     if (sensorOrigin.x < 0 || sensorOrigin.y < 0)
         CV_Error(Error::StsBadArg, format("RawFormat.sensorOrigin must be >= 0 (got (%d, %d))",
                                           sensorOrigin.x, sensorOrigin.y));
+    if (!(std::isfinite(exposureTime) && exposureTime >= 0))
+        CV_Error(Error::StsBadArg,
+                 format("RawFormat.exposureTime must be finite and >= 0 seconds (got %g)", exposureTime));
 }
 
 RawFormat RawFormat::cropped(int rowOffset, int colOffset) const
@@ -200,6 +203,9 @@ void RawFormat::write(FileStorage& fs, const String& name) const
     if (sensorOrigin != Point(0, 0))
         fs << "sensor_origin"
            << "[:" << sensorOrigin.x << sensorOrigin.y << "]";
+    // Only when stated, so that a format without one keeps the bytes it had before the field existed.
+    if (exposureTime > 0)
+        fs << "exposure_time" << exposureTime;
     fs << "}";
 }
 
@@ -214,7 +220,8 @@ RawFormat RawFormat::read(const FileNode& node)
         CV_Error(Error::StsParseError, "raw format: field 'pattern' is missing or not a string");
     f.pattern = cfaPatternFromName(patternNode.string());
     try {
-        rejectUnknownKeys(node, {"pattern", "black_level", "white_level", "gain", "sensor_origin"});
+        rejectUnknownKeys(
+            node, {"pattern", "black_level", "white_level", "gain", "sensor_origin", "exposure_time"});
         const std::vector<double> black = detail::readRealList(node, "black_level", 4);
         for (int s = 0; s < 4; ++s)
             f.blackLevel[s] = black[static_cast<size_t>(s)];
@@ -227,6 +234,7 @@ RawFormat RawFormat::read(const FileNode& node)
                     CV_Error(Error::StsParseError, "field 'sensor_origin' must be two whole numbers >= 0");
             f.sensorOrigin = Point(static_cast<int>(origin[0]), static_cast<int>(origin[1]));
         }
+        f.exposureTime = detail::readOptionalRealField(node, "exposure_time", 0);
     } catch (const Exception& e) {
         CV_Error(e.code, "raw format: " + e.err);
     }

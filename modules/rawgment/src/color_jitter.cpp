@@ -397,7 +397,7 @@ ColorJitter ColorJitter::exposureChange(double photonRatio, double gainRatio)
 
 bool ColorJitter::isIdentity() const
 {
-    return contrast == Vec4d::all(1) && brightness == 0 && gainRatio == 1;
+    return contrast == Vec4d::all(1) && brightness == 0 && gainRatio == 1 && exposureTime == 0;
 }
 
 namespace detail {
@@ -425,8 +425,13 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     checkFinitePositive(jitter.gainRatio, "colorJitter: gainRatio");
     const double newGain = format.gain * jitter.gainRatio;
     checkFinitePositive(newGain, "colorJitter: the new gain");
+    if (!(std::isfinite(jitter.exposureTime) && jitter.exposureTime >= 0))
+        CV_Error(Error::StsBadArg,
+                 cv::format("colorJitter: exposureTime must be finite and >= 0 seconds (got %g)",
+                            jitter.exposureTime));
+    const double newExposure = jitter.exposureTime > 0 ? jitter.exposureTime : format.exposureTime;
     // The model's terms at the input gain and at the output gain (its own line there with measured lines).
-    const StepNoise step(model, format, noise, jitter.gainRatio, src.size(), "colorJitter");
+    const StepNoise step(model, format, noise, jitter.gainRatio, src.size(), "colorJitter", newExposure);
     const NoiseTerms<double>&terms = step.in, &outTerms = step.out;
     {
         // The row loops run in float: the largest value and variance they can form must fit one.
@@ -448,13 +453,18 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
                          largestVariance));
     }
 
-    if (jitter.isIdentity()) {
+    // Another exposure changes the noise only through a bank's frames of it.
+    const bool sameCapture = newExposure == format.exposureTime || !step.bank;
+    ColorJitter change = jitter;
+    change.exposureTime = 0;
+    if (change.isIdentity() && sameCapture) {
         // Skipped entirely: no copy, no random draw; the values are checked, since no row reads them.
         if (!valuesChecked)
             checkMosaicInput(src, "colorJitter");
         reportSaturation(src, format, report, saturatedMask);
         _dst.assign(src);
         dstFormat = format;
+        dstFormat.exposureTime = newExposure;
         return;
     }
     JitterConstants k;
@@ -531,6 +541,7 @@ void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoi
     _dst.assign(dst);
     dstFormat = format;
     dstFormat.gain = newGain;
+    dstFormat.exposureTime = newExposure;
     if (report) {
         report->brighteningPixels += brightening.load();
         report->readBrighteningPixels += readBrightening.load();

@@ -23,19 +23,57 @@ namespace rawgment {
 
 namespace detail {
 
-int nearestGainGroup(const std::vector<DarkFrameGroup>& groups, double gain, double exposureTime)
+int nearestGainGroup(const std::vector<DarkFrameGroup>& groups, double gain, double exposureTime,
+                     const String& bankPath)
 {
     const auto logDistance = [](double a, double b) { return std::abs(std::log(std::max(a, 1e-300) / b)); };
-    int best = 0;
-    for (int i = 1; i < static_cast<int>(groups.size()); ++i) {
-        const DarkFrameGroup &g = groups[static_cast<size_t>(i)], &b = groups[static_cast<size_t>(best)];
-        const double di = logDistance(g.gain, gain), db = logDistance(b.gain, gain);
-        if (di < db - 1e-12 ||
-            (std::abs(di - db) <= 1e-12 && exposureTime > 0 &&
-             logDistance(g.exposureTime, exposureTime) < logDistance(b.exposureTime, exposureTime)))
+    int nearest = 0;
+    for (int i = 1; i < static_cast<int>(groups.size()); ++i)
+        if (logDistance(groups[static_cast<size_t>(i)].gain, gain) <
+            logDistance(groups[static_cast<size_t>(nearest)].gain, gain) - 1e-12)
+            nearest = i;
+    const double atGain = groups[static_cast<size_t>(nearest)].gain;
+    std::vector<int> sameGain;
+    for (int i = 0; i < static_cast<int>(groups.size()); ++i)
+        if (logDistance(groups[static_cast<size_t>(i)].gain, atGain) <= 1e-12)
+            sameGain.push_back(i);
+    const auto exposuresText = [&]() {
+        String text;
+        for (int i : sameGain) {
+            const double t = groups[static_cast<size_t>(i)].exposureTime;
+            text += (text.empty() ? "" : ", ") + (t > 0 ? format("%g s", t) : String("an unstated one"));
+        }
+        return text;
+    };
+    const String where = bankPath.empty() ? String() : " ('" + bankPath + "')";
+    if (exposureTime == 0) {
+        if (sameGain.size() == 1)
+            return sameGain.front();
+        CV_Error(Error::StsBadArg,
+                 format("the mosaic states no exposure time (RawFormat::exposureTime), and the dark-frame "
+                        "bank%s has frames of %zu exposures at gain %g (%s): dark current grows with the "
+                        "exposure, so state it",
+                        where.c_str(), sameGain.size(), atGain, exposuresText().c_str()));
+    }
+    int best = -1, unstated = -1;
+    for (int i : sameGain) {
+        const double t = groups[static_cast<size_t>(i)].exposureTime;
+        if (t == 0)
+            unstated = i;
+        else if (best < 0 || logDistance(t, exposureTime) <
+                                 logDistance(groups[static_cast<size_t>(best)].exposureTime, exposureTime))
             best = i;
     }
-    return best;
+    if (best >= 0 && logDistance(groups[static_cast<size_t>(best)].exposureTime, exposureTime) <=
+                         std::log(kExposureMatchFactor) + 1e-12)
+        return best;
+    if (unstated >= 0)
+        return unstated;
+    CV_Error(
+        Error::StsBadArg,
+        format("the dark-frame bank%s has no frames within a third of a stop of exposure %g s at gain %g; it "
+               "has %s there: dark current grows with the exposure, so add dark frames at %g s",
+               where.c_str(), exposureTime, atGain, exposuresText().c_str(), exposureTime));
 }
 
 DarkFrame readDarkFrame(const String& path, const NoiseModel& model)
@@ -44,13 +82,14 @@ DarkFrame readDarkFrame(const String& path, const NoiseModel& model)
     if (pathExists(sidecarPathOf(path))) {
         const MosaicMetadata meta = readMosaic(path, f.mosaic);
         f.format = meta.formatFor(model);
-        f.exposureTime = meta.hasCamera ? meta.camera.exposureTime : 0.0;
     } else {
         const RawImage raw = readRaw(path);
         f.mosaic = raw.mosaic;
         f.format = raw.formatFor(model);
-        f.exposureTime = raw.exposureTime;
     }
+    // The bank's format is its sensor's; each group holds its exposure.
+    f.exposureTime = f.format.exposureTime;
+    f.format.exposureTime = 0;
     return f;
 }
 
@@ -544,7 +583,7 @@ int DarkFrameBank::nearestGroup(double gain, double exposureTime) const
                 "DarkFrameBank: gain %g lies outside the bank's gains [%g, %g]%s: its frames say nothing of "
                 "it; add dark frames at that gain",
                 gain, lowest, highest, path.empty() ? "" : (" ('" + path + "')").c_str()));
-    return detail::nearestGainGroup(groups, gain, exposureTime);
+    return detail::nearestGainGroup(groups, gain, exposureTime, path);
 }
 
 Mat DarkFrameBank::readFrame(int group, int index) const

@@ -44,10 +44,18 @@ private:
     std::vector<double> rowSum_, rowSum2_; // per row and column parity, over frames
 };
 
-/** The group of `groups` (by increasing gain, then exposure) whose gain is nearest `gain` on a log scale,
- * then whose exposure is nearest `exposureTime` (when > 0), at any gain: DarkFrameBank::nearestGroup() adds
- * the bank's range to it, a step's input side (a gain the bank may not cover) takes it as it is. */
-int nearestGainGroup(const std::vector<DarkFrameGroup>& groups, double gain, double exposureTime);
+/** Two exposure times are the same capture's when within a third of a stop (a factor 2^(1/3)), the step of
+ * cameras' shutter settings: a nominal 1/60 s and a stated 0.0166 s match, 1/60 s and 1/30 s do not. */
+constexpr double kExposureMatchFactor = 1.2599210498948732;
+
+/** The group of `groups` (by increasing gain, then exposure) whose gain is nearest `gain` on a log scale, at
+ * any gain (DarkFrameBank::nearestGroup() adds the bank's range to it, a step's input side takes it as it
+ * is), and of that gain the group of exposure `exposureTime`: the nearest stated one within
+ * kExposureMatchFactor, else a group that states none (its frames say nothing of their exposure). Refused,
+ * naming the exposures the bank has at that gain (and `bankPath` when not empty), when no group matches, or
+ * when `exposureTime` is 0 (not stated) and the gain has groups of more than one exposure. */
+int nearestGainGroup(const std::vector<DarkFrameGroup>& groups, double gain, double exposureTime,
+                     const String& bankPath = String());
 
 //! One dark frame as read: its pixels, its format at its gain, and its exposure time (0: not stated).
 struct DarkFrame

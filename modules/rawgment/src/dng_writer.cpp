@@ -208,6 +208,12 @@ uint8_t dngColourOf(CfaChannel ch)
     return ch == CFA_R ? 0 : (ch == CFA_B ? 2 : 1);
 }
 
+//! The one ExposureTime tag: the image's, or its format's when the image states none.
+double dngExposureTime(const RawImage& image)
+{
+    return image.exposureTime > 0 ? image.exposureTime : image.format.exposureTime;
+}
+
 /** Every field writeDng stores, checked against what its tag can hold; returns the black levels as the
  * integers DNG stores for 16-bit data. */
 std::vector<uint32_t> checkDngImage(const String& path, const RawImage& image)
@@ -238,10 +244,17 @@ std::vector<uint32_t> checkDngImage(const String& path, const RawImage& image)
         CV_Error(Error::StsBadArg, format("writeDng: '%s': white level %.17g is not an integer; DNG stores "
                                           "integer levels for 16-bit data",
                                           path.c_str(), image.format.whiteLevel));
-    if (!(image.exposureTime >= 0 && image.exposureTime <= 4294967295.0))
+    const double exposureTime = dngExposureTime(image);
+    if (image.exposureTime > 0 && image.format.exposureTime > 0 &&
+        std::abs(image.exposureTime - image.format.exposureTime) > 1e-9 * image.exposureTime)
+        CV_Error(
+            Error::StsBadArg,
+            format("writeDng: '%s': exposure time %g s but format.exposureTime %g s: one capture has one",
+                   path.c_str(), image.exposureTime, image.format.exposureTime));
+    if (!(exposureTime >= 0 && exposureTime <= 4294967295.0))
         CV_Error(Error::StsBadArg, format("writeDng: '%s': exposure time %g s does not fit its DNG tag "
                                           "(a rational of at most 4294967295 s)",
-                                          path.c_str(), image.exposureTime));
+                                          path.c_str(), exposureTime));
     if (!(image.iso >= 0 && image.iso < 4294967295.5))
         CV_Error(Error::StsBadArg,
                  format("writeDng: '%s': ISO %g is not one a DNG can state (0 for unknown, or "
@@ -353,8 +366,8 @@ std::vector<uint8_t> dngFileBytes(const String& path, const RawImage& image)
         t.bytes(33422, {dngColourOf(cfaChannelAt(p, 0, 0)), dngColourOf(cfaChannelAt(p, 0, 1)),
                         dngColourOf(cfaChannelAt(p, 1, 0)), dngColourOf(cfaChannelAt(p, 1, 1))});
     }
-    if (image.exposureTime > 0)
-        t.rationals(33434, {image.exposureTime}, false);
+    if (dngExposureTime(image) > 0)
+        t.rationals(33434, {dngExposureTime(image)}, false);
     if (image.iso > 0) {
         // EXIF 2.3: ISOSpeedRatings holds 16 bits, and 65535 there says that ISOSpeed (32 bits) holds the
         // value; SensitivityType 3 says that ISOSpeed is the one stated. ISO tags hold integers.

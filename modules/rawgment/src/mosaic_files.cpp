@@ -24,11 +24,25 @@ void MosaicMetadata::write(FileStorage& fs, const String& name) const
     if (gainFromIso && !(hasCamera && camera.iso > 0 && format.gain == 1))
         CV_Error(Error::StsBadArg,
                  "mosaic metadata: gainFromIso needs camera tags with an ISO and a gain of 1");
+    // The camera tags carry the exposure time when there are tags: one capture has one.
+    if (hasCamera && format.exposureTime > 0 && camera.exposureTime > 0 &&
+        std::abs(format.exposureTime - camera.exposureTime) > 1e-9 * camera.exposureTime)
+        CV_Error(
+            Error::StsBadArg,
+            cv::format("mosaic metadata: the format's exposure time %g s differs from the camera tags' %g "
+                       "s",
+                       format.exposureTime, camera.exposureTime));
+    RawFormat written = format;
+    CameraTags tags = camera;
+    if (hasCamera) {
+        tags.exposureTime = camera.exposureTime > 0 ? camera.exposureTime : format.exposureTime;
+        written.exposureTime = 0;
+    }
     fs << name << "{";
-    // Version 4 only where its one addition is used, so that every other sidecar stays readable by older
-    // releases and its bytes stay what they were.
-    fs << "format_version" << (gainFromIso ? FORMAT_VERSION : 3);
-    format.write(fs, "raw_format");
+    // Versions 4 and 5 only where their one addition each is used, so that every other sidecar stays
+    // readable by older releases and its bytes stay what they were.
+    fs << "format_version" << (written.exposureTime > 0 ? FORMAT_VERSION : gainFromIso ? 4 : 3);
+    written.write(fs, "raw_format");
     fs << "size" << size;
     fs << "type" << typeToString(type);
     writeString(fs, "source", source);
@@ -39,7 +53,7 @@ void MosaicMetadata::write(FileStorage& fs, const String& name) const
         fs << "seed" << cv::format("%llu", static_cast<unsigned long long>(seed));
     }
     if (hasCamera)
-        camera.write(fs, "camera");
+        tags.write(fs, "camera");
     if (!noiseCamera.empty())
         writeString(fs, "noise_camera", noiseCamera);
     if (gainFromIso)
@@ -93,8 +107,11 @@ MosaicMetadata MosaicMetadata::read(const FileNode& node)
         CV_Error(Error::StsParseError, "mosaic metadata: field 'noise_camera' must be a string");
     m.noiseCamera = noiseCamera.empty() ? String() : String(noiseCamera);
     m.hasCamera = !node["camera"].empty();
-    if (m.hasCamera)
+    if (m.hasCamera) {
         m.camera = CameraTags::read(node["camera"]);
+        if (m.format.exposureTime == 0)
+            m.format.exposureTime = m.camera.exposureTime;
+    }
     const FileNode gainFromIso = node["gain_from_iso"];
     if (!gainFromIso.empty()) {
         try {

@@ -192,6 +192,7 @@ RawImage readRaw(const String& path)
             out.iso = exifIso;
     }
     out.exposureTime = d.other.shutter > 0 ? shortestDecimal(d.other.shutter) : 0.0;
+    out.format.exposureTime = out.exposureTime;
     out.make = d.idata.make;
     out.model = d.idata.model;
     // A monochrome frame has no colour to balance or convert: the identity balance and matrix.

@@ -65,6 +65,9 @@ void Scene::write(FileStorage& fs, const String& name) const
     fs << "contrast"
        << "[" << jitter.contrast[0] << jitter.contrast[1] << jitter.contrast[2] << jitter.contrast[3] << "]";
     fs << "brightness" << jitter.brightness << "gain_ratio" << jitter.gainRatio;
+    // Only when stated, so that every scene without one keeps its bytes.
+    if (jitter.exposureTime > 0)
+        fs << "exposure_time" << jitter.exposureTime;
     noise.writeFields(fs);
     fs << "motion_kernel" << (motionKernel.empty() ? Mat::ones(1, 1, CV_32F) : motionKernel);
     fs << "}";
@@ -82,15 +85,18 @@ Scene Scene::read(const FileNode& node)
                 CV_Error(Error::StsParseError, "field 'shift' must be a list of two integers (x, y)");
             s.shift = Point(static_cast<int>(shift[0]), static_cast<int>(shift[1]));
         }
-        rejectUnknownKeys(node, {"shift", "scale", "contrast", "brightness", "gain_ratio", "motion_kernel",
-                                 "alignment", "shot_sampling", "prior_mean", "blur_noise_sum", "dark_bank",
-                                 "dark_bank_tied"});
+        rejectUnknownKeys(node, {"shift", "scale", "contrast", "brightness", "gain_ratio", "exposure_time",
+                                 "motion_kernel", "alignment", "shot_sampling", "prior_mean",
+                                 "blur_noise_sum", "dark_bank", "dark_bank_tied"});
         s.scale = detail::readOptionalRealField(node, "scale", s.scale);
         const std::vector<double> contrast = detail::readRealList(node, "contrast", 4);
         for (int i = 0; i < 4; ++i)
             s.jitter.contrast[i] = contrast[static_cast<size_t>(i)];
         s.jitter.brightness = detail::readRealField(node, "brightness");
         s.jitter.gainRatio = detail::readRealField(node, "gain_ratio");
+        s.jitter.exposureTime = detail::readOptionalRealField(node, "exposure_time", 0);
+        if (!(std::isfinite(s.jitter.exposureTime) && s.jitter.exposureTime >= 0))
+            CV_Error(Error::StsParseError, "field 'exposure_time' must be a finite number of seconds >= 0");
     } catch (const Exception& e) {
         CV_Error(e.code, "scene: " + e.err);
     }

@@ -24,8 +24,9 @@ void DarkShading::checkCovers(Size size, const char* who) const
 }
 
 StepNoise::StepNoise(const ValidatedNoiseModel& valid, const RawFormat& format, const NoiseOptions& options_,
-                     double gainRatio, Size size, const char* who)
-    : options(options_), gainIn(format.gain), gainOut(format.gain * gainRatio)
+                     double gainRatio, Size size, const char* who, double exposureOut_)
+    : options(options_), gainIn(format.gain), gainOut(format.gain * gainRatio),
+      exposureIn(format.exposureTime), exposureOut(exposureOut_ > 0 ? exposureOut_ : format.exposureTime)
 {
     options.validate();
     const NoiseModel& model = valid.model();
@@ -40,12 +41,17 @@ StepNoise::StepNoise(const ValidatedNoiseModel& valid, const RawFormat& format, 
     if (addsNoise() && !options.darkBank.empty()) {
         bank = cachedDarkFrameBank(options.darkBank); // load() refuses a bank without groups
         try {
-            bankGroupOut = bank->nearestGroup(gainOut);
+            bankGroupOut = bank->nearestGroup(gainOut, exposureOut);
         } catch (const Exception& e) {
-            CV_Error(e.code, cv::format("%s: the output gain: ", who) + e.err);
+            CV_Error(e.code, cv::format("%s: the output: ", who) + e.err);
         }
-        // The input's own read noise at any gain: the nearest group's, scaled by the model's lines.
-        bankGroupIn = nearestGainGroup(bank->groups, gainIn, 0);
+        // The input's own read noise at any gain: the nearest group's, scaled by the model's lines; of the
+        // input's exposure, since dark current grows with it (#79 item 10).
+        try {
+            bankGroupIn = nearestGainGroup(bank->groups, gainIn, exposureIn, bank->path);
+        } catch (const Exception& e) {
+            CV_Error(e.code, cv::format("%s: the input: ", who) + e.err);
+        }
         const auto scaleTo = [&](const NoiseTerms<double>& at, int group) {
             const double there = valid.termsAt(bank->groups[static_cast<size_t>(group)].gain).read();
             return there > 0 ? std::sqrt(at.read() / there) : 1.0;

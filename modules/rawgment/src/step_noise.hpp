@@ -27,14 +27,17 @@ namespace detail {
  */
 struct StepNoise
 {
+    /** `exposureOut`: the target's exposure time (0: the input's, format.exposureTime); only a bank's
+     * groups depend on it. */
     StepNoise(const ValidatedNoiseModel& model, const RawFormat& format, const NoiseOptions& options,
-              double gainRatio, Size size, const char* who);
+              double gainRatio, Size size, const char* who, double exposureOut = 0);
 
     NoiseOptions options;
-    double gainIn, gainOut;     //!< g and p_g g
-    NoiseTerms<double> in, out; //!< the model's terms at gainIn and gainOut
-    bool measured;              //!< the terms are measured lines' (NoiseModel::measuredLines)
-    bool rowNoise;              //!< NoiseModel::hasRowNoise()
+    double gainIn, gainOut;         //!< g and p_g g
+    double exposureIn, exposureOut; //!< seconds, 0 when not stated
+    NoiseTerms<double> in, out;     //!< the model's terms at gainIn and gainOut
+    bool measured;                  //!< the terms are measured lines' (NoiseModel::measuredLines)
+    bool rowNoise;                  //!< NoiseModel::hasRowNoise()
     double rowSigmaD2, rowSigmaR2;
     bool tails;          //!< NoiseModel::tukeyRead
     double tukeyLambda;  //!< the read noise's Tukey-lambda shape, when `tails`
@@ -42,8 +45,8 @@ struct StepNoise
     /** NoiseOptions::darkBank's bank, when set and the step adds noise: it then stands in for the model's
      * read terms, which `in` and `out` no longer hold (nor rowNoise, tails or shading). */
     std::shared_ptr<const DarkFrameBank> bank;
-    int bankGroupIn = -1,
-        bankGroupOut = -1; //!< the bank's groups nearest gainIn (any) and gainOut (in range)
+    //! the bank's groups at gainIn (nearest) and gainOut (in range), each of its side's exposure
+    int bankGroupIn = -1, bankGroupOut = -1;
     //! sqrt of the model's read variance at gainIn (gainOut) over that at its group's gain: the frames' scale
     double bankScaleIn = 1, bankScaleOut = 1;
 

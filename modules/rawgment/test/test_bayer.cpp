@@ -219,6 +219,32 @@ TEST(Bayer, rawFormatFileStorageRoundTrip)
     EXPECT_CV_ERROR_CONTAINS(RawFormat::read(noGain["raw_format"]), "'gain' is missing");
 }
 
+/* The exposure time (#79 item 10): written only when stated, so a format without one keeps its bytes; kept by
+ * a crop; a negative, NaN or boolean one is refused. */
+TEST(Bayer, anExposureTimeIsWrittenOnlyWhenStatedAndRoundTrips)
+{
+    const auto text = [](const RawFormat& f) {
+        FileStorage out("", FileStorage::WRITE | FileStorage::MEMORY | FileStorage::FORMAT_YAML);
+        f.write(out, "raw_format");
+        return std::string(out.releaseAndGetString());
+    };
+    RawFormat f = makeFormat(CFA_GRBG);
+    EXPECT_EQ(text(f).find("exposure_time"), std::string::npos);
+    f.exposureTime = 1.0 / 60;
+    const std::string stated = text(f);
+    FileStorage in(stated, FileStorage::READ | FileStorage::MEMORY);
+    EXPECT_EQ(RawFormat::read(in["raw_format"]).exposureTime, 1.0 / 60);
+    EXPECT_EQ(f.cropped(1, 1).exposureTime, 1.0 / 60);
+    f.exposureTime = -1;
+    EXPECT_CV_ERROR_CONTAINS(f.validate(), "RawFormat.exposureTime must be finite and >= 0");
+    f.exposureTime = std::nan("");
+    EXPECT_CV_ERROR_CONTAINS(f.validate(), "RawFormat.exposureTime");
+    FileStorage boolean("%YAML:1.0\nraw_format: {pattern: RGGB, black_level: [1, 2, 3, 4], white_level: 10, "
+                        "gain: 1, exposure_time: true}",
+                        FileStorage::READ | FileStorage::MEMORY | FileStorage::FORMAT_YAML);
+    EXPECT_CV_ERROR_CONTAINS(RawFormat::read(boolean["raw_format"]), "exposure_time");
+}
+
 TEST(Bayer, aCropsSensorOriginAccumulatesAndRoundTrips)
 {
     const RawFormat whole = makeFormat(CFA_GRBG);

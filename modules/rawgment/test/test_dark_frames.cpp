@@ -351,34 +351,6 @@ TEST(DarkFrameBank, loadRefusesWhatSaveDoesNotWrite)
     EXPECT_NO_THROW(DarkFrameBank::load(dir + "/bank.yml"));
 }
 
-/* The nearest group: by gain on a log scale, then by exposure; a gain beyond the bank's range is refused, one
- * within 0.1% of its ends is its end (an ISO's rounding). */
-TEST(DarkFrameBank, theNearestGroupLiesWithinTheBanksGains)
-{
-    DarkFrameBank bank;
-    bank.size = Size(4, 4);
-    for (const auto& ge : {std::make_pair(1.0, 0.01), std::make_pair(4.0, 0.01), std::make_pair(4.0, 1.0),
-                           std::make_pair(16.0, 0.0)}) {
-        DarkFrameGroup g;
-        g.gain = ge.first;
-        g.exposureTime = ge.second;
-        bank.groups.push_back(g);
-    }
-    EXPECT_EQ(bank.nearestGroup(1.0), 0);
-    EXPECT_EQ(bank.nearestGroup(1.999), 0);
-    EXPECT_EQ(bank.nearestGroup(2.001), 1) << "log scale: 2 is as near 1 as 4";
-    EXPECT_EQ(bank.nearestGroup(4.0), 1) << "exposure 0: the shortest of the gain";
-    EXPECT_EQ(bank.nearestGroup(4.0, 0.5), 2);
-    EXPECT_EQ(bank.nearestGroup(4.0, 0.05), 1);
-    EXPECT_EQ(bank.nearestGroup(16.0 * 1.0009), 3);
-    EXPECT_CV_ERROR_CONTAINS(bank.nearestGroup(16.0 * 1.002), "outside the bank's gains [1, 16]");
-    EXPECT_CV_ERROR_CONTAINS(bank.nearestGroup(0.99), "outside the bank's gains");
-    EXPECT_CV_ERROR_CONTAINS(bank.nearestGroup(std::nan("")), "must be finite");
-    EXPECT_CV_ERROR_CONTAINS(DarkFrameBank().nearestGroup(1), "an empty bank");
-    EXPECT_CV_ERROR_CONTAINS(bank.readFrame(4, 0), "group 4 of a bank of 4");
-    EXPECT_CV_ERROR_CONTAINS(bank.readFrame(0, 0), "frame 0 of a group of 0");
-}
-
 /* A simulated sensor whose dark frames hold what the parametric components do (row noise, dark shading,
  * Tukey tails) and what they do not (hot pixels, 1% noisy pixels), its bank of 16 frames per gain at gains 1
  * and 4 saved in `dir`, and captures of any other frames. */

@@ -29,6 +29,44 @@ using test::makeTempDir;
 using test::readBytes;
 using test::writeBytes;
 
+std::string sidecarText(const std::string& mosaic)
+{
+    const std::vector<char> bytes = readBytes(mosaic + ".yml");
+    return std::string(bytes.begin(), bytes.end());
+}
+
+/* A mosaic's exposure time travels in its sidecar (#79 item 10): in the camera tags when it has them (one
+ * capture has one exposure: a format that says another is refused), else in the format, and only then at
+ * version 5, so that every other sidecar keeps its version and bytes. A DNG carries it as its ExposureTime.
+ */
+TEST(MosaicFiles, theExposureTimeTravelsInTheCameraTagsOrTheFormat)
+{
+    const std::string dir = makeTempDir("mosaic_exposure");
+    const Mat m16(24, 32, CV_16UC1, Scalar(100));
+    MosaicMetadata meta;
+    meta.format.whiteLevel = 4095;
+    writeMosaic(dir + "/plain.npy", m16, meta);
+    EXPECT_NE(sidecarText(dir + "/plain.npy").find("format_version: 3"), std::string::npos);
+    meta.format.exposureTime = 0.25;
+    for (const char* name : {"/format.npy", "/format.dng"}) {
+        writeMosaic(dir + name, m16, meta);
+        Mat back;
+        EXPECT_NEAR(readMosaic(dir + name, back).format.exposureTime, 0.25, 1e-12) << name;
+    }
+    EXPECT_NE(sidecarText(dir + "/format.npy").find("format_version: 5"), std::string::npos);
+    EXPECT_NEAR(readRaw(dir + "/format.dng").format.exposureTime, 0.25, 1e-7);
+    meta.hasCamera = true;
+    meta.camera.exposureTime = 0.25;
+    writeMosaic(dir + "/tagged.npy", m16, meta);
+    const std::string tagged = sidecarText(dir + "/tagged.npy");
+    EXPECT_NE(tagged.find("format_version: 3"), std::string::npos) << tagged;
+    Mat back;
+    EXPECT_EQ(readMosaic(dir + "/tagged.npy", back).format.exposureTime, 0.25) << "the tags' exposure";
+    meta.camera.exposureTime = 0.5;
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/two.npy", m16, meta),
+                             "the format's exposure time 0.25 s differs from the camera tags' 0.5 s");
+}
+
 TEST(MosaicFiles, cameraTagsTravelInTheSidecarAndTheDngAndFirstVersionSidecarsStillLoad)
 {
     const std::string dir = makeTempDir("raw_io_camera_tags");

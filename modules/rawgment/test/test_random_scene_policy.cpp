@@ -118,6 +118,16 @@ TEST(Augment, sceneRoundTripsThroughFileStorage)
     EXPECT_EQ(r.noise.priorMean, PriorMeanEstimate::LOCAL_MEAN);
     EXPECT_EQ(r.noise.blurNoiseSum, BlurNoiseSum::FROM_BLURRED_MEAN);
     EXPECT_EQ(norm(r.motionKernel, s.motionKernel, NORM_INF), 0);
+    EXPECT_EQ(r.jitter.exposureTime, 0);
+    // The target's exposure is written only when stated (#79 item 10), so every other scene keeps its bytes.
+    FileStorage plain("", FileStorage::WRITE | FileStorage::MEMORY | FileStorage::FORMAT_YAML);
+    s.write(plain, "scene");
+    EXPECT_EQ(std::string(plain.releaseAndGetString()).find("exposure_time"), std::string::npos);
+    s.jitter.exposureTime = 2.5;
+    FileStorage stated("", FileStorage::WRITE | FileStorage::MEMORY | FileStorage::FORMAT_YAML);
+    s.write(stated, "scene");
+    FileStorage back(stated.releaseAndGetString(), FileStorage::READ | FileStorage::MEMORY);
+    EXPECT_EQ(Scene::read(back["scene"]).jitter.exposureTime, 2.5);
 }
 
 TEST(Augment, sceneAndPolicyFilesRejectWhatIsNotANumber)
@@ -135,6 +145,8 @@ TEST(Augment, sceneAndPolicyFilesRejectWhatIsNotANumber)
                             FileStorage::READ | FileStorage::MEMORY);
     EXPECT_CV_ERROR_CONTAINS(Scene::read(badContrast["scene"]), "scene: field 'contrast[1]' is not a number");
     EXPECT_CV_ERROR_CONTAINS(readScene(", scale: big"), "scene: field 'scale' is not a number");
+    EXPECT_CV_ERROR_CONTAINS(readScene(", exposure_time: -1"), "'exposure_time' must be a finite number");
+    EXPECT_CV_ERROR_CONTAINS(readScene(", exposure_time: true"), "exposure_time");
     EXPECT_CV_ERROR_CONTAINS(readScene(", alignment: 1e10"), "'alignment' must be an integer");
     EXPECT_CV_ERROR_CONTAINS(readScene(", shift: here"), "field 'shift' must be a list of two integers");
     EXPECT_CV_ERROR_CONTAINS(readScene(", shift: [ 1.5, 2 ]"),

@@ -134,14 +134,20 @@ struct CV_EXPORTS_W_SIMPLE AugmentReport
 struct CV_EXPORTS_W_SIMPLE ColorJitter
 {
     //! The identity.
-    CV_WRAP ColorJitter() : contrast(Vec4d::all(1)), brightness(0), gainRatio(1) {}
+    CV_WRAP ColorJitter() : contrast(Vec4d::all(1)), brightness(0), gainRatio(1), exposureTime(0) {}
     CV_PROP_RW Vec4d contrast;    //!< p_c per CFA site (index = cfaSite()), > 0; one value for CFA_MONO
     CV_PROP_RW double brightness; //!< p_b in DN
     CV_PROP_RW double gainRatio;  //!< p_g: target gain / input gain, > 0
+    /** The target capture's exposure time in seconds, >= 0; 0: the input's (RawFormat::exposureTime). The
+     * darkening is the scene's light whatever it is (p_c and p_b say how much); the exposure only chooses a
+     * dark-frame bank's frames for the target, since dark current grows with it, and is the output's
+     * RawFormat::exposureTime. Without a bank the model's noise does not depend on it. */
+    CV_PROP_RW double exposureTime;
 
     //! A pure exposure change: photons x photonRatio, gain x gainRatio (paper Eq. 11).
     CV_WRAP static ColorJitter exposureChange(double photonRatio, double gainRatio);
-    //! True when the step changes nothing (contrast 1, brightness 0, gain ratio 1).
+    //! True when the step changes nothing whatever the input (contrast 1, brightness 0, gain ratio 1, no
+    //! exposure time stated); a jitter that states the input's own exposure is skipped as well.
     CV_WRAP bool isIdentity() const;
 };
 

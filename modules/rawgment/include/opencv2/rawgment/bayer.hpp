@@ -97,10 +97,10 @@ CV_EXPORTS_W CfaPattern cfaPatternFromName(const String& name);
  */
 struct CV_EXPORTS_W_SIMPLE RawFormat
 {
-    //! RGGB, no black level, white 65535, gain 1.
+    //! RGGB, no black level, white 65535, gain 1, exposure time not stated.
     CV_WRAP RawFormat()
         : pattern(CFA_RGGB), blackLevel(Vec4d::all(0)), whiteLevel(65535), gain(1.0),
-          sensorOrigin(Point(0, 0))
+          sensorOrigin(Point(0, 0)), exposureTime(0)
     {
     }
     CV_PROP_RW CfaPattern pattern; //!< CFA layout of the top-left 2x2 block
@@ -111,11 +111,16 @@ struct CV_EXPORTS_W_SIMPLE RawFormat
      * crop's offset for a crop (cropped() adds it). Per-pixel maps of the sensor (a NoiseModel's dark
      * shading) are read there, so a crop gets its own pixels' pattern. */
     CV_PROP_RW Point sensorOrigin;
+    /** The capture's exposure time in seconds (>= 0; 0: not stated). Noise itself does not depend on it in
+     * the model, but dark current does: a dark-frame bank (NoiseOptions::darkBank) draws from its frames of
+     * this exposure. readRaw() takes it from the file, readMosaic() from the sidecar. */
+    CV_PROP_RW double exposureTime;
 
     /** @brief Throws cv::Exception (StsBadArg) naming the field when the format is not usable: pattern
      * outside the enumeration, non-finite or negative black level, white level not above every black
-     * level, gain not finite and positive, a negative sensorOrigin, or a CFA_MONO format whose four black
-     * levels differ (a sensor without a colour filter has no 2x2 structure to give them).
+     * level, gain not finite and positive, a negative sensorOrigin, an exposure time not finite and >= 0, or
+     * a CFA_MONO format whose four black levels differ (a sensor without a colour filter has no 2x2 structure
+     * to give them).
      */
     CV_WRAP void validate() const;
 
@@ -126,13 +131,13 @@ struct CV_EXPORTS_W_SIMPLE RawFormat
     CV_WRAP double blackAt(int row, int col) const { return blackLevel[cfaSite(row, col)]; }
 
     /** @brief The format of a crop whose top-left corner is at (rowOffset, colOffset): the pattern and
-     * the per-site black levels follow the phase, sensorOrigin moves by the offset; levels and gain are
-     * unchanged.
+     * the per-site black levels follow the phase, sensorOrigin moves by the offset; levels, gain and exposure
+     * time are unchanged.
      */
     CV_WRAP RawFormat cropped(int rowOffset, int colOffset) const;
 
     /** @brief Writes the format as a map under `name` (fields pattern, black_level, white_level, gain,
-     * and sensor_origin [x, y] when it is not (0, 0)). */
+     * sensor_origin [x, y] when it is not (0, 0), and exposure_time when it is stated). */
     void write(FileStorage& fs, const String& name) const;
 
     /** @brief Reads a format written by write(), validating it.

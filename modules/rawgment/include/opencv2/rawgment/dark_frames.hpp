@@ -139,10 +139,14 @@ struct CV_EXPORTS_W_SIMPLE DarkFrameBank
      * could make: groups not by increasing gain, fewer than two frames, maps of another size or type,
      * statistics that are negative or not finite. */
     CV_WRAP void validate() const;
-    /** @brief The group whose gain is nearest `gain` (on a log scale), then whose exposure time is nearest
-     * `exposureTime` (on a log scale; when 0, the shortest exposure of that gain).
-     * @throws cv::Exception for an empty bank, or a gain beyond the bank's range (more than 0.1% outside its
-     * lowest and highest gains): the bank says nothing of gains it has not seen. */
+    /** @brief The group whose gain is nearest `gain` (on a log scale) and, of that gain, whose exposure time
+     * matches `exposureTime` (seconds): the nearest within a third of a stop (a factor 2^(1/3), the step of
+     * shutter settings), else a group whose frames state no exposure. With `exposureTime` 0 (not stated), the
+     * gain's one group.
+     * @throws cv::Exception for an empty bank, a gain beyond the bank's range (more than 0.1% outside its
+     * lowest and highest gains): the bank says nothing of gains it has not seen; an exposure no group of that
+     * gain matches, or 0 where the gain has groups of several exposures, naming the exposures it has (dark
+     * current grows with the exposure). */
     CV_WRAP int nearestGroup(double gain, double exposureTime = 0) const;
     /** @brief Reads frame `index` of group `group` again (raw DN, black level included).
      * @throws cv::Exception for an index out of range, a file that is missing, unreadable, of another size or

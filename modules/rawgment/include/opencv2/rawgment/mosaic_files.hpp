@@ -17,9 +17,11 @@ namespace rawgment {
 /** @brief What a sidecar file says about a mosaic written by writeMosaic(). */
 struct CV_RAWGMENT_EXPORTS MosaicMetadata
 {
-    /** Version written to files that set gainFromIso (3 otherwise, so that their bytes stay as they
-     * were); versions 1 (no camera tags), 2 (no noise camera), 3 and 4 are read. */
-    static constexpr int FORMAT_VERSION = 4;
+    /** Version written to files whose format states an exposure time without camera tags (with tags, the
+     * tags carry it); 4 to files that set gainFromIso; 3 otherwise, so that their bytes stay as they were.
+     * Versions 1 (no camera tags), 2 (no noise camera), 3, 4 and 5 are read; the format read takes the
+     * camera tags' exposure time when it states none. */
+    static constexpr int FORMAT_VERSION = 5;
     RawFormat format;       //!< the mosaic's format, with the gain after augmentation
     bool hasScene = false;  //!< whether `scene` and `seed` describe how the mosaic was made
     Scene scene;            //!< the scene applied to the source
