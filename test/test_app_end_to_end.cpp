@@ -64,11 +64,13 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
 {
     const std::string dir = freshDir("pipeline");
     // 1. Simulate. 32 frames keep the test short and still pin the model (tolerances below).
-    AppRun r = runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=32 --seed=5");
+    const std::string simulate =
+        cv::format("--out='%s/sim' --frames=%d --seed=5", dir.c_str(), framesOfThisBuild(32));
+    AppRun r = runApp("rawgment_simulate", simulate);
     ASSERT_EQ(0, r.status) << r.output;
     ASSERT_TRUE(exists(dir + "/sim/manifest.yml"));
     ASSERT_TRUE(exists(dir + "/sim/validation_manifest.yml"));
-    r = runApp("rawgment_simulate", "--out='" + dir + "/sim' --frames=32 --seed=5");
+    r = runApp("rawgment_simulate", simulate);
     EXPECT_EQ(1, r.status) << "a second run must not overwrite the first";
     EXPECT_NE(std::string::npos, r.output.find("already exists")) << r.output;
 
@@ -80,9 +82,11 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
     // The joint fit's spread over seeds at 100 frames is 0.08% / 0.45% / 1.7% (docs/performance.md,
     // study_calibration); a variance of 32 frames is sqrt(99/31) = 1.8x noisier. The bounds are about 5 of
     // those spreads.
-    EXPECT_NEAR(truth.alpha, fitted.alpha, 0.01 * truth.alpha);
-    EXPECT_NEAR(truth.sigmaD2, fitted.sigmaD2, 0.04 * truth.sigmaD2);
-    EXPECT_NEAR(truth.sigmaR2, fitted.sigmaR2, 0.15 * truth.sigmaR2);
+    if (kAccuracyChecked) {
+        EXPECT_NEAR(truth.alpha, fitted.alpha, 0.01 * truth.alpha);
+        EXPECT_NEAR(truth.sigmaD2, fitted.sigmaD2, 0.04 * truth.sigmaD2);
+        EXPECT_NEAR(truth.sigmaR2, fitted.sigmaR2, 0.15 * truth.sigmaR2);
+    }
     for (const char* f : {"calibration_report.yml", "samples.csv", "lines.csv", "shapiro.csv"})
         EXPECT_TRUE(exists(dir + "/cal/" + f)) << f;
     for (const char* png :
@@ -131,8 +135,9 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
     ASSERT_EQ(0, r.status) << r.output << manifest;
     EXPECT_NE(std::string::npos, r.output.find("patches detected with cv::mcc")) << r.output;
     // A quarter of the pixels of the given squares: alpha still within 2% (about 5 of its spreads).
-    EXPECT_NEAR(truth.alpha, cv::rawgment::NoiseModel::load(dir + "/cal_detect/noise_model.yml").alpha,
-                0.02 * truth.alpha);
+    if (kAccuracyChecked)
+        EXPECT_NEAR(truth.alpha, cv::rawgment::NoiseModel::load(dir + "/cal_detect/noise_model.yml").alpha,
+                    0.02 * truth.alpha);
 
     // 3. Validate: ACCOUNT_PRIOR matches the real darker bursts, IGNORE_PRIOR overshoots, NONE undershoots.
     r = runApp("rawgment_validate", "'" + dir + "/sim/validation_manifest.yml' --model='" + dir +
@@ -154,7 +159,8 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
     // Pooled over ~10k pixels x 31 degrees of freedom the ratio's noise is far below 1%; 3% allows for the
     // model error of a 32-frame calibration. The prior noise of the x0.5 conversion is half the target's
     // signal noise, so IGNORE_PRIOR lands ~1.5x high and NONE ~0.5x low.
-    EXPECT_NEAR(1.0, account / real, 0.03);
+    if (kAccuracyChecked)
+        EXPECT_NEAR(1.0, account / real, 0.03);
     EXPECT_GT(ignore / real, 1.3);
     EXPECT_LT(none / real, 0.7);
 
