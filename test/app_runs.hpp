@@ -1,6 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// Running the apps of this build as a user runs them: what the end-to-end tests (test_apps.cpp,
-// test_app_calibrate_emva.cpp) share. RAWGMENT_APP_DIR names the apps' folder.
+// Running the apps of this build as a user runs them: what the app tests (test/test_app_*.cpp) share.
+// RAWGMENT_APP_DIR names the apps' folder.
 #ifndef RAWGMENT_TEST_APP_RUNS_HPP
 #define RAWGMENT_TEST_APP_RUNS_HPP
 

@@ -109,7 +109,7 @@ def test_augmented_dng_keeps_the_camera_and_states_the_simulated_capture(tmp_pat
         # The white point a DNG reader derives, as an independent computation gave it for the input.
         assert xy_out == pytest.approx((0.338, 0.369), abs=1e-3)
 
-    # The preview's brightness is checked in test/test_apps.cpp (OpenCV reads PNG there).
+    # The preview's brightness is checked in test/test_app_augment.cpp (OpenCV reads PNG there).
     assert os.path.getsize(str(tmp_path / "out" / (stem + "_v00_preview.png"))) > 0
 
 
