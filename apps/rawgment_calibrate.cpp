@@ -139,6 +139,8 @@ int main(int argc, char** argv)
         "{side           | 24    | square side when the manifest says patches: detect }"
         "{shapiro        | 2000  | pixels per burst tested with Shapiro-Wilk }"
         "{seed           | 0     | seed of the robust line fits (RANSAC); with --emva, of the validation }"
+        "{bootstrap      | 200   | bootstrap replicates that confirm the standard errors (0: the fit's "
+        "covariance alone; at a bound the bootstrap gives them) }"
         "{plots          | true  | write PNG plots with gnuplot }"
         "{dark_components| false | also row noise, dark shading and the read noise's shape from the dark "
         "bursts }"
@@ -219,16 +221,18 @@ int main(int argc, char** argv)
     const std::string method = parser.get<std::string>("method");
     o.side = parser.get<int>("side");
     o.shapiroPixels = parser.get<int>("shapiro");
+    o.bootstrapReplicates = parser.get<int>("bootstrap");
     o.plots = parser.get<bool>("plots");
     o.seed = rawgment_apps::seedOption(parser, "rawgment_calibrate");
     o.darkComponents = parser.get<bool>("dark_components");
     o.darkBank = parser.get<std::string>("dark_bank");
     if (!parser.check() || o.manifest.empty() || o.outDir.empty() ||
         (method != "joint" && method != "two-stage") || o.shapiroPixels < 1 || o.shapiroPixels > 1000000 ||
-        o.side < 2 || o.side % 2) {
+        o.side < 2 || o.side % 2 || o.bootstrapReplicates < 0 || o.bootstrapReplicates == 1 ||
+        o.bootstrapReplicates > 100000) {
         parser.printErrors();
         std::cerr << "usage: rawgment_calibrate <manifest.yml> --out=<dir> [--method=joint|two-stage] "
-                     "[--shapiro=1..1000000] [--side=even >= 2]\n";
+                     "[--shapiro=1..1000000] [--side=even >= 2] [--bootstrap=0 or 2..100000]\n";
         return 2;
     }
     o.method = method == "joint" ? cv::rawgment::NOISE_FIT_JOINT : cv::rawgment::NOISE_FIT_TWO_STAGE;

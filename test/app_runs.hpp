@@ -22,6 +22,10 @@ constexpr bool kAccuracyChecked = false;
 constexpr bool kAccuracyChecked = true;
 #endif
 
+/** The bootstrap replicates rawgment_calibrate runs with where accuracy is not checked, unless a test gives
+ * --bootstrap: its 200 replicates are 60% of an instrumented calibration's time, and 20 run the same code. */
+constexpr int kSanitizedBootstrapReplicates = 20;
+
 //! `frames` where accuracy is checked, else a quarter of them but at least 16, the fewest the verdict passes.
 inline int framesOfThisBuild(int frames)
 {
@@ -52,7 +56,8 @@ enum class AllocationStacks
     FULL
 };
 
-//! Runs an app of this build with arguments (shell-quoted by the caller), capturing stdout and stderr.
+/** Runs an app of this build with arguments (shell-quoted by the caller), capturing stdout and stderr; where
+ * accuracy is not checked, rawgment_calibrate's light calibrations get kSanitizedBootstrapReplicates. */
 AppRun runApp(const std::string& app, const std::string& args,
               AllocationStacks stacks = AllocationStacks::FAST);
 

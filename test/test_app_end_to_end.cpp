@@ -89,6 +89,10 @@ TEST(Apps, simulateCalibrateValidateAugmentEndToEnd)
     }
     for (const char* f : {"calibration_report.yml", "samples.csv", "lines.csv", "shapiro.csv"})
         EXPECT_TRUE(exists(dir + "/cal/" + f)) << f;
+    EXPECT_EQ(kAccuracyChecked ? 200 : kSanitizedBootstrapReplicates,
+              cv::rawgment::CalibrationReport::load(dir + "/cal/calibration_report.yml")
+                  .uncertainty.bootstrapReplicates)
+        << "--bootstrap reaches the calibration";
     for (const char* png :
          {"calib_mean_variance.png", "calib_histograms.png", "calib_cross_gain.png", "shapiro_pvalue.png"})
         expectPngDecodes(dir + "/cal/" + png);

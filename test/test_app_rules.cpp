@@ -141,6 +141,10 @@ TEST(Apps, unusableValuesAreRefusedAndFailedRunsLeaveNoEmptyFolder)
     EXPECT_NE(std::string::npos, r.output.find("at least 3 frames")) << r.output;
     EXPECT_FALSE(exists(dir + "/two")) << "a failed run leaves no empty output folder";
     EXPECT_EQ(2, runApp("rawgment_calibrate", "m.yml --out='" + dir + "/c' --shapiro=-10").status);
+    for (const char* replicates : {"1", "-3", "100001"})
+        EXPECT_EQ(
+            2, runApp("rawgment_calibrate", "m.yml --out='" + dir + "/c' --bootstrap=" + replicates).status)
+            << replicates;
     r = runApp("rawgment_calibrate", "'" + dir + "/missing.yml' --out='" + dir + "/cal'");
     EXPECT_EQ(1, r.status) << r.output;
     EXPECT_FALSE(exists(dir + "/cal")) << "a failed run leaves no empty output folder";

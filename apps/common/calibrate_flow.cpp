@@ -675,6 +675,7 @@ CalibrateResult calibrateFromManifest(const CalibrateOptions& o)
     CalibrationParams params;
     params.method = o.method;
     params.line.seed = o.seed;
+    params.bootstrapReplicates = o.bootstrapReplicates;
     if (o.darkComponents)
         addDarkComponents(in.darkFrames, in.darkGains, firstFormat, params, samples, in.lightSample,
                           in.sampleFrame, result);

@@ -62,6 +62,8 @@ struct CalibrateOptions
     int shapiroPixels = 2000; //!< pixels per burst tested by Shapiro-Wilk (spread over the squares)
     bool plots = true;
     uint64_t seed = 0; //!< seed of the RANSAC draws of the per-gain line fits
+    //! CalibrationParams::bootstrapReplicates: 0 (the fit's covariance alone) or >= 2
+    int bootstrapReplicates = 200;
     //! Also the dark-frame components (row noise, dark shading, Tukey read noise) from the dark bursts.
     bool darkComponents = false;
     //! Also a dark-frame bank of the dark bursts' files, written there (DarkFrameBank::save()); "" for none.
