@@ -239,12 +239,20 @@ TEST(Calibration, bootstrapConfirmsTheCovarianceAndStandsInAtABound)
     o.square = 12;
     o.darkFrames = true;
     const std::vector<NoiseSample> samples = protocolSamples(o);
-    const CalibrationReport r = calibrateNoiseModel(samples);
+    CalibrationParams params;
+    EXPECT_EQ(params.bootstrapReplicates, 200);
+#ifdef RAWGMENT_SANITIZED_BUILD
+    // 200 instrumented replicates are most of 30 s; 20 run the same code, and the ratio below needs 200.
+    params.bootstrapReplicates = 20;
+#endif
+    const CalibrationReport r = calibrateNoiseModel(samples, params);
     EXPECT_EQ(r.uncertainty.source, UNCERTAINTY_COVARIANCE);
-    EXPECT_EQ(r.uncertainty.bootstrapReplicates, 200);
+    EXPECT_EQ(r.uncertainty.bootstrapReplicates, params.bootstrapReplicates);
     for (int k = 0; k < 3; ++k) {
         // 200 replicates give a standard error to 5% (1/sqrt(2R)); the two agree within 4 of those.
-        EXPECT_NEAR(r.uncertainty.bootstrapStdError[k] / r.uncertainty.fitStdError[k], 1.0, 0.2) << k;
+        if (params.bootstrapReplicates == 200)
+            EXPECT_NEAR(r.uncertainty.bootstrapStdError[k] / r.uncertainty.fitStdError[k], 1.0, 0.2) << k;
+        EXPECT_GT(r.uncertainty.bootstrapStdError[k], 0) << k;
         EXPECT_EQ(r.uncertainty.stdError[k], r.uncertainty.fitStdError[k]);
     }
     EXPECT_LT(r.uncertainty.correlation(NOISE_PARAM_SIGMA_D2, NOISE_PARAM_SIGMA_R2), 0);
@@ -269,7 +277,7 @@ TEST(Calibration, bootstrapConfirmsTheCovarianceAndStandsInAtABound)
     // nothing of its error, and the bootstrap's errors are the ones reported.
     o.sensor.noise = NoiseModel(o.sensor.noise.alpha, 0.0, o.sensor.noise.sigmaR2);
     const std::vector<NoiseSample> noPreGain = protocolSamples(o);
-    const CalibrationReport atBound = calibrateNoiseModel(noPreGain);
+    const CalibrationReport atBound = calibrateNoiseModel(noPreGain, params);
     if (atBound.model.sigmaD2 == 0) {
         EXPECT_EQ(atBound.uncertainty.source, UNCERTAINTY_BOOTSTRAP);
         EXPECT_GT(atBound.uncertainty.stdError[1], 0);
