@@ -94,6 +94,16 @@ inline std::ostream& operator<<(std::ostream& os, const Errors& e)
               << 100 * e.sigmaR2 << "%";
 }
 
+/** Calibration parameters without the bootstrap, for tests that read the fitted model alone: the bootstrap
+ * only confirms the standard errors (CalibrationUncertainty) and changes no fitted value, and its 200
+ * replicates of every sample are most of a large calibration's time. */
+inline CalibrationParams modelOnly()
+{
+    CalibrationParams params;
+    params.bootstrapReplicates = 0;
+    return params;
+}
+
 inline NoiseModel truthModel()
 {
     return SensorSimulator(test::referenceSensorParams(), Size(2, 2)).effectiveModel();

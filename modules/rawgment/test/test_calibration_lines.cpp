@@ -37,7 +37,7 @@ TEST(Calibration, perGainRSquaredIsWhatTheBurstLengthAllows)
     GTEST_SKIP() << "R^2 against the burst length is measured in the Release build only";
 #endif
     const std::vector<NoiseSample>& samples = cleanProtocol();
-    const CalibrationReport report = calibrateNoiseModel(samples);
+    const CalibrationReport report = calibrateNoiseModel(samples, modelOnly());
     ASSERT_EQ(report.perGain.size(), 3u);
     const NoiseModel truth = truthModel();
     for (const NoiseLineFit& f : report.perGain) {
@@ -75,7 +75,7 @@ TEST(Calibration, robustFitsSurviveFivePercentOutliersAndPlainLeastSquaresDoesNo
     GTEST_SKIP() << "robustness to outliers is measured in the Release build only";
 #endif
     const std::vector<NoiseSample>& samples = outlierProtocol();
-    const CalibrationReport robust = calibrateNoiseModel(samples);
+    const CalibrationReport robust = calibrateNoiseModel(samples, modelOnly());
     const Errors e = relativeErrors(robust.model, truthModel());
     std::cout << "robust joint fit with 5% outliers: " << e << "\n";
     EXPECT_LT(std::abs(e.alpha), 0.005);
@@ -83,7 +83,7 @@ TEST(Calibration, robustFitsSurviveFivePercentOutliersAndPlainLeastSquaresDoesNo
     EXPECT_LT(std::abs(e.sigmaR2), 0.05);
     EXPECT_LT(robust.samplesUsed, 0.97 * robust.samples); // the outliers were set aside
 
-    CalibrationParams plain;
+    CalibrationParams plain = modelOnly();
     plain.line.robust = false;
     const CalibrationReport naive = calibrateNoiseModel(samples, plain);
     const Errors n = relativeErrors(naive.model, truthModel());

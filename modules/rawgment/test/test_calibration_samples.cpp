@@ -68,7 +68,7 @@ TEST(Calibration, staticSceneSamplingNeedsNoChartAndLeavesOutEdgesThatShakeMoves
     // seeds 1-4 of rawgment_simulate's bursts of the same sensor (gains 6, 12, 24 dB, levels 0.2 and 0.65,
     // manifest with patches: none): alpha 0.1%, sigma_d^2 0.2%, sigma_r^2 3.9%. The bounds of 1%, 6% and
     // 15% are 10, 30 and 4 of those; alpha and sigma_d^2 keep room for the sampling's own bias, if any.
-    const CalibrationReport r = calibrateNoiseModel(calibration);
+    const CalibrationReport r = calibrateNoiseModel(calibration, modelOnly());
     const Errors e = relativeErrors(r.model, truth);
     std::cout << "no chart, 16 frames: " << e << " from " << calibration.size() << " pixels\n";
     EXPECT_LT(std::abs(e.alpha), 0.01);
