@@ -263,13 +263,14 @@ TEST(Calibration, bootstrapConfirmsTheCovarianceAndStandsInAtABound)
     EXPECT_NEAR(0.5 * (wide[1] - wide[0]), 2.5758293035489 * r.uncertainty.stdError[0], 1e-12);
     EXPECT_CV_ERROR_CONTAINS(r.interval(NOISE_PARAM_ALPHA, 1.0), "level");
     // The same seed gives the same errors on one thread as on all: 20 replicates are shared out between
-    // threads as 200 are, at a tenth of the single-threaded time.
+    // threads as 200 are, at a tenth of the single-threaded time (the samples' own thread-invariance is the
+    // simulator's, Simulate.*).
     CalibrationParams few;
     few.bootstrapReplicates = 20;
     const CalibrationReport all = calibrateNoiseModel(samples, few);
     const int threads = getNumThreads();
     setNumThreads(1);
-    const CalibrationReport one = calibrateNoiseModel(protocolSamples(o), few);
+    const CalibrationReport one = calibrateNoiseModel(samples, few);
     setNumThreads(threads);
     EXPECT_EQ(one.uncertainty.bootstrapStdError, all.uncertainty.bootstrapStdError);
 
