@@ -50,9 +50,9 @@ AppRun runApp(const std::string& app, const std::string& args, AllocationStacks 
     const std::string log = ::testing::TempDir() + "/rawgment_app_" + std::to_string(::getpid()) + "_" +
                             std::to_string(counter++) + ".log";
     std::string command = std::string(RAWGMENT_APP_DIR) + "/" + app + " " + args;
-    if (!kAccuracyChecked && app == "rawgment_calibrate" && args.find("--bootstrap") == std::string::npos &&
+    if (app == "rawgment_calibrate" && args.find("--bootstrap") == std::string::npos &&
         args.find("--emva") == std::string::npos)
-        command += " --bootstrap=" + std::to_string(kSanitizedBootstrapReplicates);
+        command += sanitizedBootstrapArgument();
     command += " > '" + log + "' 2>&1";
 #ifdef RAWGMENT_LSAN_SUPPRESSIONS
     // The apps' own processes need the suppressions of OpenCV's process-lifetime caches too, also when

@@ -26,6 +26,12 @@ constexpr bool kAccuracyChecked = true;
  * --bootstrap: its 200 replicates are 60% of an instrumented calibration's time, and 20 run the same code. */
 constexpr int kSanitizedBootstrapReplicates = 20;
 
+//! The argument rawgment_calibrate takes that: " --bootstrap=20" where accuracy is not checked, else "".
+inline std::string sanitizedBootstrapArgument()
+{
+    return kAccuracyChecked ? std::string() : " --bootstrap=" + std::to_string(kSanitizedBootstrapReplicates);
+}
+
 //! `frames` where accuracy is checked, else a quarter of them but at least 16, the fewest the verdict passes.
 inline int framesOfThisBuild(int frames)
 {

@@ -61,10 +61,9 @@ TEST(Apps, calibrateDarkComponentsFromSimulatedDarkBurstsWithPlotsAndMaps)
     // statistics) and accepts it (round 5, item 22); two identical runs at once, writing one bank and one
     // folder, both finish (item 21), taking turns at the bank (item 15).
     const std::string bankText = readText(dir + "/sim/bank.yml");
-    const std::string again =
-        std::string(RAWGMENT_APP_DIR) + "/rawgment_calibrate '" + dir + "/sim/manifest.yml' --dark_bank='" +
-        dir + "/sim/bank.yml' --out='" + dir + "/cal_again'" +
-        (kAccuracyChecked ? "" : " --bootstrap=" + std::to_string(kSanitizedBootstrapReplicates));
+    const std::string again = std::string(RAWGMENT_APP_DIR) + "/rawgment_calibrate '" + dir +
+                              "/sim/manifest.yml' --dark_bank='" + dir + "/sim/bank.yml' --out='" + dir +
+                              "/cal_again'" + sanitizedBootstrapArgument();
     const auto [first, second] = runTwiceAtOnce(again, dir);
     EXPECT_EQ(0, first.status) << first.output;
     EXPECT_EQ(0, second.status) << second.output;
