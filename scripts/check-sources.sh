@@ -95,9 +95,10 @@ fi
 if [ "${#explicit[@]}" -eq 0 ]; then
   steps=(modules/rawgment/src/color_jitter.cpp modules/rawgment/src/color_jitter_poisson.cpp
     modules/rawgment/src/color_jitter_rows.hpp modules/rawgment/src/resample.cpp
+    modules/rawgment/src/scale_mosaic.cpp modules/rawgment/src/shift_mosaic.cpp
     modules/rawgment/src/resample_rows.hpp modules/rawgment/src/motion_blur.cpp modules/rawgment/src/scene.cpp
     modules/rawgment/src/augment_steps.cpp modules/rawgment/src/augment_steps.hpp
-    modules/rawgment/src/step_noise.cpp)
+    modules/rawgment/src/noise_step.cpp modules/rawgment/src/noise_step.hpp modules/rawgment/src/step_noise.cpp)
   again='model\.(validate|lineAtGain|variance|rowVariance|darkShadingAt)\(|checkedNoiseTerms\('
   for f in "${steps[@]}"; do
     if grep -nE "$again" "$f" >/dev/null; then
@@ -108,6 +109,17 @@ if [ "${#explicit[@]}" -eq 0 ]; then
       *_rows.hpp|*_poisson.cpp|*/augment_steps.hpp)
         if grep -nE '[^d]NoiseModel&' "$f" >/dev/null; then
           grep -nE '[^d]NoiseModel&' "$f" | sed "s|^|$f: row code takes a NoiseModel (take the StepNoise's terms): |"
+          status=1
+        fi ;;
+    esac
+    # The end of a step (its rows' errors, its counts in the report, its time) is the loop's, written once
+    # in noise_step.cpp: a step reports to its StepTally.
+    case "$f" in
+      */noise_step.cpp|*/augment_steps.cpp|*/augment_steps.hpp|*/step_noise.cpp) ;;
+      *)
+        ends='(recordStep|throwNonFiniteShading)\(|BrighteningPixels \+='
+        if grep -nE "$ends" "$f" >/dev/null; then
+          grep -nE "$ends" "$f" | sed "s|^|$f: a step ends itself (report to its StepTally; the loop, runNoiseSteps(), ends it): |"
           status=1
         fi ;;
     esac

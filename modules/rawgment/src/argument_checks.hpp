@@ -30,7 +30,7 @@ Mat twoDimensional(InputArray array, const char* what);
  * outside the frame. A motion blur at the edge integrates light the sensor never saw; the nearest
  * recorded value is the estimate of it that assumes least (a reflection would invent structure that
  * moves the wrong way), and it is the rule the augmentation's noise accounting implements exactly
- * (taps that replicate one pixel are merged, resample.cpp). The simulator uses it too, so a blurred
+ * (taps that replicate one pixel are merged, motion_blur.cpp). The simulator uses it too, so a blurred
  * capture and a blurred augmentation agree up to the frame's edge. */
 constexpr int kBlurBorder = BORDER_REPLICATE;
 

@@ -57,13 +57,12 @@ void throwNonFiniteInput(const char* who)
     CV_Error(Error::StsBadArg, format("%s: src contains NaN or Inf", who));
 }
 
-void checkResampleInput(const Mat& src, const RawFormat& format, const char* who)
+void checkResampleShape(Size size, const RawFormat& format, const char* who)
 {
-    checkMosaicType(src, who);
     format.validate();
-    if (src.rows % 2 || src.cols % 2)
+    if (size.height % 2 || size.width % 2)
         CV_Error(Error::StsBadArg,
-                 cv::format("%s: both sides must be even (got %dx%d)", who, src.cols, src.rows));
+                 cv::format("%s: both sides must be even (got %dx%d)", who, size.width, size.height));
 }
 
 void recordStep(AugmentReport* report, const char* name, std::chrono::steady_clock::time_point start)

@@ -1,10 +1,11 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// The machinery that the augment topic's noise steps share (color_jitter.cpp, resample.cpp, scene.cpp):
+// The machinery that the augment topic's noise steps share (noise_step.hpp and the steps' sources):
 // input checks, the split of an added variance into shot and read parts, its sampling, and the store.
 // Private to the module.
 #ifndef OPENCV_RAWGMENT_SRC_AUGMENT_STEPS_HPP
 #define OPENCV_RAWGMENT_SRC_AUGMENT_STEPS_HPP
 
+#include "noise_step.hpp"
 #include "opencv2/rawgment/augment.hpp"
 #include "precomp.hpp"
 #include "step_noise.hpp"
@@ -19,8 +20,8 @@ namespace detail {
 
 /* A float mosaic's values are checked where a step reads them anyway, row by row while the row is in cache
  * (checkMosaicType() up front, rowIsFinite() in the rows, throwNonFiniteInput() after them): a separate pass
- * over a 48 MB frame cost a float step more than its extra memory traffic. A path that reads no row whole (an
- * identity step, a scene that only moves) checks with checkMosaicInput(). */
+ * over a 48 MB frame cost a float step more than its extra memory traffic. A sequence of steps none of which
+ * runs (runNoiseSteps(), noise_step.hpp) checks with checkMosaicInput(). */
 
 //! Throws StsBadArg naming `who` unless src is a non-empty CV_16UC1 or CV_32FC1 mosaic; its values unread.
 void checkMosaicType(const Mat& src, const char* who);
@@ -34,28 +35,9 @@ bool rowIsFinite(const float* p, int n);
 //! The error of a step whose float input held NaN or Inf (found by rowIsFinite()).
 [[noreturn]] void throwNonFiniteInput(const char* who);
 
-//! checkMosaicType() plus the format and even sides: blur and scale resample each CFA plane, so they
-//! need whole 2x2 blocks.
-void checkResampleInput(const Mat& src, const RawFormat& format, const char* who);
-
-/** @name The noise steps on a model validated once (ValidatedNoiseModel)
- * What colorJitter(), motionBlur() and scaleMosaic() run after making their src two-dimensional and
- * validating their model; applyScene() runs them all on one validated model. Same arguments and errors
- * as the public functions. */
-//! @{
-//! `valuesChecked`: another step of a scene checks (or checked) src's values, so this one need not: the
-//! output of a step is finite, and a scene's first step reads every value of its input.
-void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
-                     const ColorJitter& jitter, const NoiseOptions& noise, uint64 seed, OutputArray dst,
-                     RawFormat& dstFormat, AugmentReport* report, OutputArray saturatedMask,
-                     bool valuesChecked = false);
-void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
-                    InputArray kernel, const NoiseOptions& noise, uint64 seed, OutputArray dst,
-                    AugmentReport* report, bool valuesChecked = false);
-void scaleMosaicStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model, double scale,
-                     const NoiseOptions& noise, uint64 seed, OutputArray dst, AugmentReport* report,
-                     bool valuesChecked = false);
-//! @}
+//! The format valid and both sides even: blur and scale resample each CFA plane, so they need whole 2x2
+//! blocks.
+void checkResampleShape(Size size, const RawFormat& format, const char* who);
 
 //! Counts or masks saturated input pixels, only when the caller asks: the hot loops do not pay for it.
 void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* report, OutputArray mask);

@@ -3,6 +3,7 @@
 #include "color_jitter_rows.hpp"
 
 #include "bank_noise.hpp"
+#include "noise_step.hpp"
 
 #include <opencv2/imgproc.hpp>
 
@@ -400,153 +401,201 @@ bool ColorJitter::isIdentity() const
     return contrast == Vec4d::all(1) && brightness == 0 && gainRatio == 1 && exposureTime == 0;
 }
 
-namespace detail {
+namespace {
 
-void colorJitterStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
-                     const ColorJitter& jitter, const NoiseOptions& noise, uint64 seed, OutputArray _dst,
-                     RawFormat& dstFormat, AugmentReport* report, OutputArray saturatedMask,
-                     bool valuesChecked)
+/* A jitter as a noise step (noise_step.hpp). prepare() validates and computes the constants; begin() makes
+ * what the rows read: the local prior mean (from the input's values), the dark terms, a bank's frames. */
+class ColorJitterStep : public detail::NoiseStep
 {
-    const auto start = std::chrono::steady_clock::now();
-    checkMosaicType(src, "colorJitter");
-    format.validate();
-    for (int s = 0; s < 4; ++s)
-        checkFinitePositive(jitter.contrast[s], "colorJitter: contrast");
-    // Different contrasts per site would print a 2x2 checkerboard on a frame whose pixels all see the same
-    // light: no capture makes that.
-    if (format.isMonochrome() && jitter.contrast != Vec4d::all(jitter.contrast[0]))
-        CV_Error(
-            Error::StsBadArg,
-            cv::format("colorJitter: a CFA_MONO frame has one contrast for all four sites (got %g, %g, %g, "
-                       "%g): a monochrome sensor has no hue",
-                       jitter.contrast[0], jitter.contrast[1], jitter.contrast[2], jitter.contrast[3]));
-    if (!std::isfinite(jitter.brightness))
-        CV_Error(Error::StsBadArg, "colorJitter: brightness must be finite");
-    checkFinitePositive(jitter.gainRatio, "colorJitter: gainRatio");
-    const double newGain = format.gain * jitter.gainRatio;
-    checkFinitePositive(newGain, "colorJitter: the new gain");
-    if (!(std::isfinite(jitter.exposureTime) && jitter.exposureTime >= 0))
-        CV_Error(Error::StsBadArg,
-                 cv::format("colorJitter: exposureTime must be finite and >= 0 seconds (got %g)",
-                            jitter.exposureTime));
-    const double newExposure = jitter.exposureTime > 0 ? jitter.exposureTime : format.exposureTime;
-    // The model's terms at the input gain and at the output gain (its own line there with measured lines).
-    const StepNoise step(model, format, noise, jitter.gainRatio, src.size(), "colorJitter", newExposure);
-    const NoiseTerms<double>&terms = step.in, &outTerms = step.out;
+public:
+    ColorJitterStep(const ColorJitter& jitter, const _OutputArray* saturatedMask)
+        : jitter_(jitter), saturatedMask_(saturatedMask)
     {
-        // The row loops run in float: the largest value and variance they can form must fit one.
-        const NoiseTerms<double>& t = terms;
-        double largestContrast = 0;
+    }
+
+    const char* name() const override { return "colorJitter"; }
+
+    RawFormat prepare(const detail::StepContext& context) override
+    {
+        using namespace detail;
+        const RawFormat& format = context.format;
+        format_ = format;
+        seed_ = context.seed;
+        noise_ = context.noise;
+        format.validate();
         for (int s = 0; s < 4; ++s)
-            largestContrast = std::max(largestContrast, jitter.contrast[s]);
-        const double g2 = jitter.gainRatio * jitter.gainRatio;
-        const double largestValue = largestContrast * format.whiteLevel + std::abs(jitter.brightness);
-        const double largestVariance =
-            std::max(g2 * (t.shot * format.whiteLevel + t.readBeforeGain) + t.readAfterGain,
-                     outTerms.shot * largestContrast * format.whiteLevel + outTerms.read());
-        if (!(largestValue < 1e30 && largestVariance < 1e30 && largestContrast * jitter.gainRatio < 1e30))
+            checkFinitePositive(jitter_.contrast[s], "colorJitter: contrast");
+        // Different contrasts per site would print a 2x2 checkerboard on a frame whose pixels all see the
+        // same light: no capture makes that.
+        if (format.isMonochrome() && jitter_.contrast != Vec4d::all(jitter_.contrast[0]))
             CV_Error(Error::StsBadArg,
                      cv::format(
-                         "colorJitter: contrast %g, brightness %g and gain ratio %g make values or variances "
-                         "beyond float range (%g, %g)",
-                         largestContrast, jitter.brightness, jitter.gainRatio, largestValue,
-                         largestVariance));
+                         "colorJitter: a CFA_MONO frame has one contrast for all four sites (got %g, %g, "
+                         "%g, %g): a monochrome sensor has no hue",
+                         jitter_.contrast[0], jitter_.contrast[1], jitter_.contrast[2], jitter_.contrast[3]));
+        if (!std::isfinite(jitter_.brightness))
+            CV_Error(Error::StsBadArg, "colorJitter: brightness must be finite");
+        checkFinitePositive(jitter_.gainRatio, "colorJitter: gainRatio");
+        const double newGain = format.gain * jitter_.gainRatio;
+        checkFinitePositive(newGain, "colorJitter: the new gain");
+        if (!(std::isfinite(jitter_.exposureTime) && jitter_.exposureTime >= 0))
+            CV_Error(Error::StsBadArg,
+                     cv::format("colorJitter: exposureTime must be finite and >= 0 seconds (got %g)",
+                                jitter_.exposureTime));
+        const double newExposure = jitter_.exposureTime > 0 ? jitter_.exposureTime : format.exposureTime;
+        // The model's terms at the input gain and at the output gain (its own line there with measured
+        // lines).
+        step_.reset(new StepNoise(context.model, format, context.noise, jitter_.gainRatio, context.size,
+                                  "colorJitter", newExposure));
+        checkFloatRange();
+        // Another exposure changes the noise only through a bank's frames of it.
+        const bool sameCapture = newExposure == format.exposureTime || !step_->bank;
+        ColorJitter change = jitter_;
+        change.exposureTime = 0;
+        identity_ = change.isIdentity() && sameCapture;
+        RawFormat out = format;
+        out.exposureTime = newExposure;
+        if (identity_)
+            return out;
+        out.gain = newGain;
+        prepareConstants(context.depth);
+        return out;
     }
 
-    // Another exposure changes the noise only through a bank's frames of it.
-    const bool sameCapture = newExposure == format.exposureTime || !step.bank;
-    ColorJitter change = jitter;
-    change.exposureTime = 0;
-    if (change.isIdentity() && sameCapture) {
-        // Skipped entirely: no copy, no random draw; the values are checked, since no row reads them.
-        if (!valuesChecked)
-            checkMosaicInput(src, "colorJitter");
-        reportSaturation(src, format, report, saturatedMask);
-        _dst.assign(src);
-        dstFormat = format;
-        dstFormat.exposureTime = newExposure;
-        return;
-    }
-    JitterConstants k;
-    for (int s = 0; s < 4; ++s) {
-        k.pc[s] = static_cast<float>(jitter.contrast[s]);
-        k.black[s] = static_cast<float>(format.blackLevel[s]);
-    }
-    k.pb = static_cast<float>(jitter.brightness);
-    k.pg = static_cast<float>(jitter.gainRatio);
-    k.white = outputWhite(format, src.depth());
-    k.in = {static_cast<float>(terms.shot), static_cast<float>(terms.readBeforeGain),
-            static_cast<float>(terms.readAfterGain)};
-    k.alignment = noise.alignment;
-    k.sampling = noise.shotSampling;
-    k.lineBySite = noise.alignment == NoiseAlignment::ACCOUNT_PRIOR && jitter.brightness == 0;
-    // The output gain's line: the model's own there with measured lines, else Eq. 5's scaling of the
-    // input's (in float, as jitterVariance() had it).
-    k.measured = step.measured;
-    const double pg2 = jitter.gainRatio * jitter.gainRatio;
-    if (k.measured) {
-        k.shotOut = static_cast<float>(outTerms.shot);
-        k.readOut = static_cast<float>(outTerms.read());
-    } else {
-        k.shotOut = k.pg * k.in.shot;
-        k.readOut = k.pg * k.pg * k.in.readBeforeGain + k.in.readAfterGain;
-    }
-    k.pgShotOut = static_cast<float>(jitter.gainRatio * outTerms.shot);
-    k.pg2ShotIn = static_cast<float>(pg2 * terms.shot);
-    k.pg2ReadIn = static_cast<float>(pg2 * terms.read());
-    for (int s = 0; s < 4; ++s) {
-        k.slope[s] = k.offset[s] = 0;
-        if (k.lineBySite && k.measured)
-            measuredSiteLine(jitter.contrast[s], terms, outTerms, k.slope[s], k.offset[s]);
-        else if (k.lineBySite)
-            perSiteLine(jitter.contrast[s], jitter.gainRatio, terms, k.slope[s], k.offset[s]);
+    bool isIdentity() const override { return identity_; }
+
+    void begin(const Mat& src, bool checkValues, detail::StepTally& tally) override
+    {
+        using namespace detail;
+        const StepNoise& step = *step_;
+        inputShading_ = noise_.alignment == NoiseAlignment::ACCOUNT_PRIOR ? step.shading : DarkShading();
+        prior_ = noise_.priorMean == PriorMeanEstimate::LOCAL_MEAN && step.addsNoise()
+                     ? localPriorMean(src, format_, inputShading_)
+                     : Mat();
+        k_.dark = jitterDarkTerms(step, jitter_);
+        // With a dark-frame bank its frames are the read part; what the input holds of it is scaled by p_c.
+        if (step.bank) {
+            BankPattern pattern;
+            pattern.amplitude = jitter_.contrast;
+            bank_ = prepareBankRead(step, format_, src.size(), pattern, seed_, RandomStream::JITTER_BANK,
+                                    "colorJitter");
+        }
+        bankFactors_.reset(new BankFactors(jitter_.contrast, step.bank ? src.cols : 0));
+        keys_ = {stepKey(seed_, RandomStream::JITTER_GAUSSIAN), stepKey(seed_, RandomStream::JITTER_POISSON),
+                 stepKey(seed_, RandomStream::JITTER_ROW), stepKey(seed_, RandomStream::JITTER_TUKEY)};
+        tables_.reset(new JitterColumnTables(k_, src.cols));
+        tally_ = &tally;
+        checkValues_ = checkValues;
+        rows_ = src.rows;
     }
 
-    const DarkShading inputShading =
-        noise.alignment == NoiseAlignment::ACCOUNT_PRIOR ? step.shading : DarkShading();
-    Mat prior = noise.priorMean == PriorMeanEstimate::LOCAL_MEAN && step.addsNoise()
-                    ? localPriorMean(src, format, inputShading)
-                    : Mat();
-    k.dark = jitterDarkTerms(step, jitter);
-    // With a dark-frame bank its frames are the read part; what the input holds of it is scaled by p_c.
-    BankRead bank;
-    if (step.bank) {
-        BankPattern pattern;
-        pattern.amplitude = jitter.contrast;
-        bank = prepareBankRead(step, format, src.size(), pattern, seed, RandomStream::JITTER_BANK,
-                               "colorJitter");
-    }
-    const BankFactors bankFactors(jitter.contrast, step.bank ? src.cols : 0);
-    Mat dst = stepOutput(src, _dst);
-    std::atomic<int64> brightening{0}, readBrightening{0};
-    std::atomic<bool> nonFinite{false}, nonFiniteInput{false};
-    const JitterKeys keys = {
-        stepKey(seed, RandomStream::JITTER_GAUSSIAN), stepKey(seed, RandomStream::JITTER_POISSON),
-        stepKey(seed, RandomStream::JITTER_ROW), stepKey(seed, RandomStream::JITTER_TUKEY)};
-    const JitterColumnTables tables(k, src.cols);
-    parallel_for_(Range(0, src.rows), [&](const Range& rows) {
+    int rowCount() const override { return rows_; }
+
+    void runRows(const Mat& src, Mat& dst, const Range& rows) const override
+    {
+        const detail::BankRead* bank = bank_.empty() ? nullptr : &bank_;
+        std::atomic<bool>* nonFiniteInput = checkValues_ ? &tally_->nonFiniteInput : nullptr;
         if (src.depth() == CV_16U)
-            jitterRows<ushort>(src, prior, dst, k, tables, keys, inputShading, bank.empty() ? nullptr : &bank,
-                               bankFactors, rows, brightening, readBrightening, nonFinite, nullptr);
+            jitterRows<ushort>(src, prior_, dst, k_, *tables_, keys_, inputShading_, bank, *bankFactors_,
+                               rows, tally_->brightening, tally_->readBrightening, tally_->nonFiniteShading,
+                               nullptr);
         else
-            jitterRows<float>(src, prior, dst, k, tables, keys, inputShading, bank.empty() ? nullptr : &bank,
-                              bankFactors, rows, brightening, readBrightening, nonFinite,
-                              valuesChecked ? nullptr : &nonFiniteInput);
-    });
-    if (nonFiniteInput)
-        throwNonFiniteInput("colorJitter");
-    if (nonFinite)
-        throwNonFiniteShading("colorJitter");
-    reportSaturation(src, format, report, saturatedMask);
-    _dst.assign(dst);
-    dstFormat = format;
-    dstFormat.gain = newGain;
-    dstFormat.exposureTime = newExposure;
-    if (report) {
-        report->brighteningPixels += brightening.load();
-        report->readBrighteningPixels += readBrightening.load();
-        recordStep(report, "colorJitter", start);
+            jitterRows<float>(src, prior_, dst, k_, *tables_, keys_, inputShading_, bank, *bankFactors_, rows,
+                              tally_->brightening, tally_->readBrightening, tally_->nonFiniteShading,
+                              nonFiniteInput);
     }
+
+    void describeInput(const Mat& src, AugmentReport* report) const override
+    {
+        detail::reportSaturation(src, format_, report, saturatedMask_ ? *saturatedMask_ : noArray());
+    }
+
+private:
+    // The row loops run in float: the largest value and variance they can form must fit one.
+    void checkFloatRange() const
+    {
+        const detail::NoiseTerms<double>&t = step_->in, &outTerms = step_->out;
+        double largestContrast = 0;
+        for (int s = 0; s < 4; ++s)
+            largestContrast = std::max(largestContrast, jitter_.contrast[s]);
+        const double g2 = jitter_.gainRatio * jitter_.gainRatio;
+        const double largestValue = largestContrast * format_.whiteLevel + std::abs(jitter_.brightness);
+        const double largestVariance =
+            std::max(g2 * (t.shot * format_.whiteLevel + t.readBeforeGain) + t.readAfterGain,
+                     outTerms.shot * largestContrast * format_.whiteLevel + outTerms.read());
+        if (!(largestValue < 1e30 && largestVariance < 1e30 && largestContrast * jitter_.gainRatio < 1e30))
+            CV_Error(Error::StsBadArg,
+                     cv::format("colorJitter: contrast %g, brightness %g and gain ratio %g make values or "
+                                "variances beyond float range (%g, %g)",
+                                largestContrast, jitter_.brightness, jitter_.gainRatio, largestValue,
+                                largestVariance));
+    }
+
+    void prepareConstants(int depth)
+    {
+        const detail::NoiseTerms<double>&terms = step_->in, &outTerms = step_->out;
+        JitterConstants& k = k_;
+        for (int s = 0; s < 4; ++s) {
+            k.pc[s] = static_cast<float>(jitter_.contrast[s]);
+            k.black[s] = static_cast<float>(format_.blackLevel[s]);
+        }
+        k.pb = static_cast<float>(jitter_.brightness);
+        k.pg = static_cast<float>(jitter_.gainRatio);
+        k.white = detail::outputWhite(format_, depth);
+        k.in = {static_cast<float>(terms.shot), static_cast<float>(terms.readBeforeGain),
+                static_cast<float>(terms.readAfterGain)};
+        k.alignment = noise_.alignment;
+        k.sampling = noise_.shotSampling;
+        k.lineBySite = noise_.alignment == NoiseAlignment::ACCOUNT_PRIOR && jitter_.brightness == 0;
+        // The output gain's line: the model's own there with measured lines, else Eq. 5's scaling of the
+        // input's (in float, as jitterVariance() had it).
+        k.measured = step_->measured;
+        const double pg2 = jitter_.gainRatio * jitter_.gainRatio;
+        if (k.measured) {
+            k.shotOut = static_cast<float>(outTerms.shot);
+            k.readOut = static_cast<float>(outTerms.read());
+        } else {
+            k.shotOut = k.pg * k.in.shot;
+            k.readOut = k.pg * k.pg * k.in.readBeforeGain + k.in.readAfterGain;
+        }
+        k.pgShotOut = static_cast<float>(jitter_.gainRatio * outTerms.shot);
+        k.pg2ShotIn = static_cast<float>(pg2 * terms.shot);
+        k.pg2ReadIn = static_cast<float>(pg2 * terms.read());
+        for (int s = 0; s < 4; ++s) {
+            k.slope[s] = k.offset[s] = 0;
+            if (k.lineBySite && k.measured)
+                measuredSiteLine(jitter_.contrast[s], terms, outTerms, k.slope[s], k.offset[s]);
+            else if (k.lineBySite)
+                perSiteLine(jitter_.contrast[s], jitter_.gainRatio, terms, k.slope[s], k.offset[s]);
+        }
+    }
+
+    ColorJitter jitter_;
+    const _OutputArray* saturatedMask_;
+    RawFormat format_;
+    uint64 seed_ = 0;
+    NoiseOptions noise_;
+    std::unique_ptr<detail::StepNoise> step_;
+    bool identity_ = false;
+    JitterConstants k_;
+    detail::DarkShading inputShading_;
+    Mat prior_;
+    detail::BankRead bank_;
+    std::unique_ptr<BankFactors> bankFactors_;
+    JitterKeys keys_ = {0, 0, 0, 0};
+    std::unique_ptr<JitterColumnTables> tables_;
+    detail::StepTally* tally_ = nullptr;
+    bool checkValues_ = false;
+    int rows_ = 0;
+};
+
+} // namespace
+
+namespace detail {
+
+std::unique_ptr<NoiseStep> makeColorJitterStep(const ColorJitter& jitter, const _OutputArray* saturatedMask)
+{
+    return std::unique_ptr<NoiseStep>(new ColorJitterStep(jitter, saturatedMask));
 }
 
 } // namespace detail
@@ -556,8 +605,10 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
                  AugmentReport* report, OutputArray saturatedMask)
 {
     const Mat src = detail::twoDimensional(_src, "colorJitter: src");
-    detail::colorJitterStep(src, format, detail::ValidatedNoiseModel(model), jitter, noise, seed, dst,
-                            dstFormat, report, saturatedMask);
+    const detail::ValidatedNoiseModel valid(model);
+    detail::checkMosaicType(src, "colorJitter");
+    detail::runNoiseStep(detail::makeColorJitterStep(jitter, &saturatedMask), src, format, valid, noise, seed,
+                         dst, dstFormat, report);
 }
 
 } // namespace rawgment

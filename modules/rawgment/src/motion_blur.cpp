@@ -1,5 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Noise-accounted motion blur (paper Eq. 15 with the kernel's weights) and its kernel.
+#include "noise_step.hpp"
 #include "resample_rows.hpp"
 
 #include "cpu_dispatch.hpp"
@@ -250,71 +251,104 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
     }
 }
 
+/* A motion blur as a noise step (noise_step.hpp): prepare() validates the kernel and takes its taps, begin()
+ * makes the constants of Eq. 15 and the read part (a bank's or the dark components). */
+class MotionBlurStep : public detail::NoiseStep
+{
+public:
+    explicit MotionBlurStep(InputArray kernel) : kernel_(kernel) {}
+
+    const char* name() const override { return "motionBlur"; }
+
+    RawFormat prepare(const detail::StepContext& context) override
+    {
+        using namespace detail;
+        format_ = context.format;
+        seed_ = context.seed;
+        model_ = &context.model;
+        depth_ = context.depth;
+        checkResampleShape(context.size, format_, "motionBlur");
+        step_.reset(new StepNoise(context.model, format_, context.noise, 1, context.size, "motionBlur"));
+        w_ = normalisedKernel(kernel_, "motionBlur", format_.pattern);
+        // Sparse: a motion kernel is a line, so most of its box is zero and costs nothing.
+        taps_.clear();
+        for (int y = 0; y < w_.rows; ++y)
+            for (int x = 0; x < w_.cols; ++x) {
+                const double wk = w_.at<double>(y, x);
+                if (wk > 0)
+                    taps_.push_back({y, x, static_cast<float>(wk), static_cast<float>(wk * (1 - wk))});
+            }
+        return format_;
+    }
+
+    bool isIdentity() const override { return w_.total() == 1; }
+
+    void begin(const Mat& src, bool checkValues, detail::StepTally& tally) override
+    {
+        using namespace detail;
+        const StepNoise& step = *step_;
+        // Every source row is loaded whole: with any tap offset d, the clamped rows i + d of all output rows
+        // i are all the rows.
+        k_ = resampleConstants(depth_, format_, step, seed_, RandomStream::BLUR_GAUSSIAN,
+                               RandomStream::BLUR_POISSON);
+        readFactor_ = static_cast<float>(1 - w_.dot(w_));
+        k_.nonFiniteShading = &tally.nonFiniteShading;
+        k_.nonFiniteInput = checkValues ? &tally.nonFiniteInput : nullptr;
+        if (step.bank) {
+            const ValidatedNoiseModel& model = *model_;
+            const Mat w = w_;
+            const uint64 seed = seed_;
+            bank_ = resampleBankRead(step, format_, src.size(), w_.dot(w_), seed_, RandomStream::BLUR_BANK,
+                                     "motionBlur", [&](const Mat& in, const RawFormat& f, Mat& out) {
+                                         RawFormat unused;
+                                         runNoiseStep(makeMotionBlurStep(w), in, f, model,
+                                                      NoiseOptions(NoiseAlignment::NONE), seed, out, unused,
+                                                      nullptr, true);
+                                     });
+            k_.bank = &bank_;
+            k_.readBrightening = &tally.readBrightening;
+        } else if (step.hasDarkComponents()) {
+            Mat w2 = w_.mul(w_);
+            resampleDarkTerms(k_, step, sum(w2)[0], w2.dot(w2), seed_, RandomStream::BLUR_ROW,
+                              RandomStream::BLUR_TUKEY);
+        }
+        shotFromMean_ = step.options.blurNoiseSum == BlurNoiseSum::FROM_BLURRED_MEAN;
+        planeRows_ = src.rows / k_.grid.step;
+    }
+
+    int rowCount() const override { return planeRows_; }
+
+    void runRows(const Mat& src, Mat& dst, const Range& planeRows) const override
+    {
+        if (src.depth() == CV_16U)
+            blurPlaneRows<ushort>(src, dst, taps_, w_.size(), readFactor_, shotFromMean_, k_, planeRows);
+        else
+            blurPlaneRows<float>(src, dst, taps_, w_.size(), readFactor_, shotFromMean_, k_, planeRows);
+    }
+
+private:
+    _InputArray kernel_;
+    RawFormat format_;
+    uint64 seed_ = 0;
+    const detail::ValidatedNoiseModel* model_ = nullptr;
+    int depth_ = CV_16U;
+    std::unique_ptr<detail::StepNoise> step_;
+    Mat w_;
+    std::vector<KernelTap> taps_;
+    ResampleConstants k_;
+    float readFactor_ = 0;
+    bool shotFromMean_ = false;
+    detail::BankRead bank_;
+    int planeRows_ = 0;
+};
+
 } // namespace
 
 namespace detail {
 
-void motionBlurStep(const Mat& src, const RawFormat& format, const ValidatedNoiseModel& model,
-                    InputArray _kernel, const NoiseOptions& noise, uint64 seed, OutputArray _dst,
-                    AugmentReport* report, bool valuesChecked)
+std::unique_ptr<NoiseStep> makeMotionBlurStep(InputArray kernel)
 {
-    const auto start = std::chrono::steady_clock::now();
-    checkResampleInput(src, format, "motionBlur");
-    const StepNoise step(model, format, noise, 1, src.size(), "motionBlur");
-    const Mat w = normalisedKernel(_kernel, "motionBlur", format.pattern);
-    if (w.total() == 1) {
-        if (!valuesChecked)
-            checkMosaicInput(src, "motionBlur");
-        _dst.assign(src);
-        return;
-    }
-    // Sparse: a motion kernel is a line, so most of its box is zero and costs nothing.
-    std::vector<KernelTap> taps;
-    for (int y = 0; y < w.rows; ++y)
-        for (int x = 0; x < w.cols; ++x) {
-            const double wk = w.at<double>(y, x);
-            if (wk > 0)
-                taps.push_back({y, x, static_cast<float>(wk), static_cast<float>(wk * (1 - wk))});
-        }
-    // Every source row is loaded whole: with any tap offset d, the clamped rows i + d of all output rows i
-    // are all the rows.
-    std::atomic<bool> nonFinite{false}, nonFiniteInput{false};
-    ResampleConstants k = resampleConstants(src.depth(), format, step, seed, RandomStream::BLUR_GAUSSIAN,
-                                            RandomStream::BLUR_POISSON);
-    const float readFactor = static_cast<float>(1 - w.dot(w));
-    k.nonFiniteShading = &nonFinite;
-    k.nonFiniteInput = valuesChecked ? nullptr : &nonFiniteInput;
-    BankRead bank;
-    std::atomic<int64> readBrightening{0};
-    if (step.bank) {
-        bank = resampleBankRead(step, format, src.size(), w.dot(w), seed, RandomStream::BLUR_BANK,
-                                "motionBlur", [&](const Mat& in, const RawFormat& f, Mat& out) {
-                                    motionBlurStep(in, f, model, w, NoiseAlignment::NONE, seed, out, nullptr,
-                                                   true);
-                                });
-        k.bank = &bank;
-        k.readBrightening = &readBrightening;
-    } else if (step.hasDarkComponents()) {
-        Mat w2 = w.mul(w);
-        resampleDarkTerms(k, step, sum(w2)[0], w2.dot(w2), seed, RandomStream::BLUR_ROW,
-                          RandomStream::BLUR_TUKEY);
-    }
-    const bool shotFromMean = noise.blurNoiseSum == BlurNoiseSum::FROM_BLURRED_MEAN;
-    Mat dst = stepOutput(src, _dst);
-    parallel_for_(Range(0, src.rows / k.grid.step), [&](const Range& range) {
-        if (src.depth() == CV_16U)
-            blurPlaneRows<ushort>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
-        else
-            blurPlaneRows<float>(src, dst, taps, w.size(), readFactor, shotFromMean, k, range);
-    });
-    if (nonFiniteInput)
-        throwNonFiniteInput("motionBlur");
-    if (nonFinite)
-        throwNonFiniteShading("motionBlur");
-    _dst.assign(dst);
-    if (report)
-        report->readBrighteningPixels += readBrightening.load();
-    recordStep(report, "motionBlur", start);
+    return std::unique_ptr<NoiseStep>(new MotionBlurStep(kernel));
 }
 
 } // namespace detail
@@ -323,7 +357,11 @@ void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& mode
                 const NoiseOptions& noise, uint64 seed, OutputArray dst, AugmentReport* report)
 {
     const Mat src = detail::twoDimensional(_src, "motionBlur: src");
-    detail::motionBlurStep(src, format, detail::ValidatedNoiseModel(model), kernel, noise, seed, dst, report);
+    const detail::ValidatedNoiseModel valid(model);
+    detail::checkMosaicType(src, "motionBlur");
+    RawFormat dstFormat;
+    detail::runNoiseStep(detail::makeMotionBlurStep(kernel), src, format, valid, noise, seed, dst, dstFormat,
+                         report);
 }
 
 } // namespace rawgment

@@ -1,14 +1,12 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // Scenes (what one augmentation simulates, applied step by step) and the random scene policy.
 #include "augment_steps.hpp"
-#include "resample_rows.hpp"
+#include "noise_step.hpp"
 
-#include <opencv2/imgproc.hpp>
 #include <opencv2/rawgment/seeds.hpp>
 
 #include <atomic>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <mutex>
 
@@ -107,131 +105,21 @@ Scene Scene::read(const FileNode& node)
     return s;
 }
 
-namespace {
-
-/* Where each output pixel of a shift reads: each CFA plane (of step 2; a monochrome frame is one plane of
- * step 1, PlaneGrid) moved by shift / step, vacated pixels replicating the plane's edge. Output pixel
- * (r, c) is source pixel (step clamp(r/step - shift.y/step) + r%step, step clamp(c/step - shift.x/step) +
- * c%step), the clamps to the plane's rows and columns; output columns [first, last) read source column
- * c - shift.x, those left of them the first step of source columns, those right of them the last. */
-struct ShiftSource
-{
-    int step, planeRows, planeCols, planeShiftY, shiftX, first, last;
-
-    ShiftSource(Size size, Point shift, int gridStep)
-        : step(gridStep), planeRows(size.height / gridStep), planeCols(size.width / gridStep),
-          planeShiftY(shift.y / gridStep), shiftX(shift.x), first(std::min(std::max(shift.x, 0), size.width)),
-          last(std::max(std::min(size.width + shift.x, size.width), 0))
-    {
-    }
-    int row(int r) const
-    {
-        return step * std::min(std::max(r / step - planeShiftY, 0), planeRows - 1) + r % step;
-    }
-    int column(int c) const
-    {
-        return c < first ? c % step : c < last ? c - shiftX : step * (planeCols - 1) + c % step;
-    }
-};
-
-/* The shift in one pass (ShiftSource): the same values as splitting the planes, moving each with
- * warpAffine (INTER_NEAREST, BORDER_REPLICATE) and merging them (Augment.shiftMatchesThePlaneWise
- * Composition), at the cost of a copy: the inner columns of a row are one memcpy. */
-void shiftMosaic(const Mat& src, Point shift, int gridStep, Mat& dst)
-{
-    CV_Assert(shift.x % gridStep == 0 && shift.y % gridStep == 0 && src.rows % 2 == 0 && src.cols % 2 == 0);
-    dst.create(src.size(), src.type());
-    detail::adviseHugePages(dst);
-    const ShiftSource from(src.size(), shift, gridStep);
-    const size_t esz = src.elemSize();
-    const bool checkValues = src.depth() == CV_32F;
-    std::atomic<bool> nonFinite{false};
-    parallel_for_(Range(0, src.rows), [&](const Range& rows) {
-        for (int r = rows.start; r < rows.end; ++r) {
-            const uchar* s = src.ptr(from.row(r));
-            // The shift is the scene's first step: it checks each source row whole, while it is in cache.
-            if (checkValues && !detail::rowIsFinite(reinterpret_cast<const float*>(s), src.cols))
-                nonFinite = true;
-            uchar* d = dst.ptr(r);
-            for (int c = 0; c < from.first; ++c)
-                std::memcpy(d + c * esz, s + from.column(c) * esz, esz);
-            if (from.last > from.first)
-                std::memcpy(d + from.first * esz, s + from.column(from.first) * esz,
-                            (from.last - from.first) * esz);
-            for (int c = std::max(from.last, from.first); c < src.cols; ++c)
-                std::memcpy(d + c * esz, s + from.column(c) * esz, esz);
-        }
-    });
-    if (checkValues) {
-        // The rows the shift moved out of the frame, which no output row read.
-        std::vector<uchar> read(static_cast<size_t>(src.rows), 0);
-        for (int r = 0; r < src.rows; ++r)
-            read[static_cast<size_t>(from.row(r))] = 1;
-        for (int r = 0; r < src.rows; ++r)
-            if (!read[static_cast<size_t>(r)] && !detail::rowIsFinite(src.ptr<float>(r), src.cols))
-                nonFinite = true;
-    }
-    if (nonFinite)
-        detail::throwNonFiniteInput("applyScene");
-}
-
-/* The sensor's dark shading S stays where the sensor has it: the shifted content carries the input's S
- * of its source pixel, which is swapped for the S of the pixel it lands on, dst(x) = src(x - d) - S(x - d)
- * + S(x) (float arithmetic, the same on every path; integer mosaics rounded to nearest, ties to even, and
- * kept in range). Clipped pixels stay clipped. Row by row, from ShiftSource's pixels as shiftMosaic() copied
- * them. */
-template <typename T>
-void swapShiftedShading(const Mat& src, const RawFormat& format, const detail::DarkShading& shading,
-                        Point shift, int gridStep, Mat& dst)
-{
-    const ShiftSource from(src.size(), shift, gridStep);
-    const float white = static_cast<float>(format.whiteLevel);
-    const float highest = src.depth() == CV_16U ? 65535.f : std::numeric_limits<float>::max();
-    const float lowest = src.depth() == CV_16U ? 0.f : -std::numeric_limits<float>::max();
-    std::atomic<bool> nonFinite{false};
-    parallel_for_(Range(0, src.rows), [&](const Range& rows) {
-        for (int r = rows.start; r < rows.end; ++r) {
-            const int sr = from.row(r);
-            const float *bdSrc = shading.perGainRow(sr), *brSrc = shading.offsetRow(sr);
-            const float *bdDst = shading.perGainRow(r), *brDst = shading.offsetRow(r);
-            T* d = dst.ptr<T>(r);
-            for (int c = 0; c < src.cols; ++c) {
-                const int sc = from.column(c);
-                const float value = static_cast<float>(d[c]);
-                const float swapped = value - shading.at(bdSrc, brSrc, sc) + shading.at(bdDst, brDst, c);
-                if (!std::isfinite(swapped)) {
-                    nonFinite = true;
-                    return;
-                }
-                if (value >= white)
-                    continue;
-                const float kept = std::min(std::max(swapped, lowest), highest);
-                d[c] = static_cast<T>(src.depth() == CV_16U ? std::nearbyint(kept) : kept);
-            }
-        }
-    });
-    if (nonFinite)
-        detail::throwNonFiniteShading("applyScene");
-}
-
-} // namespace
-
 void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& model, const Scene& scene,
-                uint64 seed, OutputArray _dst, RawFormat& dstFormat, AugmentReport* report,
+                uint64 seed, OutputArray dst, RawFormat& dstFormat, AugmentReport* report,
                 std::vector<Rect>* boxes)
 {
-    Mat current = detail::twoDimensional(_src, "applyScene: src");
+    const Mat src = detail::twoDimensional(_src, "applyScene: src");
     // Its first step checks a float mosaic's values as it reads them (augment_steps.hpp).
-    detail::checkMosaicType(current, "applyScene");
+    detail::checkMosaicType(src, "applyScene");
     format.validate();
     const detail::ValidatedNoiseModel valid(model); // once for every step of the scene
-    if (current.rows % 2 || current.cols % 2)
+    if (src.rows % 2 || src.cols % 2)
         CV_Error(Error::StsBadArg, "applyScene: the mosaic needs even sides");
-    RawFormat fmt = format;
-    if (std::abs(static_cast<double>(scene.shift.x)) > current.cols ||
-        std::abs(static_cast<double>(scene.shift.y)) > current.rows)
+    if (std::abs(static_cast<double>(scene.shift.x)) > src.cols ||
+        std::abs(static_cast<double>(scene.shift.y)) > src.rows)
         CV_Error(Error::StsBadArg, cv::format("applyScene: shift (%d, %d) is larger than the %dx%d mosaic",
-                                              scene.shift.x, scene.shift.y, current.cols, current.rows));
+                                              scene.shift.x, scene.shift.y, src.cols, src.rows));
     // Every box is checked and clipped to the frame on every path, whichever steps the scene has.
     if (boxes)
         for (size_t i = 0; i < boxes->size(); ++i) {
@@ -240,82 +128,20 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
                 CV_Error(Error::StsBadArg,
                          cv::format("applyScene: box %zu (%d, %d, %d x %d) has a negative size", i, b.x, b.y,
                                     b.width, b.height));
-            b &= Rect(0, 0, current.cols, current.rows);
+            b &= Rect(0, 0, src.cols, src.rows);
         }
-    // A Bayer mosaic moves by whole 2x2 blocks so that its CFA phase stays; a monochrome frame has none.
-    const int gridStep = detail::PlaneGrid(fmt).step;
-    const Point shift = gridStep == 1
-                            ? scene.shift
-                            : Point(2 * cvRound(scene.shift.x / 2.0), 2 * cvRound(scene.shift.y / 2.0));
-    // The steps write into two buffers in turn, the last into the caller's dst when it is a Mat to reuse (as
-    // a single step's dst is): a new 48 MB float frame per step cost more in page faults than the step itself
-    // (glibc maps blocks over 32 MB afresh on every allocation). The first step reads the caller's src, which
-    // no step writes (stepOutput() gives a new Mat for a dst that overlaps it).
-    const bool jitters = !scene.jitter.isIdentity(), blurs = !isIdentityKernel(scene.motionKernel);
-    int stepsLeft = (shift != Point(0, 0)) + (scene.scale != 1) + jitters + blurs;
-    Mat buffers[2];
-    if (_dst.kind() == _InputArray::MAT) {
-        const Mat given = _dst.getMat();
-        // Never the caller's src (an in-place call, dst = src): a later step would write into it.
-        const bool overlaps = given.datastart < current.dataend && current.datastart < given.dataend;
-        if (!overlaps && given.size() == current.size() && given.type() == current.type())
-            buffers[0] = given;
-    }
-    const auto nextBuffer = [&]() -> Mat& { return buffers[--stepsLeft % 2]; };
-    // A tied bank takes the input's fixed pattern out where the sensor has it; a shift moves the pattern with
-    // the content, and the bank's pattern is not moved back as the dark shading is.
-    if (shift != Point(0, 0) && scene.noise.darkBankTied && !scene.noise.darkBank.empty() &&
-        scene.noise.alignment != NoiseAlignment::NONE)
-        CV_Error(Error::StsBadArg,
-                 "applyScene: a tied dark-frame bank (NoiseOptions::darkBankTied) cannot follow "
-                 "a shifted scene, which moves the input's fixed pattern; untie the bank or "
-                 "drop the shift");
-    if (shift != Point(0, 0)) {
-        const auto start = std::chrono::steady_clock::now();
-        Mat& shifted = nextBuffer();
-        shiftMosaic(current, shift, gridStep, shifted);
-        // The dark shading belongs to the sensor, not to the content: it must not move with the shift.
-        const detail::StepNoise step(valid, fmt, scene.noise, 1, current.size(), "applyScene");
-        if (!step.shading.empty()) {
-            if (current.depth() == CV_16U)
-                swapShiftedShading<ushort>(current, fmt, step.shading, shift, gridStep, shifted);
-            else
-                swapShiftedShading<float>(current, fmt, step.shading, shift, gridStep, shifted);
-        }
-        current = shifted;
-        if (boxes)
-            for (Rect& b : *boxes)
-                b = (b + shift) & Rect(0, 0, current.cols, current.rows);
-        detail::recordStep(report, "shift", start);
-    }
-    // The first step that runs checks the input's values as it reads them all; its output, finite, is what
-    // the later steps read, unchecked.
-    bool valuesChecked = shift != Point(0, 0);
-    if (scene.scale != 1) {
-        Mat& scaled = nextBuffer();
-        detail::scaleMosaicStep(current, fmt, valid, scene.scale, scene.noise, seed, scaled, report,
-                                valuesChecked);
-        valuesChecked = true;
-        current = scaled;
-        if (boxes)
-            for (Rect& b : *boxes)
-                b = scaleBox(b, current.size(), scene.scale);
-    }
-    // An identity jitter reads nothing: the blur after it checks then.
-    Mat unchanged;
-    Mat& jittered = jitters ? nextBuffer() : unchanged;
-    detail::colorJitterStep(current, fmt, valid, scene.jitter, scene.noise, seed, jittered, fmt, report,
-                            noArray(), valuesChecked || (!jitters && blurs));
-    valuesChecked = valuesChecked || jitters;
-    current = jittered;
-    if (blurs) {
-        Mat& blurred = nextBuffer();
-        detail::motionBlurStep(current, fmt, valid, scene.motionKernel, scene.noise, seed, blurred, report,
-                               valuesChecked);
-        current = blurred;
-    }
-    _dst.assign(current);
-    dstFormat = fmt;
+    // The scene's steps in their order; the jitter always, since it reports the saturated pixels of its
+    // input and decides for itself whether it is the identity (an exposure time with a bank is not).
+    detail::NoiseSteps steps;
+    if (scene.shift != Point(0, 0))
+        steps.push_back(detail::makeShiftStep(scene.shift));
+    if (scene.scale != 1)
+        steps.push_back(detail::makeScaleStep(scene.scale));
+    steps.push_back(detail::makeColorJitterStep(scene.jitter, nullptr));
+    if (!isIdentityKernel(scene.motionKernel))
+        steps.push_back(detail::makeMotionBlurStep(scene.motionKernel));
+    detail::runNoiseSteps(steps, src, format, valid, scene.noise, seed, dst, dstFormat, report, boxes,
+                          "applyScene");
 }
 
 namespace {
