@@ -126,6 +126,33 @@ if [ "${#explicit[@]}" -eq 0 ]; then
   done
 fi
 
+# Functions along their seams: none in the library over 120 lines. A body opens with a brace alone on its line
+# after a signature (clang-format puts a function's brace there and no other) and closes at that indentation.
+if [ "${#explicit[@]}" -eq 0 ]; then
+  library=()
+  for f in "${files[@]}"; do
+    case "$f" in modules/rawgment/src/*.cpp|modules/rawgment/src/*.hpp) [ -f "$f" ] && library+=("$f") ;; esac
+  done
+  long=$(awk -v limit=120 '
+    FNR == 1 { open = 0; prev = "" }
+    {
+      if (!open && $0 ~ /^ *\{$/ && prev ~ /\)/ && prev !~ /^ *(class|struct|enum|namespace|union)[ ]/) {
+        open = 1; start = FNR; indent = substr($0, 1, index($0, "{") - 1); sig = prev
+      } else if (open && $0 == indent "}") {
+        if (FNR - start + 2 > limit) {
+          gsub(/^ +/, "", sig)
+          printf "%s:%d: a function of %d lines (at most %d; split it along its steps): %s\n", FILENAME, start - 1, FNR - start + 2, limit, substr(sig, 1, 80)
+        }
+        open = 0
+      }
+      if ($0 ~ /[^ ]/) prev = $0
+    }' "${library[@]}")
+  if [ -n "$long" ]; then
+    echo "$long"
+    status=1
+  fi
+fi
+
 # Tests are organised like the code: no test file over 800 lines (a topic's tests split along its seams).
 # Private functions are never exported: tests reach them by linking rawgment_internal, so no header of src/
 # carries an export macro. precomp.hpp holds includes only: a declaration belongs to its topic's header.
@@ -154,6 +181,6 @@ if [ "${#explicit[@]}" -eq 0 ]; then
 fi
 
 if [ "$status" -eq 0 ]; then
-  echo "check-sources: ${#files[@]} files, no control characters, no copy of Eq. 5, layers kept, no file over 750 lines (tests 800), noise steps prepared once, no exported private function, precomp.hpp only includes"
+  echo "check-sources: ${#files[@]} files, no control characters, no copy of Eq. 5, layers kept, no file over 750 lines (tests 800), no library function over 120 lines, noise steps prepared once, no exported private function, precomp.hpp only includes"
 fi
 exit "$status"

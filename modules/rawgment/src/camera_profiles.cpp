@@ -240,72 +240,122 @@ double offsetScale(const CameraIsoFit& f, const DarktableImportParams& params)
     return std::abs(f.offset) + f.slope * params.offsetReferenceLevel;
 }
 
+/* The profiles with a positive green shot slope, by ISO (the others counted as skipped), and those of them
+ * whose colours are consistent, with their distinct ISOs. Two profiles at one ISO (19 of darktable's 4.2.1
+ * cameras have some) are two measurements of it: both are fitted. */
+struct UsableProfiles
+{
+    std::vector<const MeasuredProfile*> usable, consistent;
+    std::set<double> distinct;
+};
+
+UsableProfiles usableProfiles(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& profiles)
+{
+    UsableProfiles u;
+    for (const MeasuredProfile& p : profiles) {
+        if (!(p.a[1] > 0)) {
+            ++cam.skippedProfiles;
+            continue;
+        }
+        u.usable.push_back(&p);
+    }
+    const auto byIso = [](const MeasuredProfile* x, const MeasuredProfile* y) { return x->iso < y->iso; };
+    std::stable_sort(u.usable.begin(), u.usable.end(), byIso);
+    // A colour whose shot slope is negative is a failed fit, not a noise.
+    for (const MeasuredProfile* p : u.usable)
+        if (hasConsistentColours(*p)) {
+            u.consistent.push_back(p);
+            u.distinct.insert(p->iso);
+        }
+    cam.inconsistentProfiles = static_cast<int>(u.usable.size() - u.consistent.size());
+    return u;
+}
+
+// One ISO's measured line in the model's units (green, darktable's Haar ratio `c` taken out) and its figures.
+CameraIsoFit isoFitOf(const MeasuredProfile& p, double baseIso, const IsoSettings& settings, double c)
+{
+    CameraIsoFit f;
+    f.iso = p.iso;
+    f.gain = p.iso / baseIso;
+    f.slope = p.a[1] / c;
+    f.offset = p.b[1] / c;
+    f.expanded = settings.expanded.count(p.iso) > 0;
+    const auto digital = settings.digital.find(p.iso);
+    f.rawIso = digital == settings.digital.end() ? 0 : digital->second;
+    f.inconsistent = !hasConsistentColours(p);
+    double lo = HUGE_VAL, hi = 0;
+    for (int k = 0; k < 3; ++k)
+        if (p.a[k] > 0) {
+            lo = std::min(lo, p.a[k]);
+            hi = std::max(hi, p.a[k]);
+        }
+    f.colourSpread = hi / lo;
+    for (int k = 0; k < 2; ++k)
+        f.colourSlopeRatios[k] = p.a[2 * k] > 0 ? p.a[2 * k] / p.a[1] : 0;
+    return f;
+}
+
+// Each ISO's residuals against the fitted model, and the verdict's figures over the fitted settings.
+void measureResiduals(CameraNoiseProfile& cam, const DarktableImportParams& params)
+{
+    std::vector<double> slopeResiduals, spreads;
+    const CameraIsoFit* previous = nullptr; // the last fitted ISO
+    for (size_t k = 0; k < cam.isos.size(); ++k) {
+        CameraIsoFit& f = cam.isos[k];
+        const NoiseLine line = cam.noise.lineAtGain(f.gain);
+        f.slopeResidual = (line.a - f.slope) / f.slope;
+        f.offsetResidual = (line.b - f.offset) / offsetScale(f, params);
+        // The verdict's figures are over the fitted (analog, consistent) settings.
+        if (!f.fitted())
+            continue;
+        slopeResiduals.push_back(std::abs(f.slopeResidual));
+        spreads.push_back(f.colourSpread);
+        if (std::abs(f.slopeResidual) > cam.worstSlopeResidual) {
+            cam.worstSlopeResidual = std::abs(f.slopeResidual);
+            cam.worstSlopeIso = f.iso;
+        }
+        if (std::abs(f.offsetResidual) > cam.worstOffsetResidual) {
+            cam.worstOffsetResidual = std::abs(f.offsetResidual);
+            cam.worstOffsetIso = f.iso;
+        }
+        cam.negativeOffsets += f.offset < 0;
+        if (previous && f.iso > previous->iso && f.slope < previous->slope)
+            cam.monotoneSlope = false;
+        previous = &f;
+    }
+    cam.medianSlopeResidual = medianOf(slopeResiduals);
+    cam.medianColourSpread = medianOf(spreads);
+}
+
 //! Fits one camera from its measured profiles; sets REFUSED with the reason when it cannot.
 void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& profiles,
                const DarktableImportParams& params)
 {
     const double c = params.haarVarianceRatio;
     cam.haarVarianceRatio = c;
-    // Two profiles at one ISO (19 of darktable's 4.2.1 cameras have some) are two measurements of it:
-    // both are fitted.
-    std::vector<const MeasuredProfile*> usable, consistent;
-    std::set<double> distinct;
-    for (const MeasuredProfile& p : profiles) {
-        if (!(p.a[1] > 0)) {
-            ++cam.skippedProfiles;
-            continue;
-        }
-        usable.push_back(&p);
-    }
-    const auto byIso = [](const MeasuredProfile* x, const MeasuredProfile* y) { return x->iso < y->iso; };
-    std::stable_sort(usable.begin(), usable.end(), byIso);
-    // A colour whose shot slope is negative is a failed fit, not a noise.
-    for (const MeasuredProfile* p : usable)
-        if (hasConsistentColours(*p)) {
-            consistent.push_back(p);
-            distinct.insert(p->iso);
-        }
-    cam.inconsistentProfiles = static_cast<int>(usable.size() - consistent.size());
-    if (distinct.size() < 2) {
+    const UsableProfiles u = usableProfiles(cam, profiles);
+    if (u.distinct.size() < 2) {
         cam.verdict = CAMERA_PROFILE_REFUSED;
-        cam.reason = usable.empty() ? String("no profile with a positive green shot slope")
-                     : consistent.empty()
+        cam.reason = u.usable.empty() ? String("no profile with a positive green shot slope")
+                     : u.consistent.empty()
                          ? String("no profile without a negative colour shot slope")
                          : format("a single usable ISO (%g): the read noise before and after the "
                                   "gain cannot be told apart",
-                                  consistent[0]->iso);
+                                  u.consistent[0]->iso);
         return;
     }
-    const IsoSettings settings = isoSettingsOf(consistent);
-    const std::set<double>& expanded = settings.expanded;
-    cam.expandedIsos = static_cast<int>(expanded.size());
+    const IsoSettings settings = isoSettingsOf(u.consistent);
+    cam.expandedIsos = static_cast<int>(settings.expanded.size());
     cam.digitalIsos = static_cast<int>(settings.digital.size());
     double baseIso = 0;
-    for (const MeasuredProfile* p : consistent)
-        if (!expanded.count(p->iso) && !settings.digital.count(p->iso)) {
+    for (const MeasuredProfile* p : u.consistent)
+        if (!settings.expanded.count(p->iso) && !settings.digital.count(p->iso)) {
             baseIso = p->iso;
             break;
         }
     std::vector<double> g, a, b, g2, w;
-    for (const MeasuredProfile* p : usable) {
-        CameraIsoFit f;
-        f.iso = p->iso;
-        f.gain = p->iso / baseIso;
-        f.slope = p->a[1] / c;
-        f.offset = p->b[1] / c;
-        f.expanded = expanded.count(p->iso) > 0;
-        const auto digital = settings.digital.find(p->iso);
-        f.rawIso = digital == settings.digital.end() ? 0 : digital->second;
-        f.inconsistent = !hasConsistentColours(*p);
-        double lo = HUGE_VAL, hi = 0;
-        for (int k = 0; k < 3; ++k)
-            if (p->a[k] > 0) {
-                lo = std::min(lo, p->a[k]);
-                hi = std::max(hi, p->a[k]);
-            }
-        f.colourSpread = hi / lo;
-        for (int k = 0; k < 2; ++k)
-            f.colourSlopeRatios[k] = p->a[2 * k] > 0 ? p->a[2 * k] / p->a[1] : 0;
+    for (const MeasuredProfile* p : u.usable) {
+        const CameraIsoFit f = isoFitOf(*p, baseIso, settings, c);
         cam.isos.push_back(f);
         // Eq. 5 describes the analog settings: an expanded or digital one is measured (and followed) but not
         // fitted, an inconsistent one neither.
@@ -335,34 +385,7 @@ void fitCamera(CameraNoiseProfile& cam, const std::vector<MeasuredProfile>& prof
     }
     cam.noise = NoiseModel(alpha, offsets[0], offsets[1]);
     cam.noise.baseIso = baseIso;
-
-    std::vector<double> slopeResiduals, spreads;
-    const CameraIsoFit* previous = nullptr; // the last fitted ISO
-    for (size_t k = 0; k < cam.isos.size(); ++k) {
-        CameraIsoFit& f = cam.isos[k];
-        const NoiseLine line = cam.noise.lineAtGain(f.gain);
-        f.slopeResidual = (line.a - f.slope) / f.slope;
-        f.offsetResidual = (line.b - f.offset) / offsetScale(f, params);
-        // The verdict's figures are over the fitted (analog, consistent) settings.
-        if (!f.fitted())
-            continue;
-        slopeResiduals.push_back(std::abs(f.slopeResidual));
-        spreads.push_back(f.colourSpread);
-        if (std::abs(f.slopeResidual) > cam.worstSlopeResidual) {
-            cam.worstSlopeResidual = std::abs(f.slopeResidual);
-            cam.worstSlopeIso = f.iso;
-        }
-        if (std::abs(f.offsetResidual) > cam.worstOffsetResidual) {
-            cam.worstOffsetResidual = std::abs(f.offsetResidual);
-            cam.worstOffsetIso = f.iso;
-        }
-        cam.negativeOffsets += f.offset < 0;
-        if (previous && f.iso > previous->iso && f.slope < previous->slope)
-            cam.monotoneSlope = false;
-        previous = &f;
-    }
-    cam.medianSlopeResidual = medianOf(slopeResiduals);
-    cam.medianColourSpread = medianOf(spreads);
+    measureResiduals(cam, params);
     judgeProfileDemosaic(cam);
     if (cam.negativeOffsets == int(g.size())) {
         cam.verdict = CAMERA_PROFILE_REFUSED;

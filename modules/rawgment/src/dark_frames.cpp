@@ -68,27 +68,13 @@ int effectiveDegreesOfFreedom(std::vector<double>& ratios, int most)
     return k;
 }
 
-} // namespace
-
-DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double falseAlarm)
+/* The noisy pixels of a burst's variances: beyond the chi-square threshold of `falseAlarm` over their row's
+ * typical variance at their column parity, with the degrees of freedom the variances do scatter with. Fills
+ * e.degreesOfFreedom, e.noisyPixels, e.noisyVariance and e.rowVariance (each row's pooled variance without
+ * them); returns the mask of noisy pixels (1). */
+Mat flagNoisyPixels(const Mat& variance, int M, double falseAlarm, DarkFrameStatistics& e)
 {
-    const int M = stats.frames();
-    if (M < 2)
-        CV_Error(Error::StsBadArg,
-                 format("estimateDarkFrames: %d frame(s); temporal noise needs at least two", M));
-    if (!(falseAlarm > 0 && falseAlarm < 0.5))
-        CV_Error(Error::StsOutOfRange,
-                 format("estimateDarkFrames: falseAlarm %g must lie in (0, 0.5)", falseAlarm));
-    Mat mean, variance;
-    stats.mean(mean);
-    stats.variance(variance);
-    const int rows = mean.rows, cols = mean.cols;
-    if (rows * cols < 16)
-        CV_Error(Error::StsBadArg, format("estimateDarkFrames: %dx%d frames are too small to tell a pattern "
-                                          "from noise (at least 16 pixels)",
-                                          cols, rows));
-    DarkFrameStatistics e;
-    e.frames = M;
+    const int rows = variance.rows, cols = variance.cols;
     e.rowVariance.create(rows, 2, CV_64FC1);
     // A row's typical variance at one column parity: its median over the median of chi2(k) / k, and at least
     // 1/12 DN^2, the variance of rounding to whole DN. Below it integer frames do not resolve noise: with 0.2
@@ -116,7 +102,7 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
         }
     const int dof = effectiveDegreesOfFreedom(ratios, M - 1);
     e.degreesOfFreedom = dof;
-    const double threshold = chiSquareUpperQuantileOverDof(dof, falseAlarm);
+    const double threshold = detail::chiSquareUpperQuantileOverDof(dof, falseAlarm);
     Mat noisy(rows, cols, CV_8UC1, Scalar(0));
     for (int r = 0; r < rows; ++r) {
         const double* v = variance.ptr<double>(r);
@@ -138,14 +124,19 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
             e.rowVariance.at<double>(r, parity) = n > 0 ? sum / n : typical;
         }
     }
-    // Per site: the level, the spatial variance of the means and the temporal variance each mean holds.
+    return noisy;
+}
+
+// Per site: the level, the spatial variance of the means and the temporal variance each mean holds.
+void siteFigures(const Mat& mean, const Mat& variance, const Mat& noisy, int M, DarkFrameStatistics& e)
+{
     double sum[4] = {0, 0, 0, 0}, sum2[4] = {0, 0, 0, 0}, own[4] = {0, 0, 0, 0}, pooled[4] = {0, 0, 0, 0};
     double count[4] = {0, 0, 0, 0}, pooledCount[4] = {0, 0, 0, 0};
-    for (int r = 0; r < rows; ++r) {
+    for (int r = 0; r < mean.rows; ++r) {
         const double* m = mean.ptr<double>(r);
         const double* v = variance.ptr<double>(r);
         const uchar* flagged = noisy.ptr<uchar>(r);
-        for (int c = 0; c < cols; ++c) {
+        for (int c = 0; c < mean.cols; ++c) {
             const int s = cfaSite(r, c);
             sum[s] += m[c];
             sum2[s] += m[c] * m[c];
@@ -167,51 +158,63 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
         e.patternVariance[s] = std::max(0.0, e.meanVariance[s] - own[s] / n / M);
         e.temporalVariance[s] = pooledCount[s] > 0 ? pooled[s] / pooledCount[s] : own[s] / n;
     }
-    // The shrinkage is the bulk's: a site's centre and spread from the median and interquartile range of its
-    // means, which its hot pixels (a few far out, thousands of DN) leave alone. Those, beyond 6 robust
-    // standard deviations of the means, are pattern beyond doubt and kept as measured. With the plain
-    // variance 0.2% of hot pixels made every w 1 on a simulated sensor: no shrinkage at all, the mean's whole
-    // v/M kept.
-    double centre[4], robustSpread[4], outlier[4];
-    {
-        std::vector<double> site[4];
-        for (int r = 0; r < rows; ++r) {
-            const double* m = mean.ptr<double>(r);
-            for (int c = 0; c < cols; ++c)
-                site[cfaSite(r, c)].push_back(m[c]);
-        }
-        for (int s = 0; s < 4; ++s) {
-            std::vector<double>& x = site[s];
-            if (x.empty()) {
-                centre[s] = robustSpread[s] = outlier[s] = 0;
-                continue;
-            }
-            const size_t q1 = x.size() / 4, q3 = (3 * x.size()) / 4;
-            std::nth_element(x.begin(), x.begin() + long(q1), x.end());
-            const double low = x[q1];
-            std::nth_element(x.begin(), x.begin() + long(q3), x.end());
-            const double high = x[q3];
-            centre[s] = medianOf(x);
-            // One centre for the pattern and its users (an untied step adds F - level): the mean of a site's
-            // means moved 7 DN with 0.2% of hot pixels at 3430 DN.
-            e.level[s] = centre[s];
-            const double robustVariance = std::pow((high - low) / 1.349, 2);
-            robustSpread[s] = std::max(0.0, robustVariance - e.temporalVariance[s] / M);
-            outlier[s] = 6 * std::sqrt(robustVariance);
-        }
+}
+
+/* The shrinkage is the bulk's: a site's centre and spread from the median and interquartile range of its
+ * means, which its hot pixels (a few far out, thousands of DN) leave alone. Those, beyond 6 robust standard
+ * deviations of the means (`outlier`), are pattern beyond doubt and kept as measured. With the plain variance
+ * 0.2% of hot pixels made every w 1 on a simulated sensor: no shrinkage at all, the mean's whole v/M kept. */
+struct RobustSites
+{
+    double centre[4], spread[4], outlier[4];
+};
+
+RobustSites robustSites(const Mat& mean, int M, DarkFrameStatistics& e)
+{
+    RobustSites robust;
+    std::vector<double> site[4];
+    for (int r = 0; r < mean.rows; ++r) {
+        const double* m = mean.ptr<double>(r);
+        for (int c = 0; c < mean.cols; ++c)
+            site[cfaSite(r, c)].push_back(m[c]);
     }
-    mean.convertTo(e.mean, CV_32F);
-    mean.convertTo(e.mean, CV_32F);
-    e.pattern.create(rows, cols, CV_32FC1);
-    for (int r = 0; r < rows; ++r) {
+    for (int s = 0; s < 4; ++s) {
+        std::vector<double>& x = site[s];
+        if (x.empty()) {
+            robust.centre[s] = robust.spread[s] = robust.outlier[s] = 0;
+            continue;
+        }
+        const size_t q1 = x.size() / 4, q3 = (3 * x.size()) / 4;
+        std::nth_element(x.begin(), x.begin() + long(q1), x.end());
+        const double low = x[q1];
+        std::nth_element(x.begin(), x.begin() + long(q3), x.end());
+        const double high = x[q3];
+        robust.centre[s] = medianOf(x);
+        // One centre for the pattern and its users (an untied step adds F - level): the mean of a site's
+        // means moved 7 DN with 0.2% of hot pixels at 3430 DN.
+        e.level[s] = robust.centre[s];
+        const double robustVariance = std::pow((high - low) / 1.349, 2);
+        robust.spread[s] = std::max(0.0, robustVariance - e.temporalVariance[s] / M);
+        robust.outlier[s] = 6 * std::sqrt(robustVariance);
+    }
+    return robust;
+}
+
+// The pattern: each mean's departure from its site's centre shrunk by the share of it that is pattern, not
+// the temporal noise the mean of M frames still holds.
+void shrunkPattern(const Mat& mean, const Mat& variance, const Mat& noisy, int M, const RobustSites& robust,
+                   DarkFrameStatistics& e)
+{
+    e.pattern.create(mean.rows, mean.cols, CV_32FC1);
+    for (int r = 0; r < mean.rows; ++r) {
         const double* m = mean.ptr<double>(r);
         const double* v = variance.ptr<double>(r);
         const uchar* flagged = noisy.ptr<uchar>(r);
         float* out = e.pattern.ptr<float>(r);
-        for (int c = 0; c < cols; ++c) {
+        for (int c = 0; c < mean.cols; ++c) {
             const int s = cfaSite(r, c);
-            const double departure = m[c] - centre[s];
-            if (std::abs(departure) > outlier[s] && outlier[s] > 0) {
+            const double departure = m[c] - robust.centre[s];
+            if (std::abs(departure) > robust.outlier[s] && robust.outlier[s] > 0) {
                 out[c] = static_cast<float>(m[c]);
                 continue;
             }
@@ -219,10 +222,37 @@ DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double fals
             // sqrt(w), not w: the departures then scatter by s_F^2, the pattern's own variance, which is what
             // an augmentation adds (w, the best linear estimate, scatters by w s_F^2: less pattern than the
             // sensor).
-            const double w = robustSpread[s] > 0 ? robustSpread[s] / (robustSpread[s] + frozen) : 0.0;
-            out[c] = static_cast<float>(centre[s] + std::sqrt(w) * departure);
+            const double w = robust.spread[s] > 0 ? robust.spread[s] / (robust.spread[s] + frozen) : 0.0;
+            out[c] = static_cast<float>(robust.centre[s] + std::sqrt(w) * departure);
         }
     }
+}
+
+} // namespace
+
+DarkFrameStatistics estimateDarkFrames(const BurstStatistics& stats, double falseAlarm)
+{
+    const int M = stats.frames();
+    if (M < 2)
+        CV_Error(Error::StsBadArg,
+                 format("estimateDarkFrames: %d frame(s); temporal noise needs at least two", M));
+    if (!(falseAlarm > 0 && falseAlarm < 0.5))
+        CV_Error(Error::StsOutOfRange,
+                 format("estimateDarkFrames: falseAlarm %g must lie in (0, 0.5)", falseAlarm));
+    Mat mean, variance;
+    stats.mean(mean);
+    stats.variance(variance);
+    if (mean.rows * mean.cols < 16)
+        CV_Error(Error::StsBadArg, format("estimateDarkFrames: %dx%d frames are too small to tell a pattern "
+                                          "from noise (at least 16 pixels)",
+                                          mean.cols, mean.rows));
+    DarkFrameStatistics e;
+    e.frames = M;
+    const Mat noisy = flagNoisyPixels(variance, M, falseAlarm, e);
+    siteFigures(mean, variance, noisy, M, e);
+    const RobustSites robust = robustSites(mean, M, e);
+    mean.convertTo(e.mean, CV_32F);
+    shrunkPattern(mean, variance, noisy, M, robust, e);
     return e;
 }
 

@@ -104,18 +104,153 @@ GainPoints pointsOf(const Emva1288Results& r, double fraction, int which)
     return p;
 }
 
-} // namespace
-
-const NoiseLineFit& emva1288LineAtGain(const CalibrationReport& report, double gain)
+// One gain's line from its points: the weighted fit with its errors and its weighted R^2.
+NoiseLineFit lineFitOf(const GainPoints& p, const WeightedLine& line, double gain)
 {
-    for (const NoiseLineFit& l : report.perGain)
-        if (l.gain == gain)
-            return l;
-    CV_Error(Error::StsBadArg, cv::format("emva1288LineAtGain: the report has no line at gain %g", gain));
+    NoiseLineFit fit;
+    fit.gain = gain;
+    fit.line.a = line.a;
+    fit.line.b = line.b;
+    fit.inliers = fit.samples = line.points;
+    fit.slopeStdError = std::sqrt(line.covariance(0, 0));
+    fit.offsetStdError = std::sqrt(line.covariance(1, 1));
+    fit.slopeOffsetCorrelation = line.covariance(0, 1) / (fit.slopeStdError * fit.offsetStdError);
+    // R^2 of the weighted fit, against the weighted mean.
+    double sw = 0, swy = 0;
+    for (size_t i = 0; i < p.signal.size(); ++i) {
+        sw += 1 / (p.stdError[i] * p.stdError[i]);
+        swy += p.variance[i] / (p.stdError[i] * p.stdError[i]);
+    }
+    double ssTot = 0, ssRes = 0;
+    for (size_t i = 0; i < p.signal.size(); ++i) {
+        const double w = 1 / (p.stdError[i] * p.stdError[i]);
+        ssTot += w * (p.variance[i] - swy / sw) * (p.variance[i] - swy / sw);
+        const double e = p.variance[i] - (line.a * p.signal[i] + line.b);
+        ssRes += w * e * e;
+    }
+    fit.rSquared = ssTot > 0 ? 1 - ssRes / ssTot : 1;
+    return fit;
 }
 
-CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurements,
-                                    const std::vector<double>& gains, const Emva1288CalibrationParams& params)
+// The lines' slopes and offsets with their errors, by increasing gain.
+struct GainLines
+{
+    std::vector<double> g, a, aSe, b, bSe;
+};
+
+// sigma_d^2, sigma_r^2 and their covariance.
+struct ReadNoiseFit
+{
+    double sigmaD2 = 0, sigmaR2 = 0;
+    Matx22d covariance;
+};
+
+// alpha and its variance: a_g = g alpha through the origin, weighted, the variance scaled by a reduced
+// chi-square above 1.
+std::pair<double, double> fitAlpha(const GainLines& l)
+{
+    double swgg = 0, swga = 0;
+    for (size_t i = 0; i < l.g.size(); ++i) {
+        const double w = 1 / (l.aSe[i] * l.aSe[i]);
+        swgg += w * l.g[i] * l.g[i];
+        swga += w * l.g[i] * l.a[i];
+    }
+    const double alpha = swga / swgg;
+    double alphaVar = 1 / swgg;
+    if (l.g.size() > 1) {
+        double chi2 = 0;
+        for (size_t i = 0; i < l.g.size(); ++i)
+            chi2 += std::pow((l.a[i] - alpha * l.g[i]) / l.aSe[i], 2);
+        alphaVar *= std::max(1.0, chi2 / double(l.g.size() - 1));
+    }
+    return {alpha, alphaVar};
+}
+
+/* b_g = g^2 sigma_d^2 + sigma_r^2, weighted (two gains: exact, with the covariance of the two offsets
+ * propagated); a negative variance is held at 0 and the other refitted. Sets report.rSquaredOffset and a
+ * note when a variance was held. */
+ReadNoiseFit fitSeparableReadNoise(const GainLines& l, CalibrationReport& report)
+{
+    const std::vector<double>&g = l.g, &b = l.b, &bSe = l.bSe;
+    ReadNoiseFit r;
+    std::vector<double> g2(g.size());
+    for (size_t i = 0; i < g.size(); ++i)
+        g2[i] = g[i] * g[i];
+    if (g.size() == 2) {
+        const double d = g2[1] - g2[0];
+        r.sigmaD2 = (b[1] - b[0]) / d;
+        r.sigmaR2 = (g2[1] * b[0] - g2[0] * b[1]) / d;
+        const double v0 = bSe[0] * bSe[0], v1 = bSe[1] * bSe[1];
+        r.covariance = Matx22d((v0 + v1) / (d * d), -(g2[1] * v0 + g2[0] * v1) / (d * d),
+                               -(g2[1] * v0 + g2[0] * v1) / (d * d),
+                               (g2[1] * g2[1] * v0 + g2[0] * g2[0] * v1) / (d * d));
+    } else {
+        const WeightedLine read = weightedLine(g2, b, bSe);
+        r.sigmaD2 = read.a;
+        r.sigmaR2 = read.b;
+        r.covariance = read.covariance;
+    }
+    if (r.sigmaR2 < 0 || r.sigmaD2 < 0) {
+        report.notes.push_back(
+            cv::format("sigma_d^2 %g and sigma_r^2 %g: the negative one is held at 0 and the "
+                       "other refitted alone",
+                       r.sigmaD2, r.sigmaR2));
+        double s0 = 0, s1 = 0;
+        for (size_t i = 0; i < g.size(); ++i) {
+            const double w = 1 / (bSe[i] * bSe[i]);
+            if (r.sigmaR2 < 0) { // b = g^2 sigma_d^2
+                s0 += w * g2[i] * g2[i];
+                s1 += w * g2[i] * b[i];
+            } else { // b = sigma_r^2
+                s0 += w;
+                s1 += w * b[i];
+            }
+        }
+        if (r.sigmaR2 < 0) {
+            r.sigmaD2 = std::max(s1 / s0, 0.0);
+            r.sigmaR2 = 0;
+            r.covariance = Matx22d(1 / s0, 0, 0, 0);
+        } else {
+            r.sigmaR2 = std::max(s1 / s0, 0.0);
+            r.sigmaD2 = 0;
+            r.covariance = Matx22d(0, 0, 0, 1 / s0);
+        }
+    }
+    double ssTot = 0, ssRes = 0, mean = 0;
+    for (double v : b)
+        mean += v / double(b.size());
+    for (size_t i = 0; i < g.size(); ++i) {
+        ssTot += (b[i] - mean) * (b[i] - mean);
+        ssRes += std::pow(b[i] - detail::noiseTermsAt(g[i], 0.0, r.sigmaD2, r.sigmaR2).read(), 2);
+    }
+    report.rSquaredOffset = ssTot > 0 ? 1 - ssRes / ssTot : 1;
+    return r;
+}
+
+// One gain (or gains too close to tell the two variances apart): the read noise at that gain, after it.
+ReadNoiseFit fitReadNoiseAtItsGains(const GainLines& l, double minGainRatio, CalibrationReport& report)
+{
+    ReadNoiseFit r;
+    double sw = 0, swb = 0;
+    for (size_t i = 0; i < l.g.size(); ++i) {
+        sw += 1 / (l.bSe[i] * l.bSe[i]);
+        swb += l.b[i] / (l.bSe[i] * l.bSe[i]);
+    }
+    r.sigmaR2 = std::max(swb / sw, 0.0);
+    r.covariance = Matx22d(0, 0, 0, 1 / sw);
+    report.rSquaredOffset = 1;
+    report.notes.push_back(
+        l.g.size() == 1 ? cv::format("one gain: the read noise %.4f DN^2 is stated as sigma_r^2, which "
+                                     "holds at this gain",
+                                     r.sigmaR2)
+                        : cv::format("gains %g to %g, closer than the ratio %g: the read noise %.4f DN^2 "
+                                     "is stated as sigma_r^2, which holds at these gains",
+                                     l.g.front(), l.g.back(), minGainRatio, r.sigmaR2));
+    return r;
+}
+
+void checkCalibrationArguments(const std::vector<Emva1288Results>& measurements,
+                               const std::vector<double>& gains, const Emva1288CalibrationParams& params)
 {
     if (measurements.empty() || measurements.size() != gains.size())
         CV_Error(Error::StsBadArg,
@@ -132,7 +267,22 @@ CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurem
                             params.minGainRatio));
     for (double g : gains)
         detail::checkFinitePositive(g, "calibrateEmva1288: every gain");
+}
 
+} // namespace
+
+const NoiseLineFit& emva1288LineAtGain(const CalibrationReport& report, double gain)
+{
+    for (const NoiseLineFit& l : report.perGain)
+        if (l.gain == gain)
+            return l;
+    CV_Error(Error::StsBadArg, cv::format("emva1288LineAtGain: the report has no line at gain %g", gain));
+}
+
+CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurements,
+                                    const std::vector<double>& gains, const Emva1288CalibrationParams& params)
+{
+    checkCalibrationArguments(measurements, gains, params);
     std::vector<int> order(gains.size());
     for (size_t i = 0; i < order.size(); ++i)
         order[i] = int(i);
@@ -140,32 +290,11 @@ CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurem
 
     CalibrationReport report;
     report.method = NOISE_FIT_TWO_STAGE;
-    std::vector<double> g, a, aSe, b, bSe;
+    GainLines lines;
     for (int k : order) {
         const GainPoints p = pointsOf(measurements[k], params.maxSignalFraction, k);
         const WeightedLine line = weightedLine(p.signal, p.variance, p.stdError);
-        NoiseLineFit fit;
-        fit.gain = gains[k];
-        fit.line.a = line.a;
-        fit.line.b = line.b;
-        fit.inliers = fit.samples = line.points;
-        fit.slopeStdError = std::sqrt(line.covariance(0, 0));
-        fit.offsetStdError = std::sqrt(line.covariance(1, 1));
-        fit.slopeOffsetCorrelation = line.covariance(0, 1) / (fit.slopeStdError * fit.offsetStdError);
-        // R^2 of the weighted fit, against the weighted mean.
-        double sw = 0, swy = 0;
-        for (size_t i = 0; i < p.signal.size(); ++i) {
-            sw += 1 / (p.stdError[i] * p.stdError[i]);
-            swy += p.variance[i] / (p.stdError[i] * p.stdError[i]);
-        }
-        double ssTot = 0, ssRes = 0;
-        for (size_t i = 0; i < p.signal.size(); ++i) {
-            const double w = 1 / (p.stdError[i] * p.stdError[i]);
-            ssTot += w * (p.variance[i] - swy / sw) * (p.variance[i] - swy / sw);
-            const double e = p.variance[i] - (line.a * p.signal[i] + line.b);
-            ssRes += w * e * e;
-        }
-        fit.rSquared = ssTot > 0 ? 1 - ssRes / ssTot : 1;
+        const NoiseLineFit fit = lineFitOf(p, line, gains[k]);
         report.perGain.push_back(fit);
         report.samples += line.points;
         report.samplesUsed += line.points;
@@ -175,115 +304,26 @@ CalibrationReport calibrateEmva1288(const std::vector<Emva1288Results>& measurem
             "points, reduced chi-square %.2f%s",
             gains[k], p.maxSignal, 100 * params.maxSignalFraction, line.points, line.reducedChiSquare,
             line.reducedChiSquare > 1 ? " (errors scaled by its square root)" : ""));
-        g.push_back(gains[k]);
-        a.push_back(line.a);
-        aSe.push_back(fit.slopeStdError);
-        b.push_back(line.b);
-        bSe.push_back(fit.offsetStdError);
+        lines.g.push_back(gains[k]);
+        lines.a.push_back(line.a);
+        lines.aSe.push_back(fit.slopeStdError);
+        lines.b.push_back(line.b);
+        lines.bSe.push_back(fit.offsetStdError);
     }
-
-    // alpha: a_g = g alpha through the origin, weighted.
-    double swgg = 0, swga = 0;
-    for (size_t i = 0; i < g.size(); ++i) {
-        const double w = 1 / (aSe[i] * aSe[i]);
-        swgg += w * g[i] * g[i];
-        swga += w * g[i] * a[i];
-    }
-    const double alpha = swga / swgg;
-    double alphaVar = 1 / swgg;
-    if (g.size() > 1) {
-        double chi2 = 0;
-        for (size_t i = 0; i < g.size(); ++i)
-            chi2 += std::pow((a[i] - alpha * g[i]) / aSe[i], 2);
-        alphaVar *= std::max(1.0, chi2 / double(g.size() - 1));
-    }
+    const std::pair<double, double> alpha = fitAlpha(lines);
     report.rSquaredSlope = 1;
-    report.separable = g.back() / g.front() >= params.minGainRatio;
-    double sigmaD2 = 0, sigmaR2 = 0;
-    Matx22d readCov;
-    if (report.separable) {
-        // b_g = g^2 sigma_d^2 + sigma_r^2, weighted; a negative variance is held at 0 and the other refitted.
-        std::vector<double> g2(g.size());
-        for (size_t i = 0; i < g.size(); ++i)
-            g2[i] = g[i] * g[i];
-        if (g.size() == 2) {
-            // Two gains: exact, with the covariance of the two offsets propagated.
-            const double d = g2[1] - g2[0];
-            sigmaD2 = (b[1] - b[0]) / d;
-            sigmaR2 = (g2[1] * b[0] - g2[0] * b[1]) / d;
-            const double v0 = bSe[0] * bSe[0], v1 = bSe[1] * bSe[1];
-            readCov = Matx22d((v0 + v1) / (d * d), -(g2[1] * v0 + g2[0] * v1) / (d * d),
-                              -(g2[1] * v0 + g2[0] * v1) / (d * d),
-                              (g2[1] * g2[1] * v0 + g2[0] * g2[0] * v1) / (d * d));
-        } else {
-            const WeightedLine read = weightedLine(g2, b, bSe);
-            sigmaD2 = read.a;
-            sigmaR2 = read.b;
-            readCov = read.covariance;
-        }
-        if (sigmaR2 < 0 || sigmaD2 < 0) {
-            report.notes.push_back(
-                cv::format("sigma_d^2 %g and sigma_r^2 %g: the negative one is held at 0 and the "
-                           "other refitted alone",
-                           sigmaD2, sigmaR2));
-            double s0 = 0, s1 = 0;
-            for (size_t i = 0; i < g.size(); ++i) {
-                const double w = 1 / (bSe[i] * bSe[i]);
-                if (sigmaR2 < 0) { // b = g^2 sigma_d^2
-                    s0 += w * g2[i] * g2[i];
-                    s1 += w * g2[i] * b[i];
-                } else { // b = sigma_r^2
-                    s0 += w;
-                    s1 += w * b[i];
-                }
-            }
-            if (sigmaR2 < 0) {
-                sigmaD2 = std::max(s1 / s0, 0.0);
-                sigmaR2 = 0;
-                readCov = Matx22d(1 / s0, 0, 0, 0);
-            } else {
-                sigmaR2 = std::max(s1 / s0, 0.0);
-                sigmaD2 = 0;
-                readCov = Matx22d(0, 0, 0, 1 / s0);
-            }
-        }
-        double ssTot = 0, ssRes = 0, mean = 0;
-        for (double v : b)
-            mean += v / double(b.size());
-        for (size_t i = 0; i < g.size(); ++i) {
-            ssTot += (b[i] - mean) * (b[i] - mean);
-            ssRes += std::pow(b[i] - detail::noiseTermsAt(g[i], 0.0, sigmaD2, sigmaR2).read(), 2);
-        }
-        report.rSquaredOffset = ssTot > 0 ? 1 - ssRes / ssTot : 1;
-    } else {
-        // One gain (or gains too close to tell the two variances apart): the read noise at that gain, after
-        // it.
-        double sw = 0, swb = 0;
-        for (size_t i = 0; i < g.size(); ++i) {
-            sw += 1 / (bSe[i] * bSe[i]);
-            swb += b[i] / (bSe[i] * bSe[i]);
-        }
-        sigmaR2 = std::max(swb / sw, 0.0);
-        readCov = Matx22d(0, 0, 0, 1 / sw);
-        report.rSquaredOffset = 1;
-        report.notes.push_back(
-            g.size() == 1
-                ? cv::format("one gain: the read noise %.4f DN^2 is stated as sigma_r^2, which holds at "
-                             "this gain",
-                             sigmaR2)
-                : cv::format("gains %g to %g, closer than the ratio %g: the read noise %.4f DN^2 is "
-                             "stated as sigma_r^2, which holds at these gains",
-                             g.front(), g.back(), params.minGainRatio, sigmaR2));
-    }
-    report.model = NoiseModel(alpha, sigmaD2, sigmaR2);
+    report.separable = lines.g.back() / lines.g.front() >= params.minGainRatio;
+    const ReadNoiseFit read = report.separable ? fitSeparableReadNoise(lines, report)
+                                               : fitReadNoiseAtItsGains(lines, params.minGainRatio, report);
+    report.model = NoiseModel(alpha.first, read.sigmaD2, read.sigmaR2);
     ModelUncertainty& u = report.uncertainty;
     u.source = UNCERTAINTY_COVARIANCE;
     u.covariance = Matx33d::zeros();
-    u.covariance(NOISE_PARAM_ALPHA, NOISE_PARAM_ALPHA) = alphaVar;
-    u.covariance(NOISE_PARAM_SIGMA_D2, NOISE_PARAM_SIGMA_D2) = readCov(0, 0);
-    u.covariance(NOISE_PARAM_SIGMA_D2, NOISE_PARAM_SIGMA_R2) = readCov(0, 1);
-    u.covariance(NOISE_PARAM_SIGMA_R2, NOISE_PARAM_SIGMA_D2) = readCov(1, 0);
-    u.covariance(NOISE_PARAM_SIGMA_R2, NOISE_PARAM_SIGMA_R2) = readCov(1, 1);
+    u.covariance(NOISE_PARAM_ALPHA, NOISE_PARAM_ALPHA) = alpha.second;
+    u.covariance(NOISE_PARAM_SIGMA_D2, NOISE_PARAM_SIGMA_D2) = read.covariance(0, 0);
+    u.covariance(NOISE_PARAM_SIGMA_D2, NOISE_PARAM_SIGMA_R2) = read.covariance(0, 1);
+    u.covariance(NOISE_PARAM_SIGMA_R2, NOISE_PARAM_SIGMA_D2) = read.covariance(1, 0);
+    u.covariance(NOISE_PARAM_SIGMA_R2, NOISE_PARAM_SIGMA_R2) = read.covariance(1, 1);
     for (int i = 0; i < 3; ++i)
         u.stdError[i] = u.fitStdError[i] = std::sqrt(std::max(u.covariance(i, i), 0.0));
     return report;

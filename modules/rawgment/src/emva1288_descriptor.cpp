@@ -78,23 +78,12 @@ String resolvedImagePath(const String& folder, std::string name)
 
 } // namespace
 
-Emva1288Series readEmva1288(const String& path)
+namespace {
+
+//! The text with its line ends CRLF, LF or a lone CR (classic Mac OS) as LF: with CR alone, every line was
+//! "line 1".
+std::string withUnixLineEnds(const std::string& text)
 {
-    const std::string text = readFileBounded(path, kMaxDescriptorBytes, "EMVA 1288 descriptor");
-    if (text.find('\0') != std::string::npos)
-        CV_Error(Error::StsParseError,
-                 "EMVA 1288 descriptor '" + path + "' is not a descriptor: it holds binary data");
-    Emva1288Series series;
-    series.path = path;
-    const String folder = detail::folderOf(path);
-    std::vector<Emva1288Images> groups;
-    Emva1288Images* open = nullptr;
-    bool sawFormat = false;
-    long long imageCount = 0;
-    // Each image by its file's identity: one image listed twice (in a pair, a stack or two steps) made a
-    // temporal variance of 0 between them, and every figure carried it.
-    std::map<detail::FileIdentity, std::pair<int, String>> imageLines;
-    // Line ends CRLF, LF or a lone CR (classic Mac OS): with CR alone, every line was "line 1".
     std::string unified;
     unified.reserve(text.size());
     for (size_t k = 0; k < text.size(); ++k)
@@ -102,126 +91,177 @@ Emva1288Series readEmva1288(const String& path)
             unified += text[k];
         else if (k + 1 == text.size() || text[k + 1] != '\n')
             unified += '\n';
-    std::istringstream lines(unified);
-    int lineNumber = 0;
-    int versionLine = 0;
-    for (std::string raw; std::getline(lines, raw);) {
-        ++lineNumber;
-        if (!raw.empty() && raw.back() == '\r')
-            raw.pop_back();
+    return unified;
+}
+
+//! A descriptor read line by line: each command's line checked where it stands, naming it.
+class DescriptorReader
+{
+public:
+    DescriptorReader(const String& path, Emva1288Series& series)
+        : path_(path), folder_(detail::folderOf(path)), series_(series)
+    {
+    }
+
+    void line(const std::string& raw, int lineNumber)
+    {
         const std::vector<std::string> words = wordsOf(raw);
         if (words.empty() || words[0][0] == '#')
-            continue;
+            return;
         const std::string& command = words[0];
         if (command == "i") {
-            if (!open)
-                badLine(path, lineNumber, "an image ('i') before any 'b' or 'd' line");
-            if (words.size() < 2)
-                badLine(path, lineNumber, "expected 'i <image path>'");
-            // A path may hold spaces: the rest of the line after the command is the path.
-            const size_t start = raw.find_first_not_of(" \t", raw.find('i') + 1);
-            std::string name = raw.substr(start);
-            name.erase(name.find_last_not_of(" \t") + 1);
-            if (++imageCount > MAX_EMVA1288_IMAGES)
-                badLine(path, lineNumber,
-                        cv::format("more than %d images; a descriptor may list at most that many",
-                                   MAX_EMVA1288_IMAGES));
-            const String image = resolvedImagePath(folder, name);
-            if (!pathExists(image))
-                badLine(path, lineNumber, "image '" + image + "' does not exist");
-            detail::checkRegularFile(image, "EMVA 1288 image (descriptor '" + path +
-                                                cv::format("', line %d)", lineNumber));
-            detail::FileIdentity id;
-            if (detail::fileIdentityOf(image, id)) {
-                const auto first = imageLines.emplace(id, std::make_pair(lineNumber, image));
-                if (!first.second)
-                    badLine(path, lineNumber,
-                            cv::format("image '%s' is the file of line %d ('%s'); every image of a series is "
-                                       "a capture of its own",
-                                       image.c_str(), first.first->second.first,
-                                       first.first->second.second.c_str()));
-            }
-            open->images.push_back(image);
-            continue;
+            imageLine(raw, words, lineNumber);
+            return;
         }
-        if (open && open->images.size() < 2)
-            badLine(path, open->line,
-                    cv::format("the exposure has %d image(s); every step needs at least two",
-                               int(open->images.size())));
-        open = nullptr;
-        if (command == "v") {
-            if (words.size() != 2)
-                badLine(path, lineNumber, "expected 'v <release>'");
-            if (versionLine > 0)
-                badLine(path, lineNumber,
-                        cv::format("a second 'v' line (the first is line %d): which release holds is a guess",
-                                   versionLine));
-            versionLine = lineNumber;
-            series.version = words[1];
-        } else if (command == "n") {
-            if (words.size() != 4)
-                badLine(path, lineNumber, "expected 'n <bits> <width> <height>'");
-            if (sawFormat)
-                badLine(path, lineNumber, "a second 'n' line; a descriptor has one");
-            const long long bits = integerOf(path, lineNumber, words[1], "bits");
-            const long long width = integerOf(path, lineNumber, words[2], "width");
-            const long long height = integerOf(path, lineNumber, words[3], "height");
-            if (bits < 1 || bits > MAX_EMVA1288_BITS)
-                badLine(path, lineNumber,
-                        cv::format("bits %lld is outside [1, %d]", bits, MAX_EMVA1288_BITS));
-            if (width < 1 || height < 1)
-                badLine(path, lineNumber, cv::format("the size %lld x %lld is empty", width, height));
-            if (width > MAX_EMVA1288_PIXELS || height > MAX_EMVA1288_PIXELS ||
-                width * height > MAX_EMVA1288_PIXELS)
-                badLine(path, lineNumber,
-                        cv::format("%lld x %lld pixels is more than the %lld pixels an image may have", width,
-                                   height, MAX_EMVA1288_PIXELS));
-            series.bits = int(bits);
-            series.width = int(width);
-            series.height = int(height);
-            sawFormat = true;
-        } else if (command == "b" || command == "d") {
-            const bool dark = command == "d";
-            if (!sawFormat)
-                badLine(path, lineNumber, "an exposure before the 'n <bits> <width> <height>' line");
-            if (words.size() != (dark ? 2u : 3u))
-                badLine(path, lineNumber,
-                        dark ? "expected 'd <exposure>'" : "expected 'b <exposure> <photons>'");
-            Emva1288Images group;
-            group.dark = dark;
-            group.line = lineNumber;
-            group.exposureNs = realOf(path, lineNumber, words[1], "exposure");
-            group.photons = dark ? 0.0 : realOf(path, lineNumber, words[2], "photons");
-            if (group.exposureNs < 0)
-                badLine(path, lineNumber, cv::format("exposure %g is negative", group.exposureNs));
-            if (group.photons < 0)
-                badLine(path, lineNumber, cv::format("photons %g is negative", group.photons));
-            if (group.exposureNs > MAX_EMVA1288_EXPOSURE)
-                badLine(path, lineNumber,
-                        cv::format("exposure %g is beyond the %g a descriptor may state", group.exposureNs,
-                                   MAX_EMVA1288_EXPOSURE));
-            if (group.photons > MAX_EMVA1288_PHOTONS)
-                badLine(path, lineNumber,
-                        cv::format("photons %g is beyond the %g a descriptor may state", group.photons,
-                                   MAX_EMVA1288_PHOTONS));
-            groups.push_back(group);
-            open = &groups.back();
-        } else {
-            badLine(path, lineNumber,
+        closeExposure();
+        if (command == "v")
+            versionLine(words, lineNumber);
+        else if (command == "n")
+            formatLine(words, lineNumber);
+        else if (command == "b" || command == "d")
+            exposureLine(words, lineNumber);
+        else
+            badLine(path_, lineNumber,
                     "unknown command '" + command +
                         "' (a descriptor has 'v', 'n', 'b', 'd', 'i' and '#' comment lines): is it an EMVA "
                         "1288 descriptor?");
-        }
     }
-    if (open && open->images.size() < 2)
-        badLine(path, open->line,
-                cv::format("the exposure has %d image(s); every step needs at least two",
-                           int(open->images.size())));
-    if (!sawFormat)
-        CV_Error(Error::StsParseError,
-                 "EMVA 1288 descriptor '" + path +
-                     "' is not a descriptor: it has no 'n <bits> <width> <height>' line");
-    // Temporal and spatial as the reference classifies them; a (kind, exposure, photons) once.
+
+    //! After the last line: the exposures, each with its images.
+    std::vector<Emva1288Images> exposures()
+    {
+        closeExposure();
+        if (!sawFormat_)
+            CV_Error(Error::StsParseError,
+                     "EMVA 1288 descriptor '" + path_ +
+                         "' is not a descriptor: it has no 'n <bits> <width> <height>' line");
+        return groups_;
+    }
+
+private:
+    void closeExposure()
+    {
+        if (open_ && open_->images.size() < 2)
+            badLine(path_, open_->line,
+                    cv::format("the exposure has %d image(s); every step needs at least two",
+                               int(open_->images.size())));
+        open_ = nullptr;
+    }
+
+    void imageLine(const std::string& raw, const std::vector<std::string>& words, int lineNumber)
+    {
+        if (!open_)
+            badLine(path_, lineNumber, "an image ('i') before any 'b' or 'd' line");
+        if (words.size() < 2)
+            badLine(path_, lineNumber, "expected 'i <image path>'");
+        // A path may hold spaces: the rest of the line after the command is the path.
+        const size_t start = raw.find_first_not_of(" \t", raw.find('i') + 1);
+        std::string name = raw.substr(start);
+        name.erase(name.find_last_not_of(" \t") + 1);
+        if (++imageCount_ > MAX_EMVA1288_IMAGES)
+            badLine(path_, lineNumber,
+                    cv::format("more than %d images; a descriptor may list at most that many",
+                               MAX_EMVA1288_IMAGES));
+        const String image = resolvedImagePath(folder_, name);
+        if (!pathExists(image))
+            badLine(path_, lineNumber, "image '" + image + "' does not exist");
+        detail::checkRegularFile(image, "EMVA 1288 image (descriptor '" + path_ +
+                                            cv::format("', line %d)", lineNumber));
+        // Each image by its file's identity: one image listed twice (in a pair, a stack or two steps) made a
+        // temporal variance of 0 between them, and every figure carried it.
+        detail::FileIdentity id;
+        if (detail::fileIdentityOf(image, id)) {
+            const auto first = imageLines_.emplace(id, std::make_pair(lineNumber, image));
+            if (!first.second)
+                badLine(path_, lineNumber,
+                        cv::format("image '%s' is the file of line %d ('%s'); every image of a series is "
+                                   "a capture of its own",
+                                   image.c_str(), first.first->second.first,
+                                   first.first->second.second.c_str()));
+        }
+        open_->images.push_back(image);
+    }
+
+    void versionLine(const std::vector<std::string>& words, int lineNumber)
+    {
+        if (words.size() != 2)
+            badLine(path_, lineNumber, "expected 'v <release>'");
+        if (versionLine_ > 0)
+            badLine(path_, lineNumber,
+                    cv::format("a second 'v' line (the first is line %d): which release holds is a guess",
+                               versionLine_));
+        versionLine_ = lineNumber;
+        series_.version = words[1];
+    }
+
+    void formatLine(const std::vector<std::string>& words, int lineNumber)
+    {
+        if (words.size() != 4)
+            badLine(path_, lineNumber, "expected 'n <bits> <width> <height>'");
+        if (sawFormat_)
+            badLine(path_, lineNumber, "a second 'n' line; a descriptor has one");
+        const long long bits = integerOf(path_, lineNumber, words[1], "bits");
+        const long long width = integerOf(path_, lineNumber, words[2], "width");
+        const long long height = integerOf(path_, lineNumber, words[3], "height");
+        if (bits < 1 || bits > MAX_EMVA1288_BITS)
+            badLine(path_, lineNumber, cv::format("bits %lld is outside [1, %d]", bits, MAX_EMVA1288_BITS));
+        if (width < 1 || height < 1)
+            badLine(path_, lineNumber, cv::format("the size %lld x %lld is empty", width, height));
+        if (width > MAX_EMVA1288_PIXELS || height > MAX_EMVA1288_PIXELS ||
+            width * height > MAX_EMVA1288_PIXELS)
+            badLine(path_, lineNumber,
+                    cv::format("%lld x %lld pixels is more than the %lld pixels an image may have", width,
+                               height, MAX_EMVA1288_PIXELS));
+        series_.bits = int(bits);
+        series_.width = int(width);
+        series_.height = int(height);
+        sawFormat_ = true;
+    }
+
+    void exposureLine(const std::vector<std::string>& words, int lineNumber)
+    {
+        const bool dark = words[0] == "d";
+        if (!sawFormat_)
+            badLine(path_, lineNumber, "an exposure before the 'n <bits> <width> <height>' line");
+        if (words.size() != (dark ? 2u : 3u))
+            badLine(path_, lineNumber,
+                    dark ? "expected 'd <exposure>'" : "expected 'b <exposure> <photons>'");
+        Emva1288Images group;
+        group.dark = dark;
+        group.line = lineNumber;
+        group.exposureNs = realOf(path_, lineNumber, words[1], "exposure");
+        group.photons = dark ? 0.0 : realOf(path_, lineNumber, words[2], "photons");
+        if (group.exposureNs < 0)
+            badLine(path_, lineNumber, cv::format("exposure %g is negative", group.exposureNs));
+        if (group.photons < 0)
+            badLine(path_, lineNumber, cv::format("photons %g is negative", group.photons));
+        if (group.exposureNs > MAX_EMVA1288_EXPOSURE)
+            badLine(path_, lineNumber,
+                    cv::format("exposure %g is beyond the %g a descriptor may state", group.exposureNs,
+                               MAX_EMVA1288_EXPOSURE));
+        if (group.photons > MAX_EMVA1288_PHOTONS)
+            badLine(path_, lineNumber,
+                    cv::format("photons %g is beyond the %g a descriptor may state", group.photons,
+                               MAX_EMVA1288_PHOTONS));
+        groups_.push_back(group);
+        open_ = &groups_.back();
+    }
+
+    String path_, folder_;
+    Emva1288Series& series_;
+    std::vector<Emva1288Images> groups_;
+    Emva1288Images* open_ = nullptr;
+    bool sawFormat_ = false;
+    long long imageCount_ = 0;
+    int versionLine_ = 0;
+    std::map<detail::FileIdentity, std::pair<int, String>> imageLines_;
+};
+
+/* The exposures sorted into temporal (pairs) and spatial (stacks) as the reference classifies them; a (kind,
+ * exposure, photons) once, every temporal exposure with a dark and a bright pair, the spatial set one bright
+ * and one dark stack. */
+void classifyExposures(const String& path, const std::vector<Emva1288Images>& groups, Emva1288Series& series)
+{
     std::map<std::tuple<bool, double, double>, int> seen[2];
     for (const Emva1288Images& g : groups) {
         const bool temporal = g.images.size() == 2;
@@ -253,6 +293,24 @@ Emva1288Series readEmva1288(const String& path)
                 "the spatial set (exposures of more than two images) must be one bright and one dark stack "
                 "at one exposure time");
     }
+}
+
+} // namespace
+
+Emva1288Series readEmva1288(const String& path)
+{
+    const std::string text = readFileBounded(path, kMaxDescriptorBytes, "EMVA 1288 descriptor");
+    if (text.find('\0') != std::string::npos)
+        CV_Error(Error::StsParseError,
+                 "EMVA 1288 descriptor '" + path + "' is not a descriptor: it holds binary data");
+    Emva1288Series series;
+    series.path = path;
+    DescriptorReader reader(path, series);
+    std::istringstream lines(withUnixLineEnds(text));
+    int lineNumber = 0;
+    for (std::string raw; std::getline(lines, raw);)
+        reader.line(raw, ++lineNumber);
+    classifyExposures(path, reader.exposures(), series);
     return series;
 }
 

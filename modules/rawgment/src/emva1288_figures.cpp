@@ -251,11 +251,16 @@ Emva1288Results::Emva1288Results()
 {
 }
 
-Emva1288Results emva1288Results(const std::vector<Emva1288Pair>& pairs,
-                                const std::vector<Emva1288Stack>& stacks)
+namespace {
+
+typedef std::map<double, const Emva1288Pair*> DarkPairs;
+
+// The bright steps in the order of their light, each with the dark pair of its exposure, into r; the dark
+// pairs by exposure.
+DarkPairs takeTemporalSteps(const std::vector<Emva1288Pair>& pairs, Emva1288Results& r)
 {
     std::vector<const Emva1288Pair*> bright;
-    std::map<double, const Emva1288Pair*> darkByExposure;
+    DarkPairs darkByExposure;
     for (const Emva1288Pair& p : pairs) {
         if (!(std::isfinite(p.mean) && std::isfinite(p.variance) && std::isfinite(p.varianceStdError) &&
               std::isfinite(p.exposureNs) && std::isfinite(p.photons)))
@@ -275,9 +280,6 @@ Emva1288Results emva1288Results(const std::vector<Emva1288Pair>& pairs,
     std::stable_sort(bright.begin(), bright.end(), [](const Emva1288Pair* a, const Emva1288Pair* b) {
         return a->exposureNs != b->exposureNs ? a->exposureNs < b->exposureNs : a->photons < b->photons;
     });
-    Emva1288Results r;
-    r.pairs = pairs;
-    r.stacks = stacks;
     for (const Emva1288Pair* g : bright) {
         const auto dark = darkByExposure.find(g->exposureNs);
         if (dark == darkByExposure.end())
@@ -294,36 +296,22 @@ Emva1288Results emva1288Results(const std::vector<Emva1288Pair>& pairs,
         r.darkVarianceStdError.push_back(dark->second->varianceStdError);
         r.photonsGiven = r.photonsGiven || g->photons > 0;
     }
-    const int n = int(r.mean.size());
-    std::vector<double> signal(n), excess(n);
-    for (int i = 0; i < n; ++i) {
-        signal[i] = r.mean[i] - r.darkMean[i];
-        excess[i] = r.variance[i] - r.darkVariance[i];
-    }
-    r.saturationIndex = saturationIndexOf(r.variance);
-    const double saturated = signal[r.saturationIndex];
-    const auto lastAtMost = [&](double limit) {
-        int last = -1;
-        for (int i = 0; i < n; ++i)
-            if (signal[i] <= limit)
-                last = i;
-        return last;
-    };
-    r.sensitivityMaxIndex = lastAtMost(0.7 * saturated);
-    if (!(saturated > 0) || r.sensitivityMaxIndex < 1)
-        CV_Error(Error::StsBadArg,
-                 cv::format(
-                     "emva1288Results: the signal at saturation is %g DN above dark and %d step(s) lie below "
-                     "70%% of it; K needs a signal that rises over at least two steps",
-                     saturated, r.sensitivityMaxIndex + 1));
-    r.K = slopeThroughOrigin(signal, excess, 0, r.sensitivityMaxIndex);
-    if (!(std::isfinite(r.K) && r.K > 0))
-        CV_Error(Error::StsBadArg,
-                 cv::format("emva1288Results: the fitted K is %g; the temporal variance does not "
-                            "rise with the signal up to 70%% of saturation",
-                            r.K));
+    return darkByExposure;
+}
 
-    // The dark noise: the intercept of the dark variance against exposure time (dark current adds the slope).
+// The index of the last step whose signal is at most `limit`; -1 when none is.
+int lastStepAtMost(const std::vector<double>& signal, double limit)
+{
+    int last = -1;
+    for (int i = 0; i < int(signal.size()); ++i)
+        if (signal[i] <= limit)
+            last = i;
+    return last;
+}
+
+// The dark noise: the intercept of the dark variance against exposure time (dark current adds the slope).
+void darkNoiseFigures(const DarkPairs& darkByExposure, Emva1288Results& r)
+{
     std::vector<double> times, darkVariances;
     for (const auto& d : darkByExposure) {
         times.push_back(d.first);
@@ -333,7 +321,12 @@ Emva1288Results emva1288Results(const std::vector<Emva1288Pair>& pairs,
     darkVariance = std::max(darkVariance, 0.24); // the standard's floor: quantisation noise resolves no less
     r.sigmaYDark = std::sqrt(darkVariance);
     r.sigmaD = std::sqrt(darkVariance - 1.0 / 12.0) / r.K;
+}
 
+// Responsivity, quantum efficiency, saturation capacity, SNR and dynamic range (photon counts given), or the
+// saturation capacity in electrons alone.
+void photonFigures(const std::vector<double>& signal, double saturated, Emva1288Results& r)
+{
     if (r.photonsGiven) {
         r.responsivity = slopeThroughOrigin(r.photons, signal, 0, r.sensitivityMaxIndex);
         if (!(std::isfinite(r.responsivity) && r.responsivity > 0))
@@ -351,51 +344,94 @@ Emva1288Results emva1288Results(const std::vector<Emva1288Pair>& pairs,
     }
     r.snrMax = std::sqrt(r.muESat);
     r.snrMaxDb = 20.0 * std::log10(r.snrMax);
+}
 
-    // Linearity: the weighted fit of the reference over 5%..95% of the saturation signal, against photons
-    // (exposure time when no photon count is given).
+// Linearity: the weighted fit of the reference over 5%..95% of the saturation signal, against photons
+// (exposure time when no photon count is given).
+void linearityFigures(const std::vector<double>& signal, double saturated, Emva1288Results& r)
+{
+    const int n = int(signal.size());
     const std::vector<double>& light = r.photonsGiven ? r.photons : r.exposureNs;
     for (int i = 0; i < n && r.linearityMinIndex < 0; ++i)
         if (signal[i] >= 0.05 * saturated)
             r.linearityMinIndex = i;
-    r.linearityMaxIndex = lastAtMost(0.95 * saturated);
-    if (r.linearityMinIndex >= 0 && r.linearityMaxIndex > r.linearityMinIndex) {
-        double xy = 0, xy2 = 0, x2y2 = 0, y1 = 0, y2 = 0;
-        for (int i = r.linearityMinIndex; i <= r.linearityMaxIndex; ++i) {
-            const double X = light[i], Y = signal[i];
-            xy += X / Y;
-            xy2 += X / (Y * Y);
-            x2y2 += (X / Y) * (X / Y);
-            y1 += 1.0 / Y;
-            y2 += 1.0 / (Y * Y);
-        }
-        // The determinant vanishes when every X/Y is equal (a response exactly through the origin): b is 0.
-        const double det = xy2 * xy2 - x2y2 * y2;
-        const double b = std::abs(det) > 1e-12 * x2y2 * y2 ? (xy * xy2 - x2y2 * y1) / det : 0.0;
-        const double a = (xy - b * xy2) / x2y2;
-        r.linearityFitSlope = a;
-        r.linearityFitOffset = b;
-        r.linearityDeviation.resize(n);
-        for (int i = 0; i < n; ++i)
-            r.linearityDeviation[i] = 100.0 * (signal[i] - (a * light[i] + b)) / (a * light[i] + b);
-        const auto range = std::minmax_element(r.linearityDeviation.begin() + r.linearityMinIndex,
-                                               r.linearityDeviation.begin() + r.linearityMaxIndex + 1);
-        r.linearityErrorMin = *range.first;
-        r.linearityErrorMax = *range.second;
+    r.linearityMaxIndex = lastStepAtMost(signal, 0.95 * saturated);
+    if (r.linearityMinIndex < 0 || r.linearityMaxIndex <= r.linearityMinIndex)
+        return;
+    double xy = 0, xy2 = 0, x2y2 = 0, y1 = 0, y2 = 0;
+    for (int i = r.linearityMinIndex; i <= r.linearityMaxIndex; ++i) {
+        const double X = light[i], Y = signal[i];
+        xy += X / Y;
+        xy2 += X / (Y * Y);
+        x2y2 += (X / Y) * (X / Y);
+        y1 += 1.0 / Y;
+        y2 += 1.0 / (Y * Y);
     }
+    // The determinant vanishes when every X/Y is equal (a response exactly through the origin): b is 0.
+    const double det = xy2 * xy2 - x2y2 * y2;
+    const double b = std::abs(det) > 1e-12 * x2y2 * y2 ? (xy * xy2 - x2y2 * y1) / det : 0.0;
+    const double a = (xy - b * xy2) / x2y2;
+    r.linearityFitSlope = a;
+    r.linearityFitOffset = b;
+    r.linearityDeviation.resize(n);
+    for (int i = 0; i < n; ++i)
+        r.linearityDeviation[i] = 100.0 * (signal[i] - (a * light[i] + b)) / (a * light[i] + b);
+    const auto range = std::minmax_element(r.linearityDeviation.begin() + r.linearityMinIndex,
+                                           r.linearityDeviation.begin() + r.linearityMaxIndex + 1);
+    r.linearityErrorMin = *range.first;
+    r.linearityErrorMax = *range.second;
+}
 
-    if (!stacks.empty()) {
-        if (stacks.size() != 2 || stacks[0].dark == stacks[1].dark)
-            CV_Error(Error::StsBadArg,
-                     "emva1288Results: the spatial set must be one bright and one dark stack");
-        const Emva1288Stack& b = stacks[0].dark ? stacks[1] : stacks[0];
-        const Emva1288Stack& d = stacks[0].dark ? stacks[0] : stacks[1];
-        // A negative estimate means a pattern below what the stack resolves: stated as NaN, as the reference.
-        if (d.variance >= 0)
-            r.dsnu1288 = std::sqrt(d.variance) / r.K;
-        if (b.variance - d.variance >= 0 && b.mean > d.mean)
-            r.prnu1288 = 100.0 * std::sqrt(b.variance - d.variance) / (b.mean - d.mean);
+// DSNU and PRNU from the spatial set, one bright and one dark stack.
+void spatialFigures(const std::vector<Emva1288Stack>& stacks, Emva1288Results& r)
+{
+    if (stacks.empty())
+        return;
+    if (stacks.size() != 2 || stacks[0].dark == stacks[1].dark)
+        CV_Error(Error::StsBadArg, "emva1288Results: the spatial set must be one bright and one dark stack");
+    const Emva1288Stack& b = stacks[0].dark ? stacks[1] : stacks[0];
+    const Emva1288Stack& d = stacks[0].dark ? stacks[0] : stacks[1];
+    // A negative estimate means a pattern below what the stack resolves: stated as NaN, as the reference.
+    if (d.variance >= 0)
+        r.dsnu1288 = std::sqrt(d.variance) / r.K;
+    if (b.variance - d.variance >= 0 && b.mean > d.mean)
+        r.prnu1288 = 100.0 * std::sqrt(b.variance - d.variance) / (b.mean - d.mean);
+}
+
+} // namespace
+
+Emva1288Results emva1288Results(const std::vector<Emva1288Pair>& pairs,
+                                const std::vector<Emva1288Stack>& stacks)
+{
+    Emva1288Results r;
+    r.pairs = pairs;
+    r.stacks = stacks;
+    const DarkPairs darkByExposure = takeTemporalSteps(pairs, r);
+    const int n = int(r.mean.size());
+    std::vector<double> signal(n), excess(n);
+    for (int i = 0; i < n; ++i) {
+        signal[i] = r.mean[i] - r.darkMean[i];
+        excess[i] = r.variance[i] - r.darkVariance[i];
     }
+    r.saturationIndex = saturationIndexOf(r.variance);
+    const double saturated = signal[r.saturationIndex];
+    r.sensitivityMaxIndex = lastStepAtMost(signal, 0.7 * saturated);
+    if (!(saturated > 0) || r.sensitivityMaxIndex < 1)
+        CV_Error(Error::StsBadArg,
+                 cv::format(
+                     "emva1288Results: the signal at saturation is %g DN above dark and %d step(s) lie below "
+                     "70%% of it; K needs a signal that rises over at least two steps",
+                     saturated, r.sensitivityMaxIndex + 1));
+    r.K = slopeThroughOrigin(signal, excess, 0, r.sensitivityMaxIndex);
+    if (!(std::isfinite(r.K) && r.K > 0))
+        CV_Error(Error::StsBadArg,
+                 cv::format("emva1288Results: the fitted K is %g; the temporal variance does not "
+                            "rise with the signal up to 70%% of saturation",
+                            r.K));
+    darkNoiseFigures(darkByExposure, r);
+    photonFigures(signal, saturated, r);
+    linearityFigures(signal, saturated, r);
+    spatialFigures(stacks, r);
     return r;
 }
 

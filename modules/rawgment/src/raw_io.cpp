@@ -105,6 +105,108 @@ CfaPattern patternOf(LibRaw& raw, const String& path)
     failOn(path, "the 2x2 CFA block is not a Bayer layout (the two greens are not diagonal)");
 }
 
+/* The layout LibRaw found, refused unless it is a 2x2 Bayer mosaic of red, green and blue or a monochrome
+ * frame (one colour, no filter array) stored as integers. */
+CfaPattern mosaicLayoutOf(LibRaw& raw, const String& path)
+{
+    const libraw_data_t& d = raw.imgdata;
+    // One colour and no filter array: a monochrome sensor (a LinearRaw DNG with one sample per pixel).
+    const bool mono = d.idata.filters == 0 && d.idata.colors == 1;
+    if (d.idata.filters == 0 && !mono)
+        failOn(path, format("LibRaw reports no colour filter array and %d colours: a linear or demosaiced "
+                            "DNG or a Foveon, neither a Bayer mosaic nor a monochrome frame",
+                            d.idata.colors));
+    if (d.idata.filters == 9)
+        failOn(path, "the sensor has a 6x6 X-Trans colour filter array, not a 2x2 Bayer mosaic");
+    if (!mono && d.idata.filters < 1000)
+        failOn(path, "the colour filter array is not a 2x2 Bayer layout");
+    if (!mono && d.idata.colors != 3)
+        failOn(path, format("the sensor has %d colours (for example CMYG), not red, green and blue",
+                            d.idata.colors));
+    if (raw.is_floating_point())
+        failOn(path, "the mosaic is stored as floating point, which readRaw does not support");
+    return mono ? CFA_MONO : patternOf(raw, path);
+}
+
+// The visible area's even part, copied out of LibRaw's decoded data.
+Mat visibleMosaicOf(const LibRaw& raw, const String& path)
+{
+    const libraw_data_t& d = raw.imgdata;
+    const libraw_image_sizes_t& s = d.sizes;
+    // Our mosaic functions need even sides; an odd visible size loses its last row or column.
+    const int rows = s.height & ~1, cols = s.width & ~1;
+    if (rows < 2 || cols < 2)
+        failOn(path, format("the visible area %dx%d is too small", int(s.width), int(s.height)));
+    if (s.top_margin + rows > s.raw_height || s.left_margin + cols > s.raw_width)
+        failOn(path, "the visible area lies outside the decoded data");
+    Mat mosaic;
+    const Mat full(s.raw_height, s.raw_width, CV_16UC1, d.rawdata.raw_image, s.raw_pitch);
+    full(Rect(s.left_margin, s.top_margin, cols, rows)).copyTo(mosaic);
+    return mosaic;
+}
+
+// The black level of each site of the 2x2 block: LibRaw's common black, its per-colour one and its pattern.
+void readBlackLevels(LibRaw& raw, bool mono, RawFormat& format)
+{
+    const libraw_colordata_t& c = raw.imgdata.color;
+    for (int site = 0; site < 4; ++site) {
+        const int r = site / 2, col = site % 2;
+        // LibRaw's COLOR() has no colour index for a frame without a filter; its one colour is index 0.
+        double black = double(c.black) + double(c.cblack[mono ? 0 : raw.COLOR(r, col)]);
+        if (c.cblack[4] > 0 && c.cblack[5] > 0) {
+            const unsigned idx = 6 + (r % c.cblack[4]) * c.cblack[5] + (col % c.cblack[5]);
+            if (idx < LIBRAW_CBLACK_SIZE)
+                black += double(c.cblack[idx]);
+        }
+        format.blackLevel[site] = black;
+    }
+}
+
+/* The camera's colour: white balance, the camera-to-sRGB matrix, the DNG's NoiseProfile and colour tags; for
+ * another RAW format LibRaw's XYZ-to-camera matrix, which is Adobe's coefficients for the camera (integers
+ * over 10000, given for D65): the DNG's ColorMatrix with CalibrationIlluminant D65 (21). A monochrome frame
+ * has no colour to balance or convert: the identity balance and matrix. */
+void readCameraColour(const LibRaw& raw, bool mono, const String& path, RawImage& out)
+{
+    const libraw_colordata_t& c = raw.imgdata.color;
+    if (!mono && c.cam_mul[0] > 0 && c.cam_mul[1] > 0 && c.cam_mul[2] > 0)
+        out.whiteBalance = Vec3d(c.cam_mul[0] / c.cam_mul[1], 1.0, c.cam_mul[2] / c.cam_mul[1]);
+    bool haveMatrix = false;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            out.cameraToSrgb(i, j) = c.rgb_cam[i][j];
+            haveMatrix = haveMatrix || (!mono && i != j && c.rgb_cam[i][j] != 0);
+        }
+    if (!haveMatrix)
+        out.cameraToSrgb = Matx33d::eye();
+    out.noiseProfile = detail::readDngNoiseProfile(path);
+    if (mono && out.noiseProfile.size() > 1)
+        failOn(path, format("its NoiseProfile has %d (S, O) pairs for its one colour plane; DNG allows one",
+                            static_cast<int>(out.noiseProfile.size())));
+    out.colorTags = detail::readDngColorTags(path);
+    bool haveXyz = false;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            haveXyz = haveXyz || (!mono && c.cam_xyz[i][j] != 0);
+    if (!out.colorTags.empty() || !haveXyz)
+        return;
+    DngTag colorMatrix;
+    colorMatrix.tag = 50721;
+    colorMatrix.type = 10;
+    colorMatrix.count = 9;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            colorMatrix.values.insert(
+                colorMatrix.values.end(),
+                {static_cast<double>(std::llround(c.cam_xyz[i][j] * 10000.0)), 10000.0});
+    DngTag illuminant;
+    illuminant.tag = 50778;
+    illuminant.type = 3;
+    illuminant.count = 1;
+    illuminant.values = {21};
+    out.colorTags = {colorMatrix, illuminant};
+}
+
 } // namespace
 
 RawImage readRaw(const String& path)
@@ -125,22 +227,8 @@ RawImage readRaw(const String& path)
     if (rc != LIBRAW_SUCCESS)
         failOn(path, "LibRaw cannot open it: " + libRawError(rc));
     const libraw_data_t& d = raw->imgdata;
-    // One colour and no filter array: a monochrome sensor (a LinearRaw DNG with one sample per pixel).
-    const bool mono = d.idata.filters == 0 && d.idata.colors == 1;
-    if (d.idata.filters == 0 && !mono)
-        failOn(path, format("LibRaw reports no colour filter array and %d colours: a linear or demosaiced "
-                            "DNG or a Foveon, neither a Bayer mosaic nor a monochrome frame",
-                            d.idata.colors));
-    if (d.idata.filters == 9)
-        failOn(path, "the sensor has a 6x6 X-Trans colour filter array, not a 2x2 Bayer mosaic");
-    if (!mono && d.idata.filters < 1000)
-        failOn(path, "the colour filter array is not a 2x2 Bayer layout");
-    if (!mono && d.idata.colors != 3)
-        failOn(path, format("the sensor has %d colours (for example CMYG), not red, green and blue",
-                            d.idata.colors));
-    if (raw->is_floating_point())
-        failOn(path, "the mosaic is stored as floating point, which readRaw does not support");
-    const CfaPattern pattern = mono ? CFA_MONO : patternOf(*raw, path);
+    const CfaPattern pattern = mosaicLayoutOf(*raw, path);
+    const bool mono = pattern == CFA_MONO;
     rc = raw->unpack();
     if (rc != LIBRAW_SUCCESS)
         failOn(path, "LibRaw cannot decode the image data (truncated or corrupt?): " + libRawError(rc));
@@ -152,32 +240,11 @@ RawImage readRaw(const String& path)
     if (!d.rawdata.raw_image)
         failOn(path, "LibRaw decoded no single-channel data for it");
 
-    const libraw_image_sizes_t& s = d.sizes;
-    // Our mosaic functions need even sides; an odd visible size loses its last row or column.
-    const int rows = s.height & ~1, cols = s.width & ~1;
-    if (rows < 2 || cols < 2)
-        failOn(path, format("the visible area %dx%d is too small", int(s.width), int(s.height)));
-    if (s.top_margin + rows > s.raw_height || s.left_margin + cols > s.raw_width)
-        failOn(path, "the visible area lies outside the decoded data");
-
     RawImage out;
-    const Mat full(s.raw_height, s.raw_width, CV_16UC1, d.rawdata.raw_image, s.raw_pitch);
-    full(Rect(s.left_margin, s.top_margin, cols, rows)).copyTo(out.mosaic);
-
-    const libraw_colordata_t& c = d.color;
+    out.mosaic = visibleMosaicOf(*raw, path);
     out.format.pattern = pattern;
-    for (int site = 0; site < 4; ++site) {
-        const int r = site / 2, col = site % 2;
-        // LibRaw's COLOR() has no colour index for a frame without a filter; its one colour is index 0.
-        double black = double(c.black) + double(c.cblack[mono ? 0 : raw->COLOR(r, col)]);
-        if (c.cblack[4] > 0 && c.cblack[5] > 0) {
-            const unsigned idx = 6 + (r % c.cblack[4]) * c.cblack[5] + (col % c.cblack[5]);
-            if (idx < LIBRAW_CBLACK_SIZE)
-                black += double(c.cblack[idx]);
-        }
-        out.format.blackLevel[site] = black;
-    }
-    out.format.whiteLevel = double(c.maximum);
+    readBlackLevels(*raw, mono, out.format);
+    out.format.whiteLevel = double(d.color.maximum);
     out.format.gain = 1.0;
     try {
         out.format.validate();
@@ -195,45 +262,7 @@ RawImage readRaw(const String& path)
     out.format.exposureTime = out.exposureTime;
     out.make = d.idata.make;
     out.model = d.idata.model;
-    // A monochrome frame has no colour to balance or convert: the identity balance and matrix.
-    if (!mono && c.cam_mul[0] > 0 && c.cam_mul[1] > 0 && c.cam_mul[2] > 0)
-        out.whiteBalance = Vec3d(c.cam_mul[0] / c.cam_mul[1], 1.0, c.cam_mul[2] / c.cam_mul[1]);
-    bool haveMatrix = false;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            out.cameraToSrgb(i, j) = c.rgb_cam[i][j];
-            haveMatrix = haveMatrix || (!mono && i != j && c.rgb_cam[i][j] != 0);
-        }
-    if (!haveMatrix)
-        out.cameraToSrgb = Matx33d::eye();
-    out.noiseProfile = detail::readDngNoiseProfile(path);
-    if (mono && out.noiseProfile.size() > 1)
-        failOn(path, format("its NoiseProfile has %d (S, O) pairs for its one colour plane; DNG allows one",
-                            static_cast<int>(out.noiseProfile.size())));
-    out.colorTags = detail::readDngColorTags(path);
-    // Another RAW format: LibRaw's XYZ-to-camera matrix is Adobe's coefficients for the camera (integers
-    // over 10000, given for D65), which is the DNG's ColorMatrix with CalibrationIlluminant D65 (21).
-    bool haveXyz = false;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            haveXyz = haveXyz || (!mono && c.cam_xyz[i][j] != 0);
-    if (out.colorTags.empty() && haveXyz) {
-        DngTag colorMatrix;
-        colorMatrix.tag = 50721;
-        colorMatrix.type = 10;
-        colorMatrix.count = 9;
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                colorMatrix.values.insert(
-                    colorMatrix.values.end(),
-                    {static_cast<double>(std::llround(c.cam_xyz[i][j] * 10000.0)), 10000.0});
-        DngTag illuminant;
-        illuminant.tag = 50778;
-        illuminant.type = 3;
-        illuminant.count = 1;
-        illuminant.values = {21};
-        out.colorTags = {colorMatrix, illuminant};
-    }
+    readCameraColour(*raw, mono, path, out);
     return out;
 }
 

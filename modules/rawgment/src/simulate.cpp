@@ -110,15 +110,15 @@ NoiseModel SensorSimulator::effectiveModel() const
     return m;
 }
 
-void SensorSimulator::capture(InputArray _mean, double gain, double exposure, uint64 seed, int frameIndex,
-                              OutputArray _raw) const
+namespace {
+
+void checkCaptureArguments(const Mat& mean, Size size, double gain, double exposure, int frameIndex)
 {
-    const Mat mean = detail::twoDimensional(_mean, "SensorSimulator::capture: meanAtUnitGain");
-    if (mean.type() != CV_32FC1 || mean.size() != size_)
+    if (mean.type() != CV_32FC1 || mean.size() != size)
         CV_Error(Error::StsBadArg,
                  format("SensorSimulator::capture: meanAtUnitGain must be CV_32FC1 of %dx%d "
                         "(got %s, %dx%d)",
-                        size_.width, size_.height, typeToString(mean.type()).c_str(), mean.cols, mean.rows));
+                        size.width, size.height, typeToString(mean.type()).c_str(), mean.cols, mean.rows));
     double lo = 0;
     minMaxLoc(mean, &lo);
     if (!checkRange(mean, true) || lo < 0)
@@ -128,6 +128,31 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
     if (frameIndex < 0)
         CV_Error(Error::StsBadArg,
                  format("SensorSimulator::capture: frameIndex must be >= 0 (got %d)", frameIndex));
+}
+
+// Column offsets of one frame, from a stream of their own beside the rows' (drawn only when asked, so frames
+// without them keep their bits).
+std::vector<double> columnOffsetsOf(double variance, int columns, uint64 seed, int frameIndex)
+{
+    std::vector<double> offsets;
+    if (!(variance > 0))
+        return offsets;
+    detail::CounterRng rng(
+        detail::stepKey(seed, static_cast<uint64_t>(detail::RandomStream::SIMULATOR_COLUMNS)),
+        static_cast<uint64_t>(frameIndex));
+    const double sigma = std::sqrt(variance);
+    for (int c = 0; c < columns; ++c)
+        offsets.push_back(sigma * rng.gaussian());
+    return offsets;
+}
+
+} // namespace
+
+void SensorSimulator::capture(InputArray _mean, double gain, double exposure, uint64 seed, int frameIndex,
+                              OutputArray _raw) const
+{
+    const Mat mean = detail::twoDimensional(_mean, "SensorSimulator::capture: meanAtUnitGain");
+    checkCaptureArguments(mean, size_, gain, exposure, frameIndex);
 
     const SensorParams& p = params_;
     double prnuMax = 0, meanMax = 0;
@@ -170,17 +195,8 @@ void SensorSimulator::capture(InputArray _mean, double gain, double exposure, ui
                  format("SensorSimulator::capture: the model's dark shading is %dx%d, the sensor %dx%d",
                         shading.cols, shading.rows, size_.width, size_.height));
     const double hotLevel = std::round(0.9 * white);
-    // Column offsets of this frame, from a stream of their own beside the rows' (drawn only when asked, so
-    // frames without them keep their bits).
-    std::vector<double> columnOffset;
-    if (p.columnNoiseVariance > 0) {
-        detail::CounterRng columns(
-            detail::stepKey(seed, static_cast<uint64_t>(detail::RandomStream::SIMULATOR_COLUMNS)),
-            static_cast<uint64_t>(frameIndex));
-        const double sigma = std::sqrt(p.columnNoiseVariance);
-        for (int c = 0; c < size_.width; ++c)
-            columnOffset.push_back(sigma * columns.gaussian());
-    }
+    const std::vector<double> columnOffset =
+        columnOffsetsOf(p.columnNoiseVariance, size_.width, seed, frameIndex);
     Mat raw(size_, p.quantize ? CV_16UC1 : CV_32FC1);
     parallel_for_(Range(0, size_.height), [&](const Range& rows) {
         for (int r = rows.start; r < rows.end; ++r) {
