@@ -126,6 +126,24 @@ if [ "${#explicit[@]}" -eq 0 ]; then
   done
 fi
 
+# Files have one home, the files topic (files.cpp, file_system.cpp, text_checks.cpp; src/file_access.hpp): no
+# other source of the library stats, opens, reads by descriptor, lists, removes or renames a file, streams one
+# or reads or writes an image by its path. A rule about files (a FIFO never opened, a name resolved one way)
+# is then made once.
+if [ "${#explicit[@]}" -eq 0 ]; then
+  fileCalls='(^|[^A-Za-z0-9_>])::(stat|lstat|fstat|open|pread|read|write|close|unlink|rename)\(|std::(remove|rename)\(|std::filesystem|std::(i|o|)fstream|fopen\(|[^a-z_]im(read|write)\(|(open|read)dir\('
+  for f in "${files[@]}"; do
+    case "$f" in
+      modules/rawgment/src/files.cpp|modules/rawgment/src/file_system.cpp|modules/rawgment/src/text_checks.cpp) ;;
+      modules/rawgment/src/*.cpp|modules/rawgment/src/*.hpp)
+        if grep -nE "$fileCalls" "$f" >/dev/null; then
+          grep -nE "$fileCalls" "$f" | sed "s|^|$f: reaches a file outside the files topic (use src/file_access.hpp): |"
+          status=1
+        fi ;;
+    esac
+  done
+fi
+
 # Functions along their seams: none in the library over 120 lines. A body opens with a brace alone on its line
 # after a signature (clang-format puts a function's brace there and no other) and closes at that indentation.
 if [ "${#explicit[@]}" -eq 0 ]; then
@@ -181,6 +199,6 @@ if [ "${#explicit[@]}" -eq 0 ]; then
 fi
 
 if [ "$status" -eq 0 ]; then
-  echo "check-sources: ${#files[@]} files, no control characters, no copy of Eq. 5, layers kept, no file over 750 lines (tests 800), no library function over 120 lines, noise steps prepared once, no exported private function, precomp.hpp only includes"
+  echo "check-sources: ${#files[@]} files, no control characters, no copy of Eq. 5, layers kept, no file over 750 lines (tests 800), no library function over 120 lines, file access only in the files topic, noise steps prepared once, no exported private function, precomp.hpp only includes"
 fi
 exit "$status"

@@ -1,6 +1,7 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // The read part of a noise step drawn from a dark-frame bank (bank_noise.hpp).
 #include "bank_noise.hpp"
+#include "file_access.hpp"
 
 #include "precomp.hpp"
 
@@ -8,7 +9,6 @@
 #include <cmath>
 #include <list>
 #include <mutex>
-#include <sys/stat.h>
 
 namespace cv {
 namespace rawgment {
@@ -26,12 +26,10 @@ std::shared_ptr<const DarkFrameBank> cachedDarkFrameBank(const String& path)
     // A few banks: a data loader uses one, a comparison two or three.
     static std::mutex mutex;
     static std::list<Entry> entries;
-    struct stat info;
-    if (::stat(path.c_str(), &info) != 0)
+    FileStamp stamp;
+    if (!fileStampOf(path, stamp))
         CV_Error(Error::StsError, format("dark-frame bank file '%s' is missing", path.c_str()));
-    const long long bytes = static_cast<long long>(info.st_size),
-                    modified =
-                        static_cast<long long>(info.st_mtim.tv_sec) * 1000000000LL + info.st_mtim.tv_nsec;
+    const long long bytes = stamp.bytes, modified = stamp.modifiedNs;
     {
         std::lock_guard<std::mutex> lock(mutex);
         for (auto it = entries.begin(); it != entries.end(); ++it)

@@ -13,10 +13,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <map>
 #include <memory>
-#include <sys/stat.h>
 
 namespace cv {
 namespace rawgment {
@@ -121,10 +119,10 @@ String groupName(const DarkFrameGroup& g)
 
 double fileBytesOf(const String& path)
 {
-    struct stat info;
-    if (::stat(path.c_str(), &info) != 0)
+    detail::FileStamp stamp;
+    if (!detail::fileStampOf(path, stamp))
         CV_Error(Error::StsError, format("DarkFrameBank: dark frame '%s' is missing", path.c_str()));
-    return static_cast<double>(info.st_size);
+    return static_cast<double>(stamp.bytes);
 }
 
 bool allFinite(const Vec4d& v, bool nonNegative)
@@ -158,13 +156,7 @@ bool isBankImageOf(const String& bankPath, const String& name)
 // bank moves with its frames; absolute otherwise.
 String pathInBankFile(const String& frame, const String& bankPath)
 {
-    namespace fs = std::filesystem;
-    const fs::path absolute = fs::absolute(fs::path(frame)).lexically_normal();
-    const fs::path folder = fs::absolute(fs::path(bankPath)).parent_path().lexically_normal();
-    const fs::path relative = absolute.lexically_relative(folder);
-    if (!relative.empty() && *relative.begin() != "..")
-        return relative.string();
-    return absolute.string();
+    return detail::pathAsNamedBy(frame, bankPath);
 }
 
 std::vector<double> readList(const FileNode& node, const char* field, size_t most)
@@ -338,24 +330,20 @@ DarkFrameBank DarkFrameBank::create(const std::vector<String>& files, const Nois
 DarkFrameBank DarkFrameBank::createFromFolder(const String& folder, const NoiseModel& model,
                                               double falseAlarm)
 {
-    namespace fs = std::filesystem;
-    std::error_code error;
-    if (!fs::is_directory(fs::path(folder), error))
+    if (!detail::isFolder(folder))
         CV_Error(Error::StsBadArg,
                  cv::format("DarkFrameBank::createFromFolder: '%s' is not a folder", folder.c_str()));
+    // Entries as the folder was named: "dark/" and "dark" give "dark/f.npy".
+    const String prefix = folder.empty() || folder.back() == '/' ? folder : folder + "/";
     std::vector<String> files;
-    for (const auto& entry : fs::directory_iterator(fs::path(folder), error)) {
-        const String name = entry.path().filename().string();
+    for (const String& name : detail::folderEntryNames(folder, "DarkFrameBank::createFromFolder")) {
         const String ext = detail::lowerExtensionOf(name);
         if (name.empty() || name[0] == '.' || ext == ".yml" || ext == ".yaml" || ext == ".json" ||
             name.find(String(".") + kPatternTag) != String::npos ||
-            name.find(String(".") + kMeanTag) != String::npos || !isRegularFile(entry.path().string()))
+            name.find(String(".") + kMeanTag) != String::npos || !isRegularFile(prefix + name))
             continue;
-        files.push_back(entry.path().string());
+        files.push_back(prefix + name);
     }
-    if (error)
-        CV_Error(Error::StsError, cv::format("DarkFrameBank::createFromFolder: cannot list '%s': %s",
-                                             folder.c_str(), error.message().c_str()));
     std::sort(files.begin(), files.end());
     if (files.empty())
         CV_Error(Error::StsBadArg,
@@ -482,9 +470,7 @@ std::string bankFileText(const DarkFrameBank& bank, const String& bankPath, std:
 //! A bank's path made absolute: it is how the bank reaches other processes, whose working folder differs.
 String absoluteBankPath(const String& bankPath)
 {
-    std::error_code error;
-    const std::filesystem::path absolute = std::filesystem::absolute(bankPath, error);
-    return error ? bankPath : absolute.string();
+    return detail::absolutePathOf(bankPath);
 }
 
 } // namespace

@@ -66,6 +66,36 @@ private:
     int fd_;
     long long size_ = 0;
 };
+/** @name The file system, for the rest of the module (file_system.cpp)
+ * Every stat, listing, removal and path resolution of the library is here, so that a rule about files (a
+ * FIFO never opened, a name resolved one way) is made once; scripts/check-sources.sh refuses them elsewhere.
+ */
+//! @{
+//! What stat() says of a path, links followed: its size, its last modification in ns and its kind.
+struct FileStamp
+{
+    long long bytes = 0, modifiedNs = 0;
+    unsigned mode = 0;
+    bool regular() const;
+};
+//! The stamp of the file at `path`; false when nothing is there (or it cannot be stat'ed).
+bool fileStampOf(const String& path, FileStamp& stamp);
+//! Removes the file at `path` if one is there, silently: the undoing of a write that failed halfway.
+void removeFileIfPresent(const String& path);
+//! Whether `path` is a folder, links followed.
+bool isFolder(const String& path);
+/** The names in a folder ("" is the working folder), without "." and "..", in no order; throws StsError
+ * naming `who` and the folder when it cannot be listed. */
+std::vector<String> folderEntryNames(const String& folder, const char* who);
+//! `path` made absolute against the working folder; `path` itself when that fails.
+String absolutePathOf(const String& path);
+/** `path` as a file at `ownerPath` names it: relative to the owner's folder when it lies inside it (both made
+ * absolute and normalised lexically first), so that the owner moves with it; absolute otherwise. */
+String pathAsNamedBy(const String& path, const String& ownerPath);
+/** Reads exactly `size` bytes at `offset` of an open file (retrying an interrupted read); false when the
+ * file ends first; throws StsError naming `who` and `path` on a read error. */
+bool readFullyAt(int fd, void* data, size_t size, long long offset, const String& path, const char* who);
+//! @}
 //! A file's device and inode: what two spellings of one path, or two hard links, share.
 struct FileIdentity
 {

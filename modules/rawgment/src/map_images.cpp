@@ -12,8 +12,6 @@
 #include <cctype>
 #include <cinttypes>
 #include <cstdio>
-#include <filesystem>
-#include <sys/stat.h>
 
 namespace cv {
 namespace rawgment {
@@ -98,16 +96,19 @@ void saveWithMapImages(const String& ownerPath, const std::string& text, const s
         writeFileAtomically(ownerPath, text.data(), text.size(), true);
     } catch (...) {
         for (const String& image : created)
-            std::remove(image.c_str());
+            removeFileIfPresent(image);
         throw;
     }
     // The owner file now names only the new maps: its earlier ones go.
-    std::error_code error;
-    for (const auto& entry : std::filesystem::directory_iterator(folder.empty() ? "." : folder, error)) {
-        const std::string name = entry.path().filename().string();
-        if (isOwnImage(name) && std::find(names.begin(), names.end(), name) == names.end())
-            std::filesystem::remove(entry.path(), error);
+    std::vector<String> entries;
+    try {
+        entries = folderEntryNames(folder, who);
+    } catch (const Exception&) {
+        return; // the owner file is written: an earlier map left behind costs room, not correctness
     }
+    for (const String& name : entries)
+        if (isOwnImage(name) && std::find(names.begin(), names.end(), name) == names.end())
+            removeFileIfPresent(folder + name);
 }
 
 Mat readMapImage(const FileNode& entry, const String& what, const String& folder, Size size)
@@ -125,10 +126,10 @@ Mat readMapImage(const FileNode& entry, const String& what, const String& folder
                  format("%s.image '%s' must be a file name in the same folder as the file naming it (no '/')",
                         what.c_str(), name.c_str()));
     const String path = folder + name;
-    struct stat info;
-    if (::stat(path.c_str(), &info) != 0)
+    FileStamp stamp;
+    if (!fileStampOf(path, stamp))
         CV_Error(Error::StsError, format("%s: image '%s' is missing", what.c_str(), path.c_str()));
-    if (!S_ISREG(info.st_mode))
+    if (!stamp.regular())
         CV_Error(Error::StsParseError,
                  format("%s: image '%s' is not a regular file", what.c_str(), path.c_str()));
     // Its header is checked against the size before anything is decoded: a header claiming 30000x30000

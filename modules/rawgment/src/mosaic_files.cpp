@@ -230,7 +230,7 @@ void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& m
         // No sidecar without its image: a sidecar this call made goes with the failed image, unless an
         // image that another writer made in the meantime now depends on it.
         if (createdSidecar && !pathExists(path))
-            std::remove(sidecar.c_str());
+            detail::removeFileIfPresent(sidecar);
         throw;
     }
 }

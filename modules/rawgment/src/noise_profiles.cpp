@@ -8,7 +8,7 @@
 
 #include <algorithm>
 #include <cstring>
-#include <fstream>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -29,12 +29,14 @@ int colourPlaneOf(CfaChannel channel)
 class TiffFile
 {
 public:
-    explicit TiffFile(const String& path) : path_(path), in_(path, std::ios::binary)
+    explicit TiffFile(const String& path) : path_(path)
     {
-        if (!in_)
+        try {
+            file_.reset(new detail::RegularFileForReading(path, "RAW file"));
+        } catch (const Exception&) {
             fail("cannot be opened");
-        in_.seekg(0, std::ios::end);
-        size_ = static_cast<uint64_t>(in_.tellg());
+        }
+        size_ = static_cast<uint64_t>(file_->size());
         char order[2] = {0, 0};
         bytes(0, order, 2);
         if (order[0] == 'I' && order[1] == 'I')
@@ -120,9 +122,8 @@ private:
         if (at > size_ || n > size_ - at)
             fail(format("is truncated: a TIFF field at byte %llu lies beyond its end (%llu bytes)",
                         static_cast<unsigned long long>(at), static_cast<unsigned long long>(size_)));
-        in_.seekg(static_cast<std::streamoff>(at));
-        in_.read(static_cast<char*>(out), static_cast<std::streamsize>(n));
-        if (!in_)
+        if (!detail::readFullyAt(file_->fd(), out, static_cast<size_t>(n), static_cast<long long>(at), path_,
+                                 "readRaw"))
             fail("could not be read");
     }
     //! The unsigned integer of `Bytes` bytes at `at`, in the file's byte order.
@@ -136,7 +137,7 @@ private:
         return v;
     }
     String path_;
-    std::ifstream in_;
+    std::unique_ptr<detail::RegularFileForReading> file_;
     uint64_t size_ = 0;
     bool bigEndian_ = false;
 };
@@ -195,12 +196,11 @@ double rangeOfColourPlane(const RawFormat& format, int plane)
 //! Whether a regular file starts with a TIFF header of either byte order (DNG, NEF, ...).
 static bool isTiffBased(const String& path)
 {
-    checkRegularFile(path, "RAW file");
-    std::ifstream probe(path, std::ios::binary);
+    const RegularFileForReading file(path, "RAW file");
     char head[4] = {0, 0, 0, 0};
-    probe.read(head, 4);
-    return probe && ((head[0] == 'I' && head[1] == 'I' && head[2] == 42 && head[3] == 0) ||
-                     (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && head[3] == 42));
+    return readFullyAt(file.fd(), head, 4, 0, path, "readRaw") &&
+           ((head[0] == 'I' && head[1] == 'I' && head[2] == 42 && head[3] == 0) ||
+            (head[0] == 'M' && head[1] == 'M' && head[2] == 0 && head[3] == 42));
 }
 
 bool isColorTag(int tag)

@@ -161,19 +161,7 @@ private:
 //! Reads exactly `size` bytes at `offset`; false when the file ends first.
 bool readFully(int fd, void* data, size_t size, off_t offset, const String& path)
 {
-    uchar* out = static_cast<uchar*>(data);
-    size_t got = 0;
-    while (got < size) {
-        const ssize_t n = ::pread(fd, out + got, size - got, offset + static_cast<off_t>(got));
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n < 0)
-            CV_Error(Error::StsError, "readMosaic: cannot read '" + path + "': " + std::strerror(errno));
-        if (n == 0)
-            return false;
-        got += static_cast<size_t>(n);
-    }
-    return true;
+    return detail::readFullyAt(fd, data, size, static_cast<long long>(offset), path, "readMosaic");
 }
 
 } // namespace

@@ -11,9 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <fcntl.h>
 #include <memory>
-#include <sys/stat.h>
 #include <unistd.h>
 #include <vector>
 
@@ -215,10 +213,10 @@ RawImage readRaw(const String& path)
         CV_Error(Error::StsBadArg, "readRaw: the path is empty");
     if (!pathExists(path))
         failOn(path, "no such file");
-    struct stat status;
     // LibRaw would block on a FIFO's open and read a device until its own allocation limit.
-    if (::stat(path.c_str(), &status) == 0 && !S_ISREG(status.st_mode))
-        failOn(path, detail::notRegularReason(status.st_mode));
+    detail::FileStamp stamp;
+    if (detail::fileStampOf(path, stamp) && !stamp.regular())
+        failOn(path, detail::notRegularReason(stamp.mode));
     // LibRaw's state is a few hundred kilobytes: keep it off the stack.
     std::unique_ptr<LibRaw> raw(new LibRaw(0));
     DataErrors errors;
