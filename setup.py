@@ -1,6 +1,7 @@
 """The build of `pip install .` and `pip wheel .`: setuptools runs the project's CMake build of the Python
-module (no tests, benchmarks or apps) and takes the packages `rawgment` (with the shared library inside it,
-found by the module through $ORIGIN) and `rawgment_ablation` from CMake's install into a staging folder.
+module (no tests, benchmarks or apps) and takes the package `rawgment` (with the shared library inside it,
+found by the module through $ORIGIN) from CMake's install into a staging folder. The studies (studies/) are
+not part of it: they run from a build tree.
 
 The CMake build folder is build/pip (RAWGMENT_PIP_BUILD_DIR to change it), so that `pip install .` and
 `pip wheel .` after it compile once."""
@@ -64,9 +65,8 @@ class CMakeBuild(build_ext):
         subprocess.run(["cmake", "--install", str(build), "--prefix", str(stage)], check=True,
                        stdout=subprocess.DEVNULL)
         target = Path(self.build_lib)
-        for package in ("rawgment", "rawgment_ablation"):
-            shutil.rmtree(target / package, ignore_errors=True)
-            shutil.copytree(stage / "python" / package, target / package, symlinks=False)
+        shutil.rmtree(target / "rawgment", ignore_errors=True)
+        shutil.copytree(stage / "python" / "rawgment", target / "rawgment", symlinks=False)
         module = target / "rawgment" / Path(self.get_ext_filename(ext.name)).name
         if not module.exists():
             raise SystemExit("setup.py: CMake installed no %s" % module)

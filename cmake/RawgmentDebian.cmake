@@ -1,6 +1,6 @@
 # The Debian package: one binary package `rawgment` with the shared library (SONAME
 # libopencv_rawgment.so.MAJOR.MINOR), headers, CMake package, pkg-config file, apps, the Python packages
-# `rawgment` and `rawgment_ablation` in Debian's folder, and the docs. scripts/package-deb.sh configures
+# `rawgment` in Debian's folder, and the docs. scripts/package-deb.sh configures
 # with -DRAWGMENT_DEBIAN_PACKAGE=ON -DCMAKE_INSTALL_PREFIX=/usr, builds, runs cpack and checks the result.
 #
 # One package rather than a runtime/-dev split: the apps and the Python module are the product and need
@@ -76,8 +76,7 @@ charts, dark frames or EMVA 1288 data, and augments with the noise already
 in the input accounted for.
 
 This package holds the shared library, its headers, CMake package and
-pkg-config file, the command-line apps and the Python packages rawgment and
-rawgment_ablation.")
+pkg-config file, the command-line apps and the Python package rawgment.")
 # Depends: what dpkg-shlibdeps finds the binaries need, plus what it cannot see: the Python module is built
 # for this Python and imports NumPy. torch and dask are for rawgment.torch and rawgment.batch only.
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)

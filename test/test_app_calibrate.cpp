@@ -122,7 +122,7 @@ TEST(Apps, calibrateTakesTheGainsFromTheFilesIsoWithOrWithoutAChart)
 
 TEST(Apps, calibrateFromIsoTaggedFilesIsAsAccurateAsTheTradeoffReportSays)
 {
-    // The trade-off report's campaign (studies/tradeoffs/tradeoff_measures.cpp: alpha 0.4, sigma_d^2 0.5,
+    // The trade-off report's campaign (apps/tradeoffs/tradeoff_measures.cpp: alpha 0.4, sigma_d^2 0.5,
     // sigma_r^2 2, gains 6/12/24 dB, levels 0.2/0.65, 32 px patches sampled in 24 px squares) written as
     // DNG files that carry their ISO and no sidecar, calibrated from the files alone. docs/performance.md's
     // trade-off table gives 0.0591 at 16 frames: the RMS over 3 campaigns of the worst relative error of

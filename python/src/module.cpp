@@ -590,7 +590,6 @@ void bindSeeds(py::module_& m)
         .value("SEED_STUDY", SEED_STUDY, doc("SeedPurpose::SEED_STUDY"))
         .value("SEED_TRAINING_EPOCH", SEED_TRAINING_EPOCH, doc("SeedPurpose::SEED_TRAINING_EPOCH"))
         .value("SEED_TRAINING_SAMPLE", SEED_TRAINING_SAMPLE, doc("SeedPurpose::SEED_TRAINING_SAMPLE"))
-        .value("SEED_ABLATION", SEED_ABLATION, doc("SeedPurpose::SEED_ABLATION"))
         .export_values();
     m.def("deriveSeed", &deriveSeed, py::arg("seed"), py::arg("purpose"), py::arg("index") = 0,
           doc("deriveSeed"));

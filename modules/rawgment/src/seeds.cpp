@@ -11,7 +11,7 @@ namespace rawgment {
 
 uint64 deriveSeed(uint64 seed, SeedPurpose purpose, uint64 index)
 {
-    if (purpose < SEED_SIMULATED_BURST || purpose > SEED_ABLATION)
+    if (purpose < SEED_SIMULATED_BURST || purpose > SEED_TRAINING_SAMPLE)
         CV_Error(Error::StsBadArg, format("deriveSeed: unknown purpose %d", static_cast<int>(purpose)));
     return detail::stepKey(detail::stepKey(seed, static_cast<uint64_t>(purpose)), index);
 }

@@ -22,7 +22,7 @@ DEFAULT_ARMS = ("IGNORE_PRIOR", "ACCOUNT_PRIOR", "ORACLE", "NOISY")
 #: The training designs: one network per arm on every condition pooled (each crop draws its condition), or
 #: one network per arm and condition, trained on that condition's inputs alone.
 DESIGNS = ("pooled", "per-condition")
-# Roles of the derived seeds (the high 32 bits of deriveSeed's index under SEED_ABLATION).
+# Roles of the derived seeds (study_seed(study_seed(base, role), item)).
 (_ROLE_TRAIN_SCENES, _ROLE_TEST_SCENES, _ROLE_TEST_CAPTURE, _ROLE_BATCH, _ROLE_SAMPLE, _ROLE_NETWORK,
  _ROLE_BOOTSTRAP, _ROLE_BANK) = range(8)
 
@@ -32,6 +32,31 @@ DESIGNS = ("pooled", "per-condition")
 BLIND_STEP = 0.02
 
 
+#: The seed purpose the study derives under: 24, which rawgment's seeds.hpp keeps reserved for it (a study is
+#: not part of the package, so the package names no purpose for it).
+STUDY_SEED_PURPOSE = 24
+_MASK = (1 << 64) - 1
+
+
+def _step_key(seed, family):
+    """The library's key mixing (src/random.hpp, stepKey): the SplitMix64 finaliser of seed + golden (family + 1),
+    on which rawgment.deriveSeed(seed, purpose, index) = stepKey(stepKey(seed, purpose), index) is built."""
+    z = (int(seed) + 0x9E3779B97F4A7C15 * (int(family) + 1)) & _MASK
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK
+    return z ^ (z >> 31)
+
+
+def derive_seed(seed, purpose, index=0):
+    """rawgment.deriveSeed of any purpose, the study's reserved one included."""
+    return _step_key(_step_key(seed, purpose), index)
+
+
+def study_seed(seed, index):
+    """The study's seed of `index` under `seed`: deriveSeed(seed, 24, index)."""
+    return derive_seed(seed, STUDY_SEED_PURPOSE, index)
+
+
 def _seed(base, role, item):
-    """The seed of one item of a role: deriveSeed(deriveSeed(base, SEED_ABLATION, role), SEED_ABLATION, item)."""
-    return _rg.deriveSeed(_rg.deriveSeed(int(base), _rg.SEED_ABLATION, int(role)), _rg.SEED_ABLATION, int(item))
+    """The seed of one item of a role: study_seed(study_seed(base, role), item)."""
+    return study_seed(study_seed(int(base), int(role)), int(item))

@@ -16,8 +16,8 @@ inputs differ):
   bank of the sensor's own dark captures (docs/dark_frame_bank.md), best run with ``--departing-sensor``.
 
 Test inputs are always captures simulated at the target (exact Poisson), never the augmentation.
-Every random number derives from ``--seed`` through deriveSeed(deriveSeed(seed, SEED_ABLATION, role),
-SEED_ABLATION, item), so the same seeds give the same numbers.
+Every random number derives from ``--seed`` through study_seed(study_seed(seed, role), item) (common.py: the
+library's deriveSeed under the purpose 24 it reserves for this study), so the same seeds give the same numbers.
 """
 import argparse
 import atexit
@@ -35,7 +35,7 @@ import torch
 import rawgment as _rg
 from rawgment_ablation.common import (ARMS, BANK_ARMS, BLIND_STEP, CONTROL_ARMS, DEFAULT_ARMS, DESIGNS,
                                        TRAINED_ARMS, _ROLE_BANK, _ROLE_BATCH, _ROLE_NETWORK, _ROLE_SAMPLE,
-                                       _ROLE_TEST_CAPTURE, _ROLE_TEST_SCENES, _ROLE_TRAIN_SCENES, _seed)
+                                       _ROLE_TEST_CAPTURE, _ROLE_TEST_SCENES, _ROLE_TRAIN_SCENES, _seed, study_seed)
 from rawgment_ablation.report import (NETWORKS, SIGNIFICANCE, _plotPng, _plotScript, contrastPairs, contrastRows,
                                       correctFamily, holmAdjusted, pairedSignificance, seedsForFamily, seedsToConfirm,
                                       mergeReplicates, studyName, summarize, writeCombinedReport, writeOutputs,
@@ -162,7 +162,7 @@ class _Study:
         if bank:
             options.darkBank = self.bankPath()
             options.darkBankTied = True
-        stepSeeds = [_rg.deriveSeed(seed, _rg.SEED_ABLATION, step) for step in (1, 2)]
+        stepSeeds = [study_seed(seed, step) for step in (1, 2)]
         if condition.blurLength > 0:
             bright, _ = _rg.motionBlur(bright, self.format, self.model, self.kernel(condition), options,
                                        seed=stepSeeds[0])
@@ -198,7 +198,7 @@ class _Study:
         """ORACLE_PLUS_SHARE: a capture at the target plus Gaussian noise of the darkened prior's
         variance, so that it carries what IGNORE_PRIOR carries in excess of the target, on real noise."""
         prior, _, _ = self.priorAndTargetVariance(mean, condition)
-        draw = np.random.default_rng(_rg.deriveSeed(seed, _rg.SEED_ABLATION, 4)).standard_normal(raw.shape)
+        draw = np.random.default_rng(study_seed(seed, 4)).standard_normal(raw.shape)
         return self.asCapture(raw.astype(np.float64) + np.sqrt(prior) * draw)
 
     def asCapture(self, values):
@@ -236,7 +236,7 @@ class _Study:
         def raw(arm):
             if arm not in raws:
                 if arm == "ORACLE":
-                    raws[arm] = self.targetCapture(mean, condition, _rg.deriveSeed(seed, _rg.SEED_ABLATION, 3))
+                    raws[arm] = self.targetCapture(mean, condition, study_seed(seed, 3))
                 elif arm == "IGNORE_RESCALED":
                     raws[arm] = self.rescaledToTarget(raw("IGNORE_PRIOR"), mean, condition)
                 elif arm == "ORACLE_PLUS_SHARE":

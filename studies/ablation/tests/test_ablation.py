@@ -238,6 +238,24 @@ def test_the_same_seeds_give_the_same_numbers_and_another_seed_does_not():
     assert scores[0] != scores[2]
 
 
+# rawgment.deriveSeed(1, SEED_ABLATION, 3) while the package still named the purpose (the build of cb7e969).
+RECORDED_STUDY_SEED_1_3 = 1057235584146246385
+
+
+def test_the_studys_seeds_are_the_librarys_derivation_under_its_reserved_purpose():
+    # The study's seeds are rawgment.deriveSeed under purpose 24, which the package no longer names (a study
+    # is not part of it): the Python mixing gives the library's own derived seeds for every purpose it has, so
+    # under 24 it gives what deriveSeed(seed, 24, index) gave when the package named it (recorded below).
+    from rawgment_ablation.common import STUDY_SEED_PURPOSE, derive_seed, study_seed
+    for purpose in rg.SeedPurpose.__members__.values():
+        for seed, index in ((0, 0), (7, 3), (2**64 - 1, 2**40 + 5)):
+            assert derive_seed(seed, int(purpose), index) == rg.deriveSeed(seed, purpose, index)
+    assert STUDY_SEED_PURPOSE not in [int(p) for p in rg.SeedPurpose.__members__.values()]
+    with pytest.raises(Exception, match="unknown purpose 24"):
+        rg.deriveSeed(1, rg.SeedPurpose(24), 0)
+    assert study_seed(1, 3) == RECORDED_STUDY_SEED_1_3
+
+
 def test_a_blind_study_feeds_its_networks_the_image_only(tmp_path):
     # --blind: the networks take the four planes without noise maps (the paper's detectors see only the
     # image), start as the identity like the told networks, and the run and its report say so.

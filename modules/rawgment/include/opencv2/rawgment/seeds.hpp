@@ -14,7 +14,7 @@ namespace rawgment {
 /** @brief What a seed derived from a user's seed drives (see deriveSeed()).
  *
  * Every random number of the library comes from a registered family of counter-based streams; these
- * are the families of the apps and of programs built on the library, so that one seed reproduces a
+ * are the families of the library, its apps and its Python package (and of programs built on them), so that one seed reproduces a
  * whole run and no two uses of it share random numbers. */
 // OpenCV 4.6's binding parser reads an enum's base only with no space before ':'.
 // clang-format off
@@ -28,8 +28,9 @@ enum SeedPurpose: int
     SEED_DEMO = 20,                       //!< the demo's own captures and gallery; index: what it draws
     SEED_STUDY = 21,                      //!< accuracy studies (rawgment_tradeoffs); index: the measurement
     SEED_TRAINING_EPOCH = 22,             //!< a training epoch (Python's rawgment.torch); index: the epoch
-    SEED_TRAINING_SAMPLE = 23,            //!< a sample of an epoch's seed; index: the sample's index
-    SEED_ABLATION = 24 //!< the ablation study (rawgment_ablation); index: a role, then an item
+    SEED_TRAINING_SAMPLE = 23             //!< a sample of an epoch's seed; index: the sample's index
+    // 24 is reserved: the project's ablation study (studies/, not installed) derives its seeds under it with
+    // the same mixing, so no purpose of the library may take it.
 };
 
 /** @brief A seed for one use of a user's seed: a well-mixed (SplitMix64) function of (seed, purpose,

@@ -1,6 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // rawgment_tradeoffs' measurements: every knob of the library that trades accuracy for time, measured
-// against the sensor simulator's ground truth. The trade-off study (studies/tradeoffs), which the app
+// against the sensor simulator's ground truth. The trade-off study (apps/tradeoffs), which the app
 // rawgment_tradeoffs runs.
 #ifndef RAWGMENT_APPS_TRADEOFF_MEASURES_HPP
 #define RAWGMENT_APPS_TRADEOFF_MEASURES_HPP

@@ -1,6 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // What the trade-off studies share (tradeoff_measures.cpp, tradeoff_calibration.cpp): their seeds and
-// timers. Private to the trade-off study (studies/tradeoffs).
+// timers. Private to the trade-off study (apps/tradeoffs).
 #ifndef RAWGMENT_APPS_TRADEOFF_STUDY_HPP
 #define RAWGMENT_APPS_TRADEOFF_STUDY_HPP
 

@@ -1,6 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // The trade-off studies of calibration (rawgment_tradeoffs): each knob's time and accuracy over simulated
-// campaigns (the chart, sensor and light bursts of studies/calibration/calibration_bench.hpp), and the errors
+// campaigns (the chart, sensor and light bursts of calibration_bench.hpp), and the errors
 // a calibration states against those it makes; and the studies' shared seeds and timers (tradeoff_study.hpp).
 #include "tradeoff_study.hpp"
 
