@@ -9,7 +9,7 @@
 
 int main(int argc, char** argv)
 {
-    const char* keys =
+    const std::string keysText =
         "{help h usage ? |      | print this message }"
         "{model m        |      | noise model of the camera (required): a NoiseModel YAML/JSON, an Android "
         "profile YAML, or darktable's noiseprofiles.json with --camera }"
@@ -21,7 +21,9 @@ int main(int argc, char** argv)
         "{out o          |      | output directory (required) }"
         "{variants n     | 1    | variants per input }"
         "{seed           | 1    | seed: same seed, same outputs, on any number of threads }"
-        "{format         |      | output container: dng, png, tif or npy (npy: numpy's uncompressed format, "
+        "{format         |      | output container: " +
+        rawgment_apps::writtenContainerNames() +
+        " (npy: numpy's uncompressed format, "
         "fastest to train from; default: dng for RAW inputs) }"
         "{preview        | false| also write an sRGB preview PNG of each output }"
         "{accept_failed_calibration | false | also use a model whose calibration's verdict was FAIL }"
@@ -32,6 +34,7 @@ int main(int argc, char** argv)
         "temperature: "
         "their fixed pattern is swapped for the target's }"
         "{@inputs        |      | input files (RAW files, or mosaics with a .yml sidecar) }";
+    const char* keys = keysText.c_str();
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_augment"))
         return 2;
     rawgment_apps::installInterruptCleanup();
@@ -69,11 +72,12 @@ int main(int argc, char** argv)
         return 2;
     }
     if (!format.empty()) {
-        if (format != "dng" && format != "png" && format != "tif" && format != "npy") {
-            std::cerr << "rawgment_augment: --format must be dng, png, tif or npy\n";
+        o.extension = rawgment_apps::writtenContainerExtension(format);
+        if (o.extension.empty()) {
+            std::cerr << "rawgment_augment: --format must be " << rawgment_apps::writtenContainerNames()
+                      << "\n";
             return 2;
         }
-        o.extension = "." + format;
     }
     try {
         rawgment_apps::OutputDirectory outputDirectory(o.outDir);

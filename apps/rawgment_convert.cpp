@@ -41,12 +41,14 @@ std::vector<std::string> filesOf(const std::vector<std::string>& inputs)
 
 int main(int argc, char** argv)
 {
-    const char* keys =
-        "{help h usage ? |      | print this message }"
-        "{out o          |      | output directory (required; created if missing) }"
-        "{format         | npy  | output container: npy, tif, png or dng }"
-        "{@inputs        |      | input files (camera RAWs, or mosaics with a .yml sidecar) or folders of "
-        "them }";
+    const std::string keysText = "{help h usage ? |      | print this message }"
+                                 "{out o          |      | output directory (required; created if missing) }"
+                                 "{format         | npy  | output container: " +
+                                 rawgment_apps::writtenContainerNames() +
+                                 " }"
+                                 "{@inputs        |      | input files (camera RAWs, or mosaics with a .yml "
+                                 "sidecar) or folders of them }";
+    const char* keys = keysText.c_str();
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_convert"))
         return 2;
     rawgment_apps::installInterruptCleanup();
@@ -74,16 +76,17 @@ int main(int argc, char** argv)
         std::cerr << "usage: rawgment_convert --out=<dir> [--format=npy] <files or folders...>\n";
         return 2;
     }
-    if (format != "npy" && format != "tif" && format != "png" && format != "dng") {
-        std::cerr << "rawgment_convert: --format must be npy, tif, png or dng (got '" << format << "')\n";
+    if (rawgment_apps::writtenContainerExtension(format).empty()) {
+        std::cerr << "rawgment_convert: --format must be " << rawgment_apps::writtenContainerNames()
+                  << " (got '" << format << "')\n";
         return 2;
     }
     try {
         const std::vector<std::string> files = filesOf(inputs);
         rawgment_apps::OutputDirectory outputDirectory(outDir);
         rawgment_apps::ProgressBar progress("convert", files.size());
-        const rawgment_apps::ConvertResult r =
-            rawgment_apps::convertMosaics(files, outDir, "." + format, [&] { progress.advance(); });
+        const rawgment_apps::ConvertResult r = rawgment_apps::convertMosaics(
+            files, outDir, rawgment_apps::writtenContainerExtension(format), [&] { progress.advance(); });
         progress.finish();
         std::cout << "wrote " << r.written << " files, skipped " << r.skipped << " converted before, in "
                   << outDir << "\n";

@@ -12,7 +12,7 @@
 
 int main(int argc, char** argv)
 {
-    const char* keys =
+    const std::string keysText =
         "{help h usage ? |          | print this message }"
         "{out o          |          | output directory (required) }"
         "{gains          | 6,12,24  | analog gains in dB }"
@@ -27,12 +27,15 @@ int main(int argc, char** argv)
         "(monochrome) }"
         "{outliers       | 0        | sensor: fraction of hot + dead + noisy pixels }"
         "{seed           | 1        | noise seed }"
-        "{format         | dng      | frame container: dng, png or tif }"
+        "{format         | dng      | frame container: " +
+        rawgment_apps::writtenContainerNames() +
+        " }"
         "{dark           | false    | also a burst of dark frames (no light, as under a lens cap) per gain }"
         "{row_noise      | 0,0      | sensor: row-noise variance before, after the gain (DN^2) }"
         "{tukey_lambda   | none     | sensor: Tukey-lambda shape of the read noise (none: Gaussian) }"
         "{dark_shading   | 0        | sensor: amplitude of a dark-shading pattern (DN; 0: none) }"
         "{validation     | true     | also write the bright and x0.5, x0.1 bursts for rawgment_validate }";
+    const char* keys = keysText.c_str();
     if (!rawgment_apps::checkCommandLine(argc, argv, keys, "rawgment_simulate"))
         return 2;
     rawgment_apps::installInterruptCleanup();
@@ -62,7 +65,8 @@ int main(int argc, char** argv)
         const double outliers = parser.get<double>("outliers");
         o.sensor.hotPixelFraction = o.sensor.deadPixelFraction = o.sensor.noisyPixelFraction = outliers / 3;
         o.seed = rawgment_apps::seedOption(parser, "rawgment_simulate");
-        o.extension = "." + parser.get<std::string>("format");
+        const std::string format = parser.get<std::string>("format");
+        o.extension = rawgment_apps::writtenContainerExtension(format);
         o.validation = parser.get<bool>("validation");
         o.dark = parser.get<bool>("dark");
         const std::vector<double> rowNoise =
@@ -91,8 +95,9 @@ int main(int argc, char** argv)
             std::cerr << "rawgment_simulate: --out is required (see --help)\n";
             return 2;
         }
-        if (o.extension != ".dng" && o.extension != ".png" && o.extension != ".tif") {
-            std::cerr << "rawgment_simulate: --format must be dng, png or tif\n";
+        if (o.extension.empty()) {
+            std::cerr << "rawgment_simulate: --format must be " << rawgment_apps::writtenContainerNames()
+                      << "\n";
             return 2;
         }
         o.sensor.validate();

@@ -2,6 +2,7 @@
 #include "app_tools.hpp"
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/rawgment/mosaic_files.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
 
 #include <algorithm>
@@ -239,6 +240,26 @@ void CsvTable::write(const std::string& path) const
     for (const std::string& row : rows_)
         text += row + "\n";
     writeNewText(path, text);
+}
+
+std::string writtenContainerNames()
+{
+    std::vector<std::string> names;
+    for (const cv::rawgment::MosaicContainer& c : cv::rawgment::mosaicContainers())
+        if (c.writes)
+            names.push_back(c.name);
+    std::string text;
+    for (size_t i = 0; i < names.size(); ++i)
+        text += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+    return text;
+}
+
+std::string writtenContainerExtension(const std::string& name)
+{
+    for (const cv::rawgment::MosaicContainer& c : cv::rawgment::mosaicContainers())
+        if (c.writes && c.name == name)
+            return c.extensions.front();
+    return std::string();
 }
 
 std::string formatNumber(double value)

@@ -53,6 +53,12 @@ void installInterruptCleanup();
  * Prints the first problem, naming the option and the valid ones, to stderr and returns false. */
 bool checkCommandLine(int argc, char** argv, const char* keys, const char* app);
 
+//! The names of the containers writeMosaic() writes, from the library's table (mosaicContainers()): "dng,
+//! npy, png or tif", for a --format flag's help and errors.
+std::string writtenContainerNames();
+//! The extension a --format names ("tif" -> ".tif"); empty when no written container has that name.
+std::string writtenContainerExtension(const std::string& name);
+
 //! Comma-separated numbers ("0,6,12"); throws std::invalid_argument naming the bad item.
 std::vector<double> parseNumberList(const std::string& text);
 

@@ -30,7 +30,7 @@ struct SimulateOptions
     int patchSize = 40;
     cv::rawgment::SensorParams sensor;
     uint64_t seed = 1;
-    std::string extension = ".dng"; //!< container of the frames (.dng, .png or .tif)
+    std::string extension = ".dng"; //!< container of the frames (any that writeMosaic() writes)
     bool dark = false;              //!< also a burst of dark frames (no light) per gain
     //! Amplitude (DN) of a dark-shading pattern drawn for the chart's size (addDarkShadingPattern(); 0:
     //! none).

@@ -23,9 +23,11 @@ from . import _rawgment
 
 __all__ = ["augmentFiles", "main", "RAW_EXTENSIONS"]
 
-#: File extensions of the camera RAW formats LibRaw reads (lower case), for picking inputs from a folder.
-RAW_EXTENSIONS = (".dng", ".nef", ".cr2", ".cr3", ".crw", ".arw", ".raf", ".rw2", ".orf", ".pef", ".kdc",
-                  ".srw", ".3fr", ".iiq", ".erf", ".mef", ".mos", ".nrw", ".x3f")
+#: File extensions of the camera RAW formats LibRaw reads (lower case), for picking inputs from a folder: the
+#: library's table of containers (mosaicContainers()).
+RAW_EXTENSIONS = tuple(e for c in _rawgment.mosaicContainers() if c.cameraRaw for e in c.extensions)
+#: The containers writeMosaic() writes, by name ("dng", "npy", "png", "tif"): what --format takes.
+WRITTEN_CONTAINERS = tuple(c.name for c in _rawgment.mosaicContainers() if c.writes)
 
 
 def _runJob(job, model, scene, policy, acceptFailedCalibration=False, camera="", darkBank="", darkBankTied=False):
@@ -65,8 +67,8 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     """
     if (policy is None) == (scene is None):
         raise ValueError("give exactly one of policy and scene")
-    if format not in (None, "dng", "png", "tif", "npy"):
-        raise ValueError("format must be 'dng', 'png', 'tif' or 'npy', not %r" % (format,))
+    if format is not None and format not in WRITTEN_CONTAINERS:
+        raise ValueError("format must be %s, not %r" % (", ".join("'%s'" % n for n in WRITTEN_CONTAINERS), format))
     seed = _checkedSeed(seed)
     camera = "" if camera is None else str(camera)
     inputs = [os.fspath(p) for p in inputs]
@@ -156,7 +158,7 @@ def main(argv=None):
     parser.add_argument("--variants", type=int, default=1, help="variants per input (default 1)")
     parser.add_argument("--seed", type=int, default=1,
                         help="seed from 0 to 2**64 - 1: same seed, same files (default 1)")
-    parser.add_argument("--format", choices=("dng", "png", "tif", "npy"), help="output container")
+    parser.add_argument("--format", choices=WRITTEN_CONTAINERS, help="output container")
     parser.add_argument("--preview", action="store_true", help="also write an sRGB preview PNG per output")
     parser.add_argument("--accept_failed_calibration", action="store_true",
                         help="also use a model whose calibration's verdict was FAIL")

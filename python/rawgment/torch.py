@@ -24,7 +24,8 @@ from rawgment.batch import RAW_EXTENSIONS
 
 __all__ = ["sampleSeed", "Augmented", "RandomNoiseScene", "RawFolderDataset", "packCfaPlanes", "loadMosaic"]
 
-MOSAIC_EXTENSIONS = (".npy", ".png", ".tif", ".tiff")
+#: Extensions of the mosaics readMosaic() reads beside their sidecar: the library's table (mosaicContainers()).
+MOSAIC_EXTENSIONS = tuple(e for c in _rg.mosaicContainers() if c.readsMosaic and not c.cameraRaw for e in c.extensions)
 
 Augmented = collections.namedtuple("Augmented", ["raw", "format", "boxes", "report", "scene", "camera"],
                                    defaults=(None,))

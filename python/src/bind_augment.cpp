@@ -474,6 +474,21 @@ void bindMosaicFiles(py::module_& m)
         .def_readwrite("size", &MosaicMetadata::size, doc("MosaicMetadata::size"))
         .def_readwrite("type", &MosaicMetadata::type, doc("MosaicMetadata::type"))
         .def("formatFor", &MosaicMetadata::formatFor, py::arg("model"), doc("MosaicMetadata::formatFor"));
+    py::class_<MosaicContainer>(m, "MosaicContainer", doc("MosaicContainer"))
+        .def_readonly("name", &MosaicContainer::name, doc("MosaicContainer::name"))
+        .def_readonly("extensions", &MosaicContainer::extensions, doc("MosaicContainer::extensions"))
+        .def_readonly("readsMosaic", &MosaicContainer::readsMosaic, doc("MosaicContainer::readsMosaic"))
+        .def_readonly("writes", &MosaicContainer::writes, doc("MosaicContainer::writes"))
+        .def_readonly("float32", &MosaicContainer::float32, doc("MosaicContainer::float32"))
+        .def_readonly("cameraRaw", &MosaicContainer::cameraRaw, doc("MosaicContainer::cameraRaw"));
+    m.def("mosaicContainers", &mosaicContainers, doc("mosaicContainers"));
+    m.def(
+        "mosaicContainerOf",
+        [](const std::string& path) -> py::object {
+            const MosaicContainer* c = mosaicContainerOf(path);
+            return c ? py::cast(*c) : py::none();
+        },
+        py::arg("path"), doc("mosaicContainerOf", "Python: None when no container has the extension."));
     m.def("sidecarPathOf", &sidecarPathOf, py::arg("path"), doc("sidecarPathOf"));
     m.def(
         "writeMosaic",

@@ -7,6 +7,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/rawgment/mosaic_files.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <vector>
 
@@ -135,20 +136,24 @@ using detail::lowerExtensionOf;
 
 namespace {
 
-//! The bytes of `path`'s container (by its lower-case extension `ext`) holding `mosaic`.
-std::vector<uchar> containerBytes(const String& path, const String& ext, const Mat& mosaic,
-                                  const MosaicMetadata& meta)
+std::vector<uchar> dngBytes(const String& path, const String&, const Mat& mosaic, const MosaicMetadata& meta)
 {
-    if (ext == ".dng") {
-        RawImage image;
-        image.mosaic = mosaic;
-        image.format = meta.format;
-        if (meta.hasCamera)
-            meta.camera.applyTo(image);
-        return detail::dngFileBytes(path, image);
-    }
-    if (ext == ".npy")
-        return detail::npyFileBytes(mosaic);
+    RawImage image;
+    image.mosaic = mosaic;
+    image.format = meta.format;
+    if (meta.hasCamera)
+        meta.camera.applyTo(image);
+    return detail::dngFileBytes(path, image);
+}
+
+std::vector<uchar> npyBytes(const String&, const String&, const Mat& mosaic, const MosaicMetadata&)
+{
+    return detail::npyFileBytes(mosaic);
+}
+
+// PNG, or TIFF uncompressed, through OpenCV's encoders.
+std::vector<uchar> imageBytes(const String& path, const String& ext, const Mat& mosaic, const MosaicMetadata&)
+{
     std::vector<uchar> bytes;
     const std::vector<int> params =
         ext == ".png" ? std::vector<int>{} : std::vector<int>{IMWRITE_TIFF_COMPRESSION, 1};
@@ -164,30 +169,144 @@ std::vector<uchar> containerBytes(const String& path, const String& ext, const M
     return bytes;
 }
 
+// A DNG states its own levels and pattern: a sidecar that contradicts them describes another file.
+Mat dngMosaic(const String& path, const MosaicMetadata& meta)
+{
+    const RawImage raw = readRaw(path);
+    const RawFormat& f = raw.format;
+    if (f.pattern != meta.format.pattern || f.blackLevel != meta.format.blackLevel ||
+        f.whiteLevel != meta.format.whiteLevel)
+        CV_Error(
+            Error::StsError,
+            cv::format("readMosaic: '%s' is %s with black %g %g %g %g and white %g, but its sidecar says "
+                       "%s with black %g %g %g %g and white %g",
+                       path.c_str(), cfaPatternName(f.pattern).c_str(), f.blackLevel[0], f.blackLevel[1],
+                       f.blackLevel[2], f.blackLevel[3], f.whiteLevel,
+                       cfaPatternName(meta.format.pattern).c_str(), meta.format.blackLevel[0],
+                       meta.format.blackLevel[1], meta.format.blackLevel[2], meta.format.blackLevel[3],
+                       meta.format.whiteLevel));
+    return raw.mosaic;
+}
+
+Mat npyMosaic(const String& path, const MosaicMetadata&)
+{
+    return detail::readNpyMosaic(path);
+}
+
+// The header is held to the sidecar before any decode (round 5 item 20: a PNG claiming another size was
+// decoded first).
+Mat imageMosaic(const String& path, const MosaicMetadata& meta)
+{
+    try {
+        return detail::readImageFileOfSize(path, meta.size, meta.type, "readMosaic: mosaic");
+    } catch (const Exception& e) {
+        CV_Error(Error::StsError, e.err + " (its sidecar says " +
+                                      cv::format("%dx%d %s)", meta.size.width, meta.size.height,
+                                                 typeToString(meta.type).c_str()));
+    }
+}
+
+/* The one table of containers: what each is (MosaicContainer) and how it is written and read. Adding a
+ * container is one entry here; MosaicFiles.mosaicRoundTripsWithItsSidecarInEveryContainer writes and reads
+ * every entry. */
+struct ContainerCodec
+{
+    MosaicContainer container;
+    std::vector<uchar> (*encode)(const String& path, const String& ext, const Mat& mosaic,
+                                 const MosaicMetadata& meta);
+    Mat (*decode)(const String& path, const MosaicMetadata& meta);
+};
+
+const std::vector<ContainerCodec>& codecs()
+{
+    static const std::vector<ContainerCodec> table = {
+        {{"dng", {".dng"}, true, true, false, true}, dngBytes, dngMosaic},
+        {{"npy", {".npy"}, true, true, true, false}, npyBytes, npyMosaic},
+        {{"png", {".png"}, true, true, false, false}, imageBytes, imageMosaic},
+        {{"tif", {".tif", ".tiff"}, true, true, true, false}, imageBytes, imageMosaic},
+        // LibRaw's camera formats besides DNG, for picking a camera's files from a folder.
+        {{"camera RAW",
+          {".nef", ".cr2", ".cr3", ".crw", ".arw", ".raf", ".rw2", ".orf", ".pef", ".kdc", ".srw", ".3fr",
+           ".iiq", ".erf", ".mef", ".mos", ".nrw", ".x3f"},
+          false,
+          false,
+          false,
+          true},
+         nullptr,
+         nullptr},
+    };
+    return table;
+}
+
+const ContainerCodec* codecOf(const String& path)
+{
+    const String ext = lowerExtensionOf(path);
+    for (const ContainerCodec& c : codecs())
+        if (std::find(c.container.extensions.begin(), c.container.extensions.end(), ext) !=
+            c.container.extensions.end())
+            return &c;
+    return nullptr;
+}
+
+//! The extensions of the containers that `has`, as "a, b or c".
+String extensionsWhere(bool (*has)(const MosaicContainer&))
+{
+    std::vector<String> all;
+    for (const ContainerCodec& c : codecs())
+        if (has(c.container))
+            all.insert(all.end(), c.container.extensions.begin(), c.container.extensions.end());
+    String text;
+    for (size_t i = 0; i < all.size(); ++i)
+        text += (i == 0 ? "" : i + 1 == all.size() ? " or " : ", ") + all[i];
+    return text;
+}
+
 } // namespace
+
+const std::vector<MosaicContainer>& mosaicContainers()
+{
+    static const std::vector<MosaicContainer> containers = [] {
+        std::vector<MosaicContainer> out;
+        for (const ContainerCodec& c : codecs())
+            out.push_back(c.container);
+        return out;
+    }();
+    return containers;
+}
+
+const MosaicContainer* mosaicContainerOf(const String& path)
+{
+    const ContainerCodec* codec = codecOf(path);
+    return codec ? &mosaicContainers()[static_cast<size_t>(codec - codecs().data())] : nullptr;
+}
 
 void writeMosaic(const String& path, InputArray _mosaic, const MosaicMetadata& metadata)
 {
     const Mat mosaic = detail::twoDimensional(_mosaic, "writeMosaic: mosaic");
     const String ext = lowerExtensionOf(path);
-    const bool tiff = ext == ".tif" || ext == ".tiff", npy = ext == ".npy", takesFloat = tiff || npy;
-    if (ext != ".png" && ext != ".dng" && !tiff && !npy)
-        CV_Error(Error::StsBadArg, "writeMosaic: '" + path +
-                                       "': unsupported extension; expected .png, .tif, "
-                                       ".tiff, .dng or .npy");
+    const ContainerCodec* codec = codecOf(path);
+    if (!codec || !codec->container.writes)
+        CV_Error(Error::StsBadArg, "writeMosaic: '" + path + "': unsupported extension; expected " +
+                                       extensionsWhere([](const MosaicContainer& c) { return c.writes; }));
+    const bool takesFloat = codec->container.float32;
     if (mosaic.empty() || (mosaic.type() != CV_16UC1 && !(takesFloat && mosaic.type() == CV_32FC1)))
         CV_Error(Error::StsBadArg,
                  cv::format("writeMosaic: '%s': a %s mosaic cannot be stored as %s; expected CV_16UC1%s",
                             path.c_str(), mosaic.empty() ? "empty" : typeToString(mosaic.type()).c_str(),
                             ext.c_str(),
-                            takesFloat ? " or CV_32FC1" : " (TIFF and .npy also take CV_32FC1)"));
+                            takesFloat ? " or CV_32FC1"
+                                       : (" (" + extensionsWhere([](const MosaicContainer& c) {
+                                              return c.writes && c.float32;
+                                          }) +
+                                          " also take CV_32FC1)")
+                                             .c_str()));
     MosaicMetadata meta = metadata;
     meta.size = mosaic.size();
     meta.type = mosaic.type();
     const String sidecar = sidecarPathOf(path);
     const std::string text =
         fileStorageText(sidecar, [&](FileStorage& fs) { meta.write(fs, "mosaic_metadata"); });
-    const std::vector<uchar> bytes = containerBytes(path, ext, mosaic, meta);
+    const std::vector<uchar> bytes = codec->encode(path, ext, mosaic, meta);
     // Another writer of the same job (a second run into the same folder, started at once) may make the same
     // files at the same time: its image and sidecar, byte for byte ours, are this call's output too.
     const auto holds = [](const String& file, const void* data, size_t size) {
@@ -244,36 +363,12 @@ MosaicMetadata readMosaic(const String& path, OutputArray _mosaic)
     const MosaicMetadata meta =
         detail::loadFileStorage(sidecar, "mosaic_metadata", "mosaic sidecar",
                                 [](const FileNode& n) { return MosaicMetadata::read(n); });
-    Mat mosaic;
-    if (lowerExtensionOf(path) == ".dng") {
-        // A DNG states its own levels and pattern: a sidecar that contradicts them describes another file.
-        const RawImage raw = readRaw(path);
-        const RawFormat& f = raw.format;
-        if (f.pattern != meta.format.pattern || f.blackLevel != meta.format.blackLevel ||
-            f.whiteLevel != meta.format.whiteLevel)
-            CV_Error(
-                Error::StsError,
-                cv::format("readMosaic: '%s' is %s with black %g %g %g %g and white %g, but its sidecar says "
-                           "%s with black %g %g %g %g and white %g",
-                           path.c_str(), cfaPatternName(f.pattern).c_str(), f.blackLevel[0], f.blackLevel[1],
-                           f.blackLevel[2], f.blackLevel[3], f.whiteLevel,
-                           cfaPatternName(meta.format.pattern).c_str(), meta.format.blackLevel[0],
-                           meta.format.blackLevel[1], meta.format.blackLevel[2], meta.format.blackLevel[3],
-                           meta.format.whiteLevel));
-        mosaic = raw.mosaic;
-    } else if (lowerExtensionOf(path) == ".npy") {
-        mosaic = detail::readNpyMosaic(path);
-    } else {
-        // The header is held to the sidecar before any decode (round 5 item 20: a PNG claiming another
-        // size was decoded first).
-        try {
-            mosaic = detail::readImageFileOfSize(path, meta.size, meta.type, "readMosaic: mosaic");
-        } catch (const Exception& e) {
-            CV_Error(Error::StsError, e.err + " (its sidecar says " +
-                                          cv::format("%dx%d %s)", meta.size.width, meta.size.height,
-                                                     typeToString(meta.type).c_str()));
-        }
-    }
+    const ContainerCodec* codec = codecOf(path);
+    if (!codec || !codec->container.readsMosaic)
+        CV_Error(Error::StsError,
+                 "readMosaic: '" + path + "': no mosaic container has its extension; expected " +
+                     extensionsWhere([](const MosaicContainer& c) { return c.readsMosaic; }));
+    const Mat mosaic = codec->decode(path, meta);
     if (mosaic.empty())
         CV_Error(Error::StsError, "readMosaic: '" + path + "': OpenCV cannot decode it");
     if (mosaic.size() != meta.size || mosaic.type() != meta.type)

@@ -182,8 +182,16 @@ TEST(MosaicFiles, mosaicRoundTripsWithItsSidecarInEveryContainer)
     meta.scene.jitter.gainRatio = 2.0;
     meta.seed = 18446744073709551557ull; // the largest 64-bit prime: the seed needs all 64 bits
     meta.source = "input.dng";
-    for (const char* ext : {".png", ".tif", ".dng", ".npy"}) {
+    // Every container of the table that writes, under each of its extensions: a new entry is tested here.
+    std::vector<std::string> expected, writtenExtensions;
+    for (const MosaicContainer& c : mosaicContainers())
+        if (c.writes)
+            for (const String& e : c.extensions)
+                writtenExtensions.push_back(e);
+    ASSERT_EQ(writtenExtensions, std::vector<std::string>({".dng", ".npy", ".png", ".tif", ".tiff"}));
+    for (const std::string& ext : writtenExtensions) {
         const std::string path = dir + "/out" + ext;
+        expected.insert(expected.end(), {"out" + ext, "out" + ext + ".yml"});
         writeMosaic(path, m16, meta);
         Mat back;
         const MosaicMetadata r = readMosaic(path, back);
@@ -206,22 +214,62 @@ TEST(MosaicFiles, mosaicRoundTripsWithItsSidecarInEveryContainer)
         EXPECT_CV_ERROR_CONTAINS(writeMosaic(path, Mat(m16 + 1), meta), "never overwritten");
         EXPECT_EQ(before, test::readBytes(path));
     }
+    // Float mosaics losslessly where the table says the container holds them, refused elsewhere.
     Mat f32(32, 48, CV_32FC1);
     randu(f32, -5.0, 1000.0);
-    writeMosaic(dir + "/float.tiff", f32, meta);
-    Mat back;
-    readMosaic(dir + "/float.tiff", back);
-    EXPECT_EQ(0, norm(f32, back, NORM_INF)) << "float TIFF is lossless";
-    writeMosaic(dir + "/float.npy", f32, meta);
-    readMosaic(dir + "/float.npy", back);
-    EXPECT_EQ(0, norm(f32, back, NORM_INF)) << "float .npy is lossless";
-    EXPECT_EQ(CV_32FC1, back.type());
-    EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/float.png", f32, meta), "cannot be stored as .png");
-    EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/x.jpg", m16, meta), "unsupported extension");
-    const std::vector<std::string> expected = {"float.npy", "float.npy.yml", "float.tiff", "float.tiff.yml",
-                                               "out.dng",   "out.dng.yml",   "out.npy",    "out.npy.yml",
-                                               "out.png",   "out.png.yml",   "out.tif",    "out.tif.yml"};
+    for (const MosaicContainer& c : mosaicContainers()) {
+        if (!c.writes)
+            continue;
+        const std::string path = dir + "/float" + c.extensions.back();
+        SCOPED_TRACE(path);
+        if (!c.float32) {
+            EXPECT_CV_ERROR_CONTAINS(writeMosaic(path, f32, meta),
+                                     "cannot be stored as " + c.extensions.back());
+            continue;
+        }
+        writeMosaic(path, f32, meta);
+        expected.insert(expected.end(),
+                        {"float" + c.extensions.back(), "float" + c.extensions.back() + ".yml"});
+        Mat back;
+        readMosaic(path, back);
+        EXPECT_EQ(CV_32FC1, back.type());
+        EXPECT_EQ(0, norm(f32, back, NORM_INF)) << "float is lossless";
+    }
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/x.jpg", m16, meta),
+                             "unsupported extension; expected .dng, .npy, .png, .tif or .tiff");
+    EXPECT_CV_ERROR_CONTAINS(writeMosaic(dir + "/x.nef", m16, meta), "unsupported extension");
+    std::sort(expected.begin(), expected.end());
     EXPECT_EQ(expected, filesIn(dir)) << "no temporary files are left behind";
+}
+
+// One table of containers: every extension lower case with its dot and in one container only, a path found
+// by its extension in any case, the camera formats read by readRaw() and never written.
+TEST(MosaicFiles, theContainerTableNamesEachExtensionOnceAndFindsAPathsContainer)
+{
+    std::vector<String> all;
+    for (const MosaicContainer& c : mosaicContainers()) {
+        SCOPED_TRACE(c.name);
+        EXPECT_FALSE(c.name.empty());
+        ASSERT_FALSE(c.extensions.empty());
+        EXPECT_TRUE(c.writes || c.readsMosaic || c.cameraRaw);
+        EXPECT_FALSE(c.writes && !c.readsMosaic) << "what is written is read back";
+        for (const String& e : c.extensions) {
+            EXPECT_TRUE(e.size() > 1 && e[0] == '.') << e;
+            EXPECT_EQ(e, toLowerCase(e));
+            all.push_back(e);
+        }
+    }
+    std::vector<String> unique = all;
+    std::sort(unique.begin(), unique.end());
+    EXPECT_EQ(std::unique(unique.begin(), unique.end()), unique.end());
+    ASSERT_NE(mosaicContainerOf("/a/b/IMG_0001.NEF"), nullptr);
+    EXPECT_TRUE(mosaicContainerOf("/a/b/IMG_0001.NEF")->cameraRaw);
+    EXPECT_FALSE(mosaicContainerOf("x.nef")->writes);
+    EXPECT_EQ(mosaicContainerOf("x.TIFF")->name, "tif");
+    EXPECT_TRUE(mosaicContainerOf("x.dng")->cameraRaw && mosaicContainerOf("x.dng")->writes);
+    EXPECT_EQ(mosaicContainerOf("x.jpg"), nullptr);
+    EXPECT_EQ(mosaicContainerOf("noextension"), nullptr);
+    EXPECT_CV_ERROR_CONTAINS(readMosaic("/no/such/x.jpg", noArray()), "no such file");
 }
 
 TEST(MosaicFiles, aMonochromeFrameRoundTripsWithItsSidecarInEveryContainer)

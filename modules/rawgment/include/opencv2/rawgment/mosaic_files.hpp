@@ -48,6 +48,28 @@ struct CV_RAWGMENT_EXPORTS MosaicMetadata
     static MosaicMetadata read(const FileNode& node);
 };
 
+/** @brief A file container of mosaics: its extensions and what the library does with it.
+ *
+ * mosaicContainers() is the one table of them: writeMosaic() and readMosaic() decide by it, and the apps, the
+ * pipeline and the Python package take their lists of extensions from it. */
+struct CV_RAWGMENT_EXPORTS MosaicContainer
+{
+    String name;                    //!< the container's name, its first extension without the dot ("tif")
+    std::vector<String> extensions; //!< lower case, with the dot; the first is the one an app writes
+    bool readsMosaic = false;       //!< readMosaic() reads it beside its sidecar
+    bool writes = false;            //!< writeMosaic() writes it
+    bool float32 = false;           //!< holds CV_32FC1 mosaics as well as CV_16UC1
+    bool cameraRaw = false;         //!< a camera's own file, read by readRaw() (LibRaw) with no sidecar
+};
+
+/** @brief Every container of mosaics: DNG, numpy's `.npy`, PNG, TIFF, and the camera RAW formats LibRaw
+ * reads.
+ */
+CV_RAWGMENT_EXPORTS const std::vector<MosaicContainer>& mosaicContainers();
+
+/** @brief The container of a path by its extension (any case); null when no container has it. */
+CV_RAWGMENT_EXPORTS const MosaicContainer* mosaicContainerOf(const String& path);
+
 /** @brief The sidecar of a mosaic file: `path` + ".yml". */
 CV_RAWGMENT_EXPORTS String sidecarPathOf(const String& path);
 
