@@ -2,7 +2,6 @@
 #include "app_tools.hpp"
 
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/rawgment/mosaic_files.hpp>
 #include <opencv2/rawgment/raw_io.hpp>
 
 #include <algorithm>
@@ -55,23 +54,11 @@ void installInterruptCleanup()
     std::atexit(reportRemovedTemporaries);
 }
 
-uint64_t parseSeed(const std::string& text)
-{
-    const std::string why = "--seed must be an integer from 0 to 18446744073709551615 (got '" + text + "')";
-    if (text.empty() || text.size() > 20 || text.find_first_not_of("0123456789") != std::string::npos)
-        throw std::runtime_error(why);
-    errno = 0;
-    const unsigned long long value = std::strtoull(text.c_str(), nullptr, 10);
-    if (errno == ERANGE)
-        throw std::runtime_error(why);
-    return static_cast<uint64_t>(value);
-}
-
 uint64_t seedOption(const cv::CommandLineParser& parser, const char* app)
 {
     try {
         return parseSeed(parser.get<std::string>("seed"));
-    } catch (const std::runtime_error& e) {
+    } catch (const std::invalid_argument& e) {
         std::cerr << app << ": " << e.what() << "\n";
         std::exit(2);
     }
@@ -240,26 +227,6 @@ void CsvTable::write(const std::string& path) const
     for (const std::string& row : rows_)
         text += row + "\n";
     writeNewText(path, text);
-}
-
-std::string writtenContainerNames()
-{
-    std::vector<std::string> names;
-    for (const cv::rawgment::MosaicContainer& c : cv::rawgment::mosaicContainers())
-        if (c.writes)
-            names.push_back(c.name);
-    std::string text;
-    for (size_t i = 0; i < names.size(); ++i)
-        text += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
-    return text;
-}
-
-std::string writtenContainerExtension(const std::string& name)
-{
-    for (const cv::rawgment::MosaicContainer& c : cv::rawgment::mosaicContainers())
-        if (c.writes && c.name == name)
-            return c.extensions.front();
-    return std::string();
 }
 
 std::string formatNumber(double value)

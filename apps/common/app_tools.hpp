@@ -5,6 +5,7 @@
 #ifndef RAWGMENT_APPS_APP_TOOLS_HPP
 #define RAWGMENT_APPS_APP_TOOLS_HPP
 
+#include "augment_command_line.hpp"
 #include "output_files.hpp"
 
 #include <opencv2/core.hpp>
@@ -18,13 +19,11 @@
 
 namespace rawgment_apps {
 
-// The pipeline layer's files (paths, output folders, writes that never replace) are the apps' too.
+// The pipeline layer's files (paths, output folders, writes that never replace) are the apps' too, and so is
+// its command-line rules: parseSeed() (one --seed rule for every app and rawgment.batch; a negative seed used
+// to wrap to 2^64 - 1 here and raise in Python) and the written containers' names.
 using namespace rawgment_pipeline;
 
-/** The seed of a --seed option: decimal digits of a value in [0, 2^64 - 1], the one rule of every app
- * and of rawgment.batch (a negative seed used to wrap to 2^64 - 1 here and raise in Python). Throws
- * std::runtime_error naming the value. */
-uint64_t parseSeed(const std::string& text);
 //! parseSeed() of a command line's --seed; prints "<app>: <why>" and exits with status 2 when it is bad.
 uint64_t seedOption(const cv::CommandLineParser& parser, const char* app);
 
@@ -52,12 +51,6 @@ void installInterruptCleanup();
  * without `=<value>` (`--model m.yml` would read "true"), a number option whose value is not a number.
  * Prints the first problem, naming the option and the valid ones, to stderr and returns false. */
 bool checkCommandLine(int argc, char** argv, const char* keys, const char* app);
-
-//! The names of the containers writeMosaic() writes, from the library's table (mosaicContainers()): "dng,
-//! npy, png or tif", for a --format flag's help and errors.
-std::string writtenContainerNames();
-//! The extension a --format names ("tif" -> ".tif"); empty when no written container has that name.
-std::string writtenContainerExtension(const std::string& name);
 
 //! Comma-separated numbers ("0,6,12"); throws std::invalid_argument naming the bad item.
 std::vector<double> parseNumberList(const std::string& text);

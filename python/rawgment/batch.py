@@ -30,9 +30,9 @@ RAW_EXTENSIONS = tuple(e for c in _rawgment.mosaicContainers() if c.cameraRaw fo
 WRITTEN_CONTAINERS = tuple(c.name for c in _rawgment.mosaicContainers() if c.writes)
 
 
-def _runJob(job, model, scene, policy, acceptFailedCalibration=False, camera="", darkBank="", darkBankTied=False):
+def _runJob(job, options):
     """One output (runs on a worker). Returns its path."""
-    _rawgment._apps.runAugmentJob(job, model, scene, policy, acceptFailedCalibration, camera, darkBank, darkBankTied)
+    _rawgment._apps.runAugmentJob(job, options)
     return job["out"]
 
 
@@ -47,41 +47,51 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
         model: the noise model file: a NoiseModel, an Android profile YAML, or darktable's
             noiseprofiles.json with ``camera``. policy / scene: exactly one, a file.
         out: output folder (created). variants: outputs per input. seed: the run's seed.
-        format: output container "dng", "png", "tif" or "npy" (default: dng for RAW inputs, else the input's).
+        format: output container, a name of WRITTEN_CONTAINERS (default: dng for RAW inputs, else the input's).
         previews: also write an sRGB preview PNG per output.
         client: a ``dask.distributed.Client`` to run the jobs on; None runs them here, one by one.
-        progress: a callable(done, total), or None for a line on stderr per 5% when stderr is a terminal.
-        acceptFailedCalibration: also use a model whose calibration's verdict was FAIL (refused otherwise).
-        camera: with a darktable file, a camera name, a comma-separated list of names, "good" or "usable";
-            with several, each output draws one from its seed and records it in its sidecar.
-        darkBank: a dark-frame bank file (``DarkFrameBank.save``) as every output's read noise, instead of the
-            scene's or policy's own; workers read it by its path. darkBankTied: the inputs are the bank's
-            sensor's (``NoiseOptions.darkBankTied``).
+        progress: called as progress(done, total) after each output (default: a line on stderr when it is a
+            terminal).
+        acceptFailedCalibration: also use a model whose calibration's verdict was FAIL.
+        camera: with a darktable file, a camera name, a comma-separated list, "good" or "usable".
+        darkBank: a dark-frame bank file (rawgment_calibrate --dark_bank) as every output's read noise.
+        darkBankTied: the inputs are the bank's own sensor's.
 
     Returns:
         dict with ``written``, ``skipped`` (finished by an earlier run) and ``outputs`` (every output path).
 
     Raises:
-        RuntimeError or rawgment.error naming the file, for bad options or inputs (before any output is
-        made) and for the first job that failed (the others still finish).
+        ValueError for a value no flag of rawgment_augment takes; RuntimeError or rawgment.error naming the
+        file, for bad options or inputs (before any output is made) and for the first job that failed (the
+        others still finish).
     """
     if (policy is None) == (scene is None):
         raise ValueError("give exactly one of policy and scene")
-    if format is not None and format not in WRITTEN_CONTAINERS:
-        raise ValueError("format must be %s, not %r" % (", ".join("'%s'" % n for n in WRITTEN_CONTAINERS), format))
-    seed = _checkedSeed(seed)
-    camera = "" if camera is None else str(camera)
-    inputs = [os.fspath(p) for p in inputs]
+    if isinstance(seed, bool) or not isinstance(seed, int):
+        raise ValueError("seed must be an integer from 0 to 18446744073709551615 (got %r)" % (seed,))
+    options = _rawgment._apps.AugmentOptions()
+    options.inputs = [os.fspath(p) for p in inputs]
+    # The app's rules for every value (augmentFlags(), setAugmentOption()): one command line, two front ends.
+    given = {"model": model, "out": out, "policy": policy, "scene": scene, "variants": variants, "seed": seed,
+             "format": format, "camera": camera, "dark_bank": darkBank}
+    switches = {"preview": previews, "accept_failed_calibration": acceptFailedCalibration,
+                "dark_bank_tied": darkBankTied}
+    for flag, value in given.items():
+        if value is not None:
+            _rawgment._apps.setAugmentOption(options, flag, str(value) if isinstance(value, int) else
+                                             os.fspath(value))
+    for flag, value in switches.items():
+        _rawgment._apps.setAugmentOption(options, flag, "true" if value else "false")
+    return _augment(options, client, progress)
+
+
+def _augment(options, client, progress):
     # Workers may run elsewhere: the files every job reads are named absolutely (they are not recorded
     # in the outputs, so this changes no byte).
-    model = os.path.abspath(os.fspath(model))
-    policy = os.path.abspath(os.fspath(policy)) if policy is not None else ""
-    scene = os.path.abspath(os.fspath(scene)) if scene is not None else ""
-    darkBank = os.path.abspath(os.fspath(darkBank)) if darkBank is not None else ""
-    darkBankTied = bool(darkBankTied)
-    plan = _rawgment._apps.planAugmentJobs(inputs, model, scene, policy, os.fspath(out), int(variants), int(seed),
-                                           "" if format is None else "." + format, bool(previews),
-                                           bool(acceptFailedCalibration), camera, darkBank, darkBankTied)
+    for field in ("model", "scene", "policy", "darkBank"):
+        if getattr(options, field):
+            setattr(options, field, os.path.abspath(getattr(options, field)))
+    plan = _rawgment._apps.planAugmentJobs(options)
     jobs = plan["jobs"]
     total = len(jobs)
     if progress is None:
@@ -91,7 +101,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     if client is None:
         for job in jobs:
             try:
-                _runJob(job, model, scene, policy, bool(acceptFailedCalibration), camera, darkBank, darkBankTied)
+                _runJob(job, options)
                 written += 1
             except Exception as e:  # the others still run; the first error is raised at the end
                 errors.append("'%s' variant %d: %s" % (job["input"], job["variant"], e))
@@ -99,9 +109,7 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     else:
         from distributed import as_completed
 
-        futures = client.map(_runJob, jobs, model=model, scene=scene, policy=policy,
-                             acceptFailedCalibration=bool(acceptFailedCalibration), camera=camera,
-                             darkBank=darkBank, darkBankTied=darkBankTied, pure=False)
+        futures = client.map(_runJob, jobs, options=options, pure=False)
         where = {f.key: job for f, job in zip(futures, jobs)}
         for future in as_completed(futures):
             job = where[future.key]
@@ -114,13 +122,6 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     if errors:
         raise RuntimeError("%d of %d outputs failed; first: %s" % (len(errors), total, errors[0]))
     return {"written": written, "skipped": plan["skipped"], "outputs": list(plan["outputs"])}
-
-
-def _checkedSeed(seed):
-    """The rule of the apps' --seed: an integer from 0 to 2**64 - 1."""
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2 ** 64:
-        raise ValueError("seed must be an integer from 0 to 18446744073709551615 (got %r)" % (seed,))
-    return seed
 
 
 def _terminalProgress(total):
@@ -145,28 +146,22 @@ def main(argv=None):
         description="Noise-accounted augmentation of RAW files (the job of rawgment_augment), in this process, "
                     "on a local Dask cluster (--workers) or on a running one (--scheduler).",
         allow_abbrev=False)
-    parser.add_argument("--model", required=True,
-                        help="noise model of the camera: a NoiseModel YAML/JSON, an Android profile YAML, or "
-                             "darktable's noiseprofiles.json with --camera")
-    parser.add_argument("--camera",
-                        help="with a darktable file: a camera name, a comma-separated list, good or usable "
-                             "(several: each output draws one)")
-    group = parser.add_mutually_exclusive_group(required=True)
-    group.add_argument("--policy", help="a random policy file (map 'random_scene_policy')")
-    group.add_argument("--scene", help="a scene file (map 'scene') applied to every input")
-    parser.add_argument("--out", required=True, help="output folder")
-    parser.add_argument("--variants", type=int, default=1, help="variants per input (default 1)")
-    parser.add_argument("--seed", type=int, default=1,
-                        help="seed from 0 to 2**64 - 1: same seed, same files (default 1)")
-    parser.add_argument("--format", choices=WRITTEN_CONTAINERS, help="output container")
-    parser.add_argument("--preview", action="store_true", help="also write an sRGB preview PNG per output")
-    parser.add_argument("--accept_failed_calibration", action="store_true",
-                        help="also use a model whose calibration's verdict was FAIL")
-    parser.add_argument("--dark_bank", help="a dark-frame bank file: its real dark frames are every output's read "
-                                            "noise, accounted for the input's own")
-    parser.add_argument("--dark_bank_tied", action="store_true",
-                        help="the inputs come from the bank's own sensor: their fixed pattern is swapped for the "
-                             "target's")
+    # rawgment_augment's flags, from its own table: the same names, help and rules.
+    flags = _rawgment._apps.augmentFlags()
+    groups = {}
+    for f in flags:
+        names = ["--" + f["name"]] + (["-" + f["shortName"]] if f["shortName"] else [])
+        where = parser
+        if f["oneOf"]:
+            if f["oneOf"] not in groups:
+                groups[f["oneOf"]] = parser.add_mutually_exclusive_group(required=True)
+            where = groups[f["oneOf"]]
+        helpText = f["help"] + (" (default %s)" % f["defaultValue"] if f["defaultValue"] and not f["isSwitch"] else "")
+        helpText = helpText.replace("%", "%%")  # argparse formats help with %
+        if f["isSwitch"]:
+            where.add_argument(*names, action="store_true", help=helpText)
+        else:
+            where.add_argument(*names, required=f["required"], help=helpText)
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     where.add_argument("--workers", type=int, help="start a local Dask cluster with this many worker processes")
@@ -175,14 +170,19 @@ def main(argv=None):
                              "only; this tool opens no port to other machines unless asked)")
     parser.add_argument("inputs", nargs="+", help="input files")
     args = parser.parse_args(argv)
-    if args.variants < 1:
-        parser.error("--variants must be >= 1")
+    options = _rawgment._apps.AugmentOptions()
+    options.inputs = list(args.inputs)
+    try:
+        for f in flags:
+            value = getattr(args, f["name"])
+            if f["isSwitch"]:
+                value = "true" if value else "false"
+            if value is not None:
+                _rawgment._apps.setAugmentOption(options, f["name"], value)
+    except ValueError as e:
+        parser.error(str(e))
     if args.workers is not None and args.workers < 1:
         parser.error("--workers must be >= 1")
-    try:
-        _checkedSeed(args.seed)
-    except ValueError as e:
-        parser.error("--" + str(e))
     if args.dashboard is not None and not args.workers:
         parser.error("--dashboard is for the local cluster of --workers")
 
@@ -199,10 +199,7 @@ def main(argv=None):
                 cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
                                        host="127.0.0.1", dashboard_address=args.dashboard or "127.0.0.1:0")
                 client = Client(cluster)
-        result = augmentFiles(args.inputs, args.model, args.out, policy=args.policy, scene=args.scene,
-                              variants=args.variants, seed=args.seed, format=args.format, previews=args.preview,
-                              client=client, acceptFailedCalibration=args.accept_failed_calibration,
-                              camera=args.camera, darkBank=args.dark_bank, darkBankTied=args.dark_bank_tied)
+        result = _augment(options, client, None)
     except (RuntimeError, ValueError, OSError) as e:
         sys.stderr.write("rawgment.batch: %s\n" % e)
         return 1

@@ -2,6 +2,7 @@
 rerun after an interrupted run finishes the job without replacing anything."""
 import filecmp
 import os
+import pickle
 import subprocess
 import sys
 
@@ -71,12 +72,17 @@ def test_one_process_dask_and_the_app_make_the_same_bytes(app_dir, job):
 def test_a_rerun_resumes_and_replaces_nothing(app_dir, job):
     root = job["root"]
     out = root / "resumed"
-    plan = rg._apps.planAugmentJobs(job["inputs"], job["model"], "", job["policy"], str(out), 2, 5, "", False)
+    options = rg._apps.AugmentOptions()
+    options.inputs = list(job["inputs"])
+    for flag, value in (("model", job["model"]), ("policy", job["policy"]), ("out", str(out)), ("variants", "2"),
+                        ("seed", "5")):
+        rg._apps.setAugmentOption(options, flag, value)
+    plan = rg._apps.planAugmentJobs(options)
     assert len(plan["jobs"]) == 6 and plan["skipped"] == 0
     # Two outputs finished, then the run was killed (pid 999999) while writing a third: its temporary
     # is not an output, and the rerun removes it.
     for j in plan["jobs"][:2]:
-        rg._apps.runAugmentJob(j, job["model"], "", job["policy"])
+        rg._apps.runAugmentJob(j, options)
     leftover = plan["jobs"][2]["out"] + ".tmp-999999-0"
     open(leftover, "wb").write(b"partial")
     finished = {p: os.path.getmtime(p) for p in (plan["jobs"][0]["out"], plan["jobs"][1]["out"])}
@@ -266,3 +272,43 @@ def test_a_dark_frame_bank_reaches_the_app_and_the_workers_by_its_path(app_dir, 
     with pytest.raises(RuntimeError, match="needs the bank"):
         batch.augmentFiles(banked["inputs"], banked["model"], tmp_path / "bad", policy=str(policy), darkBankTied=True)
     assert not os.path.exists(tmp_path / "bad") or not os.listdir(tmp_path / "bad")
+
+
+def test_the_app_and_batch_share_one_command_line(app_dir):
+    # One table of flags (pipeline/augment_command_line.hpp): every flag of it in both --help texts with the same
+    # help, and one setter of values with one set of rules, so a flag added once is in both.
+    flags = rg._apps.augmentFlags()
+    assert [f["name"] for f in flags][:5] == ["model", "camera", "scene", "policy", "out"]
+    app = subprocess.run([os.path.join(app_dir, "rawgment_augment"), "--help"], capture_output=True, text=True)
+    py = subprocess.run([sys.executable, "-m", "rawgment.batch", "--help"], capture_output=True, text=True,
+                        env=dict(os.environ, COLUMNS="10000"))
+    assert app.returncode == 0 and py.returncode == 0
+    squash = lambda text: " ".join(text.split())
+    for f in flags:
+        assert "--" + f["name"] in app.stdout and "--" + f["name"] in py.stdout, f["name"]
+        assert squash(f["help"]) in squash(app.stdout), f["name"]
+        assert squash(f["help"]) in squash(py.stdout), f["name"]
+    options = rg._apps.AugmentOptions()
+    for flag, value, why in (("variants", "0", "--variants must be a whole number >= 1"),
+                             ("seed", "-1", "--seed must be an integer from 0 to 18446744073709551615"),
+                             ("format", "jpg", "--format must be dng, npy, png or tif"),
+                             ("preview", "maybe", "--preview must be true or false"),
+                             ("no_such_flag", "1", "no augment flag --no_such_flag")):
+        with pytest.raises(ValueError, match=why):
+            rg._apps.setAugmentOption(options, flag, value)
+    for flag, value in (("format", "tif"), ("seed", "18446744073709551615"), ("preview", "true"),
+                        ("variants", "3"), ("dark_bank", "bank.yml")):
+        rg._apps.setAugmentOption(options, flag, value)
+    assert (options.extension, options.seed, options.previews, options.variants, options.darkBank) == \
+        (".tif", 2**64 - 1, True, 3, "bank.yml")
+    # The options travel to Dask workers pickled: every field comes back.
+    back = pickle.loads(pickle.dumps(options))
+    assert [getattr(back, k) for k in ("extension", "seed", "previews", "variants", "darkBank")] == \
+        [".tif", 2**64 - 1, True, 3, "bank.yml"]
+    # The same refusal from both front ends, by the same rule.
+    for command in ([os.path.join(app_dir, "rawgment_augment"), "--model=m.yml", "--policy=p.yml", "--out=o",
+                     "--variants=0", "x.dng"],
+                    [sys.executable, "-m", "rawgment.batch", "--model", "m.yml", "--policy", "p.yml", "--out", "o",
+                     "--variants", "0", "x.dng"]):
+        run = subprocess.run(command, capture_output=True, text=True)
+        assert run.returncode == 2 and "--variants must be a whole number >= 1 (got '0')" in run.stderr, run.stderr

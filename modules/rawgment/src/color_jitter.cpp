@@ -604,11 +604,8 @@ void colorJitter(InputArray _src, const RawFormat& format, const NoiseModel& mod
                  const NoiseOptions& noise, uint64 seed, OutputArray dst, RawFormat& dstFormat,
                  AugmentReport* report, OutputArray saturatedMask)
 {
-    const Mat src = detail::twoDimensional(_src, "colorJitter: src");
-    const detail::ValidatedNoiseModel valid(model);
-    detail::checkMosaicType(src, "colorJitter");
-    detail::runNoiseStep(detail::makeColorJitterStep(jitter, &saturatedMask), src, format, valid, noise, seed,
-                         dst, dstFormat, report);
+    detail::runPublicStep(detail::makeColorJitterStep(jitter, &saturatedMask), _src, format, model, noise,
+                          seed, dst, dstFormat, report);
 }
 
 } // namespace rawgment

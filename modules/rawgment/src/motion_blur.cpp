@@ -253,7 +253,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
 
 /* A motion blur as a noise step (noise_step.hpp): prepare() validates the kernel and takes its taps, begin()
  * makes the constants of Eq. 15 and the read part (a bank's or the dark components). */
-class MotionBlurStep : public detail::NoiseStep
+class MotionBlurStep : public detail::ResampleStep
 {
 public:
     explicit MotionBlurStep(InputArray kernel) : kernel_(kernel) {}
@@ -262,14 +262,8 @@ public:
 
     RawFormat prepare(const detail::StepContext& context) override
     {
-        using namespace detail;
-        format_ = context.format;
-        seed_ = context.seed;
-        model_ = &context.model;
-        depth_ = context.depth;
-        checkResampleShape(context.size, format_, "motionBlur");
-        step_.reset(new StepNoise(context.model, format_, context.noise, 1, context.size, "motionBlur"));
-        w_ = normalisedKernel(kernel_, "motionBlur", format_.pattern);
+        prepareResampling(context, "motionBlur");
+        w_ = detail::normalisedKernel(kernel_, "motionBlur", format_.pattern);
         // Sparse: a motion kernel is a line, so most of its box is zero and costs nothing.
         taps_.clear();
         for (int y = 0; y < w_.rows; ++y)
@@ -328,11 +322,6 @@ public:
 
 private:
     _InputArray kernel_;
-    RawFormat format_;
-    uint64 seed_ = 0;
-    const detail::ValidatedNoiseModel* model_ = nullptr;
-    int depth_ = CV_16U;
-    std::unique_ptr<detail::StepNoise> step_;
     Mat w_;
     std::vector<KernelTap> taps_;
     ResampleConstants k_;
@@ -356,12 +345,9 @@ std::unique_ptr<NoiseStep> makeMotionBlurStep(InputArray kernel)
 void motionBlur(InputArray _src, const RawFormat& format, const NoiseModel& model, InputArray kernel,
                 const NoiseOptions& noise, uint64 seed, OutputArray dst, AugmentReport* report)
 {
-    const Mat src = detail::twoDimensional(_src, "motionBlur: src");
-    const detail::ValidatedNoiseModel valid(model);
-    detail::checkMosaicType(src, "motionBlur");
     RawFormat dstFormat;
-    detail::runNoiseStep(detail::makeMotionBlurStep(kernel), src, format, valid, noise, seed, dst, dstFormat,
-                         report);
+    detail::runPublicStep(detail::makeMotionBlurStep(kernel), _src, format, model, noise, seed, dst,
+                          dstFormat, report);
 }
 
 } // namespace rawgment

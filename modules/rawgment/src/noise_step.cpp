@@ -86,6 +86,17 @@ void runNoiseStep(std::unique_ptr<NoiseStep> step, const Mat& src, const RawForm
                   valuesChecked);
 }
 
+void runPublicStep(std::unique_ptr<NoiseStep> step, InputArray _src, const RawFormat& format,
+                   const NoiseModel& model, const NoiseOptions& noise, uint64 seed, OutputArray dst,
+                   RawFormat& dstFormat, AugmentReport* report)
+{
+    const char* who = step->name();
+    const Mat src = twoDimensional(_src, cv::format("%s: src", who).c_str());
+    const ValidatedNoiseModel valid(model);
+    checkMosaicType(src, who);
+    runNoiseStep(std::move(step), src, format, valid, noise, seed, dst, dstFormat, report);
+}
+
 } // namespace detail
 } // namespace rawgment
 } // namespace cv

@@ -122,6 +122,12 @@ void runNoiseStep(std::unique_ptr<NoiseStep> step, const Mat& src, const RawForm
                   const ValidatedNoiseModel& model, const NoiseOptions& noise, uint64 seed, OutputArray dst,
                   RawFormat& dstFormat, AugmentReport* report, bool valuesChecked = false);
 
+/** A public step function (colorJitter(), motionBlur(), scaleMosaic()): src made two-dimensional, the model
+ * validated, src's type checked, then its one step; errors name the step. */
+void runPublicStep(std::unique_ptr<NoiseStep> step, InputArray src, const RawFormat& format,
+                   const NoiseModel& model, const NoiseOptions& noise, uint64 seed, OutputArray dst,
+                   RawFormat& dstFormat, AugmentReport* report);
+
 } // namespace detail
 } // namespace rawgment
 } // namespace cv

@@ -7,6 +7,7 @@
 
 #include "augment_steps.hpp"
 #include "bank_noise.hpp"
+#include "noise_step.hpp"
 
 #include "noise_terms.hpp"
 #include <functional>
@@ -145,6 +146,28 @@ void resampleDarkTerms(ResampleConstants& k, const StepNoise& step, double sumW2
 BankRead resampleBankRead(const StepNoise& step, const RawFormat& format, Size size, double sumW2,
                           uint64 seed, RandomStream stream, const char* who,
                           const std::function<void(const Mat&, const RawFormat&, Mat&)>& withoutNoise);
+
+/** What a resampling step (scale, blur) prepares alike: its input's format, the seed, the model and the
+ * depth, the shape it needs (whole 2x2 blocks) and the model's terms at the input's gain, which it keeps. */
+class ResampleStep : public NoiseStep
+{
+protected:
+    void prepareResampling(const StepContext& context, const char* who)
+    {
+        format_ = context.format;
+        seed_ = context.seed;
+        model_ = &context.model;
+        depth_ = context.depth;
+        checkResampleShape(context.size, format_, who);
+        step_.reset(new StepNoise(context.model, format_, context.noise, 1, context.size, who));
+    }
+
+    RawFormat format_;
+    uint64 seed_ = 0;
+    const ValidatedNoiseModel* model_ = nullptr;
+    int depth_ = CV_16U;
+    std::unique_ptr<StepNoise> step_;
+};
 
 } // namespace detail
 } // namespace rawgment

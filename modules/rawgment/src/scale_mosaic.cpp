@@ -150,7 +150,7 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
 
 /* A scale as a noise step (noise_step.hpp): prepare() validates the factor, begin() makes the bilinear axes,
  * the constants of Eq. 15 with their weights and the read part (a bank's or the dark components). */
-class ScaleStep : public detail::NoiseStep
+class ScaleStep : public detail::ResampleStep
 {
 public:
     explicit ScaleStep(double scale) : scale_(scale) {}
@@ -160,13 +160,7 @@ public:
 
     RawFormat prepare(const detail::StepContext& context) override
     {
-        using namespace detail;
-        format_ = context.format;
-        seed_ = context.seed;
-        model_ = &context.model;
-        depth_ = context.depth;
-        checkResampleShape(context.size, format_, "scaleMosaic");
-        step_.reset(new StepNoise(context.model, format_, context.noise, 1, context.size, "scaleMosaic"));
+        prepareResampling(context, "scaleMosaic");
         if (!std::isfinite(scale_) || !(scale_ > 0))
             CV_Error(Error::StsBadArg,
                      cv::format("scaleMosaic: scale must be finite and > 0 (got %g)", scale_));
@@ -259,11 +253,6 @@ public:
 
 private:
     double scale_;
-    RawFormat format_;
-    uint64 seed_ = 0;
-    const detail::ValidatedNoiseModel* model_ = nullptr;
-    int depth_ = CV_16U;
-    std::unique_ptr<detail::StepNoise> step_;
     ResampleConstants k_;
     Size plane_;
     BilinearAxis cols_[2], rows_[2];
@@ -284,12 +273,9 @@ std::unique_ptr<NoiseStep> makeScaleStep(double scale)
 void scaleMosaic(InputArray _src, const RawFormat& format, const NoiseModel& model, double scale,
                  const NoiseOptions& noise, uint64 seed, OutputArray dst, AugmentReport* report)
 {
-    const Mat src = detail::twoDimensional(_src, "scaleMosaic: src");
-    const detail::ValidatedNoiseModel valid(model);
-    detail::checkMosaicType(src, "scaleMosaic");
     RawFormat dstFormat;
-    detail::runNoiseStep(detail::makeScaleStep(scale), src, format, valid, noise, seed, dst, dstFormat,
-                         report);
+    detail::runPublicStep(detail::makeScaleStep(scale), _src, format, model, noise, seed, dst, dstFormat,
+                          report);
 }
 
 Rect scaleBox(const Rect& box, Size size, double scale)
