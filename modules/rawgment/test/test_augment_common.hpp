@@ -1,5 +1,5 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// What the augmentation tests share (test_color_jitter.cpp, test_resample.cpp, test_scene.cpp): the input
+// What the augmentation tests share (test_<step>.cpp of each step, test_resample.cpp, test_scene.cpp): the input
 // bursts of the reference sensor and their temporal and spatial statistics.
 #ifndef OPENCV_RAWGMENT_TEST_AUGMENT_COMMON_HPP
 #define OPENCV_RAWGMENT_TEST_AUGMENT_COMMON_HPP
@@ -161,6 +161,16 @@ inline double fixedPatternExcess(const DarkStats& a, const DarkStats& b, int T, 
     d -= cv::mean(d)[0]; // the scene's level is not the pattern
     const double noise = (a.pixelVar + b.pixelVar + (a.rowMeanVar + b.rowMeanVar) * (1 - 1.0 / W)) / T;
     return d.dot(d) / d.total() / noise - 1;
+}
+
+//! A noiseless CV_32FC1 capture of a flat scene `level` DN above black, carrying the sensor's `pattern`.
+inline Mat flatWithPattern(const RawFormat& fmt, const Mat& pattern, double level)
+{
+    Mat flat(pattern.size(), CV_32FC1);
+    for (int r = 0; r < flat.rows; ++r)
+        for (int c = 0; c < flat.cols; ++c)
+            flat.at<float>(r, c) = static_cast<float>(fmt.blackAt(r, c) + level) + pattern.at<float>(r, c);
+    return flat;
 }
 
 //! A small 12-bit mosaic (black 256) with a pixel far below black, one saturated and one exactly at black.

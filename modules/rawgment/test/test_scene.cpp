@@ -1,7 +1,9 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// The steps together: scenes (shift, scale, jitter, blur), boxes, the dark shading under a shift or a crop,
-// identity steps, output buffers, monochrome frames, seeds and clear errors (the random policy and the files
-// of scenes and policies: test_random_scene_policy.cpp).
+// The steps together: scenes (shift, scale, jitter, blur), boxes, the dark shading under a crop, identity
+// steps, output buffers, monochrome frames, seeds and clear errors (each step alone: test_shift_mosaic.cpp,
+// test_scale_mosaic.cpp, test_color_jitter.cpp, test_motion_blur.cpp; the loop that runs them:
+// test_noise_step_internals.cpp; the random policy and the files of scenes and policies:
+// test_random_scene_policy.cpp).
 #include "test_augment_common.hpp"
 
 #include <opencv2/core/utility.hpp>
@@ -52,42 +54,6 @@ TEST(Augment, boxesAreCheckedAndClippedOnEveryPath)
     EXPECT_EQ(scaleBox(Rect(0, 0, 1, 1), Size(8, 8), 1e300).area(), 0);
 }
 
-TEST(Augment, scaleMovesBoxesKeepsThePhaseAndSkipsTheIdentity)
-{
-    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
-    const NoiseModel model(0.4, 0.5, 2.0);
-    Mat src(64, 64, CV_16UC1);
-    for (int r = 0; r < 64; ++r)
-        for (int c = 0; c < 64; ++c)
-            src.at<ushort>(r, c) = static_cast<ushort>(300 + 800 * cfaSite(r, c));
-    Mat out;
-    scaleMosaic(src, fmt, model, 1.0, NoiseAlignment::ACCOUNT_PRIOR, 1, out);
-    EXPECT_EQ(out.data, src.data);
-    // Each site resamples only its own plane: a constant plane stays constant (NONE adds no noise).
-    scaleMosaic(src, fmt, model, 1.03, NoiseAlignment::NONE, 1, out);
-    EXPECT_EQ(norm(out, src, NORM_INF), 0);
-    // Boxes: the centre is fixed, edges scale about it, the result grows to whole pixels.
-    EXPECT_EQ(scaleBox(Rect(16, 16, 32, 32), Size(64, 64), 1.5), Rect(8, 8, 48, 48));
-    EXPECT_EQ(scaleBox(Rect(0, 0, 10, 10), Size(64, 64), 2.0).area(), 0); // pushed out of the frame
-    EXPECT_EQ(scaleBox(Rect(30, 30, 4, 4), Size(64, 64), 0.5), Rect(31, 31, 2, 2));
-    Scene scene;
-    scene.scale = 2.0;
-    std::vector<Rect> boxes = {Rect(16, 16, 32, 32)};
-    RawFormat f;
-    AugmentReport report;
-    applyScene(src, fmt, model, scene, 3, out, f, &report, &boxes);
-    EXPECT_EQ(boxes[0], Rect(0, 0, 64, 64));
-    ASSERT_EQ(report.steps.size(), 1u);
-    EXPECT_EQ(report.steps[0], "scale");
-    EXPECT_CV_ERROR_CONTAINS(scaleMosaic(src, fmt, model, 0, NoiseAlignment::NONE, 1, out), "scale");
-    EXPECT_CV_ERROR_CONTAINS(
-        scaleMosaic(src, fmt, model, std::numeric_limits<double>::quiet_NaN(), NoiseAlignment::NONE, 1, out),
-        "scale");
-    EXPECT_CV_ERROR_CONTAINS(
-        scaleMosaic(src(Rect(0, 0, 63, 64)), fmt, model, 1.1, NoiseAlignment::NONE, 1, out),
-        "both sides must be even");
-}
-
 TEST(Augment, gainTravelsFromJitterToBlur)
 {
     // Fewer photons x4 at four times the gain: same mean, noisier. The blur that follows must use the
@@ -112,67 +78,6 @@ TEST(Augment, gainTravelsFromJitterToBlur)
     // 4096 pixels of 64 frames, but the blur correlates neighbours; 5% is still over 5 standard errors
     // even if only a quarter of the pixels were independent. The old gain would give 0.42 of this.
     EXPECT_NEAR(v / model.variance(m, 4 * kGain), 1.0, 0.05);
-}
-
-//! A noiseless CV_32FC1 capture of a flat scene `level` DN above black, carrying the sensor's `pattern`.
-Mat flatWithPattern(const RawFormat& fmt, const Mat& pattern, double level)
-{
-    Mat flat(pattern.size(), CV_32FC1);
-    for (int r = 0; r < flat.rows; ++r)
-        for (int c = 0; c < flat.cols; ++c)
-            flat.at<float>(r, c) = static_cast<float>(fmt.blackAt(r, c) + level) + pattern.at<float>(r, c);
-    return flat;
-}
-
-TEST(Augment, aShiftKeepsTheSensorsDarkShadingWhereTheSensorHasIt)
-{
-    // applyScene shifted the dark-shading pattern together with the content: on a noiseless flat input
-    // carrying the pattern, a shift of (8, 6) changed the output by the pattern's own difference
-    // S(x - d) - S(x), where 0 is right because the pattern belongs to the sensor.
-    const Size size(96, 64);
-    const NoiseModel model = darkComponentSensor(size).noise;
-    ASSERT_TRUE(model.hasDarkShading());
-    const RawFormat fmt = SensorSimulator(darkComponentSensor(size), size).rawFormat(kGain);
-    const Mat pattern = model.darkShadingAt(kGain);
-    const Mat flat = flatWithPattern(fmt, pattern, 500);
-    const Rect inside(8, 6, size.width - 8, size.height - 6);
-    const double patternMove =
-        norm(pattern(inside - Point(8, 6)), pattern(inside), NORM_L2) / std::sqrt(double(inside.area()));
-    ASSERT_GT(patternMove, 1.0) << "the test needs a pattern that a shift visibly moves";
-    Scene shifted;
-    shifted.shift = Point(8, 6);
-    Mat out;
-    RawFormat outFmt;
-    applyScene(flat, fmt, model, shifted, 3, out, outFmt);
-    // Float arithmetic of values below 2^12: a few ulps.
-    EXPECT_LT(norm(out, flat, NORM_INF), 1e-3) << "the pattern moved by " << patternMove << " DN RMS";
-    // An integer mosaic is rounded once more: within 1 DN, and a pixel differs (by 1) with probability
-    // E|rounding error| = 1/4, so the RMS is 0.5 on average; 4 standard errors of that share over 6144
-    // pixels (0.0055 each) allow 0.53.
-    Mat flat16, out16, diff;
-    flat.convertTo(flat16, CV_16U);
-    applyScene(flat16, fmt, model, shifted, 3, out16, outFmt);
-    absdiff(out16, flat16, diff);
-    EXPECT_LE(norm(diff, NORM_INF), 1);
-    EXPECT_LE(norm(diff, NORM_L2) / std::sqrt(double(diff.total())), 0.53);
-    // Shifted and darkened x0.5: over 24 seeds the mean output is the darker content plus the sensor's
-    // pattern in place; its residual is the mean's noise alone, below 1.5 sqrt(target variance / 24) RMS
-    // (the target's variance bounds what ACCOUNT_PRIOR adds to a noiseless input; 1.5 leaves room for the
-    // RMS over only 6144 pixels).
-    shifted.jitter = ColorJitter::exposureChange(0.5, 1);
-    const int seeds = 24;
-    Mat sum = Mat::zeros(size, CV_64FC1);
-    for (int seed = 0; seed < seeds; ++seed) {
-        applyScene(flat, fmt, model, shifted, uint64(seed), out, outFmt);
-        accumulate(out, sum);
-    }
-    Mat expected(size, CV_64FC1);
-    for (int r = 0; r < size.height; ++r)
-        for (int c = 0; c < size.width; ++c)
-            expected.at<double>(r, c) = fmt.blackAt(r, c) + 250 + pattern.at<float>(r, c);
-    const double residual = norm(sum / seeds, expected, NORM_L2) / std::sqrt(double(size.area()));
-    const double noise = std::sqrt((model.variance(250, kGain) + model.rowVariance(kGain)) / seeds);
-    EXPECT_LT(residual, 1.5 * noise) << "pattern move " << patternMove;
 }
 
 TEST(Augment, aCropReadsTheDarkShadingOfItsOwnPixelsAtItsSensorOrigin)
@@ -523,64 +428,6 @@ TEST(Augment, badArgumentsGiveClearErrors)
                    FileStorage::READ | FileStorage::MEMORY);
     EXPECT_CV_ERROR_CONTAINS(RandomScenePolicy::read(fs["scene_policy"]),
                              "'blur_noise_sum' must be an integer");
-}
-
-TEST(Augment, shiftKeepsTheCfaPhaseAndMovesBoxes)
-{
-    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
-    const NoiseModel model(0.4, 0.5, 2.0);
-    Mat src(16, 16, CV_16UC1);
-    for (int r = 0; r < 16; ++r)
-        for (int c = 0; c < 16; ++c)
-            src.at<ushort>(r, c) = static_cast<ushort>(1000 * cfaSite(r, c) + 10 * r + c);
-    Scene scene;
-    scene.shift = Point(3, 2); // x rounds to an even 4
-    std::vector<Rect> boxes = {Rect(2, 2, 4, 4), Rect(14, 0, 2, 2)};
-    Mat out;
-    RawFormat f;
-    applyScene(src, fmt, model, scene, 0, out, f, nullptr, &boxes);
-    for (int r = 2; r < 16; ++r)
-        for (int c = 4; c < 16; ++c)
-            ASSERT_EQ(out.at<ushort>(r, c), src.at<ushort>(r - 2, c - 4));
-    for (int r = 0; r < 16; ++r)
-        for (int c = 0; c < 16; ++c)
-            ASSERT_EQ(out.at<ushort>(r, c) / 1000, cfaSite(r, c)); // every pixel keeps its site's colour
-    EXPECT_EQ(boxes[0], Rect(6, 4, 4, 4));
-    EXPECT_EQ(boxes[1].area(), 0); // moved out of the frame
-}
-
-TEST(Augment, shiftMatchesThePlaneWiseComposition)
-{
-    // The one-pass shift against what it replaced: each CFA plane moved by half the shift with
-    // warpAffine (nearest, edge replicated), for shifts inside, at and beyond the middle, up to the
-    // whole frame, on both depths and on a view that is not continuous.
-    const RawFormat fmt = SensorSimulator(test::referenceSensorParams(), Size(2, 2)).rawFormat(kGain);
-    const NoiseModel model(0.4, 0.5, 2.0);
-    Mat big(22, 40, CV_16UC1);
-    randu(big, 0, 4096);
-    for (const Mat& src : {big(Rect(4, 2, 30, 18)), Mat(big(Rect(4, 2, 30, 18)).clone())})
-        for (int depth : {CV_16U, CV_32F})
-            for (const Point shift : {Point(2, 0), Point(0, -4), Point(6, 8), Point(-12, 10), Point(-30, -18),
-                                      Point(30, 18), Point(28, -16)}) {
-                Mat typed;
-                src.convertTo(typed, depth);
-                std::vector<Mat> planes;
-                splitCfaPlanes(typed, planes);
-                for (Mat& plane : planes) {
-                    Mat moved;
-                    warpAffine(plane, moved, Matx23d(1, 0, shift.x / 2, 0, 1, shift.y / 2), plane.size(),
-                               INTER_NEAREST, BORDER_REPLICATE);
-                    plane = moved;
-                }
-                Mat expected, out;
-                mergeCfaPlanes(planes, expected);
-                Scene scene;
-                scene.shift = shift;
-                RawFormat f;
-                applyScene(typed, fmt, model, scene, 0, out, f);
-                ASSERT_EQ(out.type(), typed.type());
-                EXPECT_EQ(0, norm(out, expected, NORM_INF)) << "shift " << shift << ", depth " << depth;
-            }
 }
 
 // A monochrome frame through every step: each at identity returns the input itself, a shift moves it by any
