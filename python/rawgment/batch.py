@@ -15,6 +15,7 @@ the same path; give absolute paths)::
         --policy /data/policy.yml --out /data/augmented --variants 8 /data/raws/*.dng
 """
 import argparse
+import operator
 import os
 import sys
 import time
@@ -50,12 +51,13 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
         format: output container, a name of WRITTEN_CONTAINERS (default: dng for RAW inputs, else the input's).
         previews: also write an sRGB preview PNG per output.
         client: a ``dask.distributed.Client`` to run the jobs on; None runs them here, one by one.
-        progress: called as progress(done, total) after each output (default: a line on stderr when it is a
-            terminal).
-        acceptFailedCalibration: also use a model whose calibration's verdict was FAIL.
-        camera: with a darktable file, a camera name, a comma-separated list, "good" or "usable".
-        darkBank: a dark-frame bank file (rawgment_calibrate --dark_bank) as every output's read noise.
-        darkBankTied: the inputs are the bank's own sensor's.
+        progress: a callable(done, total), or None for a line on stderr per 5% when stderr is a terminal.
+        acceptFailedCalibration: also use a model whose calibration's verdict was FAIL (refused otherwise).
+        camera: with a darktable file, a camera name, a comma-separated list of names, "good" or "usable";
+            with several, each output draws one from its seed and records it in its sidecar.
+        darkBank: a dark-frame bank file (``DarkFrameBank.save``) as every output's read noise, instead of the
+            scene's or policy's own; workers read it by its path. darkBankTied: the inputs are the bank's
+            sensor's (``NoiseOptions.darkBankTied``).
 
     Returns:
         dict with ``written``, ``skipped`` (finished by an earlier run) and ``outputs`` (every output path).
@@ -67,19 +69,23 @@ def augmentFiles(inputs, model, out, *, policy=None, scene=None, variants=1, see
     """
     if (policy is None) == (scene is None):
         raise ValueError("give exactly one of policy and scene")
-    if isinstance(seed, bool) or not isinstance(seed, int):
-        raise ValueError("seed must be an integer from 0 to 18446744073709551615 (got %r)" % (seed,))
     options = _rawgment._apps.AugmentOptions()
     options.inputs = [os.fspath(p) for p in inputs]
     # The app's rules for every value (augmentFlags(), setAugmentOption()): one command line, two front ends.
-    given = {"model": model, "out": out, "policy": policy, "scene": scene, "variants": variants, "seed": seed,
-             "format": format, "camera": camera, "dark_bank": darkBank}
+    # Whole numbers as the app reads them: an int or numpy integer, never a bool or a float.
+    numbers = {"variants": variants, "seed": seed}
+    for flag, value in numbers.items():
+        if isinstance(value, bool) or not hasattr(value, "__index__"):
+            raise ValueError("%s must be an integer%s (got %r)" % (
+                flag, " from 0 to 18446744073709551615" if flag == "seed" else "", value))
+        _rawgment._apps.setAugmentOption(options, flag, str(operator.index(value)))
+    texts = {"model": model, "out": out, "policy": policy, "scene": scene, "format": format,
+             "camera": None if camera is None else str(camera), "dark_bank": darkBank}
     switches = {"preview": previews, "accept_failed_calibration": acceptFailedCalibration,
                 "dark_bank_tied": darkBankTied}
-    for flag, value in given.items():
+    for flag, value in texts.items():
         if value is not None:
-            _rawgment._apps.setAugmentOption(options, flag, str(value) if isinstance(value, int) else
-                                             os.fspath(value))
+            _rawgment._apps.setAugmentOption(options, flag, os.fspath(value))
     for flag, value in switches.items():
         _rawgment._apps.setAugmentOption(options, flag, "true" if value else "false")
     return _augment(options, client, progress)
