@@ -362,12 +362,15 @@ TEST(Apps, convertWritesNpyThatAugmentsAsItsSource)
     // one app writes, the others write too: rawgment_simulate refused npy.
     AppRun refused = runApp("rawgment_convert", "--out='" + dir + "/x' --format=jpg '" + png + "'");
     EXPECT_EQ(2, refused.status);
-    EXPECT_NE(std::string::npos, refused.output.find("--format must be dng, npy, png or tif")) << refused.output;
+    EXPECT_NE(std::string::npos, refused.output.find("--format must be dng, npy, png or tif"))
+        << refused.output;
     refused = runApp("rawgment_simulate", "--out='" + dir + "/y' --format=jpg");
     EXPECT_EQ(2, refused.status);
-    EXPECT_NE(std::string::npos, refused.output.find("--format must be dng, npy, png or tif")) << refused.output;
+    EXPECT_NE(std::string::npos, refused.output.find("--format must be dng, npy, png or tif"))
+        << refused.output;
     r = runApp("rawgment_simulate",
-               "--out='" + dir + "/simnpy' --frames=3 --gains=6 --levels=0.5 --validation=false --format=npy");
+               "--out='" + dir +
+                   "/simnpy' --frames=3 --gains=6 --levels=0.5 --validation=false --format=npy");
     ASSERT_EQ(0, r.status) << r.output;
     EXPECT_TRUE(exists(dir + "/simnpy/g06dB_level0.50/frame_002.npy"));
     // A folder: its files (not its sidecars), each converted.

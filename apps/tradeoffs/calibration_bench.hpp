@@ -1,7 +1,8 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
 // The simulated calibration campaigns of the trade-off report's calibration knobs (apps/tradeoffs), which the
-// calibration studies (studies/calibration) run too: the simulated chart and sensor of a campaign, and a light burst of it simulated frame
-// by frame into burst statistics, cut at the burst lengths a study compares.
+// calibration studies (studies/calibration) run too: the simulated chart and sensor of a campaign, and a
+// light burst of it simulated frame by frame into burst statistics, cut at the burst lengths a study
+// compares.
 #ifndef RAWGMENT_STUDIES_CALIBRATION_BENCH_HPP
 #define RAWGMENT_STUDIES_CALIBRATION_BENCH_HPP
 

@@ -1,6 +1,6 @@
 // This file is part of cv::rawgment, licensed under the Apache License 2.0 (see LICENSE).
-// What the augmentation tests share (test_<step>.cpp of each step, test_resample.cpp, test_scene.cpp): the input
-// bursts of the reference sensor and their temporal and spatial statistics.
+// What the augmentation tests share (test_<step>.cpp of each step, test_resample.cpp, test_scene.cpp): the
+// input bursts of the reference sensor and their temporal and spatial statistics.
 #ifndef OPENCV_RAWGMENT_TEST_AUGMENT_COMMON_HPP
 #define OPENCV_RAWGMENT_TEST_AUGMENT_COMMON_HPP
 

@@ -26,8 +26,8 @@ namespace rawgment {
 //     (src/resample.cpp); nothing is computed when the model lacks it.
 //  5. tests: test_noise_model.cpp (file round trip, old version), test_simulate.cpp (its statistics),
 //     test_calibration_fit.cpp (recovery), test_color_jitter.cpp, test_motion_blur.cpp, test_scale_mosaic.cpp
-//     and test_resample.cpp (against a capture simulated at the target), and a row of apps/rawgment_tradeoffs.
-//     docs/mathematics.md gets its equation.
+//     and test_resample.cpp (against a capture simulated at the target), and a row of
+//     apps/rawgment_tradeoffs. docs/mathematics.md gets its equation.
 
 /** @brief Linear analog gain of a gain in decibels: \f$ g = 10^{dB/20} \f$ (0 dB = 1).
  * @throws cv::Exception when dB is not finite.

@@ -14,8 +14,8 @@ namespace rawgment {
 /** @brief What a seed derived from a user's seed drives (see deriveSeed()).
  *
  * Every random number of the library comes from a registered family of counter-based streams; these
- * are the families of the library, its apps and its Python package (and of programs built on them), so that one seed reproduces a
- * whole run and no two uses of it share random numbers. */
+ * are the families of the library, its apps and its Python package (and of programs built on them), so that
+ * one seed reproduces a whole run and no two uses of it share random numbers. */
 // OpenCV 4.6's binding parser reads an enum's base only with no space before ':'.
 // clang-format off
 enum SeedPurpose: int
