@@ -71,15 +71,21 @@ private:
  * FIFO never opened, a name resolved one way) is made once; scripts/check-sources.sh refuses them elsewhere.
  */
 //! @{
-//! What stat() says of a path, links followed: its size, its last modification in ns and its kind.
+/** What stat() says of a file, links followed: where it is (device, inode), its size, its last modification
+ * in ns and its kind. The one reading of a stat in the module: identities, fingerprint keys and the checks of
+ * other topics all take it. */
 struct FileStamp
 {
+    unsigned long long device = 0, inode = 0;
     long long bytes = 0, modifiedNs = 0;
     unsigned mode = 0;
     bool regular() const;
 };
-//! The stamp of the file at `path`; false when nothing is there (or it cannot be stat'ed).
+//! The stamp of the file at `path` (a NUL in it refused); false when nothing is there or it cannot be
+//! stat'ed.
 bool fileStampOf(const String& path, FileStamp& stamp);
+//! The stamp of an open file; false when it cannot be stat'ed.
+bool fileStampOf(int fd, FileStamp& stamp);
 //! Removes the file at `path` if one is there, silently: the undoing of a write that failed halfway.
 void removeFileIfPresent(const String& path);
 //! Whether `path` is a folder, links followed.

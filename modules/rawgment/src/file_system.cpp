@@ -21,14 +21,37 @@ bool FileStamp::regular() const
     return S_ISREG(mode);
 }
 
-bool fileStampOf(const String& path, FileStamp& stamp)
+namespace {
+
+FileStamp stampOf(const struct stat& info)
 {
-    struct stat info;
-    if (::stat(path.c_str(), &info) != 0)
-        return false;
+    FileStamp stamp;
+    stamp.device = static_cast<unsigned long long>(info.st_dev);
+    stamp.inode = static_cast<unsigned long long>(info.st_ino);
     stamp.bytes = static_cast<long long>(info.st_size);
     stamp.modifiedNs = static_cast<long long>(info.st_mtim.tv_sec) * 1000000000LL + info.st_mtim.tv_nsec;
     stamp.mode = static_cast<unsigned>(info.st_mode);
+    return stamp;
+}
+
+} // namespace
+
+bool fileStampOf(const String& path, FileStamp& stamp)
+{
+    checkPathHasNoNul(path);
+    struct stat info;
+    if (::stat(path.c_str(), &info) != 0)
+        return false;
+    stamp = stampOf(info);
+    return true;
+}
+
+bool fileStampOf(int fd, FileStamp& stamp)
+{
+    struct stat info;
+    if (::fstat(fd, &info) != 0)
+        return false;
+    stamp = stampOf(info);
     return true;
 }
 

@@ -190,12 +190,10 @@ namespace detail {
 
 bool fileIdentityOf(const String& path, FileIdentity& id)
 {
-    checkPathHasNoNul(path);
-    struct stat status;
-    if (::stat(path.c_str(), &status) != 0)
+    FileStamp stamp;
+    if (!fileStampOf(path, stamp))
         return false;
-    id = FileIdentity{static_cast<unsigned long long>(status.st_dev),
-                      static_cast<unsigned long long>(status.st_ino)};
+    id = FileIdentity{stamp.device, stamp.inode};
     return true;
 }
 
@@ -211,11 +209,9 @@ struct FingerprintKey
     }
 };
 
-FingerprintKey fingerprintKeyOf(const struct stat& s)
+FingerprintKey fingerprintKeyOf(const FileStamp& s)
 {
-    return FingerprintKey{static_cast<unsigned long long>(s.st_dev),
-                          static_cast<unsigned long long>(s.st_ino), static_cast<long long>(s.st_size),
-                          static_cast<long long>(s.st_mtim.tv_sec) * 1000000000LL + s.st_mtim.tv_nsec};
+    return FingerprintKey{s.device, s.inode, s.bytes, s.modifiedNs};
 }
 
 } // namespace
@@ -225,8 +221,8 @@ std::string contentFingerprintOf(const String& path, const String& what)
     static std::mutex mutex;
     static std::map<FingerprintKey, std::string> known;
     RegularFileForReading file(path, what);
-    struct stat before;
-    if (::fstat(file.fd(), &before) != 0)
+    FileStamp before;
+    if (!fileStampOf(file.fd(), before))
         CV_Error(Error::StsError, "cannot read " + what + " '" + path + "': " + std::strerror(errno));
     const FingerprintKey key = fingerprintKeyOf(before);
     {
@@ -252,9 +248,8 @@ std::string contentFingerprintOf(const String& path, const String& what)
         }
         offset += got;
     }
-    struct stat after;
-    if (::fstat(file.fd(), &after) != 0 || offset != key.size ||
-        fingerprintKeyOf(after).mtimeNs != key.mtimeNs)
+    FileStamp after;
+    if (!fileStampOf(file.fd(), after) || offset != key.size || after.modifiedNs != key.mtimeNs)
         CV_Error(Error::StsError, "cannot read " + what + " '" + path + "': it changed while it was read");
     const std::string hex = format("%016llx", static_cast<unsigned long long>(h));
     std::lock_guard<std::mutex> lock(mutex);
@@ -288,9 +283,8 @@ void refuseRepeatedFiles(const std::vector<String>& paths, const String& what)
 
 bool isRegularFile(const String& path)
 {
-    checkPathHasNoNul(path);
-    struct stat status;
-    return ::stat(path.c_str(), &status) == 0 && S_ISREG(status.st_mode);
+    detail::FileStamp stamp;
+    return detail::fileStampOf(path, stamp) && stamp.regular();
 }
 
 std::string fileStorageText(const String& path, const std::function<void(FileStorage&)>& writeBody)
