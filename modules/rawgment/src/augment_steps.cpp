@@ -57,9 +57,8 @@ void throwNonFiniteInput(const char* who)
     CV_Error(Error::StsBadArg, format("%s: src contains NaN or Inf", who));
 }
 
-void checkResampleShape(Size size, const RawFormat& format, const char* who)
+void checkResampleShape(Size size, const char* who)
 {
-    format.validate();
     if (size.height % 2 || size.width % 2)
         CV_Error(Error::StsBadArg,
                  cv::format("%s: both sides must be even (got %dx%d)", who, size.width, size.height));

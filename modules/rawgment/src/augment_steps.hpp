@@ -35,9 +35,8 @@ bool rowIsFinite(const float* p, int n);
 //! The error of a step whose float input held NaN or Inf (found by rowIsFinite()).
 [[noreturn]] void throwNonFiniteInput(const char* who);
 
-//! The format valid and both sides even: blur and scale resample each CFA plane, so they need whole 2x2
-//! blocks.
-void checkResampleShape(Size size, const RawFormat& format, const char* who);
+//! Both sides even: blur and scale resample each CFA plane, so they need whole 2x2 blocks.
+void checkResampleShape(Size size, const char* who);
 
 //! Counts or masks saturated input pixels, only when the caller asks: the hot loops do not pay for it.
 void reportSaturation(const Mat& src, const RawFormat& format, AugmentReport* report, OutputArray mask);

@@ -422,7 +422,6 @@ public:
         format_ = format;
         seed_ = context.seed;
         noise_ = context.noise;
-        format.validate();
         for (int s = 0; s < 4; ++s)
             checkFinitePositive(jitter_.contrast[s], "colorJitter: contrast");
         // Different contrasts per site would print a 2x2 checkerboard on a frame whose pixels all see the

@@ -57,7 +57,6 @@ using detail::loadPlaneRow;
 using detail::PlaneGrid;
 using detail::ResampleConstants;
 using detail::RowScratch;
-using detail::storeMosaicRow;
 
 // Every kernel tap of an output row: mean = sum over taps of w x, and for ACCOUNT_PRIOR shot = sum of
 // w (1 - w) max(x, 0) (the prior mean is never negative). Taps innermost, so the sums of a block of
@@ -154,7 +153,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
     // which addTapRow's last block reads past the row (detail::wholeBlocks()).
     const int stride = pw + 2 * rx + detail::kWidestLanes;
     // A ring per site: a task makes whole plane rows i, the four sites in turn, so that it writes both
-    // mosaic rows 2 i and 2 i + 1 whole (storeMosaicRow()).
+    // mosaic rows 2 i and 2 i + 1 whole (storePlaneRow()).
     const size_t ringRows = static_cast<size_t>(ksize.height);
     std::vector<float> ring(static_cast<size_t>(grid.sites) * ringRows * stride);
     std::vector<int> ringRow(static_cast<size_t>(grid.sites) * ringRows, -1);
@@ -243,10 +242,7 @@ void blurPlaneRows(const Mat& src, Mat& dst, const std::vector<KernelTap>& taps,
                                                           std::max(mean[static_cast<size_t>(j)], 0.0f);
             }
             finishPlaneRow(mean, shotSum.data(), readFactors.data(), scratch, k, pw, site, i, rowKeep);
-            if (grid.sites == 1)
-                detail::storeFrameRow(mean.data(), dst.ptr<T>(i), pw);
-            else if (site % 2 == 1)
-                storeMosaicRow(means[0].data(), means[1].data(), dst.ptr<T>(2 * i + site / 2), pw);
+            detail::storePlaneRow<T>(grid, means, site, i, pw, dst);
         }
     }
 }

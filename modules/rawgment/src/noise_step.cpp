@@ -16,6 +16,10 @@ void runNoiseSteps(NoiseSteps& steps, const Mat& src, const RawFormat& format,
                    RawFormat& dstFormat, AugmentReport* report, std::vector<Rect>* boxes, const char* who,
                    bool valuesChecked)
 {
+    // The format and the options once for the sequence: each step's format follows from a valid one by the
+    // step's own checked parameters (a jitter's gain ratio and exposure).
+    format.validate();
+    noise.validate();
     // Every step validates and decides before any pixel is read: a bad parameter of the last step fails
     // before the first has run.
     std::vector<bool> runs(steps.size());

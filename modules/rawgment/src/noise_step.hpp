@@ -20,8 +20,9 @@ namespace cv {
 namespace rawgment {
 namespace detail {
 
-//! What a step is prepared for: the model (validated once for the whole sequence), the noise options, the
-//! seed and the input it will read (its size, depth and format, the format the step before it left).
+//! What a step is prepared for: the model, the noise options and the input's format (each validated once for
+//! the whole sequence by runNoiseSteps()), the seed and the input it will read (its size, its depth and the
+//! format the step before it left).
 struct StepContext
 {
     const ValidatedNoiseModel& model;

@@ -86,6 +86,19 @@ void storeMosaicRow(const float* even, const float* odd, float* d, int width);
 void storeFrameRow(const float* values, ushort* d, int width);
 void storeFrameRow(const float* values, float* d, int width);
 
+/* Plane row i of `site`, finished in means[site % 2], into dst: a monochrome frame's row at once, a mosaic
+ * row once its second site is (a task makes the sites of plane row i in turn, so it writes mosaic rows 2 i
+ * and 2 i + 1 whole). */
+template <typename T>
+void storePlaneRow(const PlaneGrid& grid, const std::vector<float> (&means)[2], int site, int i, int width,
+                   Mat& dst)
+{
+    if (grid.sites == 1)
+        storeFrameRow(means[0].data(), dst.ptr<T>(i), width);
+    else if (site % 2 == 1)
+        storeMosaicRow(means[0].data(), means[1].data(), dst.ptr<T>(2 * i + site / 2), width);
+}
+
 // Plane row `planeRow` of site `site`, black-subtracted (and without the input's dark shading when
 // `shading` is not empty), into out[0..pad + width + pad) with the plane's edge replicated `pad` columns
 // on each side. Returns false when a float mosaic's values there are not all finite (the step's check of
@@ -158,7 +171,7 @@ protected:
         seed_ = context.seed;
         model_ = &context.model;
         depth_ = context.depth;
-        checkResampleShape(context.size, format_, who);
+        checkResampleShape(context.size, who);
         step_.reset(new StepNoise(context.model, format_, context.noise, 1, context.size, who));
     }
 

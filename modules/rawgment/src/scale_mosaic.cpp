@@ -19,7 +19,6 @@ using detail::loadPlaneRow;
 using detail::PlaneGrid;
 using detail::ResampleConstants;
 using detail::RowScratch;
-using detail::storeMosaicRow;
 
 // Source position on the plane grid of each output plane pixel for a scale about the mosaic centre:
 // plane index j of site column px sits at mosaic x = step j + px (PlaneGrid); its source is
@@ -127,7 +126,7 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
     std::vector<float> shot(detail::wholeBlocks(pw)), readFactor(detail::wholeBlocks(pw));
     RowScratch scratch(pw);
     // Whole plane rows i, the four sites in turn, so that a task writes mosaic rows 2 i and 2 i + 1
-    // whole (storeMosaicRow()).
+    // whole (storePlaneRow()).
     for (int i = range.start; i < range.end; ++i)
         for (int site = 0; site < grid.sites; ++site) {
             std::vector<float>& mean = means[site % 2];
@@ -141,10 +140,7 @@ void scalePlaneRows(const Mat& src, Mat& dst, const BilinearAxis* cols, const Bi
             const float fy = ay.f[static_cast<size_t>(i)];
             finishPlaneRow(mean, shot.data(), readFactor.data(), scratch, k, pw, site, i,
                            (1 - fy) * (1 - fy) + fy * fy);
-            if (grid.sites == 1)
-                detail::storeFrameRow(mean.data(), dst.ptr<T>(i), pw);
-            else if (site % 2 == 1)
-                storeMosaicRow(means[0].data(), means[1].data(), dst.ptr<T>(2 * i + site / 2), pw);
+            detail::storePlaneRow<T>(grid, means, site, i, pw, dst);
         }
 }
 

@@ -112,7 +112,6 @@ void applyScene(InputArray _src, const RawFormat& format, const NoiseModel& mode
     const Mat src = detail::twoDimensional(_src, "applyScene: src");
     // Its first step checks a float mosaic's values as it reads them (augment_steps.hpp).
     detail::checkMosaicType(src, "applyScene");
-    format.validate();
     const detail::ValidatedNoiseModel valid(model); // once for every step of the scene
     if (src.rows % 2 || src.cols % 2)
         CV_Error(Error::StsBadArg, "applyScene: the mosaic needs even sides");

@@ -7,6 +7,7 @@
 
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 namespace cv {
 namespace rawgment {
@@ -106,9 +107,8 @@ public:
                 std::memcpy(d + c * esz, s + from_->column(c) * esz, esz);
             if (shading_.empty())
                 continue;
-            const bool finite = src.depth() == CV_16U
-                                    ? swapShading<ushort>(src.depth(), r, dst.ptr<ushort>(r), src.cols)
-                                    : swapShading<float>(src.depth(), r, dst.ptr<float>(r), src.cols);
+            const bool finite = src.depth() == CV_16U ? swapShading(r, dst.ptr<ushort>(r), src.cols)
+                                                      : swapShading(r, dst.ptr<float>(r), src.cols);
             if (!finite)
                 tally_->nonFiniteShading = true;
         }
@@ -136,11 +136,12 @@ public:
 private:
     // Row r of dst, as copied from source row from_->row(r): each unclipped value's source shading swapped
     // for its own. False when a shading value is not finite.
-    template <typename T> bool swapShading(int depth, int r, T* d, int cols) const
+    template <typename T> bool swapShading(int r, T* d, int cols) const
     {
         const float white = static_cast<float>(format_.whiteLevel);
-        const float highest = depth == CV_16U ? 65535.f : std::numeric_limits<float>::max();
-        const float lowest = depth == CV_16U ? 0.f : -std::numeric_limits<float>::max();
+        const bool integer = std::is_same<T, ushort>::value;
+        const float highest = integer ? 65535.f : std::numeric_limits<float>::max();
+        const float lowest = integer ? 0.f : -std::numeric_limits<float>::max();
         const int sr = from_->row(r);
         const float *bdSrc = shading_.perGainRow(sr), *brSrc = shading_.offsetRow(sr);
         const float *bdDst = shading_.perGainRow(r), *brDst = shading_.offsetRow(r);
@@ -153,7 +154,7 @@ private:
             if (value >= white)
                 continue;
             const float kept = std::min(std::max(swapped, lowest), highest);
-            d[c] = static_cast<T>(depth == CV_16U ? std::nearbyint(kept) : kept);
+            d[c] = static_cast<T>(integer ? std::nearbyint(kept) : kept);
         }
         return true;
     }

@@ -28,7 +28,6 @@ StepNoise::StepNoise(const ValidatedNoiseModel& valid, const RawFormat& format, 
     : options(options_), gainIn(format.gain), gainOut(format.gain * gainRatio),
       exposureIn(format.exposureTime), exposureOut(exposureOut_ > 0 ? exposureOut_ : format.exposureTime)
 {
-    options.validate();
     const NoiseModel& model = valid.model();
     in = valid.termsAt(gainIn);
     out = gainRatio == 1 ? in : valid.termsAt(gainOut);

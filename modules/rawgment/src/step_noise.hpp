@@ -22,9 +22,9 @@ namespace detail {
 /** The noise of one step from gain g to p_g g on a mosaic of `size` (paper Eq. 5 and 13, and the
  * dark-frame components of docs/mathematics.md): the model's terms at both gains (each gain's own
  * measured line when the model has them), its dark-frame components and its dark shading at g where the
- * mosaic lies on the sensor. Built from a ValidatedNoiseModel, so a call validates its model once; the
- * shading is checked to cover the mosaic only when the step adds noise (NoiseAlignment::NONE reads no map).
- */
+ * mosaic lies on the sensor. Built inside a step from a ValidatedNoiseModel and the options runNoiseSteps()
+ * validated, so a call validates its model and its options once; the shading is checked to cover the mosaic
+ * only when the step adds noise (NoiseAlignment::NONE reads no map). */
 struct StepNoise
 {
     /** `exposureOut`: the target's exposure time (0: the input's, format.exposureTime); only a bank's
